@@ -1,0 +1,1 @@
+# ports/baremetal build fragment (filled in by its owner)

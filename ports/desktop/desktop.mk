@@ -1,0 +1,1 @@
+# ports/desktop build fragment (filled in by its owner)

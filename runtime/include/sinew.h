@@ -1,0 +1,225 @@
+/* sinew.h -- Sinew runtime: skeleton-driven elastic secondary motion.
+ *
+ * One header, prefix sn_. C99, compiles as C++. The runtime never allocates,
+ * performs no I/O, uses no libm and no recursion.
+ *
+ * Flavours. By default the runtime is built in fixed point (integers only,
+ * bit-identical on every platform). Define SN_FLOAT when building the runtime
+ * AND when including this header to get the float flavour of the same source.
+ * A blob is baked for one flavour; loading it into the other is an error
+ * (SN_ERR_FLAVOUR).
+ *
+ * Units and number formats of the public API (fixed flavour / float flavour):
+ *   lengths      sn_real, Q16.16 mesh units        / float mesh units
+ *   quaternions  sn_real, Q30 (1.0 = 1<<30)         / float
+ *   angles       sn_real, Q16.16 degrees            / float degrees
+ *   normals      sn_real, Q30 unit vectors          / float unit vectors
+ * "Mesh units" are the units of the OBJ the asset was baked from.
+ *
+ * Typical use:
+ *   const sn_blob *blob;
+ *   if (sn_blob_validate(bytes, nbytes, &blob) != SN_OK) ...;   // once
+ *   size_t need = sn_instance_size(blob);                        // caller owns memory
+ *   sn_instance *inst;
+ *   sn_instance_init(mem, need, blob, &inst);
+ *   each frame: sn_pose_from_local(...) or your own bone transforms,
+ *               sn_set_pose(inst, xforms, n_joints); sn_step(inst);
+ *               sn_get_surface(inst, out, 0, n_surface);
+ */
+#ifndef SINEW_H
+#define SINEW_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Version of this header and of the blob format it reads (major.minor).
+#define SN_VERSION_MAJOR 1
+#define SN_VERSION_MINOR 0
+
+#if defined(SN_FLOAT)
+/// Scalar type of the public API: float in the float flavour.
+typedef float sn_real;
+/// Flavour code stored in blobs: 0 fixed (int32), 1 float32, 2 float64 (host/reference only).
+#define SN_FLAVOUR 1
+#else
+/// Scalar type of the public API: int32 fixed point in the fixed flavour (see Q formats above).
+typedef int32_t sn_real;
+/// Flavour code stored in blobs: 0 fixed (int32), 1 float32, 2 float64 (host/reference only).
+#define SN_FLAVOUR 0
+#endif
+
+/// Fractional bits of public lengths in the fixed flavour (Q16.16 mesh units).
+#define SN_LEN_FRAC 16
+/// Fractional bits of public quaternion components and normals in the fixed flavour (Q30).
+#define SN_QUAT_FRAC 30
+/// Fractional bits of public angles in the fixed flavour (Q16.16 degrees).
+#define SN_ANGLE_FRAC 16
+
+/// Three-component vector (position in mesh units, or a unit normal).
+typedef struct sn_vec3 { sn_real x, y, z; } sn_vec3;
+/// Unit quaternion (x, y, z vector part; w scalar part).
+typedef struct sn_quat { sn_real x, y, z, w; } sn_quat;
+/// Rigid bone motion x -> R(rot) x + pos, mapping rest (model) space to the current pose.
+typedef struct sn_xform { sn_quat rot; sn_vec3 pos; } sn_xform;
+
+/// Every status code and its message, in one list (X-macro).
+#define SN_STATUS_LIST(X) \
+    X(SN_OK,            "ok") \
+    X(SN_ERR_NULL,      "a required pointer argument is NULL") \
+    X(SN_ERR_ALIGN,     "pointer is not 8-byte aligned") \
+    X(SN_ERR_TRUNCATED, "blob is shorter than its header or its stated size") \
+    X(SN_ERR_MAGIC,     "not a Sinew blob (bad magic)") \
+    X(SN_ERR_VERSION,   "unsupported blob format version") \
+    X(SN_ERR_ENDIAN,    "blob byte-order marker is wrong (corrupt or other endianness)") \
+    X(SN_ERR_FLAVOUR,   "blob flavour (fixed/float) does not match this runtime build") \
+    X(SN_ERR_CHECKSUM,  "blob checksum mismatch (corrupt)") \
+    X(SN_ERR_HEADER,    "blob header field out of range") \
+    X(SN_ERR_SECTION,   "blob section offset/size/count inconsistent or out of bounds") \
+    X(SN_ERR_INDEX,     "an index stored in the blob is out of range") \
+    X(SN_ERR_VALUE,     "a number stored in the blob is out of its allowed range") \
+    X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size()") \
+    X(SN_ERR_ARG,       "argument out of range") \
+    X(SN_ERR_INSTANCE,  "instance memory does not hold an initialised instance")
+
+/// Status code returned by every fallible call. Never mixed with data.
+typedef enum sn_status {
+#define SN_STATUS_ENUM_(name, msg) name,
+    SN_STATUS_LIST(SN_STATUS_ENUM_)
+#undef SN_STATUS_ENUM_
+    SN_STATUS_COUNT
+} sn_status;
+
+/// Human-readable message for a status code; never NULL.
+const char *sn_status_str(sn_status s);
+
+/// A validated, read-only blob. The handle points at the caller's bytes, which
+/// must stay valid and unchanged while any instance uses them (ROM is fine).
+typedef struct sn_blob sn_blob;
+
+/// An instance: all mutable simulation state, living in caller memory.
+/// The handle equals the memory pointer given to sn_instance_init(). The memory
+/// holds no pointers into itself, so a byte copy (memcpy) of sn_instance_size()
+/// bytes to another 8-byte aligned buffer is a snapshot that can be stepped or
+/// copied back (rollback, replay). It does point at its blob.
+typedef struct sn_instance sn_instance;
+
+/// Counts and settings of a blob.
+typedef struct sn_blob_info {
+    uint32_t vertices;          ///< lattice vertices (free + skeleton)
+    uint32_t free_vertices;     ///< simulated lattice vertices
+    uint32_t cells;             ///< hexahedral lattice cells
+    uint32_t joints;            ///< skeleton joints (one rigid transform each)
+    uint32_t surface_vertices;  ///< embedded mesh vertices
+    uint32_t triangles;         ///< surface triangles (may be 0)
+    uint32_t offdiag_blocks;    ///< stored off-diagonal 3x3 stiffness blocks
+    uint32_t cg_iters_default;  ///< CG iterations per step unless overridden
+    uint32_t cg_iters_max;      ///< largest accepted override
+    uint32_t instance_bytes;    ///< == sn_instance_size()
+    uint32_t blob_bytes;        ///< total blob size
+    sn_real  timestep;          ///< h in seconds (fixed: Q16.16)
+} sn_blob_info;
+
+/// Validate untrusted blob bytes once: header, checksum, every offset, size,
+/// count, index and numeric range. On SN_OK *out is the handle; after that no
+/// call re-checks the blob. data must be 8-byte aligned.
+sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out);
+
+/// Fill *info from a validated blob.
+void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info);
+
+/// Name of joint j (NUL-terminated, at most 31 chars), or NULL if j is out of range.
+const char *sn_joint_name(const sn_blob *blob, uint32_t j);
+/// Parent of joint j, or -1 for the root (and for j out of range). Parents precede children.
+int32_t sn_joint_parent(const sn_blob *blob, uint32_t j);
+/// Rest position of joint j in mesh units (model space). Returns SN_ERR_ARG if j is out of range.
+sn_status sn_joint_rest(const sn_blob *blob, uint32_t j, sn_vec3 *out);
+/// Index of the joint called name, or -1.
+int32_t sn_find_joint(const sn_blob *blob, const char *name);
+
+/// Bytes of instance memory the blob needs (8-byte aligned buffer).
+size_t sn_instance_size(const sn_blob *blob);
+
+/// Initialise an instance in caller memory (mem 8-byte aligned, mem_size >=
+/// sn_instance_size(blob)); the instance starts at rest with the rest pose.
+sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out);
+
+/// Back to rest: rest pose, zero displacement and velocity, cleared warm start
+/// and counters. Keeps iteration count and mode.
+void sn_reset(sn_instance *inst);
+
+/// Set the pose for the next sn_step: one transform per joint (rest model space
+/// to world). The first pose after init/reset also becomes the previous pose,
+/// so it causes no velocity jump.
+sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints);
+
+/// Forward kinematics: local joint rotations (each about the joint's rest
+/// position, axes of the rest/model frame, relative to its parent) plus a
+/// translation of the root joint -> per-joint transforms for sn_set_pose.
+/// local[j] and out[j] have sn_blob_info.joints entries. root_offset may be NULL.
+void sn_pose_from_local(const sn_blob *blob, const sn_quat *local,
+                        const sn_vec3 *root_offset, sn_xform *out);
+
+/// Advance one timestep h with the current pose. Cost is fixed by the blob and
+/// the iteration count: no data-dependent loop exits.
+void sn_step(sn_instance *inst);
+
+/// Override the CG iteration count (1..cg_iters_max); 0 restores the blob default.
+sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations);
+
+/// Stepping modes.
+typedef enum sn_mode {
+    SN_MODE_WARPED = 0,  ///< skeletally warped linear FEM (seed 003 eq. 7), the default
+    SN_MODE_UNWARPED = 1 ///< global linear FEM, all frames R = I (seed 000 fig. 5), for comparison
+} sn_mode;
+/// Select the stepping mode; takes effect at the next step.
+sn_status sn_set_mode(sn_instance *inst, sn_mode mode);
+
+/// Deformed lattice vertex positions (mesh units, world), vertices [first, first+count).
+/// Vertex order is the blob's: free vertices first, then skeleton vertices.
+sn_status sn_get_lattice(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count);
+
+/// Deformed surface (mesh) vertex positions, vertices [first, first+count), in mesh order.
+sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count);
+
+/// Area-weighted unit vertex normals of the deformed surface, from positions
+/// produced by sn_get_surface for all surface vertices. SN_ERR_ARG if the
+/// blob has no triangles. out has sn_blob_info.surface_vertices entries.
+sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_vec3 *out);
+
+/// Surface triangle t as three surface vertex indices; SN_ERR_ARG if out of range.
+sn_status sn_get_triangle(const sn_blob *blob, uint32_t t, uint32_t idx[3]);
+
+/// Diagnostics of an instance.
+typedef struct sn_stats {
+    uint32_t steps;        ///< steps since init/reset
+    uint32_t saturations;  ///< fixed point: values clamped since init/reset (0 in a healthy run)
+    uint32_t iterations;   ///< CG iterations per step in force
+    uint32_t mode;         ///< sn_mode in force
+} sn_stats;
+/// Read the diagnostics.
+void sn_get_stats(const sn_instance *inst, sn_stats *out);
+
+/// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
+/// (free positions, velocities, warm start, skeleton state, step count), the
+/// same on every platform. Used by the determinism tests.
+uint64_t sn_state_hash(const sn_instance *inst);
+
+/* ---- small math helpers (integer-only in the fixed flavour, deterministic) ---- */
+
+/// Unit quaternion for a rotation of angle (degrees) about axis (need not be unit, must be non-zero).
+sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees);
+/// Quaternion product a*b (apply b first, then a).
+sn_quat sn_quat_mul(sn_quat a, sn_quat b);
+/// Spherical linear interpolation along the shorter arc; t in [0,1] (fixed: Q30).
+sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t);
+/// Rotate vector v (mesh units) by unit quaternion q.
+sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SINEW_H */

@@ -1,0 +1,1 @@
+# runtime build fragment (filled in by its owner)

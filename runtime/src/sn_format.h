@@ -1,0 +1,131 @@
+/* sn_format.h -- byte layout of a Sinew blob (format 1.0).
+ *
+ * Shared by the runtime (reader), the host tool (writer) and the tests'
+ * double-precision reference (reader). Prose spec: runtime/BLOB.md.
+ * Everything is little-endian; offsets are from the first byte of the blob.
+ * Scalars called "real" are 4 bytes (int32 fixed point in flavour 0, IEEE
+ * float32 in flavour 1) or 8 bytes (IEEE float64, flavour 2, host/tests only).
+ */
+#ifndef SN_FORMAT_H
+#define SN_FORMAT_H
+
+#define SN_MAGIC0 'S'
+#define SN_MAGIC1 'N'
+#define SN_MAGIC2 'W'
+#define SN_MAGIC3 'B'
+#define SN_FORMAT_MAJOR 1
+#define SN_FORMAT_MINOR 0
+#define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
+#define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
+#define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
+/* flavour 2 (float64) stores the low 32 bits of 1.0 (0) and the high 32 bits
+ * (0x3FF00000) in the reserved word at SN_H_ONE_HI. */
+#define SN_ONE_FLOAT64_HI 0x3FF00000u
+
+#define SN_FLAVOUR_FIXED 0
+#define SN_FLAVOUR_FLOAT32 1
+#define SN_FLAVOUR_FLOAT64 2
+
+/* ---- header: SN_HEADER_BYTES bytes, then the sections ---- */
+#define SN_H_MAGIC          0   /* u8[4] "SNWB" */
+#define SN_H_VER_MAJOR      4   /* u16 */
+#define SN_H_VER_MINOR      6   /* u16 */
+#define SN_H_ENDIAN         8   /* u32 SN_ENDIAN_MARK */
+#define SN_H_CRC32         12   /* u32 CRC-32 (IEEE/zlib) of bytes [16, total_size) */
+#define SN_H_TOTAL_SIZE    16   /* u32 size of the whole blob in bytes */
+#define SN_H_HEADER_SIZE   20   /* u32 == SN_HEADER_BYTES */
+#define SN_H_FLAVOUR       24   /* u8  SN_FLAVOUR_* */
+#define SN_H_REAL_SIZE     25   /* u8  4 or 8: bytes per real */
+#define SN_H_NSECTIONS     26   /* u8  == SN_SEC_COUNT */
+#define SN_H_RESERVED0     27   /* u8  0 */
+#define SN_H_ONE           28   /* u32 1.0 in the flavour (SN_ONE_*; 0 for float64) */
+#define SN_H_N_VERTICES    32   /* u32 lattice vertices nV (free first, then skeleton) */
+#define SN_H_N_FREE        36   /* u32 free vertices nF, 1 <= nF < nV */
+#define SN_H_N_CELLS       40   /* u32 nC */
+#define SN_H_N_JOINTS      44   /* u32 nJ, 1..255 */
+#define SN_H_N_SURFACE     48   /* u32 nS surface vertices, <= 65535 */
+#define SN_H_N_TRIANGLES   52   /* u32 nT */
+#define SN_H_N_OFFDIAG     56   /* u32 nnz off-diagonal blocks */
+#define SN_H_INSTANCE_BYTES 60  /* u32 instance memory the runtime needs */
+#define SN_H_CG_DEFAULT    64   /* u16 default CG iterations, >= 1 */
+#define SN_H_CG_MAX        66   /* u16 max CG iterations, >= default, <= 256 */
+#define SN_H_LEN_SHIFT     68   /* i8  internal length unit = 2^len_shift mesh units */
+#define SN_H_FRAC_S        69   /* u8  fractional bits of stiffness entries (fixed) */
+#define SN_H_FRAC_M        70   /* u8  fractional bits of mass entries (fixed) */
+#define SN_H_FRAC_P        71   /* u8  fractional bits of preconditioner entries (fixed) */
+#define SN_H_ONE_HI        72   /* u32 high word of 1.0 for float64, else 0 */
+#define SN_H_RESERVED1     76   /* u32 0 */
+/* physics scalars: 8 reals, at SN_H_REALS + i*real_size */
+#define SN_H_REALS         80
+#define SN_R_A1             0   /* h*alpha (Rayleigh mass term), fixed Q24, >= 0 */
+#define SN_R_B1             1   /* beta/h (Rayleigh stiffness term), fixed Q24, >= 0 */
+#define SN_R_GRAV_X         2   /* h^2 g in internal length units, fixed Q22 */
+#define SN_R_GRAV_Y         3
+#define SN_R_GRAV_Z         4
+#define SN_R_TIMESTEP       5   /* h in seconds, fixed Q16.16 */
+#define SN_R_MASS_SCALE     6   /* m0 in kg (informational), fixed Q16.16 */
+#define SN_R_RESERVED       7   /* 0 */
+#define SN_H_SECTIONS     144   /* section table: SN_SEC_COUNT x {u32 offset, u32 size, u32 count, u32 elem_size} */
+#define SN_SECTION_ENTRY   16
+#define SN_HEADER_BYTES   (SN_H_SECTIONS + SN_SEC_COUNT * SN_SECTION_ENTRY)
+
+/* ---- sections, in this order; each starts 8-byte aligned; size = count*elem_size
+ * (elem_size as listed, with R = real size); padding bytes between sections are 0.
+ * Sections appear in ascending offset order and do not overlap. ---- */
+enum {
+    SN_SEC_JOINTS = 0,   /* nJ  x {u16 parent (0xFFFF root; else < own index), u16 0, u32 0, R rest[3]} ; rest Q22 internal, model space */
+    SN_SEC_JOINT_NAMES,  /* nJ  x char[32], NUL-terminated, NUL-padded, unique, non-empty */
+    SN_SEC_REST,         /* nV  x R[3] rest position, Q22 internal units, model space (relative to root joint rest) */
+    SN_SEC_FRAMES,       /* nV  x {u8 bone1, u8 bone2, u16 w Q15 (0..32768)}; R_i = slerp(R_b1, R_b2, w), c_i = (1-w)t_b1 + w t_b2
+                            skeleton vertices: bone1 = the joint whose transform moves them, bone2 = bone1, w = 0 */
+    SN_SEC_MDIAG,        /* nF  x R      M^_ii (Q frac_M) */
+    SN_SEC_SDIAG,        /* nF  x R[6]   S^_ii symmetric: xx yy zz xy xz yz (Q frac_S) */
+    SN_SEC_PRECOND,      /* nF  x R[6]   inverse of (1+a1) M^_ii I + (1+b1) S^_ii, symmetric (Q frac_P) */
+    SN_SEC_MLUMP,        /* nF  x R      row sums of M^ over all nV columns (Q frac_M) */
+    SN_SEC_ROWPTR,       /* (nF+1) x u32 row i's off-diagonal blocks are [rowptr[i], rowptr[i+1]); rowptr[0]=0, rowptr[nF]=nnz */
+    SN_SEC_COLS,         /* nnz x u16   column vertex; within a row strictly increasing, > i (upper triangle + all skeleton columns) */
+    SN_SEC_MOFF,         /* nnz x R     M^_ij (Q frac_M) */
+    SN_SEC_SOFF,         /* nnz x R[9]  S^_ij row-major (Q frac_S); S^_ji = S^_ij^T is not stored */
+    SN_SEC_CELLS,        /* nC  x u16[8] corner vertices, corner k at (k&1, k>>1&1, k>>2&1) of the cell box */
+    SN_SEC_EMBED,        /* nS  x {u16 cell, u16 t[3] Q15 (0..32768)} trilinear coordinates in the cell */
+    SN_SEC_TRIS,         /* nT  x u16[3] surface vertex indices, counter-clockwise seen from outside */
+    SN_SEC_COUNT
+};
+
+/* Sizes of section elements in bytes, given the real size R (4 or 8). */
+#define SN_ELEM_JOINTS(R)  (8 + 3 * (R))
+#define SN_ELEM_JOINT_NAMES 32
+#define SN_ELEM_REST(R)    (3 * (R))
+#define SN_ELEM_FRAMES      4
+#define SN_ELEM_MDIAG(R)   (R)
+#define SN_ELEM_SDIAG(R)   (6 * (R))
+#define SN_ELEM_PRECOND(R) (6 * (R))
+#define SN_ELEM_MLUMP(R)   (R)
+#define SN_ELEM_ROWPTR      4
+#define SN_ELEM_COLS        2
+#define SN_ELEM_MOFF(R)    (R)
+#define SN_ELEM_SOFF(R)    (9 * (R))
+#define SN_ELEM_CELLS       16
+#define SN_ELEM_EMBED       8
+#define SN_ELEM_TRIS        6
+
+#define SN_JOINT_NAME_MAX 32
+#define SN_MAX_JOINTS 255
+#define SN_MAX_SURFACE 65535u
+#define SN_MAX_VERTICES 65535u
+#define SN_MAX_CG_ITERS 256u
+
+/* Fixed-point formats of the internal state (flavour 0). */
+#define SN_Q_LEN 22   /* internal lengths, velocities per step (h*v), forces (m0 * unit) */
+#define SN_Q_ROT 30   /* quaternions, rotation matrices */
+#define SN_Q_W   15   /* frame weights, trilinear coordinates */
+#define SN_Q_COEF 24  /* a1, b1 */
+
+/* Instance memory the runtime needs for a blob (bytes, multiple of 8). The
+ * runtime owns this formula; the host tool writes its value into the header
+ * and the validator rejects a header value smaller than it. */
+#define SN_INSTANCE_BYTES(nV, nF, nJ) \
+    ((((uint32_t)256u + 64u * (uint32_t)(nJ) + 48u * (uint32_t)(nV) + 112u * (uint32_t)(nF) \
+       + 48u * ((uint32_t)(nV) - (uint32_t)(nF))) + 7u) & ~7u)
+
+#endif /* SN_FORMAT_H */
