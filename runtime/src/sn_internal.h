@@ -1,0 +1,185 @@
+/* sn_internal.h -- internal types and arithmetic of the Sinew runtime.
+ *
+ * One source, two flavours (Opus style): the default fixed flavour uses
+ * int32 values in the Q formats of runtime/NUMERICS.md with int64
+ * accumulators; -DSN_FLOAT turns the same code into float arithmetic, in which
+ * every shift argument is ignored (float blobs store true values).
+ * Nothing here allocates, calls libm or recurses.
+ */
+#ifndef SN_INTERNAL_H
+#define SN_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "sinew.h"
+#include "sn_format.h"
+
+#define SN_INLINE static inline
+
+/* ---- endian-safe reads of the little-endian blob (aliasing-safe) ---- */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define SN_HOST_LE 1
+#else
+#define SN_HOST_LE 0
+#endif
+
+SN_INLINE uint32_t sn_rd_u32(const unsigned char *p) {
+#if SN_HOST_LE
+    uint32_t v;
+    memcpy(&v, p, 4);
+    return v;
+#else
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
+           ((uint32_t)p[3] << 24);
+#endif
+}
+SN_INLINE uint32_t sn_rd_u16(const unsigned char *p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8);
+}
+SN_INLINE int32_t sn_rd_i32(const unsigned char *p) {
+    uint32_t u = sn_rd_u32(p);
+    int32_t v;
+    memcpy(&v, &u, 4); /* two's complement reinterpretation, no impl-defined cast */
+    return v;
+}
+SN_INLINE float sn_rd_f32(const unsigned char *p) {
+    uint32_t u = sn_rd_u32(p);
+    float v;
+    memcpy(&v, &u, 4);
+    return v;
+}
+
+/* ---- scalar types ----
+ * sn_q   one internal value (fixed: int32 in a Q format; float: float)
+ * sn_acc accumulator of products (fixed: int64; float: float)          */
+#if defined(SN_FLOAT)
+typedef float sn_q;
+typedef float sn_acc;
+#define SN_RD_REAL(p) sn_rd_f32(p)
+#define SN_REAL_BYTES 4
+#else
+typedef int32_t sn_q;
+typedef int64_t sn_acc;
+#define SN_RD_REAL(p) sn_rd_i32(p)
+#define SN_REAL_BYTES 4
+#endif
+
+/* Limits (fixed): state values are clamped to +-SN_LIM (Q22: +-64 internal
+ * units); accumulators to +-SN_ACC_LIM after each block (NUMERICS.md,
+ * overflow freedom). */
+#define SN_LIM ((int32_t)1 << 28)
+#define SN_ACC_LIM ((int64_t)1 << 62)
+#define SN_ENTRY_LIM ((int32_t)1 << 27)
+
+#if defined(SN_FLOAT)
+#define SN_ONE_ROT 1.0f
+#define SN_ONE_LEN 1.0f
+#define SN_FLIM 64.0f
+#else
+#define SN_ONE_ROT ((int32_t)1 << SN_Q_ROT)
+#define SN_ONE_LEN ((int32_t)1 << SN_Q_LEN)
+#endif
+
+/* Product of two values, accumulated exactly (fixed) */
+SN_INLINE sn_acc sn_mul(sn_q a, sn_q b) {
+#if defined(SN_FLOAT)
+    return a * b;
+#else
+    return (int64_t)a * (int64_t)b;
+#endif
+}
+
+/* Round-to-nearest right shift of an int64, symmetric (ties away from zero),
+ * defined for negative values without relying on arithmetic >> of negatives.
+ * Requires |x| <= 2^62 and 0 <= s <= 62. */
+SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
+    int64_t h;
+    if (s <= 0) return x;
+    h = (int64_t)1 << (s - 1);
+    return x >= 0 ? (x + h) >> s : -((-x + h) >> s);
+}
+
+/* Clamp an accumulator to +-2^62 (fixed); identity in float. */
+SN_INLINE sn_acc sn_acc_clamp(sn_acc a) {
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return a > SN_ACC_LIM ? SN_ACC_LIM : (a < -SN_ACC_LIM ? -SN_ACC_LIM : a);
+#endif
+}
+
+/* Accumulator -> value: round-shift by s, clamp to +-SN_LIM and count clamps
+ * into *sat. Float: clamp to +-SN_FLIM internal units (s ignored). */
+SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s;
+    if (a > SN_FLIM) { (*sat)++; return SN_FLIM; }
+    if (a < -SN_FLIM) { (*sat)++; return -SN_FLIM; }
+    return a;
+#else
+    int64_t v = sn_rshr64(sn_acc_clamp(a), s);
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return (int32_t)v;
+#endif
+}
+
+/* Saturating add of two state values (fixed clamps to +-SN_LIM). */
+SN_INLINE sn_q sn_add(sn_q a, sn_q b, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    return sn_out(a + b, 0, sat);
+#else
+    return sn_out((int64_t)a + (int64_t)b, 0, sat);
+#endif
+}
+
+/* a*b >> s, rounded and clamped (one product). */
+SN_INLINE sn_q sn_mulq(sn_q a, sn_q b, int s, uint32_t *sat) {
+    return sn_out(sn_mul(a, b), s, sat);
+}
+
+/* ---- 3-vectors and 3x3 rotations (row-major), rotation entries Q30 ---- */
+/* out = R v (v, out in the same Q format) */
+SN_INLINE void sn_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    int k;
+    for (k = 0; k < 3; k++)
+        out[k] = sn_out(sn_mul(R[3 * k], v[0]) + sn_mul(R[3 * k + 1], v[1]) +
+                            sn_mul(R[3 * k + 2], v[2]), SN_Q_ROT, sat);
+}
+/* out = R^T v */
+SN_INLINE void sn_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    int k;
+    for (k = 0; k < 3; k++)
+        out[k] = sn_out(sn_mul(R[k], v[0]) + sn_mul(R[3 + k], v[1]) +
+                            sn_mul(R[6 + k], v[2]), SN_Q_ROT, sat);
+}
+
+/* ---- math (sn_math.c): quaternions x,y,z,w in Q30 (fixed) or float ---- */
+/* Normalize q in place (zero quaternion -> identity). */
+void sn_qnormalize(sn_q q[4]);
+/* Row-major rotation matrix (Q30) of a unit quaternion. */
+void sn_qtomat(const sn_q q[4], sn_q R[9]);
+/* out = a*b */
+void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]);
+/* Slerp along the shorter arc, t in [0,1] (fixed: Q30), result unit. */
+void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
+/* Integer square root: floor(sqrt(x)). */
+uint32_t sn_isqrt64(uint64_t x);
+
+/* ---- validated blob, decoded once (pointers into the read-only blob) ---- */
+typedef struct sn_view {
+    const unsigned char *base;
+    const unsigned char *sec[SN_SEC_COUNT];
+    uint32_t nV, nF, nC, nJ, nS, nT, nnz;
+    uint32_t cg_default, cg_max, instance_bytes, total;
+    int len_shift, frac_S, frac_M, frac_P;
+    sn_q a1, b1, grav[3], timestep;
+} sn_view;
+
+/* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
+void sn_view_init(sn_view *v, const sn_blob *blob);
+
+#endif /* SN_INTERNAL_H */
