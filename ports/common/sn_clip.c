@@ -1,0 +1,203 @@
+/* sn_clip.c -- clip text parser (format: CLIP.md). string.h only: runs on
+ * bare metal; numbers go straight to Q16.16 with our own decimal reader. */
+#include "sn_clip.h"
+#include <string.h>
+
+#define Q16_ONE 65536
+
+/* ---- error text without stdio ---- */
+typedef struct { char *buf; size_t cap, len; } msgbuf;
+
+static void m_str(msgbuf *m, const char *s, size_t n) {
+    size_t i;
+    for (i = 0; i < n && s[i]; i++)
+        if (m->len + 1 < m->cap) m->buf[m->len++] = s[i];
+    if (m->cap) m->buf[m->len] = 0;
+}
+static void m_cstr(msgbuf *m, const char *s) { m_str(m, s, (size_t)-1); }
+static void m_uint(msgbuf *m, uint32_t v) {
+    char d[12]; int n = 0;
+    do { d[n++] = (char)('0' + v % 10u); v /= 10u; } while (v);
+    while (n) { char c = d[--n]; m_str(m, &c, 1); }
+}
+
+int sn_clip_parse_q16(const char *s, size_t n, int32_t *out) {
+    size_t i = 0;
+    int neg = 0, nint = 0, nfrac = 0;
+    uint32_t ip = 0, fp = 0, scale = 1;
+    uint64_t q;
+    if (i < n && (s[i] == '+' || s[i] == '-')) { neg = s[i] == '-'; i++; }
+    for (; i < n && s[i] >= '0' && s[i] <= '9'; i++, nint++) {
+        if (ip >= 32768u) return 2;     /* stop before it can wrap */
+        ip = ip * 10u + (uint32_t)(s[i] - '0');
+    }
+    if (i < n && s[i] == '.') {
+        for (i++; i < n && s[i] >= '0' && s[i] <= '9'; i++, nfrac++)
+            if (nfrac < 9) { fp = fp * 10u + (uint32_t)(s[i] - '0'); scale *= 10u; }
+    }
+    if (i != n || nint + nfrac == 0) return 1;
+    /* round(fp / scale * 2^16), half away from zero (applied to the magnitude) */
+    q = ((uint64_t)ip << 16) + (((uint64_t)fp << 16) + scale / 2u) / scale;
+    if (q >= (uint64_t)32768 << 16) return 2;
+    *out = neg ? -(int32_t)q : (int32_t)q;
+    return 0;
+}
+
+/* ---- tokens of one line ---- */
+#define MAX_TOK 8
+typedef struct { const char *p[MAX_TOK]; size_t n[MAX_TOK]; int count; } toks;
+
+/* Splits at blanks, stops at '#'. Returns the token count, MAX_TOK+1 if too many. */
+static int tokenize(const char *s, size_t n, toks *t) {
+    size_t i = 0;
+    t->count = 0;
+    for (;;) {
+        while (i < n && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) i++;
+        if (i >= n || s[i] == '#') break;
+        if (t->count == MAX_TOK) return MAX_TOK + 1;
+        t->p[t->count] = s + i;
+        while (i < n && s[i] != ' ' && s[i] != '\t' && s[i] != '\r' && s[i] != '#') i++;
+        t->n[t->count] = (size_t)(s + i - t->p[t->count]);
+        t->count++;
+    }
+    return t->count;
+}
+
+static int tok_is(const toks *t, int k, const char *w) {
+    size_t wl = strlen(w);
+    return t->n[k] == wl && memcmp(t->p[k], w, wl) == 0;
+}
+
+typedef struct {
+    sn_clip *clip;
+    msgbuf m;
+    uint32_t line;
+    int have_header, have_duration, have_loop;
+} pstate;
+
+static int fail(pstate *ps, const char *what, const char *tok, size_t tokn) {
+    ps->m.len = 0;
+    m_cstr(&ps->m, "line "); m_uint(&ps->m, ps->line); m_cstr(&ps->m, ": ");
+    m_cstr(&ps->m, what);
+    if (tok) { m_cstr(&ps->m, " '"); m_str(&ps->m, tok, tokn < 40 ? tokn : 40); m_cstr(&ps->m, "'"); }
+    ps->clip->error_line = ps->line;
+    return 1;
+}
+
+static int num(pstate *ps, const toks *t, int k, const char *what, int32_t *out) {
+    int r = sn_clip_parse_q16(t->p[k], t->n[k], out);
+    if (r == 1) return fail(ps, what, t->p[k], t->n[k]);
+    if (r == 2) return fail(ps, "number out of range (|x| < 32768):", t->p[k], t->n[k]);
+    return 0;
+}
+
+/* Channel for (kind, name), created on first use. -1 when full. */
+static int channel(sn_clip *c, uint8_t kind, const char *name, size_t n) {
+    int i;
+    for (i = 0; i < c->n_channels; i++)
+        if (c->chan[i].kind == kind && strlen(c->chan[i].name) == n &&
+            memcmp(c->chan[i].name, name, n) == 0) return i;
+    if (c->n_channels >= SN_CLIP_MAX_CHANNELS) return -1;
+    i = c->n_channels++;
+    memset(&c->chan[i], 0, sizeof c->chan[i]);
+    memcpy(c->chan[i].name, name, n);
+    c->chan[i].joint = -1;
+    c->chan[i].kind = kind;
+    c->chan[i].first = c->n_keys;
+    return i;
+}
+
+/* Append a key to channel ci, keeping every channel's keys contiguous. */
+static int add_key(pstate *ps, int ci, const sn_clip_key *k, const char *tok, size_t tokn) {
+    sn_clip *c = ps->clip;
+    sn_clip_channel *ch = &c->chan[ci];
+    uint16_t at = (uint16_t)(ch->first + ch->count);
+    int i;
+    if (k->t < 0) return fail(ps, "key time is negative:", tok, tokn);
+    if (k->t > c->duration) return fail(ps, "key time is after the clip duration:", tok, tokn);
+    if (ch->count && k->t <= c->keys[at - 1].t)
+        return fail(ps, "key times of a channel must strictly increase; not after the previous key:", tok, tokn);
+    if (c->n_keys >= SN_CLIP_MAX_KEYS) return fail(ps, "too many keys (limit SN_CLIP_MAX_KEYS)", 0, 0);
+    memmove(&c->keys[at + 1], &c->keys[at], (size_t)(c->n_keys - at) * sizeof c->keys[0]);
+    c->keys[at] = *k;
+    c->n_keys++;
+    ch->count++;
+    for (i = 0; i < c->n_channels; i++)
+        if (i != ci && c->chan[i].first >= at && c->chan[i].count) c->chan[i].first++;
+    return 0;
+}
+
+static int parse_line(pstate *ps, const char *s, size_t n) {
+    sn_clip *c = ps->clip;
+    toks t;
+    int nt = tokenize(s, n, &t);
+    if (nt == 0) return 0;
+    if (nt > MAX_TOK) return fail(ps, "too many fields", 0, 0);
+    if (!ps->have_header) {
+        if (!tok_is(&t, 0, "sinew-clip"))
+            return fail(ps, "a clip must start with the line 'sinew-clip 1', found", t.p[0], t.n[0]);
+        if (nt != 2 || !tok_is(&t, 1, "1"))
+            return fail(ps, "unsupported clip format version (this reader knows 'sinew-clip 1')", 0, 0);
+        ps->have_header = 1;
+        return 0;
+    }
+    if (tok_is(&t, 0, "duration")) {
+        if (nt != 2) return fail(ps, "usage: duration <seconds>", 0, 0);
+        if (ps->have_duration) return fail(ps, "duration given twice", 0, 0);
+        if (num(ps, &t, 1, "duration is not a number:", &c->duration)) return 1;
+        if (c->duration <= 0) return fail(ps, "duration must be > 0:", t.p[1], t.n[1]);
+        ps->have_duration = 1;
+        return 0;
+    }
+    if (tok_is(&t, 0, "loop")) {
+        if (nt != 2) return fail(ps, "usage: loop yes|no", 0, 0);
+        if (ps->have_loop) return fail(ps, "loop given twice", 0, 0);
+        if (tok_is(&t, 1, "yes")) c->loop = 1;
+        else if (tok_is(&t, 1, "no")) c->loop = 0;
+        else return fail(ps, "loop must be yes or no, found", t.p[1], t.n[1]);
+        ps->have_loop = 1;
+        return 0;
+    }
+    if (tok_is(&t, 0, "rot") || tok_is(&t, 0, "move")) {
+        int rot = tok_is(&t, 0, "rot"), ci, k0 = rot ? 2 : 1;
+        sn_clip_key key;
+        memset(&key, 0, sizeof key);
+        if (!ps->have_duration) return fail(ps, "'duration' must come before the first key", 0, 0);
+        if (rot && nt != 7) return fail(ps, "usage: rot <joint> <time> <axis x> <axis y> <axis z> <angle degrees>", 0, 0);
+        if (!rot && nt != 5) return fail(ps, "usage: move <time> <x> <y> <z>", 0, 0);
+        if (rot && t.n[1] > SN_CLIP_NAME_MAX) return fail(ps, "joint name longer than 31 bytes:", t.p[1], t.n[1]);
+        if (num(ps, &t, k0, "key time is not a number:", &key.t)) return 1;
+        if (num(ps, &t, k0 + 1, "not a number:", &key.v[0])) return 1;
+        if (num(ps, &t, k0 + 2, "not a number:", &key.v[1])) return 1;
+        if (num(ps, &t, k0 + 3, "not a number:", &key.v[2])) return 1;
+        if (rot) {
+            if (num(ps, &t, 6, "angle is not a number:", &key.v[3])) return 1;
+            if (!key.v[0] && !key.v[1] && !key.v[2]) return fail(ps, "rotation axis is zero", 0, 0);
+        }
+        ci = rot ? channel(c, SN_CLIP_ROT, t.p[1], t.n[1]) : channel(c, SN_CLIP_MOVE, "", 0);
+        if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
+        return add_key(ps, ci, &key, t.p[k0], t.n[k0]);
+    }
+    return fail(ps, "unknown keyword (expected duration, loop, rot, move):", t.p[0], t.n[0]);
+}
+
+int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t errlen) {
+    pstate ps;
+    size_t i = 0;
+    memset(clip, 0, sizeof *clip);
+    memset(&ps, 0, sizeof ps);
+    ps.clip = clip;
+    ps.m.buf = err; ps.m.cap = err ? errlen : 0;
+    if (ps.m.cap) err[0] = 0;
+    while (i < len) {
+        size_t j = i;
+        while (j < len && text[j] != '\n') j++;
+        ps.line++;
+        if (memchr(text + i, 0, j - i)) return fail(&ps, "NUL byte in clip text", 0, 0);
+        if (parse_line(&ps, text + i, j - i)) return 1;
+        i = j + 1;
+    }
+    if (!ps.have_header) return fail(&ps, "empty clip: missing the line 'sinew-clip 1'", 0, 0);
+    if (!ps.have_duration) return fail(&ps, "missing 'duration <seconds>'", 0, 0);
+    return 0;
+}

@@ -1,0 +1,99 @@
+/* sn_clip.h -- keyframed skeleton clips for Sinew players (format: CLIP.md).
+ *
+ * Portable C99 for desktop and bare metal: no allocation, no stdio, no libm,
+ * no strtod; only <string.h>. Numbers are parsed by our own decimal reader
+ * straight into Q16.16 and all time arithmetic is integer, so the fixed
+ * flavour gives bit-identical poses on every platform.
+ *
+ *   sn_clip clip;                    // caller storage (~23 KB with defaults)
+ *   char err[SN_CLIP_ERR_LEN];
+ *   if (sn_clip_parse(&clip, text, len, err, sizeof err)) fail(err);
+ *   if (sn_clip_bind(&clip, blob, err, sizeof err)) fail(err);
+ *   per step k: sn_clip_pose(&clip, blob, k, local_scratch, xforms);
+ *               sn_set_pose(inst, xforms, n_joints);
+ *
+ * sn_clip_parse needs nothing else; sn_clip_bind / sn_clip_pose call the
+ * runtime (sn_find_joint, sn_quat_axis_angle, sn_quat_slerp,
+ * sn_pose_from_local) and live in sn_clip_pose.c.
+ */
+#ifndef SN_CLIP_H
+#define SN_CLIP_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "sinew.h"
+
+#ifndef SN_CLIP_MAX_CHANNELS
+/// Most channels in one clip (rotation channels + the root translation channel).
+#define SN_CLIP_MAX_CHANNELS 64
+#endif
+#ifndef SN_CLIP_MAX_KEYS
+/// Most keys in one clip, all channels together.
+#define SN_CLIP_MAX_KEYS 1024
+#endif
+/// Longest joint name (bytes, without the NUL), as in the blob.
+#define SN_CLIP_NAME_MAX 31
+/// A good size for the error buffer.
+#define SN_CLIP_ERR_LEN 160
+
+/// Channel kinds.
+enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1 };
+
+/// One key. Q16.16 throughout: t seconds; v = axis x,y,z + angle degrees
+/// (rotation) or x,y,z mesh units (root translation, v[3] = 0).
+typedef struct sn_clip_key { int32_t t; int32_t v[4]; } sn_clip_key;
+
+/// One channel: keys[first .. first+count) with strictly increasing t.
+typedef struct sn_clip_channel {
+    char     name[SN_CLIP_NAME_MAX + 1]; ///< joint name ("" for the root translation)
+    int32_t  joint;                      ///< joint index after sn_clip_bind, else -1
+    uint16_t first, count;
+    uint8_t  kind;                       ///< SN_CLIP_ROT or SN_CLIP_MOVE
+} sn_clip_channel;
+
+/// A parsed clip. Plain data: may be copied, or stored in ROM once parsed.
+typedef struct sn_clip {
+    int32_t  duration;        ///< Q16.16 seconds, > 0
+    uint8_t  loop;            ///< 1: time wraps at duration; 0: holds the end
+    uint8_t  bound;           ///< set by sn_clip_bind
+    uint16_t n_channels, n_keys;
+    uint32_t error_line;      ///< line of the last parse error (0: none / not line-specific)
+    sn_clip_channel chan[SN_CLIP_MAX_CHANNELS];
+    sn_clip_key     keys[SN_CLIP_MAX_KEYS];
+} sn_clip;
+
+/// Parse clip text (len bytes, need not be NUL-terminated) into *clip.
+/// Returns 0 on success; otherwise 1 with "line N: what" in err (always
+/// NUL-terminated when errlen > 0) and clip->error_line = N.
+int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t errlen);
+
+/// Resolve joint names against a blob's skeleton. Returns 0, or 1 with a
+/// message naming the first joint the blob lacks.
+int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen);
+
+/// Clip time of step k in Q16.16 seconds: k*h (h = the blob timestep rounded
+/// to Q16.16), wrapped (loop) or clamped to the duration. Integer only.
+int32_t sn_clip_time(const sn_clip *clip, int32_t h_q16, uint32_t step);
+
+/// Blob timestep as Q16.16 seconds (either flavour).
+int32_t sn_clip_timestep_q16(const sn_blob *blob);
+
+/// Local joint rotations at clip time t (Q16.16 s): slerp between the two
+/// surrounding keys, first/last key held outside them, identity for joints
+/// without a channel. local has one entry per blob joint. *root gets the
+/// root translation (zero without a move channel). Clip must be bound.
+void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
+                    sn_quat *local, sn_vec3 *root);
+
+/// Everything for step k: sample at sn_clip_time, then sn_pose_from_local.
+/// local (scratch) and out have one entry per blob joint.
+void sn_clip_pose(const sn_clip *clip, const sn_blob *blob, uint32_t step,
+                  sn_quat *local, sn_xform *out);
+
+/// Own decimal reader (exported for tests): optional sign, digits, optional
+/// '.' and digits; no exponent. Rounds to nearest Q16.16 (half away from
+/// zero; digits after the 9th decimal ignored). Returns 0 on success, 1 if
+/// not a number, 2 if |value| >= 32768.
+int sn_clip_parse_q16(const char *s, size_t n, int32_t *out);
+
+#endif /* SN_CLIP_H */
