@@ -2,5 +2,6 @@
 # (built into $(BUILD)/tests/test_*) and anything the suites need to TEST_DEPS.
 TEST_BINS ?=
 TEST_DEPS ?=
+include tests/physics.mk
 test: $(TEST_BINS) $(TEST_DEPS)
 	sh tests/run_tests.sh $(BUILD)

@@ -1,0 +1,372 @@
+/* snref_synth.c -- synthetic box-lattice blobs with textbook hex elements. */
+#include "snref_synth.h"
+#include "../../runtime/src/sn_format.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Solve n x n system A X = B (m right-hand sides, column-major in B rows) by
+ * Gauss-Jordan with partial pivoting; A, B row-major, B is n x m. */
+static int gj_solve(double *A, double *B, int n, int m) {
+    int i, j, k;
+    for (k = 0; k < n; k++) {
+        int p = k;
+        for (i = k + 1; i < n; i++) if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (A[p * n + k] == 0) return -1;
+        if (p != k) {
+            for (j = 0; j < n; j++) { double t = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = t; }
+            for (j = 0; j < m; j++) { double t = B[k * m + j]; B[k * m + j] = B[p * m + j]; B[p * m + j] = t; }
+        }
+        for (i = 0; i < n; i++) {
+            double l;
+            if (i == k) continue;
+            l = A[i * n + k] / A[k * n + k];
+            for (j = 0; j < n; j++) A[i * n + j] -= l * A[k * n + j];
+            for (j = 0; j < m; j++) B[i * m + j] -= l * B[k * m + j];
+        }
+    }
+    for (k = 0; k < n; k++) for (j = 0; j < m; j++) B[k * m + j] /= A[k * n + k];
+    return 0;
+}
+
+/* Strain rows (Voigt: xx yy zz xy yz xz, engineering shear) of one scalar
+ * shape function gradient g for displacement component c: B[row] */
+static void bcol(const double g[3], int c, double out[6]) {
+    memset(out, 0, 6 * sizeof *out);
+    out[c] = g[c];
+    if (c == 0) { out[3] = g[1]; out[5] = g[2]; }
+    if (c == 1) { out[3] = g[0]; out[4] = g[2]; }
+    if (c == 2) { out[4] = g[1]; out[5] = g[0]; }
+}
+
+static double dmul(const double a[6], const double b[6], double lam, double mu, int part) {
+    /* a^T D b with D = lam m m^T + mu diag(2,2,2,1,1,1); part 1: lam only, 2: mu only, 3: both */
+    double r = 0;
+    if (part & 1) r += lam * (a[0] + a[1] + a[2]) * (b[0] + b[1] + b[2]);
+    if (part & 2) r += mu * (2 * (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]);
+    return r;
+}
+
+void snsyn_hex(double dx, double dy, double dz, double lam, double mu, int integ,
+               double Ke[24][24], double Me[8][8]) {
+    const double gp = 1.0 / sqrt(3.0);
+    const double sz[3] = { dx, dy, dz };
+    double Kaa[81], Kua[24 * 9];
+    int a, b, i, j, q;
+    memset(Ke, 0, sizeof(double) * 576);
+    memset(Me, 0, sizeof(double) * 64);
+    memset(Kaa, 0, sizeof Kaa);
+    memset(Kua, 0, sizeof Kua);
+    for (q = 0; q < 9; q++) {
+        /* q < 8: 2x2x2 Gauss points (weight 1 each); q == 8: centre point (weight 8) */
+        double xi[3], wq, detJ = dx * dy * dz / 8.0;
+        double N[8], G[8][3], Ginc[3][3];
+        int part;
+        if (q < 8) {
+            xi[0] = (q & 1) ? gp : -gp; xi[1] = (q >> 1 & 1) ? gp : -gp; xi[2] = (q >> 2 & 1) ? gp : -gp;
+            wq = 1.0;
+            part = integ == SNSYN_SRI_VOL ? 2 : 3;
+        } else {
+            if (integ != SNSYN_SRI_VOL) break;
+            xi[0] = xi[1] = xi[2] = 0; wq = 8.0; part = 1;
+        }
+        for (a = 0; a < 8; a++) {
+            double s[3];
+            for (i = 0; i < 3; i++) s[i] = (a >> i & 1) ? 1.0 : -1.0;
+            N[a] = 0.125 * (1 + s[0] * xi[0]) * (1 + s[1] * xi[1]) * (1 + s[2] * xi[2]);
+            G[a][0] = 0.125 * s[0] * (1 + s[1] * xi[1]) * (1 + s[2] * xi[2]) * 2.0 / sz[0];
+            G[a][1] = 0.125 * s[1] * (1 + s[0] * xi[0]) * (1 + s[2] * xi[2]) * 2.0 / sz[1];
+            G[a][2] = 0.125 * s[2] * (1 + s[0] * xi[0]) * (1 + s[1] * xi[1]) * 2.0 / sz[2];
+        }
+        if (q < 8)
+            for (a = 0; a < 8; a++) for (b = 0; b < 8; b++) Me[a][b] += N[a] * N[b] * detJ * wq;
+        for (a = 0; a < 8; a++)
+            for (i = 0; i < 3; i++) {
+                double Ba[6];
+                bcol(G[a], i, Ba);
+                for (b = 0; b < 8; b++)
+                    for (j = 0; j < 3; j++) {
+                        double Bb[6];
+                        bcol(G[b], j, Bb);
+                        Ke[3 * a + i][3 * b + j] += dmul(Ba, Bb, lam, mu, part) * detJ * wq;
+                    }
+            }
+        if (integ == SNSYN_INCOMPATIBLE && q < 8) {
+            /* bubble P_k = 1 - xi_k^2, gradient only along k */
+            int k, kk, c, cc;
+            memset(Ginc, 0, sizeof Ginc);
+            for (k = 0; k < 3; k++) Ginc[k][k] = -2.0 * xi[k] * 2.0 / sz[k];
+            for (k = 0; k < 3; k++)
+                for (c = 0; c < 3; c++) {
+                    double Bi[6];
+                    bcol(Ginc[k], c, Bi);
+                    for (kk = 0; kk < 3; kk++)
+                        for (cc = 0; cc < 3; cc++) {
+                            double Bj[6];
+                            bcol(Ginc[kk], cc, Bj);
+                            Kaa[(3 * k + c) * 9 + 3 * kk + cc] += dmul(Bi, Bj, lam, mu, 3) * detJ;
+                        }
+                    for (a = 0; a < 8; a++)
+                        for (i = 0; i < 3; i++) {
+                            double Ba[6];
+                            bcol(G[a], i, Ba);
+                            Kua[(3 * a + i) * 9 + 3 * k + c] += dmul(Ba, Bi, lam, mu, 3) * detJ;
+                        }
+                }
+        }
+    }
+    if (integ == SNSYN_INCOMPATIBLE) {
+        /* static condensation K = Kuu - Kua Kaa^-1 Kau */
+        double X[9 * 24], A[81];
+        memcpy(A, Kaa, sizeof A);
+        for (i = 0; i < 9; i++) for (j = 0; j < 24; j++) X[i * 24 + j] = Kua[j * 9 + i];
+        gj_solve(A, X, 9, 24);
+        for (a = 0; a < 24; a++)
+            for (b = 0; b < 24; b++) {
+                double t = 0;
+                for (i = 0; i < 9; i++) t += Kua[a * 9 + i] * X[i * 24 + b];
+                Ke[a][b] -= t;
+            }
+        for (a = 0; a < 24; a++)   /* symmetrize round-off */
+            for (b = a + 1; b < 24; b++) Ke[a][b] = Ke[b][a] = 0.5 * (Ke[a][b] + Ke[b][a]);
+    }
+}
+
+/* ---------------- blob writer ---------------- */
+
+typedef struct { unsigned char *d; size_t n, cap; int fl; } wbuf;
+
+static void w_grow(wbuf *w, size_t need) {
+    if (need <= w->cap) return;
+    while (w->cap < need) w->cap = w->cap ? 2 * w->cap : 4096;
+    w->d = realloc(w->d, w->cap);
+}
+static void w_u8(wbuf *w, size_t at, unsigned v) { w_grow(w, at + 1); w->d[at] = (unsigned char)v; }
+static void w_u16(wbuf *w, size_t at, unsigned v) { w_u8(w, at, v & 255u); w_u8(w, at + 1, v >> 8 & 255u); }
+static void w_u32(wbuf *w, size_t at, uint32_t v) { w_u16(w, at, v & 0xFFFFu); w_u16(w, at + 2, v >> 16); }
+static void w_real(wbuf *w, size_t at, double v) {
+    if (w->fl == SN_FLAVOUR_FLOAT32) { float f = (float)v; uint32_t u; memcpy(&u, &f, 4); w_u32(w, at, u); }
+    else { uint64_t u; memcpy(&u, &v, 8); w_u32(w, at, (uint32_t)u); w_u32(w, at + 4, (uint32_t)(u >> 32)); }
+}
+static uint32_t crc32_ieee(const unsigned char *p, size_t n) {
+    uint32_t c = 0xFFFFFFFFu;
+    size_t i;
+    int k;
+    for (i = 0; i < n; i++) {
+        c ^= p[i];
+        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
+    unsigned NX = bx->nx + 1, NY = bx->ny + 1, NZ = bx->nz + 1, nV = NX * NY * NZ, nF = 0, nC, i, k;
+    unsigned *newid, *gid_of, nJ = bx->two_joints ? 2u : 1u, nnz = 0;
+    double lam = bx->E * bx->nu / ((1 + bx->nu) * (1 - 2 * bx->nu)), mu = bx->E / (2 * (1 + bx->nu));
+    double Ke[24][24], Me[8][8], *S, *M, m0 = 0, U = 1, root[3], tip[3], h2 = bx->h * bx->h;
+    int len_shift = 0;
+    unsigned R = bx->flavour == SN_FLAVOUR_FLOAT32 ? 4u : 8u;
+    wbuf w = { 0, 0, 0, 0 };
+    size_t off[SN_SEC_COUNT], cnt[SN_SEC_COUNT], el[SN_SEC_COUNT], pos;
+    nC = bx->nx * bx->ny * bx->nz;
+    if (nV > SN_MAX_VERTICES) return NULL;
+    w.fl = bx->flavour;
+#define GID(ix, iy, iz) ((ix) + NX * ((iy) + NY * (iz)))
+    /* blocks S, M per (vertex, neighbour offset 0..26) */
+    S = calloc((size_t)nV * 27 * 9, sizeof *S);
+    M = calloc((size_t)nV * 27, sizeof *M);
+    newid = malloc(nV * sizeof *newid);
+    gid_of = malloc(nV * sizeof *gid_of);
+    snsyn_hex(bx->dx, bx->dy, bx->dz, lam, mu, bx->integration, Ke, Me);
+    {
+        unsigned cx, cy, cz, a, b2, ii, jj;
+        for (cz = 0; cz < bx->nz; cz++) for (cy = 0; cy < bx->ny; cy++) for (cx = 0; cx < bx->nx; cx++)
+            for (a = 0; a < 8; a++) for (b2 = 0; b2 < 8; b2++) {
+                unsigned ga = GID(cx + (a & 1), cy + (a >> 1 & 1), cz + (a >> 2 & 1));
+                int ox = (int)(b2 & 1) - (int)(a & 1), oy = (int)(b2 >> 1 & 1) - (int)(a >> 1 & 1),
+                    oz = (int)(b2 >> 2 & 1) - (int)(a >> 2 & 1);
+                unsigned o = (unsigned)((ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1)));
+                M[ga * 27 + o] += bx->rho * Me[a][b2];
+                for (ii = 0; ii < 3; ii++) for (jj = 0; jj < 3; jj++) S[(ga * 27 + o) * 9 + 3 * ii + jj] += Ke[3 * a + ii][3 * b2 + jj];
+            }
+    }
+    /* ordering: free first (in grid order), then skeleton */
+    for (i = 0; i < nV; i++) {
+        unsigned ix = i % NX;
+        int skel = ix == 0 || (bx->two_joints && ix == bx->nx);
+        if (!skel) { newid[i] = nF; gid_of[nF++] = i; }
+    }
+    k = nF;
+    for (i = 0; i < nV; i++) {
+        unsigned ix = i % NX;
+        if (ix == 0) { newid[i] = k; gid_of[k++] = i; }
+    }
+    if (bx->two_joints)
+        for (i = 0; i < nV; i++)
+            if (i % NX == bx->nx) { newid[i] = k; gid_of[k++] = i; }
+    root[0] = 0; root[1] = 0.5 * bx->ny * bx->dy; root[2] = 0.5 * bx->nz * bx->dz;
+    tip[0] = bx->nx * bx->dx; tip[1] = root[1]; tip[2] = root[2];
+    for (i = 0; i < nV; i++) {
+        double x[3];
+        x[0] = (i % NX) * bx->dx - root[0]; x[1] = (i / NX % NY) * bx->dy - root[1]; x[2] = (i / NX / NY) * bx->dz - root[2];
+        for (k = 0; k < 3; k++) while (fabs(x[k]) >= 2 * U) { U *= 2; len_shift++; }
+        if (M[i * 27 + 13] > m0) m0 = M[i * 27 + 13];
+    }
+    /* count off-diagonal blocks of free rows: neighbours with larger new id */
+    {
+        unsigned *rowptr = calloc(nF + 1, sizeof *rowptr);
+        unsigned *cols = NULL;
+        double *moff = NULL, *soff = NULL;
+        size_t cap = 0;
+        for (i = 0; i < nF; i++) {
+            unsigned g = gid_of[i], ix = g % NX, iy = g / NX % NY, iz = g / NX / NY, o, list[27], lo[27], nl = 0, a, b2;
+            for (o = 0; o < 27; o++) {
+                int ox = (int)(o % 3) - 1, oy = (int)(o / 3 % 3) - 1, oz = (int)(o / 9) - 1;
+                int jx = (int)ix + ox, jy = (int)iy + oy, jz = (int)iz + oz;
+                unsigned gj, nj;
+                if (o == 13 || jx < 0 || jy < 0 || jz < 0 || jx >= (int)NX || jy >= (int)NY || jz >= (int)NZ) continue;
+                if (M[g * 27 + o] == 0) continue;    /* no shared cell */
+                gj = GID((unsigned)jx, (unsigned)jy, (unsigned)jz); nj = newid[gj];
+                if (nj <= i) continue;
+                list[nl] = nj; lo[nl++] = o;
+            }
+            for (a = 1; a < nl; a++)          /* insertion sort by column */
+                for (b2 = a; b2 > 0 && list[b2 - 1] > list[b2]; b2--) {
+                    unsigned t = list[b2]; list[b2] = list[b2 - 1]; list[b2 - 1] = t;
+                    t = lo[b2]; lo[b2] = lo[b2 - 1]; lo[b2 - 1] = t;
+                }
+            if (nnz + nl > cap) {
+                cap = 2 * (nnz + nl) + 64;
+                cols = realloc(cols, cap * sizeof *cols); moff = realloc(moff, cap * sizeof *moff);
+                soff = realloc(soff, cap * 9 * sizeof *soff);
+            }
+            for (a = 0; a < nl; a++) {
+                cols[nnz] = list[a];
+                moff[nnz] = M[g * 27 + lo[a]] / m0;
+                for (k = 0; k < 9; k++) soff[9 * nnz + k] = h2 * S[(g * 27 + lo[a]) * 9 + k] / m0;
+                nnz++;
+            }
+            rowptr[i + 1] = nnz;
+        }
+        /* layout */
+        cnt[SN_SEC_JOINTS] = nJ; el[SN_SEC_JOINTS] = SN_ELEM_JOINTS(R);
+        cnt[SN_SEC_JOINT_NAMES] = nJ; el[SN_SEC_JOINT_NAMES] = SN_ELEM_JOINT_NAMES;
+        cnt[SN_SEC_REST] = nV; el[SN_SEC_REST] = SN_ELEM_REST(R);
+        cnt[SN_SEC_FRAMES] = nV; el[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
+        cnt[SN_SEC_MDIAG] = nF; el[SN_SEC_MDIAG] = SN_ELEM_MDIAG(R);
+        cnt[SN_SEC_SDIAG] = nF; el[SN_SEC_SDIAG] = SN_ELEM_SDIAG(R);
+        cnt[SN_SEC_PRECOND] = nF; el[SN_SEC_PRECOND] = SN_ELEM_PRECOND(R);
+        cnt[SN_SEC_MLUMP] = nF; el[SN_SEC_MLUMP] = SN_ELEM_MLUMP(R);
+        cnt[SN_SEC_ROWPTR] = nF + 1; el[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
+        cnt[SN_SEC_COLS] = nnz; el[SN_SEC_COLS] = SN_ELEM_COLS;
+        cnt[SN_SEC_MOFF] = nnz; el[SN_SEC_MOFF] = SN_ELEM_MOFF(R);
+        cnt[SN_SEC_SOFF] = nnz; el[SN_SEC_SOFF] = SN_ELEM_SOFF(R);
+        cnt[SN_SEC_CELLS] = nC; el[SN_SEC_CELLS] = SN_ELEM_CELLS;
+        cnt[SN_SEC_EMBED] = nV; el[SN_SEC_EMBED] = SN_ELEM_EMBED;   /* surface = every lattice vertex */
+        cnt[SN_SEC_TRIS] = 0; el[SN_SEC_TRIS] = SN_ELEM_TRIS;
+        pos = SN_HEADER_BYTES;
+        for (k = 0; k < SN_SEC_COUNT; k++) {
+            pos = (pos + 7) & ~(size_t)7;
+            off[k] = pos;
+            pos += cnt[k] * el[k];
+        }
+        pos = (pos + 7) & ~(size_t)7;
+        w_grow(&w, pos);
+        memset(w.d, 0, pos);
+        w.n = pos;
+        w.d[0] = SN_MAGIC0; w.d[1] = SN_MAGIC1; w.d[2] = SN_MAGIC2; w.d[3] = SN_MAGIC3;
+        w_u16(&w, SN_H_VER_MAJOR, SN_FORMAT_MAJOR); w_u16(&w, SN_H_VER_MINOR, SN_FORMAT_MINOR);
+        w_u32(&w, SN_H_ENDIAN, SN_ENDIAN_MARK);
+        w_u32(&w, SN_H_TOTAL_SIZE, (uint32_t)pos); w_u32(&w, SN_H_HEADER_SIZE, SN_HEADER_BYTES);
+        w_u8(&w, SN_H_FLAVOUR, (unsigned)bx->flavour); w_u8(&w, SN_H_REAL_SIZE, R); w_u8(&w, SN_H_NSECTIONS, SN_SEC_COUNT);
+        w_u32(&w, SN_H_ONE, bx->flavour == SN_FLAVOUR_FLOAT32 ? SN_ONE_FLOAT32 : 0u);
+        w_u32(&w, SN_H_ONE_HI, bx->flavour == SN_FLAVOUR_FLOAT64 ? SN_ONE_FLOAT64_HI : 0u);
+        w_u32(&w, SN_H_N_VERTICES, nV); w_u32(&w, SN_H_N_FREE, nF); w_u32(&w, SN_H_N_CELLS, nC);
+        w_u32(&w, SN_H_N_JOINTS, nJ); w_u32(&w, SN_H_N_SURFACE, nV); w_u32(&w, SN_H_N_TRIANGLES, 0);
+        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ));
+        w_u16(&w, SN_H_CG_DEFAULT, bx->cg_default); w_u16(&w, SN_H_CG_MAX, 256);
+        w_u8(&w, SN_H_LEN_SHIFT, (unsigned)(len_shift & 255));
+        {
+            size_t rp = SN_H_REALS;
+            w_real(&w, rp + SN_R_A1 * R, bx->h * bx->alpha);
+            w_real(&w, rp + SN_R_B1 * R, bx->beta / bx->h);
+            for (k = 0; k < 3; k++) w_real(&w, rp + (SN_R_GRAV_X + k) * R, h2 * bx->g[k] / U);
+            w_real(&w, rp + SN_R_TIMESTEP * R, bx->h);
+            w_real(&w, rp + SN_R_MASS_SCALE * R, m0);
+        }
+        for (k = 0; k < SN_SEC_COUNT; k++) {
+            size_t e = SN_H_SECTIONS + k * SN_SECTION_ENTRY;
+            w_u32(&w, e, (uint32_t)off[k]); w_u32(&w, e + 4, (uint32_t)(cnt[k] * el[k]));
+            w_u32(&w, e + 8, (uint32_t)cnt[k]); w_u32(&w, e + 12, (uint32_t)el[k]);
+        }
+        for (k = 0; k < nJ; k++) {
+            size_t e = off[SN_SEC_JOINTS] + k * SN_ELEM_JOINTS(R);
+            w_u16(&w, e, k == 0 ? 0xFFFFu : 0u);
+            w_real(&w, e + 8, k == 0 ? 0.0 : (tip[0] - root[0]) / U);
+            w_real(&w, e + 8 + R, 0.0); w_real(&w, e + 8 + 2 * R, 0.0);
+            memcpy(w.d + off[SN_SEC_JOINT_NAMES] + 32 * k, k == 0 ? "root" : "tip", k == 0 ? 4 : 3);
+        }
+        for (i = 0; i < nV; i++) {
+            unsigned g = gid_of[i], ix = g % NX;
+            double x[3];
+            size_t e = off[SN_SEC_FRAMES] + 4 * i;
+            x[0] = ix * bx->dx - root[0]; x[1] = (g / NX % NY) * bx->dy - root[1]; x[2] = (g / NX / NY) * bx->dz - root[2];
+            for (k = 0; k < 3; k++) w_real(&w, off[SN_SEC_REST] + (3 * i + k) * R, x[k] / U);
+            if (bx->two_joints && i >= nF && ix == bx->nx) { w_u8(&w, e, 1); w_u8(&w, e + 1, 1); w_u16(&w, e + 2, 0); }
+            else if (bx->two_joints && i < nF) {
+                w_u8(&w, e, 0); w_u8(&w, e + 1, 1); w_u16(&w, e + 2, (unsigned)lround(32768.0 * ix / bx->nx));
+            } else { w_u8(&w, e, 0); w_u8(&w, e + 1, 0); w_u16(&w, e + 2, 0); }
+            /* surface vertex i sits at lattice vertex i: a cell containing it and its corner */
+            {
+                unsigned iy = g / NX % NY, iz = g / NX / NY;
+                unsigned cx = ix < bx->nx ? ix : ix - 1, cy = iy < bx->ny ? iy : iy - 1, cz = iz < bx->nz ? iz : iz - 1;
+                size_t ee = off[SN_SEC_EMBED] + 8 * i;
+                w_u16(&w, ee, cx + bx->nx * (cy + bx->ny * cz));
+                w_u16(&w, ee + 2, ix - cx ? 32768u : 0u); w_u16(&w, ee + 4, iy - cy ? 32768u : 0u);
+                w_u16(&w, ee + 6, iz - cz ? 32768u : 0u);
+            }
+        }
+        for (i = 0; i < nF; i++) {
+            unsigned g = gid_of[i], ix = g % NX, iy = g / NX % NY, iz = g / NX / NY, o;
+            double Sd[9], P[9], A[9], lump = 0, md = M[g * 27 + 13] / m0;
+            static const int sym[6][2] = { { 0, 0 }, { 1, 1 }, { 2, 2 }, { 0, 1 }, { 0, 2 }, { 1, 2 } };
+            for (k = 0; k < 9; k++) Sd[k] = h2 * S[(g * 27 + 13) * 9 + k] / m0;
+            for (o = 0; o < 27; o++) {
+                int jx = (int)ix + (int)(o % 3) - 1, jy = (int)iy + (int)(o / 3 % 3) - 1, jz = (int)iz + (int)(o / 9) - 1;
+                if (jx < 0 || jy < 0 || jz < 0 || jx >= (int)NX || jy >= (int)NY || jz >= (int)NZ) continue;
+                lump += M[g * 27 + o] / m0;
+            }
+            for (k = 0; k < 9; k++) { A[k] = (1 + bx->beta / bx->h) * Sd[k]; P[k] = 0; }
+            for (k = 0; k < 3; k++) A[4 * k] += (1 + bx->h * bx->alpha) * md;
+            for (k = 0; k < 9; k++) P[k] = (k % 4 == 0) ? 1.0 : 0.0;
+            gj_solve(A, P, 3, 3);
+            w_real(&w, off[SN_SEC_MDIAG] + i * R, md);
+            w_real(&w, off[SN_SEC_MLUMP] + i * R, lump);
+            for (k = 0; k < 6; k++) {
+                w_real(&w, off[SN_SEC_SDIAG] + (6 * i + k) * R, Sd[3 * sym[k][0] + sym[k][1]]);
+                w_real(&w, off[SN_SEC_PRECOND] + (6 * i + k) * R, P[3 * sym[k][0] + sym[k][1]]);
+            }
+        }
+        for (i = 0; i <= nF; i++) w_u32(&w, off[SN_SEC_ROWPTR] + 4 * i, rowptr[i]);
+        for (i = 0; i < nnz; i++) {
+            w_u16(&w, off[SN_SEC_COLS] + 2 * i, cols[i]);
+            w_real(&w, off[SN_SEC_MOFF] + i * R, moff[i]);
+            for (k = 0; k < 9; k++) w_real(&w, off[SN_SEC_SOFF] + (9 * i + k) * R, soff[9 * i + k]);
+        }
+        {
+            unsigned cx, cy, cz, a, c = 0;
+            for (cz = 0; cz < bx->nz; cz++) for (cy = 0; cy < bx->ny; cy++) for (cx = 0; cx < bx->nx; cx++, c++)
+                for (a = 0; a < 8; a++)
+                    w_u16(&w, off[SN_SEC_CELLS] + 16 * c + 2 * a,
+                          newid[GID(cx + (a & 1), cy + (a >> 1 & 1), cz + (a >> 2 & 1))]);
+        }
+        free(rowptr); free(cols); free(moff); free(soff);
+    }
+    w_u32(&w, SN_H_CRC32, crc32_ieee(w.d + 16, w.n - 16));
+    free(S); free(M); free(newid); free(gid_of);
+    *size = w.n;
+    return w.d;
+#undef GID
+}
