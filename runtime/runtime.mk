@@ -1,1 +1,32 @@
-# runtime build fragment (filled in by its owner)
+# runtime build fragment: the shipping library in two flavours.
+#   $(SN_LIB_FIXED)  build/libsinew.a        integers only (default)
+#   $(SN_LIB_FLOAT)  build/libsinew_float.a  -DSN_FLOAT
+# Sources: every runtime/src/*.c (wildcard), compiled warning-clean with
+# $(SN_WARN); objects in $(BUILD)/runtime/{fixed,float}/.
+SN_INC   = -Iruntime/include
+SN_WARN  = $(WARN) -Wvla -Wshadow
+SN_SRCS  = $(wildcard runtime/src/*.c)
+SN_HDRS  = runtime/include/sinew.h $(wildcard runtime/src/*.h)
+SN_OBJS_FIXED = $(patsubst runtime/src/%.c,$(BUILD)/runtime/fixed/%.o,$(SN_SRCS))
+SN_OBJS_FLOAT = $(patsubst runtime/src/%.c,$(BUILD)/runtime/float/%.o,$(SN_SRCS))
+SN_LIB_FIXED = $(BUILD)/libsinew.a
+SN_LIB_FLOAT = $(BUILD)/libsinew_float.a
+AR ?= ar
+
+all: $(SN_LIB_FIXED) $(SN_LIB_FLOAT)
+
+$(BUILD)/runtime/fixed/%.o: runtime/src/%.c $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_INC) -c $< -o $@
+
+$(BUILD)/runtime/float/%.o: runtime/src/%.c $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_WARN) $(CFLAGS) -DSN_FLOAT $(SN_INC) -c $< -o $@
+
+$(SN_LIB_FIXED): $(SN_OBJS_FIXED)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
+	@rm -f $@
+	$(AR) rcs $@ $^

@@ -1,0 +1,416 @@
+/* sn_blob.c -- validate an untrusted blob once; read-only accessors after.
+ *
+ * sn_blob_validate() is the only place that checks the blob (like Lua's
+ * lundump or the flatcc verifier): after SN_OK every offset, count, index and
+ * number the stepping code uses is known to be in range, so the step never
+ * checks again. Every read below happens only after the bytes it reads are
+ * known to lie inside the caller's buffer; all size arithmetic is done so it
+ * cannot wrap (compare "size - offset", products in uint64).
+ *
+ * Order of checks (first failure wins): NULL -> ALIGN -> TRUNCATED (shorter
+ * than the header) -> MAGIC -> ENDIAN (byte-swapped mark) -> VERSION ->
+ * ENDIAN (any other mark) -> FLAVOUR -> HEADER / TRUNCATED (total_size) ->
+ * HEADER (header fields) -> CHECKSUM -> HEADER (counts) -> VALUE (scalars)
+ * -> SECTION (table) -> INDEX / VALUE / SECTION (contents, padding).
+ *
+ * Numeric bounds (fixed flavour, stored integers): matrix entries
+ * |e| <= 2^27; rest and joint coordinates |x| <= 2^27 (Q22: 32 internal
+ * units); a1, b1 in [0, 2^28] (Q24: [0, 16]); |gravity| <= 2^27 (Q22);
+ * timestep > 0. Float flavour: every real finite, and the same bounds as
+ * true values (the stored integer divided by 2^Q of its format; matrices
+ * taken at Q0): |e| <= 2^27, |x| <= 32, a1, b1 in [0, 16], |g| <= 32,
+ * 0 < h <= 32768, reserved reals +0.0.
+ */
+#include "sn_internal.h"
+
+static const unsigned char *sn_bytes(const sn_blob *b) {
+    return (const unsigned char *)(const void *)b;
+}
+
+/* CRC-32 (IEEE 802.3 / zlib, reflected poly 0xEDB88320), nibble table in ROM. */
+static uint32_t sn_crc32(const unsigned char *p, uint32_t n) {
+    static const uint32_t tab[16] = {
+        0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
+        0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+        0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu};
+    uint32_t c = 0xFFFFFFFFu, i;
+    for (i = 0; i < n; i++) {
+        c ^= p[i];
+        c = (c >> 4) ^ tab[c & 15u];
+        c = (c >> 4) ^ tab[c & 15u];
+    }
+    return ~c;
+}
+
+/* ---- one real in range (fixed: stored integer in [lo, hi]; float: finite
+ * and in [lo, hi] / 2^q) ---- */
+#if defined(SN_FLOAT)
+static int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
+    uint32_t u = sn_rd_u32(p);
+    float v, s = 1.0f / (float)((int32_t)1 << q);
+    if (((u >> 23) & 0xFFu) == 0xFFu) return 0; /* inf or NaN */
+    v = sn_rd_f32(p);
+    return v >= (float)lo * s && v <= (float)hi * s;
+}
+#else
+static int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
+    int32_t v = sn_rd_i32(p);
+    (void)q;
+    return v >= lo && v <= hi;
+}
+#endif
+
+/* n consecutive reals all with |v| <= lim (float: lim / 2^q). */
+static int sn_reals_ok(const unsigned char *p, uint32_t n, int32_t lim, int q) {
+    uint32_t i;
+    for (i = 0; i < n; i++)
+        if (!sn_real_ok(p + (size_t)i * SN_REAL_BYTES, -lim, lim, q)) return 0;
+    return 1;
+}
+
+/* A reserved real must be exactly zero (float: +0.0 bits). */
+static int sn_real_zero(const unsigned char *p) { return sn_rd_u32(p) == 0; }
+
+static int sn_zero_bytes(const unsigned char *p, uint32_t n) {
+    uint32_t i;
+    for (i = 0; i < n; i++)
+        if (p[i]) return 0;
+    return 1;
+}
+
+static void sn_view_header(sn_view *v, const unsigned char *p);
+static void sn_view_sections(sn_view *v);
+
+#define SN_CHK(cond, err) do { if (!(cond)) return (err); } while (0)
+
+/* Section contents, given a header and table already checked. */
+static sn_status sn_check_contents(const sn_view *v) {
+    const int32_t E = SN_ENTRY_LIM; /* 2^27 */
+    const unsigned char *s;
+    uint32_t i, j, k;
+
+    /* joints: parent < own index (root 0xFFFF only at 0), reserved 0, rest */
+    s = v->sec[SN_SEC_JOINTS];
+    for (j = 0; j < v->nJ; j++) {
+        const unsigned char *e = s + (size_t)j * SN_ELEM_JOINTS(SN_REAL_BYTES);
+        uint32_t par = sn_rd_u16(e);
+        if (j == 0) SN_CHK(par == 0xFFFFu, SN_ERR_INDEX);
+        else SN_CHK(par < j, SN_ERR_INDEX);
+        SN_CHK(sn_rd_u16(e + 2) == 0 && sn_rd_u32(e + 4) == 0, SN_ERR_VALUE);
+        SN_CHK(sn_reals_ok(e + 8, 3, E, SN_Q_LEN), SN_ERR_VALUE);
+    }
+    /* names: non-empty, NUL-terminated, NUL-padded, unique */
+    s = v->sec[SN_SEC_JOINT_NAMES];
+    for (j = 0; j < v->nJ; j++) {
+        const unsigned char *n = s + (size_t)j * SN_JOINT_NAME_MAX;
+        for (k = 0; k < SN_JOINT_NAME_MAX && n[k]; k++) {}
+        SN_CHK(k > 0 && k < SN_JOINT_NAME_MAX, SN_ERR_VALUE);
+        SN_CHK(sn_zero_bytes(n + k, SN_JOINT_NAME_MAX - k), SN_ERR_VALUE);
+        for (i = 0; i < j; i++) /* padded: equal names <=> equal 32 bytes */
+            SN_CHK(memcmp(n, s + (size_t)i * SN_JOINT_NAME_MAX, SN_JOINT_NAME_MAX) != 0,
+                   SN_ERR_VALUE);
+    }
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_REST], 3 * v->nV, E, SN_Q_LEN), SN_ERR_VALUE);
+    /* frames: bones < nJ, w <= 1 (Q15); skeleton vertices rigid to bone1 */
+    s = v->sec[SN_SEC_FRAMES];
+    for (i = 0; i < v->nV; i++) {
+        const unsigned char *f = s + (size_t)i * SN_ELEM_FRAMES;
+        SN_CHK(f[0] < v->nJ && f[1] < v->nJ, SN_ERR_INDEX);
+        SN_CHK(sn_rd_u16(f + 2) <= 32768u, SN_ERR_VALUE);
+        if (i >= v->nF) {
+            SN_CHK(f[0] == f[1], SN_ERR_INDEX);
+            SN_CHK(sn_rd_u16(f + 2) == 0, SN_ERR_VALUE);
+        }
+    }
+    /* matrices */
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_MDIAG], v->nF, E, 0), SN_ERR_VALUE);
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_SDIAG], 6 * v->nF, E, 0), SN_ERR_VALUE);
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_PRECOND], 6 * v->nF, E, 0), SN_ERR_VALUE);
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_MLUMP], v->nF, E, 0), SN_ERR_VALUE);
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_MOFF], v->nnz, E, 0), SN_ERR_VALUE);
+    /* 9*nnz fits: the section size check bounded nnz*36 by total_size */
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_SOFF], 9 * v->nnz, E, 0), SN_ERR_VALUE);
+    /* sparsity: rowptr monotone 0..nnz; per row columns strictly increasing,
+     * > row (upper triangle), < nV */
+    {
+        const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+        SN_CHK(sn_rd_u32(rp) == 0, SN_ERR_INDEX);
+        SN_CHK(sn_rd_u32(rp + 4 * (size_t)v->nF) == v->nnz, SN_ERR_INDEX);
+        for (i = 0; i < v->nF; i++) {
+            uint32_t a = sn_rd_u32(rp + 4 * (size_t)i), b = sn_rd_u32(rp + 4 * (size_t)i + 4);
+            uint32_t prev = i;
+            SN_CHK(a <= b && b <= v->nnz, SN_ERR_INDEX);
+            for (k = a; k < b; k++) {
+                uint32_t c = sn_rd_u16(cols + 2 * (size_t)k);
+                SN_CHK(c > prev && c < v->nV, SN_ERR_INDEX);
+                prev = c;
+            }
+        }
+    }
+    /* cells: corners < nV */
+    s = v->sec[SN_SEC_CELLS];
+    for (i = 0; i < 8 * v->nC; i++) SN_CHK(sn_rd_u16(s + 2 * (size_t)i) < v->nV, SN_ERR_INDEX);
+    /* embedding: cell < nC, trilinear coordinates in [0, 1] (Q15) */
+    s = v->sec[SN_SEC_EMBED];
+    for (i = 0; i < v->nS; i++) {
+        const unsigned char *e = s + (size_t)i * SN_ELEM_EMBED;
+        SN_CHK(sn_rd_u16(e) < v->nC, SN_ERR_INDEX);
+        for (k = 1; k < 4; k++) SN_CHK(sn_rd_u16(e + 2 * k) <= 32768u, SN_ERR_VALUE);
+    }
+    /* triangles: surface vertex indices < nS */
+    s = v->sec[SN_SEC_TRIS];
+    for (i = 0; i < 3 * v->nT; i++) SN_CHK(sn_rd_u16(s + 2 * (size_t)i) < v->nS, SN_ERR_INDEX);
+    return SN_OK;
+}
+
+sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
+    const unsigned char *p = (const unsigned char *)data;
+    uint32_t total, cnt[SN_SEC_COUNT], prev_end, k;
+    sn_view v;
+    sn_status st;
+
+    if (!data || !out) return SN_ERR_NULL;
+    *out = NULL;
+    if (((uintptr_t)data & 7u) != 0) return SN_ERR_ALIGN;
+    if (size < SN_HEADER_BYTES) return SN_ERR_TRUNCATED;
+
+    /* identity: magic, byte order, version, flavour */
+    if (p[0] != SN_MAGIC0 || p[1] != SN_MAGIC1 || p[2] != SN_MAGIC2 || p[3] != SN_MAGIC3)
+        return SN_ERR_MAGIC;
+    if (sn_rd_u32(p + SN_H_ENDIAN) == 0x04030201u) return SN_ERR_ENDIAN; /* byte-swapped */
+    if (sn_rd_u16(p + SN_H_VER_MAJOR) != SN_FORMAT_MAJOR ||
+        sn_rd_u16(p + SN_H_VER_MINOR) > SN_FORMAT_MINOR)
+        return SN_ERR_VERSION;
+    if (sn_rd_u32(p + SN_H_ENDIAN) != SN_ENDIAN_MARK) return SN_ERR_ENDIAN;
+    if (p[SN_H_FLAVOUR] != SN_FLAVOUR || p[SN_H_REAL_SIZE] != SN_REAL_BYTES ||
+        sn_rd_u32(p + SN_H_ONE) != (SN_FLAVOUR == SN_FLAVOUR_FIXED ? SN_ONE_FIXED : SN_ONE_FLOAT32) ||
+        sn_rd_u32(p + SN_H_ONE_HI) != 0)
+        return SN_ERR_FLAVOUR;
+
+    /* sizes and fixed header fields */
+    total = sn_rd_u32(p + SN_H_TOTAL_SIZE);
+    if (total < SN_HEADER_BYTES) return SN_ERR_HEADER;
+    if (total > size) return SN_ERR_TRUNCATED;
+    if (sn_rd_u32(p + SN_H_HEADER_SIZE) != SN_HEADER_BYTES || p[SN_H_NSECTIONS] != SN_SEC_COUNT ||
+        p[SN_H_RESERVED0] != 0 || sn_rd_u32(p + SN_H_RESERVED1) != 0)
+        return SN_ERR_HEADER;
+#if !defined(SN_VALIDATE_NO_CHECKSUM)
+    if (sn_crc32(p + 16, total - 16) != sn_rd_u32(p + SN_H_CRC32)) return SN_ERR_CHECKSUM;
+#endif
+
+    /* counts and settings (decoded by the same code the accessors use) */
+    sn_view_header(&v, p);
+    if (v.nV > SN_MAX_VERTICES || v.nF < 1 || v.nF >= v.nV) return SN_ERR_HEADER;
+    if (v.nJ < 1 || v.nJ > SN_MAX_JOINTS || v.nS > SN_MAX_SURFACE) return SN_ERR_HEADER;
+    if (v.cg_default < 1 || v.cg_default > v.cg_max || v.cg_max > SN_MAX_CG_ITERS)
+        return SN_ERR_HEADER;
+    if (v.len_shift < -24 || v.len_shift > 24 || v.frac_S > 60 || v.frac_M > 60 || v.frac_P > 60)
+        return SN_ERR_HEADER;
+    if (v.instance_bytes < SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ)) return SN_ERR_HEADER;
+
+    /* physics scalars */
+    {
+        const unsigned char *r = p + SN_H_REALS;
+        if (!sn_real_ok(r + SN_R_A1 * SN_REAL_BYTES, 0, (int32_t)1 << 28, SN_Q_COEF) ||
+            !sn_real_ok(r + SN_R_B1 * SN_REAL_BYTES, 0, (int32_t)1 << 28, SN_Q_COEF) ||
+            !sn_reals_ok(r + SN_R_GRAV_X * SN_REAL_BYTES, 3, SN_ENTRY_LIM, SN_Q_LEN) ||
+            !sn_real_ok(r + SN_R_TIMESTEP * SN_REAL_BYTES, 0, INT32_MAX, 16) ||
+            !(v.timestep > 0) ||
+            !sn_real_ok(r + SN_R_MASS_SCALE * SN_REAL_BYTES, INT32_MIN, INT32_MAX, 0) ||
+            !sn_real_zero(r + SN_R_RESERVED * SN_REAL_BYTES))
+            return SN_ERR_VALUE;
+    }
+
+    /* section table: aligned, ascending, non-overlapping, inside total,
+     * count as the header says, elem_size as the format says, size exact */
+    cnt[SN_SEC_JOINTS] = v.nJ;
+    cnt[SN_SEC_JOINT_NAMES] = v.nJ;
+    cnt[SN_SEC_REST] = v.nV;
+    cnt[SN_SEC_FRAMES] = v.nV;
+    cnt[SN_SEC_MDIAG] = v.nF;
+    cnt[SN_SEC_SDIAG] = v.nF;
+    cnt[SN_SEC_PRECOND] = v.nF;
+    cnt[SN_SEC_MLUMP] = v.nF;
+    cnt[SN_SEC_ROWPTR] = v.nF + 1;
+    cnt[SN_SEC_COLS] = v.nnz;
+    cnt[SN_SEC_MOFF] = v.nnz;
+    cnt[SN_SEC_SOFF] = v.nnz;
+    cnt[SN_SEC_CELLS] = v.nC;
+    cnt[SN_SEC_EMBED] = v.nS;
+    cnt[SN_SEC_TRIS] = v.nT;
+    {
+        static const uint8_t elem[SN_SEC_COUNT] = {
+            SN_ELEM_JOINTS(SN_REAL_BYTES), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(SN_REAL_BYTES),
+            SN_ELEM_FRAMES, SN_ELEM_MDIAG(SN_REAL_BYTES), SN_ELEM_SDIAG(SN_REAL_BYTES),
+            SN_ELEM_PRECOND(SN_REAL_BYTES), SN_ELEM_MLUMP(SN_REAL_BYTES), SN_ELEM_ROWPTR,
+            SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_SOFF(SN_REAL_BYTES),
+            SN_ELEM_CELLS, SN_ELEM_EMBED, SN_ELEM_TRIS};
+        prev_end = SN_HEADER_BYTES;
+        for (k = 0; k < SN_SEC_COUNT; k++) {
+            const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
+            uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
+            if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
+                return SN_ERR_SECTION;
+            if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
+                (uint64_t)cnt[k] * elem[k] != (uint64_t)sz)
+                return SN_ERR_SECTION;
+            /* padding since the previous section (or the header) is zero */
+            if (!sn_zero_bytes(p + prev_end, off - prev_end)) return SN_ERR_SECTION;
+            prev_end = off + sz;
+        }
+        if (!sn_zero_bytes(p + prev_end, total - prev_end)) return SN_ERR_SECTION;
+    }
+
+    sn_view_sections(&v);
+    st = sn_check_contents(&v);
+    if (st != SN_OK) return st;
+    *out = (const sn_blob *)data;
+    return SN_OK;
+}
+
+/* Decode header counts and scalars (no section pointers: validate calls
+ * this before the offsets are known to be inside the buffer). */
+static void sn_view_header(sn_view *v, const unsigned char *p) {
+    const unsigned char *r = p + SN_H_REALS;
+    v->base = p;
+    v->nV = sn_rd_u32(p + SN_H_N_VERTICES);
+    v->nF = sn_rd_u32(p + SN_H_N_FREE);
+    v->nC = sn_rd_u32(p + SN_H_N_CELLS);
+    v->nJ = sn_rd_u32(p + SN_H_N_JOINTS);
+    v->nS = sn_rd_u32(p + SN_H_N_SURFACE);
+    v->nT = sn_rd_u32(p + SN_H_N_TRIANGLES);
+    v->nnz = sn_rd_u32(p + SN_H_N_OFFDIAG);
+    v->cg_default = sn_rd_u16(p + SN_H_CG_DEFAULT);
+    v->cg_max = sn_rd_u16(p + SN_H_CG_MAX);
+    v->instance_bytes = sn_rd_u32(p + SN_H_INSTANCE_BYTES);
+    v->total = sn_rd_u32(p + SN_H_TOTAL_SIZE);
+    v->len_shift = p[SN_H_LEN_SHIFT] < 128 ? (int)p[SN_H_LEN_SHIFT] : (int)p[SN_H_LEN_SHIFT] - 256;
+    v->frac_S = p[SN_H_FRAC_S];
+    v->frac_M = p[SN_H_FRAC_M];
+    v->frac_P = p[SN_H_FRAC_P];
+    v->a1 = SN_RD_REAL(r + SN_R_A1 * SN_REAL_BYTES);
+    v->b1 = SN_RD_REAL(r + SN_R_B1 * SN_REAL_BYTES);
+    v->grav[0] = SN_RD_REAL(r + SN_R_GRAV_X * SN_REAL_BYTES);
+    v->grav[1] = SN_RD_REAL(r + SN_R_GRAV_Y * SN_REAL_BYTES);
+    v->grav[2] = SN_RD_REAL(r + SN_R_GRAV_Z * SN_REAL_BYTES);
+    v->timestep = SN_RD_REAL(r + SN_R_TIMESTEP * SN_REAL_BYTES);
+}
+
+static void sn_view_sections(sn_view *v) {
+    int k;
+    for (k = 0; k < SN_SEC_COUNT; k++)
+        v->sec[k] = v->base + sn_rd_u32(v->base + SN_H_SECTIONS + k * SN_SECTION_ENTRY);
+}
+
+/* Decode a blob that sn_blob_validate() accepted (no checks). */
+void sn_view_init(sn_view *v, const sn_blob *blob) {
+    sn_view_header(v, sn_bytes(blob));
+    sn_view_sections(v);
+}
+
+/* ---- accessors of a validated blob (NULL blob -> neutral answer) ---- */
+
+void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
+    sn_view v;
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    if (!blob) return;
+    sn_view_init(&v, blob);
+    info->vertices = v.nV;
+    info->free_vertices = v.nF;
+    info->cells = v.nC;
+    info->joints = v.nJ;
+    info->surface_vertices = v.nS;
+    info->triangles = v.nT;
+    info->offdiag_blocks = v.nnz;
+    info->cg_iters_default = v.cg_default;
+    info->cg_iters_max = v.cg_max;
+    info->instance_bytes = v.instance_bytes;
+    info->blob_bytes = v.total;
+    info->timestep = v.timestep;
+}
+
+static const unsigned char *sn_section(const sn_blob *blob, int k) {
+    const unsigned char *p = sn_bytes(blob);
+    return p + sn_rd_u32(p + SN_H_SECTIONS + k * SN_SECTION_ENTRY);
+}
+
+static uint32_t sn_njoints(const sn_blob *blob) {
+    return sn_rd_u32(sn_bytes(blob) + SN_H_N_JOINTS);
+}
+
+const char *sn_joint_name(const sn_blob *blob, uint32_t j) {
+    if (!blob || j >= sn_njoints(blob)) return NULL;
+    return (const char *)(sn_section(blob, SN_SEC_JOINT_NAMES) + (size_t)j * SN_JOINT_NAME_MAX);
+}
+
+int32_t sn_joint_parent(const sn_blob *blob, uint32_t j) {
+    uint32_t par;
+    if (!blob || j >= sn_njoints(blob)) return -1;
+    par = sn_rd_u16(sn_section(blob, SN_SEC_JOINTS) + (size_t)j * SN_ELEM_JOINTS(SN_REAL_BYTES));
+    return par == 0xFFFFu ? -1 : (int32_t)par;
+}
+
+/* Internal Q22 (internal units) -> public Q16.16 mesh units:
+ * public = internal * 2^(len_shift - 6). Exact when len_shift >= 6 (then
+ * saturated to int32, which a validated |x| <= 2^27 reaches only for
+ * len_shift >= 10 and |x| >= 2^(37 - len_shift)); rounded to nearest
+ * otherwise. Float: multiplied by 2^len_shift (exact). */
+sn_status sn_joint_rest(const sn_blob *blob, uint32_t j, sn_vec3 *out) {
+    const unsigned char *e;
+    sn_real r[3];
+    int k, ls;
+    if (!blob || !out) return SN_ERR_NULL;
+    if (j >= sn_njoints(blob)) return SN_ERR_ARG;
+    e = sn_section(blob, SN_SEC_JOINTS) + (size_t)j * SN_ELEM_JOINTS(SN_REAL_BYTES) + 8;
+    ls = sn_bytes(blob)[SN_H_LEN_SHIFT];
+    if (ls >= 128) ls -= 256;
+    for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+        float x = sn_rd_f32(e + 4 * k), f = ls >= 0 ? 2.0f : 0.5f;
+        int i, n = ls >= 0 ? ls : -ls;
+        for (i = 0; i < n; i++) x *= f;
+        r[k] = x;
+#else
+        int64_t x = sn_rd_i32(e + 4 * k);
+        int sh = ls - (SN_Q_LEN - SN_LEN_FRAC);
+        x = sh >= 0 ? x * ((int64_t)1 << sh) : sn_rshr64(x, -sh);
+        r[k] = (int32_t)(x > INT32_MAX ? INT32_MAX : (x < -INT32_MAX ? -INT32_MAX : x));
+#endif
+    }
+    out->x = r[0];
+    out->y = r[1];
+    out->z = r[2];
+    return SN_OK;
+}
+
+int32_t sn_find_joint(const sn_blob *blob, const char *name) {
+    const unsigned char *names;
+    uint32_t j, n, k;
+    if (!blob || !name) return -1;
+    n = sn_njoints(blob);
+    names = sn_section(blob, SN_SEC_JOINT_NAMES);
+    for (j = 0; j < n; j++) {
+        const unsigned char *s = names + (size_t)j * SN_JOINT_NAME_MAX;
+        /* stored names are NUL-terminated within 32 bytes (validated) */
+        for (k = 0; s[k] && s[k] == (unsigned char)name[k]; k++) {}
+        if (s[k] == (unsigned char)name[k]) return (int32_t)j;
+    }
+    return -1;
+}
+
+sn_status sn_get_triangle(const sn_blob *blob, uint32_t t, uint32_t idx[3]) {
+    const unsigned char *p;
+    if (!blob || !idx) return SN_ERR_NULL;
+    if (t >= sn_rd_u32(sn_bytes(blob) + SN_H_N_TRIANGLES)) return SN_ERR_ARG;
+    p = sn_section(blob, SN_SEC_TRIS) + (size_t)t * SN_ELEM_TRIS;
+    idx[0] = sn_rd_u16(p);
+    idx[1] = sn_rd_u16(p + 2);
+    idx[2] = sn_rd_u16(p + 4);
+    return SN_OK;
+}
+
+size_t sn_instance_size(const sn_blob *blob) {
+    if (!blob) return 0;
+    return (size_t)sn_rd_u32(sn_bytes(blob) + SN_H_INSTANCE_BYTES);
+}

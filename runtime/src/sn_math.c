@@ -1,0 +1,534 @@
+/* sn_math.c -- integer (or float) square root, quaternions, sin/cos/atan2.
+ *
+ * No libm in either flavour: every function below uses a fixed number of
+ * iterations / polynomial terms, so its cost does not depend on the data.
+ * Fixed flavour: quaternion components and rotation entries are Q30
+ * (1.0 = 2^30), angles inside this file are Q30 radians; all rounding is to
+ * nearest (ties away from zero, sn_rshr64); no signed overflow for ANY int32
+ * input (inputs that cannot be unit are clamped first, as documented per
+ * function). Error figures below are measured against libm in double by
+ * tests/test_runtime_math.c.
+ */
+#include "sn_internal.h"
+
+/* floor(sqrt(x)) for every uint64 x, exact. Bit-by-bit method, 32 fixed
+ * iterations, shifts and subtractions only (same code in both flavours). */
+uint32_t sn_isqrt64(uint64_t x) {
+    uint64_t rem = x, root = 0, bit = (uint64_t)1 << 62;
+    int i;
+    for (i = 0; i < 32; i++) {
+        uint64_t trial = root + bit;
+        if (rem >= trial) {
+            rem -= trial;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    return (uint32_t)root;
+}
+
+/* Message table generated from the one status list in sinew.h. */
+const char *sn_status_str(sn_status s) {
+#define SN_STATUS_MSG_(name, msg) msg,
+    static const char *const msgs[] = {SN_STATUS_LIST(SN_STATUS_MSG_)};
+#undef SN_STATUS_MSG_
+    int i = (int)s;
+    if (i < 0 || i >= (int)SN_STATUS_COUNT) return "unknown status code";
+    return msgs[i];
+}
+
+#if !defined(SN_FLOAT)
+/* ======================= fixed flavour ======================= */
+
+#define SN_Q30 ((int64_t)1 << 30)
+#define SN_PI_2_Q30 ((int64_t)1686629713) /* pi/2 * 2^30 */
+#define SN_PI_4_Q30 ((int64_t)843314857)  /* pi/4 * 2^30 */
+
+/* Round-to-nearest right shift for any int64 except INT64_MIN (magnitude in
+ * uint64, so also valid above the 2^62 bound of sn_rshr64). */
+static int64_t sn_rshr_any(int64_t x, int s) {
+    uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
+    m = (m + ((uint64_t)1 << (s - 1))) >> s;
+    return x < 0 ? -(int64_t)m : (int64_t)m;
+}
+
+static int64_t sn_clamp64(int64_t x, int64_t lim) {
+    return x > lim ? lim : (x < -lim ? -lim : x);
+}
+
+/* Saturate to the int32 range (symmetric, +-(2^31-1)). */
+static int32_t sn_sat32(int64_t x) {
+    return (int32_t)sn_clamp64(x, (int64_t)INT32_MAX);
+}
+
+/* Number of significant bits of x (0 for 0); 6 fixed steps. */
+static int sn_bitlen64(uint64_t x) {
+    int n = 0, s;
+    for (s = 32; s > 0; s >>= 1)
+        if (x >> s) {
+            x >>= s;
+            n += s;
+        }
+    return n + (x != 0);
+}
+
+/* out = c/|c| in Q30 for n <= 4 components (any int64 except INT64_MIN).
+ * Returns 0 (out untouched) for the zero vector.
+ * Scaling: magnitudes are first shifted so the largest lies in [2^30, 2^31)
+ * (truncating right shift only when it has more than 31 significant bits),
+ * so the sum of squares fits uint64; |c| = isqrt rounded to nearest;
+ * one division 2^62/|c|, then a multiply per component.
+ * Error: <= 1.5 LSB per component (test: <= 2). |out_i| <= 2^30. */
+static int sn_unit(const int64_t *c, int n, int32_t *out) {
+    uint64_t a[4], m = 0, n2 = 0, N, r;
+    int i, b;
+    for (i = 0; i < n; i++) {
+        a[i] = c[i] < 0 ? (uint64_t)0 - (uint64_t)c[i] : (uint64_t)c[i];
+        if (a[i] > m) m = a[i];
+    }
+    if (m == 0) return 0;
+    b = sn_bitlen64(m);
+    for (i = 0; i < n; i++) {
+        if (b > 31) a[i] >>= (b - 31);
+        else a[i] <<= (31 - b);
+        n2 += a[i] * a[i]; /* each < 2^62, n <= 4: < 2^64 */
+    }
+    N = sn_isqrt64(n2);
+    if (n2 - N * N > N) N++;  /* round: sqrt(n2) > N + 1/2 */
+    r = (((uint64_t)1 << 62) + (N >> 1)) / N;  /* N in [2^30, 2^32] */
+    for (i = 0; i < n; i++) {
+        uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32; /* a*r < 2^63 */
+        out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+    return 1;
+}
+
+/* Normalize q in place (Q30). Zero quaternion -> identity (0,0,0,1).
+ * Any int32 input; error <= 1.5 LSB per component. */
+void sn_qnormalize(sn_q q[4]) {
+    int64_t c[4];
+    int i;
+    for (i = 0; i < 4; i++) c[i] = q[i];
+    if (!sn_unit(c, 4, q)) {
+        q[0] = q[1] = q[2] = 0;
+        q[3] = (int32_t)SN_Q30;
+    }
+}
+
+/* Row-major rotation matrix of a unit quaternion, Q30 in and out.
+ * Components are clamped to +-2^30 (a unit quaternion's range), so every
+ * product is <= 2^60 and no sum overflows; entries are rounded from Q60
+ * (error <= 0.5 LSB for the given q) and clamped to +-2^30. */
+void sn_qtomat(const sn_q q[4], sn_q R[9]) {
+    int64_t x = sn_clamp64(q[0], SN_Q30), y = sn_clamp64(q[1], SN_Q30);
+    int64_t z = sn_clamp64(q[2], SN_Q30), w = sn_clamp64(q[3], SN_Q30);
+    int64_t xx = x * x, yy = y * y, zz = z * z, xy = x * y, xz = x * z, yz = y * z;
+    int64_t xw = x * w, yw = y * w, zw = z * w;
+    int64_t e[9];
+    int k;
+    e[0] = SN_Q30 - sn_rshr64(yy + zz, 29);
+    e[1] = sn_rshr64(xy - zw, 29);
+    e[2] = sn_rshr64(xz + yw, 29);
+    e[3] = sn_rshr64(xy + zw, 29);
+    e[4] = SN_Q30 - sn_rshr64(xx + zz, 29);
+    e[5] = sn_rshr64(yz - xw, 29);
+    e[6] = sn_rshr64(xz - yw, 29);
+    e[7] = sn_rshr64(yz + xw, 29);
+    e[8] = SN_Q30 - sn_rshr64(xx + yy, 29);
+    for (k = 0; k < 9; k++) R[k] = (int32_t)sn_clamp64(e[k], SN_Q30);
+}
+
+/* Hamilton product out = a*b, Q30. Inputs clamped to +-2^30 (sums of four
+ * Q60 products <= 2^62), each output rounded (<= 0.5 LSB for the clamped
+ * inputs) and saturated to int32. Not renormalized: the product of two unit
+ * quaternions is unit within ~2 LSB. */
+void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]) {
+    int64_t ax = sn_clamp64(a[0], SN_Q30), ay = sn_clamp64(a[1], SN_Q30);
+    int64_t az = sn_clamp64(a[2], SN_Q30), aw = sn_clamp64(a[3], SN_Q30);
+    int64_t bx = sn_clamp64(b[0], SN_Q30), by = sn_clamp64(b[1], SN_Q30);
+    int64_t bz = sn_clamp64(b[2], SN_Q30), bw = sn_clamp64(b[3], SN_Q30);
+    out[0] = sn_sat32(sn_rshr64(aw * bx + ax * bw + ay * bz - az * by, 30));
+    out[1] = sn_sat32(sn_rshr64(aw * by - ax * bz + ay * bw + az * bx, 30));
+    out[2] = sn_sat32(sn_rshr64(aw * bz + ax * by - ay * bx + az * bw, 30));
+    out[3] = sn_sat32(sn_rshr64(aw * bw - ax * bx - ay * by - az * bz, 30));
+}
+
+/* sin and cos of (quad*pi/2 + r), r Q30 radians with |r| <= ~pi/4.
+ * Taylor polynomials to r^11 / r^12 (truncation < 1e-11), Horner in Q30
+ * with rounding: error <= ~1.5 LSB (Q30). */
+static void sn_sincos_red(int64_t r, int quad, int64_t *s, int64_t *c) {
+    static const int64_t ks[6] = {SN_Q30, -178956971, 8947849, -213044, 2959, -27};
+    static const int64_t kc[7] = {SN_Q30, -536870912, 44739243, -1491308, 26630, -296, 2};
+    int64_t u = sn_rshr64(r * r, 30), ps = ks[5], pc = kc[6], sv, cv;
+    int k;
+    for (k = 4; k >= 0; k--) ps = ks[k] + sn_rshr64(ps * u, 30);
+    for (k = 5; k >= 0; k--) pc = kc[k] + sn_rshr64(pc * u, 30);
+    sv = sn_rshr64(ps * r, 30);
+    cv = pc;
+    switch (quad & 3) {
+    case 0: *s = sv; *c = cv; break;
+    case 1: *s = cv; *c = -sv; break;
+    case 2: *s = -sv; *c = -cv; break;
+    default: *s = -cv; *c = sv; break;
+    }
+}
+
+/* atan2(y, x) in Q30 radians for x, y >= 0 (any magnitude <= 2^40), result
+ * in [0, pi/2]. CORDIC vectoring, 32 fixed iterations, 8 guard bits, angle
+ * table atan(2^-i) in Q40: error <= ~1 LSB (Q30). atan2(0, 0) = 0. */
+static int64_t sn_atan2_pos(int64_t y, int64_t x) {
+    static const int64_t tab[32] = {
+        863554413089, 509785937287, 269356888665, 136729762476, 68630207382,
+        34348560106, 17178471287, 8589759836, 4294945451, 2147480917,
+        1073741483, 536870869, 268435451, 134217727, 67108864, 33554432,
+        16777216, 8388608, 4194304, 2097152, 1048576, 524288, 262144, 131072,
+        65536, 32768, 16384, 8192, 4096, 2048, 1024, 512};
+    int64_t X = x * 256, Y = y * 256, Z = 0;
+    int i;
+    if (x == 0 && y == 0) return 0;
+    for (i = 0; i < 32; i++) {
+        int64_t dx = sn_rshr64(Y, i), dy = sn_rshr64(X, i);
+        if (Y > 0) {
+            X += dx;
+            Y -= dy;
+            Z += tab[i];
+        } else {
+            X -= dx;
+            Y += dy;
+            Z -= tab[i];
+        }
+    }
+    return sn_rshr64(Z, 10);
+}
+
+/* Slerp along the shorter arc, Q30 in and out, t in [0, 2^30] (clamped).
+ * Method (stable for tiny angles): d = a.b (b negated if d < 0),
+ * v = b - d a (so |v| = sin theta), theta = atan2(|v|, d),
+ * out = normalize(a cos(t theta) + v sin(t theta)/|v|).
+ * Components clamped to +-2^30 and the ratio sin(t theta)/|v| to [0,1],
+ * so no intermediate overflows for any input. Exact shortcuts: t == 0 -> a,
+ * t == 1 -> b (sign chosen for the shorter arc), a == b -> a.
+ * Error for unit inputs: <= ~4 LSB per component (test: <= 8). */
+void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    int64_t A[4], B[4], v[4], o[4], d = 0, tt, th, ph, sp, cp, k;
+    uint64_t n2 = 0, s;
+    int i, same = 1;
+    for (i = 0; i < 4; i++) {
+        A[i] = sn_clamp64(a[i], SN_Q30);
+        B[i] = sn_clamp64(b[i], SN_Q30);
+        d += A[i] * B[i];
+        same &= a[i] == b[i];
+    }
+    if (d < 0)
+        for (i = 0; i < 4; i++) B[i] = -B[i];
+    tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
+    if (same || tt == 0 || tt == SN_Q30) {
+        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == SN_Q30 && !same ? B[i] : A[i]);
+        return;
+    }
+    d = sn_rshr64(d < 0 ? -d : d, 30);
+    if (d > SN_Q30) d = SN_Q30;
+    for (i = 0; i < 4; i++) {
+        v[i] = sn_clamp64(B[i] - sn_rshr64(A[i] * d, 30), (int64_t)INT32_MAX);
+        n2 += (uint64_t)(v[i] * v[i]); /* < 2^62 each */
+    }
+    s = sn_isqrt64(n2);
+    if (n2 - s * s > s) s++;
+    th = sn_atan2_pos((int64_t)s, d);
+    ph = sn_rshr64(th * tt, 30); /* [0, pi/2] */
+    if (ph > SN_PI_4_Q30) sn_sincos_red(ph - SN_PI_2_Q30, 1, &sp, &cp);
+    else sn_sincos_red(ph, 0, &sp, &cp);
+    if (s == 0) k = tt;
+    else k = (sp * SN_Q30 + (int64_t)(s >> 1)) / (int64_t)s;
+    k = k < 0 ? 0 : (k > SN_Q30 ? SN_Q30 : k);
+    for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + v[i] * k, 30);
+    if (!sn_unit(o, 4, out)) {
+        for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
+    }
+}
+
+/* ---- public helpers (fixed) ---- */
+
+/* Axis (Q16.16, any non-zero length; zero -> identity) and angle (Q16.16
+ * degrees, any int32) -> unit quaternion Q30. The half angle is reduced
+ * exactly modulo 360 degrees in integers, then to |r| <= 45 degrees and
+ * converted to radians with a 2^-45-accurate constant; axis normalized by
+ * sn_unit. Error vs double: <= ~3 LSB per component (test: <= 4). */
+sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees) {
+    /* Q17 degrees of the half angle == angle_degrees as stored (Q16). */
+    const int64_t P = (int64_t)360 << 17, Q = (int64_t)90 << 17;
+    const int64_t K = 614083138197; /* pi/180 * 2^45 */
+    int64_t c[3], rm, rem, r, s, co, o[4];
+    int32_t u[3];
+    int quad;
+    sn_quat q;
+    c[0] = axis.x;
+    c[1] = axis.y;
+    c[2] = axis.z;
+    if (!sn_unit(c, 3, u)) {
+        q.x = q.y = q.z = 0;
+        q.w = (int32_t)SN_Q30;
+        return q;
+    }
+    rm = (int64_t)angle_degrees % P;
+    if (rm < 0) rm += P;
+    quad = (int)((rm + Q / 2) / Q);
+    rem = rm - (int64_t)quad * Q;       /* [-45, 45) degrees, Q17 */
+    r = sn_rshr64(rem * K, 32);         /* Q30 radians; |rem*K| < 2^62 */
+    sn_sincos_red(r, quad, &s, &co);
+    o[0] = (int64_t)u[0] * s;
+    o[1] = (int64_t)u[1] * s;
+    o[2] = (int64_t)u[2] * s;
+    o[3] = co * SN_Q30;
+    {
+        int32_t qq[4];
+        (void)sn_unit(o, 4, qq); /* |o| ~ 2^60, never zero */
+        q.x = qq[0];
+        q.y = qq[1];
+        q.z = qq[2];
+        q.w = qq[3];
+    }
+    return q;
+}
+
+sn_quat sn_quat_mul(sn_quat a, sn_quat b) {
+    sn_q qa[4], qb[4], o[4];
+    sn_quat r;
+    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
+    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
+    sn_qmul(qa, qb, o);
+    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
+    return r;
+}
+
+/* Public slerp: inputs are normalized first (any int32 input is fine). */
+sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t) {
+    sn_q qa[4], qb[4], o[4];
+    sn_quat r;
+    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
+    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
+    sn_qnormalize(qa);
+    sn_qnormalize(qb);
+    sn_qslerp(qa, qb, t, o);
+    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
+    return r;
+}
+
+/* v (Q16.16) rotated by q (Q30, assumed unit): R(q) v via sn_qtomat; sums of
+ * three Q46 products (< 2^63) rounded to Q16.16 and saturated to int32.
+ * Error: <= 0.5 LSB + |v| * ~2^-29 (matrix rounding). */
+sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v) {
+    sn_q qq[4], R[9];
+    int64_t o[3];
+    int k;
+    sn_vec3 r;
+    qq[0] = q.x; qq[1] = q.y; qq[2] = q.z; qq[3] = q.w;
+    sn_qtomat(qq, R);
+    for (k = 0; k < 3; k++)
+        o[k] = sn_sat32(sn_rshr_any((int64_t)R[3 * k] * v.x + (int64_t)R[3 * k + 1] * v.y +
+                                        (int64_t)R[3 * k + 2] * v.z, 30));
+    r.x = (int32_t)o[0];
+    r.y = (int32_t)o[1];
+    r.z = (int32_t)o[2];
+    return r;
+}
+
+#else
+/* ======================= float flavour ======================= */
+/* Same algorithms in float. Accuracy: a few float ulps (<~ 3e-7 absolute for
+ * unit quantities). Inputs must be finite; NaN/inf propagate. */
+
+#define SN_FPI_2 1.57079632679489662f
+#define SN_FPI_4 0.78539816339744831f
+#define SN_FPI_6 0.52359877559829887f
+
+/* 1/sqrt(x) for x > 0: bit-level first guess, 3 Newton steps (error after
+ * 3 steps ~3e-11 before float rounding, i.e. ~1 ulp). x <= 0 -> 0. */
+static float sn_frsqrt(float x) {
+    uint32_t i;
+    float y;
+    int k;
+    if (!(x > 1e-37f)) return 0.0f;
+    memcpy(&i, &x, 4);
+    i = 0x5f3759dfu - (i >> 1);
+    memcpy(&y, &i, 4);
+    for (k = 0; k < 3; k++) y = y * (1.5f - 0.5f * x * y * y);
+    return y;
+}
+
+static float sn_fabs(float x) { return x < 0.0f ? -x : x; }
+
+/* Scale c[0..n) to unit length; returns 0 if |c| is ~0 (or NaN). */
+static int sn_funit(const float *c, int n, float *out) {
+    float m = 0.0f, n2 = 0.0f, r;
+    int i;
+    for (i = 0; i < n; i++)
+        if (sn_fabs(c[i]) > m) m = sn_fabs(c[i]);
+    if (!(m > 1e-30f)) return 0;
+    for (i = 0; i < n; i++) n2 += (c[i] / m) * (c[i] / m); /* scaled: no overflow */
+    r = sn_frsqrt(n2) / m;
+    for (i = 0; i < n; i++) out[i] = c[i] * r;
+    return 1;
+}
+
+void sn_qnormalize(sn_q q[4]) {
+    float c[4];
+    memcpy(c, q, sizeof c);
+    if (!sn_funit(c, 4, q)) {
+        q[0] = q[1] = q[2] = 0.0f;
+        q[3] = 1.0f;
+    }
+}
+
+void sn_qtomat(const sn_q q[4], sn_q R[9]) {
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    R[0] = 1.0f - 2.0f * (y * y + z * z);
+    R[1] = 2.0f * (x * y - z * w);
+    R[2] = 2.0f * (x * z + y * w);
+    R[3] = 2.0f * (x * y + z * w);
+    R[4] = 1.0f - 2.0f * (x * x + z * z);
+    R[5] = 2.0f * (y * z - x * w);
+    R[6] = 2.0f * (x * z - y * w);
+    R[7] = 2.0f * (y * z + x * w);
+    R[8] = 1.0f - 2.0f * (x * x + y * y);
+}
+
+void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]) {
+    float o0 = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
+    float o1 = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
+    float o2 = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
+    float o3 = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    out[0] = o0; out[1] = o1; out[2] = o2; out[3] = o3;
+}
+
+/* sin, cos of quad*pi/2 + r, |r| <= ~pi/4: Taylor to r^11 / r^12. */
+static void sn_fsincos_red(float r, int quad, float *s, float *c) {
+    float u = r * r;
+    float sv = r * (1.0f + u * (-1.0f / 6 + u * (1.0f / 120 + u * (-1.0f / 5040 +
+                    u * (1.0f / 362880 - u * (1.0f / 39916800))))));
+    float cv = 1.0f + u * (-0.5f + u * (1.0f / 24 + u * (-1.0f / 720 + u * (1.0f / 40320 +
+                    u * (-1.0f / 3628800 + u * (1.0f / 479001600))))));
+    switch (quad & 3) {
+    case 0: *s = sv; *c = cv; break;
+    case 1: *s = cv; *c = -sv; break;
+    case 2: *s = -sv; *c = -cv; break;
+    default: *s = -cv; *c = sv; break;
+    }
+}
+
+/* atan2(y, x) for x, y >= 0, in [0, pi/2]: reduce to z in [0,1], then to
+ * |w| <= tan(15 deg) via atan z = pi/6 + atan((z sqrt3 - 1)/(sqrt3 + z)),
+ * Taylor to w^11 (truncation < 3e-9). */
+static float sn_fatan2_pos(float y, float x) {
+    const float r3 = 1.73205080756887729f;
+    float z, w, u, a;
+    int swap = y > x, big;
+    if (!(x > 0.0f) && !(y > 0.0f)) return 0.0f;
+    z = swap ? x / y : y / x;
+    big = z > 0.26794919243112270f;
+    w = big ? (z * r3 - 1.0f) / (r3 + z) : z;
+    u = w * w;
+    a = w * (1.0f + u * (-1.0f / 3 + u * (1.0f / 5 + u * (-1.0f / 7 + u * (1.0f / 9 - u * (1.0f / 11))))));
+    if (big) a += SN_FPI_6;
+    return swap ? SN_FPI_2 - a : a;
+}
+
+void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    float B[4], v[4], o[4], d = 0.0f, n2 = 0.0f, s, th, ph, sp, cp, k;
+    int i, same = 1;
+    for (i = 0; i < 4; i++) {
+        d += a[i] * b[i];
+        same &= a[i] == b[i];
+    }
+    for (i = 0; i < 4; i++) B[i] = d < 0.0f ? -b[i] : b[i];
+    if (!(t > 0.0f)) t = 0.0f; /* also NaN -> 0 */
+    if (t > 1.0f) t = 1.0f;
+    if (same || t == 0.0f || t == 1.0f) {
+        for (i = 0; i < 4; i++) out[i] = t == 1.0f && !same ? B[i] : a[i];
+        return;
+    }
+    d = sn_fabs(d);
+    if (d > 1.0f) d = 1.0f;
+    for (i = 0; i < 4; i++) {
+        v[i] = B[i] - a[i] * d;
+        n2 += v[i] * v[i];
+    }
+    s = n2 * sn_frsqrt(n2);
+    th = sn_fatan2_pos(s, d);
+    ph = th * t;
+    if (ph > SN_FPI_4) sn_fsincos_red(ph - SN_FPI_2, 1, &sp, &cp);
+    else sn_fsincos_red(ph, 0, &sp, &cp);
+    k = s > 1e-20f ? sp / s : t;
+    k = k < 0.0f ? 0.0f : (k > 1.0f ? 1.0f : k);
+    for (i = 0; i < 4; i++) o[i] = a[i] * cp + v[i] * k;
+    if (!sn_funit(o, 4, out)) memcpy(out, a, 4 * sizeof(float));
+}
+
+/* Axis (any non-zero length; zero -> identity), angle in degrees. The half
+ * angle is reduced to |r| <= 45 degrees (exactly, for |angle| < 2e7; larger
+ * or non-finite angles are treated as 0). */
+sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees) {
+    float c[3], u[3], half = 0.5f * angle_degrees, s, co, qv[4];
+    long n;
+    sn_quat q;
+    c[0] = axis.x;
+    c[1] = axis.y;
+    c[2] = axis.z;
+    if (!sn_funit(c, 3, u)) {
+        q.x = q.y = q.z = 0.0f;
+        q.w = 1.0f;
+        return q;
+    }
+    if (!(sn_fabs(half) < 1e7f)) half = 0.0f;
+    {
+        float qf = half / 90.0f;
+        n = (long)(qf + (qf >= 0.0f ? 0.5f : -0.5f));
+    }
+    sn_fsincos_red((half - (float)n * 90.0f) * (SN_FPI_2 / 90.0f), (int)(((n % 4) + 4) % 4), &s, &co);
+    qv[0] = u[0] * s;
+    qv[1] = u[1] * s;
+    qv[2] = u[2] * s;
+    qv[3] = co;
+    sn_qnormalize(qv);
+    q.x = qv[0];
+    q.y = qv[1];
+    q.z = qv[2];
+    q.w = qv[3];
+    return q;
+}
+
+sn_quat sn_quat_mul(sn_quat a, sn_quat b) {
+    sn_q qa[4], qb[4], o[4];
+    sn_quat r;
+    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
+    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
+    sn_qmul(qa, qb, o);
+    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
+    return r;
+}
+
+sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t) {
+    sn_q qa[4], qb[4], o[4];
+    sn_quat r;
+    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
+    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
+    sn_qnormalize(qa);
+    sn_qnormalize(qb);
+    sn_qslerp(qa, qb, t, o);
+    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
+    return r;
+}
+
+sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v) {
+    sn_q qq[4], R[9];
+    sn_vec3 r;
+    qq[0] = q.x; qq[1] = q.y; qq[2] = q.z; qq[3] = q.w;
+    sn_qtomat(qq, R);
+    r.x = R[0] * v.x + R[1] * v.y + R[2] * v.z;
+    r.y = R[3] * v.x + R[4] * v.y + R[5] * v.z;
+    r.z = R[6] * v.x + R[7] * v.y + R[8] * v.z;
+    return r;
+}
+#endif
