@@ -1,1 +1,129 @@
-# ports/baremetal build fragment (filled in by its owner)
+# ports/baremetal + ports/cross build fragment.
+#   make ports            Cortex-M4 images (QEMU mps2-an386) + cross determinism drivers
+#   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
+#   make deps             install the cross toolchains and QEMU (Debian, root)
+# Inputs from other fragments: SN_SRCS / SN_INC (runtime.mk), the host tool's
+# C-array blobs $(BUILD)/examples/<asset>_blob.c (tools.mk).
+
+.PHONY: deps ports-baremetal ports-cross bench-baremetal port-ready
+
+deps:
+	bash .ci/install-deps.sh
+
+# ---- common inputs ----
+PORT_SN_SRCS  = $(SN_SRCS)
+PORT_SN_INC   = $(if $(SN_INC),$(SN_INC),-Iruntime/include)
+PORT_WARN     = -std=c99 -Wall -Wextra -Wpedantic -Werror
+PORT_INC      = $(PORT_SN_INC) -Iports/common -Iports/cross
+PORT_COMMON   = ports/cross/sn_det.c ports/common/sn_clip.c ports/common/sn_clip_pose.c
+PORT_HDRS     = ports/cross/sn_det.h ports/common/sn_clip.h runtime/include/sinew.h \
+                $(wildcard runtime/src/*.h)
+COW_BLOB_C   ?= $(BUILD)/examples/cow_blob.c
+LIMB_BLOB_C  ?= $(BUILD)/examples/limb_blob.c
+COW_CLIP     ?= tools/examples/cow/trot.clip
+LIMB_CLIP    ?= $(wildcard tools/examples/limb/*.clip)
+# the blob C file also gives the blob bytes to hosted drivers (see det_main.c)
+
+# Exit 0 when the runtime sources and the cow blob rule exist (the port
+# tests skip before that).
+port-ready:
+	@test -n "$(strip $(PORT_SN_SRCS))" || { echo "not ready: runtime.mk defines no SN_SRCS"; exit 1; }
+	@$(MAKE) -s -n $(COW_BLOB_C) >/dev/null 2>&1 || test -f $(COW_BLOB_C) || \
+	    { echo "not ready: no rule for $(COW_BLOB_C)"; exit 1; }
+
+# ---- Cortex-M4 images ----
+BM_CC     ?= arm-none-eabi-gcc
+BM_SIZE   ?= arm-none-eabi-size
+BM_DIR     = $(BUILD)/baremetal
+BM_ARCH    = -mcpu=cortex-m4 -mthumb -mfloat-abi=soft
+BM_CFLAGS  = $(BM_ARCH) $(PORT_WARN) -O2 -g -ffunction-sections -fdata-sections \
+             $(PORT_INC) -Iports/baremetal
+BM_LDFLAGS = $(BM_ARCH) -nostartfiles --specs=nano.specs -T ports/baremetal/an386.ld \
+             -Wl,--gc-sections
+BM_STEPS  ?= 1000
+BM_BENCH_STEPS ?= 100
+BM_QEMU   ?= qemu-system-arm
+BM_RUN     = $(BM_QEMU) -M mps2-an386 -nographic -semihosting-config enable=on,target=native
+BM_SRCS    = ports/baremetal/startup.c $(PORT_COMMON) $(PORT_SN_SRCS)
+BM_OBJS    = $(patsubst %.c,$(BM_DIR)/obj/%.o,$(BM_SRCS))
+
+$(BM_DIR)/obj/%.o: %.c $(PORT_HDRS) ports/baremetal/semihost.h
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+
+# Generated C: blob arrays compiled as they come, clip text via bin2c.sh.
+$(BM_DIR)/obj/cow_blob.o: $(COW_BLOB_C)
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+$(BM_DIR)/obj/limb_blob.o: $(LIMB_BLOB_C)
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+$(BM_DIR)/cow_clip.c: $(COW_CLIP) ports/baremetal/bin2c.sh
+	@mkdir -p $(dir $@)
+	sh ports/baremetal/bin2c.sh sn_bm_clip $(COW_CLIP) > $@
+$(BM_DIR)/limb_clip.c: $(LIMB_CLIP) ports/baremetal/bin2c.sh
+	@mkdir -p $(dir $@)
+	sh ports/baremetal/bin2c.sh sn_bm_clip $(firstword $(LIMB_CLIP)) > $@
+$(BM_DIR)/obj/%_clip.o: $(BM_DIR)/%_clip.c
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+
+# main.c per image: asset, steps, clip or built-in poses, bench or not.
+# $(1) image name, $(2) asset, $(3) steps, $(4) bench 0/1, $(5) clip file or empty
+define bm_image
+$(BM_DIR)/obj/main_$(1).o: ports/baremetal/main.c $(PORT_HDRS) ports/baremetal/semihost.h
+	@mkdir -p $$(dir $$@)
+	$(BM_CC) $(BM_CFLAGS) -DSN_BM_BLOB=sinew_$(2)_blob -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size \
+	    -DSN_BM_STEPS=$(3) -DSN_BM_BENCH=$(4) -DSN_BM_CLIP=$(if $(5),1,0) -c $$< -o $$@
+$(BM_DIR)/$(1).elf: $(BM_DIR)/obj/main_$(1).o $(BM_OBJS) $(BM_DIR)/obj/$(2)_blob.o \
+        $(if $(5),$(BM_DIR)/obj/$(2)_clip.o) ports/baremetal/an386.ld
+	$(BM_CC) $(BM_LDFLAGS) -Wl,-Map,$$@.map -o $$@ $$(filter %.o,$$^)
+endef
+$(eval $(call bm_image,sinew_cow,cow,$(BM_STEPS),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,bench_cow,cow,$(BM_BENCH_STEPS),1,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,sinew_limb,limb,$(BM_STEPS),0,$(LIMB_CLIP)))
+$(eval $(call bm_image,bench_limb,limb,$(BM_BENCH_STEPS),1,$(LIMB_CLIP)))
+$(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+$(eval $(call bm_image,bad_blob,bad,10,0,))
+
+BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf
+ports-baremetal: $(BM_IMAGES)
+
+# test_nofloat.sh: the float flavour of the runtime objects is its positive control
+.PHONY: bm-float-objs print-port-sn-srcs
+$(BM_DIR)/obj-float/%.o: %.c $(PORT_HDRS)
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -DSN_FLOAT -c $< -o $@
+bm-float-objs: $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(PORT_SN_SRCS))
+print-port-sn-srcs:
+	@echo $(PORT_SN_SRCS)
+
+bench-baremetal:
+	BUILD=$(BUILD) sh ports/baremetal/bench.sh
+bench: bench-baremetal
+
+# ---- hosted determinism drivers (det_main) for every compiler/CPU ----
+CROSS_DIR   = $(BUILD)/cross
+DET_SRCS    = ports/cross/det_main.c $(PORT_COMMON) $(PORT_SN_SRCS)
+DET_CFLAGS  = $(PORT_WARN) -g $(PORT_INC)
+# $(1) name, $(2) compiler, $(3) flags
+define det_driver
+$(CROSS_DIR)/det_$(1): $(DET_SRCS) $(PORT_HDRS) $(COW_BLOB_C)
+	@mkdir -p $$(dir $$@)
+	$(2) $(DET_CFLAGS) $(3) -DSN_DET_BLOB=sinew_cow_blob -DSN_DET_BLOB_SIZE=sinew_cow_blob_size \
+	    -o $$@ $(DET_SRCS) $(COW_BLOB_C)
+endef
+$(eval $(call det_driver,x86_64-gcc-O0,gcc,-O0))
+$(eval $(call det_driver,x86_64-gcc-O2,gcc,-O2))
+$(eval $(call det_driver,x86_64-clang-O2,clang,-O2))
+$(eval $(call det_driver,i686-gcc-O2,i686-linux-gnu-gcc,-O2 -static))
+$(eval $(call det_driver,armhf-gcc-O2,arm-linux-gnueabihf-gcc,-O2 -static))
+$(eval $(call det_driver,mips-be-gcc-O2,mips-linux-gnu-gcc,-O2 -static))
+# float flavour: desktop only, no FMA contraction so -O0/-O2 and gcc/clang agree
+$(eval $(call det_driver,float-gcc-O0,gcc,-O0 -DSN_FLOAT -ffp-contract=off))
+$(eval $(call det_driver,float-gcc-O2,gcc,-O2 -DSN_FLOAT -ffp-contract=off))
+$(eval $(call det_driver,float-clang-O2,clang,-O2 -DSN_FLOAT -ffp-contract=off))
+
+ports-cross: $(CROSS_DIR)/det_x86_64-gcc-O2
+ports: ports-baremetal ports-cross

@@ -1,0 +1,36 @@
+#!/bin/sh
+# bench.sh -- `make bench-baremetal`: cost of Sinew on a Cortex-M4 (QEMU
+# mps2-an386 under -icount shift=0, one instruction per virtual ns; the image
+# times pose and sn_step with CMSDK timer 0 and converts ticks to
+# instructions with a calibration loop of known length), plus flash and RAM.
+# Instruction counts are repeatable, not cycles: real M4 cycles add wait
+# states and multi-cycle loads/multiplies.
+. ports/cross/port_lib.sh
+if ! have arm-none-eabi-gcc || ! have qemu-system-arm; then
+    echo "SKIPPED: bench-baremetal needs arm-none-eabi-gcc and qemu-system-arm (make deps)"; exit 0
+fi
+if ! msg=$(pmake port-ready 2>&1); then echo "SKIPPED: bench-baremetal: $msg"; exit 0; fi
+B=$BUILD/baremetal
+assets=cow
+if pmake -n "$BUILD/examples/limb_blob.c" >/dev/null 2>&1 || [ -f "$BUILD/examples/limb_blob.c" ]; then
+    assets="$assets limb"
+fi
+rt_text=$(for s in $(pmake print-port-sn-srcs); do echo "$B/obj/${s%.c}.o"; done)
+for a in $assets; do
+    pmake "$B/sinew_$a.elf" "$B/bench_$a.elf" > "$B/bench_build_$a.log" 2>&1 || {
+        echo "bench-baremetal: build of $a failed"; tail -n 20 "$B/bench_build_$a.log"; exit 1; }
+    # shellcheck disable=SC2086
+    timeout 600 $BM_QEMU_RUN -icount shift=0,sleep=off -kernel "$B/bench_$a.elf" < /dev/null > "$B/bench_$a.log" 2>&1 || {
+        echo "bench-baremetal: $a image failed"; cat "$B/bench_$a.log"; exit 1; }
+    v() { sed -n "s/^$1: //p" "$B/bench_$a.log"; }
+    # flash = text + data (initialised data is stored in flash too); RAM =
+    # data + bss + instance pool use + stack
+    set -- $(arm-none-eabi-size "$B/sinew_$a.elf" | tail -n 1)
+    text=$1; data=$2; bss=$3
+    rt=$(arm-none-eabi-size -t $rt_text | tail -n 1 | awk '{print $1}')
+    blob=$(arm-none-eabi-nm -S "$B/sinew_$a.elf" | awk -v s="sinew_${a}_blob" '$4 == s {print $2}')
+    blob=$((0x${blob:-0}))
+    inst=$(v instance_bytes); stack=$(v stack_bytes)
+    echo "bench-baremetal: cortex-m4 $a: $(v insns_per_step) instructions per sn_step, $(v insns_per_pose) per clip pose (mean of $(v bench_steps) steps, qemu -icount)"
+    echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + inst + stack)) B (static $((data + bss)) B incl. clip, instance $inst B, stack peak $stack B)"
+done

@@ -1,0 +1,119 @@
+/* main.c -- Sinew on a Cortex-M4 (QEMU mps2-an386): plays a clip on a blob
+ * linked into flash, with the instance in the RAM pool, and prints
+ * "hash: <16 hex>" through semihosting like `sinew-play --hash`.
+ * Built per asset with:
+ *   SN_BM_BLOB, SN_BM_BLOB_SIZE  the tool's C-array symbols
+ *   SN_BM_CLIP                   1: link sn_bm_clip_text (generated), 0: built-in poses
+ *   SN_BM_STEPS                  steps to play
+ *   SN_BM_BENCH                  1: also time pose and step with CMSDK timer 0;
+ *                                meaningful only under `-icount shift=0`
+ */
+#include <stddef.h>
+#include <stdint.h>
+#include "semihost.h"
+#include "sn_det.h"
+
+#ifndef SN_BM_STEPS
+#define SN_BM_STEPS 1000
+#endif
+#ifndef SN_BM_BENCH
+#define SN_BM_BENCH 0
+#endif
+
+extern const unsigned char SN_BM_BLOB[];
+extern const uint32_t SN_BM_BLOB_SIZE;
+#if SN_BM_CLIP
+extern const unsigned char sn_bm_clip_text[];
+extern const uint32_t sn_bm_clip_len;
+#endif
+extern uint32_t __pool_start[], __pool_end[];
+uint32_t sn_bm_stack_used(void);
+
+static sn_det det;
+static sn_clip clip;
+
+static void put_u64(uint64_t v) {
+    char d[21];
+    int n = 20;
+    d[n] = 0;
+    do { d[--n] = (char)('0' + (int)(v % 10u)); v /= 10u; } while (v);
+    sn_bm_puts(&d[n]);
+}
+
+static void put_kv(const char *k, uint64_t v) {
+    sn_bm_puts(k); put_u64(v); sn_bm_puts("\n");
+}
+
+#if SN_BM_BENCH
+static uint32_t timer_now(void) { return SN_CMSDK_TIMER0[SN_TIMER_VALUE]; }
+
+/* Ticks of a loop of exactly 2*n instructions (subs + bne), so that ticks
+ * convert to instructions without trusting the clock rate. */
+static uint32_t calibrate(uint32_t n, uint32_t *insns) {
+    uint32_t t0, t1, r = n;
+    t0 = timer_now();
+    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(r) : : "cc");
+    t1 = timer_now();
+    *insns = 2u * n;
+    return t0 - t1;
+}
+#endif
+
+int main(void) {
+    char err[SN_CLIP_ERR_LEN * 2], hex[17];
+    size_t pool = (size_t)((uintptr_t)__pool_end - (uintptr_t)__pool_start);
+    const char *text = NULL;
+    size_t text_len = 0;
+    uint64_t hash;
+#if SN_BM_BENCH
+    uint32_t k;
+    uint64_t pose_ticks = 0, step_ticks = 0;
+    uint32_t cal_insns, cal_ticks, overhead;
+#endif
+#if SN_BM_CLIP
+    text = (const char *)sn_bm_clip_text;
+    text_len = sn_bm_clip_len;
+#endif
+    if (sn_det_init(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, text, text_len, &clip,
+                    __pool_start, pool, err, sizeof err)) {
+        sn_bm_puts("FAIL: "); sn_bm_puts(err); sn_bm_puts("\n");
+        return 1;
+    }
+    put_kv("instance_bytes: ", sn_instance_size(det.blob));
+#if SN_BM_BENCH
+    SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 0;
+    SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;
+    SN_CMSDK_TIMER0[SN_TIMER_VALUE] = 0xFFFFFFFFu;
+    SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 1u;
+    cal_ticks = calibrate(2000000u, &cal_insns);
+    { uint32_t a = timer_now(); overhead = a - timer_now(); }
+    if (cal_ticks == 0) { sn_bm_puts("FAIL: timer does not run\n"); return 1; }
+    for (k = 0; k < SN_BM_STEPS; k++) {
+        uint32_t t0 = timer_now(), t1, t2;
+        sn_det_pose(&det);
+        t1 = timer_now();
+        sn_det_step(&det);
+        t2 = timer_now();
+        pose_ticks += t0 - t1 - overhead;
+        step_ticks += t1 - t2 - overhead;
+    }
+    /* instructions = ticks * cal_insns / cal_ticks, per step */
+    put_kv("bench_steps: ", SN_BM_STEPS);
+    put_kv("insns_per_step: ", (step_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
+    put_kv("insns_per_pose: ", (pose_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
+    put_kv("insns_per_tick_x1000: ", (uint64_t)cal_insns * 1000u / cal_ticks);
+    hash = sn_state_hash(det.inst);
+#else
+    hash = sn_det_run(&det, SN_BM_STEPS);
+#endif
+    {
+        sn_stats st;
+        sn_get_stats(det.inst, &st);
+        put_kv("steps: ", st.steps);
+        put_kv("saturations: ", st.saturations);
+    }
+    put_kv("stack_bytes: ", sn_bm_stack_used());
+    sn_det_hex64(hash, hex);
+    sn_bm_puts("hash: "); sn_bm_puts(hex); sn_bm_puts("\n");
+    return 0;
+}

@@ -1,0 +1,99 @@
+/* det_main.c -- headless determinism driver, built by every compiler and
+ * cross compiler of tests/scripts/test_determinism.sh.
+ *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K]
+ * Without BLOB it uses the array linked in with -DSN_DET_BLOB=sym
+ * -DSN_DET_BLOB_SIZE=sym (the host tool's C-array output), copied to
+ * malloc memory because the runtime wants 8-byte alignment.
+ * Prints "hash: <16 hex>" after N steps (default 1000); --trace K also prints
+ * "step <k> <hash>" every K steps, to find the first step where ports differ. */
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "sn_det.h"
+
+#ifdef SN_DET_BLOB
+extern const unsigned char SN_DET_BLOB[];
+extern const uint32_t SN_DET_BLOB_SIZE;
+#endif
+
+/* Whole file into malloc memory (8-byte aligned, as the runtime needs). */
+static char *slurp(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    long sz;
+    if (!f) return NULL;
+    if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0) {
+        buf = malloc((size_t)sz + 1);
+        if (buf && fread(buf, 1, (size_t)sz, f) != (size_t)sz) { free(buf); buf = NULL; }
+        if (buf) { buf[sz] = 0; *n = (size_t)sz; }
+    }
+    fclose(f);
+    return buf;
+}
+
+int main(int argc, char **argv) {
+    static sn_det det;
+    static sn_clip clip;
+    char err[SN_CLIP_ERR_LEN * 2], hex[17];
+    const char *blob_path = NULL, *clip_path = NULL;
+    char *blob, *clip_text = NULL;
+    size_t blob_n = 0, clip_n = 0, mem_n;
+    unsigned long steps = 1000, trace = 0, k;
+    void *mem;
+    int i;
+    for (i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--clip") && i + 1 < argc) clip_path = argv[++i];
+        else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--trace") && i + 1 < argc) trace = strtoul(argv[++i], NULL, 10);
+        else if (argv[i][0] != '-' && !blob_path) blob_path = argv[i];
+        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K]\n"); return 2; }
+    }
+    if (blob_path) {
+        blob = slurp(blob_path, &blob_n);
+        if (!blob) { fprintf(stderr, "det_main: cannot read %s\n", blob_path); return 2; }
+    } else {
+#ifdef SN_DET_BLOB
+        blob_n = SN_DET_BLOB_SIZE;
+        blob = malloc(blob_n ? blob_n : 1);
+        if (!blob) { fprintf(stderr, "det_main: out of memory\n"); return 2; }
+        memcpy(blob, SN_DET_BLOB, blob_n);
+        blob_path = "(linked blob)";
+#else
+        fprintf(stderr, "det_main: no blob\n"); return 2;
+#endif
+    }
+    if (clip_path && !(clip_text = slurp(clip_path, &clip_n))) {
+        fprintf(stderr, "det_main: cannot read %s\n", clip_path); return 2;
+    }
+    /* size from a throwaway validate: sn_det_init validates again */
+    {
+        const sn_blob *b;
+        sn_status s = sn_blob_validate(blob, blob_n, &b);
+        if (s != SN_OK) { fprintf(stderr, "det_main: %s: %s\n", blob_path, sn_status_str(s)); return 1; }
+        mem_n = sn_instance_size(b);
+    }
+    mem = malloc(mem_n);
+    if (!mem) { fprintf(stderr, "det_main: out of memory\n"); return 2; }
+    if (sn_det_init(&det, blob, blob_n, clip_text, clip_n, clip_text ? &clip : NULL,
+                    mem, mem_n, err, sizeof err)) {
+        fprintf(stderr, "det_main: %s\n", err); return 1;
+    }
+    for (k = 0; k < steps; k++) {
+        sn_det_pose(&det);
+        sn_det_step(&det);
+        if (trace && (k + 1) % trace == 0) {
+            sn_det_hex64(sn_state_hash(det.inst), hex);
+            printf("step %lu %s\n", k + 1, hex);
+        }
+    }
+    sn_det_hex64(sn_state_hash(det.inst), hex);
+    printf("hash: %s\n", hex);
+    {
+        sn_stats st;
+        sn_get_stats(det.inst, &st);
+        printf("steps: %" PRIu32 " saturations: %" PRIu32 "\n", st.steps, st.saturations);
+    }
+    free(mem); free(blob); free(clip_text);
+    return 0;
+}

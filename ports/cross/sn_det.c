@@ -1,0 +1,84 @@
+/* sn_det.c -- determinism workload (see sn_det.h). Integer-only in the fixed
+ * flavour; in the float flavour only the final conversions are float. */
+#include "sn_det.h"
+
+#ifdef SN_FLOAT
+static sn_real from_q16(int32_t v) { return (sn_real)v / 65536.0f; }
+static const sn_real ONE = 1.0f;
+#else
+static sn_real from_q16(int32_t v) { return v; }
+static const sn_real ONE = (sn_real)1 << SN_QUAT_FRAC;
+#endif
+
+static void put(char *err, size_t cap, size_t *len, const char *s) {
+    for (; *s; s++) if (*len + 1 < cap) err[(*len)++] = *s;
+    if (cap) err[*len] = 0;
+}
+
+int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
+                const char *clip_text, size_t clip_len, sn_clip *clip,
+                void *mem, size_t mem_size, char *err, size_t errlen) {
+    sn_blob_info info;
+    sn_status s;
+    size_t len = 0;
+    if (errlen) err[0] = 0;
+    d->clip = NULL;
+    d->k = 0;
+    s = sn_blob_validate(blob, blob_size, &d->blob);
+    if (s != SN_OK) { put(err, errlen, &len, "blob: "); put(err, errlen, &len, sn_status_str(s)); return 1; }
+    sn_blob_get_info(d->blob, &info);
+    d->n_joints = info.joints;
+    if (info.joints > SN_DET_MAX_JOINTS) { put(err, errlen, &len, "too many joints"); return 1; }
+    s = sn_instance_init(mem, mem_size, d->blob, &d->inst);
+    if (s != SN_OK) { put(err, errlen, &len, "instance: "); put(err, errlen, &len, sn_status_str(s)); return 1; }
+    if (clip_text) {
+        if (sn_clip_parse(clip, clip_text, clip_len, err, errlen)) return 1;
+        if (sn_clip_bind(clip, d->blob, err, errlen)) return 1;
+        d->clip = clip;
+    }
+    return 0;
+}
+
+/* Built-in sequence for assets without a clip: every non-root joint swings
+ * +-20 degrees (triangle wave, own phase) about a model axis, root bobs. */
+static void builtin_pose(sn_det *d) {
+    uint32_t j, k = d->k;
+    sn_vec3 root;
+    for (j = 0; j < d->n_joints; j++) {
+        sn_vec3 axis;
+        int32_t p = (int32_t)((k * 4u + j * 13u) % 128u);
+        int32_t tri = p < 64 ? p : 128 - p;             /* 0..64 */
+        if (j == 0) { d->local[j].x = d->local[j].y = d->local[j].z = 0; d->local[j].w = ONE; continue; }
+        axis.x = from_q16(j % 3u == 0 ? 65536 : 0);
+        axis.y = from_q16(j % 3u == 1 ? 65536 : 0);
+        axis.z = from_q16(j % 3u == 2 ? 65536 : 32768);
+        d->local[j] = sn_quat_axis_angle(axis, from_q16((tri - 32) * 40960)); /* 20/32 deg per unit */
+    }
+    root.x = 0;
+    root.y = from_q16(((int32_t)(k % 64u) - 32) * 64);     /* +-1/32 mesh unit */
+    root.z = 0;
+    sn_pose_from_local(d->blob, d->local, &root, d->xf);
+}
+
+void sn_det_pose(sn_det *d) {
+    if (d->clip) sn_clip_pose(d->clip, d->blob, d->k, d->local, d->xf);
+    else builtin_pose(d);
+    (void)sn_set_pose(d->inst, d->xf, d->n_joints);
+}
+
+void sn_det_step(sn_det *d) {
+    sn_step(d->inst);
+    d->k++;
+}
+
+uint64_t sn_det_run(sn_det *d, uint32_t n) {
+    uint32_t i;
+    for (i = 0; i < n; i++) { sn_det_pose(d); sn_det_step(d); }
+    return sn_state_hash(d->inst);
+}
+
+void sn_det_hex64(uint64_t h, char out[17]) {
+    int i;
+    for (i = 15; i >= 0; i--) { out[i] = "0123456789abcdef"[h & 15u]; h >>= 4; }
+    out[16] = 0;
+}

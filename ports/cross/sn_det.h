@@ -1,0 +1,48 @@
+/* sn_det.h -- the determinism workload shared by every port: validate a blob,
+ * put an instance in caller memory, and for step k = 0, 1, ... set the pose of
+ * step k (from a clip, or a built-in sequence without one) and call sn_step.
+ * No allocation, no stdio: the same code runs hosted and on bare metal, so a
+ * hash that differs between ports can only come from the compiler or CPU.
+ * Mirrors the desktop player: pose k, sn_set_pose, sn_step, hash at the end.
+ */
+#ifndef SN_DET_H
+#define SN_DET_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "sinew.h"
+#include "sn_clip.h"
+
+/// Most joints a blob may have (blob format limit).
+#define SN_DET_MAX_JOINTS 255
+
+typedef struct sn_det {
+    const sn_blob *blob;
+    sn_instance *inst;
+    const sn_clip *clip;     ///< NULL: built-in pose sequence
+    uint32_t n_joints;
+    uint32_t k;              ///< next step
+    sn_quat local[SN_DET_MAX_JOINTS];
+    sn_xform xf[SN_DET_MAX_JOINTS];
+} sn_det;
+
+/// Validate blob, init the instance in mem, parse and bind clip_text if
+/// clip_text != NULL (clip is caller storage for it). 0 on success, else 1
+/// with a message in err.
+int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
+                const char *clip_text, size_t clip_len, sn_clip *clip,
+                void *mem, size_t mem_size, char *err, size_t errlen);
+
+/// Compute and set the pose of step d->k.
+void sn_det_pose(sn_det *d);
+
+/// sn_step and advance d->k.
+void sn_det_step(sn_det *d);
+
+/// n times pose + step; returns sn_state_hash.
+uint64_t sn_det_run(sn_det *d, uint32_t n);
+
+/// 16 lowercase hex digits of h plus NUL into out[17].
+void sn_det_hex64(uint64_t h, char out[17]);
+
+#endif /* SN_DET_H */
