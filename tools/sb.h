@@ -1,0 +1,153 @@
+/* sb.h -- sinew-bake library: description + OBJ mesh -> control lattice ->
+ * integrated matrices -> Sinew blob. Host-side C99 + libc + libm; allocates.
+ * Every fallible function returns 0 on success, -1 on error with a message in
+ * sb_error() (file:line for description mistakes). */
+#ifndef SB_H
+#define SB_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define SB_NAME_MAX 32
+
+/* ---- errors, small utilities (sb_util.c) ---- */
+const char *sb_error(void);
+int sb_fail(const char *fmt, ...);          /* sets the message, returns -1 */
+void *sb_alloc(size_t n);                   /* zeroed; exits on out-of-memory */
+uint32_t sb_crc32(const unsigned char *p, size_t n);
+double sb_now(void);                        /* seconds, for progress/timing */
+
+/* ---- mesh (sb_mesh.c) ---- */
+typedef struct sb_mesh {
+    int nv, nt;
+    double *v;      /* nv x 3, mesh units */
+    int *tri;       /* nt x 3, 0-based, counter-clockwise seen from outside */
+    double lo[3], hi[3];
+} sb_mesh;
+int sb_mesh_load_obj(const char *path, sb_mesh *m);  /* parse, fan-triangulate, check closed */
+void sb_mesh_free(sb_mesh *m);
+double sb_mesh_volume(const sb_mesh *m);             /* divergence theorem, mesh units^3 */
+
+/* Inside test: rays along +x; triangles binned by their (y,z) bounding box. */
+typedef struct sb_inside {
+    const sb_mesh *m;
+    double y0, z0, dy, dz;
+    int ny, nz;
+    int *start;   /* (ny*nz+1) */
+    int *tris;
+    double *ty, *tz, *tx;  /* per triangle projected corners (3 each) */
+} sb_inside;
+void sb_inside_init(sb_inside *in, const sb_mesh *m);
+int sb_inside_test(const sb_inside *in, const double p[3]);
+void sb_inside_free(sb_inside *in);
+
+/* ---- description (sb_desc.c) ---- */
+enum { SB_RG_ALL, SB_RG_BOX, SB_RG_SPHERE, SB_RG_BONE };
+typedef struct sb_region {
+    int kind;
+    double a[6];    /* box: lo xyz, hi xyz; sphere: centre xyz, radius */
+    int bone;       /* SB_RG_BONE: joint index (description order) ending the bone */
+    int line;
+} sb_region;
+typedef struct sb_matrule { sb_region r; int mat; } sb_matrule;
+typedef struct sb_framerule { sb_region r; int j1, j2; double w; } sb_framerule;
+typedef struct sb_pin { sb_region r; int joint; } sb_pin;
+typedef struct sb_material { char name[SB_NAME_MAX]; double E, nu, rho; int line; } sb_material;
+typedef struct sb_joint {
+    char name[SB_NAME_MAX];
+    char parent_name[SB_NAME_MAX];
+    int parent;     /* index in description order, -1 root */
+    double pos[3];  /* mesh units */
+    int line;
+} sb_joint;
+
+typedef struct sb_desc {
+    char path[1024];
+    char mesh_path[1024];   /* resolved relative to the description's directory */
+    int mesh_line;
+    double unit;            /* metres per mesh unit */
+    double cell;            /* lattice cell edge, mesh units */
+    double origin[3]; int has_origin;
+    int subdiv;             /* quadrature sub-boxes per cell edge */
+    double air;             /* weight of outside quadrature points in kept cells */
+    double min_fill;        /* drop cells whose inside fraction is below this */
+    double blend;           /* frame blend width, mesh units (0: = cell) */
+    sb_joint *joints; int nj;
+    sb_material *mats; int nm;
+    sb_matrule *mrules; int nmr;
+    sb_framerule *frules; int nfr;
+    sb_pin *pins; int npin;
+    double alpha, beta, h;
+    int cg_def, cg_max;
+    double g[3];
+    double kappa, twist_r;  /* twist stiffness (Pa/m^2) and radius (mesh units) */
+} sb_desc;
+int sb_desc_load(const char *path, sb_desc *d);
+void sb_desc_free(sb_desc *d);
+
+/* ---- lattice + integration (sb_lattice.c, sb_integrate.c) ---- */
+typedef struct sb_model {
+    /* skeleton, sorted so parents precede children */
+    int nj;
+    sb_joint *joints;       /* sorted copy; parent indices refer to this order */
+    int *desc_to_sorted;
+    /* segments: one per non-root joint j, parent(j) -> j, moved by parent(j) */
+    int nseg;
+    int *seg_child;         /* sorted joint index of the child */
+    /* grid */
+    int gn[3];              /* grid vertices per axis */
+    double gorg[3], c;
+    double *gpos;           /* grid vertex positions after skeleton snapping (mesh units) */
+    int *gjoint;            /* joint moving a skeleton grid vertex, -1 free */
+    int *gvert;             /* blob vertex index, -1 not in lattice */
+    /* lattice */
+    int nv, nf, nc;
+    int *v_grid;            /* grid vertex of each blob vertex */
+    double *x;              /* rest positions (mesh units, model space) */
+    int *cells;             /* nc x 8 blob vertex indices */
+    int *cell_grid;         /* grid cell index (i + gn0*(j + gn1*k) over cells) */
+    double *cell_fill;      /* inside fraction of each cell */
+    int *fb1, *fb2; double *fw;   /* frames (sorted joint indices, weight of b2) */
+    /* sparse symmetric block pattern: for vertex i, neighbours nb[nbptr[i]..nbptr[i+1]) sorted, includes i */
+    int *nbptr, *nb;
+    double *M;              /* per pattern entry, kg */
+    double *S;              /* per pattern entry, 9 doubles row-major, N/m (elastic) */
+    double *T;              /* per pattern entry, twist scalar, N/m */
+    double inside_volume;   /* m^3 of quadrature points inside */
+    double mass;            /* kg, sum of all M entries */
+    /* surface */
+    int ns, nt;
+    int *emb_cell; double *emb_t;   /* per mesh vertex, trilinear coords in [0,1]^3 */
+    int *tri;
+    /* description copy of physics */
+    double h, alpha, beta, g[3], unit;
+    int cg_def, cg_max;
+    double bbox_diag;
+    int quiet;
+} sb_model;
+
+int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
+void sb_model_free(sb_model *o);
+int sb_pattern_find(const sb_model *o, int i, int j);  /* entry index or -1 */
+/* trilinear shape functions at reference coords t (corner k at (k&1,k>>1&1,k>>2&1)) */
+void sb_shape(const double t[3], double N[8], double dN[8][3]);
+/* point of cell ci at reference coords t */
+void sb_cell_point(const sb_model *o, int ci, const double t[3], double p[3]);
+
+/* ---- blob (sb_blob.c) ---- */
+enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };
+typedef struct sb_blob {
+    unsigned char *bytes; size_t size;
+    uint32_t sec_off[16], sec_size[16];
+    int len_shift, frac_S, frac_M, frac_P;
+    double m0;
+} sb_blob;
+int sb_blob_make(const sb_model *o, int flavour, sb_blob *b);
+void sb_blob_free(sb_blob *b);
+int sb_write_file(const char *path, const unsigned char *p, size_t n);  /* temp + rename */
+int sb_write_c_array(const char *path, const char *symbol, const unsigned char *p, size_t n);
+
+/* ---- whole bake (sb_bake.c) ---- */
+int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b);
+
+#endif /* SB_H */

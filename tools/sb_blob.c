@@ -1,0 +1,292 @@
+/* sb_blob.c -- baked units (runtime/NUMERICS.md) and the byte layout
+ * (runtime/src/sn_format.h, prose in runtime/BLOB.md). */
+#include "sb.h"
+#include "../runtime/src/sn_format.h"
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    unsigned char *p;
+    int flavour, rs;   /* real size */
+    int err;
+} wr_t;
+
+static void put_u8(wr_t *w, size_t at, unsigned v) { w->p[at] = (unsigned char)v; }
+static void put_u16(wr_t *w, size_t at, unsigned v) { w->p[at] = (unsigned char)(v & 255u); w->p[at + 1] = (unsigned char)((v >> 8) & 255u); }
+static void put_u32(wr_t *w, size_t at, uint32_t v)
+{
+    int k;
+    for (k = 0; k < 4; k++) w->p[at + (size_t)k] = (unsigned char)((v >> (8 * k)) & 255u);
+}
+static void put_u64(wr_t *w, size_t at, uint64_t v)
+{
+    int k;
+    for (k = 0; k < 8; k++) w->p[at + (size_t)k] = (unsigned char)((v >> (8 * k)) & 255u);
+}
+
+/* round to nearest, ties away from zero */
+static double rnd(double x) { return x < 0 ? -floor(-x + 0.5) : floor(x + 0.5); }
+
+/* one real: fixed = round(x * 2^frac) as int32, float32, or float64 */
+static void put_real(wr_t *w, size_t at, double x, int frac)
+{
+    if (w->flavour == SB_FIXED) {
+        double q = rnd(ldexp(x, frac));
+        if (!(q >= -2147483648.0 && q <= 2147483647.0)) { w->err = 1; q = 0; }
+        put_u32(w, at, (uint32_t)(int32_t)q);
+    } else if (w->flavour == SB_FLOAT) {
+        float f = (float)x;
+        uint32_t u;
+        memcpy(&u, &f, 4);
+        put_u32(w, at, u);
+    } else {
+        uint64_t u;
+        memcpy(&u, &x, 8);
+        put_u64(w, at, u);
+    }
+}
+
+/* fractional bits so that the largest |entry| lands in [2^26, 2^27] */
+static int pick_frac(double maxabs)
+{
+    int e;
+    if (!(maxabs > 0)) return 0;
+    frexp(maxabs, &e);          /* maxabs in [2^(e-1), 2^e) */
+    return 26 - (e - 1);
+}
+
+static void inv3sym(const double A[3][3], double R[3][3])
+{
+    double D = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+               A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+    R[0][0] = (A[1][1] * A[2][2] - A[1][2] * A[2][1]) / D; R[0][1] = (A[0][2] * A[2][1] - A[0][1] * A[2][2]) / D;
+    R[0][2] = (A[0][1] * A[1][2] - A[0][2] * A[1][1]) / D; R[1][0] = R[0][1];
+    R[1][1] = (A[0][0] * A[2][2] - A[0][2] * A[2][0]) / D; R[1][2] = (A[0][2] * A[1][0] - A[0][0] * A[1][2]) / D;
+    R[2][0] = R[0][2]; R[2][1] = R[1][2];
+    R[2][2] = (A[0][0] * A[1][1] - A[0][1] * A[1][0]) / D;
+}
+
+int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
+{
+    const int nF = o->nf, nV = o->nv, nJ = o->nj;
+    const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    int i, j, k, e, nnz = 0, rs = flavour == SB_DOUBLE ? 8 : 4, s;
+    double m0 = 0, maxS = 0, maxM = 0, maxP = 0, maxx = 0, h = o->h, a1, b1, U, *P, *lump;
+    const double *root = o->joints[0].pos;
+    uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total;
+    wr_t w;
+
+    memset(b, 0, sizeof *b);
+    for (i = 0; i < nV; i++) { e = sb_pattern_find(o, i, i); if (o->M[e] > m0) m0 = o->M[e]; }
+    if (!(m0 > 0)) return sb_fail("lattice has no mass");
+    a1 = h * o->alpha;
+    b1 = o->beta / h;
+    /* len_shift: smallest s with every |rest coordinate - root| < 2 * 2^s mesh units */
+    for (i = 0; i < nV; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->x[3 * i + k] - root[k]));
+    for (i = 0; i < nJ; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->joints[i].pos[k] - root[k]));
+    for (s = -60; s < 100 && !(maxx < ldexp(2.0, s)); s++) {}
+    if (s < -128 || s > 127) return sb_fail("model size out of range (len_shift %d)", s);
+    U = ldexp(1.0, s);   /* internal unit in mesh units */
+    b->len_shift = s;
+    b->m0 = m0;
+
+    /* baked scalars and matrices: M^ = M/m0, S^ = h^2 (S+T)/m0 (NUMERICS.md) */
+    P = sb_alloc(sizeof(double) * 6 * (size_t)nF);
+    lump = sb_alloc(sizeof(double) * (size_t)nF);
+    for (i = 0; i < nF; i++) {
+        double A[3][3], R[3][3], mii;
+        e = sb_pattern_find(o, i, i);
+        mii = o->M[e] / m0;
+        for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++) {
+            lump[i] += o->M[j] / m0;
+            if (o->nb[j] > i) {
+                nnz++;
+                maxM = fmax(maxM, fabs(o->M[j] / m0));
+                for (k = 0; k < 9; k++) maxS = fmax(maxS, fabs(h * h * (o->S[9 * (size_t)j + (size_t)k] + (k % 4 == 0 ? o->T[j] : 0)) / m0));
+            }
+        }
+        maxM = fmax(maxM, fmax(mii, fabs(lump[i])));
+        for (j = 0; j < 3; j++)
+            for (k = 0; k < 3; k++) {
+                double sv = h * h * (0.5 * (o->S[9 * (size_t)e + (size_t)(3 * j + k)] + o->S[9 * (size_t)e + (size_t)(3 * k + j)]) + (j == k ? o->T[e] : 0)) / m0;
+                maxS = fmax(maxS, fabs(sv));
+                A[j][k] = (1 + b1) * sv + (j == k ? (1 + a1) * mii : 0);
+            }
+        inv3sym((const double (*)[3])A, R);
+        for (k = 0; k < 6; k++) { P[6 * i + k] = R[sym6[k][0]][sym6[k][1]]; maxP = fmax(maxP, fabs(P[6 * i + k])); }
+    }
+    if (flavour == SB_FIXED) {
+        b->frac_S = pick_frac(maxS); b->frac_M = pick_frac(maxM); b->frac_P = pick_frac(maxP);
+        if (b->frac_S < 0 || b->frac_S > 60) { free(P); free(lump); return sb_fail("stiffness out of fixed-point range (largest S^ entry %g): change the timestep or E", maxS); }
+        if (b->frac_M < 0 || b->frac_M > 60 || b->frac_P < 0 || b->frac_P > 60) { free(P); free(lump); return sb_fail("mass/preconditioner out of fixed-point range"); }
+    }
+
+    /* section table */
+    cnt[SN_SEC_JOINTS] = (uint32_t)nJ;        esz[SN_SEC_JOINTS] = SN_ELEM_JOINTS(rs);
+    cnt[SN_SEC_JOINT_NAMES] = (uint32_t)nJ;   esz[SN_SEC_JOINT_NAMES] = SN_ELEM_JOINT_NAMES;
+    cnt[SN_SEC_REST] = (uint32_t)nV;          esz[SN_SEC_REST] = SN_ELEM_REST(rs);
+    cnt[SN_SEC_FRAMES] = (uint32_t)nV;        esz[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
+    cnt[SN_SEC_MDIAG] = (uint32_t)nF;         esz[SN_SEC_MDIAG] = SN_ELEM_MDIAG(rs);
+    cnt[SN_SEC_SDIAG] = (uint32_t)nF;         esz[SN_SEC_SDIAG] = SN_ELEM_SDIAG(rs);
+    cnt[SN_SEC_PRECOND] = (uint32_t)nF;       esz[SN_SEC_PRECOND] = SN_ELEM_PRECOND(rs);
+    cnt[SN_SEC_MLUMP] = (uint32_t)nF;         esz[SN_SEC_MLUMP] = SN_ELEM_MLUMP(rs);
+    cnt[SN_SEC_ROWPTR] = (uint32_t)nF + 1;    esz[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
+    cnt[SN_SEC_COLS] = (uint32_t)nnz;         esz[SN_SEC_COLS] = SN_ELEM_COLS;
+    cnt[SN_SEC_MOFF] = (uint32_t)nnz;         esz[SN_SEC_MOFF] = SN_ELEM_MOFF(rs);
+    cnt[SN_SEC_SOFF] = (uint32_t)nnz;         esz[SN_SEC_SOFF] = SN_ELEM_SOFF(rs);
+    cnt[SN_SEC_CELLS] = (uint32_t)o->nc;      esz[SN_SEC_CELLS] = SN_ELEM_CELLS;
+    cnt[SN_SEC_EMBED] = (uint32_t)o->ns;      esz[SN_SEC_EMBED] = SN_ELEM_EMBED;
+    cnt[SN_SEC_TRIS] = (uint32_t)o->nt;       esz[SN_SEC_TRIS] = SN_ELEM_TRIS;
+    total = SN_HEADER_BYTES;
+    for (k = 0; k < SN_SEC_COUNT; k++) {
+        total = (total + 7u) & ~7u;
+        off[k] = total;
+        total += cnt[k] * esz[k];
+        b->sec_off[k] = off[k]; b->sec_size[k] = cnt[k] * esz[k];
+    }
+    total = (total + 7u) & ~7u;
+    b->size = total;
+    b->bytes = sb_alloc(total);
+    w.p = b->bytes; w.flavour = flavour; w.rs = rs; w.err = 0;
+
+    /* header */
+    w.p[SN_H_MAGIC] = SN_MAGIC0; w.p[SN_H_MAGIC + 1] = SN_MAGIC1; w.p[SN_H_MAGIC + 2] = SN_MAGIC2; w.p[SN_H_MAGIC + 3] = SN_MAGIC3;
+    put_u16(&w, SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
+    put_u16(&w, SN_H_VER_MINOR, SN_FORMAT_MINOR);
+    put_u32(&w, SN_H_ENDIAN, SN_ENDIAN_MARK);
+    put_u32(&w, SN_H_TOTAL_SIZE, total);
+    put_u32(&w, SN_H_HEADER_SIZE, SN_HEADER_BYTES);
+    put_u8(&w, SN_H_FLAVOUR, (unsigned)flavour);
+    put_u8(&w, SN_H_REAL_SIZE, (unsigned)rs);
+    put_u8(&w, SN_H_NSECTIONS, SN_SEC_COUNT);
+    put_u32(&w, SN_H_ONE, flavour == SB_FIXED ? SN_ONE_FIXED : flavour == SB_FLOAT ? SN_ONE_FLOAT32 : 0u);
+    put_u32(&w, SN_H_ONE_HI, flavour == SB_DOUBLE ? SN_ONE_FLOAT64_HI : 0u);
+    put_u32(&w, SN_H_N_VERTICES, (uint32_t)nV);
+    put_u32(&w, SN_H_N_FREE, (uint32_t)nF);
+    put_u32(&w, SN_H_N_CELLS, (uint32_t)o->nc);
+    put_u32(&w, SN_H_N_JOINTS, (uint32_t)nJ);
+    put_u32(&w, SN_H_N_SURFACE, (uint32_t)o->ns);
+    put_u32(&w, SN_H_N_TRIANGLES, (uint32_t)o->nt);
+    put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
+    put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ));
+    put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
+    put_u16(&w, SN_H_CG_MAX, (unsigned)o->cg_max);
+    put_u8(&w, SN_H_LEN_SHIFT, (unsigned)(s & 255));
+    put_u8(&w, SN_H_FRAC_S, (unsigned)b->frac_S);
+    put_u8(&w, SN_H_FRAC_M, (unsigned)b->frac_M);
+    put_u8(&w, SN_H_FRAC_P, (unsigned)b->frac_P);
+    {
+        size_t R0 = SN_H_REALS;
+        double gs = h * h / (U * o->unit);   /* g^ = h^2 g / U, U in metres */
+        put_real(&w, R0 + SN_R_A1 * (size_t)rs, a1, SN_Q_COEF);
+        put_real(&w, R0 + SN_R_B1 * (size_t)rs, b1, SN_Q_COEF);
+        for (k = 0; k < 3; k++) put_real(&w, R0 + (size_t)(SN_R_GRAV_X + k) * (size_t)rs, gs * o->g[k], SN_Q_LEN);
+        put_real(&w, R0 + SN_R_TIMESTEP * (size_t)rs, h, 16);
+        put_real(&w, R0 + SN_R_MASS_SCALE * (size_t)rs, fmin(m0, 32767.0), 16);
+        put_real(&w, R0 + SN_R_RESERVED * (size_t)rs, 0.0, 0);
+    }
+    for (k = 0; k < SN_SEC_COUNT; k++) {
+        size_t at = SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
+        put_u32(&w, at, off[k]); put_u32(&w, at + 4, cnt[k] * esz[k]); put_u32(&w, at + 8, cnt[k]); put_u32(&w, at + 12, esz[k]);
+    }
+
+    /* sections */
+    for (j = 0; j < nJ; j++) {
+        size_t at = off[SN_SEC_JOINTS] + (size_t)j * esz[SN_SEC_JOINTS];
+        put_u16(&w, at, o->joints[j].parent < 0 ? 0xFFFFu : (unsigned)o->joints[j].parent);
+        for (k = 0; k < 3; k++) put_real(&w, at + 8 + (size_t)(k * rs), (o->joints[j].pos[k] - root[k]) / U, SN_Q_LEN);
+        memcpy(w.p + off[SN_SEC_JOINT_NAMES] + 32 * (size_t)j, o->joints[j].name, strlen(o->joints[j].name));
+    }
+    for (i = 0; i < nV; i++) {
+        size_t at = off[SN_SEC_FRAMES] + 4 * (size_t)i;
+        for (k = 0; k < 3; k++) put_real(&w, off[SN_SEC_REST] + (size_t)(3 * i + k) * (size_t)rs, (o->x[3 * i + k] - root[k]) / U, SN_Q_LEN);
+        put_u8(&w, at, (unsigned)o->fb1[i]);
+        put_u8(&w, at + 1, (unsigned)o->fb2[i]);
+        put_u16(&w, at + 2, (unsigned)rnd(o->fw[i] * 32768.0));
+    }
+    nnz = 0;
+    for (i = 0; i < nF; i++) {
+        e = sb_pattern_find(o, i, i);
+        put_real(&w, off[SN_SEC_MDIAG] + (size_t)i * (size_t)rs, o->M[e] / m0, b->frac_M);
+        for (k = 0; k < 6; k++) {
+            int r = sym6[k][0], c = sym6[k][1];
+            double sv = h * h * (0.5 * (o->S[9 * (size_t)e + (size_t)(3 * r + c)] + o->S[9 * (size_t)e + (size_t)(3 * c + r)]) + (r == c ? o->T[e] : 0)) / m0;
+            put_real(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, sv, b->frac_S);
+            put_real(&w, off[SN_SEC_PRECOND] + (size_t)(6 * i + k) * (size_t)rs, P[6 * i + k], b->frac_P);
+        }
+        put_real(&w, off[SN_SEC_MLUMP] + (size_t)i * (size_t)rs, lump[i], b->frac_M);
+        put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)i, (uint32_t)nnz);
+        for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++) {
+            if (o->nb[j] <= i) continue;
+            put_u16(&w, off[SN_SEC_COLS] + 2 * (size_t)nnz, (unsigned)o->nb[j]);
+            put_real(&w, off[SN_SEC_MOFF] + (size_t)nnz * (size_t)rs, o->M[j] / m0, b->frac_M);
+            for (k = 0; k < 9; k++)
+                put_real(&w, off[SN_SEC_SOFF] + (size_t)(9 * nnz + k) * (size_t)rs,
+                         h * h * (o->S[9 * (size_t)j + (size_t)k] + (k % 4 == 0 ? o->T[j] : 0)) / m0, b->frac_S);
+            nnz++;
+        }
+    }
+    put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)nF, (uint32_t)nnz);
+    for (i = 0; i < o->nc; i++)
+        for (k = 0; k < 8; k++) put_u16(&w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
+    for (i = 0; i < o->ns; i++) {
+        size_t at = off[SN_SEC_EMBED] + 8 * (size_t)i;
+        put_u16(&w, at, (unsigned)o->emb_cell[i]);
+        for (k = 0; k < 3; k++) put_u16(&w, at + 2 + 2 * (size_t)k, (unsigned)rnd(o->emb_t[3 * i + k] * 32768.0));
+    }
+    for (i = 0; i < o->nt; i++)
+        for (k = 0; k < 3; k++) put_u16(&w, off[SN_SEC_TRIS] + 6 * (size_t)i + 2 * (size_t)k, (unsigned)o->tri[3 * i + k]);
+    free(P); free(lump);
+    if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
+    if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }
+    put_u32(&w, SN_H_CRC32, sb_crc32(b->bytes + 16, total - 16));
+    return 0;
+}
+
+void sb_blob_free(sb_blob *b)
+{
+    free(b->bytes);
+    memset(b, 0, sizeof *b);
+}
+
+/* Write to PATH.tmp in the same directory, then rename: no partial output. */
+static int write_via_tmp(const char *path, const unsigned char *p, size_t n, const char *text)
+{
+    char tmp[4200];
+    FILE *f;
+    int ok;
+    if (strlen(path) > 4000) return sb_fail("%s: path too long", path);
+    sprintf(tmp, "%s.tmp", path);
+    f = fopen(tmp, "wb");
+    if (!f) return sb_fail("%s: cannot create: %s", tmp, strerror(errno));
+    ok = text ? fputs(text, f) >= 0 : fwrite(p, 1, n, f) == n;
+    if (fclose(f) != 0) ok = 0;
+    if (!ok) { remove(tmp); return sb_fail("%s: write failed", tmp); }
+    if (rename(tmp, path) != 0) { remove(tmp); return sb_fail("%s: cannot rename to %s: %s", tmp, path, strerror(errno)); }
+    return 0;
+}
+
+int sb_write_file(const char *path, const unsigned char *p, size_t n) { return write_via_tmp(path, p, n, NULL); }
+
+int sb_write_c_array(const char *path, const char *sym, const unsigned char *p, size_t n)
+{
+    size_t i, cap = 600 + 6 * n + 3 * strlen(sym), len = 0;
+    char *t = sb_alloc(cap);
+    int rc;
+    const char *c;
+    for (c = sym; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || *c == '_' || (c != sym && *c >= '0' && *c <= '9'))) {
+            free(t);
+            return sb_fail("'%s' is not a C identifier", sym);
+        }
+    len += (size_t)sprintf(t + len, "/* Sinew blob, generated by sinew-bake; do not edit. */\n#include <stdint.h>\n\n"
+                                    "const union { uint64_t align_; unsigned char bytes[%lu]; } %s = { .bytes = {", (unsigned long)n, sym);
+    for (i = 0; i < n; i++) len += (size_t)sprintf(t + len, "%s%u,", i % 20 == 0 ? "\n    " : "", (unsigned)p[i]);
+    len += (size_t)sprintf(t + len, "\n} };\nconst unsigned long %s_size = %lu;\n", sym, (unsigned long)n);
+    rc = write_via_tmp(path, NULL, 0, t);
+    free(t);
+    return rc;
+}

@@ -1,0 +1,258 @@
+/* sb_desc.c -- the text character description (format: tools/DESCRIPTION.md). */
+#include "sb.h"
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    const char *path;
+    int line;
+    char *tok[64];
+    int nt;
+} ctx_t;
+
+static int num(ctx_t *c, int i, double *out)
+{
+    char *end;
+    if (i >= c->nt) return sb_fail("%s:%d: missing value after '%s'", c->path, c->line, c->tok[c->nt - 1]);
+    *out = strtod(c->tok[i], &end);
+    if (end == c->tok[i] || *end) return sb_fail("%s:%d: '%s' is not a number", c->path, c->line, c->tok[i]);
+    if (!isfinite(*out)) return sb_fail("%s:%d: '%s' is not a finite number", c->path, c->line, c->tok[i]);
+    return 0;
+}
+
+static int inum(ctx_t *c, int i, int lo, int hi, int *out)
+{
+    double v;
+    if (num(c, i, &v)) return -1;
+    if (v != floor(v) || v < lo || v > hi) return sb_fail("%s:%d: '%s' must be an integer in %d..%d", c->path, c->line, c->tok[i], lo, hi);
+    *out = (int)v;
+    return 0;
+}
+
+static int nargs(ctx_t *c, int n)
+{
+    if (c->nt - 1 < n) return sb_fail("%s:%d: missing value: '%s' takes %d value(s), got %d", c->path, c->line, c->tok[0], n, c->nt - 1);
+    if (c->nt - 1 > n) return sb_fail("%s:%d: '%s' takes %d value(s), got %d (extra '%s')", c->path, c->line, c->tok[0], n, c->nt - 1, c->tok[n + 1]);
+    return 0;
+}
+
+static int find_joint(const sb_desc *d, const char *name)
+{
+    int i;
+    for (i = 0; i < d->nj; i++) if (!strcmp(d->joints[i].name, name)) return i;
+    return -1;
+}
+static int find_mat(const sb_desc *d, const char *name)
+{
+    int i;
+    for (i = 0; i < d->nm; i++) if (!strcmp(d->mats[i].name, name)) return i;
+    return -1;
+}
+
+/* region at tok[first]: all | box x0 y0 z0 x1 y1 z1 | sphere cx cy cz r | bone JOINT.
+ * Returns the number of tokens used, -1 on error. */
+static int region(ctx_t *c, const sb_desc *d, int first, int tail, sb_region *r)
+{
+    int k, n;
+    const char *kind;
+    memset(r, 0, sizeof *r);
+    r->line = c->line;
+    if (first >= c->nt) return sb_fail("%s:%d: missing region (all, box, sphere or bone)", c->path, c->line);
+    kind = c->tok[first];
+    if (!strcmp(kind, "all")) { r->kind = SB_RG_ALL; n = 1; }
+    else if (!strcmp(kind, "box")) { r->kind = SB_RG_BOX; n = 7; }
+    else if (!strcmp(kind, "sphere")) { r->kind = SB_RG_SPHERE; n = 5; }
+    else if (!strcmp(kind, "bone")) { r->kind = SB_RG_BONE; n = 2; }
+    else return sb_fail("%s:%d: unknown region '%s' (want all, box, sphere or bone)", c->path, c->line, kind);
+    if (c->nt != first + n + tail)
+        return sb_fail("%s:%d: %s: '%s %s' takes %d value(s) followed by %d more", c->path, c->line,
+                       c->nt < first + n + tail ? "missing value" : "too many values", c->tok[0], kind, n - 1, tail);
+    if (r->kind == SB_RG_BOX || r->kind == SB_RG_SPHERE)
+        for (k = 0; k < n - 1; k++) if (num(c, first + 1 + k, &r->a[k])) return -1;
+    if (r->kind == SB_RG_BOX)
+        for (k = 0; k < 3; k++) if (r->a[k] > r->a[k + 3]) return sb_fail("%s:%d: box lower corner above upper corner", c->path, c->line);
+    if (r->kind == SB_RG_SPHERE && r->a[3] <= 0) return sb_fail("%s:%d: sphere radius must be positive", c->path, c->line);
+    if (r->kind == SB_RG_BONE) {
+        r->bone = find_joint(d, c->tok[first + 1]);
+        if (r->bone < 0) return sb_fail("%s:%d: unknown joint '%s' (declare joints before using them)", c->path, c->line, c->tok[first + 1]);
+        if (d->joints[r->bone].parent < 0) return sb_fail("%s:%d: '%s' is the root: a bone is named by its child joint", c->path, c->line, c->tok[first + 1]);
+    }
+    return n;
+}
+
+#define GROW(arr, n) do { arr = realloc(arr, sizeof(*(arr)) * (size_t)((n) + 1)); if (!(arr)) return sb_fail("out of memory"); memset(&(arr)[n], 0, sizeof(*(arr))); } while (0)
+
+static int parse_line(ctx_t *c, sb_desc *d, int *seen)
+{
+    const char *kw = c->tok[0];
+    int k, n;
+    if (!strcmp(kw, "mesh")) {
+        const char *slash;
+        size_t dl;
+        if (nargs(c, 1)) return -1;
+        slash = strrchr(d->path, '/');
+        dl = slash ? (size_t)(slash - d->path + 1) : 0;
+        if (c->tok[1][0] == '/') dl = 0;
+        if (dl + strlen(c->tok[1]) + 1 > sizeof d->mesh_path) return sb_fail("%s:%d: mesh path too long", c->path, c->line);
+        memcpy(d->mesh_path, d->path, dl);
+        strcpy(d->mesh_path + dl, c->tok[1]);
+        d->mesh_line = c->line;
+        seen[0] = 1;
+    } else if (!strcmp(kw, "unit")) {
+        if (nargs(c, 1) || num(c, 1, &d->unit)) return -1;
+        if (d->unit <= 0) return sb_fail("%s:%d: unit (metres per mesh unit) must be positive", c->path, c->line);
+        seen[1] = 1;
+    } else if (!strcmp(kw, "cell")) {
+        if (nargs(c, 1) || num(c, 1, &d->cell)) return -1;
+        if (d->cell <= 0) return sb_fail("%s:%d: cell size must be positive", c->path, c->line);
+        seen[2] = 1;
+    } else if (!strcmp(kw, "origin")) {
+        if (nargs(c, 3)) return -1;
+        for (k = 0; k < 3; k++) if (num(c, 1 + k, &d->origin[k])) return -1;
+        d->has_origin = 1;
+    } else if (!strcmp(kw, "subdiv")) {
+        if (nargs(c, 1) || inum(c, 1, 1, 16, &d->subdiv)) return -1;
+    } else if (!strcmp(kw, "air")) {
+        if (nargs(c, 1) || num(c, 1, &d->air)) return -1;
+        if (d->air < 0 || d->air > 1) return sb_fail("%s:%d: air must be in [0, 1]", c->path, c->line);
+    } else if (!strcmp(kw, "min_fill")) {
+        if (nargs(c, 1) || num(c, 1, &d->min_fill)) return -1;
+        if (d->min_fill < 0 || d->min_fill >= 1) return sb_fail("%s:%d: min_fill must be in [0, 1)", c->path, c->line);
+    } else if (!strcmp(kw, "blend")) {
+        if (nargs(c, 1) || num(c, 1, &d->blend)) return -1;
+        if (d->blend <= 0) return sb_fail("%s:%d: blend width must be positive", c->path, c->line);
+    } else if (!strcmp(kw, "joint")) {
+        sb_joint *j;
+        if (nargs(c, 5)) return -1;
+        if (strlen(c->tok[1]) >= SB_NAME_MAX || strlen(c->tok[2]) >= SB_NAME_MAX)
+            return sb_fail("%s:%d: joint names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
+        if (find_joint(d, c->tok[1]) >= 0) return sb_fail("%s:%d: joint '%s' declared twice", c->path, c->line, c->tok[1]);
+        if (!strcmp(c->tok[1], "-")) return sb_fail("%s:%d: '-' is not a joint name", c->path, c->line);
+        if (d->nj >= 255) return sb_fail("%s:%d: more than 255 joints", c->path, c->line);
+        GROW(d->joints, d->nj);
+        j = &d->joints[d->nj];
+        strcpy(j->name, c->tok[1]);
+        strcpy(j->parent_name, c->tok[2]);
+        for (k = 0; k < 3; k++) if (num(c, 3 + k, &j->pos[k])) return -1;
+        j->line = c->line;
+        j->parent = -1;
+        d->nj++;
+    } else if (!strcmp(kw, "material")) {
+        sb_material *m;
+        if (nargs(c, 4)) return -1;
+        if (strlen(c->tok[1]) >= SB_NAME_MAX) return sb_fail("%s:%d: material name too long", c->path, c->line);
+        if (find_mat(d, c->tok[1]) >= 0) return sb_fail("%s:%d: material '%s' declared twice", c->path, c->line, c->tok[1]);
+        GROW(d->mats, d->nm);
+        m = &d->mats[d->nm];
+        strcpy(m->name, c->tok[1]);
+        if (num(c, 2, &m->E) || num(c, 3, &m->nu) || num(c, 4, &m->rho)) return -1;
+        if (m->E <= 0) return sb_fail("%s:%d: Young's modulus E must be positive (got %g)", c->path, c->line, m->E);
+        if (m->nu >= 0.5 || m->nu <= -1.0) return sb_fail("%s:%d: Poisson ratio must be in (-1, 0.5) (got %g)", c->path, c->line, m->nu);
+        if (m->rho <= 0) return sb_fail("%s:%d: density must be positive (got %g)", c->path, c->line, m->rho);
+        m->line = c->line;
+        d->nm++;
+    } else if (!strcmp(kw, "region")) {
+        sb_matrule r;
+        if ((n = region(c, d, 1, 1, &r.r)) < 0) return -1;
+        r.mat = find_mat(d, c->tok[1 + n]);
+        if (r.mat < 0) return sb_fail("%s:%d: unknown material '%s' (declare materials before regions)", c->path, c->line, c->tok[1 + n]);
+        GROW(d->mrules, d->nmr);
+        d->mrules[d->nmr++] = r;
+    } else if (!strcmp(kw, "frame")) {
+        sb_framerule r;
+        if ((n = region(c, d, 1, 3, &r.r)) < 0) return -1;
+        r.j1 = find_joint(d, c->tok[1 + n]);
+        r.j2 = find_joint(d, c->tok[2 + n]);
+        if (r.j1 < 0 || r.j2 < 0) return sb_fail("%s:%d: unknown joint '%s'", c->path, c->line, c->tok[r.j1 < 0 ? 1 + n : 2 + n]);
+        if (num(c, 3 + n, &r.w)) return -1;
+        if (r.w < 0 || r.w > 1) return sb_fail("%s:%d: frame weight must be in [0, 1]", c->path, c->line);
+        GROW(d->frules, d->nfr);
+        d->frules[d->nfr++] = r;
+    } else if (!strcmp(kw, "pin")) {
+        sb_pin p;
+        if ((n = region(c, d, 1, 1, &p.r)) < 0) return -1;
+        p.joint = find_joint(d, c->tok[1 + n]);
+        if (p.joint < 0) return sb_fail("%s:%d: unknown joint '%s'", c->path, c->line, c->tok[1 + n]);
+        GROW(d->pins, d->npin);
+        d->pins[d->npin++] = p;
+    } else if (!strcmp(kw, "rayleigh")) {
+        if (nargs(c, 2) || num(c, 1, &d->alpha) || num(c, 2, &d->beta)) return -1;
+        if (d->alpha < 0 || d->beta < 0) return sb_fail("%s:%d: Rayleigh coefficients must be >= 0", c->path, c->line);
+    } else if (!strcmp(kw, "timestep")) {
+        if (nargs(c, 1) || num(c, 1, &d->h)) return -1;
+        if (d->h <= 0 || d->h > 1) return sb_fail("%s:%d: timestep must be in (0, 1] seconds", c->path, c->line);
+    } else if (!strcmp(kw, "iterations")) {
+        if (nargs(c, 2) || inum(c, 1, 1, 256, &d->cg_def) || inum(c, 2, 1, 256, &d->cg_max)) return -1;
+        if (d->cg_max < d->cg_def) return sb_fail("%s:%d: max iterations below the default", c->path, c->line);
+    } else if (!strcmp(kw, "gravity")) {
+        if (nargs(c, 3)) return -1;
+        for (k = 0; k < 3; k++) if (num(c, 1 + k, &d->g[k])) return -1;
+    } else if (!strcmp(kw, "twist")) {
+        if (nargs(c, 2) || num(c, 1, &d->kappa) || num(c, 2, &d->twist_r)) return -1;
+        if (d->kappa < 0 || d->twist_r < 0) return sb_fail("%s:%d: twist stiffness and radius must be >= 0", c->path, c->line);
+    } else {
+        return sb_fail("%s:%d: unknown keyword '%s'", c->path, c->line, kw);
+    }
+    return 0;
+}
+
+int sb_desc_load(const char *path, sb_desc *d)
+{
+    FILE *f;
+    char buf[4096];
+    ctx_t c;
+    int seen[3] = {0, 0, 0}, i, j;
+    memset(d, 0, sizeof *d);
+    if (strlen(path) >= sizeof d->path) return sb_fail("%s: path too long", path);
+    strcpy(d->path, path);
+    d->subdiv = 4; d->air = 1e-3; d->min_fill = 0.0;
+    d->h = 1.0 / 60.0; d->cg_def = 16; d->cg_max = 64;
+    d->g[1] = -9.81;
+    f = fopen(path, "r");
+    if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    while (fgets(buf, sizeof buf, f)) {
+        char *s, *hash;
+        c.line++;
+        if (!strchr(buf, '\n') && !feof(f)) { fclose(f); return sb_fail("%s:%d: line too long", path, c.line); }
+        if ((hash = strchr(buf, '#'))) *hash = '\0';
+        c.nt = 0;
+        for (s = strtok(buf, " \t\r\n"); s; s = strtok(NULL, " \t\r\n")) {
+            if (c.nt == 64) { fclose(f); return sb_fail("%s:%d: too many values", path, c.line); }
+            c.tok[c.nt++] = s;
+        }
+        if (c.nt == 0) continue;
+        if (parse_line(&c, d, seen)) { fclose(f); return -1; }
+    }
+    fclose(f);
+    if (!seen[0]) return sb_fail("%s: missing 'mesh PATH'", path);
+    if (!seen[1]) return sb_fail("%s: missing 'unit METRES_PER_MESH_UNIT'", path);
+    if (!seen[2]) return sb_fail("%s: missing 'cell SIZE'", path);
+    if (d->nj == 0) return sb_fail("%s: no joints", path);
+    if (d->nm == 0) return sb_fail("%s: no materials", path);
+    /* resolve parents (they may be declared after their children) */
+    for (i = 0, j = 0; i < d->nj; i++) {
+        sb_joint *jt = &d->joints[i];
+        if (!strcmp(jt->parent_name, "-")) { jt->parent = -1; j++; continue; }
+        jt->parent = find_joint(d, jt->parent_name);
+        if (jt->parent < 0) return sb_fail("%s:%d: joint '%s': unknown parent '%s'", path, jt->line, jt->name, jt->parent_name);
+        if (jt->parent == i) return sb_fail("%s:%d: joint '%s' is its own parent", path, jt->line, jt->name);
+    }
+    if (j != 1) return sb_fail("%s: want exactly one root joint (parent '-'), got %d", path, j);
+    for (i = 0; i < d->nj; i++) {   /* cycle check: walking up must reach the root within nj steps */
+        int p = i, steps = 0;
+        while (p >= 0 && steps <= d->nj) { p = d->joints[p].parent; steps++; }
+        if (p >= 0) return sb_fail("%s:%d: joint '%s' is in a parent cycle", path, d->joints[i].line, d->joints[i].name);
+    }
+    return 0;
+}
+
+void sb_desc_free(sb_desc *d)
+{
+    free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins);
+    memset(d, 0, sizeof *d);
+}
