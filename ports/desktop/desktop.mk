@@ -1,1 +1,56 @@
-# ports/desktop build fragment (filled in by its owner)
+# ports/desktop build fragment: the CLI player in two flavours, its tests,
+# and `make demo`.
+#   $(BUILD)/sinew-play        fixed runtime ($(SN_LIB_FIXED))
+#   $(BUILD)/sinew-play-float  same source, -DSN_FLOAT, float runtime
+# ports/common (clip parser) is shared with the bare-metal port.
+DESK_INC  = $(if $(SN_INC),$(SN_INC),-Iruntime/include) -Iruntime/src -Iports/common -Iports/desktop
+DESK_HDRS = runtime/include/sinew.h runtime/src/sn_format.h ports/common/sn_clip.h \
+            ports/desktop/raster.h ports/desktop/png.h
+PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c \
+            ports/common/sn_clip.c ports/common/sn_clip_pose.c
+DEMO_DIR  = $(BUILD)/demo
+COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip
+
+# Tests that need no runtime.
+$(BUILD)/tests/test_clip: tests/test_clip.c ports/common/sn_clip.c ports/common/sn_clip.h tests/sn_test.h
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_clip.c ports/common/sn_clip.c -o $@ -lm
+
+$(BUILD)/tests/test_png: tests/test_png.c ports/desktop/png.c ports/desktop/png.h tests/sn_test.h
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_png.c ports/desktop/png.c -o $@ -lm
+
+TEST_BINS += $(BUILD)/tests/test_clip $(BUILD)/tests/test_png
+
+# The player needs the runtime libraries (runtime/runtime.mk).
+ifdef SN_LIB_FIXED
+all: $(BUILD)/sinew-play $(BUILD)/sinew-play-float
+
+$(BUILD)/sinew-play: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FIXED) -o $@ -lm
+
+$(BUILD)/sinew-play-float: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FLOAT) -o $@ -lm
+
+# Clip sampling through the runtime against a double reference.
+$(BUILD)/tests/test_clip_pose: tests/test_clip_pose.c ports/common/sn_clip.c ports/common/sn_clip_pose.c \
+                               ports/common/sn_clip.h tests/sn_test.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_clip_pose.c ports/common/sn_clip.c \
+	    ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -o $@ -lm
+
+$(BUILD)/tests/test_clip_pose_float: tests/test_clip_pose.c ports/common/sn_clip.c ports/common/sn_clip_pose.c \
+                                     ports/common/sn_clip.h tests/sn_test.h $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) -Itests tests/test_clip_pose.c ports/common/sn_clip.c \
+	    ports/common/sn_clip_pose.c $(SN_LIB_FLOAT) -o $@ -lm
+
+TEST_BINS += $(BUILD)/tests/test_clip_pose $(BUILD)/tests/test_clip_pose_float
+TEST_DEPS += $(BUILD)/sinew-play $(BUILD)/sinew-play-float
+endif
+
+# make demo: bake the cow, play both clips in both flavours, write pictures.
+demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob $(COW_CLIPS)
+	@BUILD=$(BUILD) sh ports/desktop/demo.sh

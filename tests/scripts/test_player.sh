@@ -1,0 +1,97 @@
+#!/bin/sh
+# test_player.sh -- the desktop player (sinew-play, sinew-play-float) on bad
+# input and on the baked cow: clear messages, non-zero exits, nothing partial
+# written, a repeatable --hash, a working float build.
+BUILD=${BUILD:-build}
+PLAY=$BUILD/sinew-play
+PLAYF=$BUILD/sinew-play-float
+BLOB=$BUILD/examples/cow.blob
+BLOBF=$BUILD/examples/cow_float.blob
+CLIP=tools/examples/cow/head_turn.clip
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/sn_player.XXXXXX") || exit 1
+trap 'rm -rf "$TMP"' EXIT
+pass=0; fail=0
+
+ok()  { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+# expect STATUS PATTERN CMD...: exit status STATUS ("nz" = any non-zero) and
+# PATTERN (grep -E) in stdout+stderr.
+expect() {
+    want=$1; pat=$2; shift 2
+    out=$("$@" 2>&1); rc=$?
+    if [ "$want" = nz ]; then [ "$rc" -ne 0 ] || { bad "$* exited 0, want non-zero"; return; }
+    else [ "$rc" -eq "$want" ] || { bad "$* exited $rc, want $want: $out"; return; }; fi
+    echo "$out" | grep -Eq -e "$pat" || { bad "$*: output lacks /$pat/: $out"; return; }
+    ok
+}
+
+for f in "$PLAY" "$PLAYF" "$BLOB" "$BLOBF" "$CLIP"; do
+    [ -e "$f" ] || { echo "FAIL: missing $f (run make first)"; echo "0 passed, 1 failed"; exit 1; }
+done
+
+# usage
+expect 0 'usage: sinew-play BLOB' "$PLAY" --help
+expect 0 'usage: sinew-play-float BLOB' "$PLAYF" --help
+expect 2 'usage' "$PLAY"
+expect 2 "unknown option '--bogus'" "$PLAY" "$BLOB" --bogus
+expect 2 '--frames needs a value' "$PLAY" "$BLOB" --frames
+expect 2 "bad number 'x'" "$PLAY" "$BLOB" --frames x
+expect nz 'this blob allows 1\.\.' "$PLAY" "$BLOB" --iterations 100000
+
+# blobs: missing, empty, truncated, corrupt, wrong flavour
+expect 1 "cannot read $TMP/none.blob" "$PLAY" "$TMP/none.blob"
+: > "$TMP/empty.blob"
+expect 1 'invalid blob: blob is shorter' "$PLAY" "$TMP/empty.blob"
+head -c 1000 "$BLOB" > "$TMP/trunc.blob"
+expect 1 'invalid blob: blob is shorter' "$PLAY" "$TMP/trunc.blob"
+# flip one byte in the middle: the checksum must catch it
+size=$(wc -c < "$BLOB")
+cp "$BLOB" "$TMP/corrupt.blob"
+printf '\377' | dd of="$TMP/corrupt.blob" bs=1 seek=$((size / 2)) conv=notrunc 2>/dev/null
+cmp -s "$BLOB" "$TMP/corrupt.blob" && printf '\000' | dd of="$TMP/corrupt.blob" bs=1 seek=$((size / 2)) conv=notrunc 2>/dev/null
+expect 1 'invalid blob: blob checksum mismatch' "$PLAY" "$TMP/corrupt.blob"
+printf 'XXXX' | dd of="$TMP/corrupt.blob" bs=1 seek=0 conv=notrunc 2>/dev/null
+expect 1 'invalid blob: not a Sinew blob' "$PLAY" "$TMP/corrupt.blob"
+expect 1 'flavour.*use sinew-play-float' "$PLAY" "$BLOBF"
+expect 1 'flavour.*use sinew-play for fixed' "$PLAYF" "$BLOB"
+
+# clips: missing, malformed (line number), for another skeleton
+expect 1 "cannot read $TMP/none.clip" "$PLAY" "$BLOB" --clip "$TMP/none.clip"
+printf 'sinew-clip 1\nduration 1\nrot head 0 0 1 0 five\n' > "$TMP/bad.clip"
+expect 1 "bad.clip: line 3: angle is not a number: 'five'" "$PLAY" "$BLOB" --clip "$TMP/bad.clip"
+printf 'sinew-clip 1\nduration 1\nrot left_wing 0 0 1 0 5\n' > "$TMP/bird.clip"
+expect 1 "does not fit .*clip joint 'left_wing' is not in the blob's skeleton" "$PLAY" "$BLOB" --clip "$TMP/bird.clip"
+
+# unwritable outputs: clear message, non-zero, nothing written anywhere
+mkdir "$TMP/out"
+expect 1 "cannot write $TMP/nodir/x.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 2 --png "$TMP/nodir/x.png" --sheet "$TMP/out/s.png"
+expect 1 "cannot write $TMP/nodir/s.png" "$PLAY" "$BLOB" --frames 2 --png "$TMP/out/p.png" --sheet "$TMP/nodir/s.png"
+expect 1 "cannot write $TMP/nodir/c.png" "$PLAY" "$BLOB" --frames 2 --compare "$TMP/nodir/c.png" --obj-dir "$TMP/out"
+expect 1 "cannot write $TMP/nodir/frame_0000.obj" "$PLAY" "$BLOB" --frames 2 --png "$TMP/out/p.png" --obj-dir "$TMP/nodir"
+if [ -z "$(ls -A "$TMP/out")" ]; then ok; else bad "failed runs left files: $(ls "$TMP/out")"; fi
+
+# good runs
+expect 0 'step: median [0-9.]+ us, p99 [0-9.]+ us' "$PLAY" "$BLOB" --clip "$CLIP" --frames 20 --obj-dir "$TMP/out" --png "$TMP/out/p.png" --sheet "$TMP/out/s.png"
+n=$(ls "$TMP/out"/frame_*.obj 2>/dev/null | wc -l)
+[ "$n" -eq 20 ] && ok || bad "--obj-dir wrote $n frames, want 20"
+grep -c '^v ' "$TMP/out/frame_0020.obj" | grep -q '^2903$' && ok || bad "frame_0020.obj does not have 2903 vertices"
+for p in p s; do
+    [ "$(head -c 8 "$TMP/out/$p.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && ok || bad "$p.png is not a PNG"
+done
+ls "$TMP/out" | grep -q 'tmp\|probe' && bad "temp files left: $(ls "$TMP/out")" || ok
+
+# --hash: same line twice; differs with a different mode; float player runs
+h1=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet | grep '^hash: ')
+h2=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet | grep '^hash: ')
+echo "$h1" | grep -Eq '^hash: [0-9a-f]{16}$' && ok || bad "hash line malformed: '$h1'"
+[ "$h1" = "$h2" ] && ok || bad "hash differs between runs: '$h1' vs '$h2'"
+h3=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet --unwarped | grep '^hash: ')
+[ "$h1" != "$h3" ] && ok || bad "--unwarped gives the same hash as warped"
+echo "  determinism: sinew-play head_turn 30 steps $h1"
+expect 0 'step: median .*\(float' "$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash
+f1=$("$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash --quiet | grep '^hash: ')
+f2=$("$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash --quiet | grep '^hash: ')
+[ -n "$f1" ] && [ "$f1" = "$f2" ] && ok || bad "float hash not repeatable: '$f1' vs '$f2'"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
