@@ -182,7 +182,7 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     rs_downsample2(&big, out);
     rs_image_free(&big);
     if (label) rs_draw_text(out, 8, 8, out->w >= 480 ? 2 : 1, label, ink);
-    if (label2) rs_draw_text(out, 8, out->w >= 480 ? 26 : 18, 1, label2, ink);
+    if (label2) rs_draw_text(out, 8, out->w >= 480 ? 28 : 18, out->w >= 480 ? 2 : 1, label2, ink);
     return 0;
 }
 
@@ -433,6 +433,9 @@ int main(int argc, char **argv) {
         printf("step: median %.1f us, p99 %.1f us, max %.1f us over %ld steps (%s, %u CG iterations, %u saturations)\n",
                times[n_frames / 2], times[p99], times[n_frames - 1], n_frames,
                SN_FLAVOUR ? "float" : "fixed", stats.iterations, stats.saturations);
+        if (stats.saturations)
+            fprintf(stderr, PROG ": warning: %u fixed-point values were clamped (saturated) in this run; "
+                    "the motion is not trustworthy\n", stats.saturations);
     } else printf("step: no steps run\n");
 
     /* pictures */

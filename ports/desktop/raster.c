@@ -41,7 +41,7 @@ void rs_camera_frame(rs_camera *cam, const float lo[3], const float hi[3], int w
     }
     r = sqrtf(r);
     /* fit the bounding sphere, scaled down a little: the box corners are empty */
-    d = 0.86f * r / sinf(0.5f * fov * ((float)w < (float)h ? (float)w / (float)h : 1.0f));
+    d = 0.80f * r / sinf(0.5f * fov * ((float)w < (float)h ? (float)w / (float)h : 1.0f));
     cam->fwd[0] = -sinf(az) * cosf(el);
     cam->fwd[1] = -sinf(el);
     cam->fwd[2] = -cosf(az) * cosf(el);

@@ -1,0 +1,55 @@
+#!/bin/sh
+# demo.sh -- `make demo`: play the cow's clips in both flavours and write
+# pictures to $BUILD/demo/. Run from the repository root by the Makefile.
+set -e
+BUILD=${BUILD:-build}
+OUT=$BUILD/demo
+CLIPS=tools/examples/cow
+PLAY=$BUILD/sinew-play
+PLAYF=$BUILD/sinew-play-float
+COW=$BUILD/examples/cow.blob
+COWF=$BUILD/examples/cow_float.blob
+mkdir -p "$OUT"
+log=$OUT/timing.txt
+: > "$log"
+
+run() {   # label, then player arguments
+    label=$1; shift
+    echo "== $label: $*" | sed "s|$BUILD/||g"
+    "$@" --quiet > "$OUT/run.out" 2>&1 || { cat "$OUT/run.out"; exit 1; }
+    cat "$OUT/run.out"
+    printf '%-38s %s\n' "$label" "$(grep '^step:' "$OUT/run.out")" >> "$log"
+}
+
+# Head turn (seed 000 fig. 5): whole clip as a sheet; at t = 2.17 s (head
+# turned 60 degrees towards the camera) rest | unwarped | warped side by side.
+run "head_turn fixed (180 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 180 \
+    --sheet "$OUT/head_turn_sheet.png" --title "head turn (fixed point)"
+run "head_turn fixed compare (130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
+    --compare "$OUT/head_turn_compare.png" --view 25,40
+run "head_turn float (180 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/head_turn.clip" --frames 180 --hash
+run "head_turn float compare (130 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/head_turn.clip" --frames 130 \
+    --compare "$OUT/head_turn_compare_float.png" --view 25,40
+
+# Trot in place, then stand: bounce, leg swings, settling flesh. The sheet
+# shows the first two strides (12 frames, 0.1 s apart); the timing run plays
+# the whole clip.
+run "trot fixed (216 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 216 --hash
+run "trot fixed sheet (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 \
+    --sheet "$OUT/trot_sheet.png" --title "trot (fixed point)"
+run "trot fixed lattice (40 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 40 \
+    --png "$OUT/trot_lattice.png" --lattice --title "trot, control lattice"
+run "trot float (216 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --frames 216 --hash
+run "trot float sheet (72 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --frames 72 \
+    --sheet "$OUT/trot_sheet_float.png" --title "trot (float)"
+# The README picture.
+run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
+    --compare "$OUT/demo.png" --size 320x240 --view 25,40
+rm -f "$OUT/run.out"
+
+echo
+echo "Per-step time of sn_step (median / p99 / max, this machine):"
+sed 's/^/  /' "$log"
+echo
+echo "Pictures in $OUT/:"
+for f in "$OUT"/*.png; do echo "  $f"; done
