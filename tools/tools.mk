@@ -67,3 +67,10 @@ EXAMPLE_BLOBS = $(EX)/cow.blob $(EX)/cow_float.blob $(EX)/cow_double.blob $(EX)/
 TEST_DEPS += $(EXAMPLE_BLOBS)
 
 all: $(BAKE) $(EXAMPLE_BLOBS)
+
+# ---- tests of the tool (tests/test_bake*.c link the tool library) ----
+BAKE_TESTS = $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_bake*.c))
+$(BUILD)/tests/test_bake%: tests/test_bake%.c $(TOOLS_LIB) $(TOOLS_HDR) tests/sn_test.h
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itools -Itests -Iruntime/src -o $@ $< $(TOOLS_LIB) -lm
+TEST_BINS += $(BAKE_TESTS)

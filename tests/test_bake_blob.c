@@ -1,0 +1,129 @@
+/* test_bake_blob.c -- host tool: blob bytes. Determinism, header and section
+ * table against sn_format.h, checksum, fixed/float/double agreement, Q ranges. */
+#include "sb.h"
+#include "sn_format.h"
+#include "sn_test.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static uint32_t u32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static unsigned u16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
+
+/* value of real number n of a section (any flavour), fixed decoded with q fractional bits */
+static double real_at(const unsigned char *b, uint32_t off, uint32_t n, int q)
+{
+    int fl = b[SN_H_FLAVOUR];
+    const unsigned char *p = b + off + (size_t)n * (fl == 2 ? 8u : 4u);
+    if (fl == 0) return ldexp((double)(int32_t)u32(p), -q);
+    if (fl == 1) { float f; uint32_t u = u32(p); memcpy(&f, &u, 4); return f; }
+    { double d; uint64_t u = (uint64_t)u32(p) | (uint64_t)u32(p + 4) << 32; memcpy(&d, &u, 8); return d; }
+}
+static uint32_t sec_off(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k); }
+static uint32_t sec_cnt(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k + 8); }
+
+static void check_structure(const sb_blob *bl, int flavour, const char *what)
+{
+    const unsigned char *b = bl->bytes;
+    uint32_t total = u32(b + SN_H_TOTAL_SIZE), prev = SN_HEADER_BYTES, k, i;
+    int rs = flavour == SB_DOUBLE ? 8 : 4;
+    T_CHECK(b[0] == 'S' && b[1] == 'N' && b[2] == 'W' && b[3] == 'B', "%s: magic", what);
+    T_CHECK(u32(b + SN_H_ENDIAN) == SN_ENDIAN_MARK && b[SN_H_ENDIAN] == 4, "%s: endian mark stored LE", what);
+    T_CHECK(total == bl->size && total % 8 == 0, "%s: total size %u", what, (unsigned)total);
+    T_CHECK(u32(b + SN_H_CRC32) == sb_crc32(b + 16, total - 16), "%s: CRC-32 of [16, total)", what);
+    T_CHECK(b[SN_H_FLAVOUR] == flavour && b[SN_H_REAL_SIZE] == rs && b[SN_H_NSECTIONS] == SN_SEC_COUNT, "%s: flavour fields", what);
+    T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
+            u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
+    T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS)),
+            "%s: instance bytes from SN_INSTANCE_BYTES", what);
+    for (k = 0; k < SN_SEC_COUNT; k++) {
+        uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);
+        T_CHECK(off % 8 == 0 && off >= prev && off + size <= total && size == cnt * es, "%s: section %u placement", what, (unsigned)k);
+        for (i = prev; i < off; i++) if (b[i]) break;
+        T_CHECK(i == off, "%s: zero padding before section %u", what, (unsigned)k);
+        prev = off + size;
+    }
+    /* sparsity: columns strictly increasing and above the row */
+    {
+        uint32_t nF = u32(b + SN_H_N_FREE), nV = u32(b + SN_H_N_VERTICES), r, bad = 0;
+        for (r = 0; r < nF; r++) {
+            uint32_t a = u32(b + sec_off(b, SN_SEC_ROWPTR) + 4 * r), e = u32(b + sec_off(b, SN_SEC_ROWPTR) + 4 * r + 4), c, prevc = r;
+            for (c = a; c < e; c++) { unsigned col = u16(b + sec_off(b, SN_SEC_COLS) + 2 * c); if (col <= prevc || col >= nV) bad++; prevc = col; }
+        }
+        T_CHECK(bad == 0, "%s: %u bad column indices", what, (unsigned)bad);
+    }
+}
+
+/* largest |stored integer| of a group of sections, fixed flavour */
+static double max_stored(const unsigned char *b, const int *secs, int nsec)
+{
+    double mx = 0;
+    int s;
+    uint32_t i;
+    for (s = 0; s < nsec; s++) {
+        uint32_t n = u32(b + SN_H_SECTIONS + 16 * secs[s] + 4) / 4;
+        for (i = 0; i < n; i++) mx = fmax(mx, fabs((double)(int32_t)u32(b + sec_off(b, secs[s]) + 4 * i)));
+    }
+    return mx;
+}
+
+int main(void)
+{
+    const char *descs[3] = {"tools/examples/cow/cow.sinew", "tools/examples/limb/limb.sinew", NULL};
+    int di;
+    (void)t_seed;
+    for (di = 0; descs[di]; di++) {
+        sb_model o1, o2, o3, o4;
+        sb_blob fx, fx2, fl, db;
+        const char *what = descs[di];
+        if (sb_bake_file(what, SB_FIXED, 1, &o1, &fx) || sb_bake_file(what, SB_FIXED, 1, &o2, &fx2) ||
+            sb_bake_file(what, SB_FLOAT, 1, &o3, &fl) || sb_bake_file(what, SB_DOUBLE, 1, &o4, &db)) {
+            T_CHECK(0, "bake %s: %s", what, sb_error());
+            continue;
+        }
+        T_CHECK(fx.size == fx2.size && memcmp(fx.bytes, fx2.bytes, fx.size) == 0, "%s: two bakes give identical bytes", what);
+        T_CHECK(fl.size == fx.size, "%s: float32 and fixed blobs have the same size", what);
+        check_structure(&fx, SB_FIXED, what);
+        check_structure(&fl, SB_FLOAT, what);
+        check_structure(&db, SB_DOUBLE, what);
+        {   /* fixed formats: the largest |entry| of each group lands in [2^26, 2^27] */
+            static const int gS[2] = {SN_SEC_SDIAG, SN_SEC_SOFF}, gM[3] = {SN_SEC_MDIAG, SN_SEC_MOFF, SN_SEC_MLUMP}, gP[1] = {SN_SEC_PRECOND};
+            double ms = max_stored(fx.bytes, gS, 2), mm = max_stored(fx.bytes, gM, 3), mp = max_stored(fx.bytes, gP, 1);
+            T_CHECK(ms >= 67108864.0 && ms <= 134217728.0, "%s: max |S| stored %.0f in [2^26, 2^27]", what, ms);
+            T_CHECK(mm >= 67108864.0 && mm <= 134217728.0, "%s: max |M| stored %.0f in [2^26, 2^27]", what, mm);
+            T_CHECK(mp >= 67108864.0 && mp <= 134217728.0, "%s: max |P| stored %.0f in [2^26, 2^27]", what, mp);
+            T_FIGURE("%s: frac_S %d frac_M %d frac_P %d len_shift %d, fixed blob %lu bytes, double %lu bytes",
+                     what, fx.frac_S, fx.frac_M, fx.frac_P, fx.len_shift, (unsigned long)fx.size, (unsigned long)db.size);
+        }
+        {   /* every real of every section: fixed within half an LSB of double, float32 within float rounding */
+            static const int secs[8] = {SN_SEC_REST, SN_SEC_MDIAG, SN_SEC_SDIAG, SN_SEC_PRECOND, SN_SEC_MLUMP, SN_SEC_MOFF, SN_SEC_SOFF, SN_SEC_JOINTS};
+            int s;
+            for (s = 0; s < 8; s++) {
+                int k = secs[s], q = k == SN_SEC_REST || k == SN_SEC_JOINTS ? SN_Q_LEN
+                                   : (k == SN_SEC_SDIAG || k == SN_SEC_SOFF) ? fx.frac_S : k == SN_SEC_PRECOND ? fx.frac_P : fx.frac_M;
+                uint32_t n = u32(fx.bytes + SN_H_SECTIONS + 16 * k + 4) / 4, i;
+                double efx = 0, efl = 0, mx = 0;
+                if (k == SN_SEC_JOINTS) continue;
+                for (i = 0; i < n; i++) {
+                    double d = real_at(db.bytes, sec_off(db.bytes, k), i, 0);
+                    efx = fmax(efx, fabs(real_at(fx.bytes, sec_off(fx.bytes, k), i, q) - d));
+                    efl = fmax(efl, fabs(real_at(fl.bytes, sec_off(fl.bytes, k), i, 0) - d));
+                    mx = fmax(mx, fabs(d));
+                }
+                T_NEAR(efx, 0, ldexp(0.5, -q) * (1 + 1e-9), "fixed = round to nearest: at most half an LSB");
+                T_NEAR(efl, 0, mx * 6e-8, "float32 rounding: 2^-24 relative to the entry, <= 2^-24 * max");
+            }
+        }
+        {   /* header scalars: h, gravity in internal units per step^2 */
+            double h = real_at(db.bytes, SN_H_REALS, SN_R_TIMESTEP, 0), gy = real_at(db.bytes, SN_H_REALS, SN_R_GRAV_Y, 0);
+            double U = ldexp(o4.unit, db.len_shift);
+            T_NEAR(gy, h * h * o4.g[1] / U, 1e-15, "g^ = h^2 g / U (NUMERICS.md), double round-off");
+            T_NEAR(real_at(fx.bytes, SN_H_REALS, SN_R_GRAV_Y, SN_Q_LEN), gy, ldexp(0.5, -SN_Q_LEN), "Q22 rounding");
+        }
+        T_CHECK(o1.nf < o1.nv && o1.nf >= 1, "%s: free and skeleton vertices present", what);
+        sb_blob_free(&fx); sb_blob_free(&fx2); sb_blob_free(&fl); sb_blob_free(&db);
+        sb_model_free(&o1); sb_model_free(&o2); sb_model_free(&o3); sb_model_free(&o4);
+    }
+    T_CHECK(sb_crc32((const unsigned char *)"123456789", 9) == 0xCBF43926u, "CRC-32 check value (zlib)");
+    return T_END();
+}
