@@ -1,0 +1,84 @@
+#!/bin/sh
+# Bad inputs to sinew-bake: each must fail with a clear message (file:line for
+# description mistakes), a non-zero exit and no output file (nor a temp file).
+BUILD=${BUILD:-build}
+BAKE=$BUILD/sinew-bake
+pass=0; fail=0
+[ -x "$BAKE" ] || { echo "FAIL: $BAKE not built"; echo "0 passed, 1 failed"; exit 1; }
+T=$(mktemp -d "${TMPDIR:-/tmp}/sinew_bake_err.XXXXXX") || exit 1
+trap 'rm -rf "$T"' EXIT
+sh tools/examples/make_box.sh -1 -1 -1 5 1 1 6 2 2 > "$T/box.obj"
+base() {   # a valid description: a 6x2x2 box with a two-bone chain
+    cat <<EOT
+mesh box.obj
+unit 0.1
+cell 1
+joint a - 0 0 0
+joint b a 2 0 0
+joint c b 4 0 0
+material flesh 1e5 0.3 1000
+EOT
+}
+# expect NAME MESSAGE_REGEX DESCRIPTION_FILE
+expect() {
+    name=$1; msg=$2; desc=$3
+    rm -f "$T/out.blob" "$T/out.blob.tmp" "$T/out.c"
+    "$BAKE" "$desc" -o "$T/out.blob" --c-array "$T/out.c" > "$T/stdout" 2> "$T/stderr"
+    rc=$?
+    if [ "$rc" -eq 0 ]; then
+        echo "FAIL $name: exit status 0"; fail=$((fail + 1))
+    elif ! grep -Eq "$msg" "$T/stderr"; then
+        echo "FAIL $name: message does not match /$msg/:"; sed 's/^/    /' "$T/stderr"; fail=$((fail + 1))
+    elif [ -e "$T/out.blob" ] || [ -e "$T/out.blob.tmp" ] || [ -e "$T/out.c" ] || [ -e "$T/out.c.tmp" ]; then
+        echo "FAIL $name: an output file was left behind"; fail=$((fail + 1))
+    else
+        echo "ok   $name: $(head -n 1 "$T/stderr")"; pass=$((pass + 1))
+    fi
+}
+# the valid base bakes (so the failures below are caused by the edits)
+base > "$T/ok.sinew"
+if "$BAKE" "$T/ok.sinew" -o "$T/ok.blob" --quiet && [ -s "$T/ok.blob" ]; then echo "ok   base description bakes"; pass=$((pass + 1)); else echo "FAIL base description"; fail=$((fail + 1)); fi
+
+# --- description mistakes: file:line ---
+{ base; echo "wobble 3"; } > "$T/d1.sinew";                        expect unknown-keyword "d1.sinew:8: unknown keyword 'wobble'" "$T/d1.sinew"
+{ base; echo "timestep"; } > "$T/d2.sinew";                        expect missing-value "d2.sinew:8: missing value" "$T/d2.sinew"
+{ base; echo "gravity 0 -9.81"; } > "$T/d3.sinew";                 expect missing-value-3 "d3.sinew:8: missing value" "$T/d3.sinew"
+{ base; echo "material soft nan 0.3 1000"; } > "$T/d4.sinew";      expect nan "d4.sinew:8: 'nan' is not a finite number" "$T/d4.sinew"
+{ base; echo "rayleigh inf 0"; } > "$T/d5.sinew";                  expect inf "d5.sinew:8: 'inf' is not a finite number" "$T/d5.sinew"
+{ base; echo "timestep 0.01x"; } > "$T/d6.sinew";                  expect not-a-number "d6.sinew:8: '0.01x' is not a number" "$T/d6.sinew"
+{ base; echo "material soft 0 0.3 1000"; } > "$T/d7.sinew";        expect E-zero "d7.sinew:8: Young's modulus E must be positive" "$T/d7.sinew"
+{ base; echo "material soft -5 0.3 1000"; } > "$T/d8.sinew";       expect E-negative "d8.sinew:8: Young's modulus E must be positive" "$T/d8.sinew"
+{ base; echo "material soft 1e5 0.3 0"; } > "$T/d9.sinew";         expect density-zero "d9.sinew:8: density must be positive" "$T/d9.sinew"
+{ base; echo "material soft 1e5 0.5 1000"; } > "$T/d10.sinew";     expect nu-half "d10.sinew:8: Poisson ratio must be in \(-1, 0.5\)" "$T/d10.sinew"
+{ base; echo "material soft 1e5 0.7 1000"; } > "$T/d11.sinew";     expect nu-large "d11.sinew:8: Poisson ratio" "$T/d11.sinew"
+{ base; echo "material soft 1e5 -1 1000"; } > "$T/d12.sinew";      expect nu-minus-one "d12.sinew:8: Poisson ratio" "$T/d12.sinew"
+{ base; echo "region box 0 0 0 1 1 1 rubber"; } > "$T/d13.sinew";  expect unknown-material "d13.sinew:8: unknown material 'rubber'" "$T/d13.sinew"
+{ base; echo "joint d zz 1 0 0"; } > "$T/d14.sinew";               expect unknown-parent "d14.sinew:8: joint 'd': unknown parent 'zz'" "$T/d14.sinew"
+{ base; echo "cell -1"; } > "$T/d15.sinew";                        expect cell-negative "d15.sinew:8: cell size must be positive" "$T/d15.sinew"
+{ base; echo "iterations 8 300"; } > "$T/d16.sinew";               expect iterations "d16.sinew:8: '300' must be an integer in 1..256" "$T/d16.sinew"
+base | sed 's/^joint c b 4 0 0/joint c b 9 0 0/' > "$T/d17.sinew"; expect joint-outside "d17.sinew:6: joint 'c' at \(9, 0, 0\) is outside the mesh" "$T/d17.sinew"
+base | sed 's/^joint c b 4 0 0/joint c b 2.3 0 0/' > "$T/d18.sinew"; expect bone-too-short "d18.sinew:6: bone 'b'->'c' \(length 0.3.*\) is too short for cell size 1" "$T/d18.sinew"
+base | sed 's/^joint c b 4 0 0/joint c a 3 0 0.4/' > "$T/d19.sinew"; expect bones-share-vertex "claim the same lattice vertex" "$T/d19.sinew"
+base | sed 's/^joint a - 0 0 0/joint a b 0 0 0/' > "$T/d20.sinew"; expect no-root "want exactly one root joint" "$T/d20.sinew"
+base | sed '/^mesh/d' > "$T/d21.sinew";                            expect no-mesh "missing 'mesh PATH'" "$T/d21.sinew"
+base | sed 's/^mesh box.obj/mesh nothere.obj/' > "$T/d22.sinew";   expect mesh-missing "nothere.obj: cannot open mesh" "$T/d22.sinew"
+expect no-description "cannot open description" "$T/nothere.sinew"
+
+# --- mesh problems ---
+base | sed 's/^mesh box.obj/mesh bad.obj/' > "$T/m.sinew"
+{ cat "$T/box.obj"; echo "v 1.0 2.0"; } > "$T/bad.obj";                     expect obj-short-vertex "bad.obj:[0-9]+: malformed vertex" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "f 1 2 x"; } > "$T/bad.obj";                       expect obj-bad-index "bad.obj:[0-9]+: malformed face" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "f 1 2 9999"; } > "$T/bad.obj";                    expect obj-index-range "bad.obj:[0-9]+: malformed face: bad or out-of-range vertex index '9999'" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "v 1 nan 2"; } > "$T/bad.obj";                     expect obj-nan "bad.obj:[0-9]+: malformed vertex coordinate 'nan'" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "bogus 1 2 3"; } > "$T/bad.obj";                   expect obj-statement "bad.obj:[0-9]+: malformed OBJ: unsupported statement 'bogus'" "$T/m.sinew"
+grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | sed 1d >> "$T/bad.obj"; expect mesh-open "bad.obj: mesh is not closed" "$T/m.sinew"
+grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | awk '{ print $1, $2, $4, $3 }' >> "$T/bad.obj"; expect mesh-inside-out "bad.obj: mesh encloses a non-positive volume" "$T/m.sinew"
+
+# --- command line ---
+"$BAKE" --help > "$T/help" 2>&1 && grep -q "usage: sinew-bake" "$T/help" && { echo "ok   --help"; pass=$((pass + 1)); } || { echo "FAIL --help"; fail=$((fail + 1)); }
+"$BAKE" "$T/ok.sinew" > /dev/null 2>&1 && { echo "FAIL missing -o accepted"; fail=$((fail + 1)); } || { echo "ok   missing -o rejected"; pass=$((pass + 1)); }
+"$BAKE" "$T/ok.sinew" -o "$T/x.blob" --flavour half > /dev/null 2>&1 || [ -e "$T/x.blob" ] && { echo "FAIL bad flavour"; fail=$((fail + 1)); } || { echo "ok   bad flavour rejected"; pass=$((pass + 1)); }
+"$BAKE" "$T/ok.sinew" -o "$T/x.blob" --c-array "$T/x.c" --name "9bad" > /dev/null 2>&1; rc=$?
+if [ $rc -ne 0 ] && [ ! -e "$T/x.blob" ] && [ ! -e "$T/x.c" ]; then echo "ok   bad C symbol rejected, no output"; pass=$((pass + 1)); else echo "FAIL bad C symbol"; fail=$((fail + 1)); fi
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
