@@ -21,15 +21,19 @@ run() {   # label, then player arguments
     printf '%-38s %s\n' "$label" "$(grep '^step:' "$OUT/run.out")" >> "$log"
 }
 
+# Camera on the front half of the cow (box in model space: mesh units
+# relative to the root joint, the hips).
+FRONT="--view 30,30 --frame-box 3,-3.4,-1.7,9.2,3,1.7"
+
 # Head turn (seed 000 fig. 5): whole clip as a sheet; at t = 2.17 s (head
 # turned 60 degrees towards the camera) rest | unwarped | warped side by side.
 run "head_turn fixed (180 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 180 \
     --sheet "$OUT/head_turn_sheet.png" --title "head turn (fixed point)"
 run "head_turn fixed compare (130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
-    --compare "$OUT/head_turn_compare.png" --view 25,40
+    --compare "$OUT/head_turn_compare.png" $FRONT
 run "head_turn float (180 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/head_turn.clip" --frames 180 --hash
 run "head_turn float compare (130 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/head_turn.clip" --frames 130 \
-    --compare "$OUT/head_turn_compare_float.png" --view 25,40
+    --compare "$OUT/head_turn_compare_float.png" $FRONT
 
 # Trot in place, then stand: bounce, leg swings, settling flesh. The sheet
 # shows the first two strides (12 frames, 0.1 s apart); the timing run plays
@@ -44,7 +48,7 @@ run "trot float sheet (72 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --f
     --sheet "$OUT/trot_sheet_float.png" --title "trot (float)"
 # The README picture.
 run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
-    --compare "$OUT/demo.png" --size 320x240 --view 25,40
+    --compare "$OUT/demo.png" --size 400x300 $FRONT
 rm -f "$OUT/run.out"
 
 echo

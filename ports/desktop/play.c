@@ -39,6 +39,7 @@ static void usage(FILE *f) {
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
         "  --size WxH         picture size for --png (default 640x480)\n"
         "  --view AZ,EL       camera azimuth, elevation in degrees (default 30,15)\n"
+        "  --frame-box X0,Y0,Z0,X1,Y1,Z1  box the camera frames, model space (mesh units relative to the root joint; default: rest surface)\n"
         "  --title TEXT       caption on the pictures\n"
         "  --hash             end with 'hash: <16 hex>' (sn_state_hash of the final state)\n"
         "  --quiet            only errors, timing and hash\n"
@@ -87,9 +88,11 @@ static int probe_writable(const char *path, char *err, size_t errlen) {
     return 0;
 }
 
-static double now_us(void) {
+/* Wall clock; the thread's CPU clock too, which leaves out time the OS gave
+ * to other processes (stabler figures on a busy machine). */
+static double now_us(clockid_t which) {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(which, &ts);
     return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
 }
 static int cmp_double(const void *a, const void *b) {
@@ -106,6 +109,7 @@ typedef struct {
     sn_vec3 *surf, *latt;       /* scratch outputs */
     float *pos, *lpos;          /* float copies */
     float lo[3], hi[3];         /* rest surface box: the camera's frame */
+    float flo[3], fhi[3];       /* box the camera frames (default: lo, hi) */
     float az, el;
     int lattice;
 } scene;
@@ -169,7 +173,8 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     uint32_t e, v;
     if (rs_image_alloc(&big, 2 * out->w, 2 * out->h)) return -1;
     fetch(s, inst);
-    rs_camera_frame(&cam, s->lo, s->hi, big.w, big.h, s->az, s->el);
+    rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
+    cam.ground_y = s->lo[1];   /* the ground stays under the hooves */
     rs_clear(&big, &cam);
     rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
     if (s->lattice) {
@@ -190,12 +195,13 @@ typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *png, *sheet, *compare, *title;
     long frames, iterations;
     int unwarped, hash, lattice, quiet, w, h;
-    float az, el;
+    float az, el, box[6];
+    int have_box;
 } options;
 
 static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--png", "--sheet", "--compare", "--title",
-                                         "--frames", "--iterations", "--size", "--view", NULL};
+                                         "--frames", "--iterations", "--size", "--view", "--frame-box", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -224,6 +230,13 @@ static int parse_args(int argc, char **argv, options *o) {
             if (sscanf(v, "%dx%d", &o->w, &o->h) != 2 || o->w < 16 || o->h < 16 || o->w > 4096 || o->h > 4096) {
                 fprintf(stderr, PROG ": --size: want WxH (16..4096), got '%s'\n", v); return 2;
             }
+        } else if (!strcmp(a, "--frame-box")) {
+            float *b = o->box;
+            if (sscanf(v, "%f,%f,%f,%f,%f,%f", b, b + 1, b + 2, b + 3, b + 4, b + 5) != 6 ||
+                !(b[0] < b[3] && b[1] < b[4] && b[2] < b[5])) {
+                fprintf(stderr, PROG ": --frame-box: want X0,Y0,Z0,X1,Y1,Z1 with X0<X1 etc., got '%s'\n", v); return 2;
+            }
+            o->have_box = 1;
         } else if (!strcmp(a, "--view")) {
             if (sscanf(v, "%f,%f", &o->az, &o->el) != 2 || o->el < -89 || o->el > 89) {
                 fprintf(stderr, PROG ": --view: want AZ,EL in degrees, got '%s'\n", v); return 2;
@@ -273,7 +286,7 @@ int main(int argc, char **argv) {
     int have_clip = 0, rc = 1;
     sn_quat *local = NULL;
     sn_xform *xf = NULL;
-    double *times = NULL, h_s;
+    double *times = NULL, *cpu = NULL, h_s;
     long k, n_frames;
     uint32_t i, t;
     rs_image sheet, panel, cmp;
@@ -351,7 +364,8 @@ int main(int argc, char **argv) {
     s.lpos = malloc(s.info.vertices * 3 * sizeof(float));
     s.tri = malloc((s.info.triangles + 1) * 3 * sizeof(uint32_t));
     times = malloc(((size_t)n_frames + 1) * sizeof(double));
-    if (!local || !xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times) { die("out of memory"); goto done; }
+    cpu = malloc(((size_t)n_frames + 1) * sizeof(double));
+    if (!local || !xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times || !cpu) { die("out of memory"); goto done; }
     for (t = 0; t < s.info.triangles; t++) sn_get_triangle(s.blob, t, s.tri + 3 * t);
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((o.png || o.sheet || o.compare) && !s.info.triangles) {
@@ -369,6 +383,10 @@ int main(int argc, char **argv) {
                 if (s.pos[3 * i + (uint32_t)k] < s.lo[k]) s.lo[k] = s.pos[3 * i + (uint32_t)k];
                 if (s.pos[3 * i + (uint32_t)k] > s.hi[k]) s.hi[k] = s.pos[3 * i + (uint32_t)k];
             }
+        for (k = 0; k < 3; k++) {
+            s.flo[k] = o.have_box ? o.box[k] : s.lo[k];
+            s.fhi[k] = o.have_box ? o.box[3 + k] : s.hi[k];
+        }
     }
     if (!o.quiet)
         printf("%s: %u lattice vertices (%u free), %u cells, %u joints, %u surface vertices, %u triangles, "
@@ -388,7 +406,7 @@ int main(int argc, char **argv) {
 
     /* run */
     for (k = 1; k <= n_frames; k++) {
-        double t0, t1;
+        double t0, t1, c0, c1;
         if (have_clip) sn_clip_pose(&clip, s.blob, (uint32_t)k, local, xf);
         else {
             for (i = 0; i < s.info.joints; i++) {
@@ -402,10 +420,13 @@ int main(int argc, char **argv) {
             sn_pose_from_local(s.blob, local, NULL, xf);
         }
         sn_set_pose(inst, xf, s.info.joints);
-        t0 = now_us();
+        c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
+        t0 = now_us(CLOCK_MONOTONIC);
         sn_step(inst);
-        t1 = now_us();
+        t1 = now_us(CLOCK_MONOTONIC);
+        c1 = now_us(CLOCK_THREAD_CPUTIME_ID);
         times[k - 1] = t1 - t0;
+        cpu[k - 1] = c1 - c0;
         if (inst2) { sn_set_pose(inst2, xf, s.info.joints); sn_step(inst2); }
         if (o.obj_dir) {
             snprintf(path, sizeof path, "%s/frame_%04ld.obj", o.obj_dir, k);
@@ -417,7 +438,7 @@ int main(int argc, char **argv) {
             for (p = 0; p < SHEET_COLS * SHEET_ROWS; p++)
                 if (sheet_at[p] == k) {
                     char lab[64];
-                    snprintf(lab, sizeof lab, "t=%.2fs", (double)k * h_s);
+                    snprintf(lab, sizeof lab, "t = %.2f s", (double)k * h_s);
                     if (render(&s, inst, &panel, lab, p == 0 ? o.title : NULL)) { die("out of memory"); goto done; }
                     rs_blit(&sheet, (p % SHEET_COLS) * panel.w, (p / SHEET_COLS) * panel.h, &panel);
                 }
@@ -429,10 +450,12 @@ int main(int argc, char **argv) {
         sn_stats stats;
         long p99 = (long)(0.99 * (double)(n_frames - 1) + 0.5);
         qsort(times, (size_t)n_frames, sizeof(double), cmp_double);
+        qsort(cpu, (size_t)n_frames, sizeof(double), cmp_double);
         sn_get_stats(inst, &stats);
-        printf("step: median %.1f us, p99 %.1f us, max %.1f us over %ld steps (%s, %u CG iterations, %u saturations)\n",
+        printf("step: median %.1f us, p99 %.1f us, max %.1f us over %ld steps (%s, %u CG iterations, %u saturations); "
+               "thread CPU time: median %.1f us, p99 %.1f us\n",
                times[n_frames / 2], times[p99], times[n_frames - 1], n_frames,
-               SN_FLAVOUR ? "float" : "fixed", stats.iterations, stats.saturations);
+               SN_FLAVOUR ? "float" : "fixed", stats.iterations, stats.saturations, cpu[n_frames / 2], cpu[p99]);
         if (stats.saturations)
             fprintf(stderr, PROG ": warning: %u fixed-point values were clamped (saturated) in this run; "
                     "the motion is not trustworthy\n", stats.saturations);
@@ -442,7 +465,7 @@ int main(int argc, char **argv) {
     if (o.png) {
         char lab[64];
         if (rs_image_alloc(&cmp, o.w, o.h)) { die("out of memory"); goto done; }
-        snprintf(lab, sizeof lab, "t=%.2fs", (double)n_frames * h_s);
+        snprintf(lab, sizeof lab, "t = %.2f s", (double)n_frames * h_s);
         if (render(&s, inst, &cmp, o.title ? o.title : lab, o.title ? lab : NULL) ||
             png_write(o.png, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
         rs_image_free(&cmp);
@@ -465,7 +488,7 @@ int main(int argc, char **argv) {
         int pw = o.w * 3 / 4 > 240 ? o.w * 3 / 4 : 240, ph = pw * 3 / 4;
         if (!mem0 || sn_instance_init(mem0, need, s.blob, &rest) != SN_OK ||
             rs_image_alloc(&cmp, 3 * pw, ph) || rs_image_alloc(&pane, pw, ph)) { free(mem0); die("out of memory"); goto done; }
-        snprintf(lab, sizeof lab, "t=%.2fs", (double)n_frames * h_s);
+        snprintf(lab, sizeof lab, "t = %.2f s", (double)n_frames * h_s);
         render(&s, rest, &pane, "rest", NULL);
         rs_blit(&cmp, 0, 0, &pane);
         render(&s, unwarped, &pane, "unwarped (global linear)", lab);
@@ -483,7 +506,7 @@ int main(int argc, char **argv) {
     rc = 0;
 done:
     rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp);
-    free(bytes); free(mem); free(mem2); free(local); free(xf); free(times);
+    free(bytes); free(mem); free(mem2); free(local); free(xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
     return rc;
 }

@@ -43,8 +43,8 @@ void rs_draw_line(rs_image *im, const rs_camera *cam, const float a[3], const fl
 /// Dot of radius r pixels at p, drawn over everything.
 void rs_draw_dot(rs_image *im, const rs_camera *cam, const float p[3], float r, const uint8_t color[3]);
 
-/// Text at pixel (x, y) (top-left), 5x7 glyphs scaled by s; ASCII 32..126
-/// (lower case drawn as upper case).
+/// Text at pixel (x, y) (top-left), 5x7 glyphs scaled by s: letters, digits,
+/// . : = - + / ( ) , | % _ and space; other characters are skipped.
 void rs_draw_text(rs_image *im, int x, int y, int s, const char *text, const uint8_t color[3]);
 
 /// Box-filter src (2w x 2h) into dst (w x h).

@@ -78,6 +78,13 @@ grep -c '^v ' "$TMP/out/frame_0020.obj" | grep -q '^2903$' && ok || bad "frame_0
 for p in p s; do
     [ "$(head -c 8 "$TMP/out/$p.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && ok || bad "$p.png is not a PNG"
 done
+# compare (two instances) with the lattice overlay and a framing box
+expect 0 "wrote $TMP/out/c.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 10 --compare "$TMP/out/c.png" \
+    --lattice --view 20,30 --frame-box 0,-3,-2,9,3,2 --size 320x240
+[ "$(head -c 24 "$TMP/out/c.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a0000000d49484452000002d0000000b4 ] \
+    && ok || bad "compare picture is not a 720x180 PNG"
+expect 2 'frame-box: want' "$PLAY" "$BLOB" --frame-box 1,2,3
+expect 2 'size: want WxH' "$PLAY" "$BLOB" --size 10x10
 ls "$TMP/out" | grep -q 'tmp\|probe' && bad "temp files left: $(ls "$TMP/out")" || ok
 
 # --hash: same line twice; differs with a different mode; float player runs
