@@ -451,8 +451,8 @@ static int32_t ratio(sn_dotv num, sn_dotv den) {
     d = (uint64_t)den.m;
     e = SN_Q_SCAL + num.e - den.e;
     /* normalize den to [2^30, 2^31) and num to [2^61, 2^62) */
-    bd = bitlen64(d);
-    if (bd > 31) { d >>= (bd - 31); e += bd - 31; } else { d <<= (31 - bd); e -= 31 - bd; }
+    bd = bitlen64(d); /* den = d * 2^(bd-31): a larger true den lowers the exponent */
+    if (bd > 31) { d >>= (bd - 31); e -= bd - 31; } else { d <<= (31 - bd); e += 31 - bd; }
     bn = bitlen64(n);
     if (bn > 62) { n >>= (bn - 62); e += bn - 62; } else { n <<= (62 - bn); e -= 62 - bn; }
     q = n / d; /* in [2^30, 2^32) */
