@@ -30,3 +30,19 @@ $(SN_LIB_FIXED): $(SN_OBJS_FIXED)
 $(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
 	@rm -f $@
 	$(AR) rcs $@ $^
+
+# ---- runtime tests: each built fixed and float (suffix _float) ----
+SN_TCFLAGS = -std=c99 -Wall -Wextra -Wpedantic -Werror $(CFLAGS) $(SN_INC) -Iruntime/src -Itests
+SN_TEST_HDRS = $(SN_HDRS) tests/sn_test.h tests/fuzz/sn_tblob.h
+SN_TESTS = math blob
+
+define SN_TEST_RULE
+$(BUILD)/tests/test_runtime_$(1): tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $$(@D)
+	$(CC) $(SN_TCFLAGS) -o $$@ $$< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_$(1)_float: tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $$(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $$@ $$< $(SN_LIB_FLOAT) -lm
+endef
+$(foreach t,$(SN_TESTS),$(eval $(call SN_TEST_RULE,$(t))))
+TEST_BINS += $(foreach t,$(SN_TESTS),$(BUILD)/tests/test_runtime_$(t) $(BUILD)/tests/test_runtime_$(t)_float)

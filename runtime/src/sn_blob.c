@@ -15,10 +15,10 @@
  *
  * Numeric bounds (fixed flavour, stored integers): matrix entries
  * |e| <= 2^27; rest and joint coordinates |x| <= 2^27 (Q22: 32 internal
- * units); a1, b1 in [0, 2^28] (Q24: [0, 16]); |gravity| <= 2^27 (Q22);
+ * units) and at most 16384 mesh units (|x| <= 2^(36 - len_shift)); a1, b1 in [0, 2^28] (Q24: [0, 16]); |gravity| <= 2^27 (Q22);
  * timestep > 0. Float flavour: every real finite, and the same bounds as
  * true values (the stored integer divided by 2^Q of its format; matrices
- * taken at Q0): |e| <= 2^27, |x| <= 32, a1, b1 in [0, 16], |g| <= 32,
+ * taken at Q0): |e| <= 2^27, |x| <= min(32, 2^(14 - len_shift)), a1, b1 in [0, 16], |g| <= 32,
  * 0 < h <= 32768, reserved reals +0.0.
  */
 #include "sn_internal.h"
@@ -86,6 +86,10 @@ static void sn_view_sections(sn_view *v);
 /* Section contents, given a header and table already checked. */
 static sn_status sn_check_contents(const sn_view *v) {
     const int32_t E = SN_ENTRY_LIM; /* 2^27 */
+    /* coordinates: |x| <= 2^27 (Q22) and, in public Q16.16 mesh units,
+     * |x * 2^(len_shift-6)| <= 2^30 (16384 mesh units), so public rest values
+     * and their differences cannot overflow int32 */
+    const int32_t X = v->len_shift > 9 ? (int32_t)1 << (36 - v->len_shift) : E;
     const unsigned char *s;
     uint32_t i, j, k;
 
@@ -97,7 +101,7 @@ static sn_status sn_check_contents(const sn_view *v) {
         if (j == 0) SN_CHK(par == 0xFFFFu, SN_ERR_INDEX);
         else SN_CHK(par < j, SN_ERR_INDEX);
         SN_CHK(sn_rd_u16(e + 2) == 0 && sn_rd_u32(e + 4) == 0, SN_ERR_VALUE);
-        SN_CHK(sn_reals_ok(e + 8, 3, E, SN_Q_LEN), SN_ERR_VALUE);
+        SN_CHK(sn_reals_ok(e + 8, 3, X, SN_Q_LEN), SN_ERR_VALUE);
     }
     /* names: non-empty, NUL-terminated, NUL-padded, unique */
     s = v->sec[SN_SEC_JOINT_NAMES];
@@ -110,7 +114,7 @@ static sn_status sn_check_contents(const sn_view *v) {
             SN_CHK(memcmp(n, s + (size_t)i * SN_JOINT_NAME_MAX, SN_JOINT_NAME_MAX) != 0,
                    SN_ERR_VALUE);
     }
-    SN_CHK(sn_reals_ok(v->sec[SN_SEC_REST], 3 * v->nV, E, SN_Q_LEN), SN_ERR_VALUE);
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_REST], 3 * v->nV, X, SN_Q_LEN), SN_ERR_VALUE);
     /* frames: bones < nJ, w <= 1 (Q15); skeleton vertices rigid to bone1 */
     s = v->sec[SN_SEC_FRAMES];
     for (i = 0; i < v->nV; i++) {

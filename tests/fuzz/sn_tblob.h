@@ -1,0 +1,220 @@
+/* sn_tblob.h -- a tiny, independent writer of valid Sinew blobs for the
+ * runtime's own tests (validator, accessors, fuzz seed). Not the host tool:
+ * it shares only the layout constants of sn_format.h.
+ *
+ * The asset: 2 hexahedral cells along x (3x2x2 = 12 lattice vertices), the
+ * x = 0 face (4 vertices) bound rigidly to the root joint (skeleton), 8 free
+ * vertices framed by root/tip; consistent trilinear mass, a graph-Laplacian
+ * stiffness (3x3 blocks = scalar x I, PSD, translations in the null space),
+ * its block-Jacobi preconditioner, 4 embedded surface vertices, 2 triangles.
+ * Flavour follows SN_FLOAT of the including file (fixed: Q formats of
+ * NUMERICS.md; float: true values).
+ */
+#ifndef SN_TBLOB_H
+#define SN_TBLOB_H
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#include "sinew.h"
+#include "sn_format.h"
+
+#define TB_NV 12
+#define TB_NF 8
+#define TB_NJ 2
+#define TB_NC 2
+#define TB_NS 4
+#define TB_NT 2
+#define TB_FRAC 26   /* frac_S = frac_P */
+#define TB_FRAC_M 24 /* lumped mass rows reach 3.4 */
+
+static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
+static void tb_u32(unsigned char *p, uint32_t v) {
+    tb_u16(p, v & 0xFFFFu);
+    tb_u16(p + 2, v >> 16);
+}
+static uint32_t tb_rd32(const unsigned char *p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+/* a real with value v, in Q q for the fixed flavour */
+static void tb_real(unsigned char *p, double v, int q) {
+#if defined(SN_FLOAT)
+    float f = (float)v;
+    uint32_t u;
+    (void)q;
+    memcpy(&u, &f, 4);
+    tb_u32(p, u);
+#else
+    double s = floor(v * ldexp(1.0, q) + 0.5);
+    tb_u32(p, (uint32_t)(int32_t)s);
+#endif
+}
+
+static uint32_t tb_crc32(const unsigned char *p, uint32_t n) {
+    uint32_t c = 0xFFFFFFFFu, i;
+    int k;
+    for (i = 0; i < n; i++) {
+        c ^= p[i];
+        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+/* Recompute the checksum after editing a blob. */
+static void tb_fix_crc(unsigned char *b) {
+    uint32_t total = tb_rd32(b + SN_H_TOTAL_SIZE);
+    tb_u32(b + SN_H_CRC32, tb_crc32(b + 16, total - 16));
+}
+static uint32_t tb_sec(const unsigned char *b, int k) { return tb_rd32(b + SN_H_SECTIONS + 16 * k); }
+
+/* vertex index of grid point (ix 0..2, iy 0..1, iz 0..1): x = 0 face last */
+static int tb_vid(int ix, int iy, int iz) {
+    return ix == 0 ? TB_NF + iy + 2 * iz : (ix - 1) * 4 + iy + 2 * iz;
+}
+
+/* Write the blob into b (zeroed by the caller? no: written whole here);
+ * returns its size. len_shift: internal unit = 2^len_shift mesh units.
+ * cap must be >= 4096. */
+static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
+    const int R = 4;
+    double X[TB_NV][3], M[TB_NV][TB_NV], S[TB_NV][TB_NV], m0 = 0.0;
+    const double a1 = 1.0 / 60.0, b1 = 0.06, k = 0.05, cell = 0.5;
+    int corner[TB_NC][8];
+    uint32_t off, cnt[SN_SEC_COUNT], elem[SN_SEC_COUNT], secoff[SN_SEC_COUNT];
+    int c, i, j, a, bb, d, sec, nnz = 0;
+    memset(b, 0, cap);
+    memset(M, 0, sizeof M);
+    memset(S, 0, sizeof S);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 2; j++)
+            for (d = 0; d < 2; d++) {
+                int v = tb_vid(i, j, d);
+                X[v][0] = i * cell;
+                X[v][1] = (j - 0.5) * cell;
+                X[v][2] = (d - 0.5) * cell;
+            }
+    for (c = 0; c < TB_NC; c++)
+        for (a = 0; a < 8; a++) corner[c][a] = tb_vid(c + (a & 1), (a >> 1) & 1, (a >> 2) & 1);
+    /* consistent trilinear hex mass V/216 * prod(1 + [same coordinate]); Laplacian stiffness */
+    for (c = 0; c < TB_NC; c++)
+        for (a = 0; a < 8; a++)
+            for (bb = 0; bb < 8; bb++) {
+                double m = cell * cell * cell / 216.0;
+                for (d = 0; d < 3; d++) m *= 1.0 + (((a >> d) & 1) == ((bb >> d) & 1));
+                M[corner[c][a]][corner[c][bb]] += m;
+                if (a != bb) {
+                    S[corner[c][a]][corner[c][bb]] -= k;
+                    S[corner[c][a]][corner[c][a]] += k;
+                }
+            }
+    for (i = 0; i < TB_NV; i++) m0 = M[i][i] > m0 ? M[i][i] : m0;
+    for (i = 0; i < TB_NV; i++)
+        for (j = 0; j < TB_NV; j++) M[i][j] /= m0;
+    for (i = 0; i < TB_NF; i++)
+        for (j = i + 1; j < TB_NV; j++) nnz += M[i][j] != 0.0;
+
+    cnt[SN_SEC_JOINTS] = TB_NJ;       elem[SN_SEC_JOINTS] = (uint32_t)SN_ELEM_JOINTS(R);
+    cnt[SN_SEC_JOINT_NAMES] = TB_NJ;  elem[SN_SEC_JOINT_NAMES] = SN_ELEM_JOINT_NAMES;
+    cnt[SN_SEC_REST] = TB_NV;         elem[SN_SEC_REST] = (uint32_t)SN_ELEM_REST(R);
+    cnt[SN_SEC_FRAMES] = TB_NV;       elem[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
+    cnt[SN_SEC_MDIAG] = TB_NF;        elem[SN_SEC_MDIAG] = (uint32_t)SN_ELEM_MDIAG(R);
+    cnt[SN_SEC_SDIAG] = TB_NF;        elem[SN_SEC_SDIAG] = (uint32_t)SN_ELEM_SDIAG(R);
+    cnt[SN_SEC_PRECOND] = TB_NF;      elem[SN_SEC_PRECOND] = (uint32_t)SN_ELEM_PRECOND(R);
+    cnt[SN_SEC_MLUMP] = TB_NF;        elem[SN_SEC_MLUMP] = (uint32_t)SN_ELEM_MLUMP(R);
+    cnt[SN_SEC_ROWPTR] = TB_NF + 1;   elem[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
+    cnt[SN_SEC_COLS] = (uint32_t)nnz; elem[SN_SEC_COLS] = SN_ELEM_COLS;
+    cnt[SN_SEC_MOFF] = (uint32_t)nnz; elem[SN_SEC_MOFF] = (uint32_t)SN_ELEM_MOFF(R);
+    cnt[SN_SEC_SOFF] = (uint32_t)nnz; elem[SN_SEC_SOFF] = (uint32_t)SN_ELEM_SOFF(R);
+    cnt[SN_SEC_CELLS] = TB_NC;        elem[SN_SEC_CELLS] = SN_ELEM_CELLS;
+    cnt[SN_SEC_EMBED] = TB_NS;        elem[SN_SEC_EMBED] = SN_ELEM_EMBED;
+    cnt[SN_SEC_TRIS] = TB_NT;         elem[SN_SEC_TRIS] = SN_ELEM_TRIS;
+    off = SN_HEADER_BYTES;
+    for (sec = 0; sec < SN_SEC_COUNT; sec++) {
+        off = (off + 7u) & ~7u;
+        secoff[sec] = off;
+        tb_u32(b + SN_H_SECTIONS + 16 * sec, off);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 4, cnt[sec] * elem[sec]);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 8, cnt[sec]);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 12, elem[sec]);
+        off += cnt[sec] * elem[sec];
+    }
+    /* joints: root at the origin, tip at (0.5, 0, 0) */
+    tb_u16(b + secoff[SN_SEC_JOINTS], 0xFFFFu);
+    tb_u16(b + secoff[SN_SEC_JOINTS] + elem[SN_SEC_JOINTS], 0);
+    tb_real(b + secoff[SN_SEC_JOINTS] + elem[SN_SEC_JOINTS] + 8, cell, SN_Q_LEN);
+    memcpy(b + secoff[SN_SEC_JOINT_NAMES], "root", 4);
+    memcpy(b + secoff[SN_SEC_JOINT_NAMES] + 32, "tip", 3);
+    for (i = 0; i < TB_NV; i++) {
+        unsigned char *f = b + secoff[SN_SEC_FRAMES] + 4 * i;
+        for (d = 0; d < 3; d++) tb_real(b + secoff[SN_SEC_REST] + (3 * i + d) * R, X[i][d], SN_Q_LEN);
+        if (i < TB_NF) { /* blend root -> tip along x */
+            f[0] = 0;
+            f[1] = 1;
+            tb_u16(f + 2, (uint32_t)(X[i][0] * 32768.0 + 0.5));
+        }
+    }
+    {
+        uint32_t e = 0;
+        for (i = 0; i < TB_NF; i++) {
+            double ms = 0.0, p = (1.0 + a1) * M[i][i] + (1.0 + b1) * S[i][i];
+            tb_real(b + secoff[SN_SEC_MDIAG] + i * R, M[i][i], TB_FRAC_M);
+            for (d = 0; d < 3; d++) {
+                tb_real(b + secoff[SN_SEC_SDIAG] + (6 * i + d) * R, S[i][i], TB_FRAC);
+                tb_real(b + secoff[SN_SEC_PRECOND] + (6 * i + d) * R, 1.0 / p, TB_FRAC);
+            }
+            for (j = 0; j < TB_NV; j++) ms += M[i][j];
+            tb_real(b + secoff[SN_SEC_MLUMP] + i * R, ms, TB_FRAC_M);
+            tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * i, e);
+            for (j = i + 1; j < TB_NV; j++) {
+                if (M[i][j] == 0.0) continue;
+                tb_u16(b + secoff[SN_SEC_COLS] + 2 * e, (uint32_t)j);
+                tb_real(b + secoff[SN_SEC_MOFF] + e * R, M[i][j], TB_FRAC_M);
+                for (d = 0; d < 3; d++)
+                    tb_real(b + secoff[SN_SEC_SOFF] + (9 * e + 4 * (uint32_t)d) * R, S[i][j], TB_FRAC);
+                e++;
+            }
+        }
+        tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * TB_NF, e);
+    }
+    for (c = 0; c < TB_NC; c++)
+        for (a = 0; a < 8; a++) tb_u16(b + secoff[SN_SEC_CELLS] + 16 * c + 2 * a, (uint32_t)corner[c][a]);
+    {
+        static const uint16_t emb[TB_NS][4] = {
+            {0, 16384, 0, 32768}, {1, 32768, 0, 32768}, {1, 32768, 32768, 32768}, {0, 16384, 32768, 32768}};
+        static const uint16_t tri[TB_NT][3] = {{0, 1, 2}, {0, 2, 3}};
+        for (i = 0; i < TB_NS; i++)
+            for (d = 0; d < 4; d++) tb_u16(b + secoff[SN_SEC_EMBED] + 8 * i + 2 * d, emb[i][d]);
+        for (i = 0; i < TB_NT; i++)
+            for (d = 0; d < 3; d++) tb_u16(b + secoff[SN_SEC_TRIS] + 6 * i + 2 * d, tri[i][d]);
+    }
+    /* header */
+    b[0] = 'S'; b[1] = 'N'; b[2] = 'W'; b[3] = 'B';
+    tb_u16(b + SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
+    tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR);
+    tb_u32(b + SN_H_ENDIAN, SN_ENDIAN_MARK);
+    tb_u32(b + SN_H_TOTAL_SIZE, off);
+    tb_u32(b + SN_H_HEADER_SIZE, SN_HEADER_BYTES);
+    b[SN_H_FLAVOUR] = SN_FLAVOUR;
+    b[SN_H_REAL_SIZE] = 4;
+    b[SN_H_NSECTIONS] = SN_SEC_COUNT;
+    tb_u32(b + SN_H_ONE, SN_FLAVOUR ? SN_ONE_FLOAT32 : SN_ONE_FIXED);
+    tb_u32(b + SN_H_N_VERTICES, TB_NV);
+    tb_u32(b + SN_H_N_FREE, TB_NF);
+    tb_u32(b + SN_H_N_CELLS, TB_NC);
+    tb_u32(b + SN_H_N_JOINTS, TB_NJ);
+    tb_u32(b + SN_H_N_SURFACE, TB_NS);
+    tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
+    tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ));
+    tb_u16(b + SN_H_CG_DEFAULT, 8);
+    tb_u16(b + SN_H_CG_MAX, 32);
+    b[SN_H_LEN_SHIFT] = (unsigned char)(len_shift & 0xFF);
+    b[SN_H_FRAC_S] = b[SN_H_FRAC_P] = TB_FRAC;
+    b[SN_H_FRAC_M] = TB_FRAC_M;
+    tb_real(b + SN_H_REALS + SN_R_A1 * R, a1, SN_Q_COEF);
+    tb_real(b + SN_H_REALS + SN_R_B1 * R, b1, SN_Q_COEF);
+    tb_real(b + SN_H_REALS + SN_R_GRAV_Y * R, -9.81 / 3600.0, SN_Q_LEN);
+    tb_real(b + SN_H_REALS + SN_R_TIMESTEP * R, 1.0 / 60.0, 16);
+    tb_real(b + SN_H_REALS + SN_R_MASS_SCALE * R, m0, 16);
+    tb_fix_crc(b);
+    return off;
+}
+#endif

@@ -1,0 +1,413 @@
+/* test_runtime_blob.c -- sn_blob_validate and the blob accessors.
+ *
+ * A hand-built minimal blob (tests/fuzz/sn_tblob.h, independent of the host
+ * tool) must be accepted; then every header, section-table and content rule
+ * is broken one at a time (checksum recomputed, so the rule itself is what
+ * fails) and the validator must return that rule's specific status. Built
+ * twice: fixed (default) and float (-DSN_FLOAT).
+ */
+#include <stdint.h>
+#include <string.h>
+
+#include "sn_test.h"
+#include "sinew.h"
+#include "sn_internal.h"
+#include "fuzz/sn_tblob.h"
+
+#define CAP 8192
+typedef union { uint64_t align; unsigned char b[CAP + 16]; } tbuf;
+static tbuf g_base, g_work;
+static uint32_t g_total;
+
+#if defined(SN_FLOAT)
+#define FLAV "float"
+#define SN_FLOAT_OR(f, i) (f)
+#else
+#define FLAV "fixed"
+#define SN_FLOAT_OR(f, i) (i)
+#endif
+
+/* A raw value just beyond an integer bound `lim` of Q format q (fixed: lim+1;
+ * float: the true value lim/2^q times 1.0001), or exactly at it. */
+static void put_over(unsigned char *p, double lim, int q) {
+#if defined(SN_FLOAT)
+    tb_real(p, lim / ldexp(1.0, q) * 1.0001, 0);
+#else
+    (void)q;
+    tb_u32(p, (uint32_t)(int32_t)(lim >= 0 ? lim + 1 : lim - 1));
+#endif
+}
+static void put_at(unsigned char *p, double lim, int q) {
+#if defined(SN_FLOAT)
+    tb_real(p, lim / ldexp(1.0, q), 0);
+#else
+    (void)q;
+    tb_u32(p, (uint32_t)(int32_t)lim);
+#endif
+}
+
+static sn_status run(const unsigned char *b, size_t size) {
+    const sn_blob *out = (const sn_blob *)1;
+    sn_status s = sn_blob_validate(b, size, &out);
+    if (s != SN_OK && out != NULL) return SN_STATUS_COUNT; /* must clear *out */
+    if (s == SN_OK && out != (const sn_blob *)(const void *)b) return SN_STATUS_COUNT;
+    return s;
+}
+
+static void expect(const char *what, sn_status got, sn_status want) {
+    T_CHECK(got == want, "[%s] %s: got %s (%d), want %s (%d)", FLAV, what,
+            got < SN_STATUS_COUNT ? sn_status_str(got) : "bad *out", (int)got, sn_status_str(want),
+            (int)want);
+}
+
+/* Mutate a fresh copy (b), recompute the CRC, validate `size` bytes. */
+#define CASE(want, what, code) do { \
+    unsigned char *b = g_work.b; \
+    memcpy(b, g_base.b, CAP); \
+    { code; } \
+    tb_fix_crc(b); \
+    expect(what, run(b, g_total), want); \
+} while (0)
+/* Same, validating `size` bytes. */
+#define CASE_SZ(want, what, size, code) do { \
+    unsigned char *b = g_work.b; \
+    memcpy(b, g_base.b, CAP); \
+    { code; } \
+    tb_fix_crc(b); \
+    expect(what, run(b, size), want); \
+} while (0)
+/* Same without the CRC fix-up (for total_size edits and checksum tests). */
+#define CASE_RAW(want, what, size, code) do { \
+    unsigned char *b = g_work.b; \
+    memcpy(b, g_base.b, CAP); \
+    { code; } \
+    expect(what, run(b, size), want); \
+} while (0)
+
+#define SEC(k) (b + tb_sec(b, k))
+#define TAB(k, f) (b + SN_H_SECTIONS + 16 * (k) + 4 * (f)) /* f: 0 off, 1 size, 2 count, 3 elem */
+
+static void test_header(void) {
+    uint32_t nnz;
+    expect("valid blob", run(g_base.b, g_total), SN_OK);
+    expect("valid blob, larger buffer", run(g_base.b, CAP), SN_OK);
+    {
+        const sn_blob *o;
+        expect("NULL data", sn_blob_validate(NULL, g_total, &o), SN_ERR_NULL);
+        expect("NULL out", sn_blob_validate(g_base.b, g_total, NULL), SN_ERR_NULL);
+    }
+    memcpy(g_work.b + 4, g_base.b, g_total);
+    expect("4-byte aligned data", run(g_work.b + 4, g_total), SN_ERR_ALIGN);
+    expect("shorter than header", run(g_base.b, SN_HEADER_BYTES - 1), SN_ERR_TRUNCATED);
+    expect("empty", run(g_base.b, 0), SN_ERR_TRUNCATED);
+    expect("one byte short", run(g_base.b, g_total - 1), SN_ERR_TRUNCATED);
+
+    CASE(SN_ERR_MAGIC, "magic", b[3] = 'X');
+    CASE(SN_ERR_ENDIAN, "byte-swapped endian mark", tb_u32(b + SN_H_ENDIAN, 0x04030201u));
+    CASE(SN_ERR_ENDIAN, "wrong endian mark", tb_u32(b + SN_H_ENDIAN, 0x01020305u));
+    CASE(SN_ERR_VERSION, "major 2", tb_u16(b + SN_H_VER_MAJOR, 2));
+    CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
+    CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0100));
+    CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
+    CASE(SN_ERR_FLAVOUR, "other flavour", b[SN_H_FLAVOUR] = (unsigned char)(1 - SN_FLAVOUR));
+    CASE(SN_ERR_FLAVOUR, "float64 flavour", b[SN_H_FLAVOUR] = 2);
+    CASE(SN_ERR_FLAVOUR, "real size 8", b[SN_H_REAL_SIZE] = 8);
+    CASE(SN_ERR_FLAVOUR, "other flavour's one",
+         tb_u32(b + SN_H_ONE, SN_FLAVOUR ? SN_ONE_FIXED : SN_ONE_FLOAT32));
+    CASE(SN_ERR_FLAVOUR, "one_hi of float64", tb_u32(b + SN_H_ONE_HI, SN_ONE_FLOAT64_HI));
+    CASE_RAW(SN_ERR_HEADER, "total < header", g_total, tb_u32(b + SN_H_TOTAL_SIZE, 100));
+    CASE_RAW(SN_ERR_TRUNCATED, "total > size", g_total, tb_u32(b + SN_H_TOTAL_SIZE, g_total + 8));
+    CASE_RAW(SN_ERR_TRUNCATED, "total huge", g_total, tb_u32(b + SN_H_TOTAL_SIZE, 0xFFFFFFFFu));
+    CASE(SN_ERR_HEADER, "header_size", tb_u32(b + SN_H_HEADER_SIZE, SN_HEADER_BYTES + 8));
+    CASE(SN_ERR_HEADER, "n_sections", b[SN_H_NSECTIONS] = SN_SEC_COUNT - 1);
+    CASE(SN_ERR_HEADER, "reserved0", b[SN_H_RESERVED0] = 1);
+    CASE(SN_ERR_HEADER, "reserved1", tb_u32(b + SN_H_RESERVED1, 1));
+#if !defined(SN_VALIDATE_NO_CHECKSUM)
+    CASE_RAW(SN_ERR_CHECKSUM, "flipped data bit", g_total, b[g_total - 3] ^= 0x10);
+    CASE_RAW(SN_ERR_CHECKSUM, "flipped header count bit", g_total, b[SN_H_N_CELLS] ^= 0x01);
+    CASE_RAW(SN_ERR_CHECKSUM, "crc field", g_total, b[SN_H_CRC32] ^= 0x80);
+#endif
+
+    /* counts and settings */
+    CASE(SN_ERR_HEADER, "nF = 0", tb_u32(b + SN_H_N_FREE, 0));
+    CASE(SN_ERR_HEADER, "nF = nV", tb_u32(b + SN_H_N_FREE, TB_NV));
+    CASE(SN_ERR_HEADER, "nF > nV", tb_u32(b + SN_H_N_FREE, TB_NV + 1));
+    CASE(SN_ERR_HEADER, "nV = 65536", tb_u32(b + SN_H_N_VERTICES, 65536));
+    CASE(SN_ERR_HEADER, "nJ = 0", tb_u32(b + SN_H_N_JOINTS, 0));
+    CASE(SN_ERR_HEADER, "nJ = 256", tb_u32(b + SN_H_N_JOINTS, 256));
+    CASE(SN_ERR_HEADER, "nS = 65536", tb_u32(b + SN_H_N_SURFACE, 65536));
+    CASE(SN_ERR_HEADER, "cg default 0", tb_u16(b + SN_H_CG_DEFAULT, 0));
+    CASE(SN_ERR_HEADER, "cg default > max", tb_u16(b + SN_H_CG_DEFAULT, 33));
+    CASE(SN_ERR_HEADER, "cg max 257", tb_u16(b + SN_H_CG_MAX, 257));
+    CASE(SN_OK, "cg max 256", tb_u16(b + SN_H_CG_MAX, 256));
+    CASE(SN_OK, "cg default = max", tb_u16(b + SN_H_CG_DEFAULT, 32));
+    CASE(SN_ERR_HEADER, "len_shift 25", b[SN_H_LEN_SHIFT] = 25);
+    CASE(SN_ERR_HEADER, "len_shift -25", b[SN_H_LEN_SHIFT] = (unsigned char)(256 - 25));
+    CASE(SN_OK, "len_shift -24", b[SN_H_LEN_SHIFT] = (unsigned char)(256 - 24));
+    CASE(SN_ERR_HEADER, "frac_S 61", b[SN_H_FRAC_S] = 61);
+    CASE(SN_ERR_HEADER, "frac_M 61", b[SN_H_FRAC_M] = 61);
+    CASE(SN_ERR_HEADER, "frac_P 255", b[SN_H_FRAC_P] = 255);
+    CASE(SN_OK, "frac_P 60", b[SN_H_FRAC_P] = 60);
+    CASE(SN_ERR_HEADER, "instance_bytes too small",
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ) - 8));
+    CASE(SN_OK, "instance_bytes larger", tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
+
+    /* physics scalars */
+#define RL(i) (b + SN_H_REALS + 4 * (i))
+    CASE(SN_ERR_VALUE, "a1 < 0", tb_real(RL(SN_R_A1), -0.001, SN_Q_COEF));
+    CASE(SN_ERR_VALUE, "a1 > 16", put_over(RL(SN_R_A1), 1 << 28, SN_Q_COEF));
+    CASE(SN_OK, "a1 = 16", put_at(RL(SN_R_A1), 1 << 28, SN_Q_COEF));
+    CASE(SN_OK, "a1 = 0", put_at(RL(SN_R_A1), 0, SN_Q_COEF));
+    CASE(SN_ERR_VALUE, "b1 > 16", put_over(RL(SN_R_B1), 1 << 28, SN_Q_COEF));
+    CASE(SN_ERR_VALUE, "b1 < 0", tb_real(RL(SN_R_B1), -0.5, SN_Q_COEF));
+    CASE(SN_ERR_VALUE, "grav x > 2^27", put_over(RL(SN_R_GRAV_X), 1 << 27, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "grav z < -2^27", put_over(RL(SN_R_GRAV_Z), -(1 << 27), SN_Q_LEN));
+    CASE(SN_OK, "grav y = -2^27", put_at(RL(SN_R_GRAV_Y), -(1 << 27), SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "timestep 0", tb_real(RL(SN_R_TIMESTEP), 0.0, 16));
+    CASE(SN_ERR_VALUE, "timestep < 0", tb_real(RL(SN_R_TIMESTEP), -1.0 / 60, 16));
+    CASE(SN_ERR_VALUE, "reserved real", tb_real(RL(SN_R_RESERVED), 1.0, 16));
+#if defined(SN_FLOAT)
+    CASE(SN_ERR_VALUE, "a1 NaN", tb_u32(RL(SN_R_A1), 0x7FC00000u));
+    CASE(SN_ERR_VALUE, "grav inf", tb_u32(RL(SN_R_GRAV_X), 0x7F800000u));
+    CASE(SN_ERR_VALUE, "timestep inf", tb_u32(RL(SN_R_TIMESTEP), 0x7F800000u));
+    CASE(SN_ERR_VALUE, "mass scale NaN", tb_u32(RL(SN_R_MASS_SCALE), 0xFFC00000u));
+    CASE(SN_ERR_VALUE, "reserved real -0.0", tb_u32(RL(SN_R_RESERVED), 0x80000000u));
+#endif
+#undef RL
+
+    /* section table */
+    nnz = tb_rd32(g_base.b + SN_H_N_OFFDIAG);
+    CASE(SN_ERR_SECTION, "misaligned offset", tb_u32(TAB(SN_SEC_REST, 0), tb_sec(b, SN_SEC_REST) + 4));
+    CASE(SN_ERR_SECTION, "offset inside header", tb_u32(TAB(SN_SEC_JOINTS, 0), 8));
+    CASE(SN_ERR_SECTION, "overlap", tb_u32(TAB(SN_SEC_MDIAG, 0), tb_sec(b, SN_SEC_FRAMES)));
+    CASE(SN_ERR_SECTION, "descending", tb_u32(TAB(SN_SEC_SOFF, 0), tb_sec(b, SN_SEC_COLS)));
+    CASE(SN_ERR_SECTION, "past the end", tb_u32(TAB(SN_SEC_TRIS, 0), g_total));
+    CASE(SN_ERR_SECTION, "offset wraps", tb_u32(TAB(SN_SEC_TRIS, 0), 0xFFFFFFF8u));
+    CASE(SN_ERR_SECTION, "size wraps", tb_u32(TAB(SN_SEC_TRIS, 1), 0xFFFFFFFFu));
+    CASE(SN_ERR_SECTION, "count != header", tb_u32(TAB(SN_SEC_COLS, 2), nnz + 1));
+    CASE(SN_ERR_SECTION, "count*elem overflow",
+         tb_u32(TAB(SN_SEC_TRIS, 2), 0x80000000u); tb_u32(b + SN_H_N_TRIANGLES, 0x80000000u));
+    CASE(SN_ERR_SECTION, "elem_size", tb_u32(TAB(SN_SEC_REST, 3), 16));
+    CASE(SN_ERR_SECTION, "size != count*elem", tb_u32(TAB(SN_SEC_SOFF, 1), nnz * 36 - 4));
+    CASE(SN_ERR_SECTION, "nonzero padding", SEC(SN_SEC_ROWPTR)[4 * (TB_NF + 1)] = 1);
+    {   /* trailing bytes inside total_size must be zero */
+        CASE_SZ(SN_OK, "zero trailing bytes", g_total + 8, tb_u32(b + SN_H_TOTAL_SIZE, g_total + 8));
+        CASE_SZ(SN_ERR_SECTION, "nonzero trailing bytes", g_total + 8,
+             tb_u32(b + SN_H_TOTAL_SIZE, g_total + 8); b[g_total + 7] = 1);
+    }
+    /* empty triangle section: fine */
+    {
+        unsigned char *b = g_work.b;
+        const sn_blob *blob;
+        uint32_t idx[3];
+        memcpy(b, g_base.b, CAP);
+        tb_u32(b + SN_H_N_TRIANGLES, 0);
+        tb_u32(TAB(SN_SEC_TRIS, 1), 0);
+        tb_u32(TAB(SN_SEC_TRIS, 2), 0);
+        memset(SEC(SN_SEC_TRIS), 0, 12);
+        tb_fix_crc(b);
+        expect("no triangles", sn_blob_validate(b, g_total, &blob), SN_OK);
+        expect("get_triangle without triangles", sn_get_triangle(blob, 0, idx), SN_ERR_ARG);
+    }
+}
+
+static void test_contents(void) {
+    const uint32_t J = (uint32_t)SN_ELEM_JOINTS(4);
+    uint32_t nnz = tb_rd32(g_base.b + SN_H_N_OFFDIAG), r0, r1;
+    /* joints */
+    CASE(SN_ERR_INDEX, "root parent 0", tb_u16(SEC(SN_SEC_JOINTS), 0));
+    CASE(SN_ERR_INDEX, "self parent", tb_u16(SEC(SN_SEC_JOINTS) + J, 1));
+    CASE(SN_ERR_INDEX, "second root", tb_u16(SEC(SN_SEC_JOINTS) + J, 0xFFFF));
+    CASE(SN_ERR_VALUE, "joint reserved u16", tb_u16(SEC(SN_SEC_JOINTS) + J + 2, 1));
+    CASE(SN_ERR_VALUE, "joint reserved u32", tb_u32(SEC(SN_SEC_JOINTS) + 4, 1));
+    CASE(SN_ERR_VALUE, "joint rest > 2^27", put_over(SEC(SN_SEC_JOINTS) + J + 12, 1 << 27, SN_Q_LEN));
+    CASE(SN_OK, "joint rest = -2^27", put_at(SEC(SN_SEC_JOINTS) + J + 16, -(1 << 27), SN_Q_LEN));
+    /* names */
+    CASE(SN_ERR_VALUE, "empty name", SEC(SN_SEC_JOINT_NAMES)[32] = 0);
+    CASE(SN_ERR_VALUE, "unterminated name", memset(SEC(SN_SEC_JOINT_NAMES) + 32, 'a', 32));
+    CASE(SN_OK, "31-char name", memset(SEC(SN_SEC_JOINT_NAMES) + 32, 'a', 31));
+    CASE(SN_ERR_VALUE, "duplicate name", memcpy(SEC(SN_SEC_JOINT_NAMES) + 32, "root", 4));
+    CASE(SN_ERR_VALUE, "garbage after NUL", SEC(SN_SEC_JOINT_NAMES)[40] = 'x');
+    /* rest positions */
+    CASE(SN_ERR_VALUE, "rest > 2^27", put_over(SEC(SN_SEC_REST) + 4 * 7, 1 << 27, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "rest < -2^27", put_over(SEC(SN_SEC_REST) + 4 * 35, -(1 << 27), SN_Q_LEN));
+    CASE(SN_OK, "rest = 2^27", put_at(SEC(SN_SEC_REST), 1 << 27, SN_Q_LEN));
+    CASE(SN_OK, "len_shift 12, rest = 2^24", b[SN_H_LEN_SHIFT] = 12;
+         put_at(SEC(SN_SEC_REST) + 8, 1 << 24, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "len_shift 12, rest > 2^24 (16384 mesh units)", b[SN_H_LEN_SHIFT] = 12;
+         put_over(SEC(SN_SEC_REST) + 8, 1 << 24, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "len_shift 12, joint rest > 2^24", b[SN_H_LEN_SHIFT] = 12;
+         put_over(SEC(SN_SEC_JOINTS) + J + 8, 1 << 24, SN_Q_LEN));
+    /* frames */
+    CASE(SN_ERR_INDEX, "bone1 >= nJ", SEC(SN_SEC_FRAMES)[0] = TB_NJ);
+    CASE(SN_ERR_INDEX, "bone2 >= nJ", SEC(SN_SEC_FRAMES)[4 * 3 + 1] = 255);
+    CASE(SN_ERR_VALUE, "w > 1", tb_u16(SEC(SN_SEC_FRAMES) + 4 * 2 + 2, 32769));
+    CASE(SN_OK, "w = 1", tb_u16(SEC(SN_SEC_FRAMES) + 4 * 2 + 2, 32768));
+    CASE(SN_ERR_INDEX, "skeleton bone1 != bone2", SEC(SN_SEC_FRAMES)[4 * TB_NF + 1] = 1);
+    CASE(SN_ERR_VALUE, "skeleton w != 0", tb_u16(SEC(SN_SEC_FRAMES) + 4 * (TB_NV - 1) + 2, 1));
+    /* matrices */
+    CASE(SN_ERR_VALUE, "MDIAG > 2^27", put_over(SEC(SN_SEC_MDIAG), 1 << 27, 0));
+    CASE(SN_OK, "MDIAG = 2^27", put_at(SEC(SN_SEC_MDIAG), 1 << 27, 0));
+    CASE(SN_ERR_VALUE, "SDIAG < -2^27", put_over(SEC(SN_SEC_SDIAG) + 4 * 47, -(1 << 27), 0));
+    CASE(SN_ERR_VALUE, "PRECOND > 2^27", put_over(SEC(SN_SEC_PRECOND) + 4 * 5, 1 << 27, 0));
+    CASE(SN_ERR_VALUE, "MLUMP > 2^27", put_over(SEC(SN_SEC_MLUMP) + 4 * 7, 1 << 27, 0));
+    CASE(SN_ERR_VALUE, "MOFF < -2^27", put_over(SEC(SN_SEC_MOFF) + 4 * (nnz - 1), -(1 << 27), 0));
+    CASE(SN_ERR_VALUE, "SOFF > 2^27", put_over(SEC(SN_SEC_SOFF) + 4 * (9 * nnz - 1), 1 << 27, 0));
+#if defined(SN_FLOAT)
+    CASE(SN_ERR_VALUE, "SOFF NaN", tb_u32(SEC(SN_SEC_SOFF) + 4 * 3, 0x7FC00001u));
+    CASE(SN_ERR_VALUE, "rest -inf", tb_u32(SEC(SN_SEC_REST) + 4 * 3, 0xFF800000u));
+#endif
+    /* sparsity */
+    r0 = tb_rd32(g_base.b + tb_sec(g_base.b, SN_SEC_ROWPTR) + 4);
+    r1 = tb_rd32(g_base.b + tb_sec(g_base.b, SN_SEC_ROWPTR) + 8);
+    CASE(SN_ERR_INDEX, "rowptr[0] != 0", tb_u32(SEC(SN_SEC_ROWPTR), 1));
+    CASE(SN_ERR_INDEX, "rowptr[nF] != nnz", tb_u32(SEC(SN_SEC_ROWPTR) + 4 * TB_NF, nnz - 1));
+    CASE(SN_ERR_INDEX, "rowptr decreasing", tb_u32(SEC(SN_SEC_ROWPTR) + 4, r1 + 1));
+    CASE(SN_ERR_INDEX, "rowptr > nnz", tb_u32(SEC(SN_SEC_ROWPTR) + 4, nnz + 100));
+    CASE(SN_ERR_INDEX, "cols not increasing", tb_u16(SEC(SN_SEC_COLS) + 2, tb_rd32(SEC(SN_SEC_COLS)) & 0xFFFF));
+    CASE(SN_ERR_INDEX, "col == row", tb_u16(SEC(SN_SEC_COLS) + 2 * r0, 1)); /* row 1's first column */
+    CASE(SN_ERR_INDEX, "col < row", tb_u16(SEC(SN_SEC_COLS) + 2 * r0, 0));
+    CASE(SN_ERR_INDEX, "col >= nV", tb_u16(SEC(SN_SEC_COLS) + 2 * (nnz - 1), TB_NV));
+    CASE(SN_ERR_INDEX, "col 0xFFFF", tb_u16(SEC(SN_SEC_COLS) + 2 * (r0 - 1), 0xFFFF));
+    /* cells, embedding, triangles */
+    CASE(SN_ERR_INDEX, "cell corner >= nV", tb_u16(SEC(SN_SEC_CELLS) + 2 * 13, TB_NV));
+    CASE(SN_ERR_INDEX, "embed cell >= nC", tb_u16(SEC(SN_SEC_EMBED) + 8 * 3, TB_NC));
+    CASE(SN_ERR_VALUE, "embed t > 1", tb_u16(SEC(SN_SEC_EMBED) + 8 * 1 + 6, 32769));
+    CASE(SN_ERR_INDEX, "triangle index >= nS", tb_u16(SEC(SN_SEC_TRIS) + 2 * 5, TB_NS));
+}
+
+static void test_accessors(int len_shift) {
+    unsigned char *b = g_work.b;
+    const sn_blob *blob = NULL;
+    sn_blob_info info;
+    sn_vec3 r;
+    uint32_t idx[3];
+    tb_build(b, CAP, len_shift);
+    expect("build with len_shift", sn_blob_validate(b, CAP, &blob), SN_OK);
+    if (!blob) return;
+    sn_blob_get_info(blob, &info);
+    T_CHECK(info.vertices == TB_NV && info.free_vertices == TB_NF && info.cells == TB_NC &&
+                info.joints == TB_NJ && info.surface_vertices == TB_NS && info.triangles == TB_NT,
+            "info counts");
+    T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
+    T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ), "info instance bytes");
+    T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
+    T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
+#if defined(SN_FLOAT)
+    T_NEAR(info.timestep, 1.0 / 60, 1e-9, "float stored value");
+#else
+    T_CHECK(info.timestep == 1092, "timestep Q16.16 = round(65536/60), got %d", (int)info.timestep);
+#endif
+    T_CHECK(sn_joint_name(blob, 0) && strcmp(sn_joint_name(blob, 0), "root") == 0, "name 0");
+    T_CHECK(sn_joint_name(blob, 1) && strcmp(sn_joint_name(blob, 1), "tip") == 0, "name 1");
+    T_CHECK(sn_joint_name(blob, 2) == NULL && sn_joint_name(NULL, 0) == NULL, "name out of range");
+    T_CHECK(sn_joint_parent(blob, 0) == -1 && sn_joint_parent(blob, 1) == 0 &&
+                sn_joint_parent(blob, 2) == -1 && sn_joint_parent(NULL, 1) == -1, "parents");
+    T_CHECK(sn_find_joint(blob, "root") == 0 && sn_find_joint(blob, "tip") == 1, "find");
+    T_CHECK(sn_find_joint(blob, "ro") == -1 && sn_find_joint(blob, "rootx") == -1 &&
+                sn_find_joint(blob, "") == -1 && sn_find_joint(blob, NULL) == -1 &&
+                sn_find_joint(NULL, "root") == -1 && sn_find_joint(blob, "Root") == -1,
+            "find misses");
+    T_CHECK(sn_joint_rest(blob, 1, &r) == SN_OK, "rest ok");
+    /* tip at 0.5 internal units = 0.5 * 2^len_shift mesh units (exact here) */
+#if defined(SN_FLOAT)
+    T_NEAR(r.x, ldexp(0.5, len_shift), 0, "power-of-two scaling is exact in float");
+#else
+    T_CHECK(r.x == (int32_t)ldexp(0.5 * 65536, len_shift), "rest x = %d (len_shift %d)", (int)r.x, len_shift);
+#endif
+    T_CHECK(r.y == 0 && r.z == 0, "rest y z");
+    expect("rest j out of range", sn_joint_rest(blob, 2, &r), SN_ERR_ARG);
+    expect("rest NULL out", sn_joint_rest(blob, 0, NULL), SN_ERR_NULL);
+    expect("triangle 1", sn_get_triangle(blob, 1, idx), SN_OK);
+    T_CHECK(idx[0] == 0 && idx[1] == 2 && idx[2] == 3, "triangle 1 indices");
+    expect("triangle 2", sn_get_triangle(blob, 2, idx), SN_ERR_ARG);
+    expect("triangle NULL", sn_get_triangle(blob, 0, NULL), SN_ERR_NULL);
+    {
+        sn_view v;
+        int k;
+        sn_view_init(&v, blob);
+        T_CHECK(v.nV == TB_NV && v.nF == TB_NF && v.len_shift == len_shift && v.frac_S == TB_FRAC &&
+                    v.total == info.blob_bytes, "view header");
+        for (k = 0; k < SN_SEC_COUNT; k++)
+            T_CHECK(v.sec[k] == b + tb_sec(b, k), "view section %d", k);
+    }
+    sn_blob_get_info(NULL, &info);
+    T_CHECK(info.vertices == 0 && info.blob_bytes == 0, "info of NULL blob is zero");
+}
+
+/* Fixed: public rest = internal * 2^(len_shift - 6), rounded to nearest
+ * (ties away from zero) when len_shift < 6, exact otherwise. */
+static void test_rest_rounding(void) {
+#if !defined(SN_FLOAT)
+    static const struct { int ls; int32_t raw; int32_t want; } c[] = {
+        {0, (1 << 21) + 3, 32768},    /* +0.047 LSB -> down */
+        {0, (1 << 21) + 32, 32769},   /* +0.5 LSB   -> away from zero */
+        {0, -(1 << 21) - 32, -32769}, /* -0.5 LSB   -> away from zero */
+        {0, (1 << 21) + 33, 32769},
+        {-3, 1000, 2},                /* 1000 / 512 = 1.95 */
+        {6, (1 << 21) + 3, (1 << 21) + 3},
+        {8, (1 << 21) + 3, 4 * ((1 << 21) + 3)},
+        {-24, (1 << 27), 0},          /* 2^27 / 2^30 = 0.125 -> 0 */
+    };
+    size_t i;
+    for (i = 0; i < sizeof c / sizeof c[0]; i++) {
+        unsigned char *b = g_work.b;
+        const sn_blob *blob;
+        sn_vec3 r;
+        tb_build(b, CAP, c[i].ls);
+        tb_u32(b + tb_sec(b, SN_SEC_JOINTS) + SN_ELEM_JOINTS(4) + 8, (uint32_t)c[i].raw);
+        tb_fix_crc(b);
+        if (sn_blob_validate(b, CAP, &blob) != SN_OK) {
+            T_CHECK(0, "rounding case %d rejected", (int)i);
+            continue;
+        }
+        sn_joint_rest(blob, 1, &r);
+        T_CHECK(r.x == c[i].want, "len_shift %d raw %d: got %d want %d", c[i].ls, (int)c[i].raw,
+                (int)r.x, (int)c[i].want);
+    }
+#endif
+}
+
+/* The test blob is also a working asset: a few steps stay finite and unsaturated. */
+static void test_steps(void) {
+    static union { uint64_t a; unsigned char m[8192]; } mem;
+    const sn_blob *blob;
+    sn_instance *inst;
+    sn_xform x[TB_NJ];
+    sn_vec3 surf[TB_NS], nrm[TB_NS];
+    sn_stats st;
+    int j, s;
+    if (sn_blob_validate(g_base.b, g_total, &blob) != SN_OK) return;
+    T_CHECK(sn_instance_size(blob) <= sizeof mem.m, "instance fits");
+    expect("init", sn_instance_init(mem.m, sizeof mem.m, blob, &inst), SN_OK);
+    for (j = 0; j < TB_NJ; j++) {
+        sn_vec3 ax = {0, 0, 0};
+        ax.z = SN_FLOAT_OR(1.0f, 65536);
+        x[j].rot = sn_quat_axis_angle(ax, SN_FLOAT_OR(10.0f, 10 << 16));
+        x[j].pos.x = x[j].pos.y = x[j].pos.z = 0;
+    }
+    expect("set pose", sn_set_pose(inst, x, TB_NJ), SN_OK);
+    for (s = 0; s < 10; s++) sn_step(inst);
+    expect("surface", sn_get_surface(inst, surf, 0, TB_NS), SN_OK);
+    expect("normals", sn_get_normals(inst, surf, nrm), SN_OK);
+    sn_get_stats(inst, &st);
+    T_CHECK(st.steps == 10 && st.saturations == 0, "steps %u saturations %u (float: 0; a fixed-only blow-up points at the fixed CG scalars)", st.steps, st.saturations);
+    for (s = 0; s < TB_NS; s++)
+        T_CHECK(surf[s].x == surf[s].x && surf[s].y == surf[s].y, "surface finite");
+}
+
+int main(void) {
+    (void)t_seed; /* no random inputs here */
+    printf("  flavour: %s\n", FLAV);
+    g_total = tb_build(g_base.b, CAP, 0);
+    T_FIGURE("%s test blob: %u bytes, header %d bytes", FLAV, g_total, SN_HEADER_BYTES);
+    test_header();
+    test_contents();
+    test_accessors(0);
+    test_accessors(8);
+    test_accessors(-3);
+    test_rest_rounding();
+    test_steps();
+    return T_END();
+}
