@@ -126,6 +126,6 @@ enum {
  * and the validator rejects a header value smaller than it. */
 #define SN_INSTANCE_BYTES(nV, nF, nJ) \
     (((uint32_t)512u + 76u * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
-      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + 7u) & ~7u)
+      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

@@ -24,14 +24,14 @@ typedef struct sn_ihdr {
     float to_int, to_pub;   /* mesh units <-> internal units */
 #endif
     /* byte offsets of the arrays from the instance start */
-    uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds;
+    uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds, o_k;
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
 
 /* Layout (must match SN_INSTANCE_BYTES in sn_format.h):
  * hdr | acc nF*3 acc | per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
- * per free: x3 r3 d3 q3 | per skeleton: ds3 */
+ * per free: x3 r3 d3 q3 | per skeleton: ds3 | per free: k (u8) */
 static void layout(sn_ihdr *h) {
     uint32_t nV = h->v.nV, nF = h->v.nF, nJ = h->v.nJ, o = SN_HDR_BYTES;
 #define SN_TAKE_(field, bytes) do { h->field = o; o += (bytes); } while (0)
@@ -50,8 +50,26 @@ static void layout(sn_ihdr *h) {
     SN_TAKE_(o_d, nF * 3u * 4u);
     SN_TAKE_(o_q, nF * 3u * 4u);
     SN_TAKE_(o_ds, (nV - nF) * 3u * 4u);
+    SN_TAKE_(o_k, nF);
 #undef SN_TAKE_
 }
+
+#if !defined(SN_FLOAT)
+/* number of significant bits of x (0 for 0); fixed 6-step search */
+static int bitlen64(uint64_t x) {
+    int n = 0, s;
+    for (s = 32; s > 0; s >>= 1) {
+        uint64_t hi = x >> s;
+        int take = hi != 0;
+        n += take ? s : 0;
+        x = take ? hi : x;
+    }
+    return n + (x != 0);
+}
+#endif
+
+/* Most extra fractional bits of a force-like value (see sn_instance_init). */
+#define SN_KMAX 12
 
 #define ARR(h, off, T) ((T *)(void *)((unsigned char *)(h) + (h)->off))
 #define CARR(h, off, T) ((const T *)(const void *)((const unsigned char *)(h) + (h)->off))
@@ -118,6 +136,24 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
         h->to_int = 1.0f / h->to_pub;
     }
 #endif
+    {   /* Force-like CG vectors (b, r, q) of free vertex i carry k_i extra
+         * fractional bits: forces scale with the interior volume of a vertex's
+         * support (as M^_ii does), so a barely-inside vertex would otherwise
+         * have forces of a few LSBs that the preconditioner amplifies.
+         * k_i = bits between the largest and this M^_ii, at most SN_KMAX. */
+        uint8_t *kk = ARR(h, o_k, uint8_t);
+        uint32_t i;
+        for (i = 0; i < h->v.nF; i++) {
+#if defined(SN_FLOAT)
+            kk[i] = 0;
+#else
+            int32_t m = rd_real(h->v.sec[SN_SEC_MDIAG], i);
+            int k = (h->v.frac_M + 1) - bitlen64(m > 0 ? (uint64_t)m : 0u);
+            k = k < 0 ? 0 : (k > SN_KMAX ? SN_KMAX : k);
+            kk[i] = (uint8_t)k;
+#endif
+        }
+    }
     *out = (sn_instance *)mem;
     sn_reset(*out);
     return SN_OK;
@@ -130,8 +166,8 @@ void sn_reset(sn_instance *inst) {
     sn_q *pq = ARR(h, o_pq, sn_q), *pt = ARR(h, o_pt, sn_q);
     sn_q *pos = ARR(h, o_pos, sn_q);
     const unsigned char *j0 = v->sec[SN_SEC_JOINTS];
-    /* zero everything after the header */
-    memset((unsigned char *)h + SN_HDR_BYTES, 0, v->instance_bytes - SN_HDR_BYTES);
+    /* zero the state (everything after the header, before the k table) */
+    memset((unsigned char *)h + SN_HDR_BYTES, 0, h->o_k - SN_HDR_BYTES);
     h->steps = 0;
     h->saturations = 0;
     h->have_prev = 0;
@@ -298,15 +334,17 @@ SN_INLINE sn_q coef(sn_q v, sn_q c, uint32_t *sat) { return sn_mulq(v, c, SN_Q_C
 #define ONE_COEF ((int32_t)1 << SN_Q_COEF)
 #endif
 
-/* out_i (Q22) = R_i (acc_i >> fS) for free rows */
+/* Force rows out_i (Q22+k_i) = R_i (acc_i >> (frac - k_i)) for free rows */
 static void rows_out_rot(const sn_ihdr *h, const sn_acc *acc, int frac, sn_q *out, uint32_t *sat) {
     const sn_q *R = CARR(h, o_R, sn_q);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i;
     for (i = 0; i < h->v.nF; i++) {
         sn_q t[3];
-        t[0] = sn_out(acc[3 * i], frac, sat);
-        t[1] = sn_out(acc[3 * i + 1], frac, sat);
-        t[2] = sn_out(acc[3 * i + 2], frac, sat);
+        int s = frac - kk[i];
+        t[0] = sn_out(acc[3 * i], s, sat);
+        t[1] = sn_out(acc[3 * i + 1], s, sat);
+        t[2] = sn_out(acc[3 * i + 2], s, sat);
         sn_rot(R + 9 * i, t, out + 3 * i, sat);
     }
 }
@@ -359,6 +397,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     sn_acc *acc = ARR(h, o_acc, sn_acc);
     sn_q *u = ARR(h, o_u, sn_q);
     const sn_q *R = CARR(h, o_R, sn_q);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < nF; i++) sn_rot_t(R + 9 * i, d + 3 * i, u + 3 * i, sat);
@@ -367,7 +406,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     pass_M_ff(h, d, acc);
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) {
-            sn_q mk = sn_out(acc[3 * i + k], v->frac_M, sat);
+            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - kk[i], sat);
             sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
             q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
         }
@@ -378,15 +417,17 @@ static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *R = CARR(h, o_R, sn_q);
     const unsigned char *P = v->sec[SN_SEC_PRECOND];
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i;
     for (i = 0; i < v->nF; i++) {
         sn_q t[3], s[3];
         sn_acc a[3] = {0, 0, 0};
+        int sh = v->frac_P + kk[i]; /* r is Q22+k_i, z is Q22 */
         sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
         sym_mac(a, P + (size_t)i * 6 * RB, t);
-        s[0] = sn_out(a[0], v->frac_P, sat);
-        s[1] = sn_out(a[1], v->frac_P, sat);
-        s[2] = sn_out(a[2], v->frac_P, sat);
+        s[0] = sn_out(a[0], sh, sat);
+        s[1] = sn_out(a[1], sh, sat);
+        s[2] = sn_out(a[2], sh, sat);
         sn_rot(R + 9 * i, s, z + 3 * i, sat);
     }
 }
@@ -394,10 +435,11 @@ static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
 /* ---- CG scalars ---- */
 #if defined(SN_FLOAT)
 typedef struct { float m; } sn_dotv;
-static sn_dotv dot(const sn_q *a, const sn_q *b, uint32_t n) {
+static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
     sn_dotv r;
     uint32_t i;
     float s = 0.0f;
+    (void)kk;
     for (i = 0; i < n; i++) s += a[i] * b[i];
     r.m = s;
     return r;
@@ -412,18 +454,8 @@ static float ratio(sn_dotv num, sn_dotv den) {
 typedef struct { int64_t m; int e; } sn_dotv;
 #define SN_Q_SCAL 28 /* alpha, beta in Q28 */
 
-/* number of significant bits of x >= 0 (0 for 0); fixed 6-step search */
-static int bitlen64(uint64_t x) {
-    int n = 0, s;
-    for (s = 32; s > 0; s >>= 1) {
-        uint64_t hi = x >> s;
-        int take = hi != 0;
-        n += take ? s : 0;
-        x = take ? hi : x;
-    }
-    return n + (x != 0);
-}
-static sn_dotv dot(const sn_q *a, const sn_q *b, uint32_t n) {
+/* a force-like (Q22+k_i per vertex), b velocity-like (Q22): sum of a.b in Q44 */
+static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
     sn_dotv r;
     uint32_t i, ma = 0, mb = 0;
     int s;
@@ -437,7 +469,7 @@ static sn_dotv dot(const sn_q *a, const sn_q *b, uint32_t n) {
     /* n * ma * mb < 2^62 after shifting each product right by s */
     s = bitlen64(ma) + bitlen64(mb) + bitlen64(n) - 62;
     s = s < 0 ? 0 : s;
-    for (i = 0; i < n; i++) sum += sn_rshr64((int64_t)a[i] * b[i], s);
+    for (i = 0; i < n; i++) sum += sn_rshr64((int64_t)a[i] * b[i], s + kk[i / 3]);
     r.m = sum;
     r.e = s;
     return r;
@@ -609,6 +641,7 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     const sn_q *ds = CARR(h, o_ds, sn_q);
     sn_q *u = ARR(h, o_u, sn_q);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF, nV = v->nV;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
 
@@ -660,8 +693,8 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
         for (k = 0; k < 3; k++) {
-            sn_q g = sn_mulq(mi, v->grav[k], v->frac_M, sat);
-            sn_q ma = sn_out(acc[3 * i + k], v->frac_M, sat);
+            sn_q g = sn_mulq(mi, v->grav[k], v->frac_M - kk[i], sat);
+            sn_q ma = sn_out(acc[3 * i + k], v->frac_M - kk[i], sat);
             b[3 * i + k] = sn_add(sn_add(b[3 * i + k], g, sat), -ma, sat);
         }
     }
@@ -675,6 +708,7 @@ void sn_step(sn_instance *inst) {
     sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
     sn_q *q = ARR(h, o_q, sn_q), *z = ARR(h, o_u, sn_q); /* z shares u: never live together */
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
 
     frames(h, &sat);
@@ -686,18 +720,18 @@ void sn_step(sn_instance *inst) {
     for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], &sat);
     precond(h, r, z, &sat);
     memcpy(d, z, n3 * sizeof(sn_q));
-    rz = dot(r, z, n3);
+    rz = dot(r, z, kk, n3);
     for (it = 0; it < h->iterations; it++) {
         sn_dotv dq, rz1;
         sn_q alpha, beta, nalpha;
         matvec(h, d, q, &sat);
-        dq = dot(d, q, n3);
+        dq = dot(q, d, kk, n3);
         alpha = ratio(rz, dq);
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, &sat);
         axpy(r, nalpha, q, n3, &sat);
         precond(h, r, z, &sat);
-        rz1 = dot(r, z, n3);
+        rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz);
         for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, &sat), &sat);
         rz = rz1;
