@@ -272,10 +272,15 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
                 double bd = HUGE_VAL;
                 for (k = 0; k < 3; k++) {
                     double q[3], dd;
+                    int nx[3] = {cur[0], cur[1], cur[2]}, gn;
                     if (cur[k] == tgt[k]) continue;
-                    q[0] = o->gorg[0] + cur[0] * c; q[1] = o->gorg[1] + cur[1] * c; q[2] = o->gorg[2] + cur[2] * c;
-                    q[k] += (tgt[k] > cur[k] ? 1 : -1) * c;
+                    nx[k] += tgt[k] > cur[k] ? 1 : -1;
+                    gn = gidx(o, nx[0], nx[1], nx[2]);
+                    q[0] = o->gorg[0] + nx[0] * c; q[1] = o->gorg[1] + nx[1] * c; q[2] = o->gorg[2] + nx[2] * c;
                     dd = seg_dist(q, P, C);
+                    /* steer around vertices other bones already own (a large penalty, not a ban:
+                     * if every step is taken the conflict is reported below) */
+                    if (gn != gsnap[ch] && gclaim[gn] != -1) dd += 1e6 * c;
                     if (dd < bd - 1e-12 * c) { bd = dd; bestax = k; }
                 }
                 cur[bestax] += tgt[bestax] > cur[bestax] ? 1 : -1;
@@ -336,18 +341,27 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
         int gi[3], found = -1, pass, di, dj, dk;
         double t[3], tf[3] = {0, 0, 0};
         for (k = 0; k < 3; k++) gi[k] = (int)floor((q[k] - o->gorg[k]) / c);
-        for (pass = 0; pass < 2 && found < 0; pass++)
-            for (dk = 0; dk < 3 && found < 0; dk++) for (dj = 0; dj < 3 && found < 0; dj++) for (di = 0; di < 3 && found < 0; di++) {
-                int ci = gi[0] + (di == 2 ? -1 : di), cj = gi[1] + (dj == 2 ? -1 : dj), ck = gi[2] + (dk == 2 ? -1 : dk), gc, g[8];
+        /* pass 0: kept cells nearby, pass 1: any cell nearby, pass 2: any cell within 2 (bone snapping
+         * moves vertices by up to ~0.9 cell) */
+        for (pass = 0; pass < 3 && found < 0; pass++)
+            for (dk = 0; dk < 5 && found < 0; dk++) for (dj = 0; dj < 5 && found < 0; dj++) for (di = 0; di < 5 && found < 0; di++) {
+                static const int off[5] = {0, -1, 1, -2, 2};
+                int ci = gi[0] + off[di], cj = gi[1] + off[dj], ck = gi[2] + off[dk], gc, g[8];
+                if ((pass < 2) && (di > 2 || dj > 2 || dk > 2)) continue;
                 const double *xc[8];
                 if (ci < 0 || cj < 0 || ck < 0 || ci >= o->gn[0] - 1 || cj >= o->gn[1] - 1 || ck >= o->gn[2] - 1) continue;
                 gc = ci + (o->gn[0] - 1) * (cj + (o->gn[1] - 1) * ck);
-                if ((pass == 0) != (keep[gc] != 0)) continue;
+                if ((pass == 0) != (keep[gc] != 0) && pass < 2) continue;
                 cell_corners(o, gc, g);
                 for (k = 0; k < 8; k++) xc[k] = o->gpos + 3 * g[k];
                 if (inverse_trilinear((const double *const *)xc, q, c, t)) { found = gc; memcpy(tf, t, sizeof t); }
             }
-        if (found < 0) { sb_fail("%s: mesh vertex %d at (%g, %g, %g) lies in no lattice cell (lattice too distorted near a bone?)", d->mesh_path, i + 1, q[0], q[1], q[2]); goto done; }
+        if (found < 0) {
+            sb_fail("%s: mesh vertex %d at (%g, %g, %g) lies in no lattice cell: the lattice folds there after moving vertices onto "
+                    "the bones; try another cell size (e.g. %g or %g) or move the joints nearer lattice vertices",
+                    d->mesh_path, i + 1, q[0], q[1], q[2], c * 0.8, c * 1.2);
+            goto done;
+        }
         keep[found] = 1;
         o->emb_cell[i] = found;   /* grid cell for now; renumbered below */
         memcpy(o->emb_t + 3 * i, tf, sizeof tf);

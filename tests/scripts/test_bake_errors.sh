@@ -62,6 +62,9 @@ base | sed 's/^joint c b 4 0 0/joint c a 3 0 0.4/' > "$T/d19.sinew"; expect bone
 base | sed 's/^joint a - 0 0 0/joint a b 0 0 0/' > "$T/d20.sinew"; expect no-root "want exactly one root joint" "$T/d20.sinew"
 base | sed '/^mesh/d' > "$T/d21.sinew";                            expect no-mesh "missing 'mesh PATH'" "$T/d21.sinew"
 base | sed 's/^mesh box.obj/mesh nothere.obj/' > "$T/d22.sinew";   expect mesh-missing "nothere.obj: cannot open mesh" "$T/d22.sinew"
+# two bones whose snapped chains cross inside one cell: that cell inverts
+base | sed -e 's/^joint b a 2 0 0/joint b a 2.4 0.45 0/' -e 's/^joint c b 4 0 0/joint c a 0 0.9 0\njoint d c 2.6 0.55 0/' > "$T/d23.sinew"
+expect inverted-cell "lattice cell near .* is inverted .*try another cell size" "$T/d23.sinew"
 expect no-description "cannot open description" "$T/nothere.sinew"
 
 # --- mesh problems ---
