@@ -84,6 +84,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     if (!(m0 > 0)) return sb_fail("lattice has no mass");
     a1 = h * o->alpha;
     b1 = o->beta / h;
+    if (a1 > 16 || b1 > 16) return sb_fail("Rayleigh damping out of range: h*alpha = %g and beta/h = %g must be <= 16", a1, b1);
     /* len_shift: smallest s with every |rest coordinate - root| < 2 * 2^s mesh units */
     for (i = 0; i < nV; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->x[3 * i + k] - root[k]));
     for (i = 0; i < nJ; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->joints[i].pos[k] - root[k]));

@@ -9,6 +9,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: sinew-bake DESCRIPTION -o OUT.blob [--c-array OUT.c [--name SYMBOL]]\n"
             "                  [--flavour fixed|float|double] [--quiet]\n"
+            "       (-o may be left out when --c-array is given)\n"
             "Bakes a character (OBJ mesh + text description, see tools/DESCRIPTION.md) into a\n"
             "Sinew blob (runtime/BLOB.md).\n"
             "  -o OUT.blob       binary blob (written to OUT.blob.tmp, then renamed)\n"
@@ -45,11 +46,17 @@ int main(int argc, char **argv)
         else if (!desc) desc = a;
         else { fprintf(stderr, "sinew-bake: more than one description given ('%s')\n", a); return 2; }
     }
-    if (!desc || !out) { usage(stderr); return 2; }
+    if (!desc || (!out && !carray)) { usage(stderr); return 2; }
+    if (carray) {   /* check the symbol before any work or output */
+        const char *c;
+        for (c = name; *c; c++)
+            if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || *c == '_' || (c != name && *c >= '0' && *c <= '9'))) break;
+        if (*c || !*name) { fprintf(stderr, "sinew-bake: --name '%s' is not a C identifier\n", name); return 2; }
+    }
     if (sb_bake_file(desc, flavour, quiet, &o, &b)) { fprintf(stderr, "sinew-bake: error: %s\n", sb_error()); return 1; }
-    if (sb_write_file(out, b.bytes, b.size) || (carray && sb_write_c_array(carray, name, b.bytes, b.size))) {
+    if ((out && sb_write_file(out, b.bytes, b.size)) || (carray && sb_write_c_array(carray, name, b.bytes, b.size))) {
         fprintf(stderr, "sinew-bake: error: %s\n", sb_error());
-        remove(out);
+        if (out) remove(out);   /* all or nothing */
         sb_blob_free(&b); sb_model_free(&o);
         return 1;
     }

@@ -24,8 +24,10 @@ LIMB_DEPS = tools/examples/limb/limb.sinew tools/examples/limb/limb.obj $(BAKE)
 
 $(EX)/cow.blob: $(COW_DEPS)
 	@mkdir -p $(EX)
-	$(BAKE) tools/examples/cow/cow.sinew -o $@ --c-array $(EX)/cow_blob.c --name sinew_cow_blob --quiet
-$(EX)/cow_blob.c: $(EX)/cow.blob
+	$(BAKE) tools/examples/cow/cow.sinew -o $@ --quiet
+$(EX)/cow_blob.c: $(COW_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/cow/cow.sinew --c-array $@ --name sinew_cow_blob --quiet
 $(EX)/cow_float.blob: $(COW_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/cow/cow.sinew -o $@ --flavour float --quiet
@@ -35,8 +37,10 @@ $(EX)/cow_double.blob: $(COW_DEPS)
 
 $(EX)/limb.blob: $(LIMB_DEPS)
 	@mkdir -p $(EX)
-	$(BAKE) tools/examples/limb/limb.sinew -o $@ --c-array $(EX)/limb_blob.c --name sinew_limb_blob --quiet
-$(EX)/limb_blob.c: $(EX)/limb.blob
+	$(BAKE) tools/examples/limb/limb.sinew -o $@ --quiet
+$(EX)/limb_blob.c: $(LIMB_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/limb/limb.sinew --c-array $@ --name sinew_limb_blob --quiet
 $(EX)/limb_float.blob: $(LIMB_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/limb/limb.sinew -o $@ --flavour float --quiet
