@@ -9,6 +9,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+typedef struct snref_band snref_band;
+static snref_band *band_build(snref_state *s, int which, size_t max_doubles);
+static void band_solve(const snref_band *B, const double *r, double *x);
+static void band_free(snref_band *B);
+static const double *band_key(const snref_band *B);
+
 /* ---------------- small linear algebra ---------------- */
 
 static void mat_vec(const double A[9], const double x[3], double y[3]) {
@@ -20,6 +26,19 @@ static void matT_vec(const double A[9], const double x[3], double y[3]) {
     y[0] = A[0] * x[0] + A[3] * x[1] + A[6] * x[2];
     y[1] = A[1] * x[0] + A[4] * x[1] + A[7] * x[2];
     y[2] = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
+}
+static void mat_mul_(const double A[9], const double B[9], double C[9]) {
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+/* C = A B^T */
+static void mat_mulT_(const double A[9], const double B[9], double C[9]) {
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] + A[3 * i + 2] * B[3 * j + 2];
 }
 static int mat_inv(const double A[9], double B[9]) {
     double d = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6])
@@ -282,11 +301,13 @@ int snref_init(snref_state *s, const snref_model *m) {
     s->warm = 1;
     s->gscale = 1.0;
     s->hscale = 1.0;
+    s->first_pose_moves_free = 1;
     snref_reset(s);
     return 0;
 }
 
 void snref_release(snref_state *s) {
+    band_free(s->band);
     free(s->p); free(s->v); free(s->dv); free(s->R); free(s->c); free(s->jq); free(s->jt); free(s->work);
     memset(s, 0, sizeof *s);
 }
@@ -323,7 +344,9 @@ static void skeleton_pos(const snref_state *s, unsigned k, double out[3]) {
 void snref_reset(snref_state *s) {
     const snref_model *m = s->m;
     unsigned j;
-    memcpy(s->p, m->rest, 3 * m->nV * sizeof *s->p);
+    unsigned root = 0;
+    for (j = 0; j < m->nJ; j++) if (m->jparent[j] < 0) { root = j; break; }
+    for (j = 0; j < 3 * m->nV; j++) s->p[j] = m->rest[j] + m->jrest[3 * root + j % 3];
     memset(s->v, 0, 3 * m->nV * sizeof *s->v);
     memset(s->dv, 0, 3 * m->nV * sizeof *s->dv);
     for (j = 0; j < m->nJ; j++) {
@@ -338,9 +361,16 @@ void snref_reset(snref_state *s) {
 void snref_set_pose(snref_state *s, const snref_xform *pose) {
     const snref_model *m = s->m;
     unsigned j, k;
+    unsigned root = 0;
+    for (j = 0; j < m->nJ; j++) if (m->jparent[j] < 0) { root = j; break; }
+    /* Poses act on model space; internal positions are relative to the root
+     * joint's rest x0, so in internal units x -> R x + (R x0 + t)/U. */
     for (j = 0; j < m->nJ; j++) {
+        double Rj[9], y[3];
         for (k = 0; k < 4; k++) s->jq[4 * j + k] = pose[j].q[k];
-        for (k = 0; k < 3; k++) s->jt[3 * j + k] = pose[j].t[k] / m->unit;
+        snref_quat_to_mat(pose[j].q, Rj);
+        mat_vec(Rj, m->jrest + 3 * root, y);
+        for (k = 0; k < 3; k++) s->jt[3 * j + k] = pose[j].t[k] / m->unit + y[k];
     }
     if (!s->posed) {
         /* First pose is also the previous pose: skeleton state jumps with zero velocity. */
@@ -539,6 +569,30 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     return bn > 0 ? sqrt(dot(r, r, n)) / bn : 0.0;
 }
 
+
+/* Exact step solve by a banded LU of A, cached while the frames (pose, mode,
+ * time-step scale) are unchanged. Returns -1 if the band is too large. */
+static int exact_direct(snref_state *s, const double *b, double *x) {
+    const snref_model *m = s->m;
+    double key[64];
+    unsigned j, k = 0;
+    memset(key, 0, sizeof key);
+    /* A depends on the joint rotations only (frames), the mode and the h scale */
+    for (j = 0; j < m->nJ && k + 4 <= 60; j++) {
+        unsigned c;
+        for (c = 0; c < 4; c++) key[k++] = s->jq[4 * j + c];
+    }
+    key[60] = s->mode; key[61] = s->hscale; key[62] = m->nJ; key[63] = (double)m->nF;
+    if (m->nJ * 4 > 60) { band_free(s->band); s->band = NULL; } /* too many joints to key: no caching */
+    if (s->band && memcmp(band_key(s->band), key, sizeof key) == 0) { band_solve(s->band, b, x); return 0; }
+    band_free(s->band);
+    s->band = band_build(s, 1, (size_t)60000000);
+    if (!s->band) return -1;
+    memcpy((double *)band_key(s->band), key, sizeof key);
+    band_solve(s->band, b, x);
+    return 0;
+}
+
 void snref_step(snref_state *s) {
     const snref_model *m = s->m;
     unsigned i, k, nF = m->nF, nV = m->nV;
@@ -593,7 +647,8 @@ void snref_step(snref_state *s) {
     {
         double *x = s->dv;
         if (!s->warm) memset(x, 0, 3 * nF * sizeof *x);
-        s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
+        if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
+        else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
     }
     /* 7. update */
     for (i = 0; i < 3 * nF; i++) { s->v[i] += s->dv[i]; s->p[i] += s->v[i]; }
@@ -601,8 +656,9 @@ void snref_step(snref_state *s) {
 }
 
 void snref_get_lattice(const snref_state *s, double *out) {
+    const snref_model *m = s->m;
     unsigned i;
-    for (i = 0; i < 3 * s->m->nV; i++) out[i] = s->p[i] * s->m->unit;
+    for (i = 0; i < 3 * m->nV; i++) out[i] = s->p[i] * m->unit;
 }
 
 void snref_surface_from_lattice(const snref_model *m, const double *lat, double *out) {
@@ -726,6 +782,150 @@ static void bicgstab(snref_state *s, const double *rhs, double *x, double tol) {
     free(r); free(r0); free(pv); free(v); free(ph); free(sv); free(sh); free(t); free(Pi);
 }
 
+/* Reverse Cuthill-McKee order of the free vertices (bandwidth reduction for
+ * the banded direct solve). perm[new] = old, inv[old] = new. */
+static void rcm(const snref_model *m, unsigned *perm, unsigned *inv) {
+    unsigned nF = m->nF, i, e, head = 0, tail = 0, *deg = calloc(nF, sizeof *deg), *adjp = calloc(nF + 1, sizeof *adjp), *adj;
+    unsigned char *seen = calloc(nF, 1);
+    for (i = 0; i < nF; i++)
+        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++)
+            if (m->cols[e] < nF) { deg[i]++; deg[m->cols[e]]++; }
+    for (i = 0; i < nF; i++) adjp[i + 1] = adjp[i] + deg[i];
+    adj = malloc((adjp[nF] + 1) * sizeof *adj);
+    memset(deg, 0, nF * sizeof *deg);
+    for (i = 0; i < nF; i++)
+        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
+            unsigned j = m->cols[e];
+            if (j >= nF) continue;
+            adj[adjp[i] + deg[i]++] = j; adj[adjp[j] + deg[j]++] = i;
+        }
+    while (tail < nF) {
+        /* new component: start at a min-degree vertex, then move to the last BFS level twice (pseudo-peripheral) */
+        unsigned start = nF, pass, k;
+        for (i = 0; i < nF; i++) if (!seen[i] && (start == nF || deg[i] < deg[start])) start = i;
+        for (pass = 0; pass < 2; pass++) {
+            unsigned h2 = tail, t2 = tail;
+            perm[t2++] = start; seen[start] = 1;
+            while (h2 < t2) {
+                unsigned u = perm[h2++];
+                for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[t2++] = adj[k]; }
+            }
+            for (k = tail; k < t2; k++) seen[perm[k]] = 0;
+            start = perm[t2 - 1];
+        }
+        head = tail;
+        perm[tail++] = start; seen[start] = 1;
+        while (head < tail) {
+            unsigned u = perm[head++], first = tail, a, b;
+            for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[tail++] = adj[k]; }
+            for (a = first + 1; a < tail; a++)     /* neighbours by increasing degree */
+                for (b = a; b > first && deg[perm[b - 1]] > deg[perm[b]]; b--) { unsigned t = perm[b]; perm[b] = perm[b - 1]; perm[b - 1] = t; }
+        }
+    }
+    for (i = 0; i < nF / 2; i++) { unsigned t = perm[i]; perm[i] = perm[nF - 1 - i]; perm[nF - 1 - i] = t; }
+    for (i = 0; i < nF; i++) inv[perm[i]] = i;
+    free(deg); free(adjp); free(adj); free(seen);
+}
+
+/* Banded LU of a free-free system in RCM order. which = 0: -J (exact static
+ * Jacobian, row i: R_i S^_ij R_i^T); which = 1: the step matrix A =
+ * (1+a1) M^_FF + (1+b1) R_i S^_ij R_j^T. No pivoting: both are close to (or
+ * congruent to) SPD matrices. */
+struct snref_band {
+    unsigned n, nF, bw;
+    size_t W;
+    double *A;
+    unsigned *inv;
+    double key[64]; /* pose of a cached step matrix */
+};
+
+static void band_free(snref_band *B) { if (B) { free(B->A); free(B->inv); free(B); } }
+static const double *band_key(const snref_band *B) { return B->key; }
+
+static snref_band *band_build(snref_state *s, int which, size_t max_doubles) {
+    const snref_model *m = s->m;
+    unsigned nF = m->nF, n = 3 * nF, i, e, bw = 0, *perm = malloc(nF * sizeof *perm), *inv = malloc(nF * sizeof *inv);
+    size_t W, row, col;
+    double *A, sc = sscale(s), ca = 1.0 + a1_of(s), cb = which ? 1.0 + b1_of(s) : 1.0;
+    snref_band *B;
+    rcm(m, perm, inv);
+    free(perm);
+    for (i = 0; i < nF; i++)
+        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++)
+            if (m->cols[e] < nF) {
+                unsigned d = inv[i] > inv[m->cols[e]] ? inv[i] - inv[m->cols[e]] : inv[m->cols[e]] - inv[i];
+                if (d > bw) bw = d;
+            }
+    bw = 3 * bw + 2;
+    W = 2 * (size_t)bw + 1;
+    if ((size_t)n * W > max_doubles) { free(inv); return NULL; }
+    A = calloc((size_t)n * W, sizeof *A);
+    if (!A) { free(inv); return NULL; }
+#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
+    for (i = 0; i < nF; i++) {
+        double RS[9], Bk[9], St[9];
+        unsigned a, b;
+        const double *Ri = s->R + 9 * i;
+        mat_mulT_(m->sdiag + 9 * i, Ri, RS); mat_mul_(Ri, RS, Bk);
+        for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[i] + a, 3 * inv[i] + b) += cb * sc * Bk[3 * a + b];
+        if (which) for (a = 0; a < 3; a++) AB(3 * inv[i] + a, 3 * inv[i] + a) += ca * m->mdiag[i];
+        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
+            unsigned j = m->cols[e];
+            const double *Rj = s->R + 9 * j;
+            if (j >= nF) continue;
+            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) St[3 * a + b] = m->soff[9 * e + 3 * b + a];
+            /* row i */
+            mat_mulT_(m->soff + 9 * e, which ? Rj : Ri, RS); mat_mul_(Ri, RS, Bk);
+            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[i] + a, 3 * inv[j] + b) += cb * sc * Bk[3 * a + b];
+            /* row j */
+            mat_mulT_(St, which ? Ri : Rj, RS); mat_mul_(Rj, RS, Bk);
+            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[j] + a, 3 * inv[i] + b) += cb * sc * Bk[3 * a + b];
+            if (which)
+                for (a = 0; a < 3; a++) {
+                    AB(3 * inv[i] + a, 3 * inv[j] + a) += ca * m->moff[e];
+                    AB(3 * inv[j] + a, 3 * inv[i] + a) += ca * m->moff[e];
+                }
+        }
+    }
+    for (row = 0; row < n; row++) {              /* in-place LU (L unit, multipliers below) */
+        double piv = AB(row, row);
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        for (col = row + 1; col <= end; col++) {
+            double l = AB(col, row) / piv;
+            size_t k;
+            AB(col, row) = l;
+            if (l == 0) continue;
+            for (k = row + 1; k <= end; k++) AB(col, k) -= l * AB(row, k);
+        }
+    }
+#undef AB
+    B = calloc(1, sizeof *B);
+    B->n = n; B->nF = nF; B->bw = bw; B->W = W; B->A = A; B->inv = inv;
+    return B;
+}
+
+static void band_solve(const snref_band *B, const double *r, double *x) {
+    size_t n = B->n, bw = B->bw, W = B->W, row, k;
+    unsigned i, e;
+    double *y = malloc(n * sizeof *y);
+    const double *A = B->A;
+#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
+    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) y[3 * B->inv[i] + e] = r[3 * i + e];
+    for (row = 0; row < n; row++) {
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        for (k = row + 1; k <= end; k++) y[k] -= AB(k, row) * y[row];
+    }
+    for (row = n; row-- > 0;) {
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        double t = y[row];
+        for (k = row + 1; k <= end; k++) t -= AB(row, k) * y[k];
+        y[row] = t / AB(row, row);
+    }
+#undef AB
+    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) x[3 * i + e] = y[3 * B->inv[i] + e];
+    free(y);
+}
+
 double snref_static(snref_state *s, unsigned dense_max) {
     const snref_model *m = s->m;
     unsigned n = 3 * m->nF, i, k, pass;
@@ -752,7 +952,9 @@ double snref_static(snref_state *s, unsigned dense_max) {
             dense_solve(A, dx, n);
             free(A); free(e); free(col);
         } else {
-            bicgstab(s, r, dx, 1e-13);
+            snref_band *B = band_build(s, 0, (size_t)60000000);
+            if (B) band_solve(B, r, dx); else bicgstab(s, r, dx, 1e-13);
+            band_free(B);
         }
         for (i = 0; i < n; i++) s->p[i] += dx[i];
     }

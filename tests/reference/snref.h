@@ -6,7 +6,8 @@
  * (the host tool's unquantized matrices).
  *
  * Units: positions/velocities inside are internal units (U = 2^len_shift mesh
- * units) in world space; the API takes poses and returns positions in mesh
+ * units) in world space relative to the root joint's rest position x0 (blob
+ * joint rests are model space, REST is relative to x0); the API takes poses and returns positions in mesh
  * units, like the runtime. The state is "world" positions in doubles: no
  * origin shifting is needed at double precision (NUMERICS.md "Origin" only
  * changes representation, not the maths).
@@ -72,10 +73,11 @@ typedef struct snref_state {
     unsigned iters;/* CG iterations per step */
     int exact;     /* 1: solve each step to convergence instead of N iterations */
     int warm;      /* 1 (default): warm-start CG from the previous dv */
-    int first_pose_moves_free; /* 1: first pose also places free vertices rigidly (default 0) */
+    int first_pose_moves_free; /* 1 (default, as the runtime): the first pose places free vertices at R_i x_i + c_i */
     double gscale; /* multiplies the baked gravity (1 by default) */
     double hscale; /* step h' = hscale*h: S^,g^ scale by hscale^2, a1 by hscale, b1 by 1/hscale */
     unsigned steps;
+    struct snref_band *band; /* cached factor of the step matrix (exact mode) */
     double last_cg_relres; /* |b - A dv| / |b| after the last step's solve */
 } snref_state;
 
@@ -96,7 +98,8 @@ void snref_surface_from_lattice(const snref_model *m, const double *lat, double 
  * the pose, frames from the pose): f(p_F) + m^ g^ = 0, solved as one linear
  * system with the exact (non-symmetric) Jacobian -R_i S^_ij R_i^T. Dense LU
  * when 3 nF <= dense_max, else BiCGSTAB to a relative residual of 1e-12.
- * Writes the solution into the state's free positions (velocities zeroed).
+ * Otherwise banded LU in reverse Cuthill-McKee order (BiCGSTAB if the band
+ * is too large). Writes the solution into the state's free positions (velocities zeroed).
  * Returns the final relative residual |f + m g| / |m g| (or / |f(p0)|). */
 double snref_static(snref_state *s, unsigned dense_max);
 
