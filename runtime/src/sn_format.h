@@ -114,6 +114,9 @@ enum {
 #define SN_MAX_SURFACE 65535u
 #define SN_MAX_VERTICES 65535u
 #define SN_MAX_CG_ITERS 256u
+/* A stored row holds only neighbours j > i of a hex lattice vertex: at most 26.
+ * The runtime relies on it to sum a row's own blocks without clamping. */
+#define SN_MAX_ROW_BLOCKS 26u
 
 /* Fixed-point formats of the internal state (flavour 0). */
 #define SN_Q_LEN 22   /* internal lengths, velocities per step (h*v), forces (m0 * unit) */

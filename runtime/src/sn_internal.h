@@ -92,14 +92,15 @@ SN_INLINE sn_acc sn_mul(sn_q a, sn_q b) {
 #endif
 }
 
-/* Round-to-nearest right shift of an int64, symmetric (ties away from zero),
- * defined for negative values without relying on arithmetic >> of negatives.
- * Requires |x| <= 2^62 and 0 <= s <= 62. */
+/* Round-to-nearest right shift of an int64 (ties toward +infinity).
+ * Right-shifting a negative value is implementation-defined in C99; every
+ * supported compiler shifts arithmetically, and the check below refuses to
+ * build where that is not so (the result would not be bit-identical).
+ * Requires |x| <= 2^62 and s <= 62; s <= 0 returns x unchanged. */
+typedef char sn_arithmetic_shift_required_[(((int64_t)-3) >> 1) == -2 ? 1 : -1];
 SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
-    int64_t h;
     if (s <= 0) return x;
-    h = (int64_t)1 << (s - 1);
-    return x >= 0 ? (x + h) >> s : -((-x + h) >> s);
+    return (x + ((int64_t)1 << (s - 1))) >> s;
 }
 
 /* Clamp an accumulator to +-2^62 (fixed); identity in float. */

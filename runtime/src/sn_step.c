@@ -287,15 +287,34 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3
 
 /* ---- the step ---- */
 
-/* acc += B e (B 3x3 row-major reals in the blob), clamped after the block */
-SN_INLINE void blk_mac(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    acc[0] = sn_acc_clamp(acc[0] + sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) +
-                          sn_mul(rd_real(b, 2), e[2]));
-    acc[1] = sn_acc_clamp(acc[1] + sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) +
-                          sn_mul(rd_real(b, 5), e[2]));
-    acc[2] = sn_acc_clamp(acc[2] + sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) +
-                          sn_mul(rd_real(b, 8), e[2]));
+/* Row-local sums: a row's own blocks (diagonal + at most SN_MAX_ROW_BLOCKS,
+ * validated) are summed unclamped in registers: each block row is < 3*2^55,
+ * so the row total stays < 2^61.3 and adding it to an accumulator already
+ * clamped to 2^62 cannot overflow. Scatter (transposed) adds clamp each time. */
+SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
+    l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
+    l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
+    l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
 }
+SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
+    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
+    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
+    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
+}
+SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
+    l[0] += sn_mul(m, e[0]);
+    l[1] += sn_mul(m, e[1]);
+    l[2] += sn_mul(m, e[2]);
+}
+/* acc_i = clamp(acc_i + l) at the end of row i */
+SN_INLINE void row_done(sn_acc *acc, const sn_acc l[3]) {
+    acc[0] = sn_acc_clamp(acc[0] + l[0]);
+    acc[1] = sn_acc_clamp(acc[1] + l[1]);
+    acc[2] = sn_acc_clamp(acc[2] + l[2]);
+}
+
 /* acc += B^T e */
 SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
     acc[0] = sn_acc_clamp(acc[0] + sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) +
@@ -358,15 +377,17 @@ static void pass_S_ff(const sn_ihdr *h, const sn_q *u, sn_acc *acc) {
     acc_zero(acc, 3 * nF);
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
-        sym_mac(acc + 3 * i, sd + (size_t)i * 6 * RB, u + 3 * i);
+        sn_acc l[3] = {0, 0, 0};
+        sym_row(l, sd + (size_t)i * 6 * RB, u + 3 * i);
         /* columns ascend and skeleton columns (>= nF) come last: a blob-fixed prefix */
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             const unsigned char *b = so + (size_t)e * 9 * RB;
             if (j >= nF) break;
-            blk_mac(acc + 3 * i, b, u + 3 * j);
+            blk_row(l, b, u + 3 * j);
             blk_mac_t(acc + 3 * j, b, u + 3 * i);
         }
+        row_done(acc + 3 * i, l);
     }
 }
 
@@ -379,15 +400,17 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
     acc_zero(acc, 3 * nF);
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
-        sca_mac(acc + 3 * i, rd_real(md, i), y + 3 * i);
+        sn_acc l[3] = {0, 0, 0};
+        sca_row(l, rd_real(md, i), y + 3 * i);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m;
             if (j >= nF) break;
             m = rd_real(mo, e);
-            sca_mac(acc + 3 * i, m, y + 3 * j);
+            sca_row(l, m, y + 3 * j);
             sca_mac(acc + 3 * j, m, y + 3 * i);
         }
+        row_done(acc + 3 * i, l);
     }
 }
 
@@ -656,18 +679,20 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_q a[3];
+        sn_acc l[3] = {0, 0, 0};
         warp_arg(R + 9 * i, c + 3 * i, pos + 3 * i, rest + (size_t)3 * i * RB, u + 3 * i, a, sat);
-        sym_mac(acc + 3 * i, sd + (size_t)i * 6 * RB, a);
+        sym_row(l, sd + (size_t)i * 6 * RB, a);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             const unsigned char *blk = so + (size_t)e * 9 * RB;
             warp_arg(R + 9 * i, c + 3 * i, pos + 3 * j, rest + (size_t)3 * j * RB, u + 3 * j, a, sat);
-            blk_mac(acc + 3 * i, blk, a);
+            blk_row(l, blk, a);
             if (j < nF) {
                 warp_arg(R + 9 * j, c + 3 * j, pos + 3 * i, rest + (size_t)3 * i * RB, u + 3 * i, a, sat);
                 blk_mac_t(acc + 3 * j, blk, a);
             }
         }
+        row_done(acc + 3 * i, l);
     }
     rows_out_rot(h, acc, v->frac_S, b, sat);
     for (i = 0; i < 3 * nF; i++) b[i] = (sn_q)-b[i]; /* |b| <= SN_LIM: negation is safe */
@@ -677,8 +702,9 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_q yi[3], yj[3];
+        sn_acc l[3] = {0, 0, 0};
         for (k = 0; k < 3; k++) yi[k] = coef(vel[3 * i + k], v->a1, sat);
-        sca_mac(acc + 3 * i, rd_real(md, i), yi);
+        sca_row(l, rd_real(md, i), yi);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m = rd_real(mo, e);
@@ -686,9 +712,10 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
                 yj[k] = coef(vel[3 * j + k], v->a1, sat);
                 if (j >= nF) yj[k] = sn_add(yj[k], ds[3 * (j - nF) + k], sat);
             }
-            sca_mac(acc + 3 * i, m, yj);
+            sca_row(l, m, yj);
             if (j < nF) sca_mac(acc + 3 * j, m, yi);
         }
+        row_done(acc + 3 * i, l);
     }
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
