@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifdef SN_FLOAT
@@ -59,9 +60,14 @@ static int die(const char *fmt, ...) {
 
 /* Whole file into malloc'd memory (8-byte aligned: malloc's guarantee). */
 static void *read_file(const char *path, size_t *n, char *err, size_t errlen) {
-    FILE *f = fopen(path, "rb");
+    FILE *f;
     long len;
     void *buf;
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "cannot read %s: not a regular file", path); return NULL;
+    }
+    f = fopen(path, "rb");
     if (!f) { snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno)); return NULL; }
     if (fseek(f, 0, SEEK_END) || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
         snprintf(err, errlen, "cannot read %s: not a regular file", path); fclose(f); return NULL;
@@ -402,6 +408,12 @@ int main(int argc, char **argv) {
         if (rs_image_alloc(&sheet, SHEET_COLS * pw, SHEET_ROWS * ph) || rs_image_alloc(&panel, pw, ph)) { die("out of memory"); goto done; }
         for (k = 0; k < SHEET_COLS * SHEET_ROWS; k++)
             sheet_at[k] = (long)(((double)k + 1) * (double)n_frames / (SHEET_COLS * SHEET_ROWS) + 0.5);
+        /* fewer steps than panels: some show step 0, the rest state */
+        for (k = 0; k < SHEET_COLS * SHEET_ROWS; k++)
+            if (sheet_at[k] == 0) {
+                if (render(&s, inst, &panel, "t = 0.00 s", k == 0 ? o.title : NULL)) { die("out of memory"); goto done; }
+                rs_blit(&sheet, (int)(k % SHEET_COLS) * panel.w, (int)(k / SHEET_COLS) * panel.h, &panel);
+            }
     }
 
     /* run */

@@ -40,6 +40,7 @@ expect nz 'this blob allows 1\.\.' "$PLAY" "$BLOB" --iterations 100000
 
 # blobs: missing, empty, truncated, corrupt, wrong flavour
 expect 1 "cannot read $TMP/none.blob" "$PLAY" "$TMP/none.blob"
+expect 1 "cannot read $TMP: not a regular file" "$PLAY" "$TMP"
 : > "$TMP/empty.blob"
 expect 1 'invalid blob: blob is shorter' "$PLAY" "$TMP/empty.blob"
 head -c 1000 "$BLOB" > "$TMP/trunc.blob"
@@ -83,6 +84,8 @@ expect 0 "wrote $TMP/out/c.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 10 --com
     --lattice --view 20,30 --frame-box 0,-3,-2,9,3,2 --size 320x240
 [ "$(head -c 24 "$TMP/out/c.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a0000000d49484452000002d0000000b4 ] \
     && ok || bad "compare picture is not a 720x180 PNG"
+# fewer steps than sheet panels (some panels show the rest state)
+expect 0 "wrote $TMP/out/s3.png" "$PLAY" "$BLOB" --frames 3 --sheet "$TMP/out/s3.png"
 expect 2 'frame-box: want' "$PLAY" "$BLOB" --frame-box 1,2,3
 expect 2 'size: want WxH' "$PLAY" "$BLOB" --size 10x10
 ls "$TMP/out" | grep -q 'tmp\|probe' && bad "temp files left: $(ls "$TMP/out")" || ok
