@@ -21,7 +21,7 @@
 #endif
 
 extern const unsigned char SN_BM_BLOB[];
-extern const uint32_t SN_BM_BLOB_SIZE;
+extern const unsigned long SN_BM_BLOB_SIZE; /* as sinew-bake --c-array writes it */
 #if SN_BM_CLIP
 extern const unsigned char sn_bm_clip_text[];
 extern const uint32_t sn_bm_clip_len;
@@ -30,7 +30,12 @@ extern uint32_t __pool_start[], __pool_end[];
 uint32_t sn_bm_stack_used(void);
 
 static sn_det det;
-static sn_clip clip;
+#if SN_BM_CLIP
+static sn_clip clip;   /* ~23 KB: only in images that play a clip */
+#define CLIP_MEM (&clip)
+#else
+#define CLIP_MEM NULL
+#endif
 
 static void put_u64(uint64_t v) {
     char d[21];
@@ -74,12 +79,21 @@ int main(void) {
     text = (const char *)sn_bm_clip_text;
     text_len = sn_bm_clip_len;
 #endif
-    if (sn_det_init(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, text, text_len, &clip,
+    if (sn_det_init(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, text, text_len, CLIP_MEM,
                     __pool_start, pool, err, sizeof err)) {
         sn_bm_puts("FAIL: "); sn_bm_puts(err); sn_bm_puts("\n");
         return 1;
     }
     put_kv("instance_bytes: ", sn_instance_size(det.blob));
+    {
+        sn_blob_info bi;
+        sn_blob_get_info(det.blob, &bi);
+        put_kv("lattice_vertices: ", bi.vertices);
+        put_kv("free_vertices: ", bi.free_vertices);
+        put_kv("offdiag_blocks: ", bi.offdiag_blocks);
+        put_kv("cg_iterations: ", bi.cg_iters_default);
+        put_kv("clip: ", SN_BM_CLIP);
+    }
 #if SN_BM_BENCH
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 0;
     SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;

@@ -14,7 +14,7 @@
 
 #ifdef SN_DET_BLOB
 extern const unsigned char SN_DET_BLOB[];
-extern const uint32_t SN_DET_BLOB_SIZE;
+extern const unsigned long SN_DET_BLOB_SIZE; /* as sinew-bake --c-array writes it */
 #endif
 
 /* Whole file into malloc memory (8-byte aligned, as the runtime needs). */

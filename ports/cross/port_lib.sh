@@ -19,15 +19,6 @@ finish() {
 have() { command -v "$1" >/dev/null 2>&1; }
 pmake() { make -s --no-print-directory BUILD="$BUILD" "$@"; }
 
-# The runtime sources and the host tool's cow blob must exist first; until
-# the other fragments land the port suites report that and pass.
-port_ready_or_exit() {
-    if ! msg=$(pmake port-ready 2>&1); then
-        echo "SKIPPED: port suite waits for the runtime and the host tool ($msg)"
-        finish; exit $?
-    fi
-}
-
 # run_log LOG TIMEOUT CMD... : run with a time limit, output to LOG; returns rc.
 run_log() {
     log=$1; t=$2; shift 2

@@ -61,7 +61,8 @@ static void builtin_pose(sn_det *d) {
 }
 
 void sn_det_pose(sn_det *d) {
-    if (d->clip) sn_clip_pose(d->clip, d->blob, d->k, d->local, d->xf);
+    /* step k+1 ends at time (k+1)h: pose it there, as sinew-play does */
+    if (d->clip) sn_clip_pose(d->clip, d->blob, d->k + 1u, d->local, d->xf);
     else builtin_pose(d);
     (void)sn_set_pose(d->inst, d->xf, d->n_joints);
 }

@@ -3,7 +3,8 @@
  * step k (from a clip, or a built-in sequence without one) and call sn_step.
  * No allocation, no stdio: the same code runs hosted and on bare metal, so a
  * hash that differs between ports can only come from the compiler or CPU.
- * Mirrors the desktop player: pose k, sn_set_pose, sn_step, hash at the end.
+ * Mirrors the desktop player: for k = 1..N: clip pose at step k (time k*h),
+ * sn_set_pose, sn_step; hash at the end.
  */
 #ifndef SN_DET_H
 #define SN_DET_H
@@ -33,7 +34,7 @@ int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
                 const char *clip_text, size_t clip_len, sn_clip *clip,
                 void *mem, size_t mem_size, char *err, size_t errlen);
 
-/// Compute and set the pose of step d->k.
+/// Compute and set the pose for the next step (clip time (d->k + 1) * h).
 void sn_det_pose(sn_det *d);
 
 /// sn_step and advance d->k.

@@ -6,7 +6,6 @@
 # the float flavour of the same runtime objects does reference such helpers,
 # so the check can see them.
 . ports/cross/port_lib.sh
-port_ready_or_exit
 
 FLOAT_RE='__aeabi_([fd][a-z0-9]+|[ui]2[fd]|u?l2[fd])$|__(add|sub|mul|div|neg)[sdt]f3$|__float(un)?[sdt]i[sdt]f$|__fix(uns)?[sdt]f[sdt]i$|__extendsfdf2$|__truncdfsf2$|__(eq|ne|lt|le|gt|ge|un|cmp)[sd]f2$'
 LIBM_RE='^(sqrtf?|sinf?|cosf?|tanf?|atan2f?|atanf?|acosf?|asinf?|expf?|logf?|powf?|fabsf?|floorf?|ceilf?|fmodf?|roundf?|lrintf?)$'
