@@ -299,6 +299,7 @@ int main(int argc, char **argv) {
     long sheet_at[SHEET_COLS * SHEET_ROWS];
     int r = parse_args(argc, argv, &o);
     if (r) return r;
+    srand((unsigned)getpid());   /* distinct temp-file names for concurrent players */
     memset(&s, 0, sizeof s);
     memset(&sheet, 0, sizeof sheet); memset(&panel, 0, sizeof panel); memset(&cmp, 0, sizeof cmp);
 

@@ -79,6 +79,12 @@ grep -c '^v ' "$TMP/out/frame_0020.obj" | grep -q '^2903$' && ok || bad "frame_0
 for p in p s; do
     [ "$(head -c 8 "$TMP/out/$p.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && ok || bad "$p.png is not a PNG"
 done
+# same run twice: byte-identical OBJ frames and pictures
+mkdir "$TMP/again"
+"$PLAY" "$BLOB" --clip "$CLIP" --frames 20 --obj-dir "$TMP/again" --png "$TMP/again/p.png" --quiet > /dev/null 2>&1
+cmp -s "$TMP/out/frame_0020.obj" "$TMP/again/frame_0020.obj" && ok || bad "OBJ frame 20 differs between identical runs"
+cmp -s "$TMP/out/p.png" "$TMP/again/p.png" && ok || bad "PNG differs between identical runs"
+
 # compare (two instances) with the lattice overlay and a framing box
 expect 0 "wrote $TMP/out/c.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 10 --compare "$TMP/out/c.png" \
     --lattice --view 20,30 --frame-box 0,-3,-2,9,3,2 --size 320x240
