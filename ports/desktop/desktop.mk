@@ -20,7 +20,11 @@ $(BUILD)/tests/test_png: tests/test_png.c ports/desktop/png.c ports/desktop/png.
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_png.c ports/desktop/png.c -o $@ -lm
 
-TEST_BINS += $(BUILD)/tests/test_clip $(BUILD)/tests/test_png
+$(BUILD)/tests/test_desktop_raster: tests/test_desktop_raster.c ports/desktop/raster.c ports/desktop/raster.h tests/sn_test.h
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_desktop_raster.c ports/desktop/raster.c -o $@ -lm
+
+TEST_BINS += $(BUILD)/tests/test_clip $(BUILD)/tests/test_png $(BUILD)/tests/test_desktop_raster
 
 # The player needs the runtime libraries (runtime/runtime.mk).
 ifdef SN_LIB_FIXED
