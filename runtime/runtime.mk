@@ -46,3 +46,19 @@ $(BUILD)/tests/test_runtime_$(1)_float: tests/test_runtime_$(1).c $(SN_TEST_HDRS
 endef
 $(foreach t,$(SN_TESTS),$(eval $(call SN_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(SN_TESTS),$(BUILD)/tests/test_runtime_$(t) $(BUILD)/tests/test_runtime_$(t)_float)
+
+# ---- hostile blobs (tests/fuzz): the runtime sources compiled into the
+# fuzzer with ASan + UBSan; _ck keeps the checksum (every flip must fail) ----
+SN_FUZZ_CFLAGS = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
+                 -fno-sanitize-recover=all $(SN_INC) -Iruntime/src -Itests/fuzz
+SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h $(SN_SRCS) $(SN_HDRS)
+$(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+$(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+$(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float

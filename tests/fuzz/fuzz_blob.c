@@ -1,0 +1,331 @@
+/* fuzz_blob.c -- hostile blobs: every single-bit flip and every truncation
+ * of a real blob must be handled without an out-of-bounds access or
+ * undefined behaviour (built with -fsanitize=address,undefined
+ * -fno-sanitize-recover=all, so any finding aborts the run).
+ *
+ * For each mutated blob: validate; if accepted, initialise an instance, pose
+ * it (sn_pose_from_local + sn_set_pose), step twice with 2 CG iterations, and
+ * read everything back (lattice, surface, normals, hash, accessors).
+ *
+ * Two builds of the same file (tests/fuzz/fuzz.mk... see runtime/runtime.mk):
+ *   test_runtime_fuzz     -DSN_VALIDATE_NO_CHECKSUM: the checksum is skipped so
+ *                         mutations reach every later rule and the stepper;
+ *   test_runtime_fuzz_ck  normal validator: every flip must be rejected
+ *                         (CRC-32 detects every single-bit error; bytes 0..15,
+ *                         outside the CRC, are magic/version/endian/CRC).
+ *
+ * Usage: test_runtime_fuzz [blob] [--all] [--per-section N] [--seed S]
+ *   blob       default $BUILD/examples/cow.blob (fixed) or cow_float.blob
+ *              (float); if missing, the hand-built test blob (sn_tblob.h)
+ *   --all      every bit of the blob (slow for a 200 KB blob: ~1.5 M cases)
+ *   default    every bit of the header and section table, every bit of the
+ *              first and last 16 bytes of each section, plus N (default 600)
+ *              random bits inside each section; truncations: every size
+ *              (size only), and total_size patched to the cut for every size
+ *              up to 4 KB, every section boundary +-16, and 2000 random sizes.
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sinew.h"
+#include "sn_format.h"
+#include "sn_tblob.h"
+
+#if defined(__has_include)
+#if __has_include(<sanitizer/common_interface_defs.h>)
+#include <sanitizer/common_interface_defs.h>
+#define HAVE_SAN_CB 1
+#endif
+#endif
+
+#if defined(SN_FLOAT)
+#define FLAV "float"
+#define DEFAULT_BLOB "examples/cow_float.blob"
+#define REAL(f, i) (f)
+#else
+#define FLAV "fixed"
+#define DEFAULT_BLOB "examples/cow.blob"
+#define REAL(f, i) (i)
+#endif
+
+#if defined(SN_VALIDATE_NO_CHECKSUM)
+#define MODE "no-checksum"
+#else
+#define MODE "checksum"
+#endif
+
+static unsigned char *g_orig, *g_work;
+static size_t g_size, g_last_end; /* end of the last non-empty section */
+static void *g_mem;
+static size_t g_mem_size;
+static char g_case[128];
+static uint64_t g_rng;
+
+static struct {
+    unsigned long flips, flips_ok, stepped, trunc, trunc_ok, trunc_total, trunc_total_ok, huge;
+    unsigned long by_status[SN_STATUS_COUNT];
+} g;
+
+static uint64_t rnd64(void) {
+    g_rng ^= g_rng << 13;
+    g_rng ^= g_rng >> 7;
+    g_rng ^= g_rng << 17;
+    return g_rng;
+}
+
+#ifdef HAVE_SAN_CB
+static void on_death(void) { fprintf(stderr, "fuzz: sanitizer finding while running case: %s\n", g_case); }
+#endif
+
+static uint32_t rd32(const unsigned char *p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+/* Use an accepted blob the way a game would. */
+static void exercise(const sn_blob *blob) {
+    sn_blob_info info;
+    sn_instance *inst;
+    size_t need = sn_instance_size(blob);
+    uint32_t j, idx[3];
+    sn_quat *local;
+    sn_xform *xf;
+    sn_vec3 *surf, *nrm, *lat, root, r;
+    int s;
+
+    sn_blob_get_info(blob, &info);
+    for (j = 0; j < info.joints; j++) {
+        const char *n = sn_joint_name(blob, j);
+        (void)sn_joint_parent(blob, j);
+        (void)sn_joint_rest(blob, j, &r);
+        if (n) (void)sn_find_joint(blob, n);
+    }
+    (void)sn_find_joint(blob, "no such joint");
+    for (j = 0; j < info.triangles && j < 8; j++) (void)sn_get_triangle(blob, j, idx);
+    if (need > (16u << 20)) { /* a flipped high bit of instance_bytes: valid, but too big to bother */
+        g.huge++;
+        return;
+    }
+    if (need > g_mem_size) {
+        free(g_mem);
+        g_mem = malloc(need);
+        g_mem_size = need;
+        if (!g_mem) { fprintf(stderr, "out of memory\n"); exit(2); }
+    }
+    if (sn_instance_init(g_mem, need, blob, &inst) != SN_OK) {
+        printf("FAIL: init refused an accepted blob (%s)\n", g_case);
+        exit(1);
+    }
+    local = (sn_quat *)malloc(sizeof *local * info.joints);
+    xf = (sn_xform *)malloc(sizeof *xf * info.joints);
+    surf = (sn_vec3 *)malloc(sizeof *surf * (info.surface_vertices + 1));
+    nrm = (sn_vec3 *)malloc(sizeof *nrm * (info.surface_vertices + 1));
+    lat = (sn_vec3 *)malloc(sizeof *lat * info.vertices);
+    if (!local || !xf || !surf || !nrm || !lat) { fprintf(stderr, "out of memory\n"); exit(2); }
+    for (j = 0; j < info.joints; j++) {
+        sn_vec3 ax;
+        ax.x = REAL(0.3f, 19661);
+        ax.y = REAL(1.0f, 65536);
+        ax.z = REAL(-0.2f, -13107);
+        local[j] = sn_quat_axis_angle(ax, REAL(25.0f, 25 << 16));
+    }
+    root.x = REAL(0.5f, 32768);
+    root.y = REAL(-0.25f, -16384);
+    root.z = 0;
+    sn_pose_from_local(blob, local, &root, xf);
+    (void)sn_set_pose(inst, xf, info.joints);
+    (void)sn_set_iterations(inst, info.cg_iters_max < 2 ? info.cg_iters_max : 2);
+    (void)sn_set_mode(inst, SN_MODE_WARPED);
+    for (s = 0; s < 2; s++) sn_step(inst);
+    (void)sn_get_lattice(inst, lat, 0, info.vertices);
+    (void)sn_get_surface(inst, surf, 0, info.surface_vertices);
+    if (info.triangles) (void)sn_get_normals(inst, surf, nrm);
+    (void)sn_state_hash(inst);
+    g.stepped++;
+    free(local); free(xf); free(surf); free(nrm); free(lat);
+}
+
+static sn_status run_case(size_t size) {
+    const sn_blob *blob;
+    sn_status st = sn_blob_validate(g_work, size, &blob);
+    if ((int)st >= 0 && st < SN_STATUS_COUNT) g.by_status[st]++;
+    if (st == SN_OK) exercise(blob);
+    return st;
+}
+
+static void flip(size_t byte, int bit) {
+    sn_status st;
+    sprintf(g_case, "flip byte %lu bit %d", (unsigned long)byte, bit);
+    g_work[byte] ^= (unsigned char)(1u << bit);
+    st = run_case(g_size);
+    g_work[byte] ^= (unsigned char)(1u << bit);
+    g.flips++;
+    if (st == SN_OK) g.flips_ok++;
+}
+
+static void flip_byte(size_t byte) {
+    int bit;
+    for (bit = 0; bit < 8; bit++) flip(byte, bit);
+}
+
+/* Cut to n bytes; with_total also writes n into total_size (a consistent
+ * but short blob: then the section table must catch it). */
+static void truncate_to(size_t n, int with_total) {
+    sn_status st;
+    unsigned char save[4];
+    sprintf(g_case, "truncate to %lu%s", (unsigned long)n, with_total ? " (total_size patched)" : "");
+    if (with_total) {
+        if (n < SN_H_TOTAL_SIZE + 4) return;
+        memcpy(save, g_work + SN_H_TOTAL_SIZE, 4);
+        tb_u32(g_work + SN_H_TOTAL_SIZE, (uint32_t)n);
+    }
+    st = run_case(n);
+    if (with_total) {
+        memcpy(g_work + SN_H_TOTAL_SIZE, save, 4);
+        g.trunc_total++;
+        /* cutting only trailing padding after the last section is legitimate */
+        if (st == SN_OK && n < g_last_end) g.trunc_total_ok++;
+    } else {
+        g.trunc++;
+        if (st == SN_OK) g.trunc_ok++;
+    }
+}
+
+/* Fuzz one blob (g_orig, g_size); returns the number of failed checks. */
+static int fuzz_one(const char *name, int all, unsigned long per_section) {
+    size_t n;
+    int i, k, fails = 0;
+    clock_t t0 = clock();
+    /* the work copy is exactly g_size bytes in its own allocation, so ASan
+     * catches any read past the end */
+    g_work = (unsigned char *)malloc(g_size);
+    if (!g_work) exit(2);
+    memcpy(g_work, g_orig, g_size);
+    printf("  fuzz: %s build (%s), blob %s, %lu bytes, %s\n", FLAV, MODE, name, (unsigned long)g_size,
+           all ? "every bit and every truncation" : "sampled (see header comment)");
+    {
+        sn_status st = run_case(g_size);
+        if (st != SN_OK) {
+            printf("FAIL: the unmodified blob is rejected: %s\n", sn_status_str(st));
+            free(g_work);
+            return 1;
+        }
+    }
+    memset(&g, 0, sizeof g);
+    g_last_end = 0;
+    for (k = 0; k < SN_SEC_COUNT; k++) {
+        size_t e = (size_t)rd32(g_orig + SN_H_SECTIONS + 16 * k) + rd32(g_orig + SN_H_SECTIONS + 16 * k + 4);
+        g_last_end = e > g_last_end ? e : g_last_end;
+    }
+
+    /* ---- single-bit flips ---- */
+    if (all) {
+        for (n = 0; n < g_size; n++) flip_byte(n);
+    } else {
+        for (n = 0; n < SN_HEADER_BYTES && n < g_size; n++) flip_byte(n);
+        for (k = 0; k < SN_SEC_COUNT; k++) {
+            uint32_t off = rd32(g_orig + SN_H_SECTIONS + 16 * k), sz = rd32(g_orig + SN_H_SECTIONS + 16 * k + 4);
+            uint32_t end = off + sz, gap_end = k + 1 < SN_SEC_COUNT ? rd32(g_orig + SN_H_SECTIONS + 16 * (k + 1))
+                                                                  : rd32(g_orig + SN_H_TOTAL_SIZE);
+            unsigned long r;
+            if (sz == 0) continue;
+            for (n = off; n < end && n < off + 16; n++) flip_byte(n);
+            for (n = end > off + 16 ? end - 16 : off + 16; n < end; n++) flip_byte(n);
+            for (n = end; n < gap_end && n < g_size; n++) flip_byte(n); /* padding */
+            for (r = 0; r < per_section; r++) {
+                uint64_t x = rnd64();
+                flip(off + (size_t)(x % sz), (int)((x >> 40) & 7));
+            }
+        }
+    }
+    /* ---- truncations ---- */
+    for (n = 0; n < g_size; n++) truncate_to(n, 0);
+    if (all) {
+        for (n = 0; n < g_size; n++) truncate_to(n, 1);
+    } else {
+        for (n = 0; n < g_size && n < 4096; n++) truncate_to(n, 1);
+        for (k = 0; k < SN_SEC_COUNT; k++) {
+            uint32_t off = rd32(g_orig + SN_H_SECTIONS + 16 * k), sz = rd32(g_orig + SN_H_SECTIONS + 16 * k + 4);
+            int d;
+            for (d = -16; d <= 16; d++) {
+                if ((long)off + d > 4096 && (size_t)((long)off + d) < g_size) truncate_to((size_t)((long)off + d), 1);
+                if ((long)(off + sz) + d > 4096 && (size_t)((long)(off + sz) + d) < g_size)
+                    truncate_to((size_t)((long)(off + sz) + d), 1);
+            }
+        }
+        for (i = 0; i < 2000; i++) truncate_to((size_t)(rnd64() % g_size), 1);
+    }
+
+    printf("  fuzz: flips %lu: accepted %lu (stepped %lu, instance > 16 MB %lu), rejected %lu\n", g.flips,
+           g.flips_ok, g.stepped, g.huge, g.flips - g.flips_ok);
+    printf("  fuzz: truncations (size only) %lu: accepted %lu; (total_size patched) %lu: accepted %lu\n",
+           g.trunc, g.trunc_ok, g.trunc_total, g.trunc_total_ok);
+    printf("  fuzz: statuses:");
+    for (i = 0; i < (int)SN_STATUS_COUNT; i++)
+        if (g.by_status[i]) printf(" %s=%lu", sn_status_str((sn_status)i), g.by_status[i]);
+    printf("\n");
+    printf("  figure: fuzz %s/%s %s: %lu flips (%lu accepted, %lu stepped), %lu truncations, %.1f s\n", FLAV, MODE,
+           name, g.flips, g.flips_ok, g.stepped, g.trunc + g.trunc_total, (double)(clock() - t0) / CLOCKS_PER_SEC);
+    if (g.trunc_ok != 0) { printf("FAIL: %s: a blob shorter than total_size was accepted\n", name); fails++; }
+    if (g.trunc_total_ok != 0) { printf("FAIL: %s: a cut blob with patched total_size was accepted\n", name); fails++; }
+#if !defined(SN_VALIDATE_NO_CHECKSUM)
+    if (g.flips_ok != 0) { printf("FAIL: %s: %lu flipped blobs passed the checksum\n", name, g.flips_ok); fails++; }
+#endif
+    free(g_work);
+    return fails;
+}
+
+int main(int argc, char **argv) {
+    const char *path = NULL, *bdir = getenv("BUILD");
+    char defpath[512];
+    int all = 0, i, fails = 0, runs = 0;
+    unsigned long per_section = 400, seed = 12345;
+    static union { uint64_t a; unsigned char b[8192]; } tb;
+
+    for (i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--all") == 0) all = 1;
+        else if (strcmp(argv[i], "--per-section") == 0 && i + 1 < argc) per_section = strtoul(argv[++i], NULL, 0);
+        else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = strtoul(argv[++i], NULL, 0);
+        else path = argv[i];
+    }
+    if (getenv("SN_TEST_SEED")) seed = strtoul(getenv("SN_TEST_SEED"), NULL, 0);
+    g_rng = 0x9E3779B97F4A7C15ull ^ (uint64_t)seed;
+    printf("  seed: %lu (set SN_TEST_SEED to change)\n", seed);
+#ifdef HAVE_SAN_CB
+    __sanitizer_set_death_callback(on_death);
+#endif
+    if (!path) { /* default: the hand-built blob exhaustively, then the cow sampled */
+        g_size = tb_build(tb.b, sizeof tb.b, 3);
+        g_orig = (unsigned char *)malloc(g_size);
+        if (!g_orig) return 2;
+        memcpy(g_orig, tb.b, g_size);
+        fails += fuzz_one("hand-built (tests/fuzz/sn_tblob.h)", 1, 0);
+        runs++;
+        free(g_orig);
+        sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
+        path = defpath;
+    }
+    {
+        FILE *f = fopen(path, "rb");
+        if (f) {
+            long len;
+            fseek(f, 0, SEEK_END);
+            len = ftell(f);
+            fseek(f, 0, SEEK_SET);
+            g_size = (size_t)len;
+            g_orig = (unsigned char *)malloc(g_size + 8);
+            if (!g_orig || fread(g_orig, 1, g_size, f) != g_size) { printf("FAIL: cannot read %s\n", path); return 1; }
+            fclose(f);
+            fails += fuzz_one(path, all, per_section);
+            runs++;
+            free(g_orig);
+        } else {
+            printf("  SKIPPED: %s not found (make it with the host tool); fuzzed the hand-built blob only\n", path);
+        }
+    }
+    free(g_mem);
+    printf("%d passed, %d failed\n", runs - (fails > runs ? runs : fails) + 1, fails);
+    return fails != 0;
+}
