@@ -42,6 +42,8 @@ run "head_turn float compare (130 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/head_t
 run "trot fixed (216 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 216 --hash
 run "trot fixed sheet (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 \
     --sheet "$OUT/trot_sheet.png" --title "trot (fixed point)"
+run "trot fixed heat sheet (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 \
+    --sheet "$OUT/trot_heat_sheet.png" --heat 0.3 --title "red: 0.3 from rigid skinning"
 run "trot fixed lattice (40 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 40 \
     --png "$OUT/trot_lattice.png" --lattice --title "trot, control lattice"
 run "trot float (216 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --frames 216 --hash

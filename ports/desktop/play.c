@@ -9,6 +9,7 @@
 #include "raster.h"
 #include "png.h"
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,6 +39,7 @@ static void usage(FILE *f) {
         "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid\n"
         "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
+        "  --heat D           colour the flesh by its distance from rigid skinning (red at D mesh units)\n"
         "  --size WxH         picture size for --png (default 640x480)\n"
         "  --view AZ,EL       camera azimuth, elevation in degrees (default 30,15)\n"
         "  --frame-box X0,Y0,Z0,X1,Y1,Z1  box the camera frames, model space (mesh units relative to the root joint; default: rest surface)\n"
@@ -118,6 +120,12 @@ typedef struct {
     float flo[3], fhi[3];       /* box the camera frames (default: lo, hi) */
     float az, el;
     int lattice;
+    /* --heat: colour by distance from the rigidly skinned lattice */
+    float heat;                 /* mesh units drawn at full colour; 0 = off */
+    float *rest;                /* lattice rest positions, model space, mesh units */
+    const unsigned char *frames, *cells, *embed;
+    float *dev, *col;           /* per lattice vertex (3), per surface vertex (3) */
+    const sn_xform *pose;       /* pose of the state being drawn */
 } scene;
 
 static int cmp_edge(const void *a, const void *b) {
@@ -161,7 +169,7 @@ static void fetch(scene *s, const sn_instance *inst) {
     for (i = 0; i < s->info.surface_vertices; i++) {
         s->pos[3 * i] = F(s->surf[i].x); s->pos[3 * i + 1] = F(s->surf[i].y); s->pos[3 * i + 2] = F(s->surf[i].z);
     }
-    if (s->lattice) {
+    if (s->lattice || s->heat > 0) {
         sn_get_lattice(inst, s->latt, 0, s->info.vertices);
         for (i = 0; i < s->info.vertices; i++) {
             s->lpos[3 * i] = F(s->latt[i].x); s->lpos[3 * i + 1] = F(s->latt[i].y); s->lpos[3 * i + 2] = F(s->latt[i].z);
@@ -170,6 +178,101 @@ static void fetch(scene *s, const sn_instance *inst) {
 }
 
 static const float cow_colour[3] = {0.78f, 0.60f, 0.44f};
+
+static const unsigned char *section(const unsigned char *bytes, int sec, uint32_t *count) {
+    const unsigned char *ent = bytes + SN_H_SECTIONS + (size_t)sec * SN_SECTION_ENTRY;
+    if (count) *count = rd_u32(ent + 8);
+    return bytes + rd_u32(ent);
+}
+
+/* Rest lattice, frames, cells and embedding from the validated blob
+ * (runtime/BLOB.md). Reals are little-endian like this host. */
+static int heat_setup(scene *s, const unsigned char *bytes) {
+    const unsigned char *rest = section(bytes, SN_SEC_REST, NULL);
+    float unit = (float)ldexp(1.0, (int)(signed char)bytes[SN_H_LEN_SHIFT]);
+    uint32_t i;
+    s->frames = section(bytes, SN_SEC_FRAMES, NULL);
+    s->cells = section(bytes, SN_SEC_CELLS, NULL);
+    s->embed = section(bytes, SN_SEC_EMBED, NULL);
+    s->rest = malloc((size_t)s->info.vertices * 3 * sizeof(float));
+    s->dev = malloc((size_t)s->info.vertices * 3 * sizeof(float));
+    s->col = malloc(((size_t)s->info.surface_vertices + 1) * 3 * sizeof(float));
+    if (!s->rest || !s->dev || !s->col) return -1;
+    for (i = 0; i < 3 * s->info.vertices; i++) {
+#ifdef SN_FLOAT
+        float v;
+        memcpy(&v, rest + 4 * (size_t)i, 4);
+        s->rest[i] = v * unit;
+#else
+        int32_t v;
+        memcpy(&v, rest + 4 * (size_t)i, 4);
+        s->rest[i] = (float)ldexp((double)v, -SN_Q_LEN) * unit;
+#endif
+    }
+    return 0;
+}
+
+typedef struct { float x, y, z, w; } fq;
+static fq to_fq(sn_quat q) {
+#ifdef SN_FLOAT
+    fq r = {q.x, q.y, q.z, q.w};
+#else
+    fq r = {(float)q.x / 1073741824.0f, (float)q.y / 1073741824.0f, (float)q.z / 1073741824.0f, (float)q.w / 1073741824.0f};
+#endif
+    return r;
+}
+static fq fq_slerp(fq a, fq b, float u) {
+    float c = a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w, wa = 1 - u, wb = u, l;
+    fq r;
+    if (c < 0) { c = -c; b.x = -b.x; b.y = -b.y; b.z = -b.z; b.w = -b.w; }
+    if (c < 0.9995f) {
+        float th = acosf(c);
+        wa = sinf((1 - u) * th) / sinf(th); wb = sinf(u * th) / sinf(th);
+    }
+    r.x = wa * a.x + wb * b.x; r.y = wa * a.y + wb * b.y; r.z = wa * a.z + wb * b.z; r.w = wa * a.w + wb * b.w;
+    l = sqrtf(r.x * r.x + r.y * r.y + r.z * r.z + r.w * r.w);
+    r.x /= l; r.y /= l; r.z /= l; r.w /= l;
+    return r;
+}
+static void fq_rotate(fq q, const float v[3], float o[3]) {   /* v + 2w(u x v) + 2u x (u x v) */
+    float tx = 2 * (q.y * v[2] - q.z * v[1]), ty = 2 * (q.z * v[0] - q.x * v[2]), tz = 2 * (q.x * v[1] - q.y * v[0]);
+    o[0] = v[0] + q.w * tx + (q.y * tz - q.z * ty);
+    o[1] = v[1] + q.w * ty + (q.z * tx - q.x * tz);
+    o[2] = v[2] + q.w * tz + (q.x * ty - q.y * tx);
+}
+
+/* Per surface vertex: how far the simulated flesh is from where rigid
+ * skinning by the lattice frames (R_i x_i + c_i, BLOB.md FRAMES) would put it:
+ * the secondary motion (plus the static sag under gravity). */
+static void heat_colours(scene *s) {
+    uint32_t i, k;
+    for (i = 0; i < s->info.vertices; i++) {
+        const unsigned char *f = s->frames + 4 * (size_t)i;
+        const sn_xform *b1 = &s->pose[f[0]], *b2 = &s->pose[f[1]];
+        float w = (float)(f[2] | f[3] << 8) / 32768.0f, r[3];
+        fq q = fq_slerp(to_fq(b1->rot), to_fq(b2->rot), w);
+        fq_rotate(q, s->rest + 3 * i, r);
+        s->dev[3 * i] = s->lpos[3 * i] - (r[0] + (1 - w) * F(b1->pos.x) + w * F(b2->pos.x));
+        s->dev[3 * i + 1] = s->lpos[3 * i + 1] - (r[1] + (1 - w) * F(b1->pos.y) + w * F(b2->pos.y));
+        s->dev[3 * i + 2] = s->lpos[3 * i + 2] - (r[2] + (1 - w) * F(b1->pos.z) + w * F(b2->pos.z));
+    }
+    for (i = 0; i < s->info.surface_vertices; i++) {
+        const unsigned char *e = s->embed + 8 * (size_t)i;
+        const unsigned char *cell = s->cells + SN_ELEM_CELLS * (size_t)(e[0] | e[1] << 8);
+        float t[3], d[3] = {0, 0, 0}, m;
+        for (k = 0; k < 3; k++) t[k] = (float)(e[2 + 2 * k] | e[3 + 2 * k] << 8) / 32768.0f;
+        for (k = 0; k < 8; k++) {
+            uint32_t v = cell[2 * k] | (uint32_t)cell[2 * k + 1] << 8;
+            float n = (k & 1 ? t[0] : 1 - t[0]) * (k & 2 ? t[1] : 1 - t[1]) * (k & 4 ? t[2] : 1 - t[2]);
+            d[0] += n * s->dev[3 * v]; d[1] += n * s->dev[3 * v + 1]; d[2] += n * s->dev[3 * v + 2];
+        }
+        m = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / s->heat;
+        if (m > 1) m = 1;
+        s->col[3 * i] = cow_colour[0] + m * (0.95f - cow_colour[0]);
+        s->col[3 * i + 1] = cow_colour[1] + m * (0.12f - cow_colour[1]);
+        s->col[3 * i + 2] = cow_colour[2] + m * (0.05f - cow_colour[2]);
+    }
+}
 static const uint8_t ink[3] = {25, 28, 38};
 
 /* Render the instance into out (w x h) at 2x2 supersampling. */
@@ -179,10 +282,12 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     uint32_t e, v;
     if (rs_image_alloc(&big, 2 * out->w, 2 * out->h)) return -1;
     fetch(s, inst);
+    if (s->heat > 0) heat_colours(s);
     rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
     cam.ground_y = s->lo[1];   /* the ground stays under the hooves */
     rs_clear(&big, &cam);
-    rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
+    if (s->heat > 0) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
+    else rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
     if (s->lattice) {
         const uint8_t lc[3] = {30, 60, 140}, sc[3] = {200, 30, 30};
         float r = (float)big.w / 320.0f;
@@ -201,13 +306,13 @@ typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *png, *sheet, *compare, *title;
     long frames, iterations;
     int unwarped, hash, lattice, quiet, w, h;
-    float az, el, box[6];
+    float az, el, box[6], heat;
     int have_box;
 } options;
 
 static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--png", "--sheet", "--compare", "--title",
-                                         "--frames", "--iterations", "--size", "--view", "--frame-box", NULL};
+                                         "--frames", "--iterations", "--size", "--view", "--frame-box", "--heat", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -243,6 +348,9 @@ static int parse_args(int argc, char **argv, options *o) {
                 fprintf(stderr, PROG ": --frame-box: want X0,Y0,Z0,X1,Y1,Z1 with X0<X1 etc., got '%s'\n", v); return 2;
             }
             o->have_box = 1;
+        } else if (!strcmp(a, "--heat")) {
+            o->heat = strtof(v, &end);
+            if (!*v || *end || !(o->heat > 0)) { fprintf(stderr, PROG ": --heat: want a distance > 0 in mesh units, got '%s'\n", v); return 2; }
         } else if (!strcmp(a, "--view")) {
             if (sscanf(v, "%f,%f", &o->az, &o->el) != 2 || o->el < -89 || o->el > 89) {
                 fprintf(stderr, PROG ": --view: want AZ,EL in degrees, got '%s'\n", v); return 2;
@@ -291,7 +399,7 @@ int main(int argc, char **argv) {
     static sn_clip clip;
     int have_clip = 0, rc = 1;
     sn_quat *local = NULL;
-    sn_xform *xf = NULL;
+    sn_xform *xf = NULL, *rest_xf = NULL;
     double *times = NULL, *cpu = NULL, h_s;
     long k, n_frames;
     uint32_t i, t;
@@ -362,9 +470,10 @@ int main(int argc, char **argv) {
     }
 
     /* scratch */
-    s.lattice = o.lattice; s.az = o.az; s.el = o.el;
+    s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat;
     local = malloc(s.info.joints * sizeof *local);
     xf = malloc(s.info.joints * sizeof *xf);
+    rest_xf = malloc(s.info.joints * sizeof *rest_xf);
     s.surf = malloc((s.info.surface_vertices + 1) * sizeof *s.surf);
     s.latt = malloc(s.info.vertices * sizeof *s.latt);
     s.pos = malloc((s.info.surface_vertices + 1) * 3 * sizeof(float));
@@ -372,9 +481,21 @@ int main(int argc, char **argv) {
     s.tri = malloc((s.info.triangles + 1) * 3 * sizeof(uint32_t));
     times = malloc(((size_t)n_frames + 1) * sizeof(double));
     cpu = malloc(((size_t)n_frames + 1) * sizeof(double));
-    if (!local || !xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times || !cpu) { die("out of memory"); goto done; }
+    if (!local || !xf || !rest_xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times || !cpu) { die("out of memory"); goto done; }
     for (t = 0; t < s.info.triangles; t++) sn_get_triangle(s.blob, t, s.tri + 3 * t);
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
+    if (o.heat > 0 && heat_setup(&s, bytes)) { die("out of memory"); goto done; }
+    /* rest pose: identity local rotations */
+    for (i = 0; i < s.info.joints; i++) {
+        local[i].x = local[i].y = local[i].z = 0;
+#ifdef SN_FLOAT
+        local[i].w = 1.0f;
+#else
+        local[i].w = (sn_real)1 << SN_QUAT_FRAC;
+#endif
+    }
+    sn_pose_from_local(s.blob, local, NULL, rest_xf);
+    s.pose = rest_xf;
     if ((o.png || o.sheet || o.compare) && !s.info.triangles) {
         fprintf(stderr, PROG ": %s has no triangles: cannot draw pictures\n", o.blob_path); goto done;
     }
@@ -421,17 +542,8 @@ int main(int argc, char **argv) {
     for (k = 1; k <= n_frames; k++) {
         double t0, t1, c0, c1;
         if (have_clip) sn_clip_pose(&clip, s.blob, (uint32_t)k, local, xf);
-        else {
-            for (i = 0; i < s.info.joints; i++) {
-                local[i].x = local[i].y = local[i].z = 0;
-#ifdef SN_FLOAT
-                local[i].w = 1.0f;
-#else
-                local[i].w = (sn_real)1 << SN_QUAT_FRAC;
-#endif
-            }
-            sn_pose_from_local(s.blob, local, NULL, xf);
-        }
+        else memcpy(xf, rest_xf, s.info.joints * sizeof *xf);
+        s.pose = xf;
         sn_set_pose(inst, xf, s.info.joints);
         c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
         t0 = now_us(CLOCK_MONOTONIC);
@@ -502,7 +614,9 @@ int main(int argc, char **argv) {
         if (!mem0 || sn_instance_init(mem0, need, s.blob, &rest) != SN_OK ||
             rs_image_alloc(&cmp, 3 * pw, ph) || rs_image_alloc(&pane, pw, ph)) { free(mem0); die("out of memory"); goto done; }
         snprintf(lab, sizeof lab, "t = %.2f s", (double)n_frames * h_s);
+        s.pose = rest_xf;
         render(&s, rest, &pane, "rest", NULL);
+        s.pose = xf;
         rs_blit(&cmp, 0, 0, &pane);
         render(&s, unwarped, &pane, "unwarped (global linear)", lab);
         rs_blit(&cmp, pw, 0, &pane);
@@ -519,7 +633,8 @@ int main(int argc, char **argv) {
     rc = 0;
 done:
     rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp);
-    free(bytes); free(mem); free(mem2); free(local); free(xf); free(times); free(cpu);
+    free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
+    free(s.rest); free(s.dev); free(s.col);
     return rc;
 }

@@ -136,8 +136,21 @@ static void fill_tri(rs_image *im, const svert *a, const svert *b, const svert *
         }
 }
 
+static void draw_mesh(rs_image *im, const rs_camera *cam, const float *pos, int nv,
+                      const uint32_t *tri, int nt, const float *color, int per_vertex);
+
 void rs_draw_mesh(rs_image *im, const rs_camera *cam, const float *pos, int nv,
                   const uint32_t *tri, int nt, const float color[3]) {
+    draw_mesh(im, cam, pos, nv, tri, nt, color, 0);
+}
+
+void rs_draw_mesh_colors(rs_image *im, const rs_camera *cam, const float *pos, int nv,
+                         const uint32_t *tri, int nt, const float *colors) {
+    draw_mesh(im, cam, pos, nv, tri, nt, colors, 1);
+}
+
+static void draw_mesh(rs_image *im, const rs_camera *cam, const float *pos, int nv,
+                      const uint32_t *tri, int nt, const float *color, int per_vertex) {
     float *nrm = calloc((size_t)nv * 3, sizeof(float));
     svert *sv = malloc((size_t)nv * sizeof(svert));
     uint8_t *mark = calloc((size_t)im->w * (size_t)im->h, 1);
@@ -181,7 +194,7 @@ void rs_draw_mesh(rs_image *im, const rs_camera *cam, const float *pos, int nv,
         sp = powf(fmaxf(0, dot3(n, hv)), 24.0f) * 0.18f;
         for (k = 0; k < 3; k++) {
             float amb = (0.10f + 0.12f * hemi);
-            sv[v].c[k] = color[k] * (amb + 0.85f * d1 + 0.22f * d2) + sp;
+            sv[v].c[k] = color[per_vertex ? 3 * v + k : k] * (amb + 0.85f * d1 + 0.22f * d2) + sp;
         }
     }
     for (t = 0; t < nt; t++) {

@@ -36,6 +36,9 @@ void rs_clear(rs_image *im, const rs_camera *cam);
 /// tri: nt*3 indices, counter-clockwise seen from outside.
 void rs_draw_mesh(rs_image *im, const rs_camera *cam, const float *pos, int nv,
                   const uint32_t *tri, int nt, const float color[3]);
+/// The same with one colour per vertex (nv*3 floats, linear 0..1).
+void rs_draw_mesh_colors(rs_image *im, const rs_camera *cam, const float *pos, int nv,
+                         const uint32_t *tri, int nt, const float *colors);
 
 /// Line a-b, solid where in front of the surface, faint (alpha) where hidden.
 void rs_draw_line(rs_image *im, const rs_camera *cam, const float a[3], const float b[3],

@@ -92,6 +92,10 @@ expect 0 "wrote $TMP/out/c.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 10 --com
     && ok || bad "compare picture is not a 720x180 PNG"
 # fewer steps than sheet panels (some panels show the rest state)
 expect 0 "wrote $TMP/out/s3.png" "$PLAY" "$BLOB" --frames 3 --sheet "$TMP/out/s3.png"
+# heat colouring (distance from rigid skinning), both flavours
+expect 0 "wrote $TMP/out/h.png" "$PLAY" "$BLOB" --clip "$CLIP" --frames 5 --png "$TMP/out/h.png" --heat 0.2 --size 160x120
+expect 0 "wrote $TMP/out/hf.png" "$PLAYF" "$BLOBF" --clip "$CLIP" --frames 5 --compare "$TMP/out/hf.png" --heat 0.2
+expect 2 'heat: want a distance' "$PLAY" "$BLOB" --heat -1
 expect 2 'frame-box: want' "$PLAY" "$BLOB" --frame-box 1,2,3
 expect 2 'size: want WxH' "$PLAY" "$BLOB" --size 10x10
 ls "$TMP/out" | grep -q 'tmp\|probe' && bad "temp files left: $(ls "$TMP/out")" || ok
