@@ -123,6 +123,7 @@ typedef struct sb_model {
     double h, alpha, beta, g[3], unit;
     int cg_def, cg_max;
     double bbox_diag;
+    double min_jac;         /* smallest Jacobian determinant in kept cells / cell volume (1 = undistorted) */
     int quiet;
 } sb_model;
 

@@ -37,6 +37,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         printf("  skeleton  %d joints, %d bones\n", o->nj, o->nseg);
         printf("  lattice   %d vertices (%d free, %d skeleton), %d cells (mean fill %.2f, min %.3f), cell %g mesh units\n",
                o->nv, o->nf, o->nv - o->nf, o->nc, fsum / o->nc, fmin_, o->c);
+        printf("  quality   smallest Jacobian / cell volume %.3g (0 where a bone chain turns)\n", o->min_jac);
         printf("  mass      %.6g kg (interior volume %.6g m^3 = %.4f x mesh volume), m0 %.6g kg\n",
                o->mass, o->inside_volume, o->inside_volume / vol, b->m0);
         printf("  units     len_shift %d, frac_S %d, frac_M %d, frac_P %d\n", b->len_shift, b->frac_S, b->frac_M, b->frac_P);

@@ -263,6 +263,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
         }
         for (a = 0; a < o->nseg; a++) {
             int ch = o->seg_child[a], pa = o->joints[ch].parent, cur[3], tgt[3], path[4096], L = 0, p;
+            double spos[4096];
             const double *P = o->joints[pa].pos, *C = o->joints[ch].pos;
             cur[0] = gsnap[pa] % o->gn[0]; cur[1] = (gsnap[pa] / o->gn[0]) % o->gn[1]; cur[2] = gsnap[pa] / (o->gn[0] * o->gn[1]);
             tgt[0] = gsnap[ch] % o->gn[0]; tgt[1] = (gsnap[ch] / o->gn[0]) % o->gn[1]; tgt[2] = gsnap[ch] / (o->gn[0] * o->gn[1]);
@@ -287,6 +288,20 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
                 if (L >= 4095) { sb_fail("%s: bone too long for the lattice", d->path); goto done; }
                 path[L++] = gidx(o, cur[0], cur[1], cur[2]);
             }
+            {   /* where the chain's vertices go on the segment: the projection of each grid vertex
+                 * (smallest moves, so the least cell distortion), kept strictly increasing with a
+                 * minimum gap of a quarter of the even spacing */
+                double L2 = 0, gap = 0.25 / (double)(L - 1);
+                for (k = 0; k < 3; k++) L2 += (C[k] - P[k]) * (C[k] - P[k]);
+                spos[0] = 0; spos[L - 1] = 1;
+                for (p = 1; p < L - 1; p++) {
+                    double dp = 0;
+                    for (k = 0; k < 3; k++) dp += (o->gpos[3 * path[p] + k] - P[k]) * (C[k] - P[k]);
+                    spos[p] = dp / L2;
+                    if (spos[p] < spos[p - 1] + gap) spos[p] = spos[p - 1] + gap;
+                    if (spos[p] > 1 - (double)(L - 1 - p) * gap) spos[p] = 1 - (double)(L - 1 - p) * gap;
+                }
+            }
             for (p = 1; p < L - 1; p++) {
                 int g = path[p];
                 if (gclaim[g] != -1) {
@@ -298,7 +313,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
                 }
                 gclaim[g] = a;
                 o->gjoint[g] = pa;
-                for (k = 0; k < 3; k++) o->gpos[3 * g + k] = P[k] + (C[k] - P[k]) * (double)p / (double)(L - 1);
+                for (k = 0; k < 3; k++) o->gpos[3 * g + k] = P[k] + (C[k] - P[k]) * spos[p];
             }
         }
     }
@@ -316,6 +331,14 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
         cell_corners(o, a, g);
         for (k = 0; k < 8; k++) xc[k] = o->gpos + 3 * g[k];
         mindet[a] = HUGE_VAL;
+        /* inversion check independent of the quadrature: Jacobian on a 9x9x9 grid including the corners */
+        for (k = 0; k < 729; k++) {
+            double t[3], p[3], J[3][3], D;
+            t[0] = (k % 9) / 8.0; t[1] = (k / 9 % 9) / 8.0; t[2] = (k / 81) / 8.0;
+            corners_point(xc, t, p, J);
+            D = det3(J);
+            if (D < mindet[a]) mindet[a] = D;
+        }
         for (sz = 0; sz < n; sz++) for (sy = 0; sy < n; sy++) for (sx = 0; sx < n; sx++)
             for (gp = 0; gp < 8; gp++, q++) {
                 double t[3], p[3], J[3][3], D;
@@ -369,16 +392,21 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
 
     /* 6. kept cells must not be inverted by the bone snapping */
     for (a = 0; a < ngc; a++)
-        if (keep[a] && !(mindet[a] > 0)) {
+        /* a zero Jacobian at a corner is expected where a bone chain turns (three chain vertices
+         * on one straight segment are corners of one face): only a negative one beyond round-off fails */
+        if (keep[a] && !(mindet[a] > -1e-9 * c * c * c)) {
             int g[8];
             double ctr[3] = {0, 0, 0};
             cell_corners(o, a, g);
             for (k = 0; k < 8; k++) for (j = 0; j < 3; j++) ctr[j] += o->gpos[3 * g[k] + j] / 8;
             sb_fail("%s: lattice cell near (%.3g, %.3g, %.3g) is inverted after moving skeleton vertices onto the bones "
-                    "(Jacobian %g <= 0 at a quadrature point); try another cell size (e.g. %g or %g) or move the joints nearer lattice vertices",
+                    "(Jacobian %.3g <= 0 inside the cell); try another cell size (e.g. %g or %g) or move the joints nearer lattice vertices",
                     d->path, ctr[0], ctr[1], ctr[2], mindet[a], c * 0.8, c * 1.2);
             goto done;
         }
+
+    o->min_jac = HUGE_VAL;
+    for (a = 0; a < ngc; a++) if (keep[a] && mindet[a] / (c * c * c) < o->min_jac) o->min_jac = mindet[a] / (c * c * c);
 
     /* 7. lattice vertices, pins, free-first order */
     {
