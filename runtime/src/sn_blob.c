@@ -110,9 +110,12 @@ static sn_status sn_check_contents(const sn_view *v) {
         for (k = 0; k < SN_JOINT_NAME_MAX && n[k]; k++) {}
         SN_CHK(k > 0 && k < SN_JOINT_NAME_MAX, SN_ERR_VALUE);
         SN_CHK(sn_zero_bytes(n + k, SN_JOINT_NAME_MAX - k), SN_ERR_VALUE);
-        for (i = 0; i < j; i++) /* padded: equal names <=> equal 32 bytes */
-            SN_CHK(memcmp(n, s + (size_t)i * SN_JOINT_NAME_MAX, SN_JOINT_NAME_MAX) != 0,
-                   SN_ERR_VALUE);
+        for (i = 0; i < j; i++) { /* padded: equal names <=> equal 32 bytes */
+            const unsigned char *o = s + (size_t)i * SN_JOINT_NAME_MAX;
+            uint32_t diff = 0;
+            for (k = 0; k < SN_JOINT_NAME_MAX; k++) diff |= (uint32_t)(n[k] ^ o[k]); /* no memcmp: libc */
+            SN_CHK(diff != 0, SN_ERR_VALUE);
+        }
     }
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_REST], 3 * v->nV, X, SN_Q_LEN), SN_ERR_VALUE);
     /* frames: bones < nJ, w <= 1 (Q15); skeleton vertices rigid to bone1 */
@@ -144,6 +147,7 @@ static sn_status sn_check_contents(const sn_view *v) {
             uint32_t a = sn_rd_u32(rp + 4 * (size_t)i), b = sn_rd_u32(rp + 4 * (size_t)i + 4);
             uint32_t prev = i;
             SN_CHK(a <= b && b <= v->nnz, SN_ERR_INDEX);
+            SN_CHK(b - a <= SN_MAX_ROW_BLOCKS, SN_ERR_INDEX);
             for (k = a; k < b; k++) {
                 uint32_t c = sn_rd_u16(cols + 2 * (size_t)k);
                 SN_CHK(c > prev && c < v->nV, SN_ERR_INDEX);

@@ -29,14 +29,16 @@ uint32_t sn_isqrt64(uint64_t x) {
     return (uint32_t)root;
 }
 
-/* Message table generated from the one status list in sinew.h. */
+/* Messages from the one status list in sinew.h. A switch rather than a
+ * pointer table: no relocated data (.data.rel.ro), strings stay in ROM. */
 const char *sn_status_str(sn_status s) {
-#define SN_STATUS_MSG_(name, msg) msg,
-    static const char *const msgs[] = {SN_STATUS_LIST(SN_STATUS_MSG_)};
-#undef SN_STATUS_MSG_
-    int i = (int)s;
-    if (i < 0 || i >= (int)SN_STATUS_COUNT) return "unknown status code";
-    return msgs[i];
+    switch (s) {
+#define SN_STATUS_CASE_(name, msg) case name: return msg;
+        SN_STATUS_LIST(SN_STATUS_CASE_)
+#undef SN_STATUS_CASE_
+    default: break;
+    }
+    return "unknown status code";
 }
 
 #if !defined(SN_FLOAT)
