@@ -113,5 +113,17 @@ f1=$("$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash --quiet | grep '^hash: 
 f2=$("$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash --quiet | grep '^hash: ')
 [ -n "$f1" ] && [ "$f1" = "$f2" ] && ok || bad "float hash not repeatable: '$f1' vs '$f2'"
 
+# fixed and float players agree on the trot: surface of frame 60.
+# Tolerance 2e-3 mesh units (0.02% of the cow's 10.5-unit length): fixed point
+# keeps lengths in Q22 of 4-unit internal units (1e-6 mesh units per LSB) and
+# OBJ text has 6 significant digits (<= 5e-6); measured ~1e-4.
+mkdir "$TMP/fx" "$TMP/fl"
+"$PLAY" "$BLOB" --clip tools/examples/cow/trot.clip --frames 60 --obj-dir "$TMP/fx" --quiet > /dev/null 2>&1
+"$PLAYF" "$BLOBF" --clip tools/examples/cow/trot.clip --frames 60 --obj-dir "$TMP/fl" --quiet > /dev/null 2>&1
+worst=$(paste -d' ' "$TMP/fx/frame_0060.obj" "$TMP/fl/frame_0060.obj" | awk '$1 == "v" {
+    d = ($2 - $6) ^ 2 + ($3 - $7) ^ 2 + ($4 - $8) ^ 2; if (d > m) m = d } END { printf "%.6f", sqrt(m) }')
+echo "  figure: fixed vs float surface after 60 trot steps: max distance $worst mesh units"
+awk -v w="$worst" 'BEGIN { exit !(w != "" && w <= 0.002) }' && ok || bad "fixed vs float differ by $worst mesh units (> 2e-3)"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
