@@ -337,13 +337,14 @@ static void test_accessors(int len_shift) {
 }
 
 /* Fixed: public rest = internal * 2^(len_shift - 6), rounded to nearest
- * (ties away from zero) when len_shift < 6, exact otherwise. */
+ * (ties toward +infinity, sn_rshr64) when len_shift < 6, exact otherwise. */
 static void test_rest_rounding(void) {
 #if !defined(SN_FLOAT)
     static const struct { int ls; int32_t raw; int32_t want; } c[] = {
         {0, (1 << 21) + 3, 32768},    /* +0.047 LSB -> down */
-        {0, (1 << 21) + 32, 32769},   /* +0.5 LSB   -> away from zero */
-        {0, -(1 << 21) - 32, -32769}, /* -0.5 LSB   -> away from zero */
+        {0, (1 << 21) + 32, 32769},   /* +0.5 LSB   -> up */
+        {0, -(1 << 21) - 32, -32768}, /* -0.5 LSB   -> up (toward +infinity) */
+        {0, -(1 << 21) - 33, -32769},
         {0, (1 << 21) + 33, 32769},
         {-3, 1000, 2},                /* 1000 / 512 = 1.95 */
         {6, (1 << 21) + 3, (1 << 21) + 3},

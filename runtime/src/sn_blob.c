@@ -361,9 +361,9 @@ int32_t sn_joint_parent(const sn_blob *blob, uint32_t j) {
 
 /* Internal Q22 (internal units) -> public Q16.16 mesh units:
  * public = internal * 2^(len_shift - 6). Exact when len_shift >= 6 (then
- * saturated to int32, which a validated |x| <= 2^27 reaches only for
- * len_shift >= 10 and |x| >= 2^(37 - len_shift)); rounded to nearest
- * otherwise. Float: multiplied by 2^len_shift (exact). */
+ * never saturating: the validator bounds public rest values to 2^30);
+ * rounded to nearest (ties toward +infinity, sn_rshr64) otherwise.
+ * Float: multiplied by 2^len_shift (exact). */
 sn_status sn_joint_rest(const sn_blob *blob, uint32_t j, sn_vec3 *out) {
     const unsigned char *e;
     sn_real r[3];

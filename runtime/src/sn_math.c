@@ -4,7 +4,8 @@
  * iterations / polynomial terms, so its cost does not depend on the data.
  * Fixed flavour: quaternion components and rotation entries are Q30
  * (1.0 = 2^30), angles inside this file are Q30 radians; all rounding is to
- * nearest (ties away from zero, sn_rshr64); no signed overflow for ANY int32
+ * nearest (sn_rshr64: ties toward +infinity; sn_unit and sn_quat_rotate
+ * round magnitudes: ties away from zero); no signed overflow for ANY int32
  * input (inputs that cannot be unit are clamped first, as documented per
  * function). Error figures below are measured against libm in double by
  * tests/test_runtime_math.c.
