@@ -62,3 +62,13 @@ $(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float
+
+# ---- make bench (runtime part): runtime/bench/bench.sh ----
+$(BUILD)/bench/sn_bench: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FLOAT) -lm
+bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
+	BUILD=$(BUILD) sh runtime/bench/bench.sh $(BUILD)

@@ -1,0 +1,186 @@
+/* bench.c -- speed, memory and arithmetic figures of one Sinew step.
+ *
+ *   sn_bench [blob ...]        time sn_step over a clip-like pose sequence
+ *   sn_bench --steps N blob    set one pose, run N steps, nothing else (for
+ *                              callgrind: instructions per step =
+ *                              (N-step run - 0-step run) / N; the cost of a
+ *                              step is fixed by the blob, not by the pose)
+ *
+ * Built against the shipping library (libsinew.a / libsinew_float.a).
+ * The pose sequence: every joint swings about its own axis with its own
+ * period and phase (sn_quat_axis_angle), the root walks and bobs, all fed
+ * through sn_pose_from_local, as a game would every frame.
+ * Never fails on speed: exit status reports only errors.
+ */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sinew.h"
+#include "sn_format.h"
+
+#if defined(SN_FLOAT)
+#define FLAV "float"
+#define LEN(x) ((float)(x))
+#define DEG(x) ((float)(x))
+#else
+#define FLAV "fixed"
+#define LEN(x) ((int32_t)floor((x) * 65536.0 + 0.5))
+#define DEG(x) ((int32_t)floor((x) * 65536.0 + 0.5))
+#endif
+
+static unsigned char *load(const char *path, size_t *size) {
+    FILE *f = fopen(path, "rb");
+    unsigned char *p;
+    long n;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    p = (unsigned char *)malloc((size_t)n + 8); /* malloc: 16-byte aligned */
+    if (p && fread(p, 1, (size_t)n, f) != (size_t)n) { free(p); p = NULL; }
+    fclose(f);
+    *size = (size_t)n;
+    return p;
+}
+
+static double now(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int cmp_d(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Pose for frame k (60 Hz): per joint a swing of up to 25 degrees. */
+static void pose(const sn_blob *blob, uint32_t nJ, int k, sn_quat *local, sn_xform *out) {
+    uint32_t j;
+    double t = k / 60.0;
+    sn_vec3 root;
+    for (j = 0; j < nJ; j++) {
+        sn_vec3 ax;
+        double ph = 0.7 * j, per = 0.8 + 0.13 * (j % 5);
+        ax.x = LEN(cos(1.3 * j));
+        ax.y = LEN(0.5);
+        ax.z = LEN(sin(1.3 * j));
+        local[j] = sn_quat_axis_angle(ax, DEG((j == 0 ? 8.0 : 25.0) * sin(2 * 3.14159265358979 * t / per + ph)));
+    }
+    root.x = LEN(0.4 * t);
+    root.y = LEN(0.05 * sin(2 * 3.14159265358979 * t * 2));
+    root.z = LEN(0.0);
+    sn_pose_from_local(blob, local, &root, out);
+}
+
+/* Exact arithmetic of one sn_step, in scalar multiply-adds, counted from the
+ * code of runtime/src/sn_step.c (commit 628d221) and the blob's counts:
+ *   rhs        12 nV + 36 nF + 24 nnz + 21 nnzFF
+ *   skeleton   9 (nV - nF)
+ *   CG start   66 nF + 24 nnzFF      (matvec + preconditioner + 1 dot)
+ *   CG iter    78 nF + 24 nnzFF      (matvec 36 nF + 24 nnzFF: rotate in, S^ pass
+ *              nF + 2 nnzFF blocks, rotate out, M^ pass, combine; precond 27 nF;
+ *              2 dots, 2 axpys, 1 direction update 15 nF)
+ * A "block multiply-add" is one 3x3 block times a 3-vector = 9 multiply-adds.
+ * Not counted: the frames (nJ quaternion->matrix, one slerp per blended vertex)
+ * and the O(n) adds/clamps/shifts. */
+static double step_macs(uint32_t nV, uint32_t nF, uint32_t nnz, uint32_t nnzff, uint32_t iters) {
+    return 12.0 * nV + 36.0 * nF + 24.0 * nnz + 21.0 * nnzff + 9.0 * (nV - nF) + 66.0 * nF +
+           24.0 * nnzff + (double)iters * (78.0 * nF + 24.0 * nnzff);
+}
+
+static uint32_t rd32(const unsigned char *p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static int bench_blob(const char *path, int only_steps) {
+    size_t size, need;
+    unsigned char *bytes = load(path, &size);
+    const sn_blob *blob;
+    sn_blob_info info;
+    sn_instance *inst;
+    void *mem;
+    sn_quat *local;
+    sn_xform *xf;
+    sn_vec3 *surf;
+    sn_status st;
+    uint32_t nnzff = 0, e, blended = 0, i;
+    int k, warm = 30, n = 400;
+    double *ts, sum = 0, macs;
+    if (!bytes) { fprintf(stderr, "sn_bench: cannot read %s\n", path); return 1; }
+    st = sn_blob_validate(bytes, size, &blob);
+    if (st != SN_OK) { fprintf(stderr, "sn_bench: %s: %s\n", path, sn_status_str(st)); return 1; }
+    sn_blob_get_info(blob, &info);
+    need = sn_instance_size(blob);
+    mem = malloc(need);
+    local = (sn_quat *)malloc(sizeof *local * info.joints);
+    xf = (sn_xform *)malloc(sizeof *xf * info.joints);
+    surf = (sn_vec3 *)malloc(sizeof *surf * info.surface_vertices);
+    ts = (double *)malloc(sizeof *ts * (size_t)n);
+    if (!mem || !local || !xf || !surf || !ts) return 2;
+    if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
+    if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
+        pose(blob, info.joints, 7, local, xf);
+        sn_set_pose(inst, xf, info.joints);
+        for (k = 0; k < only_steps; k++) sn_step(inst);
+        printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
+        return 0;
+    }
+    {   /* free-free blocks and blended vertices, from the blob */
+        const unsigned char *cols = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_COLS);
+        const unsigned char *fr = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_FRAMES);
+        for (e = 0; e < info.offdiag_blocks; e++) nnzff += (uint32_t)(cols[2 * e] | (cols[2 * e + 1] << 8)) < info.free_vertices;
+        for (i = 0; i < info.vertices; i++) blended += fr[4 * i] != fr[4 * i + 1] && (fr[4 * i + 2] | fr[4 * i + 3]);
+    }
+    for (k = 0; k < warm + n; k++) {
+        double t0;
+        pose(blob, info.joints, k, local, xf);
+        sn_set_pose(inst, xf, info.joints);
+        t0 = now();
+        sn_step(inst);
+        if (k >= warm) ts[k - warm] = now() - t0;
+    }
+    for (k = 0; k < n; k++) sum += ts[k];
+    qsort(ts, (size_t)n, sizeof *ts, cmp_d);
+    {
+        double t0 = now();
+        int rep = 50;
+        for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
+        macs = step_macs(info.vertices, info.free_vertices, info.offdiag_blocks, nnzff, info.cg_iters_default);
+        printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
+               "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u\n",
+               path, FLAV, info.blob_bytes, (unsigned)need, info.vertices, info.free_vertices, info.joints,
+               info.cells, info.surface_vertices, info.triangles, info.offdiag_blocks, nnzff, blended,
+               info.cg_iters_default);
+        printf("  figure: %s step time: median %.1f us, min %.1f us, mean %.1f us, p90 %.1f us (%d steps); "
+               "get_surface %.1f us\n", FLAV, 1e6 * ts[n / 2], 1e6 * ts[0], 1e6 * sum / n, 1e6 * ts[n * 9 / 10], n,
+               1e6 * (now() - t0) / rep);
+        printf("  figure: %s arithmetic per step: %.0f multiply-adds = %.0f block multiply-adds (3x3 block x 3-vector)\n",
+               FLAV, macs, macs / 9.0);
+        printf("  macs: %.0f\n", macs / 9.0);
+    }
+    {
+        sn_stats s;
+        sn_get_stats(inst, &s);
+        printf("  %s after %d steps: saturations %u, state hash %016llx\n", FLAV, warm + n, s.saturations,
+               (unsigned long long)sn_state_hash(inst));
+    }
+    free(mem); free(local); free(xf); free(surf); free(ts); free(bytes);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    int i, steps = -1, rc = 0, any = 0;
+    for (i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) { steps = atoi(argv[++i]); continue; }
+        rc |= bench_blob(argv[i], steps);
+        any = 1;
+    }
+    if (!any) { fprintf(stderr, "usage: sn_bench [--steps N] blob...\n"); return 2; }
+    return rc;
+}
