@@ -8,3 +8,19 @@ $(BUILD)/tests/test_reference: tests/test_reference.c $(REF_SRC) $(REF_HDR)
 	$(CC) $(HOST_CFLAGS) -Itests -o $@ tests/test_reference.c $(REF_SRC) -lm
 
 TEST_BINS += $(BUILD)/tests/test_reference
+
+# Physics tests against the runtime: each built fixed and float (suffix _float).
+PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference
+PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
+PHYS_TESTS  = cantilever runtime
+
+define PHYS_TEST_RULE
+$(BUILD)/tests/test_physics_$(1): tests/test_physics_$(1).c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $$(@D)
+	$(CC) $(PHYS_CFLAGS) -o $$@ $$< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_physics_$(1)_float: tests/test_physics_$(1).c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $$(@D)
+	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $$@ $$< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+endef
+$(foreach t,$(PHYS_TESTS),$(eval $(call PHYS_TEST_RULE,$(t))))
+TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)

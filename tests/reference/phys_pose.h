@@ -1,0 +1,66 @@
+/* phys_pose.h -- deterministic pose sequences for the physics tests, built with
+ * the runtime's own helpers (sn_quat_axis_angle, sn_pose_from_local) so the
+ * runtime and the reference get exactly the same transforms. Include after
+ * phys_util.h. */
+#ifndef PHYS_POSE_H
+#define PHYS_POSE_H
+
+#define PU_PI 3.14159265358979323846
+
+static inline sn_quat pu_axis_angle(double ax, double ay, double az, double deg) {
+    sn_vec3 a;
+    a.x = pu_rlen(ax); a.y = pu_rlen(ay); a.z = pu_rlen(az);
+    return sn_quat_axis_angle(a, pu_rang(deg));
+}
+
+static inline sn_quat pu_qident(void) {
+    sn_quat q;
+    memset(&q, 0, sizeof q);
+#if defined(SN_FLOAT)
+    q.w = 1.0f;
+#else
+    q.w = (sn_real)1 << SN_QUAT_FRAC;
+#endif
+    return q;
+}
+
+static inline void pu_set_local(const sn_blob *b, sn_quat *local, const char *name, sn_quat q) {
+    int32_t j = sn_find_joint(b, name);
+    if (j >= 0) local[j] = q;
+}
+
+/* Cow (and any asset with these joint names) at step k: head turning, neck
+ * nodding, tail swinging, body bouncing and walking forward, a little roll. */
+static inline void pu_cow_pose(const sn_blob *b, unsigned nJ, unsigned k, double h, sn_xform *out) {
+    sn_quat local[256];
+    sn_vec3 off;
+    double t = k * h;
+    unsigned j;
+    for (j = 0; j < nJ; j++) local[j] = pu_qident();
+    pu_set_local(b, local, "head", pu_axis_angle(0, 1, 0, 35 * sin(2 * PU_PI * 0.5 * t)));
+    pu_set_local(b, local, "neck", pu_axis_angle(0, 0, 1, 15 * sin(2 * PU_PI * 0.7 * t)));
+    pu_set_local(b, local, "tail_base", pu_axis_angle(0, 1, 0, 30 * sin(2 * PU_PI * 1.3 * t)));
+    pu_set_local(b, local, "hips", pu_axis_angle(1, 0, 0, 5 * sin(2 * PU_PI * 0.9 * t)));
+    pu_set_local(b, local, "hip_l", pu_axis_angle(0, 0, 1, 20 * sin(2 * PU_PI * 1.5 * t)));
+    pu_set_local(b, local, "hip_r", pu_axis_angle(0, 0, 1, -20 * sin(2 * PU_PI * 1.5 * t)));
+    pu_set_local(b, local, "shoulder_l", pu_axis_angle(0, 0, 1, -20 * sin(2 * PU_PI * 1.5 * t)));
+    pu_set_local(b, local, "shoulder_r", pu_axis_angle(0, 0, 1, 20 * sin(2 * PU_PI * 1.5 * t)));
+    off.x = pu_rlen(0.5 * t);                                  /* walk forward */
+    off.y = pu_rlen(0.25 * sin(2 * PU_PI * 1.5 * t));           /* bounce */
+    off.z = pu_rlen(0);
+    sn_pose_from_local(b, local, &off, out);
+}
+
+/* Limb: elbow bending 0..90 degrees and back, shoulder twisting and lifting. */
+static inline void pu_limb_pose(const sn_blob *b, unsigned nJ, unsigned k, double h, sn_xform *out) {
+    sn_quat local[256];
+    double t = k * h;
+    unsigned j;
+    for (j = 0; j < nJ; j++) local[j] = pu_qident();
+    pu_set_local(b, local, "elbow", pu_axis_angle(0, 0, 1, 45 * (1 - cos(2 * PU_PI * 0.4 * t))));
+    pu_set_local(b, local, "shoulder", sn_quat_mul(pu_axis_angle(1, 0, 0, 20 * sin(2 * PU_PI * 0.3 * t)),
+                                                  pu_axis_angle(0, 0, 1, 15 * sin(2 * PU_PI * 0.6 * t))));
+    sn_pose_from_local(b, local, NULL, out);
+}
+
+#endif
