@@ -264,6 +264,8 @@ static void test_contents(void) {
     CASE(SN_ERR_INDEX, "rowptr[nF] != nnz", tb_u32(SEC(SN_SEC_ROWPTR) + 4 * TB_NF, nnz - 1));
     CASE(SN_ERR_INDEX, "rowptr decreasing", tb_u32(SEC(SN_SEC_ROWPTR) + 4, r1 + 1));
     CASE(SN_ERR_INDEX, "rowptr > nnz", tb_u32(SEC(SN_SEC_ROWPTR) + 4, nnz + 100));
+    CASE(SN_ERR_INDEX, "row with more than SN_MAX_ROW_BLOCKS blocks",
+         tb_u32(SEC(SN_SEC_ROWPTR) + 4, SN_MAX_ROW_BLOCKS + 1); tb_u32(SEC(SN_SEC_ROWPTR) + 8, SN_MAX_ROW_BLOCKS + 1));
     CASE(SN_ERR_INDEX, "cols not increasing", tb_u16(SEC(SN_SEC_COLS) + 2, tb_rd32(SEC(SN_SEC_COLS)) & 0xFFFF));
     CASE(SN_ERR_INDEX, "col == row", tb_u16(SEC(SN_SEC_COLS) + 2 * r0, 1)); /* row 1's first column */
     CASE(SN_ERR_INDEX, "col < row", tb_u16(SEC(SN_SEC_COLS) + 2 * r0, 0));

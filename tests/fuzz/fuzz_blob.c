@@ -24,8 +24,11 @@
  *              (size only), and total_size patched to the cut for every size
  *              up to 4 KB, every section boundary +-16, and 2000 random sizes.
  */
+#define _POSIX_C_SOURCE 200112L /* fork, waitpid: crafted cases run in a child */
 #include <stdint.h>
 #include <stdio.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -63,6 +66,7 @@ static void *g_mem;
 static size_t g_mem_size;
 static char g_case[128];
 static uint64_t g_rng;
+static int g_pose; /* 0: 25 degrees about one axis; 1: (1,1,1) onto -x, root far away */
 
 static struct {
     unsigned long flips, flips_ok, stepped, trunc, trunc_ok, trunc_total, trunc_total_ok, huge;
@@ -126,12 +130,13 @@ static void exercise(const sn_blob *blob) {
     if (!local || !xf || !surf || !nrm || !lat) { fprintf(stderr, "out of memory\n"); exit(2); }
     for (j = 0; j < info.joints; j++) {
         sn_vec3 ax;
-        ax.x = REAL(0.3f, 19661);
-        ax.y = REAL(1.0f, 65536);
-        ax.z = REAL(-0.2f, -13107);
-        local[j] = sn_quat_axis_angle(ax, REAL(25.0f, 25 << 16));
+        ax.x = g_pose ? 0 : REAL(0.3f, 19661);
+        ax.y = g_pose ? REAL(-1.0f, -65536) : REAL(1.0f, 65536);
+        ax.z = g_pose ? REAL(1.0f, 65536) : REAL(-0.2f, -13107);
+        /* 125.26 degrees about (0,-1,1) takes (1,1,1) to -sqrt(3) x */
+        local[j] = sn_quat_axis_angle(ax, g_pose ? REAL(125.26439f, 8209327) : REAL(25.0f, 25 << 16));
     }
-    root.x = REAL(0.5f, 32768);
+    root.x = g_pose ? REAL(30000.0f, 30000 << 16) : REAL(0.5f, 32768);
     root.y = REAL(-0.25f, -16384);
     root.z = 0;
     sn_pose_from_local(blob, local, &root, xf);
@@ -191,6 +196,86 @@ static void truncate_to(size_t n, int with_total) {
         g.trunc++;
         if (st == SN_OK) g.trunc_ok++;
     }
+}
+
+
+/* ---- crafted hostile blobs: valid by every rule, extreme on purpose ----
+ * Each runs in a child process, so a sanitizer finding is reported as a
+ * failure of that case and the remaining cases still run. */
+static union { uint64_t a; unsigned char b[16384]; } g_craft;
+
+/* Many triangles on one vertex: vertex normals sum every face (valence 2000). */
+static size_t craft_valence(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0), off = tb_sec(b, SN_SEC_TRIS), t, nT = 2000;
+    for (t = 0; t < nT; t++) {
+        tb_u16(b + off + 6 * t, 0);
+        tb_u16(b + off + 6 * t + 2, 1 + (t & 1));
+        tb_u16(b + off + 6 * t + 4, 2 + (t & 1));
+    }
+    total = off + 6 * nT;
+    tb_u32(b + SN_H_N_TRIANGLES, nT);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 4, 6 * nT);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 8, nT);
+    tb_u32(b + SN_H_TOTAL_SIZE, total);
+    tb_fix_crc(b);
+    return total;
+}
+
+/* Largest rest coordinates the validator allows (16384 mesh units per axis,
+ * len_shift 24); exercise() then rotates (1,1,1) onto an axis. */
+static size_t craft_far_joint(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 24), j1 = tb_sec(b, SN_SEC_JOINTS) + SN_ELEM_JOINTS(4) + 8;
+    uint32_t rest = tb_sec(b, SN_SEC_REST), i;
+    int k;
+    for (k = 0; k < 3; k++) tb_real(b + j1 + 4 * k, 4096.0 / 4194304.0, SN_Q_LEN);
+    for (i = 0; i < 3 * TB_NV; i++) { /* shrink the lattice into the 16384-unit box */
+        unsigned char *p = b + rest + 4 * i;
+#if defined(SN_FLOAT)
+        float v;
+        uint32_t u = rd32(p);
+        memcpy(&v, &u, 4);
+        tb_real(p, v / 1024.0, 0);
+#else
+        tb_u32(p, (uint32_t)((int32_t)rd32(p) / 1024));
+#endif
+    }
+    tb_fix_crc(b);
+    return total;
+}
+
+static int run_crafted(const char *name, size_t (*make)(void), int posetype) {
+    pid_t pid;
+    int status = 0;
+    fflush(stdout);
+    pid = fork();
+    if (pid == 0) {
+        size_t n = make();
+        const sn_blob *blob;
+        sn_status st;
+        g_work = g_craft.b;
+        sprintf(g_case, "crafted: %s", name);
+        st = sn_blob_validate(g_craft.b, n, &blob);
+        if (st != SN_OK) { printf("  crafted %s: rejected (%s)\n", name, sn_status_str(st)); fflush(stdout); _exit(3); }
+        g_pose = posetype;
+        exercise(blob);
+        _exit(0);
+    }
+    if (pid < 0 || waitpid(pid, &status, 0) != pid) { printf("FAIL: crafted %s: fork failed\n", name); return 1; }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) { printf("  crafted %s: ok\n", name); return 0; }
+    printf("FAIL: crafted %s: %s (exit %d, signal %d) -- see the sanitizer report above\n", name,
+           WIFEXITED(status) && WEXITSTATUS(status) == 3 ? "rejected by the validator" : "sanitizer finding",
+           WIFEXITED(status) ? WEXITSTATUS(status) : -1, WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    return 1;
+}
+
+static int crafted_all(void) {
+    int fails = 0;
+    fails += run_crafted("2000 triangles on one vertex (normals)", craft_valence, 0);
+    fails += run_crafted("joint at (16384,16384,16384) mesh units rotated onto an axis (pose_from_local)",
+                         craft_far_joint, 1);
+    return fails;
 }
 
 /* Fuzz one blob (g_orig, g_size); returns the number of failed checks. */
@@ -286,6 +371,11 @@ int main(int argc, char **argv) {
 
     for (i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--all") == 0) all = 1;
+        else if (strcmp(argv[i], "--crafted") == 0) { /* only the crafted cases */
+            i = crafted_all();
+            printf("%d passed, %d failed\n", 2 - i, i);
+            return i != 0;
+        }
         else if (strcmp(argv[i], "--per-section") == 0 && i + 1 < argc) per_section = strtoul(argv[++i], NULL, 0);
         else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = strtoul(argv[++i], NULL, 0);
         else path = argv[i];
@@ -303,6 +393,8 @@ int main(int argc, char **argv) {
         memcpy(g_orig, tb.b, g_size);
         fails += fuzz_one("hand-built (tests/fuzz/sn_tblob.h)", 1, 0);
         runs++;
+        fails += crafted_all();
+        runs += 2;
         free(g_orig);
         sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
         path = defpath;
