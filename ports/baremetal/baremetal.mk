@@ -82,7 +82,7 @@ $(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
 $(eval $(call bm_image,bad_blob,bad,10,0,))
 
-BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf
+BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bench_limb.elf
 ports-baremetal: $(BM_IMAGES)
 
 # test_nofloat.sh: the float flavour of the runtime objects is its positive control
@@ -126,5 +126,9 @@ $(eval $(call det_float,float-gcc-O0,gcc,-O0))
 $(eval $(call det_float,float-gcc-O2,gcc,-O2))
 $(eval $(call det_float,float-clang-O2,clang,-O2))
 
-ports-cross: $(CROSS_DIR)/det_x86_64-gcc-O2
+# every driver whose compiler is installed (make deps installs them all)
+CROSS_HAVE = $(foreach d,x86_64-gcc-O2:gcc x86_64-clang-O2:clang i686-gcc-O2:i686-linux-gnu-gcc \
+               armhf-gcc-O2:arm-linux-gnueabihf-gcc mips-be-gcc-O2:mips-linux-gnu-gcc,\
+               $(if $(shell command -v $(word 2,$(subst :, ,$(d))) 2>/dev/null),$(CROSS_DIR)/det_$(word 1,$(subst :, ,$(d)))))
+ports-cross: $(CROSS_HAVE)
 ports: ports-baremetal ports-cross

@@ -26,16 +26,19 @@ want() {  # name compiler runner
     if [ "$3" != "-" ] && ! have "$3"; then skip "$1: no $3 (make deps)"; return; fi
     add "$1" "$D/det_$1" "$3"
 }
-want x86_64-gcc-O0   gcc -
-want x86_64-gcc-O2   gcc -
-want x86_64-clang-O2 clang -
-want i686-gcc-O2     i686-linux-gnu-gcc -
-want armhf-gcc-O2    arm-linux-gnueabihf-gcc qemu-arm
-want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
+# longest runs first, so two at a time pack well
 if ! have arm-none-eabi-gcc; then skip "cortex-m4: no arm-none-eabi-gcc (make deps)"
 elif ! have qemu-system-arm; then skip "cortex-m4: no qemu-system-arm (make deps)"
 else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; fi
-for p in float-gcc-O0 float-gcc-O2 float-clang-O2; do add "$p" "$D/det_$p" -; done
+want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
+want armhf-gcc-O2    arm-linux-gnueabihf-gcc qemu-arm
+want x86_64-gcc-O0   gcc -
+want float-gcc-O0   gcc -
+want i686-gcc-O2     i686-linux-gnu-gcc -
+want x86_64-gcc-O2   gcc -
+want x86_64-clang-O2 clang -
+want float-gcc-O2   gcc -
+want float-clang-O2 clang -
 
 # ---- build everything in one make -k -j2 ----
 targets=$(printf '%s' "$plats" | awk '{print $2}')
