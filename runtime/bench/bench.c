@@ -116,6 +116,17 @@ static int bench_blob(const char *path, int only_steps) {
     st = sn_blob_validate(bytes, size, &blob);
     if (st != SN_OK) { fprintf(stderr, "sn_bench: %s: %s\n", path, sn_status_str(st)); return 1; }
     sn_blob_get_info(blob, &info);
+    if (only_steps < 0) { /* load-time cost: full validation incl. CRC-32 */
+        double tv[21];
+        for (k = 0; k < 21; k++) {
+            double t0 = now();
+            (void)sn_blob_validate(bytes, size, &blob);
+            tv[k] = now() - t0;
+        }
+        qsort(tv, 21, sizeof tv[0], cmp_d);
+        printf("  figure: %s sn_blob_validate: median %.0f us for %lu bytes (%.1f ns/byte)\n", FLAV, 1e6 * tv[10],
+               (unsigned long)size, 1e9 * tv[10] / (double)size);
+    }
     need = sn_instance_size(blob);
     mem = malloc(need);
     local = (sn_quat *)malloc(sizeof *local * info.joints);
