@@ -18,6 +18,10 @@ mkdir -p "$out" || exit 1
 nx=$((len * n))
 sh "$here/../make_box.sh" 0 0 0 "$len" 1 1 "$nx" "$n" "$n" > "$out/beam.obj.tmp" && mv "$out/beam.obj.tmp" "$out/beam.obj" || exit 1
 cell=$(awk -v n="$n" 'BEGIN { printf "%.17g", 1 / n }')
+# CG iterations per step: the beam is stiff in step units (S^ up to ~1e4), and too few
+# fixed, warm-started iterations make the step diverge (double reference, h = 1/60:
+# 32 diverges with 2 cells, 64 with 4 cells); 64 * CELLS_HIGH keeps a 2x margin.
+iters=$((64 * n))
 half=$(awk -v n="$n" 'BEGIN { printf "%.17g", 0.5 / n }')
 cat > "$out/beam.sinew.tmp" <<EOT
 # Cantilever beam: ${len} x 1 x 1 mesh units (0.1 m per unit), $n cell(s) through the height.
@@ -31,7 +35,7 @@ material steelish $E $nu $rho
 pin box -1 -1 -1  1e-9 2 2  root   # clamp: every lattice vertex of the face x = 0
 rayleigh 0 0
 timestep 0.0166666667
-iterations 32 256
+iterations $iters 256
 gravity 0 -9.81 0
 EOT
 mv "$out/beam.sinew.tmp" "$out/beam.sinew"
