@@ -153,6 +153,40 @@ static void test_material_rules(void)
     sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
 }
 
+/* frames on the straight limb (shoulder (0,0,0) -> elbow (4,0,0) -> wrist (8,0,0), blend width
+ * B = cell = 1): bone1/bone2 = the joints of the nearer/farther bone, w from the documented rule
+ * s = clamp(1 - (d2 - d1)/B, 0, 1), w = s^2 (3 - 2s) / 2 (distances computed here, in closed form) */
+static double dist_seg_x(const double *p, double x0, double x1)
+{
+    double dx = p[0] < x0 ? x0 - p[0] : p[0] > x1 ? p[0] - x1 : 0;
+    return sqrt(dx * dx + p[1] * p[1] + p[2] * p[2]);
+}
+static void test_limb_frames(void)
+{
+    sb_desc d;
+    sb_mesh m;
+    sb_model o;
+    int i, bad = 0, n_half = 0, n_zero = 0;
+    if (sb_desc_load("tools/examples/limb/limb.sinew", &d) || sb_mesh_load_obj(d.mesh_path, &m)) { T_CHECK(0, "load limb: %s", sb_error()); return; }
+    if (sb_build(&d, &m, &o, 1)) { T_CHECK(0, "build limb: %s", sb_error()); return; }
+    for (i = 0; i < o.nf; i++) {
+        const double *p = o.x + 3 * i;
+        double da = dist_seg_x(p, 0, 4), db = dist_seg_x(p, 4, 8), d1 = fmin(da, db), d2 = fmax(da, db), sc, w;
+        int near = da <= db ? 0 : 1;   /* sorted joints: shoulder 0, elbow 1, wrist 2 */
+        sc = 1 - (d2 - d1) / 1.0;
+        sc = sc < 0 ? 0 : sc > 1 ? 1 : sc;
+        w = 0.5 * sc * sc * (3 - 2 * sc);
+        if (fabs(o.fw[i] - w) > 1e-12) bad++;
+        else if (w > 0 && da != db && (o.fb1[i] != near || o.fb2[i] != 1 - near)) bad++;
+        else if (w == 0 && (o.fb1[i] != near || o.fb2[i] != near)) bad++;
+        if (w == 0.5) n_half++;
+        if (w == 0) n_zero++;
+    }
+    T_CHECK(bad == 0, "limb frames follow the documented blend rule: %d of %d free vertices differ", bad, o.nf);
+    T_CHECK(n_half > 0 && n_zero > 0, "both blended (%d at w = 1/2) and single-bone (%d) vertices exist", n_half, n_zero);
+    sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
+}
+
 /* volume by the divergence theorem, written here independently of the tool */
 static double volume(const sb_mesh *m)
 {
@@ -252,6 +286,7 @@ int main(void)
     test_single_cell();
     test_inside_edges();
     test_material_rules();
+    test_limb_frames();
     test_cow();
     return T_END();
 }

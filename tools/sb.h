@@ -134,6 +134,12 @@ int sb_pattern_find(const sb_model *o, int i, int j);  /* entry index or -1 */
 void sb_shape(const double t[3], double N[8], double dN[8][3]);
 /* point of cell ci at reference coords t */
 void sb_cell_point(const sb_model *o, int ci, const double t[3], double p[3]);
+/* nearest bone segment to p (index into seg_child, -1 if none) and its distance */
+int sb_nearest_seg(const sb_model *o, const double p[3], double *dist);
+/* does a description region (joint indices in description order) contain p? */
+int sb_region_has(const sb_model *o, const sb_region *r, const double p[3]);
+/* integrals over the kept cells (sb_integrate.c); inbits: per grid cell, per quadrature point, inside flag */
+int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits);
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

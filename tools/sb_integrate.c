@@ -8,15 +8,11 @@
 #include <stdio.h>
 #include <string.h>
 
-int sb_region_has(const sb_model *o, const sb_region *r, const double p[3]);
-int sb_nearest_seg(const sb_model *o, const double p[3], double *dist);
-
-int sb_integrate(const sb_desc *d, const sb_mesh *m, const sb_inside *in_, sb_model *o, const unsigned char *inbits)
+int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits)
 {
     static const double gp2[2] = {0.21132486540518711775, 0.78867513459481288225};
     int n = d->subdiv, npt = n * n * n * 8, ci, a, b, k, q, r;
     double u = d->unit, t0 = sb_now();
-    (void)m; (void)in_;
     o->inside_volume = 0; o->mass = 0;
     for (ci = 0; ci < o->nc; ci++) {
         double Me[8][8], Te[8][8], Se[8][8][9];

@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-int sb_integrate(const sb_desc *d, const sb_mesh *m, const sb_inside *in_, sb_model *o, const unsigned char *inbits);
 
 void sb_shape(const double t[3], double N[8], double dN[8][3])
 {
@@ -522,7 +521,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     o->T = sb_alloc(sizeof(double) * (size_t)o->nbptr[o->nv]);
 
     /* 10. integrals */
-    if (sb_integrate(d, m, &in, o, inbits)) goto done;
+    if (sb_integrate(d, o, inbits)) goto done;
 
     o->nt = m->nt;
     o->tri = sb_alloc(sizeof(int) * 3 * (size_t)m->nt);
