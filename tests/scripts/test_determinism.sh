@@ -13,7 +13,7 @@ STEPS=1000                       # = BM_STEPS, the Cortex-M image's count
 COW_CLIP=${COW_CLIP:-tools/examples/cow/trot.clip}; export COW_CLIP
 D=$BUILD/cross
 L=$D/logs
-mkdir -p "$L"
+mkdir -p "$L"; rm -f "$L"/trace_*.log
 clip_arg=""
 if [ -f "$COW_CLIP" ]; then clip_arg="--clip $COW_CLIP"; else echo "note: $COW_CLIP missing, built-in pose sequence"; fi
 
@@ -114,5 +114,27 @@ agree() {  # label list min
     else bad "$1: hashes differ:"; printf '%s' "$2" | sed 's/^/    /'; fi
 }
 agree "fixed flavour" "$fixed" 2
+# on a mismatch, locate it: the first step (traced every 10) where a hosted
+# build leaves the trace of a build with the most common hash
+major=$(printf '%s' "$fixed" | awk '{print $2}' | sort | uniq -c | sort -rn | awk 'NR==1 {print $2}')
+if [ "$(printf '%s' "$fixed" | awk '{print $2}' | sort -u | grep -c .)" -gt 1 ]; then
+    for pass in ref odd; do
+        while read -r name target runner; do
+            case $name in float-*|cortex-*|"") continue ;; esac
+            h=$(hash_of "$L/run_$name.log")
+            [ -n "$h" ] || continue
+            c=$(cmd_for "$name" "$target" "$runner")
+            if [ "$pass" = ref ] && [ "$runner" = - ] && [ "$h" = "$major" ] && [ ! -f "$L/trace_ref.log" ]; then
+                timeout 600 $c --trace 10 < /dev/null > "$L/trace_ref.log" 2>&1; echo "    trace reference: $name"
+            elif [ "$pass" = odd ] && [ "$h" != "$major" ] && [ -f "$L/trace_ref.log" ]; then
+                timeout 600 $c --trace 10 < /dev/null > "$L/trace_$name.log" 2>&1
+                echo "    $name: first differing trace line: $(diff "$L/trace_ref.log" "$L/trace_$name.log" | grep '^>' | head -n 1)"
+            fi
+        done <<EOF2
+$plats
+EOF2
+    done
+    rm -f "$L/trace_ref.log"
+fi
 agree "float flavour" "$float" 3
 finish
