@@ -13,7 +13,8 @@ deps:
 # ---- common inputs ----
 PORT_SN_SRCS  = $(SN_SRCS)
 PORT_SN_INC   = $(if $(SN_INC),$(SN_INC),-Iruntime/include)
-PORT_WARN     = -std=c99 -Wall -Wextra -Wpedantic -Werror
+# the runtime's own warning set (-Wconversion catches int widths that differ per target)
+PORT_WARN     = -std=c99 -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Wvla -Werror
 PORT_INC      = $(PORT_SN_INC) -Iports/common -Iports/cross
 PORT_COMMON   = ports/cross/sn_det.c ports/common/sn_clip.c ports/common/sn_clip_pose.c
 PORT_HDRS     = ports/cross/sn_det.h ports/common/sn_clip.h runtime/include/sinew.h \
@@ -28,7 +29,6 @@ COW_FLOAT_BLOB ?= $(BUILD)/examples/cow_float.blob
 
 # ---- Cortex-M4 images ----
 BM_CC     ?= arm-none-eabi-gcc
-BM_SIZE   ?= arm-none-eabi-size
 BM_DIR     = $(BUILD)/baremetal
 BM_ARCH    = -mcpu=cortex-m4 -mthumb -mfloat-abi=soft
 BM_CFLAGS  = $(BM_ARCH) $(PORT_WARN) -O2 -g -ffunction-sections -fdata-sections \
@@ -37,8 +37,7 @@ BM_LDFLAGS = $(BM_ARCH) -nostartfiles --specs=nano.specs -T ports/baremetal/an38
              -Wl,--gc-sections
 BM_STEPS  ?= 1000
 BM_BENCH_STEPS ?= 100
-BM_QEMU   ?= qemu-system-arm
-BM_RUN     = $(BM_QEMU) -M mps2-an386 -nographic -semihosting-config enable=on,target=native
+# run: see BM_QEMU_RUN in ports/cross/port_lib.sh
 BM_SRCS    = ports/baremetal/startup.c $(PORT_COMMON) $(PORT_SN_SRCS)
 BM_OBJS    = $(patsubst %.c,$(BM_DIR)/obj/%.o,$(BM_SRCS))
 

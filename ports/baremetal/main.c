@@ -100,7 +100,7 @@ int main(void) {
     SN_CMSDK_TIMER0[SN_TIMER_VALUE] = 0xFFFFFFFFu;
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 1u;
     cal_ticks = calibrate(2000000u, &cal_insns);
-    { uint32_t a = timer_now(); overhead = a - timer_now(); }
+    { uint32_t t_a = timer_now(); overhead = t_a - timer_now(); }
     if (cal_ticks == 0) { sn_bm_puts("FAIL: timer does not run\n"); return 1; }
     for (k = 0; k < SN_BM_STEPS; k++) {
         uint32_t t0 = timer_now(), t1, t2;
