@@ -24,3 +24,30 @@ $(BUILD)/tests/test_physics_$(1)_float: tests/test_physics_$(1).c $(REF_SRC) $(P
 endef
 $(foreach t,$(PHYS_TESTS),$(eval $(call PHYS_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)
+
+# Beam 4 re-baked with a small time step (h = 1/960 s) for the free-vibration test.
+PHYS_EX = $(BUILD)/physics
+$(PHYS_EX)/beam4_h960/beam.sinew: $(BUILD)/examples/beam4/beam.sinew
+	@mkdir -p $(@D)
+	sed 's/^timestep .*/timestep 0.00104166667/' $< > $@
+	cp $(BUILD)/examples/beam4/beam.obj $(@D)/beam.obj
+$(PHYS_EX)/beam4_h960.blob: $(PHYS_EX)/beam4_h960/beam.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(PHYS_EX)/beam4_h960_float.blob: $(PHYS_EX)/beam4_h960/beam.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+$(PHYS_EX)/beam4_h960_double.blob: $(PHYS_EX)/beam4_h960/beam.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour double --quiet
+TEST_DEPS += $(PHYS_EX)/beam4_h960.blob $(PHYS_EX)/beam4_h960_float.blob $(PHYS_EX)/beam4_h960_double.blob
+
+# Beams re-baked with mass damping (alpha = 20/s, about critical for the first
+# mode) so the runtime settles on the static equilibrium in a few hundred steps.
+$(PHYS_EX)/beam%_damped/beam.sinew: $(BUILD)/examples/beam%/beam.sinew
+	@mkdir -p $(@D)
+	sed 's/^rayleigh .*/rayleigh 20 0/' $< > $@
+	cp $(BUILD)/examples/beam$*/beam.obj $(@D)/beam.obj
+$(PHYS_EX)/beam%_damped.blob: $(PHYS_EX)/beam%_damped/beam.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(PHYS_EX)/beam%_damped_float.blob: $(PHYS_EX)/beam%_damped/beam.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(PHYS_EX)/beam%_damped/beam.sinew $(PHYS_EX)/beam4_h960/beam.sinew
+TEST_DEPS += $(foreach n,1 2 4,$(PHYS_EX)/beam$(n)_damped.blob $(PHYS_EX)/beam$(n)_damped_float.blob)
