@@ -38,5 +38,11 @@ for a in $assets; do
     pose=$( [ "$(v clip)" = 1 ] && echo "clip pose" || echo "built-in pose" )
     echo "bench-baremetal: cortex-m4 $a: $ips instructions per sn_step, $(v insns_per_pose) per $pose (mean of $(v bench_steps) steps, qemu -icount)"
     echo "bench-baremetal: cortex-m4 $a: lattice $(v lattice_vertices) vertices ($nF free), $nb off-diagonal blocks, $it CG iterations: ~$macs block multiply-adds per step (estimate), ~$((ips / macs)) instructions each, all step work included"
+    ipc=$(v insns_per_cg_iteration)
+    if [ -n "$ipc" ]; then
+        # one CG iteration = one matvec (<= 2*blocks + free 3x3 block MACs,
+        # skeleton columns excluded) + preconditioner + dots/axpys
+        echo "bench-baremetal: cortex-m4 $a: $ipc instructions per CG iteration (slope $it -> $(v cg_iterations_more) iterations: $(v insns_per_step_more) per step), <= $((2 * nb + nF)) block multiply-adds each: >= $((ipc / (2 * nb + nF))) instructions per block multiply-add"
+    fi
     echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + inst + stack)) B (static $((data + bss)) B$( [ "$(v clip)" = 1 ] && echo " incl. the parsed clip"), instance $inst B, stack peak $stack B)"
 done

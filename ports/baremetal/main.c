@@ -62,6 +62,22 @@ static uint32_t calibrate(uint32_t n, uint32_t *insns) {
     *insns = 2u * n;
     return t0 - t1;
 }
+
+static uint32_t overhead;   /* ticks of two back-to-back timer reads */
+
+/* n steps; adds the ticks spent in pose and in sn_step */
+static void time_steps(uint32_t n, uint64_t *pose_ticks, uint64_t *step_ticks) {
+    uint32_t k;
+    for (k = 0; k < n; k++) {
+        uint32_t t0 = timer_now(), t1, t2;
+        sn_det_pose(&det);
+        t1 = timer_now();
+        sn_det_step(&det);
+        t2 = timer_now();
+        *pose_ticks += t0 - t1 - overhead;
+        *step_ticks += t1 - t2 - overhead;
+    }
+}
 #endif
 
 int main(void) {
@@ -70,10 +86,10 @@ int main(void) {
     const char *text = NULL;
     size_t text_len = 0;
     uint64_t hash;
+    sn_blob_info bi;
 #if SN_BM_BENCH
-    uint32_t k;
-    uint64_t pose_ticks = 0, step_ticks = 0;
-    uint32_t cal_insns, cal_ticks, overhead;
+    uint64_t pose_ticks = 0, step_ticks = 0, more_ticks = 0, unused = 0;
+    uint32_t cal_insns, cal_ticks, more_iters;
 #endif
 #if SN_BM_CLIP
     text = (const char *)sn_bm_clip_text;
@@ -85,15 +101,12 @@ int main(void) {
         return 1;
     }
     put_kv("instance_bytes: ", sn_instance_size(det.blob));
-    {
-        sn_blob_info bi;
-        sn_blob_get_info(det.blob, &bi);
-        put_kv("lattice_vertices: ", bi.vertices);
-        put_kv("free_vertices: ", bi.free_vertices);
-        put_kv("offdiag_blocks: ", bi.offdiag_blocks);
-        put_kv("cg_iterations: ", bi.cg_iters_default);
-        put_kv("clip: ", SN_BM_CLIP);
-    }
+    sn_blob_get_info(det.blob, &bi);
+    put_kv("lattice_vertices: ", bi.vertices);
+    put_kv("free_vertices: ", bi.free_vertices);
+    put_kv("offdiag_blocks: ", bi.offdiag_blocks);
+    put_kv("cg_iterations: ", bi.cg_iters_default);
+    put_kv("clip: ", SN_BM_CLIP);
 #if SN_BM_BENCH
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 0;
     SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;
@@ -102,21 +115,27 @@ int main(void) {
     cal_ticks = calibrate(2000000u, &cal_insns);
     { uint32_t t_a = timer_now(); overhead = t_a - timer_now(); }
     if (cal_ticks == 0) { sn_bm_puts("FAIL: timer does not run\n"); return 1; }
-    for (k = 0; k < SN_BM_STEPS; k++) {
-        uint32_t t0 = timer_now(), t1, t2;
-        sn_det_pose(&det);
-        t1 = timer_now();
-        sn_det_step(&det);
-        t2 = timer_now();
-        pose_ticks += t0 - t1 - overhead;
-        step_ticks += t1 - t2 - overhead;
+    time_steps(SN_BM_STEPS, &pose_ticks, &step_ticks);
+    hash = sn_state_hash(det.inst);
+    /* cost of one CG iteration: the slope between the default count and
+     * twice that (steps are fixed-cost, so a few steps suffice) */
+    more_iters = bi.cg_iters_default * 2u <= bi.cg_iters_max ? bi.cg_iters_default * 2u : bi.cg_iters_max;
+    if (more_iters > bi.cg_iters_default && sn_set_iterations(det.inst, more_iters) == SN_OK) {
+        uint32_t n_more = SN_BM_STEPS / 4u + 1u;
+        uint64_t a, b;
+        time_steps(n_more, &unused, &more_ticks);
+        (void)sn_set_iterations(det.inst, 0);
+        a = step_ticks * cal_insns / cal_ticks / SN_BM_STEPS;
+        b = more_ticks * cal_insns / cal_ticks / n_more;
+        put_kv("cg_iterations_more: ", more_iters);
+        put_kv("insns_per_step_more: ", b);
+        put_kv("insns_per_cg_iteration: ", (b - a) / (more_iters - bi.cg_iters_default));
     }
     /* instructions = ticks * cal_insns / cal_ticks, per step */
     put_kv("bench_steps: ", SN_BM_STEPS);
     put_kv("insns_per_step: ", (step_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
     put_kv("insns_per_pose: ", (pose_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
     put_kv("insns_per_tick_x1000: ", (uint64_t)cal_insns * 1000u / cal_ticks);
-    hash = sn_state_hash(det.inst);
 #else
     hash = sn_det_run(&det, SN_BM_STEPS);
 #endif
