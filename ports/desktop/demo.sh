@@ -55,8 +55,9 @@ run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_tur
 rm -f "$OUT/run.out"
 
 echo
-echo "Time of one sn_step in microseconds, this machine (cow: 288 free lattice"
-echo "vertices, 16 CG iterations; CPU = thread CPU time, unaffected by other processes):"
+echo "Time of one sn_step in microseconds on this machine (CPU = thread CPU time,"
+echo "unaffected by other processes). The asset:"
+"$PLAY" "$COW" --frames 1 2>/dev/null | grep 'lattice vertices' | sed "s|^$BUILD/|  |"
 printf '  %-38s %9s %9s %9s %9s\n' "run" "median" "p99" "CPU med" "CPU p99"
 cat "$log"
 echo
