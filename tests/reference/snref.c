@@ -992,3 +992,16 @@ void snref_energy(const snref_state *s, double *kinetic, double *elastic) {
     free(t); free(u);
 }
 
+
+/* Solve the static system for an arbitrary load: -J x = load (free rows,
+ * internal units), i.e. x = K^-1 load at the current frames; banded LU, or
+ * BiCGSTAB if the band is too large. */
+void snref_solve_load(snref_state *s, const double *load, double *x) {
+    snref_band *B = band_build(s, 0, (size_t)60000000);
+    memset(x, 0, 3 * s->m->nF * sizeof *x);
+    if (B) band_solve(B, load, x); else bicgstab(s, load, x, 1e-13);
+    band_free(B);
+}
+
+/* y = M^_FF x (free rows, free columns). */
+void snref_mass_mul(const snref_state *s, const double *x, double *y) { mass_mul(s, x, y, 0); }

@@ -103,6 +103,11 @@ void snref_surface_from_lattice(const snref_model *m, const double *lat, double 
  * Returns the final relative residual |f + m g| / |m g| (or / |f(p0)|). */
 double snref_static(snref_state *s, unsigned dense_max);
 
+/* x = (-J)^-1 load at the current frames (free rows; the stiffness solve of
+ * eq. 10 for an arbitrary load), and y = M^_FF x. Used for eigen-frequencies. */
+void snref_solve_load(snref_state *s, const double *load, double *x);
+void snref_mass_mul(const snref_state *s, const double *x, double *y);
+
 /* Net force residual f + m^g^ (internal units) at the current positions, free rows. */
 void snref_residual(const snref_state *s, double *out);
 
