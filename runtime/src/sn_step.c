@@ -245,6 +245,23 @@ void sn_get_stats(const sn_instance *inst, sn_stats *out) {
     out->mode = h->mode;
 }
 
+/* ---- saturating public-vector arithmetic (fixed: int32 Q16.16 could overflow
+ * for extreme but valid inputs; float: plain) ---- */
+static sn_real pub_add(sn_real a, sn_real b) {
+#if defined(SN_FLOAT)
+    return a + b;
+#else
+    return clamp32((int64_t)a + b);
+#endif
+}
+static sn_real pub_sub(sn_real a, sn_real b) {
+#if defined(SN_FLOAT)
+    return a - b;
+#else
+    return clamp32((int64_t)a - b);
+#endif
+}
+
 /* ---- forward kinematics (public units) ---- */
 void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3 *root_offset,
                         sn_xform *out) {
@@ -264,23 +281,23 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3
         }
         /* rotation about the joint's rest position: x -> Rl (x - xj) + xj */
         rx = sn_quat_rotate(ql, x);
-        d.x = x.x - rx.x; d.y = x.y - rx.y; d.z = x.z - rx.z;
+        d.x = pub_sub(x.x, rx.x); d.y = pub_sub(x.y, rx.y); d.z = pub_sub(x.z, rx.z);
         if (p < 0) {
             out[j].rot = ql;
             out[j].pos = d;
             if (root_offset) {
-                out[j].pos.x += root_offset->x;
-                out[j].pos.y += root_offset->y;
-                out[j].pos.z += root_offset->z;
+                out[j].pos.x = pub_add(out[j].pos.x, root_offset->x);
+                out[j].pos.y = pub_add(out[j].pos.y, root_offset->y);
+                out[j].pos.z = pub_add(out[j].pos.z, root_offset->z);
             }
         } else {
             /* T_j = T_p o local: R = Rp Rl, t = Rp (xj - Rl xj) + tp */
             const sn_xform *tp = &out[p];
             sn_vec3 rd = sn_quat_rotate(tp->rot, d);
             out[j].rot = sn_quat_mul(tp->rot, ql);
-            out[j].pos.x = rd.x + tp->pos.x;
-            out[j].pos.y = rd.y + tp->pos.y;
-            out[j].pos.z = rd.z + tp->pos.z;
+            out[j].pos.x = pub_add(rd.x, tp->pos.x);
+            out[j].pos.y = pub_add(rd.y, tp->pos.y);
+            out[j].pos.z = pub_add(rd.z, tp->pos.z);
         }
     }
 }
@@ -877,7 +894,8 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
 #else
     {
         /* area-weighted sums in int32: a pre-pass picks one shift for the mesh
-         * so the largest face normal is <= 2^24 (128 faces per vertex fit) */
+         * so the largest face normal is <= 2^24 (128 faces per vertex fit);
+         * beyond that the sums saturate instead of overflowing */
         int64_t maxn = 0;
         int pass, shift = 0;
         for (pass = 0; pass < 2; pass++) {
@@ -904,9 +922,9 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
                 } else {
                     int32_t s0 = (int32_t)sn_rshr64(n[0], shift), s1 = (int32_t)sn_rshr64(n[1], shift),
                             s2 = (int32_t)sn_rshr64(n[2], shift);
-                    out[a].x += s0; out[a].y += s1; out[a].z += s2;
-                    out[b].x += s0; out[b].y += s1; out[b].z += s2;
-                    out[c].x += s0; out[c].y += s1; out[c].z += s2;
+                    out[a].x = pub_add(out[a].x, s0); out[a].y = pub_add(out[a].y, s1); out[a].z = pub_add(out[a].z, s2);
+                    out[b].x = pub_add(out[b].x, s0); out[b].y = pub_add(out[b].y, s1); out[b].z = pub_add(out[b].z, s2);
+                    out[c].x = pub_add(out[c].x, s0); out[c].y = pub_add(out[c].y, s1); out[c].z = pub_add(out[c].z, s2);
                 }
             }
             if (pass == 0) {
