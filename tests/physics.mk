@@ -12,7 +12,7 @@ TEST_BINS += $(BUILD)/tests/test_reference
 # Physics tests against the runtime: each built fixed and float (suffix _float).
 PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference
 PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
-PHYS_TESTS  = cantilever runtime vibration
+PHYS_TESTS  = cantilever runtime vibration rigid
 
 define PHYS_TEST_RULE
 $(BUILD)/tests/test_physics_$(1): tests/test_physics_$(1).c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
@@ -51,3 +51,19 @@ $(PHYS_EX)/beam%_damped_float.blob: $(PHYS_EX)/beam%_damped/beam.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 .PRECIOUS: $(PHYS_EX)/beam%_damped/beam.sinew $(PHYS_EX)/beam4_h960/beam.sinew
 TEST_DEPS += $(foreach n,1 2 4,$(PHYS_EX)/beam$(n)_damped.blob $(PHYS_EX)/beam$(n)_damped_float.blob)
+
+# Cow and limb re-baked without gravity: a rigid skeleton motion must then leave
+# the shape exactly undeformed (rigid-invariance test).
+define PHYS_NOGRAV_RULE
+$(PHYS_EX)/$(1)_nograv/asset.sinew: tools/examples/$(1)/$(1).sinew tools/examples/$(1)/$(1).obj
+	@mkdir -p $$(@D)
+	sed 's/^gravity .*/gravity 0 0 0/' $$< > $$@
+	cp tools/examples/$(1)/$(1).obj $$(@D)/$(1).obj
+endef
+$(foreach a,cow limb,$(eval $(call PHYS_NOGRAV_RULE,$(a))))
+$(PHYS_EX)/%_nograv.blob: $(PHYS_EX)/%_nograv/asset.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(PHYS_EX)/%_nograv_float.blob: $(PHYS_EX)/%_nograv/asset.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(PHYS_EX)/%_nograv/asset.sinew
+TEST_DEPS += $(foreach a,cow limb,$(PHYS_EX)/$(a)_nograv.blob $(PHYS_EX)/$(a)_nograv_float.blob)
