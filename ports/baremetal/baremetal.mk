@@ -85,13 +85,15 @@ BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf $(BM_DIR)/sinew_limb
 ports-baremetal: $(BM_IMAGES)
 
 # test_nofloat.sh: the float flavour of the runtime objects is its positive control
-.PHONY: bm-float-objs print-port-sn-srcs
+.PHONY: bm-float-objs print-port-sn-srcs print-sn-libs
 $(BM_DIR)/obj-float/%.o: %.c $(PORT_HDRS)
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -DSN_FLOAT -c $< -o $@
 bm-float-objs: $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(PORT_SN_SRCS))
 print-port-sn-srcs:
 	@echo $(PORT_SN_SRCS)
+print-sn-libs:
+	@echo $(SN_LIB_FIXED) $(SN_LIB_FLOAT)
 
 bench-baremetal:
 	BUILD=$(BUILD) sh ports/baremetal/bench.sh

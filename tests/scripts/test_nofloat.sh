@@ -4,7 +4,8 @@
 # references no soft-float helper (__aeabi_f*/d*, i2f/f2i..., libgcc
 # __addsf3...), no libm function and no VFP instruction. Positive control:
 # the float flavour of the same runtime objects does reference such helpers,
-# so the check can see them.
+# so the check can see them. Host too: the x86-64 fixed library has no SSE/x87
+# float arithmetic (integer SIMD is fine), the float library has.
 . ports/cross/port_lib.sh
 
 FLOAT_RE='__aeabi_([fd][a-z0-9]+|[ui]2[fd]|u?l2[fd])$|__(add|sub|mul|div|neg)[sdt]f3$|__float(un)?[sdt]i[sdt]f$|__fix(uns)?[sdt]f[sdt]i$|__extendsfdf2$|__truncdfsf2$|__(eq|ne|lt|le|gt|ge|un|cmp)[sd]f2$'
@@ -43,4 +44,16 @@ if pmake bm-float-objs > "$L/build_float.log" 2>&1; then
 else
     bad "control: float flavour build failed"; tail -n 20 "$L/build_float.log"
 fi
+# host (x86-64) fixed library: no float arithmetic instructions
+X86_FP_RE='[[:space:]](add|sub|mul|div|sqrt|min|max|cvt[a-z0-9]*|u?comi|rcp|rsqrt)(ss|sd|ps|pd)[[:space:]]|[[:space:]]f(add|sub|mul|div|ld|st|sqrt|comi)[a-z]*[[:space:]]'
+if have objdump && [ "$(uname -m)" = x86_64 ]; then
+    libs=$(pmake print-sn-libs)
+    if pmake $libs > "$L/build_host.log" 2>&1; then
+        set -- $libs
+        n=$(objdump -d "$1" | grep -cE "$X86_FP_RE")
+        c=$(objdump -d "$2" | grep -cE "$X86_FP_RE")
+        if [ "$n" -eq 0 ]; then ok "x86-64 fixed library: no float instruction"; else bad "x86-64 fixed library: $n float instructions"; fi
+        if [ "$c" -gt 0 ]; then ok "control: x86-64 float library: $c float instructions"; else bad "control: x86-64 float library shows none; the check is blind"; fi
+    else bad "build $libs"; tail -n 20 "$L/build_host.log"; fi
+else echo "note: not on x86-64, host library check left out"; fi
 finish
