@@ -106,6 +106,16 @@ if pmake "$BUILD/sinew-play" "$BUILD/examples/cow.blob" > "$L/build_play.log" 2>
     else bad "sinew-play: run failed"; tail -n 5 "$L/run_play.log" | sed 's/^/    /'; fi
 else bad "sinew-play: build failed"; tail -n 10 "$L/build_play.log"; fi
 
+# desktop player (float) against the float drivers
+if pmake "$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" > "$L/build_play_float.log" 2>&1; then
+    if run_log "$L/run_play_float.log" 600 "$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" $clip_arg \
+            --frames "$STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_play_float.log")" ]; then
+        h=$(hash_of "$L/run_play_float.log"); echo "determinism: sinew-play-float $h"
+        float="${float}sinew-play-float $h
+"
+    else bad "sinew-play-float: run failed"; tail -n 5 "$L/run_play_float.log" | sed 's/^/    /'; fi
+else bad "sinew-play-float: build failed"; tail -n 10 "$L/build_play_float.log"; fi
+
 agree() {  # label list min
     n=$(printf '%s' "$2" | grep -c .)
     d=$(printf '%s' "$2" | awk '{print $2}' | sort -u | grep -c .)
