@@ -1,6 +1,7 @@
 # ports/baremetal + ports/cross build fragment.
 #   make ports            Cortex-M4 images (QEMU mps2-an386) + cross determinism drivers
 #   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
+#   make profile-baremetal  Cortex-M4 instructions per function (QEMU exec log)
 #   make deps             install the cross toolchains and QEMU (Debian, root)
 # Inputs from other fragments: SN_SRCS / SN_INC (runtime.mk), the host tool's
 # C-array blobs $(BUILD)/examples/<asset>_blob.c (tools.mk).
@@ -76,6 +77,7 @@ $(eval $(call bm_image,sinew_cow,cow,$(BM_STEPS),0,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,bench_cow,cow,$(BM_BENCH_STEPS),1,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,sinew_limb,limb,$(BM_STEPS),0,$(LIMB_CLIP)))
 $(eval $(call bm_image,bench_limb,limb,$(BM_BENCH_STEPS),1,$(LIMB_CLIP)))
+$(eval $(call bm_image,prof_cow,cow,2,0,$(wildcard $(COW_CLIP))))
 $(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
@@ -98,6 +100,9 @@ print-sn-libs:
 bench-baremetal:
 	BUILD=$(BUILD) sh ports/baremetal/bench.sh
 bench: bench-baremetal
+.PHONY: profile-baremetal
+profile-baremetal:
+	BUILD=$(BUILD) sh ports/baremetal/profile.sh
 
 # ---- hosted determinism drivers (det_main) for every compiler/CPU ----
 CROSS_DIR   = $(BUILD)/cross
