@@ -145,6 +145,8 @@ size_t sn_instance_size(const sn_blob *blob);
 
 /// Initialise an instance in caller memory (mem 8-byte aligned, mem_size >=
 /// sn_instance_size(blob)); the instance starts at rest with the rest pose.
+/// SN_ERR_INDEX if a lattice vertex has more than 26 stored neighbours (a
+/// property of hex lattices the overflow-free arithmetic relies on).
 sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out);
 
 /// Back to rest: rest pose, zero displacement and velocity, cleared warm start

@@ -68,7 +68,7 @@ typedef int64_t sn_acc;
 #endif
 
 /* Limits (fixed): state values are clamped to +-SN_LIM (Q22: +-64 internal
- * units); accumulators to +-SN_ACC_LIM after each block (NUMERICS.md,
+ * units); SN_ACC_LIM bounds intermediate public-unit sums (NUMERICS.md,
  * overflow freedom). */
 #define SN_LIM ((int32_t)1 << 28)
 #define SN_ACC_LIM ((int64_t)1 << 62)
@@ -103,17 +103,10 @@ SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
     return (x + ((int64_t)1 << (s - 1))) >> s;
 }
 
-/* Clamp an accumulator to +-2^62 (fixed); identity in float. */
-SN_INLINE sn_acc sn_acc_clamp(sn_acc a) {
-#if defined(SN_FLOAT)
-    return a;
-#else
-    return a > SN_ACC_LIM ? SN_ACC_LIM : (a < -SN_ACC_LIM ? -SN_ACC_LIM : a);
-#endif
-}
-
 /* Accumulator -> value: round-shift by s, clamp to +-SN_LIM and count clamps
- * into *sat. Float: clamp to +-SN_FLIM internal units (s ignored). */
+ * into *sat. Float: clamp to +-SN_FLIM internal units (s ignored).
+ * Fixed: requires |a| < 2^62.5 so the rounding add cannot overflow; every
+ * caller's sum is bounded below that (NUMERICS.md, overflow freedom). */
 SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
 #if defined(SN_FLOAT)
     (void)s;
@@ -121,7 +114,7 @@ SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
     if (a < -SN_FLIM) { (*sat)++; return -SN_FLIM; }
     return a;
 #else
-    int64_t v = sn_rshr64(sn_acc_clamp(a), s);
+    int64_t v = sn_rshr64(a, s);
     if (v > SN_LIM) { (*sat)++; return SN_LIM; }
     if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
     return (int32_t)v;

@@ -124,6 +124,18 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     h = (sn_ihdr *)mem;
     sn_view_init(&h->v, blob);
     layout(h);
+    {   /* each free vertex may be the column of at most SN_MAX_ROW_BLOCKS rows
+         * (true of any hex lattice); the unclamped accumulation relies on it.
+         * The accumulator array (24 bytes per free vertex) serves as counters. */
+        uint16_t *cnt = ARR(h, o_acc, uint16_t);
+        const unsigned char *cols = h->v.sec[SN_SEC_COLS];
+        uint32_t e, nF = h->v.nF;
+        memset(cnt, 0, nF * sizeof *cnt);
+        for (e = 0; e < h->v.nnz; e++) {
+            uint32_t j = sn_rd_u16(cols + 2 * e);
+            if (j < nF && ++cnt[j] > SN_MAX_ROW_BLOCKS) return SN_ERR_INDEX;
+        }
+    }
     h->magic = SN_INST_MAGIC;
     h->iterations = h->v.cg_default;
     h->mode = SN_MODE_WARPED;
@@ -304,15 +316,17 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3
 
 /* ---- the step ---- */
 
-/* Row-local sums: a row's own blocks (diagonal + at most SN_MAX_ROW_BLOCKS,
- * validated) are summed unclamped in registers: each block row is < 3*2^55,
- * so the row total stays < 2^61.3 and adding it to an accumulator already
- * clamped to 2^62 cannot overflow. Scatter (transposed) adds clamp each time. */
+/* Overflow freedom without clamps: entries |e| <= 2^27 (validator), operands
+ * |x| <= 2^28 (every sn_q is clamped), so one block row is < 3*2^55 = 2^56.6.
+ * A free vertex's accumulator receives its own row (diagonal + at most 26
+ * blocks, validator) and at most 26 transposed blocks (checked by
+ * sn_instance_init): 53 * 2^56.6 < 2^62.4 < 2^63. */
 SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
     l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
     l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
     l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
 }
+/* l += D e, D symmetric stored xx yy zz xy xz yz */
 SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
     sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
     sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
@@ -325,35 +339,24 @@ SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[1] += sn_mul(m, e[1]);
     l[2] += sn_mul(m, e[2]);
 }
-/* acc_i = clamp(acc_i + l) at the end of row i */
+/* acc_i += l at the end of row i */
 SN_INLINE void row_done(sn_acc *acc, const sn_acc l[3]) {
-    acc[0] = sn_acc_clamp(acc[0] + l[0]);
-    acc[1] = sn_acc_clamp(acc[1] + l[1]);
-    acc[2] = sn_acc_clamp(acc[2] + l[2]);
+    acc[0] += l[0];
+    acc[1] += l[1];
+    acc[2] += l[2];
 }
 
-/* acc += B^T e */
+/* acc += B^T e (scatter of the transposed block) */
 SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    acc[0] = sn_acc_clamp(acc[0] + sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) +
-                          sn_mul(rd_real(b, 6), e[2]));
-    acc[1] = sn_acc_clamp(acc[1] + sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) +
-                          sn_mul(rd_real(b, 7), e[2]));
-    acc[2] = sn_acc_clamp(acc[2] + sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) +
-                          sn_mul(rd_real(b, 8), e[2]));
-}
-/* acc += D e, D symmetric stored xx yy zz xy xz yz */
-SN_INLINE void sym_mac(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
-    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
-    acc[0] = sn_acc_clamp(acc[0] + sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]));
-    acc[1] = sn_acc_clamp(acc[1] + sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]));
-    acc[2] = sn_acc_clamp(acc[2] + sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]));
+    acc[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) + sn_mul(rd_real(b, 6), e[2]);
+    acc[1] += sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 7), e[2]);
+    acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
 }
 /* acc += m e (scalar block) */
 SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
-    acc[0] = sn_acc_clamp(acc[0] + sn_mul(m, e[0]));
-    acc[1] = sn_acc_clamp(acc[1] + sn_mul(m, e[1]));
-    acc[2] = sn_acc_clamp(acc[2] + sn_mul(m, e[2]));
+    acc[0] += sn_mul(m, e[0]);
+    acc[1] += sn_mul(m, e[1]);
+    acc[2] += sn_mul(m, e[2]);
 }
 
 static void acc_zero(sn_acc *acc, uint32_t n3) {
@@ -464,7 +467,7 @@ static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
         sn_acc a[3] = {0, 0, 0};
         int sh = v->frac_P + kk[i]; /* r is Q22+k_i, z is Q22 */
         sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
-        sym_mac(a, P + (size_t)i * 6 * RB, t);
+        sym_row(a, P + (size_t)i * 6 * RB, t);
         s[0] = sn_out(a[0], sh, sat);
         s[1] = sn_out(a[1], sh, sat);
         s[2] = sn_out(a[2], sh, sat);
