@@ -68,8 +68,12 @@ static int bitlen64(uint64_t x) {
 }
 #endif
 
-/* Most extra fractional bits of a force-like value (see sn_instance_init). */
-#define SN_KMAX 12
+/* Force-like values of free vertex i are Q(SN_Q_FORCE + k_i), k_i in
+ * [0, SN_KMAX] (see sn_instance_init): the stiffest vertex gets Q19, three
+ * bits of headroom over the Q22 lengths for violent poses. */
+#define SN_Q_FORCE 19
+#define SN_KMAX 15
+#define SN_KREL(k) ((int)(k) + SN_Q_FORCE - SN_Q_LEN) /* bits relative to Q22 */
 
 #define ARR(h, off, T) ((T *)(void *)((unsigned char *)(h) + (h)->off))
 #define CARR(h, off, T) ((const T *)(const void *)((const unsigned char *)(h) + (h)->off))
@@ -149,18 +153,30 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     }
 #endif
     {   /* Force-like CG vectors (b, r, q) of free vertex i carry k_i extra
-         * fractional bits: forces scale with the interior volume of a vertex's
-         * support (as M^_ii does), so a barely-inside vertex would otherwise
-         * have forces of a few LSBs that the preconditioner amplifies.
-         * k_i = bits between the largest and this M^_ii, at most SN_KMAX. */
+         * fractional bits. A row's forces scale with its diagonal block of A
+         * (mass + stiffness of the vertex's support), so a barely-inside vertex
+         * would otherwise have forces of a few LSBs that the preconditioner
+         * amplifies, while a stiff one needs the range. k_i = bits between
+         * this vertex's P_i = A_ii^-1 (trace) and the smallest, at most SN_KMAX. */
+        /* (format: SN_Q_FORCE + k_i fractional bits) */
         uint8_t *kk = ARR(h, o_k, uint8_t);
+        const unsigned char *P = h->v.sec[SN_SEC_PRECOND];
         uint32_t i;
+#if !defined(SN_FLOAT)
+        int bmin = 64;
+        for (i = 0; i < h->v.nF; i++) {
+            int64_t tr = (int64_t)rd_real(P, 6 * i) + rd_real(P, 6 * i + 1) + rd_real(P, 6 * i + 2);
+            int b = bitlen64(tr > 0 ? (uint64_t)tr : 0u);
+            bmin = b < bmin ? b : bmin;
+        }
+#endif
         for (i = 0; i < h->v.nF; i++) {
 #if defined(SN_FLOAT)
             kk[i] = 0;
+            (void)P;
 #else
-            int32_t m = rd_real(h->v.sec[SN_SEC_MDIAG], i);
-            int k = (h->v.frac_M + 1) - bitlen64(m > 0 ? (uint64_t)m : 0u);
+            int64_t tr = (int64_t)rd_real(P, 6 * i) + rd_real(P, 6 * i + 1) + rd_real(P, 6 * i + 2);
+            int k = bitlen64(tr > 0 ? (uint64_t)tr : 0u) - bmin;
             k = k < 0 ? 0 : (k > SN_KMAX ? SN_KMAX : k);
             kk[i] = (uint8_t)k;
 #endif
@@ -373,14 +389,14 @@ SN_INLINE sn_q coef(sn_q v, sn_q c, uint32_t *sat) { return sn_mulq(v, c, SN_Q_C
 #define ONE_COEF ((int32_t)1 << SN_Q_COEF)
 #endif
 
-/* Force rows out_i (Q22+k_i) = R_i (acc_i >> (frac - k_i)) for free rows */
+/* Force rows out_i (Q(19+k_i)) = R_i (acc_i >> (frac - k_i + 3)) for free rows */
 static void rows_out_rot(const sn_ihdr *h, const sn_acc *acc, int frac, sn_q *out, uint32_t *sat) {
     const sn_q *R = CARR(h, o_R, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i;
     for (i = 0; i < h->v.nF; i++) {
         sn_q t[3];
-        int s = frac - kk[i];
+        int s = frac - SN_KREL(kk[i]);
         t[0] = sn_out(acc[3 * i], s, sat);
         t[1] = sn_out(acc[3 * i + 1], s, sat);
         t[2] = sn_out(acc[3 * i + 2], s, sat);
@@ -449,7 +465,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     pass_M_ff(h, d, acc);
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) {
-            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - kk[i], sat);
+            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
             sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
             q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
         }
@@ -465,7 +481,7 @@ static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
     for (i = 0; i < v->nF; i++) {
         sn_q t[3], s[3];
         sn_acc a[3] = {0, 0, 0};
-        int sh = v->frac_P + kk[i]; /* r is Q22+k_i, z is Q22 */
+        int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
         sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
         sym_row(a, P + (size_t)i * 6 * RB, t);
         s[0] = sn_out(a[0], sh, sat);
@@ -497,7 +513,7 @@ static float ratio(sn_dotv num, sn_dotv den) {
 typedef struct { int64_t m; int e; } sn_dotv;
 #define SN_Q_SCAL 28 /* alpha, beta in Q28 */
 
-/* a force-like (Q22+k_i per vertex), b velocity-like (Q22): sum of a.b in Q44 */
+/* a force-like (Q(19+k_i) per vertex), b velocity-like (Q22): sum of a.b in Q41 */
 static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
     sn_dotv r;
     uint32_t i, ma = 0, mb = 0;
@@ -740,8 +756,8 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
         for (k = 0; k < 3; k++) {
-            sn_q g = sn_mulq(mi, v->grav[k], v->frac_M - kk[i], sat);
-            sn_q ma = sn_out(acc[3 * i + k], v->frac_M - kk[i], sat);
+            sn_q g = sn_mulq(mi, v->grav[k], v->frac_M - SN_KREL(kk[i]), sat);
+            sn_q ma = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
             b[3 * i + k] = sn_add(sn_add(b[3 * i + k], g, sat), -ma, sat);
         }
     }
