@@ -121,6 +121,9 @@ $(eval $(call det_driver,x86_64-clang-O2,clang,-O2))
 $(eval $(call det_driver,i686-gcc-O2,i686-linux-gnu-gcc,-O2 -static))
 $(eval $(call det_driver,armhf-gcc-O2,arm-linux-gnueabihf-gcc,-O2 -static))
 $(eval $(call det_driver,mips-be-gcc-O2,mips-linux-gnu-gcc,-O2 -static))
+# clang as a cross compiler, on the cross gcc's sysroot and libgcc
+$(eval $(call det_driver,i686-clang-O2,clang --target=i686-linux-gnu,-O2 -static))
+$(eval $(call det_driver,mips-be-clang-O2,clang --target=mips-linux-gnu,-O2 -static))
 # float flavour: desktop only, no FMA contraction so -O0/-O2 and gcc/clang
 # agree; the blob comes from the file (the target builds it too)
 define det_float

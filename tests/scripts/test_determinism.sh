@@ -1,10 +1,11 @@
 #!/bin/sh
 # Determinism across compilers, optimisation levels, word sizes, endianness
 # and bare metal: the fixed-flavour cow after 1000 steps of its clip must give
-# the same sn_state_hash on x86-64 (gcc -O0/-O2, clang -O2), i686, 32-bit ARM
-# Linux and big-endian MIPS (static, qemu user mode), the Cortex-M4 image (QEMU
-# mps2-an386) and the desktop player. Float flavour: its own desktop-only
-# check (gcc/clang, -O0/-O2, -ffp-contract=off).
+# the same sn_state_hash on x86-64 (gcc -O0/-O2, clang -O2), i686 (gcc, clang),
+# 32-bit ARM Linux and big-endian MIPS (gcc, clang; static, qemu user mode),
+# the Cortex-M4 image (QEMU mps2-an386) and the desktop player. Float
+# flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
+# and sinew-play-float).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
 # emulator is a loud SKIPPED line (a failure when CI is set).
 . ports/cross/port_lib.sh
@@ -31,10 +32,13 @@ if ! have arm-none-eabi-gcc; then skip "cortex-m4: no arm-none-eabi-gcc (make de
 elif ! have qemu-system-arm; then skip "cortex-m4: no qemu-system-arm (make deps)"
 else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; fi
 want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
+# clang cross: needs the cross gcc for headers, crt files and libgcc
+if have clang; then want mips-be-clang-O2 mips-linux-gnu-gcc qemu-mips; else skip "mips-be-clang-O2: no clang"; fi
 want armhf-gcc-O2    arm-linux-gnueabihf-gcc qemu-arm
 want x86_64-gcc-O0   gcc -
 want float-gcc-O0   gcc -
 want i686-gcc-O2     i686-linux-gnu-gcc -
+if have clang; then want i686-clang-O2 i686-linux-gnu-gcc -; else skip "i686-clang-O2: no clang"; fi
 want x86_64-gcc-O2   gcc -
 want x86_64-clang-O2 clang -
 want float-gcc-O2   gcc -
@@ -64,7 +68,7 @@ while read -r name target runner; do
     fi
     c=$(cmd_for "$name" "$target" "$runner")
     # i686: native on an x86-64 kernel with IA-32 support, else qemu-i386
-    if [ "$name" = i686-gcc-O2 ] && ! "$target" --steps 0 >/dev/null 2>&1; then c="qemu-i386 $c"; fi
+    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
     ( t0=$(date +%s); timeout 600 $c < /dev/null > "$L/run_$name.log" 2>&1; echo "$? $(( $(date +%s) - t0 ))" > "$L/rc_$name" ) &
     pids="$pids $!"; n_run=$((n_run + 1))
     # at most 2 at once (2 cores): poll for a finished one
