@@ -62,12 +62,21 @@ $(BM_DIR)/limb_clip.c: $(LIMB_CLIP) ports/baremetal/bin2c.sh
 $(BM_DIR)/obj/%_clip.o: $(BM_DIR)/%_clip.c
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
 
+# the instance size of each blob, for main.c's static instance buffer
+$(BM_DIR)/gen/%_inst.h: $(BUILD)/examples/%_blob.c ports/baremetal/inst_bytes.sh
+	@mkdir -p $(dir $@)
+	sh ports/baremetal/inst_bytes.sh $< > $@
+$(BM_DIR)/gen/bad_inst.h:
+	@mkdir -p $(dir $@)
+	echo '#define SN_BM_INSTANCE_BYTES 8u' > $@
+
 # main.c per image: asset, steps, clip or built-in poses, bench or not.
 # $(1) image name, $(2) asset, $(3) steps, $(4) bench 0/1, $(5) clip file or empty
 define bm_image
-$(BM_DIR)/obj/main_$(1).o: ports/baremetal/main.c $(PORT_HDRS) ports/baremetal/semihost.h
+$(BM_DIR)/obj/main_$(1).o: ports/baremetal/main.c $(PORT_HDRS) ports/baremetal/semihost.h \
+        $(BM_DIR)/gen/$(2)_inst.h
 	@mkdir -p $$(dir $$@)
-	$(BM_CC) $(BM_CFLAGS) -DSN_BM_BLOB=sinew_$(2)_blob -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size \
+	$(BM_CC) $(BM_CFLAGS) -include $(BM_DIR)/gen/$(2)_inst.h -DSN_BM_BLOB=sinew_$(2)_blob -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size \
 	    -DSN_BM_STEPS=$(3) -DSN_BM_BENCH=$(4) -DSN_BM_CLIP=$(if $(5),1,0) -c $$< -o $$@
 $(BM_DIR)/$(1).elf: $(BM_DIR)/obj/main_$(1).o $(BM_OBJS) $(BM_DIR)/obj/$(2)_blob.o \
         $(if $(5),$(BM_DIR)/obj/$(2)_clip.o) ports/baremetal/an386.ld

@@ -23,7 +23,7 @@ for a in $assets; do
         echo "bench-baremetal: $a image failed"; cat "$B/bench_$a.log"; exit 1; }
     v() { sed -n "s/^$1: //p" "$B/bench_$a.log"; }
     # flash = text + data (initialised data is stored in flash too); RAM =
-    # data + bss + instance pool use + stack
+    # data + bss (the instance buffer is in .bss) + stack peak
     set -- $(arm-none-eabi-size "$B/sinew_$a.elf" | tail -n 1)
     text=$1; data=$2; bss=$3
     rt=$(arm-none-eabi-size -t $rt_text | tail -n 1 | awk '{print $1}')
@@ -44,5 +44,5 @@ for a in $assets; do
         # skeleton columns excluded) + preconditioner + dots/axpys
         echo "bench-baremetal: cortex-m4 $a: $ipc instructions per CG iteration (slope $it -> $(v cg_iterations_more) iterations: $(v insns_per_step_more) per step), <= $((2 * nb + nF)) block multiply-adds each: >= $((ipc / (2 * nb + nF))) instructions per block multiply-add"
     fi
-    echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + inst + stack)) B (static $((data + bss)) B$( [ "$(v clip)" = 1 ] && echo " incl. the parsed clip"), instance $inst B, stack peak $stack B)"
+    echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + stack)) B (.data+.bss $((data + bss)) B: instance $inst B$( [ "$(v clip)" = 1 ] && echo ", parsed clip $(arm-none-eabi-nm -S "$B/sinew_$a.elf" | awk '$4 == "clip" {print 0 + ("0x" $2)}') B"), pose scratch; stack peak $stack B)"
 done

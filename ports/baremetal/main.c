@@ -1,5 +1,5 @@
 /* main.c -- Sinew on a Cortex-M4 (QEMU mps2-an386): plays a clip on a blob
- * linked into flash, with the instance in the RAM pool, and prints
+ * linked into flash, with the instance in a static RAM buffer, and prints
  * "hash: <16 hex>" through semihosting like `sinew-play --hash`.
  * Built per asset with:
  *   SN_BM_BLOB, SN_BM_BLOB_SIZE  the tool's C-array symbols
@@ -7,6 +7,8 @@
  *   SN_BM_STEPS                  steps to play
  *   SN_BM_BENCH                  1: also time pose and step with CMSDK timer 0;
  *                                meaningful only under `-icount shift=0`
+ *   SN_BM_INSTANCE_BYTES         the blob's instance size (inst_bytes.sh), so the
+ *                                instance is a static buffer that `size` counts
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -26,10 +28,13 @@ extern const unsigned long SN_BM_BLOB_SIZE; /* as sinew-bake --c-array writes it
 extern const unsigned char sn_bm_clip_text[];
 extern const uint32_t sn_bm_clip_len;
 #endif
-extern uint32_t __pool_start[], __pool_end[];
+#ifndef SN_BM_INSTANCE_BYTES
+#error "SN_BM_INSTANCE_BYTES: see ports/baremetal/inst_bytes.sh"
+#endif
 uint32_t sn_bm_stack_used(void);
 
 static sn_det det;
+static uint64_t instance_mem[(SN_BM_INSTANCE_BYTES + 7u) / 8u];  /* 8-byte aligned */
 #if SN_BM_CLIP
 static sn_clip clip;   /* ~23 KB: only in images that play a clip */
 #define CLIP_MEM (&clip)
@@ -82,7 +87,6 @@ static void time_steps(uint32_t n, uint64_t *pose_ticks, uint64_t *step_ticks) {
 
 int main(void) {
     char err[SN_CLIP_ERR_LEN * 2], hex[17];
-    size_t pool = (size_t)((uintptr_t)__pool_end - (uintptr_t)__pool_start);
     const char *text = NULL;
     size_t text_len = 0;
     uint64_t hash;
@@ -96,7 +100,7 @@ int main(void) {
     text_len = sn_bm_clip_len;
 #endif
     if (sn_det_init(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, text, text_len, CLIP_MEM,
-                    __pool_start, pool, err, sizeof err)) {
+                    instance_mem, sizeof instance_mem, err, sizeof err)) {
         sn_bm_puts("FAIL: "); sn_bm_puts(err); sn_bm_puts("\n");
         return 1;
     }
