@@ -145,7 +145,7 @@ int main(void) {
             int pass;
             for (pass = 0; pass < 2; pass++) {
                 pu_rt r;
-                unsigned k, steps = pass == 0 ? 250 : 700;
+                unsigned k, steps = pass == 0 ? 200 : 700;
                 if (pass == 1 && n != 1) break;
                 if (pass == 0) snprintf(path, sizeof path, "%s/physics/beam%u_damped%s.blob", pu_build(), n, PU_BLOB_SUFFIX);
                 else { snprintf(name, sizeof name, "beam%u%s", n, PU_BLOB_SUFFIX); pu_example(path, sizeof path, name); }
