@@ -31,18 +31,22 @@ for a in $assets; do
     blob=$((0x${blob:-0}))
     inst=$(v instance_bytes); stack=$(v stack_bytes)
     ips=$(v insns_per_step); nF=$(v free_vertices); nb=$(v offdiag_blocks); it=$(v cg_iterations)
-    # 3x3 stiffness block multiply-adds per step, estimated from the blob:
-    # (CG iterations + 1 initial residual) matvecs, each using every stored
-    # off-diagonal block twice (B and B^T) and every diagonal block once
-    macs=$(( (it + 1) * (2 * nb + nF) ))
     pose=$( [ "$(v clip)" = 1 ] && echo "clip pose" || echo "built-in pose" )
     echo "bench-baremetal: cortex-m4 $a: $ips instructions per sn_step, $(v insns_per_pose) per $pose (mean of $(v bench_steps) steps, qemu -icount)"
-    echo "bench-baremetal: cortex-m4 $a: lattice $(v lattice_vertices) vertices ($nF free), $nb off-diagonal blocks, $it CG iterations: ~$macs block multiply-adds per step (estimate), ~$((ips / macs)) instructions each, all step work included"
+    # block multiply-adds per step: the runtime bench's exact count (sn_bench)
+    macs=""
+    if pmake "$BUILD/bench/sn_bench" "$BUILD/examples/$a.blob" > "$B/bench_macs_$a.log" 2>&1; then
+        macs=$("$BUILD/bench/sn_bench" "$BUILD/examples/$a.blob" 2>&1 | sed -n 's/^  macs: //p')
+    fi
+    if [ -n "$macs" ]; then
+        echo "bench-baremetal: cortex-m4 $a: lattice $(v lattice_vertices) vertices ($nF free), $nb off-diagonal blocks, $it CG iterations: $macs block multiply-adds per step (runtime bench count): $((ips / macs)) instructions per block multiply-add, all step work included"
+    else
+        echo "bench-baremetal: cortex-m4 $a: no block multiply-add count ($BUILD/bench/sn_bench not built)"
+    fi
     ipc=$(v insns_per_cg_iteration)
     if [ -n "$ipc" ]; then
-        # one CG iteration = one matvec (<= 2*blocks + free 3x3 block MACs,
-        # skeleton columns excluded) + preconditioner + dots/axpys
-        echo "bench-baremetal: cortex-m4 $a: $ipc instructions per CG iteration (slope $it -> $(v cg_iterations_more) iterations: $(v insns_per_step_more) per step), <= $((2 * nb + nF)) block multiply-adds each: >= $((ipc / (2 * nb + nF))) instructions per block multiply-add"
+        # one CG iteration = matvec + preconditioner + dots/axpys
+        echo "bench-baremetal: cortex-m4 $a: $ipc instructions per CG iteration (slope $it -> $(v cg_iterations_more) iterations: $(v insns_per_step_more) per step)"
     fi
     echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + stack)) B (.data+.bss $((data + bss)) B: instance $inst B$( [ "$(v clip)" = 1 ] && echo ", parsed clip $(arm-none-eabi-nm -S "$B/sinew_$a.elf" | awk '$4 == "clip" {print 0 + ("0x" $2)}') B"), pose scratch; stack peak $stack B)"
 done
