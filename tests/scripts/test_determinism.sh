@@ -14,7 +14,7 @@ STEPS=1000                       # = BM_STEPS, the Cortex-M image's count
 COW_CLIP=${COW_CLIP:-tools/examples/cow/trot.clip}; export COW_CLIP
 D=$BUILD/cross
 L=$D/logs
-mkdir -p "$L"; rm -f "$L"/trace_*.log
+mkdir -p "$L"; rm -f "$L"/trace_*.log "$L"/rc_* "$L"/run_*
 clip_arg=""
 if [ -f "$COW_CLIP" ]; then clip_arg="--clip $COW_CLIP"; else echo "note: $COW_CLIP missing, built-in pose sequence"; fi
 
@@ -62,7 +62,8 @@ pids=""; n_run=0
 start=$(date +%s)
 while read -r name target runner; do
     [ -n "$name" ] || continue
-    if [ ! -f "$target" ]; then
+    # -q: a failed build may leave an old binary behind; only an up-to-date one runs
+    if ! pmake -q "$target" 2>/dev/null; then
         bad "$name: build failed (see $L/build.log)"; grep -E 'error|Error' "$L/build.log" | head -n 5
         continue
     fi
