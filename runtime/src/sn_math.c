@@ -296,29 +296,6 @@ sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees) {
     return q;
 }
 
-sn_quat sn_quat_mul(sn_quat a, sn_quat b) {
-    sn_q qa[4], qb[4], o[4];
-    sn_quat r;
-    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
-    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
-    sn_qmul(qa, qb, o);
-    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
-    return r;
-}
-
-/* Public slerp: inputs are normalized first (any int32 input is fine). */
-sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t) {
-    sn_q qa[4], qb[4], o[4];
-    sn_quat r;
-    qa[0] = a.x; qa[1] = a.y; qa[2] = a.z; qa[3] = a.w;
-    qb[0] = b.x; qb[1] = b.y; qb[2] = b.z; qb[3] = b.w;
-    sn_qnormalize(qa);
-    sn_qnormalize(qb);
-    sn_qslerp(qa, qb, t, o);
-    r.x = o[0]; r.y = o[1]; r.z = o[2]; r.w = o[3];
-    return r;
-}
-
 /* v (Q16.16) rotated by q (Q30, assumed unit): R(q) v via sn_qtomat; sums of
  * three Q46 products (< 2^63) rounded to Q16.16 and saturated to int32.
  * Error: <= 0.5 LSB + |v| * ~2^-29 (matrix rounding). */
@@ -502,6 +479,20 @@ sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees) {
     return q;
 }
 
+sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v) {
+    sn_q qq[4], R[9];
+    sn_vec3 r;
+    qq[0] = q.x; qq[1] = q.y; qq[2] = q.z; qq[3] = q.w;
+    sn_qtomat(qq, R);
+    r.x = R[0] * v.x + R[1] * v.y + R[2] * v.z;
+    r.y = R[3] * v.x + R[4] * v.y + R[5] * v.z;
+    r.z = R[6] * v.x + R[7] * v.y + R[8] * v.z;
+    return r;
+}
+#endif
+
+/* ---- flavour-independent public wrappers ---- */
+
 sn_quat sn_quat_mul(sn_quat a, sn_quat b) {
     sn_q qa[4], qb[4], o[4];
     sn_quat r;
@@ -512,6 +503,7 @@ sn_quat sn_quat_mul(sn_quat a, sn_quat b) {
     return r;
 }
 
+/* Public slerp: inputs are normalized first (any int32 input is fine). */
 sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t) {
     sn_q qa[4], qb[4], o[4];
     sn_quat r;
@@ -524,14 +516,3 @@ sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t) {
     return r;
 }
 
-sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v) {
-    sn_q qq[4], R[9];
-    sn_vec3 r;
-    qq[0] = q.x; qq[1] = q.y; qq[2] = q.z; qq[3] = q.w;
-    sn_qtomat(qq, R);
-    r.x = R[0] * v.x + R[1] * v.y + R[2] * v.z;
-    r.y = R[3] * v.x + R[4] * v.y + R[5] * v.z;
-    r.z = R[6] * v.x + R[7] * v.y + R[8] * v.z;
-    return r;
-}
-#endif
