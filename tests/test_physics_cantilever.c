@@ -133,6 +133,26 @@ int main(void) {
             T_FIGURE("  %7u | %13.4f | %12.4f | %18.4f | %10.4f | %12.4f | %.4f", n, r64, rtext, rinc, rfix, rf32, tim / eb);
             T_NEAR(r64 / rtext, 1.0, 1e-6, "tool integration (subdivided Gauss) = textbook 2x2x2 hex for full cells; round-off only");
             if (n == 4) T_NEAR(r64, 1.0, 0.05, "goal: within 5% of Euler-Bernoulli at the finest lattice (brief)");
+            if (n == 2) {   /* the scheme itself (double reference), undamped, the runtime's CG count: warm vs cold start */
+                unsigned its[3] = { 32, 64, 128 }, q, k;
+                int warm;
+                snprintf(name, sizeof name, "beam%u_double", n); pu_example(path, sizeof path, name);
+                for (q = 0; q < 3; q++)
+                    for (warm = 1; warm >= 0; warm--) {
+                        snref_model mw;
+                        snref_state sw;
+                        double *l2, t;
+                        if (pu_ref_open(&mw, &sw, path) != 0) break;
+                        l2 = malloc(3 * mw.nV * sizeof *l2);
+                        sw.iters = its[q]; sw.warm = warm;
+                        for (k = 0; k < 600; k++) snref_step(&sw);
+                        snref_get_lattice(&sw, l2);
+                        t = tip_dy(&mw, l2);
+                        T_FIGURE("beam2 undamped, double reference, %u CG it., %s start, 600 steps: tip %.5g (static %.5f)%s", its[q],
+                                 warm ? "warm" : "cold", t, tip64, fabs(t / tip64 - 1) > 0.5 ? "  DIVERGED" : "");
+                        free(l2); snref_release(&sw); snref_free(&mw);
+                    }
+            }
             T_NEAR(rinc, tim / eb, 0.03 * tim / eb, "incompatible modes remove the locking at every resolution (3%: clamp/3-D effects)");
             PU_GOAL(fabs(rfix / r64 - 1) <= 0.01, "beam%u fixed blob quantization changes the static tip by %+.3f%% (budget 1%%, as the runtime goal)", n, 100 * (rfix / r64 - 1));
             PU_GOAL(fabs(rf32 / r64 - 1) <= 0.01, "beam%u float32 blob quantization changes the static tip by %+.3f%% (budget 1%%)", n, 100 * (rf32 / r64 - 1));
