@@ -563,6 +563,18 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         beta = rz > 0 ? rz2 / rz : 0.0;
         for (i = 0; i < n; i++) d[i] = z[i] + beta * d[i];
         rz = rz2;
+#ifdef SNREF_TRACE  /* magnitudes a fixed-point CG must hold (debugging aid) */
+        {
+            double md = 0, mad = 0, mx = 0, mr = 0;
+            for (i = 0; i < n; i++) {
+                if (fabs(d[i]) > md) md = fabs(d[i]);
+                if (fabs(Ad[i]) > mad) mad = fabs(Ad[i]);
+                if (fabs(x[i]) > mx) mx = fabs(x[i]);
+                if (fabs(r[i]) > mr) mr = fabs(r[i]);
+            }
+            fprintf(stderr, "  cg %u: alpha %.3g beta %.3g |d| %.3g |Ad| %.3g |x| %.3g |r| %.3g\n", it, alpha, beta, md, mad, mx, mr);
+        }
+#endif
     }
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
