@@ -49,6 +49,47 @@ static void put_real(wr_t *w, size_t at, double x, int frac)
     }
 }
 
+/* symmetric 3x3 storage order of SDIAG / PRECOND: xx yy zz xy xz yz */
+static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+
+/* S^ = h^2 (S + T) / m0 entry k (row-major) of pattern entry e */
+static double shat(const sb_model *o, int e, int k, double h, double m0)
+{
+    return h * h * (o->S[9 * (size_t)e + (size_t)k] + (k % 4 == 0 ? o->T[e] : 0)) / m0;
+}
+
+/* Fixed flavour: diagonal block of row i such that the integer block row sums
+ * equal the rounded exact ones. Rounding each entry on its own breaks the
+ * translation null space of the elastic part (rows of S sum to zero), which
+ * moved a slender beam's static tip by 1.4% (tests/reference/README.md,
+ * finding 2). D = round(sum_j S^_ij) - sum_{j>i} q(S^_ij) - sum_{j<i} q(S^_ji)^T,
+ * i.e. exactly the blocks the runtime uses; then symmetrized (<= 1 LSB). */
+static void diag_fixed(const sb_model *o, int i, double h, double m0, int frac, int64_t out6[6])
+{
+    double exact[9] = {0};
+    int64_t D[9];
+    int j, k;
+    for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++)
+        for (k = 0; k < 9; k++) exact[k] += shat(o, j, k, h, m0);
+    for (k = 0; k < 9; k++) D[k] = (int64_t)rnd(ldexp(exact[k], frac));
+    for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++) {
+        int n = o->nb[j], r, c;
+        if (n == i) continue;
+        if (n > i) {
+            for (k = 0; k < 9; k++) D[k] -= (int64_t)rnd(ldexp(shat(o, j, k, h, m0), frac));
+        } else { /* the runtime applies row n's stored block transposed */
+            int e = sb_pattern_find(o, n, i);
+            for (r = 0; r < 3; r++)
+                for (c = 0; c < 3; c++) D[3 * r + c] -= (int64_t)rnd(ldexp(shat(o, e, 3 * c + r, h, m0), frac));
+        }
+    }
+    for (k = 0; k < 6; k++) {
+        int r = sym6[k][0], c = sym6[k][1];
+        int64_t a = D[3 * r + c], b = D[3 * c + r];
+        out6[k] = r == c ? a : (int64_t)rnd(0.5 * (double)(a + b));
+    }
+}
+
 /* fractional bits so that the largest |entry| lands in [2^26, 2^27] */
 static int pick_frac(double maxabs)
 {
@@ -72,7 +113,6 @@ static void inv3sym(const double A[3][3], double R[3][3])
 int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
 {
     const int nF = o->nf, nV = o->nv, nJ = o->nj;
-    const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
     int i, j, k, e, nnz = 0, rs = flavour == SB_DOUBLE ? 8 : 4, s;
     double m0 = 0, maxS = 0, maxM = 0, maxP = 0, maxx = 0, h = o->h, a1, b1, U, *P, *lump;
     const double *root = o->joints[0].pos;
@@ -212,10 +252,18 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (i = 0; i < nF; i++) {
         e = sb_pattern_find(o, i, i);
         put_real(&w, off[SN_SEC_MDIAG] + (size_t)i * (size_t)rs, o->M[e] / m0, b->frac_M);
+        if (flavour == SB_FIXED) {
+            int64_t d6[6];
+            diag_fixed(o, i, h, m0, b->frac_S, d6);
+            for (k = 0; k < 6; k++) {
+                if (d6[k] < INT32_MIN || d6[k] > INT32_MAX) w.err = 1;
+                put_u32(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, (uint32_t)(int32_t)d6[k]);
+            }
+        }
         for (k = 0; k < 6; k++) {
             int r = sym6[k][0], c = sym6[k][1];
             double sv = h * h * (0.5 * (o->S[9 * (size_t)e + (size_t)(3 * r + c)] + o->S[9 * (size_t)e + (size_t)(3 * c + r)]) + (r == c ? o->T[e] : 0)) / m0;
-            put_real(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, sv, b->frac_S);
+            if (flavour != SB_FIXED) put_real(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, sv, b->frac_S);
             put_real(&w, off[SN_SEC_PRECOND] + (size_t)(6 * i + k) * (size_t)rs, P[6 * i + k], b->frac_P);
         }
         put_real(&w, off[SN_SEC_MLUMP] + (size_t)i * (size_t)rs, lump[i], b->frac_M);
@@ -225,8 +273,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             put_u16(&w, off[SN_SEC_COLS] + 2 * (size_t)nnz, (unsigned)o->nb[j]);
             put_real(&w, off[SN_SEC_MOFF] + (size_t)nnz * (size_t)rs, o->M[j] / m0, b->frac_M);
             for (k = 0; k < 9; k++)
-                put_real(&w, off[SN_SEC_SOFF] + (size_t)(9 * nnz + k) * (size_t)rs,
-                         h * h * (o->S[9 * (size_t)j + (size_t)k] + (k % 4 == 0 ? o->T[j] : 0)) / m0, b->frac_S);
+                put_real(&w, off[SN_SEC_SOFF] + (size_t)(9 * nnz + k) * (size_t)rs, shat(o, j, k, h, m0), b->frac_S);
             nnz++;
         }
     }
