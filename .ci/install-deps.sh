@@ -10,7 +10,7 @@ set -euo pipefail
 # The libc6-dev-*-cross packages are only Recommends of the cross gcc packages
 # and --no-install-recommends would leave the cross compilers without headers.
 PKGS=(
-    make gcc clang valgrind libclang-rt-14-dev
+    make gcc g++ binutils clang valgrind libclang-rt-14-dev
     gcc-arm-none-eabi binutils-arm-none-eabi libnewlib-arm-none-eabi
     qemu-system-arm qemu-user
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross
