@@ -81,7 +81,10 @@ typedef struct sb_desc {
     int cg_def, cg_max;
     double g[3];
     double kappa, twist_r;  /* twist stiffness (Pa/m^2) and radius (mesh units) */
+    int element;            /* SB_ELEM_*: stiffness element (sb_integrate.c) */
 } sb_desc;
+/* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
+enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
 int sb_desc_load(const char *path, sb_desc *d);
 void sb_desc_free(sb_desc *d);
 
@@ -124,6 +127,7 @@ typedef struct sb_model {
     int cg_def, cg_max;
     double bbox_diag;
     double min_jac;         /* smallest Jacobian determinant in kept cells / cell volume (1 = undistorted) */
+    int n_uncondensed;      /* incompatible element: cells left trilinear (bubble stiffness not positive definite) */
     int quiet;
 } sb_model;
 

@@ -193,6 +193,11 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
     } else if (!strcmp(kw, "twist")) {
         if (nargs(c, 2) || num(c, 1, &d->kappa) || num(c, 2, &d->twist_r)) return -1;
         if (d->kappa < 0 || d->twist_r < 0) return sb_fail("%s:%d: twist stiffness and radius must be >= 0", c->path, c->line);
+    } else if (!strcmp(kw, "element")) {
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "incompatible")) d->element = SB_ELEM_INCOMPATIBLE;
+        else if (!strcmp(c->tok[1], "trilinear")) d->element = SB_ELEM_TRILINEAR;
+        else return sb_fail("%s:%d: unknown element '%s' (want incompatible or trilinear)", c->path, c->line, c->tok[1]);
     } else {
         return sb_fail("%s:%d: unknown keyword '%s'", c->path, c->line, kw);
     }
@@ -211,6 +216,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->subdiv = 4; d->air = 1e-3; d->min_fill = 0.0;
     d->h = 1.0 / 60.0; d->cg_def = 16; d->cg_max = 64;
     d->g[1] = -9.81;
+    d->element = SB_ELEM_INCOMPATIBLE;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
     memset(&c, 0, sizeof c);
