@@ -113,7 +113,7 @@ int main(void) {
         free(lat); free(x); free(y);
     }
     (void)ystat;
-    T_FIGURE("beam4 (L %.2f m, H %.2f m, E %.3g, rho %.0f): Euler-Bernoulli f1 = %.4f Hz; lattice model (inverse iteration) %.4f Hz (%+.2f%%: locking)",
+    T_FIGURE("beam4 (L %.2f m, H %.2f m, E %.3g, rho %.0f): Euler-Bernoulli f1 = %.4f Hz; lattice model (inverse iteration) %.4f Hz (%+.2f%%: discretization)",
              L, H, E, rho, f_eb, omega_model / (2 * PI), 100 * (omega_model / (2 * PI) / f_eb - 1));
 #if !defined(SN_FLOAT)
     /* h table: reference, exact solves (the scheme itself), h = h0 / {1, 2, 4, 8} */
