@@ -34,7 +34,8 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         for (k = 0; k < o->nc; k++) { fsum += o->cell_fill[k]; if (o->cell_fill[k] < fmin_) fmin_ = o->cell_fill[k]; }
         printf("sinew-bake: %s (%s)\n", desc_path, flavour == 0 ? "fixed" : flavour == 1 ? "float" : "double");
         printf("  mesh      %d vertices, %d triangles, volume %.6g m^3\n", m.nv, m.nt, vol);
-        printf("  skeleton  %d joints, %d bones\n", o->nj, o->nseg);
+        printf("  skeleton  %d joints, %d bones; model-space origin = root joint '%s' at (%g, %g, %g) mesh units\n",
+               o->nj, o->nseg, o->joints[0].name, o->joints[0].pos[0], o->joints[0].pos[1], o->joints[0].pos[2]);
         printf("  lattice   %d vertices (%d free, %d skeleton), %d cells (mean fill %.2f, min %.3f), cell %g mesh units\n",
                o->nv, o->nf, o->nv - o->nf, o->nc, fsum / o->nc, fmin_, o->c);
         printf("  quality   smallest Jacobian / cell volume %.3g (0 where a bone chain turns)\n", o->min_jac);

@@ -14,7 +14,10 @@
  *   quaternions  sn_real, Q30 (1.0 = 1<<30)         / float
  *   angles       sn_real, Q16.16 degrees            / float degrees
  *   normals      sn_real, Q30 unit vectors          / float unit vectors
- * "Mesh units" are the units of the OBJ the asset was baked from.
+ * "Mesh units" are the units of the OBJ the asset was baked from. "Model
+ * space" is the OBJ's frame with its origin moved to the root joint's rest
+ * position (the host tool does this so internal numbers stay small): add that
+ * position (printed by sinew-bake) to outputs to draw them in OBJ coordinates.
  *
  * Typical use:
  *   const sn_blob *blob;

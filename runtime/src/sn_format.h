@@ -73,7 +73,7 @@
  * (elem_size as listed, with R = real size); padding bytes between sections are 0.
  * Sections appear in ascending offset order and do not overlap. ---- */
 enum {
-    SN_SEC_JOINTS = 0,   /* nJ  x {u16 parent (0xFFFF root; else < own index), u16 0, u32 0, R rest[3]} ; rest Q22 internal, model space */
+    SN_SEC_JOINTS = 0,   /* nJ  x {u16 parent (0xFFFF root; else < own index), u16 0, u32 0, R rest[3]} ; rest Q22 internal, model space = relative to the root joint (joint 0 rests at 0) */
     SN_SEC_JOINT_NAMES,  /* nJ  x char[32], NUL-terminated, NUL-padded, unique, non-empty */
     SN_SEC_REST,         /* nV  x R[3] rest position, Q22 internal units, model space (relative to root joint rest) */
     SN_SEC_FRAMES,       /* nV  x {u8 bone1, u8 bone2, u16 w Q15 (0..32768)}; R_i = slerp(R_b1, R_b2, w), c_i = (1-w)t_b1 + w t_b2
