@@ -96,7 +96,7 @@ static uint32_t rd_u32(const unsigned char *p) {
 }
 static unsigned rd_u16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
 
-static uint32_t crc32_ieee(const unsigned char *p, size_t n) {
+uint32_t snref_crc32(const unsigned char *p, size_t n) {
     uint32_t c = 0xFFFFFFFFu;
     size_t i;
     int k;
@@ -143,7 +143,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
     if (rd_u32(d + SN_H_ENDIAN) != SN_ENDIAN_MARK) FAIL("endian");
     total = rd_u32(d + SN_H_TOTAL_SIZE);
     if (total > size || total < SN_HEADER_BYTES) FAIL("total size %u > %zu", (unsigned)total, size);
-    if (crc32_ieee(d + 16, total - 16) != rd_u32(d + SN_H_CRC32)) FAIL("crc mismatch");
+    if (snref_crc32(d + 16, total - 16) != rd_u32(d + SN_H_CRC32)) FAIL("crc mismatch");
     m->flavour = d[SN_H_FLAVOUR];
     m->real_size = R = d[SN_H_REAL_SIZE];
     if (m->flavour > 2 || R != (m->flavour == 2 ? 8u : 4u)) FAIL("flavour %d real size %u", m->flavour, R);

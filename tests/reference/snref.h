@@ -16,6 +16,7 @@
 #define SNREF_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* A rigid bone motion x -> R(q) x + t (mesh units), as sn_xform in doubles. */
 typedef struct snref_xform { double q[4]; double t[3]; } snref_xform; /* q = x,y,z,w */
@@ -122,5 +123,8 @@ void snref_quat_axis_angle(const double axis[3], double deg, double q[4]);
 void snref_quat_mul(const double a[4], const double b[4], double out[4]);
 void snref_quat_slerp(const double a[4], const double b[4], double t, double out[4]);
 void snref_quat_to_mat(const double q[4], double R[9]);
+
+/* CRC-32 (zlib polynomial) of n bytes: the blob checksum (runtime/BLOB.md). */
+uint32_t snref_crc32(const unsigned char *p, size_t n);
 
 #endif /* SNREF_H */

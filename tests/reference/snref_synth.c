@@ -1,5 +1,6 @@
 /* snref_synth.c -- synthetic box-lattice blobs with textbook hex elements. */
 #include "snref_synth.h"
+#include "snref.h"
 #include "../../runtime/src/sn_format.h"
 
 #include <math.h>
@@ -149,16 +150,6 @@ static void w_u32(wbuf *w, size_t at, uint32_t v) { w_u16(w, at, v & 0xFFFFu); w
 static void w_real(wbuf *w, size_t at, double v) {
     if (w->fl == SN_FLAVOUR_FLOAT32) { float f = (float)v; uint32_t u; memcpy(&u, &f, 4); w_u32(w, at, u); }
     else { uint64_t u; memcpy(&u, &v, 8); w_u32(w, at, (uint32_t)u); w_u32(w, at + 4, (uint32_t)(u >> 32)); }
-}
-static uint32_t crc32_ieee(const unsigned char *p, size_t n) {
-    uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        c ^= p[i];
-        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-    }
-    return ~c;
 }
 
 unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
@@ -364,7 +355,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         }
         free(rowptr); free(cols); free(moff); free(soff);
     }
-    w_u32(&w, SN_H_CRC32, crc32_ieee(w.d + 16, w.n - 16));
+    w_u32(&w, SN_H_CRC32, snref_crc32(w.d + 16, w.n - 16));
     free(S); free(M); free(newid); free(gid_of);
     *size = w.n;
     return w.d;
