@@ -14,18 +14,6 @@
 
 #define MAXJ 32
 
-static void random_quat(unsigned long long *st, double maxdeg, double q[4]) {
-    double ax[3], n, a;
-    int k;
-    do {
-        for (k = 0; k < 3; k++) ax[k] = 2 * pu_rand(st) - 1;
-        n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-    } while (n < 0.1 || n > 1);
-    a = maxdeg * pu_rand(st) * PU_PI / 180;
-    for (k = 0; k < 3; k++) q[k] = ax[k] / n * sin(a / 2);
-    q[3] = cos(a / 2);
-}
-
 static sn_quat to_sn(const double q[4]) {
     sn_quat r;
 #if defined(SN_FLOAT)
@@ -80,7 +68,7 @@ static void run(const char *name, unsigned steps, unsigned hold, unsigned long l
         if (seg_left == 0) {     /* new target */
             int jump = pu_rand(&st) < 0.25;
             seg_len = 1 + (unsigned)(60 * pu_rand(&st));
-            for (j = 0; j < nJ; j++) { memcpy(from[j], to[j], sizeof to[j]); random_quat(&st, 120, to[j]); }
+            for (j = 0; j < nJ; j++) { memcpy(from[j], to[j], sizeof to[j]); pu_random_quat(&st, 120, to[j]); }
             memcpy(off_from, off_to, sizeof off_to);
             for (j = 0; j < 3; j++) off_to[j] = 2 * pu_rand(&st) - 1;
             if (jump) { seg_len = 1; jumps++; }

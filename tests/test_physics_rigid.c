@@ -23,15 +23,8 @@ static void rigid_pose(unsigned nJ, const double q[4], const double t[3], sn_xfo
 }
 
 static void random_rigid(unsigned long long *st, double maxdeg, double q[4], double t[3]) {
-    double ax[3], n, a;
     int k;
-    do {
-        for (k = 0; k < 3; k++) ax[k] = 2 * pu_rand(st) - 1;
-        n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-    } while (n < 0.1 || n > 1);
-    a = maxdeg * pu_rand(st) * 3.14159265358979323846 / 180;
-    for (k = 0; k < 3; k++) q[k] = ax[k] / n * sin(a / 2);
-    q[3] = cos(a / 2);
+    pu_random_quat(st, maxdeg, q);
     for (k = 0; k < 3; k++) t[k] = 40 * pu_rand(st) - 20;
 }
 

@@ -76,11 +76,9 @@ typedef int64_t sn_acc;
 
 #if defined(SN_FLOAT)
 #define SN_ONE_ROT 1.0f
-#define SN_ONE_LEN 1.0f
 #define SN_FLIM 4096.0f /* float: only a guard against runaway values (no format range to protect) */
 #else
 #define SN_ONE_ROT ((int32_t)1 << SN_Q_ROT)
-#define SN_ONE_LEN ((int32_t)1 << SN_Q_LEN)
 #endif
 
 /* Product of two values, accumulated exactly (fixed) */

@@ -138,6 +138,20 @@ static inline double pu_rand(unsigned long long *st) {
     return (double)(*st >> 11) / 9007199254740992.0;
 }
 
+/* Random unit quaternion q (x,y,z,w): axis uniform in the unit ball (shell
+ * 0.1..1 rejected for a well-defined direction), angle uniform in [0, maxdeg]. */
+static inline void pu_random_quat(unsigned long long *st, double maxdeg, double q[4]) {
+    double ax[3], n, a;
+    int k;
+    do {
+        for (k = 0; k < 3; k++) ax[k] = 2 * pu_rand(st) - 1;
+        n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    } while (n < 0.1 || n > 1);
+    a = maxdeg * pu_rand(st) * 3.14159265358979323846 / 180;
+    for (k = 0; k < 3; k++) q[k] = ax[k] / n * sin(a / 2);
+    q[3] = cos(a / 2);
+}
+
 /* max_i |a_i - b_i| over n points (3 doubles each) */
 static inline double pu_maxdist(const double *a, const double *b, unsigned n) {
     double mx = 0;
