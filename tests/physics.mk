@@ -9,6 +9,12 @@ $(BUILD)/tests/test_reference: tests/test_reference.c $(REF_SRC) $(REF_HDR)
 
 TEST_BINS += $(BUILD)/tests/test_reference
 
+# make soak: the held-twist energy check of test_reference (limb twisted 170
+# degrees, damping off) over 600 s instead of make test's 60 s.
+.PHONY: soak
+soak: $(BUILD)/tests/test_reference $(BUILD)/examples/limb_double.blob
+	SN_SOAK_SECONDS=$${SN_SOAK_SECONDS:-600} BUILD=$(BUILD) $(BUILD)/tests/test_reference --soak
+
 # Physics tests against the runtime: each built fixed and float (suffix _float).
 PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference
 PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
@@ -67,3 +73,40 @@ $(PHYS_EX)/%_nograv_float.blob: $(PHYS_EX)/%_nograv/asset.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 .PRECIOUS: $(PHYS_EX)/%_nograv/asset.sinew
 TEST_DEPS += $(foreach a,cow limb,$(PHYS_EX)/$(a)_nograv.blob $(PHYS_EX)/$(a)_nograv_float.blob)
+
+# Head-turn acceptance (issue 9 item 2): neck turned 90 degrees about its own
+# axis on the cow and the beast (blobs from tools/tools.mk, and without gravity).
+$(eval $(call PHYS_TEST_RULE,headturn))
+TEST_BINS += $(BUILD)/tests/test_physics_headturn $(BUILD)/tests/test_physics_headturn_float
+$(eval $(call PHYS_NOGRAV_RULE,beast))
+TEST_DEPS += $(PHYS_EX)/beast_nograv.blob $(PHYS_EX)/beast_nograv_float.blob
+
+# Held poses (issue 9 item 1): limb, cow and beast, joints ramped to 0..180
+# degrees and held, with the asset's damping (examples blobs) and re-baked
+# with Rayleigh 0 0 into $(HELD_DIR). `make soak`: the full sweep (long).
+$(eval $(call PHYS_TEST_RULE,held))
+TEST_BINS += $(BUILD)/tests/test_physics_held $(BUILD)/tests/test_physics_held_float
+HELD_DIR    = $(PHYS_EX)/held
+HELD_ASSETS = cow limb $(if $(wildcard tools/examples/beast/beast.sinew),beast)
+define HELD_UNDAMPED_RULE
+$(HELD_DIR)/$(1)_undamped/asset.sinew: tools/examples/$(1)/$(1).sinew $(wildcard tools/examples/$(1)/*.obj)
+	@mkdir -p $$(@D)
+	sed '/^[[:space:]]*rayleigh[[:space:]]/d' $$< > $$@
+	echo 'rayleigh 0 0' >> $$@
+	for f in tools/examples/$(1)/*.obj; do ln -sf "$$(CURDIR)/$$$$f" $$(@D)/; done
+endef
+$(foreach a,$(HELD_ASSETS),$(eval $(call HELD_UNDAMPED_RULE,$(a))))
+$(HELD_DIR)/%_undamped.blob: $(HELD_DIR)/%_undamped/asset.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(HELD_DIR)/%_undamped_float.blob: $(HELD_DIR)/%_undamped/asset.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(HELD_DIR)/%_undamped/asset.sinew
+HELD_BLOBS = $(foreach a,$(HELD_ASSETS),$(HELD_DIR)/$(a)_undamped.blob $(HELD_DIR)/$(a)_undamped_float.blob \
+                 $(EX)/$(a).blob $(EX)/$(a)_float.blob $(EX)/$(a)_double.blob)
+TEST_DEPS += $(HELD_BLOBS)
+# soak has its recipe above; this only adds a prerequisite.
+.PHONY: soak soak-held
+soak: soak-held
+soak-held: $(BUILD)/tests/test_physics_held $(BUILD)/tests/test_physics_held_float $(HELD_BLOBS)
+	BUILD=$(BUILD) $(BUILD)/tests/test_physics_held soak
+	BUILD=$(BUILD) $(BUILD)/tests/test_physics_held_float soak

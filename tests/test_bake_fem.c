@@ -1,13 +1,15 @@
 /* test_bake_fem.c -- host tool: integrals and lattice against independent
  * references (closed-form trilinear hex element, with condensed incompatible
- * modes, patch test, null spaces, volume by the
- * divergence theorem, bones on lattice edges). */
+ * modes, patch test, null spaces, volume by the divergence theorem), the
+ * volumetric bones (chain, radius, nearest-bone ownership), per-cell
+ * matrices and frames, and the description's newer statements. */
 #include "sb.h"
 #include "sn_test.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *COW = "tools/examples/cow/cow.sinew";
 
@@ -207,9 +209,8 @@ static void test_single_cell(int inc)
     sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
 }
 
-/* constant-strain patch test on the distorted cells of the cow (Taylor, Beresford & Wilson 1976:
- * bubble gradients with the centre Jacobian times det J0 / det J integrate to zero on any hex).
- * With uniform material and air 1 (constant weight in every cell) a linear field u = A x
+/* constant-strain patch test on the cow's cells (the bubble gradients integrate to zero over a
+ * cell). With uniform material and air 1 (constant weight in every cell) a linear field u = A x
  * gives zero bubble forces, so the condensed S u equals the trilinear S u (round-off). */
 static void test_cow_patch(void)
 {
@@ -229,7 +230,8 @@ static void test_cow_patch(void)
     }
     if (built < 2) { if (built) sb_model_free(&o[0]); return; }
     T_CHECK(o[0].nv == o[1].nv && o[0].nbptr[o[0].nv] == o[1].nbptr[o[1].nv], "same lattice");
-    T_CHECK(o[0].min_jac < 0.9, "the cow has distorted cells (smallest Jacobian / cell volume %.3f)", o[0].min_jac);
+    /* the lattice is never moved: every cell is a cube (the old construction distorted cells here) */
+    T_NEAR(o[0].min_jac, 1.0, 1e-12, "every cell an undistorted cube: Jacobian / c^3 = 1 up to round-off");
     T_CHECK(o[0].n_uncondensed == 0, "air 1: every cell condensed (got %d left trilinear)", o[0].n_uncondensed);
     for (e = 0; e < o[0].nbptr[o[0].nv]; e++) for (k = 0; k < 9; k++) maxS = fmax(maxS, fabs(o[0].S[9 * e + k]));
     for (i = 0; i < o[0].nv; i++)
@@ -313,6 +315,120 @@ static void test_material_rules(void)
     sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
 }
 
+/* distance from p to segment a-b (written here, independently of the tool) */
+static double dseg(const double *p, const double *a, const double *b)
+{
+    double ab[3], ap[3], L2 = 0, t = 0, d2 = 0;
+    int k;
+    for (k = 0; k < 3; k++) { ab[k] = b[k] - a[k]; ap[k] = p[k] - a[k]; L2 += ab[k] * ab[k]; t += ab[k] * ap[k]; }
+    t = L2 > 0 ? fmin(1, fmax(0, t / L2)) : 0;
+    for (k = 0; k < 3; k++) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+    return sqrt(d2);
+}
+
+/* lattice vertex at grid position p, or -1 */
+static int vert_at(const sb_model *o, const double *p)
+{
+    int gi[3], k;
+    for (k = 0; k < 3; k++) {
+        gi[k] = (int)floor((p[k] - o->gorg[k]) / o->c + 0.5);
+        if (gi[k] < 0 || gi[k] >= o->gn[k]) return -1;
+    }
+    return o->gvert[gi[0] + o->gn[0] * (gi[1] + o->gn[1] * gi[2])];
+}
+
+/* Volumetric bones (DESCRIPTION.md "Skeleton"), checked from the definitions:
+ * (a) the grid vertex nearest each sample of a bone (ceil(L / (c/8)) equal steps, ends included)
+ *     is a skeleton vertex when it is a lattice vertex;
+ * (b) every lattice vertex within a bone's radius of its segment is a skeleton vertex;
+ * a captured vertex moves with the parent joint of the nearest capturing bone;
+ * every vertex is a grid vertex (cells are cubes); frames of skeleton vertices are rigid. */
+static void check_bones(const sb_model *o, const char *what)
+{
+    int i, a, k, bad_chain = 0, bad_radius = 0, bad_owner = 0, bad_grid = 0, nchain = 0, ncap = 0;
+    for (a = 0; a < o->nseg; a++) {
+        const double *P = o->joints[o->joints[o->seg_child[a]].parent].pos, *C = o->joints[o->seg_child[a]].pos;
+        double L = 0;
+        int s, ns;
+        for (k = 0; k < 3; k++) L += (C[k] - P[k]) * (C[k] - P[k]);
+        ns = (int)ceil(sqrt(L) / (o->c / 8));
+        if (ns < 1) ns = 1;
+        for (s = 0; s <= ns; s++) {
+            double p[3];
+            int v;
+            for (k = 0; k < 3; k++) p[k] = P[k] + (C[k] - P[k]) * s / ns;
+            v = vert_at(o, p);
+            if (v < 0) continue;   /* not a lattice vertex (bone outside the kept cells) */
+            nchain++;
+            if (v < o->nf) bad_chain++;
+        }
+    }
+    for (i = 0; i < o->nv; i++) {
+        const double *x = o->x + 3 * i;
+        double best = HUGE_VAL;
+        int owner = -1, captured = 0;
+        for (k = 0; k < 3; k++) {
+            double u = (x[k] - o->gorg[k]) / o->c;
+            if (fabs(u - floor(u + 0.5)) > 1e-9) bad_grid++;
+        }
+        for (a = 0; a < o->nseg; a++) {
+            double d = dseg(x, o->joints[o->joints[o->seg_child[a]].parent].pos, o->joints[o->seg_child[a]].pos);
+            if (d <= o->seg_r[a]) { captured = 1; if (d < best) { best = d; owner = a; } }
+        }
+        if (captured) {
+            ncap++;
+            if (i < o->nf) bad_radius++;
+            /* the owner is the nearest capturing bone unless a nearer bone's chain took the vertex */
+            else if (o->vseg[i] >= 0 && o->vseg[i] != owner) {
+                double dv = dseg(x, o->joints[o->joints[o->seg_child[o->vseg[i]]].parent].pos, o->joints[o->seg_child[o->vseg[i]]].pos);
+                if (dv > best) bad_owner++;
+            }
+        }
+        if (i >= o->nf) {
+            T_CHECK(o->fb1[i] == o->fb2[i] && o->fw[i] == 0, "%s: skeleton vertex %d: bone1 == bone2, w = 0", what, i);
+            if (o->vseg[i] >= 0 && o->fb1[i] != o->joints[o->seg_child[o->vseg[i]]].parent) bad_owner++;
+        }
+    }
+    T_CHECK(bad_grid == 0, "%s: every lattice vertex on the undistorted grid (%d coordinates off)", what, bad_grid);
+    T_CHECK(bad_chain == 0, "%s: rasterized chain: %d of %d bone points have a free nearest vertex", what, bad_chain, nchain);
+    T_CHECK(bad_radius == 0, "%s: %d of %d vertices within a bone radius are free", what, bad_radius, ncap);
+    T_CHECK(bad_owner == 0, "%s: %d skeleton vertices not moved by the nearest capturing bone's parent joint", what, bad_owner);
+    for (a = 0; a < o->nseg; a++) T_CHECK(o->seg_ncap[a] > 0, "%s: bone %d captures a vertex", what, a);
+}
+
+/* per-cell data: Se assembles to S exactly, is symmetric with the rigid null space;
+ * twist entries are all zero; cell frames are valid; limits default to none */
+static void check_cells(const sb_model *o, const char *what)
+{
+    size_t ne = (size_t)o->nbptr[o->nv], e;
+    double *S2 = calloc(9 * ne, sizeof *S2), maxS = 0, err = 0, asym = 0, tr = 0;
+    int ci, a, b, i, j, tz = 0;
+    for (ci = 0; ci < o->nc; ci++) {
+        const double *K = o->Se + 576 * (size_t)ci;
+        for (a = 0; a < 8; a++)
+            for (b = 0; b < 8; b++) {
+                int pe = sb_pattern_find(o, o->cells[8 * ci + a], o->cells[8 * ci + b]);
+                for (i = 0; i < 3; i++) for (j = 0; j < 3; j++) S2[9 * (size_t)pe + (size_t)(3 * i + j)] += K[24 * (3 * a + i) + 3 * b + j];
+            }
+        for (i = 0; i < 24; i++) {
+            double rs[3] = {0, 0, 0};
+            for (j = 0; j < 24; j++) { asym = fmax(asym, fabs(K[24 * i + j] - K[24 * j + i])); rs[j % 3] += K[24 * i + j]; }
+            for (j = 0; j < 3; j++) tr = fmax(tr, fabs(rs[j]));
+        }
+        T_CHECK(o->cfb1[ci] >= 0 && o->cfb1[ci] < o->nj && o->cfb2[ci] >= 0 && o->cfb2[ci] < o->nj && o->cfw[ci] >= 0 && o->cfw[ci] <= 1,
+                "%s: cell %d frame valid", what, ci);
+    }
+    for (e = 0; e < 9 * ne; e++) { maxS = fmax(maxS, fabs(o->S[e])); err = fmax(err, fabs(S2[e] - o->S[e])); }
+    for (e = 0; e < ne; e++) if (o->T[e] != 0) tz++;
+    free(S2);
+    T_NEAR(err / maxS, 0, 1e-12, "assembled per-cell Se = S (the same numbers summed)");
+    T_NEAR(asym / maxS, 0, 1e-15, "per-cell Se symmetric (the tool symmetrizes exactly)");
+    T_NEAR(tr / maxS, 0, 1e-12, "per-cell Se: translations in the null space, round-off");
+    T_CHECK(tz == 0, "%s: twist retired: %d non-zero T entries", what, tz);
+    for (i = 0; i < o->nv; i++) if (o->limit[i] != 0) break;
+    T_CHECK(i == o->nv, "%s: no 'limit' rules: every limit 0", what);
+}
+
 /* frames on the straight limb (shoulder (0,0,0) -> elbow (4,0,0) -> wrist (8,0,0), blend width
  * B = cell = 1): bone1/bone2 = the joints of the nearer/farther bone, w from the documented rule
  * s = clamp(1 - (d2 - d1)/B, 0, 1), w = s^2 (3 - 2s) / 2 (distances computed here, in closed form) */
@@ -344,6 +460,20 @@ static void test_limb_frames(void)
     }
     T_CHECK(bad == 0, "limb frames follow the documented blend rule: %d of %d free vertices differ", bad, o.nf);
     T_CHECK(n_half > 0 && n_zero > 0, "both blended (%d at w = 1/2) and single-bone (%d) vertices exist", n_half, n_zero);
+    for (i = 0, bad = 0; i < o.nc; i++) {   /* cell frames: the same rule at the cell centre */
+        double p[3], da, db, d1, d2, sc, w;
+        int k, near;
+        for (k = 0; k < 3; k++) p[k] = o.x[3 * o.cells[8 * i] + k] + 0.5 * o.c;
+        da = dist_seg_x(p, 0, 4); db = dist_seg_x(p, 4, 8); d1 = fmin(da, db); d2 = fmax(da, db); near = da <= db ? 0 : 1;
+        sc = 1 - (d2 - d1) / 1.0;
+        sc = sc < 0 ? 0 : sc > 1 ? 1 : sc;
+        w = 0.5 * sc * sc * (3 - 2 * sc);
+        if (fabs(o.cfw[i] - w) > 1e-12) bad++;
+        else if (w > 0 && da != db && (o.cfb1[i] != near || o.cfb2[i] != 1 - near)) bad++;
+        else if (w == 0 && (o.cfb1[i] != near || o.cfb2[i] != near)) bad++;
+    }
+    T_CHECK(bad == 0, "limb cell frames follow the blend rule at the cell centres: %d of %d cells differ", bad, o.nc);
+    check_cells(&o, "limb");
     sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
 }
 
@@ -378,7 +508,7 @@ static void test_cow(void)
              o.nv, o.nf, o.nv - o.nf, o.nc, o.n_uncondensed);
     T_CHECK(o.nv >= 150 && o.nv <= 360, "cow lattice size %d in the target range (~150-300)", o.nv);
     vol = volume(&m) * unit * unit * unit;
-    T_NEAR(o.mass / (1000 * vol), 1.0, 0.01, "interior quadrature (4^3 sub-boxes x 8 points per cell) resolves the surface to ~1/8 cell");
+    T_NEAR(o.mass / (1000 * vol), 1.0, 0.01, "inside fractions exact along x, sampled in y and z at <= 1/2000 of the extent");
     T_FIGURE("cow: lattice mass %.4f kg vs rho*vol %.4f kg (ratio %.5f)", o.mass, 1000 * vol, o.mass / (1000 * vol));
     /* null space of the elastic stiffness (no twist): translations, infinitesimal rotations */
     for (e = 0; e < o.nbptr[o.nv]; e++) for (k = 0; k < 9; k++) maxS = fmax(maxS, fabs(o.S[9 * e + k]));
@@ -404,25 +534,9 @@ static void test_cow(void)
     T_NEAR(trans / maxS, 0, 1e-12, "block row sums: sum of ~27 blocks of size maxS, double round-off");
     T_NEAR(rot / (maxS * maxx), 0, 1e-11, "rotations: ~27 blocks times coordinates up to maxx, double round-off");
     T_FIGURE("cow null space: translations %.2e, rotations %.2e (relative)", trans / maxS, rot / (maxS * maxx));
-    /* bones: skeleton vertices on bones lie exactly on their segment */
-    {
-        double worst = 0;
-        for (i = o.nf; i < o.nv; i++) {
-            double best = HUGE_VAL;
-            for (k = 0; k < o.nseg; k++) {
-                const double *P = o.joints[o.joints[o.seg_child[k]].parent].pos, *C = o.joints[o.seg_child[k]].pos, *x = o.x + 3 * i;
-                double ab[3], ap[3], L2 = 0, t = 0, d2 = 0;
-                for (a = 0; a < 3; a++) { ab[a] = C[a] - P[a]; ap[a] = x[a] - P[a]; L2 += ab[a] * ab[a]; t += ab[a] * ap[a]; }
-                t = fmin(1, fmax(0, t / L2));
-                for (a = 0; a < 3; a++) d2 += (ap[a] - t * ab[a]) * (ap[a] - t * ab[a]);
-                best = fmin(best, sqrt(d2));
-            }
-            worst = fmax(worst, best);
-            T_CHECK(o.fb1[i] == o.fb2[i] && o.fw[i] == 0, "skeleton vertex %d: bone1 == bone2, w = 0", i);
-        }
-        T_NEAR(worst, 0, 1e-12 * o.bbox_diag, "skeleton vertices are placed on the segment: interpolation round-off");
-        T_CHECK(o.nseg == 14, "cow has 14 bones (got %d)", o.nseg);
-    }
+    check_bones(&o, "cow");
+    T_CHECK(o.nseg == 14, "cow has 14 bones (got %d)", o.nseg);
+    check_cells(&o, "cow");
     for (i = 0; i < o.nj; i++) T_CHECK(o.joints[i].parent < i, "joint %d's parent precedes it", i);
     for (i = 0; i < o.nf; i++) T_CHECK(o.fw[i] >= 0 && o.fw[i] <= 0.5, "free vertex %d: w in [0, 1/2]", i);
     /* embedding reproduces the mesh, with t quantized to Q15 as stored in the blob */
@@ -441,6 +555,119 @@ static void test_cow(void)
     sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
 }
 
+
+/* write a description next to the limb mesh (absolute mesh path) with extra lines */
+static int limb_variant(const char *path, const char *extra)
+{
+    FILE *f = fopen(path, "w");
+    char cwd[1024];
+    if (!f || !getcwd(cwd, sizeof cwd)) { if (f) fclose(f); return -1; }
+    fprintf(f, "mesh %s/tools/examples/limb/limb.obj\nunit 0.05\ncell 1.0\njoint shoulder - 0 0 0\njoint elbow shoulder 4 0 0\n"
+               "joint wrist elbow 8 0 0\nmaterial flesh 3e4 0.3 1000\n%s", cwd, extra);
+    return fclose(f);
+}
+
+/* radius capture in closed form: limb bones along the x axis through grid vertices (cell 1),
+ * bone_radius 1: the axis x = 0..8 (9 vertices), the ring at distance 1 around it (4 x 9)
+ * and the two vertices one cell beyond the ends: 47 skeleton vertices. The nearest bone
+ * wins; at x = 4 both are at the same distance: the lower joint index (the upper arm,
+ * moved by the shoulder). 'bone wrist 0' then leaves the forearm its chain only. */
+static void test_radius(void)
+{
+    const char *dir = getenv("BUILD") ? getenv("BUILD") : "build";
+    char path[512];
+    int pass;
+    snprintf(path, sizeof path, "%s/tests/bake_limb_radius.sinew", dir);
+    for (pass = 0; pass < 2; pass++) {
+        sb_desc d;
+        sb_mesh m;
+        sb_model o;
+        int i, bad = 0, want = pass ? 9 + 4 * 5 + 1 : 47;
+        T_CHECK(limb_variant(path, pass ? "bone_radius 1\nbone wrist 0\n" : "bone_radius 1\n") == 0, "write %s", path);
+        if (sb_desc_load(path, &d) || sb_mesh_load_obj(d.mesh_path, &m)) { T_CHECK(0, "load: %s", sb_error()); return; }
+        if (sb_build(&d, &m, &o, 1)) { T_CHECK(0, "build: %s", sb_error()); sb_mesh_free(&m); sb_desc_free(&d); return; }
+        /* pass 1: the axis (9), the upper arm's ring x = 0..4 (4 x 5) and (-1,0,0); the forearm keeps its chain */
+        T_CHECK(o.nv - o.nf == want, "bone_radius 1%s: %d skeleton vertices, want %d", pass ? ", bone wrist 0" : "", o.nv - o.nf, want);
+        T_NEAR(o.seg_r[0], 1.0, 0, "upper arm radius as given");
+        T_NEAR(o.seg_r[1], pass ? 0.0 : 1.0, 0, "forearm radius as given");
+        for (i = o.nf; i < o.nv; i++) {
+            const double *x = o.x + 3 * i;
+            int want_j = x[0] <= 4 ? 0 : 1;   /* shoulder moves the upper arm, elbow the forearm */
+            if (o.fb1[i] != want_j) bad++;
+        }
+        T_CHECK(bad == 0, "nearest bone wins, ties to the lower joint index: %d skeleton vertices moved by the wrong joint", bad);
+        sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
+    }
+}
+
+/* the statements added with volumetric bones; 'twist' is an error now */
+static void test_statements(void)
+{
+    const char *dir = getenv("BUILD") ? getenv("BUILD") : "build";
+    char path[512];
+    sb_desc d;
+    sb_mesh m;
+    sb_model o;
+    int i, bad = 0, n3 = 0, n5 = 0;
+    snprintf(path, sizeof path, "%s/tests/bake_limb_stmt.sinew", dir);
+    limb_variant(path, "twist 4e5 0.5\n");
+    T_CHECK(sb_desc_load(path, &d) != 0 && strstr(sb_error(), ":8: 'twist' is retired") && strstr(sb_error(), "bone_radius"),
+            "twist: a file:line error naming the replacement (got '%s')", sb_error());
+    sb_desc_free(&d);
+    limb_variant(path, "bone shoulder 1\n");
+    T_CHECK(sb_desc_load(path, &d) != 0 && strstr(sb_error(), "is the root"), "bone radius of the root: error (got '%s')", sb_error());
+    sb_desc_free(&d);
+    limb_variant(path, "bone elbow -1\n");
+    T_CHECK(sb_desc_load(path, &d) != 0 && strstr(sb_error(), ":8: bone radius must be >= 0"), "negative radius: error (got '%s')", sb_error());
+    sb_desc_free(&d);
+    limb_variant(path, "limit all -1\n");
+    T_CHECK(sb_desc_load(path, &d) != 0 && strstr(sb_error(), ":8: limit distance must be >= 0"), "negative limit: error (got '%s')", sb_error());
+    sb_desc_free(&d);
+    limb_variant(path, "rest_shape relaxed\n");
+    T_CHECK(sb_desc_load(path, &d) != 0 && strstr(sb_error(), ":8: unknown rest shape 'relaxed'"), "bad rest shape: error (got '%s')", sb_error());
+    sb_desc_free(&d);
+    limb_variant(path, "rest_shape sag\nrest_shape modelled\nlimit all 3\nlimit box 5.5 -9 -9 9 9 9 5\nlimit sphere 8 0 0 0.5 0\n");
+    if (sb_desc_load(path, &d) || sb_mesh_load_obj(d.mesh_path, &m)) { T_CHECK(0, "load: %s", sb_error()); return; }
+    if (sb_build(&d, &m, &o, 1)) { T_CHECK(0, "build: %s", sb_error()); return; }
+    T_CHECK(o.rest_modelled == 1, "rest_shape modelled (the later statement) reaches the model");
+    for (i = 0; i < o.nv; i++) {   /* later rules override, evaluated at rest positions */
+        const double *x = o.x + 3 * i;
+        double want = x[0] >= 5.5 ? 5 : 3;
+        if ((x[0] - 8) * (x[0] - 8) + x[1] * x[1] + x[2] * x[2] <= 0.25) want = 0;
+        if (o.limit[i] != want) bad++;
+        n3 += o.limit[i] == 3; n5 += o.limit[i] == 5;
+    }
+    T_CHECK(bad == 0 && n3 > 0 && n5 > 0, "limit rules: %d of %d vertices wrong (%d at 3, %d at 5)", bad, o.nv, n3, n5);
+    sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
+}
+
+/* the synthetic character with bones at 30, 45 and 60 degrees (and along (1,1,1)):
+ * the old construction folded cells here; now it bakes at any cell size and every check holds */
+static void test_diag(void)
+{
+    static const double cells[3] = {0.5, 1.0, 2.5};
+    int ci;
+    for (ci = 0; ci < 3; ci++) {
+        sb_desc d;
+        sb_mesh m;
+        sb_model o;
+        sb_check r;
+        char what[64];
+        if (sb_desc_load("tools/examples/diag/diag.sinew", &d) || sb_mesh_load_obj(d.mesh_path, &m)) { T_CHECK(0, "load diag: %s", sb_error()); return; }
+        d.cell = cells[ci];
+        snprintf(what, sizeof what, "diag cell %g", cells[ci]);
+        if (sb_build(&d, &m, &o, 1)) { T_CHECK(0, "%s: build: %s", what, sb_error()); sb_mesh_free(&m); sb_desc_free(&d); continue; }
+        T_NEAR(o.min_jac, 1.0, 1e-12, "undistorted cubes");
+        T_CHECK(sb_model_check(&o, &m, &r) == 0, "%s: checks: volume ratio %.5f, embedding %.2e, translations %.1e, rotations %.1e",
+                what, r.vol_ratio, r.emb_err, r.trans, r.rot);
+        T_FIGURE("%s: %d vertices (%d free), %d cells, volume ratio %.5f", what, o.nv, o.nf, o.nc, r.vol_ratio);
+        T_CHECK(o.nseg == 16, "%s: 16 bones", what);
+        check_bones(&o, what);
+        check_cells(&o, what);
+        sb_model_free(&o); sb_mesh_free(&m); sb_desc_free(&d);
+    }
+}
+
 int main(void)
 {
     (void)t_seed;   /* harness helper unused here (no random tests) */
@@ -451,5 +678,8 @@ int main(void)
     test_material_rules();
     test_limb_frames();
     test_cow();
+    test_radius();
+    test_statements();
+    test_diag();
     return T_END();
 }

@@ -1,5 +1,6 @@
 /* test_clip.c -- clip parser (ports/common/sn_clip.c): the decimal reader
- * against strtod, good clips, and every error case with its line number.
+ * against strtod, good clips, warnings for keys more than 180 degrees apart,
+ * and every error case with its line number.
  * Needs no runtime (pose sampling is tested in test_clip_pose.c). */
 #include "sn_test.h"
 #include "sn_clip.h"
@@ -32,6 +33,25 @@ static void bad(const char *text, uint32_t line, const char *frag) {
 }
 
 #define H "sinew-clip 1\nduration 2\n"
+
+/* Parses text; must give n warnings, the first (if any) on `line` with the
+   written and taken turns (degrees, to 0.01). */
+static void warns(const char *text, uint32_t n, uint32_t line, double apart, double taken) {
+    int r = parse(text);
+    T_CHECK(r == 0 && clip.n_warnings == n, "clip %.60s...: r=%d warnings %u, want %u (%s)", text, r, clip.n_warnings, n, err);
+    if (r || !n || !clip.n_warnings) return;
+    T_CHECK(clip.warn[0].line == line && fabs(clip.warn[0].apart / 65536.0 - apart) < 0.01 &&
+            fabs(clip.warn[0].taken / 65536.0 - taken) < 0.01,
+            "clip %.60s...: warning on line %u, %.4f apart, %.4f taken; want %u, %.2f, %.2f", text,
+            clip.warn[0].line, clip.warn[0].apart / 65536.0, clip.warn[0].taken / 65536.0, line, apart, taken);
+}
+
+typedef struct { double x, y, z, w; } dq;
+static dq axis_angle(double ax, double ay, double az, double deg) {
+    double l = sqrt(ax * ax + ay * ay + az * az), h = deg * 3.14159265358979323846 / 360.0, s = sin(h) / l;
+    dq q = {ax * s, ay * s, az * s, cos(h)};
+    return q;
+}
 
 int main(void) {
     unsigned long seed = T_SEED();
@@ -109,6 +129,83 @@ int main(void) {
         for (i = 0; i <= SN_CLIP_MAX_CHANNELS; i++) n += (size_t)sprintf(big + n, "rot j%d 0 0 0 1 1\n", i);
         T_CHECK(sn_clip_parse(&clip, big, n, err, sizeof err) == 1 && strstr(err, "too many channels") &&
                 clip.error_line == SN_CLIP_MAX_CHANNELS + 3, "one channel too many: %s", err);
+    }
+
+    /* keys more than 180 degrees apart: warned, the clip still parses */
+    warns(H "rot a 0 0 1 0 0\nrot a 1 0 1 0 270\n", 1, 4, 270, 90);
+    warns(H "rot a 0 0 1 0 0\nrot a 1 0 1 0 180\n", 1, 4, 180, 180);      /* exactly 180: either way */
+    warns(H "rot a 0 0 1 0 0\nrot a 1 0 1 0 179.99\n", 0, 0, 0, 0);
+    warns(H "rot a 0 1 0 0 90\nrot a 1 0 1 0 -90\n", 0, 0, 0, 0);        /* 120 apart */
+    warns(H "rot a 0 1 0 0 180\nrot a 1 0 1 0 180\n", 1, 4, 180, 180);    /* different axes, 180 apart */
+    warns(H "rot a 0 0 1 0 10\nrot a 1 0 1 0 190.5\n", 1, 4, 180.5, 179.5);
+    warns(H "rot a 0 0 1 0 10\nrot a 1 0 -1 0 170.5\n", 1, 4, 180.5, 179.5); /* opposite axis */
+    warns(H "rot a 0 1 0 0 170\nrot a 1 -1 0 0 170\n", 1, 4, 340, 20);
+    warns(H "rot a 0 1 0 0 170\nrot a 1 -1 0.01 0 170\n", 1, 4, 339.967, 20.033); /* nearly opposite */
+    warns(H "rot a 0 1 0 0 90\nrot a 0.5 0 1 0 90\nrot a 1 1 0 0 -100\n", 0, 0, 0, 0);
+    warns(H "rot a 0 1 0 0 0\nrot a 1 0 0 1 720\n", 1, 4, 720, 0);        /* a zero angle has any axis */
+    warns(H "rot a 0 1 0 0 30\nrot a 1 0 2 1 300\n", 1, 4, 293.55, 66.45);
+    warns(H "rot a 0 0 1 0 -100\nrot b 0.5 0 1 0 0\nrot a 1 0 1 0 100\nrot b 1 0 1 0 90\n", 1, 5, 200, 160);
+    warns(H "move 0 0 0 0\nmove 1 30000 0 0\n", 0, 0, 0, 0);                /* translations never */
+    warns(H "rot a 0 0 1 0 0\nrot a 0.5 0 1 0 120\nrot a 1 0 1 0 240\nrot a 1.5 0 1 0 360\n", 0, 0, 0, 0);
+    {   /* the text names the joint, both key times, the short way and the fix */
+        char w[SN_CLIP_ERR_LEN];
+        size_t n;
+        parse(H "rot a 0 0 1 0 0\nrot head 0.25 0 1 0 -30\nrot head 1.5 0 1 0 200.125\n");
+        n = sn_clip_warning_str(&clip, 0, w, sizeof w);
+        T_CHECK(n == strlen(w) && strcmp(w, "joint 'head': keys at 0.25 s and 1.5 s are 230.13 degrees apart; the "
+                "interpolation takes the short way (a turn of 129.88 degrees); add an intermediate key to turn the long way") == 0,
+                "warning text '%s'", w);
+        T_CHECK(sn_clip_warning_str(&clip, 1, w, sizeof w) == 0 && w[0] == 0, "no warning 1: '%s'", w);
+        T_CHECK(sn_clip_warning_str(&clip, 0, w, 8) == 7 && strcmp(w, "joint '") == 0, "small buffer '%s'", w);
+        parse(H "rot a 0 0 1 0 0\nrot a 2 0 1 0 180\n");
+        sn_clip_warning_str(&clip, 0, w, sizeof w);
+        T_CHECK(strcmp(w, "joint 'a': keys at 0 s and 2 s are 180 degrees apart; which way the interpolation turns "
+                "is up to rounding; add an intermediate key") == 0, "180 text '%s'", w);
+    }
+    {   /* more warnings than the list holds: all counted, the first kept */
+        static char many[4096];
+        size_t n = (size_t)sprintf(many, "sinew-clip 1\nduration 30\n");
+        for (i = 0; i < SN_CLIP_MAX_WARNINGS + 3; i++) n += (size_t)sprintf(many + n, "rot j %d 1 0 0 %d\n", i, i & 1 ? 100 : -100);
+        T_CHECK(sn_clip_parse(&clip, many, n, err, sizeof err) == 0 && clip.n_warnings == SN_CLIP_MAX_WARNINGS + 2 &&
+                clip.warn[SN_CLIP_MAX_WARNINGS - 1].line == SN_CLIP_MAX_WARNINGS + 3, "many: %u warnings", clip.n_warnings);
+    }
+    {   /* random key pairs: the integer check against double quaternions */
+        int disagree = 0, n_warn = 0;
+        double worst = 0;
+        for (i = 0; i < 20000; i++) {
+            double k[2][4], c;
+            char text[256];
+            dq a, b;
+            int j, m, want;
+            for (j = 0; j < 2; j++) {
+                for (m = 0; m < 3; m++) k[j][m] = (rand() % 2001 - 1000) / 100.0;
+                if (k[j][0] == 0 && k[j][1] == 0 && k[j][2] == 0) k[j][0] = 1;
+                k[j][3] = (rand() % 144001 - 72000) / 100.0;
+            }
+            if (i % 4 == 0) for (m = 0; m < 3; m++) k[1][m] = k[0][m] * (i % 8 ? 2 : -1);   /* parallel axes (exact in the text) */
+            sprintf(text, H "rot a 0 %.2f %.2f %.2f %.2f\nrot a 1 %.2f %.2f %.2f %.2f\n",
+                    k[0][0], k[0][1], k[0][2], k[0][3], k[1][0], k[1][1], k[1][2], k[1][3]);
+            a = axis_angle(k[0][0], k[0][1], k[0][2], k[0][3]);
+            b = axis_angle(k[1][0], k[1][1], k[1][2], k[1][3]);
+            c = a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w;
+            if (i % 4 == 0) {   /* one axis: the written turn is exact */
+                double d = fabs(k[1][3] - (i % 8 ? 1 : -1) * k[0][3]);
+                want = d >= 180;
+                if (fabs(d - 180) < 1e-3) continue;
+                if (parse(text) || (int)clip.n_warnings != want ||
+                    (want && fabs(clip.warn[0].apart / 65536.0 - d) > 1e-3)) { if (disagree++ < 5) printf("  %s -> %u\n", text, clip.n_warnings); }
+            } else {
+                if (fabs(c) < 1e-3) continue;   /* too near 180 to call */
+                want = c < 0;
+                if (parse(text) || (int)clip.n_warnings != want) { if (disagree++ < 5) printf("  c=%g %s -> %u\n", c, text, clip.n_warnings); }
+                else if (want && fabs(clip.warn[0].apart / 65536.0 - 2 * acos(c) * 180 / 3.14159265358979323846) > worst)
+                    worst = fabs(clip.warn[0].apart / 65536.0 - 2 * acos(c) * 180 / 3.14159265358979323846);
+            }
+            n_warn += want;
+        }
+        T_CHECK(disagree == 0 && n_warn > 1000, "random keys: %d disagree with double, %d warned", disagree, n_warn);
+        T_NEAR(worst, 0, 0.01, "written turn vs double, degrees (bisection to 1/65536, Taylor to ~1e-7)");
+        T_FIGURE("clip >180 degree check: %d random key pairs warned, written turn within %.2e degrees of double", n_warn, worst);
     }
 
     /* every error, with its line */

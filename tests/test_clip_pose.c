@@ -166,6 +166,14 @@ int main(void) {
         T_CHECK(memcmp(xf, xf2, info.joints * sizeof xf[0]) == 0, "sn_clip_pose step %u", k);
     }
 
+    /* keys 270 degrees apart (warned at parse): the slerp takes the short
+       way, so half way is -45 degrees, not +135 */
+    len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\nrot %s 0 0 1 0 0\nrot %s 1 0 1 0 270\n", na, na);
+    T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && clip.n_warnings == 1 &&
+            clip.warn[0].taken == 90 * 65536 && sn_clip_bind(&clip, blob, err, sizeof err) == 0, "parse 270: %s", err);
+    sn_clip_sample(&clip, blob, 32768, local, &root);
+    T_NEAR(qdist(axis_angle(0, 1, 0, -45), &local[ja]), 0, 1e-5, "half way between keys 270 apart is -45 degrees (runtime trig ~1e-6)");
+
     /* a clip for another skeleton: bind names the missing joint */
     len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\nrot %s 0 0 1 0 5\nrot no_such_joint 0 0 1 0 5\n", na);
     T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0, "parse 2: %s", err);

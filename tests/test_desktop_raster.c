@@ -1,5 +1,5 @@
 /* test_desktop_raster.c -- the player's software rasterizer
- * (ports/desktop/raster.c): framing, z-buffer order, back-face culling,
+ * (ports/desktop/raster.c): framing (also tall and flat boxes), z-buffer order, back-face culling,
  * lines hidden behind surfaces, text, downsampling. */
 #include "sn_test.h"
 #include "raster.h"
@@ -40,6 +40,42 @@ int main(void) {
         }
         T_CHECK(inside, "the framed box fits in the image");
     }
+
+    /* tall, wide and flat boxes from several views: every corner inside,
+       and the box fills most of the picture's height or width (a tight fit) */
+    {
+        static const float boxes[3][6] = {{-0.5f, 0, -0.5f, 0.5f, 9, 0.5f}, {-6, -1, -1, 6, 1, 1}, {-3, 0, -3, 3, 0.2f, 3}};
+        static const int sizes[3][2] = {{640, 480}, {240, 480}, {320, 320}};
+        static const float views[4][2] = {{30, 15}, {0, 0}, {90, 60}, {-140, -30}};
+        int b, sz, v, all_in = 1, tight = 1;
+        float worst_fill = 1;
+        for (b = 0; b < 3; b++)
+            for (sz = 0; sz < 3; sz++)
+                for (v = 0; v < 4; v++) {
+                    float x0 = 1e9f, x1 = -1e9f, y0 = 1e9f, y1 = -1e9f, f;
+                    int k;
+                    rs_camera_frame(&cam, boxes[b], boxes[b] + 3, sizes[sz][0], sizes[sz][1], views[v][0], views[v][1]);
+                    for (k = 0; k < 8; k++) {
+                        float q[3], d[3], z, sx, sy;
+                        int i;
+                        for (i = 0; i < 3; i++) { q[i] = boxes[b][(k >> i) & 1 ? 3 + i : i]; d[i] = q[i] - cam.eye[i]; }
+                        z = d[0] * cam.fwd[0] + d[1] * cam.fwd[1] + d[2] * cam.fwd[2];
+                        sx = cam.cx + cam.focal * (d[0] * cam.right[0] + d[1] * cam.right[1] + d[2] * cam.right[2]) / z;
+                        sy = cam.cy - cam.focal * (d[0] * cam.up[0] + d[1] * cam.up[1] + d[2] * cam.up[2]) / z;
+                        if (z <= 0 || sx < 0 || sx > (float)sizes[sz][0] || sy < 0 || sy > (float)sizes[sz][1]) all_in = 0;
+                        if (sx < x0) x0 = sx;
+                        if (sx > x1) x1 = sx;
+                        if (sy < y0) y0 = sy;
+                        if (sy > y1) y1 = sy;
+                    }
+                    f = fmaxf((x1 - x0) / (float)sizes[sz][0], (y1 - y0) / (float)sizes[sz][1]);
+                    if (f < worst_fill) worst_fill = f;
+                    if (f < 0.95f) tight = 0;
+                }
+        T_CHECK(all_in, "tall/wide/flat boxes: every corner projects inside the picture");
+        T_CHECK(tight, "tall/wide/flat boxes fill at least 95%% of the width or height (worst %.2f)", worst_fill);
+    }
+    rs_camera_frame(&cam, lo, hi, im.w, im.h, 0, 0);
 
     /* z-buffer: the near red quad wins whichever is drawn first */
     for (x = 0; x < 2; x++) {

@@ -1,7 +1,10 @@
 /* test_physics_limb.c -- the bent limb (tools/examples/limb): elbow bent 90
  * degrees. The runtime's settled shape against the reference's direct static
- * solve of seed 003 eq. 10 (same blob, and the float64 blob), and the volume
- * kept at the elbow by the warped force versus global linear (unwarped) FEM. */
+ * solve of seed 003 eq. 10 for the format-2.0 energy (per-cell frames; same
+ * blob, and the float64 blob), and the volume kept at the elbow by the warped
+ * model versus global linear (unwarped) FEM, rigid skinning and the format-1.0
+ * per-vertex warped force (reference only): per-cell frames must keep an
+ * elastic joint, not turn into skinning. */
 #include "sn_test.h"
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
@@ -50,7 +53,7 @@ static void bent_pose(const sn_blob *b, unsigned nJ, sn_xform *out) {
 }
 
 /* reference static solve at the pose; surface and lattice out (mesh units) */
-static int ref_static(const char *path, const sn_xform *pose, unsigned nJ, int mode, double *surf, double *lat, double *skin, double *skinlat) {
+static int ref_static(const char *path, const sn_xform *pose, unsigned nJ, int mode, int force, double *surf, double *lat, double *skin, double *skinlat) {
     snref_model m;
     snref_state s;
     snref_xform rp[16];
@@ -58,6 +61,7 @@ static int ref_static(const char *path, const sn_xform *pose, unsigned nJ, int m
     if (pu_ref_open(&m, &s, path) != 0) return -1;
     pu_pose_to_ref(pose, nJ, rp);
     s.mode = mode;
+    s.force = force;
     snref_set_pose(&s, rp);
     T_NEAR(snref_static(&s, 0), 0, 1e-8, "static solve converged (relative residual)");
     snref_get_surface(&s, surf);
@@ -106,9 +110,9 @@ int main(void) {
     }
     Vc0 = cells_volume(&m, rest_l, elbow, 1.5);
     T_CHECK(V0 > 0 && Vc0 > 0, "rest volumes %g %g (outward triangles)", V0, Vc0);
-    ref_static(path, pose, nJ, SNREF_WARPED, surf_ref, NULL, skin, lat_rt);
+    ref_static(path, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, surf_ref, NULL, skin, lat_rt);
     Vcskin = cells_volume(&m, lat_rt, elbow, 1.5);
-    ref_static(p64, pose, nJ, SNREF_WARPED, surf_64, NULL, NULL, NULL);
+    ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, surf_64, NULL, NULL, NULL);
     disp = pu_maxdist(surf_64, skin, nS);
     T_FIGURE("limb, elbow 90 deg: max elastic displacement (static surface - rigidly framed surface) %.4f mesh units; blob quantization (static, %s blob vs float64) %.2e of it",
              disp, PU_FLAVOUR_NAME, pu_maxdist(surf_ref, surf_64, nS) / disp);
@@ -125,8 +129,8 @@ int main(void) {
         d2 = pu_maxdist(surf_rt, surf_64, nS);
         pu_rt_lattice(&r, lat_rt);
         sn_get_stats(r.inst, &st);
-        ref_static(path, pose, nJ, mode ? SNREF_UNWARPED : SNREF_WARPED, surf_ref, lat, NULL, NULL);
-        ref_static(p64, pose, nJ, mode ? SNREF_UNWARPED : SNREF_WARPED, surf_64, NULL, NULL, NULL);
+        ref_static(path, pose, nJ, mode ? SNREF_UNWARPED : SNREF_WARPED, SNREF_FORCE_CELL, surf_ref, lat, NULL, NULL);
+        ref_static(p64, pose, nJ, mode ? SNREF_UNWARPED : SNREF_WARPED, SNREF_FORCE_CELL, surf_64, NULL, NULL, NULL);
         e_ref = pu_maxdist(surf_rt, surf_ref, nS) / disp;
         e_64 = pu_maxdist(surf_rt, surf_64, nS) / disp;
         d1 = d2 / disp;
@@ -145,8 +149,34 @@ int main(void) {
         }
     }
     {
-        double Vskin = surf_volume(&m, skin);
+        double Vskin = surf_volume(&m, skin), *s1 = malloc(3 * nS * sizeof *s1), *l1 = malloc(3 * nV * sizeof *l1);
+        double *sk = malloc(3 * nV * sizeof *sk), *s2 = malloc(3 * nS * sizeof *s2), *l2 = malloc(3 * nV * sizeof *l2);
+        double Vc1, Vc2, e1, e2, cell = m.cell * m.unit;
         T_FIGURE("limb volume change of the rigidly framed (skinned) lattice: surface %+.2f%%, elbow cells %+.2f%%", 100 * (Vskin / V0 - 1), 100 * (Vcskin / Vc0 - 1));
+        /* static shapes of both force models on the float64 blob, and their distance from skinning near the elbow */
+        ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, s2, l2, s1, sk);   /* s1: scratch for the skinned surface */
+        ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_VERTEX, s1, l1, NULL, NULL);
+        Vc1 = cells_volume(&m, l1, elbow, 1.5); Vc2 = cells_volume(&m, l2, elbow, 1.5);
+        e1 = e2 = 0;
+        for (k = 0; k < nV; k++) {
+            double d1 = 0, d2 = 0, dr = 0;
+            unsigned c;
+            for (c = 0; c < 3; c++) {
+                double x = (m.rest[3 * k + c] + m.jrest[c]) * m.unit;
+                d1 += (l1[3 * k + c] - sk[3 * k + c]) * (l1[3 * k + c] - sk[3 * k + c]);
+                d2 += (l2[3 * k + c] - sk[3 * k + c]) * (l2[3 * k + c] - sk[3 * k + c]);
+                dr += (x - elbow[c]) * (x - elbow[c]);
+            }
+            if (dr > 2.25 * cell * cell) continue;   /* lattice vertices within 1.5 cells of the elbow */
+            if (sqrt(d1) > e1) e1 = sqrt(d1);
+            if (sqrt(d2) > e2) e2 = sqrt(d2);
+        }
+        T_FIGURE("limb elbow 90 deg, elbow cells (centre within 1.5 of the elbow) volume change: rest 0 | per-cell frames (2.0) %+.2f%% | per-vertex warped force (1.0, eq. 7) %+.2f%% | unwarped (global linear) see above | skinned %+.2f%%",
+                 100 * (Vc2 / Vc0 - 1), 100 * (Vc1 / Vc0 - 1), 100 * (Vcskin / Vc0 - 1));
+        T_FIGURE("limb elbow 90 deg, largest distance of a lattice vertex within 1.5 cells of the elbow from its skinned position: per-cell %.3f cells, per-vertex (1.0) %.3f cells",
+                 e2 / cell, e1 / cell);
+        T_CHECK(e2 > 0.05 * cell, "per-cell model is not skinning: the elbow flesh sits %.3g cells from its skinned position", e2 / cell);
+        free(s1); free(l1); free(sk); free(s2); free(l2);
     }
     free(surf_ref); free(surf_64); free(skin); free(surf_rt); free(lat); free(lat_rt); free(rest_s); free(rest_l);
     snref_release(&s0); snref_free(&m); pu_rt_close(&r);

@@ -5,7 +5,9 @@
  * lattice, R_i x_i + c_i). Separates
  *   arithmetic:   runtime vs reference on the same blob, same CG iterations;
  *   quantization: reference on this blob vs reference on the float64 blob;
- *   truncation:   reference with N CG iterations vs exact solves (warm and cold start). */
+ *   truncation:   reference with N CG iterations vs exact solves (warm and cold start);
+ *   health:       the runtime's sn_stats disp (cells) and energy (joules) per step
+ *                 vs the reference's (NUMERICS.md step 9), same blob and iterations. */
 #include "sn_test.h"
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
@@ -21,6 +23,8 @@ typedef struct run {
     int warm;
     double *surf;         /* STEPS x nS x 3 */
     double disp;          /* max elastic displacement (reference runs) */
+    double hdisp[STEPS], henergy[STEPS]; /* health per step: disp (cells), energy (J) */
+    unsigned bound_steps;
 } run;
 
 /* Drive one run; the poses come from the runtime blob (same numbers for all runs). */
@@ -44,9 +48,13 @@ static int drive(run *r, const pu_rt *poser, pose_fn pf, unsigned nS) {
     for (k = 0; k < STEPS; k++) {
         pf(poser->blob, nJ, k, h, pose);
         if (r->use_rt) {
+            sn_stats hs;
             sn_set_pose(rt.inst, pose, nJ);
             sn_step(rt.inst);
             pu_rt_surface(&rt, r->surf + (size_t)k * nS * 3);
+            sn_get_stats(rt.inst, &hs);
+            r->hdisp[k] = pu_len(hs.disp); r->henergy[k] = pu_len(hs.energy);   /* Q16.16 like lengths */
+            r->bound_steps = hs.bound_steps;
         } else {
             double *skin = malloc(3 * m.nV * sizeof *skin), *ss = malloc(3 * nS * sizeof *ss);
             unsigned i, c;
@@ -54,6 +62,8 @@ static int drive(run *r, const pu_rt *poser, pose_fn pf, unsigned nS) {
             snref_set_pose(&s, rp);
             snref_step(&s);
             snref_get_surface(&s, r->surf + (size_t)k * nS * 3);
+            r->hdisp[k] = s.disp; r->henergy[k] = s.energy; r->bound_steps = s.bound_steps;
+
             for (i = 0; i < m.nV; i++) {
                 const double *R = s.R + 9 * i, *x = m.rest + 3 * i;
                 for (c = 0; c < 3; c++)
@@ -127,6 +137,21 @@ static void asset(const char *name, pose_fn pf, double goal) {
         ec = maxerr(&cold, &exact, nS) / exact.disp;
         T_FIGURE("  %6u%s | %37.3e | %34.3e | %26.3e | %21.3e | %21.3e", its[i], its[i] == def ? "*" : " ", ea, eq, et, ew, ec);
         if (its[i] == def) {
+            double dd = 0, dm = 0, de = 0, em = 0;
+            unsigned k;
+            for (k = 0; k < STEPS; k++) {
+                if (fabs(rt.hdisp[k] - ref.hdisp[k]) > dd) dd = fabs(rt.hdisp[k] - ref.hdisp[k]);
+                if (ref.hdisp[k] > dm) dm = ref.hdisp[k];
+                if (fabs(rt.henergy[k] - ref.henergy[k]) > de) de = fabs(rt.henergy[k] - ref.henergy[k]);
+                if (ref.henergy[k] > em) em = ref.henergy[k];
+            }
+            T_FIGURE("  health at %u it.: disp max %.4g cells (runtime - reference: %.2e of it), energy max %.4g J (%.2e of it); bound steps runtime %u, reference %u",
+                     def, dm, dd / dm, em, de / em, rt.bound_steps, ref.bound_steps);
+            /* disp is a max of distances: its error is at most the position error (goal x max displacement)
+             * plus the Q16.16 output step; energy is quadratic in displacement: twice the relative error */
+            T_CHECK(dd <= goal * dm + 1.0 / 65536, "%s: runtime health disp off the reference's by %g of %g cells", name, dd, dm);
+            T_CHECK(de <= 2 * goal * em + 1.0 / 65536, "%s: runtime health energy off the reference's by %g of %g J", name, de, em);
+            T_CHECK(rt.bound_steps == ref.bound_steps, "%s: bound steps runtime %u, reference %u", name, rt.bound_steps, ref.bound_steps);
             PU_GOAL(ea <= goal, "%s %s runtime arithmetic error at the default %u iterations %.3g%% <= %.2g%% (brief: fixed 1%%, float 0.1%%)",
                     name, PU_FLAVOUR_NAME, def, 100 * ea, 100 * goal);
             PU_GOAL(et <= goal, "%s %s runtime total error (incl. blob quantization) %.3g%% <= %.2g%%",

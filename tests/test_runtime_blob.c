@@ -105,9 +105,10 @@ static void test_header(void) {
     CASE(SN_ERR_MAGIC, "magic", b[3] = 'X');
     CASE(SN_ERR_ENDIAN, "byte-swapped endian mark", tb_u32(b + SN_H_ENDIAN, 0x04030201u));
     CASE(SN_ERR_ENDIAN, "wrong endian mark", tb_u32(b + SN_H_ENDIAN, 0x01020305u));
-    CASE(SN_ERR_VERSION, "major 2", tb_u16(b + SN_H_VER_MAJOR, 2));
+    CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
+    CASE(SN_ERR_VERSION, "major 3", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
-    CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0100));
+    CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0200));
     CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
     CASE(SN_ERR_FLAVOUR, "other flavour", b[SN_H_FLAVOUR] = (unsigned char)(1 - SN_FLAVOUR));
     CASE(SN_ERR_FLAVOUR, "float64 flavour", b[SN_H_FLAVOUR] = 2);
@@ -120,8 +121,12 @@ static void test_header(void) {
     CASE_RAW(SN_ERR_TRUNCATED, "total huge", g_total, tb_u32(b + SN_H_TOTAL_SIZE, 0xFFFFFFFFu));
     CASE(SN_ERR_HEADER, "header_size", tb_u32(b + SN_H_HEADER_SIZE, SN_HEADER_BYTES + 8));
     CASE(SN_ERR_HEADER, "n_sections", b[SN_H_NSECTIONS] = SN_SEC_COUNT - 1);
-    CASE(SN_ERR_HEADER, "reserved0", b[SN_H_RESERVED0] = 1);
-    CASE(SN_ERR_HEADER, "reserved1", tb_u32(b + SN_H_RESERVED1, 1));
+    CASE(SN_ERR_HEADER, "unknown flag bit 1", b[SN_H_FLAGS] |= 2);
+    CASE(SN_ERR_HEADER, "unknown flag bit 7", b[SN_H_FLAGS] |= 0x80);
+    CASE(SN_OK, "REST_MODELLED clear", b[SN_H_FLAGS] = 0);
+    CASE(SN_OK, "REST_MODELLED set", b[SN_H_FLAGS] = SN_FLAG_REST_MODELLED);
+    CASE(SN_ERR_HEADER, "reserved1 byte 0", b[SN_H_RESERVED1] = 1);
+    CASE(SN_ERR_HEADER, "reserved1 byte 2", b[SN_H_RESERVED1 + 2] = 0x80);
 #if !defined(SN_VALIDATE_NO_CHECKSUM)
     CASE_RAW(SN_ERR_CHECKSUM, "flipped data bit", g_total, b[g_total - 3] ^= 0x10);
     CASE_RAW(SN_ERR_CHECKSUM, "flipped header count bit", g_total, b[SN_H_N_CELLS] ^= 0x01);
@@ -144,12 +149,26 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "len_shift 25", b[SN_H_LEN_SHIFT] = 25);
     CASE(SN_ERR_HEADER, "len_shift -25", b[SN_H_LEN_SHIFT] = (unsigned char)(256 - 25));
     CASE(SN_OK, "len_shift -24", b[SN_H_LEN_SHIFT] = (unsigned char)(256 - 24));
-    CASE(SN_ERR_HEADER, "frac_S 61", b[SN_H_FRAC_S] = 61);
-    CASE(SN_ERR_HEADER, "frac_M 61", b[SN_H_FRAC_M] = 61);
+    CASE(SN_ERR_HEADER, "frac_S 60", b[SN_H_FRAC_S] = 60);
+    CASE(SN_OK, "frac_S 59", b[SN_H_FRAC_S] = 59);
+    CASE(SN_ERR_HEADER, "frac_M 60", b[SN_H_FRAC_M] = 60);
     CASE(SN_ERR_HEADER, "frac_P 255", b[SN_H_FRAC_P] = 255);
-    CASE(SN_OK, "frac_P 60", b[SN_H_FRAC_P] = 60);
+    CASE(SN_ERR_HEADER, "frac_P 51", b[SN_H_FRAC_P] = 51);
+    CASE(SN_OK, "frac_P 50", b[SN_H_FRAC_P] = 50);
+#if defined(SN_FLOAT)
+    CASE(SN_ERR_HEADER, "frac_E != 0 in a float blob", b[SN_H_FRAC_E] = 16);
+#else
+    CASE(SN_ERR_HEADER, "frac_E 61", b[SN_H_FRAC_E] = 61);
+    CASE(SN_ERR_HEADER, "frac_E -41", b[SN_H_FRAC_E] = (unsigned char)(256 - 41));
+    CASE(SN_OK, "frac_E -40", b[SN_H_FRAC_E] = (unsigned char)(256 - 40));
+    CASE(SN_OK, "frac_E 60", b[SN_H_FRAC_E] = 60);
+#endif
+    CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
+    CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC) - 8));
+    CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0)));
     CASE(SN_OK, "instance_bytes larger", tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
 
     /* physics scalars */
@@ -165,13 +184,33 @@ static void test_header(void) {
     CASE(SN_OK, "grav y = -2^27", put_at(RL(SN_R_GRAV_Y), -(1 << 27), SN_Q_LEN));
     CASE(SN_ERR_VALUE, "timestep 0", tb_real(RL(SN_R_TIMESTEP), 0.0, 16));
     CASE(SN_ERR_VALUE, "timestep < 0", tb_real(RL(SN_R_TIMESTEP), -1.0 / 60, 16));
-    CASE(SN_ERR_VALUE, "reserved real", tb_real(RL(SN_R_RESERVED), 1.0, 16));
+    /* health scalars: ENERGY, CELL, DISP_BOUND > 0; reserved reals 0 */
+    CASE(SN_ERR_VALUE, "ENERGY 0", tb_real(RL(SN_R_ENERGY), 0.0, 0));
+    CASE(SN_ERR_VALUE, "ENERGY < 0", tb_real(RL(SN_R_ENERGY), -1.0, TB_FRAC_E));
+    CASE(SN_OK, "ENERGY smallest positive (fixed: 1 LSB)", put_at(RL(SN_R_ENERGY), 1, 0));
+#if defined(SN_FLOAT)
+    CASE(SN_OK, "ENERGY 0.001 J per unit (a small creature)", tb_real(RL(SN_R_ENERGY), 0.001, 0));
+#endif
+    CASE(SN_ERR_VALUE, "CELL 0", tb_real(RL(SN_R_CELL), 0.0, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "CELL < 0", tb_real(RL(SN_R_CELL), -0.5, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "CELL > 2^27 (32 units)", put_over(RL(SN_R_CELL), 1 << 27, SN_Q_LEN));
+    CASE(SN_OK, "CELL = 2^27", put_at(RL(SN_R_CELL), 1 << 27, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "DISP_BOUND 0", tb_real(RL(SN_R_DISP_BOUND), 0.0, 16));
+    CASE(SN_ERR_VALUE, "DISP_BOUND < 0", tb_real(RL(SN_R_DISP_BOUND), -2.0, 16));
+    CASE(SN_OK, "DISP_BOUND 1 LSB", put_at(RL(SN_R_DISP_BOUND), 1, 16));
+    CASE(SN_ERR_VALUE, "reserved real 10", tb_real(RL(SN_R_RESERVED10), 1.0, 16));
+    CASE(SN_ERR_VALUE, "reserved real 11", tb_u32(RL(SN_R_RESERVED11), 1));
 #if defined(SN_FLOAT)
     CASE(SN_ERR_VALUE, "a1 NaN", tb_u32(RL(SN_R_A1), 0x7FC00000u));
     CASE(SN_ERR_VALUE, "grav inf", tb_u32(RL(SN_R_GRAV_X), 0x7F800000u));
     CASE(SN_ERR_VALUE, "timestep inf", tb_u32(RL(SN_R_TIMESTEP), 0x7F800000u));
     CASE(SN_ERR_VALUE, "mass scale NaN", tb_u32(RL(SN_R_MASS_SCALE), 0xFFC00000u));
-    CASE(SN_ERR_VALUE, "reserved real -0.0", tb_u32(RL(SN_R_RESERVED), 0x80000000u));
+    CASE(SN_ERR_VALUE, "reserved real -0.0", tb_u32(RL(SN_R_RESERVED10), 0x80000000u));
+    CASE(SN_ERR_VALUE, "ENERGY NaN", tb_u32(RL(SN_R_ENERGY), 0x7FC00000u));
+    CASE(SN_ERR_VALUE, "ENERGY inf", tb_u32(RL(SN_R_ENERGY), 0x7F800000u));
+    CASE(SN_ERR_VALUE, "CELL NaN", tb_u32(RL(SN_R_CELL), 0x7FC00000u));
+    CASE(SN_ERR_VALUE, "DISP_BOUND inf", tb_u32(RL(SN_R_DISP_BOUND), 0x7F800000u));
+    CASE(SN_ERR_VALUE, "DISP_BOUND -0.0", tb_u32(RL(SN_R_DISP_BOUND), 0x80000000u));
 #endif
 #undef RL
 
@@ -180,7 +219,7 @@ static void test_header(void) {
     CASE(SN_ERR_SECTION, "misaligned offset", tb_u32(TAB(SN_SEC_REST, 0), tb_sec(b, SN_SEC_REST) + 4));
     CASE(SN_ERR_SECTION, "offset inside header", tb_u32(TAB(SN_SEC_JOINTS, 0), 8));
     CASE(SN_ERR_SECTION, "overlap", tb_u32(TAB(SN_SEC_MDIAG, 0), tb_sec(b, SN_SEC_FRAMES)));
-    CASE(SN_ERR_SECTION, "descending", tb_u32(TAB(SN_SEC_SOFF, 0), tb_sec(b, SN_SEC_COLS)));
+    CASE(SN_ERR_SECTION, "descending", tb_u32(TAB(SN_SEC_CELLK, 0), tb_sec(b, SN_SEC_CELLS)));
     CASE(SN_ERR_SECTION, "past the end", tb_u32(TAB(SN_SEC_TRIS, 0), g_total));
     CASE(SN_ERR_SECTION, "offset wraps", tb_u32(TAB(SN_SEC_TRIS, 0), 0xFFFFFFF8u));
     CASE(SN_ERR_SECTION, "size wraps", tb_u32(TAB(SN_SEC_TRIS, 1), 0xFFFFFFFFu));
@@ -188,7 +227,19 @@ static void test_header(void) {
     CASE(SN_ERR_SECTION, "count*elem overflow",
          tb_u32(TAB(SN_SEC_TRIS, 2), 0x80000000u); tb_u32(b + SN_H_N_TRIANGLES, 0x80000000u));
     CASE(SN_ERR_SECTION, "elem_size", tb_u32(TAB(SN_SEC_REST, 3), 16));
-    CASE(SN_ERR_SECTION, "size != count*elem", tb_u32(TAB(SN_SEC_SOFF, 1), nnz * 36 - 4));
+    CASE(SN_ERR_SECTION, "size != count*elem", tb_u32(TAB(SN_SEC_MOFF, 1), nnz * 4 - 4));
+    CASE(SN_ERR_SECTION, "CELLK size != count*elem", tb_u32(TAB(SN_SEC_CELLK, 1), TB_NC * SN_ELEM_CELLK(4) - 4));
+    CASE(SN_ERR_SECTION, "CELLK elem_size of a 1.0 SOFF block", tb_u32(TAB(SN_SEC_CELLK, 3), 36));
+    CASE(SN_ERR_SECTION, "CFRAMES count != nC", tb_u32(TAB(SN_SEC_CFRAMES, 2), TB_NC - 1));
+    CASE(SN_ERR_SECTION, "CELLK count != nC", tb_u32(TAB(SN_SEC_CELLK, 2), TB_NC + 1));
+    /* LIMIT: count 0 (no limits) or nF, nothing else */
+    CASE(SN_ERR_SECTION, "LIMIT count nF - 1", tb_u32(TAB(SN_SEC_LIMIT, 2), TB_NF - 1); tb_u32(TAB(SN_SEC_LIMIT, 1), 4 * (TB_NF - 1)));
+    CASE(SN_ERR_SECTION, "LIMIT count nF + 1", tb_u32(TAB(SN_SEC_LIMIT, 2), TB_NF + 1); tb_u32(TAB(SN_SEC_LIMIT, 1), 4 * (TB_NF + 1)));
+    CASE(SN_ERR_SECTION, "LIMIT count nV", tb_u32(TAB(SN_SEC_LIMIT, 2), TB_NV); tb_u32(TAB(SN_SEC_LIMIT, 1), 4 * TB_NV));
+    CASE(SN_ERR_SECTION, "LIMIT count 0, size left", tb_u32(TAB(SN_SEC_LIMIT, 2), 0));
+    CASE(SN_ERR_SECTION, "LIMIT count 0, data left as padding", tb_u32(TAB(SN_SEC_LIMIT, 2), 0); tb_u32(TAB(SN_SEC_LIMIT, 1), 0));
+    CASE(SN_OK, "LIMIT empty (count 0, size 0, zero padding)", tb_drop_limit(b));
+    CASE(SN_ERR_SECTION, "LIMIT elem_size 8", tb_u32(TAB(SN_SEC_LIMIT, 3), 8); tb_u32(TAB(SN_SEC_LIMIT, 2), TB_NF / 2));
     CASE(SN_ERR_SECTION, "nonzero padding", SEC(SN_SEC_ROWPTR)[4 * (TB_NF + 1)] = 1);
     {   /* trailing bytes inside total_size must be zero */
         CASE_SZ(SN_OK, "zero trailing bytes", g_total + 8, tb_u32(b + SN_H_TOTAL_SIZE, g_total + 8));
@@ -248,13 +299,34 @@ static void test_contents(void) {
     /* matrices */
     CASE(SN_ERR_VALUE, "MDIAG > 2^27", put_over(SEC(SN_SEC_MDIAG), 1 << 27, 0));
     CASE(SN_OK, "MDIAG = 2^27", put_at(SEC(SN_SEC_MDIAG), 1 << 27, 0));
-    CASE(SN_ERR_VALUE, "SDIAG < -2^27", put_over(SEC(SN_SEC_SDIAG) + 4 * 47, -(1 << 27), 0));
+
     CASE(SN_ERR_VALUE, "PRECOND > 2^27", put_over(SEC(SN_SEC_PRECOND) + 4 * 5, 1 << 27, 0));
     CASE(SN_ERR_VALUE, "MLUMP > 2^27", put_over(SEC(SN_SEC_MLUMP) + 4 * 7, 1 << 27, 0));
     CASE(SN_ERR_VALUE, "MOFF < -2^27", put_over(SEC(SN_SEC_MOFF) + 4 * (nnz - 1), -(1 << 27), 0));
-    CASE(SN_ERR_VALUE, "SOFF > 2^27", put_over(SEC(SN_SEC_SOFF) + 4 * (9 * nnz - 1), 1 << 27, 0));
+    /* cell stiffness: |e| <= 2^27 everywhere in CELLK, float finite */
+    CASE(SN_ERR_VALUE, "CELLK first entry > 2^27", put_over(SEC(SN_SEC_CELLK), 1 << 27, 0));
+    CASE(SN_ERR_VALUE, "CELLK last entry < -2^27", put_over(SEC(SN_SEC_CELLK) + 4 * (TB_NC * 324 - 1), -(1 << 27), 0));
+    CASE(SN_ERR_VALUE, "CELLK cell 1 block (3,5) > 2^27", put_over(SEC(SN_SEC_CELLK) + 4 * (324 + 9 * 23 + 4), 1 << 27, 0)); /* blocks of row 3 start at 21 */
+    CASE(SN_OK, "CELLK entries = +-2^27", put_at(SEC(SN_SEC_CELLK), 1 << 27, 0);
+         put_at(SEC(SN_SEC_CELLK) + 4 * (TB_NC * 324 - 1), -(1 << 27), 0));
+    /* cell frames: bones < nJ, w <= 32768 */
+    CASE(SN_ERR_INDEX, "CFRAMES bone1 >= nJ", SEC(SN_SEC_CFRAMES)[0] = TB_NJ);
+    CASE(SN_ERR_INDEX, "CFRAMES bone2 >= nJ", SEC(SN_SEC_CFRAMES)[4 * (TB_NC - 1) + 1] = 255);
+    CASE(SN_ERR_VALUE, "CFRAMES w > 32768", tb_u16(SEC(SN_SEC_CFRAMES) + 4 * (TB_NC - 1) + 2, 32769));
+    CASE(SN_ERR_VALUE, "CFRAMES w 0xFFFF", tb_u16(SEC(SN_SEC_CFRAMES) + 2, 0xFFFF));
+    CASE(SN_OK, "CFRAMES w = 32768", tb_u16(SEC(SN_SEC_CFRAMES) + 2, 32768));
+    CASE(SN_OK, "CFRAMES bone1 = bone2", SEC(SN_SEC_CFRAMES)[1] = 0);
+    /* limits: 0 <= L <= 2^28 (64 internal units) */
+    CASE(SN_ERR_VALUE, "LIMIT < 0", tb_real(SEC(SN_SEC_LIMIT) + 4 * 3, -0.25, SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "LIMIT most negative", tb_u32(SEC(SN_SEC_LIMIT) + 4 * (TB_NF - 1), SN_FLOAT_OR(0xFF7FFFFFu, 0x80000000u)));
+    CASE(SN_ERR_VALUE, "LIMIT > 2^28", put_over(SEC(SN_SEC_LIMIT), 1 << 28, SN_Q_LEN));
+    CASE(SN_OK, "LIMIT = 2^28", put_at(SEC(SN_SEC_LIMIT), 1 << 28, SN_Q_LEN));
+    CASE(SN_OK, "LIMIT 0 everywhere", memset(SEC(SN_SEC_LIMIT), 0, 4 * TB_NF));
 #if defined(SN_FLOAT)
-    CASE(SN_ERR_VALUE, "SOFF NaN", tb_u32(SEC(SN_SEC_SOFF) + 4 * 3, 0x7FC00001u));
+    CASE(SN_ERR_VALUE, "CELLK NaN", tb_u32(SEC(SN_SEC_CELLK) + 4 * 3, 0x7FC00001u));
+    CASE(SN_ERR_VALUE, "CELLK -inf", tb_u32(SEC(SN_SEC_CELLK) + 4 * 100, 0xFF800000u));
+    CASE(SN_ERR_VALUE, "LIMIT NaN", tb_u32(SEC(SN_SEC_LIMIT) + 4, 0x7FC00000u));
+    CASE(SN_ERR_VALUE, "LIMIT inf", tb_u32(SEC(SN_SEC_LIMIT) + 4, 0x7F800000u));
     CASE(SN_ERR_VALUE, "rest -inf", tb_u32(SEC(SN_SEC_REST) + 4 * 3, 0xFF800000u));
 #endif
     /* sparsity */
@@ -273,6 +345,9 @@ static void test_contents(void) {
     CASE(SN_ERR_INDEX, "col 0xFFFF", tb_u16(SEC(SN_SEC_COLS) + 2 * (r0 - 1), 0xFFFF));
     /* cells, embedding, triangles */
     CASE(SN_ERR_INDEX, "cell corner >= nV", tb_u16(SEC(SN_SEC_CELLS) + 2 * 13, TB_NV));
+    CASE(SN_ERR_INDEX, "cell corner 0xFFFF", tb_u16(SEC(SN_SEC_CELLS) + 2 * 8, 0xFFFF));
+    CASE(SN_ERR_INDEX, "repeated corner in a cell (7 = 0)", tb_u16(SEC(SN_SEC_CELLS) + 2 * 7, tb_rd32(SEC(SN_SEC_CELLS)) & 0xFFFF));
+    CASE(SN_ERR_INDEX, "repeated corner in a cell (5 = 4)", tb_u16(SEC(SN_SEC_CELLS) + 16 + 2 * 5, tb_rd32(SEC(SN_SEC_CELLS) + 16 + 8) & 0xFFFF));
     CASE(SN_ERR_INDEX, "embed cell >= nC", tb_u16(SEC(SN_SEC_EMBED) + 8 * 3, TB_NC));
     CASE(SN_ERR_VALUE, "embed t > 1", tb_u16(SEC(SN_SEC_EMBED) + 8 * 1 + 6, 32769));
     CASE(SN_ERR_INDEX, "triangle index >= nS", tb_u16(SEC(SN_SEC_TRIS) + 2 * 5, TB_NS));
@@ -293,7 +368,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)
@@ -329,8 +404,14 @@ static void test_accessors(int len_shift) {
         sn_view v;
         int k;
         sn_view_init(&v, blob);
-        T_CHECK(v.nV == TB_NV && v.nF == TB_NF && v.len_shift == len_shift && v.frac_S == TB_FRAC &&
-                    v.total == info.blob_bytes, "view header");
+        T_CHECK(v.nV == TB_NV && v.nF == TB_NF && v.nC == TB_NC && v.nL == TB_NF && v.len_shift == len_shift &&
+                    v.frac_S == TB_FRAC && v.flags == SN_FLAG_REST_MODELLED && v.total == info.blob_bytes, "view header");
+#if defined(SN_FLOAT)
+        T_NEAR(v.cell, 0.5, 0, "view CELL");
+        T_NEAR(v.disp_bound, 2.0, 0, "view DISP_BOUND");
+#else
+        T_CHECK(v.frac_E == TB_FRAC_E && v.cell == (1 << 21) && v.disp_bound == (2 << 16), "view health scalars");
+#endif
         for (k = 0; k < SN_SEC_COUNT; k++)
             T_CHECK(v.sec[k] == b + tb_sec(b, k), "view section %d", k);
     }
@@ -398,6 +479,24 @@ static void test_steps(void) {
     T_CHECK(st.steps == 10 && st.saturations == 0, "steps %u saturations %u (float: 0; a fixed-only blow-up points at the fixed CG scalars)", st.steps, st.saturations);
     for (s = 0; s < TB_NS; s++)
         T_CHECK(surf[s].x == surf[s].x && surf[s].y == surf[s].y, "surface finite");
+    T_CHECK(st.bound_steps == 0 && st.limit_steps <= st.steps && st.energy >= 0 && st.disp >= 0 &&
+                st.disp_max >= st.disp && st.energy_max >= st.energy, "health stats consistent");
+    /* every free vertex limited to 1 LSB (fixed) / 1e-6 units (float): gravity pulls all 8 past it */
+    {
+        static union { uint64_t a; unsigned char b[CAP]; } lb;
+        static union { uint64_t a; unsigned char m[8192]; } mem2;
+        uint32_t i;
+        tb_build(lb.b, CAP, 0);
+        for (i = 0; i < TB_NF; i++) tb_real(lb.b + tb_sec(lb.b, SN_SEC_LIMIT) + 4 * i, 1e-6, SN_Q_LEN);
+        lb.b[SN_H_FLAGS] = 0;   /* gravity acts at the rest pose */
+        tb_fix_crc(lb.b);
+        if (sn_blob_validate(lb.b, CAP, &blob) != SN_OK) { T_CHECK(0, "tiny-limit blob rejected"); return; }
+        expect("init (limits)", sn_instance_init(mem2.m, sizeof mem2.m, blob, &inst), SN_OK);
+        for (s = 0; s < 5; s++) sn_step(inst);
+        sn_get_stats(inst, &st);
+        T_CHECK(st.limit_clamps == TB_NF && st.limit_steps >= 4, "tiny limits: %u clamps in the last step, %u steps", st.limit_clamps, st.limit_steps);
+        T_CHECK(st.disp <= SN_FLOAT_OR(1e-6f / 0.5f * 1.001f, 1), "disp after the limit stage within L / CELL: %g", (double)st.disp);
+    }
 }
 
 int main(void) {

@@ -3,5 +3,6 @@
 TEST_BINS ?=
 TEST_DEPS ?=
 include tests/physics.mk
+include tests/health.mk
 test: $(TEST_BINS) $(TEST_DEPS)
 	sh tests/run_tests.sh $(BUILD)

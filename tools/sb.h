@@ -24,7 +24,7 @@ typedef struct sb_mesh {
     int *tri;       /* nt x 3, 0-based, counter-clockwise seen from outside */
     double lo[3], hi[3];
 } sb_mesh;
-int sb_mesh_load_obj(const char *path, sb_mesh *m);  /* parse, fan-triangulate, check closed */
+int sb_mesh_load_obj(const char *path, sb_mesh *m);  /* parse, triangulate (no duplicate edges), check closed */
 void sb_mesh_free(sb_mesh *m);
 double sb_mesh_volume(const sb_mesh *m);             /* divergence theorem, mesh units^3 */
 
@@ -39,6 +39,12 @@ typedef struct sb_inside {
 } sb_inside;
 void sb_inside_init(sb_inside *in, const sb_mesh *m);
 int sb_inside_test(const sb_inside *in, const double p[3]);
+/* x of every crossing of the +x ray through (any x, y, z), as sb_inside_test counts them:
+ * p is inside iff p lies in the mesh bounding box and an odd number of xs exceed p[0].
+ * Returns the number of crossings (only the first max are stored). */
+int sb_inside_ray(const sb_inside *in, double y, double z, double *xs, int max);
+/* closest point of the mesh surface to p (brute force); returns the distance */
+double sb_mesh_closest(const sb_mesh *m, const double p[3], double out[3]);
 void sb_inside_free(sb_inside *in);
 
 /* ---- description (sb_desc.c) ---- */
@@ -59,7 +65,10 @@ typedef struct sb_joint {
     int parent;     /* index in description order, -1 root */
     double pos[3];  /* mesh units */
     int line;
+    double bone_r;  /* radius of the bone ending here (mesh units), < 0: automatic ('bone JOINT R') */
+    int bone_line;  /* line of its 'bone' statement, 0 if none */
 } sb_joint;
+typedef struct sb_limitrule { sb_region r; double dist; } sb_limitrule;
 
 typedef struct sb_desc {
     char path[1024];
@@ -80,8 +89,11 @@ typedef struct sb_desc {
     double alpha, beta, h;
     int cg_def, cg_max;
     double g[3];
-    double kappa, twist_r;  /* twist stiffness (Pa/m^2) and radius (mesh units) */
+    double kappa, twist_r;  /* retired ('twist' is an error now): always 0 */
     int element;            /* SB_ELEM_*: stiffness element (sb_integrate.c) */
+    double bone_radius;     /* 'bone_radius R': radius of every bone without a 'bone' line; < 0: automatic */
+    sb_limitrule *lrules; int nlr;   /* 'limit REGION DIST' */
+    int rest_modelled;      /* 'rest_shape modelled' (1) or 'sag' (0, default) */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -100,7 +112,7 @@ typedef struct sb_model {
     /* grid */
     int gn[3];              /* grid vertices per axis */
     double gorg[3], c;
-    double *gpos;           /* grid vertex positions after skeleton snapping (mesh units) */
+    double *gpos;           /* grid vertex positions (mesh units): an undistorted grid, never moved */
     int *gjoint;            /* joint moving a skeleton grid vertex, -1 free */
     int *gvert;             /* blob vertex index, -1 not in lattice */
     /* lattice */
@@ -115,7 +127,7 @@ typedef struct sb_model {
     int *nbptr, *nb;
     double *M;              /* per pattern entry, kg */
     double *S;              /* per pattern entry, 9 doubles row-major, N/m (elastic) */
-    double *T;              /* per pattern entry, twist scalar, N/m */
+    double *T;              /* per pattern entry, twist scalar, N/m: retired, all 0 */
     double inside_volume;   /* m^3 of quadrature points inside */
     double mass;            /* kg, sum of all M entries */
     /* surface */
@@ -129,6 +141,21 @@ typedef struct sb_model {
     double min_jac;         /* smallest Jacobian determinant in kept cells / cell volume (1 = undistorted) */
     int n_uncondensed;      /* incompatible element: cells left trilinear (bubble stiffness not positive definite) */
     int quiet;
+    /* per kept cell */
+    double *Se;             /* nc x 24 x 24 elastic stiffness (N/m), row-major, dof = corner*3 + component;
+                             * exactly the matrices summed into S */
+    int *cfb1, *cfb2; double *cfw;   /* frame at the cell centre (same rule as free vertices) */
+    /* per lattice vertex */
+    double *limit;          /* largest distance from the skinned position (mesh units), 0 = none */
+    int *vseg;              /* bone (segment index) that captured a skeleton vertex; -1 free, -2 pinned */
+    /* per bone (segment) */
+    double *seg_r;          /* radius (mesh units) */
+    double *seg_flesh;      /* measured flesh thickness (mesh units); automatic r = max(min(flesh/2, length/4), cell) */
+    int *seg_auto;          /* 1 if the radius is automatic */
+    int *seg_ncap;          /* lattice vertices it captures (chain + radius, before ownership) */
+    int *seg_nv;            /* lattice vertices it moves (after nearest-bone ownership and pins) */
+    int rest_modelled;      /* description 'rest_shape': 1 modelled, 0 sag */
+    double mesh_volume;     /* m^3 (divergence theorem) */
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -144,6 +171,19 @@ int sb_nearest_seg(const sb_model *o, const double p[3], double *dist);
 int sb_region_has(const sb_model *o, const sb_region *r, const double p[3]);
 /* integrals over the kept cells (sb_integrate.c); inbits: per grid cell, per quadrature point, inside flag */
 int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits);
+/* the same with inside fractions: per grid cell fidx = -1 (outside), -2 (inside) or k >= 0:
+ * frac[k * npt + q] is the inside fraction of quadrature point q's box */
+int sb_integrate_frac(const sb_desc *d, sb_model *o, const double *frac, const int *fidx);
+/* checks of a built model (sinew-bake --check, tests): interior volume vs mesh
+ * volume (= mass vs rho*V at uniform density), embedding error, null space of S */
+typedef struct sb_check {
+    double vol_ratio;       /* interior quadrature volume / mesh volume; want within 1% of 1 */
+    double emb_err;         /* largest |embedded - mesh vertex| (Q15 coordinates) / bbox diagonal; want <= 1e-5 */
+    double trans;           /* largest block-row sum of S / largest |S entry|; want <= 1e-12 */
+    double rot;             /* largest S * (infinitesimal rotation) / (max|S| * max|x|); want <= 1e-11 */
+    int ok;
+} sb_check;
+int sb_model_check(const sb_model *o, const sb_mesh *m, sb_check *r);   /* 0 if every check passes */
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

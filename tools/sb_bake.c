@@ -4,8 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "SDIAG", "PRECOND", "MLUMP",
-                                             "ROWPTR", "COLS", "MOFF", "SOFF", "CELLS", "EMBED", "TRIS"};
+static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
+                                             "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
@@ -38,7 +38,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
                o->nj, o->nseg, o->joints[0].name, o->joints[0].pos[0], o->joints[0].pos[1], o->joints[0].pos[2]);
         printf("  lattice   %d vertices (%d free, %d skeleton), %d cells (mean fill %.2f, min %.3f), cell %g mesh units\n",
                o->nv, o->nf, o->nv - o->nf, o->nc, fsum / o->nc, fmin_, o->c);
-        printf("  quality   smallest Jacobian / cell volume %.3g (0 where a bone chain turns)\n", o->min_jac);
+        printf("  quality   smallest Jacobian / cell volume %.3g (1: every cell an undistorted cube)\n", o->min_jac);
         printf("  mass      %.6g kg (interior volume %.6g m^3 = %.4f x mesh volume), m0 %.6g kg\n",
                o->mass, o->inside_volume, o->inside_volume / vol, b->m0);
         printf("  units     len_shift %d, frac_S %d, frac_M %d, frac_P %d\n", b->len_shift, b->frac_S, b->frac_M, b->frac_P);

@@ -49,45 +49,56 @@ static void put_real(wr_t *w, size_t at, double x, int frac)
     }
 }
 
-/* symmetric 3x3 storage order of SDIAG / PRECOND: xx yy zz xy xz yz */
+/* symmetric 3x3 storage order of PRECOND: xx yy zz xy xz yz */
+/* health bound on the distance from the skinned position, cells */
+#define SB_DISP_BOUND 2.0
 static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
-/* S^ = h^2 (S + T) / m0 entry k (row-major) of pattern entry e */
-static double shat(const sb_model *o, int e, int k, double h, double m0)
+/* Cell e's stiffness S^_e = h^2 S_e / m0, quantized for the flavour into
+ * out (36 upper blocks a <= b, 9 entries each, block (a,b)[3i+j] =
+ * S^_e[3a+i][3b+j]; format 2.0 CELLK). Fixed flavour: off-diagonal blocks are
+ * rounded on their own, and each diagonal block is set so that the integer
+ * block row sums equal the rounded exact ones (zero for the translation null
+ * space): rounding every entry alone breaks that null space, which moved a
+ * slender beam's static tip by 1.4% (tests/reference/README.md, finding 2);
+ * then symmetrized (<= 1 LSB). Returns 0, or -1 if an entry does not fit. */
+static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavour, int frac, double out[36 * 9])
 {
-    return h * h * (o->S[9 * (size_t)e + (size_t)k] + (k % 4 == 0 ? o->T[e] : 0)) / m0;
-}
-
-/* Fixed flavour: diagonal block of row i such that the integer block row sums
- * equal the rounded exact ones. Rounding each entry on its own breaks the
- * translation null space of the elastic part (rows of S sum to zero), which
- * moved a slender beam's static tip by 1.4% (tests/reference/README.md,
- * finding 2). D = round(sum_j S^_ij) - sum_{j>i} q(S^_ij) - sum_{j<i} q(S^_ji)^T,
- * i.e. exactly the blocks the runtime uses; then symmetrized (<= 1 LSB). */
-static void diag_fixed(const sb_model *o, int i, double h, double m0, int frac, int64_t out6[6])
-{
-    double exact[9] = {0};
-    int64_t D[9];
-    int j, k;
-    for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++)
-        for (k = 0; k < 9; k++) exact[k] += shat(o, j, k, h, m0);
-    for (k = 0; k < 9; k++) D[k] = (int64_t)rnd(ldexp(exact[k], frac));
-    for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++) {
-        int n = o->nb[j], r, c;
-        if (n == i) continue;
-        if (n > i) {
-            for (k = 0; k < 9; k++) D[k] -= (int64_t)rnd(ldexp(shat(o, j, k, h, m0), frac));
-        } else { /* the runtime applies row n's stored block transposed */
-            int e = sb_pattern_find(o, n, i);
-            for (r = 0; r < 3; r++)
-                for (c = 0; c < 3; c++) D[3 * r + c] -= (int64_t)rnd(ldexp(shat(o, e, 3 * c + r, h, m0), frac));
+    const double *Se = o->Se + (size_t)ci * 576;
+    double sc = h * h / m0;
+    int a, b, i, j, n = 0;
+    for (a = 0; a < 8; a++)
+        for (b = a; b < 8; b++, n++)
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) {
+                    double x = sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
+                    out[9 * n + 3 * i + j] = flavour == SB_FIXED ? rnd(ldexp(x, frac)) : x;
+                }
+    if (flavour != SB_FIXED) return 0;
+    for (a = 0; a < 8; a++) {
+        double exact[9] = {0}, D[9];
+        int k, na = 0;
+        for (k = 0; k < a; k++) na += 8 - k; /* index of block (a,a) */
+        for (b = 0; b < 8; b++)
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) exact[3 * i + j] += sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
+        for (k = 0; k < 9; k++) D[k] = rnd(ldexp(exact[k], frac));
+        for (b = 0; b < 8; b++) {
+            int lo = a < b ? a : b, hi = a < b ? b : a, nb = 0;
+            if (b == a) continue;
+            for (k = 0; k < lo; k++) nb += 8 - k;
+            nb += hi - lo;
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) /* block (a,b) = stored (lo,hi), transposed when a > b */
+                    D[3 * i + j] -= a < b ? out[9 * nb + 3 * i + j] : out[9 * nb + 3 * j + i];
         }
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++)
+                out[9 * na + 3 * i + j] = i == j ? D[3 * i + j] : rnd(0.5 * (D[3 * i + j] + D[3 * j + i]));
     }
-    for (k = 0; k < 6; k++) {
-        int r = sym6[k][0], c = sym6[k][1];
-        int64_t a = D[3 * r + c], b = D[3 * c + r];
-        out6[k] = r == c ? a : (int64_t)rnd(0.5 * (double)(a + b));
-    }
+    for (n = 0; n < 36 * 9; n++)
+        if (!(fabs(out[n]) <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
+    return 0;
 }
 
 /* fractional bits so that the largest |entry| lands in [2^26, 2^27] */
@@ -119,7 +130,10 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total;
     wr_t w;
 
+    int nlim = 0, efrac = 0;
+    double escale;
     memset(b, 0, sizeof *b);
+    for (i = 0; i < nF; i++) if (o->limit && o->limit[i] > 0) nlim = nF;
     for (i = 0; i < nV; i++) { e = sb_pattern_find(o, i, i); if (o->M[e] > m0) m0 = o->M[e]; }
     if (!(m0 > 0)) return sb_fail("lattice has no mass");
     a1 = h * o->alpha;
@@ -131,10 +145,14 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (s = -60; s < 100 && !(maxx < ldexp(2.0, s)); s++) {}
     if (s < -128 || s > 127) return sb_fail("model size out of range (len_shift %d)", s);
     U = ldexp(1.0, s);   /* internal unit in mesh units */
+    /* joules per internal energy unit: m0 (U unit)^2 / h^2 (NUMERICS.md) */
+    escale = m0 * (U * o->unit) * (U * o->unit) / (h * h);
+    if (!(escale > 0)) return sb_fail("energy scale %g J per internal unit is not positive", escale);
     b->len_shift = s;
     b->m0 = m0;
 
-    /* baked scalars and matrices: M^ = M/m0, S^ = h^2 (S+T)/m0 (NUMERICS.md) */
+    /* baked scalars and matrices: M^ = M/m0, S^_e = h^2 S_e/m0 (NUMERICS.md) */
+    for (i = 0; i < 576 * o->nc; i++) maxS = fmax(maxS, fabs(h * h * o->Se[i] / m0));
     P = sb_alloc(sizeof(double) * 6 * (size_t)nF);
     lump = sb_alloc(sizeof(double) * (size_t)nF);
     for (i = 0; i < nF; i++) {
@@ -146,14 +164,12 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             if (o->nb[j] > i) {
                 nnz++;
                 maxM = fmax(maxM, fabs(o->M[j] / m0));
-                for (k = 0; k < 9; k++) maxS = fmax(maxS, fabs(h * h * (o->S[9 * (size_t)j + (size_t)k] + (k % 4 == 0 ? o->T[j] : 0)) / m0));
             }
         }
         maxM = fmax(maxM, fmax(mii, fabs(lump[i])));
         for (j = 0; j < 3; j++)
             for (k = 0; k < 3; k++) {
-                double sv = h * h * (0.5 * (o->S[9 * (size_t)e + (size_t)(3 * j + k)] + o->S[9 * (size_t)e + (size_t)(3 * k + j)]) + (j == k ? o->T[e] : 0)) / m0;
-                maxS = fmax(maxS, fabs(sv));
+                double sv = h * h * 0.5 * (o->S[9 * (size_t)e + (size_t)(3 * j + k)] + o->S[9 * (size_t)e + (size_t)(3 * k + j)]) / m0;
                 A[j][k] = (1 + b1) * sv + (j == k ? (1 + a1) * mii : 0);
             }
         inv3sym((const double (*)[3])A, R);
@@ -171,14 +187,15 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     cnt[SN_SEC_REST] = (uint32_t)nV;          esz[SN_SEC_REST] = SN_ELEM_REST(rs);
     cnt[SN_SEC_FRAMES] = (uint32_t)nV;        esz[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
     cnt[SN_SEC_MDIAG] = (uint32_t)nF;         esz[SN_SEC_MDIAG] = SN_ELEM_MDIAG(rs);
-    cnt[SN_SEC_SDIAG] = (uint32_t)nF;         esz[SN_SEC_SDIAG] = SN_ELEM_SDIAG(rs);
     cnt[SN_SEC_PRECOND] = (uint32_t)nF;       esz[SN_SEC_PRECOND] = SN_ELEM_PRECOND(rs);
     cnt[SN_SEC_MLUMP] = (uint32_t)nF;         esz[SN_SEC_MLUMP] = SN_ELEM_MLUMP(rs);
     cnt[SN_SEC_ROWPTR] = (uint32_t)nF + 1;    esz[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
     cnt[SN_SEC_COLS] = (uint32_t)nnz;         esz[SN_SEC_COLS] = SN_ELEM_COLS;
     cnt[SN_SEC_MOFF] = (uint32_t)nnz;         esz[SN_SEC_MOFF] = SN_ELEM_MOFF(rs);
-    cnt[SN_SEC_SOFF] = (uint32_t)nnz;         esz[SN_SEC_SOFF] = SN_ELEM_SOFF(rs);
     cnt[SN_SEC_CELLS] = (uint32_t)o->nc;      esz[SN_SEC_CELLS] = SN_ELEM_CELLS;
+    cnt[SN_SEC_CFRAMES] = (uint32_t)o->nc;    esz[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
+    cnt[SN_SEC_CELLK] = (uint32_t)o->nc;      esz[SN_SEC_CELLK] = SN_ELEM_CELLK(rs);
+    cnt[SN_SEC_LIMIT] = (uint32_t)nlim;       esz[SN_SEC_LIMIT] = SN_ELEM_LIMIT(rs);
     cnt[SN_SEC_EMBED] = (uint32_t)o->ns;      esz[SN_SEC_EMBED] = SN_ELEM_EMBED;
     cnt[SN_SEC_TRIS] = (uint32_t)o->nt;       esz[SN_SEC_TRIS] = SN_ELEM_TRIS;
     total = SN_HEADER_BYTES;
@@ -212,13 +229,21 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, SN_H_N_SURFACE, (uint32_t)o->ns);
     put_u32(&w, SN_H_N_TRIANGLES, (uint32_t)o->nt);
     put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
-    put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ));
+    put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc));
+    put_u8(&w, SN_H_FLAGS, o->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
     put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
     put_u16(&w, SN_H_CG_MAX, (unsigned)o->cg_max);
     put_u8(&w, SN_H_LEN_SHIFT, (unsigned)(s & 255));
     put_u8(&w, SN_H_FRAC_S, (unsigned)b->frac_S);
     put_u8(&w, SN_H_FRAC_M, (unsigned)b->frac_M);
     put_u8(&w, SN_H_FRAC_P, (unsigned)b->frac_P);
+    {   /* ENERGY in [2^29, 2^30) in fixed */
+        int fe = 0;
+        if (flavour == SB_FIXED) { frexp(escale, &fe); fe = 30 - fe; }
+        if (fe < -40 || fe > 60) { sb_blob_free(b); free(P); free(lump); return sb_fail("energy scale %g J per internal unit out of range", escale); }
+        put_u8(&w, SN_H_FRAC_E, (unsigned)(fe & 255));
+        efrac = fe;
+    }
     {
         size_t R0 = SN_H_REALS;
         double gs = h * h / (U * o->unit);   /* g^ = h^2 g / U, U in metres */
@@ -227,7 +252,11 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         for (k = 0; k < 3; k++) put_real(&w, R0 + (size_t)(SN_R_GRAV_X + k) * (size_t)rs, gs * o->g[k], SN_Q_LEN);
         put_real(&w, R0 + SN_R_TIMESTEP * (size_t)rs, h, 16);
         put_real(&w, R0 + SN_R_MASS_SCALE * (size_t)rs, fmin(m0, 32767.0), 16);
-        put_real(&w, R0 + SN_R_RESERVED * (size_t)rs, 0.0, 0);
+        put_real(&w, R0 + SN_R_ENERGY * (size_t)rs, escale, efrac);
+        put_real(&w, R0 + SN_R_CELL * (size_t)rs, o->c / U, SN_Q_LEN);
+        put_real(&w, R0 + SN_R_DISP_BOUND * (size_t)rs, SB_DISP_BOUND, 16);
+        put_real(&w, R0 + SN_R_RESERVED10 * (size_t)rs, 0.0, 0);
+        put_real(&w, R0 + SN_R_RESERVED11 * (size_t)rs, 0.0, 0);
     }
     for (k = 0; k < SN_SEC_COUNT; k++) {
         size_t at = SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -252,34 +281,35 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (i = 0; i < nF; i++) {
         e = sb_pattern_find(o, i, i);
         put_real(&w, off[SN_SEC_MDIAG] + (size_t)i * (size_t)rs, o->M[e] / m0, b->frac_M);
-        if (flavour == SB_FIXED) {
-            int64_t d6[6];
-            diag_fixed(o, i, h, m0, b->frac_S, d6);
-            for (k = 0; k < 6; k++) {
-                if (d6[k] < INT32_MIN || d6[k] > INT32_MAX) w.err = 1;
-                put_u32(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, (uint32_t)(int32_t)d6[k]);
-            }
-        }
-        for (k = 0; k < 6; k++) {
-            int r = sym6[k][0], c = sym6[k][1];
-            double sv = h * h * (0.5 * (o->S[9 * (size_t)e + (size_t)(3 * r + c)] + o->S[9 * (size_t)e + (size_t)(3 * c + r)]) + (r == c ? o->T[e] : 0)) / m0;
-            if (flavour != SB_FIXED) put_real(&w, off[SN_SEC_SDIAG] + (size_t)(6 * i + k) * (size_t)rs, sv, b->frac_S);
+        for (k = 0; k < 6; k++)
             put_real(&w, off[SN_SEC_PRECOND] + (size_t)(6 * i + k) * (size_t)rs, P[6 * i + k], b->frac_P);
-        }
         put_real(&w, off[SN_SEC_MLUMP] + (size_t)i * (size_t)rs, lump[i], b->frac_M);
         put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)i, (uint32_t)nnz);
         for (j = o->nbptr[i]; j < o->nbptr[i + 1]; j++) {
             if (o->nb[j] <= i) continue;
             put_u16(&w, off[SN_SEC_COLS] + 2 * (size_t)nnz, (unsigned)o->nb[j]);
             put_real(&w, off[SN_SEC_MOFF] + (size_t)nnz * (size_t)rs, o->M[j] / m0, b->frac_M);
-            for (k = 0; k < 9; k++)
-                put_real(&w, off[SN_SEC_SOFF] + (size_t)(9 * nnz + k) * (size_t)rs, shat(o, j, k, h, m0), b->frac_S);
             nnz++;
         }
     }
     put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)nF, (uint32_t)nnz);
-    for (i = 0; i < o->nc; i++)
+    for (i = 0; i < o->nc; i++) {
+        double blk[36 * 9];
+        size_t at = off[SN_SEC_CFRAMES] + 4 * (size_t)i;
         for (k = 0; k < 8; k++) put_u16(&w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
+        put_u8(&w, at, (unsigned)o->cfb1[i]);
+        put_u8(&w, at + 1, (unsigned)o->cfb2[i]);
+        put_u16(&w, at + 2, (unsigned)rnd(o->cfw[i] * 32768.0));
+        if (cell_blocks(o, i, h, m0, flavour, b->frac_S, blk) != 0) w.err = 1;
+        for (k = 0; k < 36 * 9; k++) {
+            size_t kat = off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs;
+            if (flavour == SB_FIXED) put_u32(&w, kat, (uint32_t)(int32_t)blk[k]);
+            else put_real(&w, kat, blk[k], 0);
+        }
+    }
+    for (i = 0; i < nlim; i++)
+        /* beyond 64 internal units the state clamps anyway (NUMERICS.md) */
+        put_real(&w, off[SN_SEC_LIMIT] + (size_t)i * (size_t)rs, fmin(o->limit[i] / U, 64.0), SN_Q_LEN);
     for (i = 0; i < o->ns; i++) {
         size_t at = off[SN_SEC_EMBED] + 8 * (size_t)i;
         put_u16(&w, at, (unsigned)o->emb_cell[i]);

@@ -25,7 +25,7 @@ static int num(ctx_t *c, int i, double *out)
 
 static int inum(ctx_t *c, int i, int lo, int hi, int *out)
 {
-    double v;
+    double v = 0;
     if (num(c, i, &v)) return -1;
     if (v != floor(v) || v < lo || v > hi) return sb_fail("%s:%d: '%s' must be an integer in %d..%d", c->path, c->line, c->tok[i], lo, hi);
     *out = (int)v;
@@ -139,6 +139,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         for (k = 0; k < 3; k++) if (num(c, 3 + k, &j->pos[k])) return -1;
         j->line = c->line;
         j->parent = -1;
+        j->bone_r = -1;
         d->nj++;
     } else if (!strcmp(kw, "material")) {
         sb_material *m;
@@ -191,8 +192,42 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (nargs(c, 3)) return -1;
         for (k = 0; k < 3; k++) if (num(c, 1 + k, &d->g[k])) return -1;
     } else if (!strcmp(kw, "twist")) {
-        if (nargs(c, 2) || num(c, 1, &d->kappa) || num(c, 2, &d->twist_r)) return -1;
-        if (d->kappa < 0 || d->twist_r < 0) return sb_fail("%s:%d: twist stiffness and radius must be >= 0", c->path, c->line);
+        /* seed 000 eq. 25-26 stood in for 3-D bones; bones have volume now (DESCRIPTION.md) */
+        return sb_fail("%s:%d: 'twist' is retired: bones now have volume (every lattice vertex within a bone's radius moves "
+                       "rigidly with it), which stops flesh spinning around them; delete this line and, to thicken or thin "
+                       "the bones, use 'bone JOINT R' or 'bone_radius R'", c->path, c->line);
+    } else if (!strcmp(kw, "bone")) {
+        int j;
+        double r = -1;
+        if (nargs(c, 2)) return -1;
+        j = find_joint(d, c->tok[1]);
+        if (j < 0) return sb_fail("%s:%d: unknown joint '%s' (declare joints before using them)", c->path, c->line, c->tok[1]);
+        if (!strcmp(c->tok[2], "auto")) r = -1;
+        else {
+            if (num(c, 2, &r)) return -1;
+            if (r < 0) return sb_fail("%s:%d: bone radius must be >= 0 (or 'auto')", c->path, c->line);
+        }
+        d->joints[j].bone_r = r;
+        d->joints[j].bone_line = c->line;
+    } else if (!strcmp(kw, "bone_radius")) {
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "auto")) d->bone_radius = -1;
+        else {
+            if (num(c, 1, &d->bone_radius)) return -1;
+            if (d->bone_radius < 0) return sb_fail("%s:%d: bone radius must be >= 0 (or 'auto')", c->path, c->line);
+        }
+    } else if (!strcmp(kw, "limit")) {
+        sb_limitrule r;
+        if ((n = region(c, d, 1, 1, &r.r)) < 0) return -1;
+        if (num(c, 1 + n, &r.dist)) return -1;
+        if (r.dist < 0) return sb_fail("%s:%d: limit distance must be >= 0 (0 = no limit)", c->path, c->line);
+        GROW(d->lrules, d->nlr);
+        d->lrules[d->nlr++] = r;
+    } else if (!strcmp(kw, "rest_shape")) {
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "modelled")) d->rest_modelled = 1;
+        else if (!strcmp(c->tok[1], "sag")) d->rest_modelled = 0;
+        else return sb_fail("%s:%d: unknown rest shape '%s' (want modelled or sag)", c->path, c->line, c->tok[1]);
     } else if (!strcmp(kw, "element")) {
         if (nargs(c, 1)) return -1;
         if (!strcmp(c->tok[1], "incompatible")) d->element = SB_ELEM_INCOMPATIBLE;
@@ -217,6 +252,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->h = 1.0 / 60.0; d->cg_def = 16; d->cg_max = 64;
     d->g[1] = -9.81;
     d->element = SB_ELEM_INCOMPATIBLE;
+    d->bone_radius = -1;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
     memset(&c, 0, sizeof c);
@@ -249,6 +285,9 @@ int sb_desc_load(const char *path, sb_desc *d)
         if (jt->parent == i) return sb_fail("%s:%d: joint '%s' is its own parent", path, jt->line, jt->name);
     }
     if (j != 1) return sb_fail("%s: want exactly one root joint (parent '-'), got %d", path, j);
+    for (i = 0; i < d->nj; i++)
+        if (d->joints[i].bone_line && d->joints[i].parent < 0)
+            return sb_fail("%s:%d: '%s' is the root: a bone is named by its child joint", path, d->joints[i].bone_line, d->joints[i].name);
     for (i = 0; i < d->nj; i++) {   /* cycle check: walking up must reach the root within nj steps */
         int p = i, steps = 0;
         while (p >= 0 && steps <= d->nj) { p = d->joints[p].parent; steps++; }
@@ -259,6 +298,6 @@ int sb_desc_load(const char *path, sb_desc *d)
 
 void sb_desc_free(sb_desc *d)
 {
-    free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins);
+    free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins); free(d->lrules);
     memset(d, 0, sizeof *d);
 }

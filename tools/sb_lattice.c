@@ -1,14 +1,15 @@
-/* sb_lattice.c -- automatic control lattice (seed 000 §3.1): a regular grid of
- * cubes covering the mesh, bones realised as chains of lattice edges whose
- * vertices are moved exactly onto the bone (condition ii), kept cells = those
- * meeting the interior, free/skeleton split, frames (seed 003 §3.3), surface
- * embedding by inverse trilinear map. */
+/* sb_lattice.c -- automatic control lattice (seed 000 §3.1) with volumetric
+ * bones: an undistorted grid of cubes covering the mesh (grid vertices are
+ * never moved, so no cell can fold); kept cells = those meeting the interior
+ * (or holding a mesh vertex, a joint or a bone sample); skeleton vertices =
+ * lattice vertices a bone captures (its rasterized chain and every vertex
+ * within its radius; the nearest segment wins); frames (seed 003 §3.3) at
+ * vertices and cell centres; surface embedding; model checks. */
 #include "sb.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 
 void sb_shape(const double t[3], double N[8], double dN[8][3])
 {
@@ -60,31 +61,6 @@ static double det3(double J[3][3])
            J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
 }
 
-/* Newton on x(t) = q; returns 1 if q is in the cell (t in [0,1]^3 up to round-off). */
-static int inverse_trilinear(const double *const xc[8], const double q[3], double c, double t[3])
-{
-    int it, a;
-    double p[3], J[3][3], r[3], dt[3], D;
-    t[0] = t[1] = t[2] = 0.5;
-    for (it = 0; it < 40; it++) {
-        corners_point(xc, t, p, J);
-        for (a = 0; a < 3; a++) r[a] = p[a] - q[a];
-        D = det3(J);
-        if (!(fabs(D) > 1e-300)) return 0;
-        /* Cramer's rule: J dt = r */
-        dt[0] = (r[0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (r[1] * J[2][2] - J[1][2] * r[2]) + J[0][2] * (r[1] * J[2][1] - J[1][1] * r[2])) / D;
-        dt[1] = (J[0][0] * (r[1] * J[2][2] - J[1][2] * r[2]) - r[0] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) + J[0][2] * (J[1][0] * r[2] - r[1] * J[2][0])) / D;
-        dt[2] = (J[0][0] * (J[1][1] * r[2] - r[1] * J[2][1]) - J[0][1] * (J[1][0] * r[2] - r[1] * J[2][0]) + r[0] * (J[1][0] * J[2][1] - J[1][1] * J[2][0])) / D;
-        for (a = 0; a < 3; a++) t[a] -= dt[a];
-        if (fabs(t[0]) > 10 || fabs(t[1]) > 10 || fabs(t[2]) > 10) return 0;
-        if (fabs(dt[0]) + fabs(dt[1]) + fabs(dt[2]) < 1e-15) break;
-    }
-    corners_point(xc, t, p, J);
-    for (a = 0; a < 3; a++) if (fabs(p[a] - q[a]) > 1e-9 * c) return 0;
-    for (a = 0; a < 3; a++) if (t[a] < -1e-9 || t[a] > 1 + 1e-9) return 0;
-    for (a = 0; a < 3; a++) t[a] = t[a] < 0 ? 0 : t[a] > 1 ? 1 : t[a];
-    return 1;
-}
 
 /* distance from p to segment a-b */
 static double seg_dist(const double p[3], const double a[3], const double b[3])
@@ -160,18 +136,143 @@ static void progress(const sb_model *o, double t0, const char *what, int done, i
         fprintf(stderr, "\rsinew-bake: %s %3d%%", what, (int)(100.0 * done / total));
 }
 
+
+/* grid cell (clamped) containing p, and the grid vertex nearest p */
+static int cell_of(const sb_model *o, const double p[3])
+{
+    int k, gi[3];
+    for (k = 0; k < 3; k++) {
+        gi[k] = (int)floor((p[k] - o->gorg[k]) / o->c);
+        gi[k] = gi[k] < 0 ? 0 : gi[k] > o->gn[k] - 2 ? o->gn[k] - 2 : gi[k];
+    }
+    return gi[0] + (o->gn[0] - 1) * (gi[1] + (o->gn[1] - 1) * gi[2]);
+}
+static int vertex_near(const sb_model *o, const double p[3])
+{
+    int k, gi[3];
+    for (k = 0; k < 3; k++) {
+        gi[k] = (int)floor((p[k] - o->gorg[k]) / o->c + 0.5);
+        gi[k] = gi[k] < 0 ? 0 : gi[k] > o->gn[k] - 1 ? o->gn[k] - 1 : gi[k];
+    }
+    return gidx(o, gi[0], gi[1], gi[2]);
+}
+
+static const double *seg_p(const sb_model *o, int a) { return o->joints[o->joints[o->seg_child[a]].parent].pos; }
+static const double *seg_c(const sb_model *o, int a) { return o->joints[o->seg_child[a]].pos; }
+
+/* samples along segment a every cell/8 or finer, ends included */
+static int seg_samples(const sb_model *o, int a)
+{
+    double L = 0;
+    int k;
+    for (k = 0; k < 3; k++) L += (seg_c(o, a)[k] - seg_p(o, a)[k]) * (seg_c(o, a)[k] - seg_p(o, a)[k]);
+    L = sqrt(L);
+    return (int)ceil(L / (o->c / 8)) > 1 ? (int)ceil(L / (o->c / 8)) : 1;
+}
+static void seg_point(const sb_model *o, int a, double t, double p[3])
+{
+    int k;
+    for (k = 0; k < 3; k++) p[k] = seg_p(o, a)[k] + t * (seg_c(o, a)[k] - seg_p(o, a)[k]);
+}
+
+/* Frame at rest point p (seed 003 §3.3): bone1/bone2 = the two nearest joints that
+ * move a bone (distance to the nearest of their child segments), w = 1/2 where they
+ * are equally near, falling smoothly (smoothstep) to 0 when bone2 is B farther
+ * (continuous where the nearest bone changes); 'frame' rules override. */
+static void frame_at(const sb_desc *d, const sb_model *o, const double p[3], double B, double *jd, int *fb1, int *fb2, double *fw)
+{
+    int j, a, b1 = 0, b2 = 0;
+    double d1 = HUGE_VAL, d2 = HUGE_VAL, w = 0;
+    for (j = 0; j < o->nj; j++) jd[j] = HUGE_VAL;
+    for (a = 0; a < o->nseg; a++) {
+        int pa = o->joints[o->seg_child[a]].parent;
+        double dd = seg_dist(p, seg_p(o, a), seg_c(o, a));
+        if (dd < jd[pa]) jd[pa] = dd;
+    }
+    for (j = 0; j < o->nj; j++) {
+        if (jd[j] < d1) { d2 = d1; b2 = b1; d1 = jd[j]; b1 = j; }
+        else if (jd[j] < d2) { d2 = jd[j]; b2 = j; }
+    }
+    if (d2 < HUGE_VAL) {
+        double s = 1.0 - (d2 - d1) / B;
+        s = s < 0 ? 0 : s > 1 ? 1 : s;
+        w = 0.5 * s * s * (3 - 2 * s);
+    } else b2 = b1;
+    if (w == 0) b2 = b1;
+    for (a = 0; a < d->nfr; a++)
+        if (sb_region_has(o, &d->frules[a].r, p)) {
+            b1 = o->desc_to_sorted[d->frules[a].j1]; b2 = o->desc_to_sorted[d->frules[a].j2]; w = d->frules[a].w;
+        }
+    *fb1 = b1; *fb2 = b2; *fw = w;
+}
+
+/* Flesh thickness of bone a: distance from the segment to the mesh surface, the
+ * smallest over 9 samples of its middle half (0 where the segment leaves the mesh). */
+static double flesh_thickness(const sb_model *o, const sb_mesh *m, const sb_inside *in, int a)
+{
+    double best = HUGE_VAL, p[3], q[3];
+    int s;
+    for (s = 0; s <= 8; s++) {
+        seg_point(o, a, 0.25 + 0.5 * s / 8.0, p);
+        if (!sb_inside_test(in, p)) return 0;
+        best = fmin(best, sb_mesh_closest(m, p, q));
+    }
+    return best;
+}
+
+/* every joint outside the mesh, each with its nearest surface point and a point just inside */
+static int joints_outside(const sb_desc *d, const sb_model *o, const sb_mesh *m, const sb_inside *in)
+{
+    char msg[16384];
+    size_t len = 0;
+    int k, nout = 0, pass;
+    for (k = 0; k < o->nj; k++) if (!sb_inside_test(in, o->joints[k].pos)) nout++;
+    if (!nout) return 0;
+    for (pass = 0; pass < 3; pass++) {   /* shorter entries if the message would not fit */
+        len = (size_t)snprintf(msg, sizeof msg, "%d joint(s) outside the mesh (every joint must lie inside):", nout);
+        for (k = 0; k < o->nj && len < sizeof msg; k++) {
+            const sb_joint *J = &o->joints[k];
+            double s[3], tryp[3], dist, step;
+            int e, found = 0;
+            if (sb_inside_test(in, J->pos)) continue;
+            if (pass == 2) { len += (size_t)snprintf(msg + len, sizeof msg - len, " '%s'", J->name); continue; }
+            dist = sb_mesh_closest(m, J->pos, s);
+            /* just past the nearest surface point, away from the joint */
+            for (step = 0.25 * o->c; step > 1e-6 * o->c && !found; step *= 0.5) {
+                for (e = 0; e < 3; e++) tryp[e] = s[e] + (dist > 0 ? (s[e] - J->pos[e]) / dist * step : 0);
+                found = sb_inside_test(in, tryp);
+            }
+            if (pass == 0 && found)
+                len += (size_t)snprintf(msg + len, sizeof msg - len, "\n  %s:%d: joint '%s' at (%g, %g, %g) is %.3g outside; nearest surface point (%.4g, %.4g, %.4g): move it inside, e.g. to (%.4g, %.4g, %.4g)",
+                                        d->path, J->line, J->name, J->pos[0], J->pos[1], J->pos[2], dist, s[0], s[1], s[2], tryp[0], tryp[1], tryp[2]);
+            else if (pass == 0)
+                len += (size_t)snprintf(msg + len, sizeof msg - len, "\n  %s:%d: joint '%s' at (%g, %g, %g) is %.3g outside; nearest surface point (%.4g, %.4g, %.4g): move it inside, past that point",
+                                        d->path, J->line, J->name, J->pos[0], J->pos[1], J->pos[2], dist, s[0], s[1], s[2]);
+            else
+                len += (size_t)snprintf(msg + len, sizeof msg - len, " '%s' (%.4g,%.4g,%.4g)->inside past (%.4g,%.4g,%.4g);", J->name, J->pos[0], J->pos[1], J->pos[2], s[0], s[1], s[2]);
+        }
+        if (len < 2000) break;   /* sb_fail keeps 2047 characters */
+    }
+    if (nout == o->nj)
+        snprintf(msg + (len < sizeof msg ? len : sizeof msg - 1), sizeof msg - (len < sizeof msg ? len : sizeof msg - 1),
+                 "\n  (no joint is inside: check that the skeleton and the mesh use the same units and axes)");
+    return sb_fail("%s", msg);
+}
+
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
 {
     sb_inside in;
     int i, j, k, a, nj = d->nj, ngv, ngc, n = d->subdiv, npt = n * n * n * 8;
-    int *gsnap = NULL, *gclaim = NULL, *keep = NULL, *order;
-    unsigned char *inbits = NULL;
-    double c = d->cell, t0 = sb_now(), *mindet = NULL;
+    int *keep = NULL, *order, *bestseg = NULL, *mark = NULL, *cellno = NULL, *fidx = NULL, q;
+    unsigned char *used = NULL;
+    double *frac = NULL, c = d->cell, t0 = sb_now(), *bestd = NULL, *jd = NULL, B = d->blend > 0 ? d->blend : d->cell;
     int rc = -1;
 
     memset(o, 0, sizeof *o);
     o->quiet = quiet;
     o->unit = d->unit; o->h = d->h; o->alpha = d->alpha; o->beta = d->beta; o->cg_def = d->cg_def; o->cg_max = d->cg_max;
+    o->rest_modelled = d->rest_modelled;
+    o->mesh_volume = sb_mesh_volume(m) * d->unit * d->unit * d->unit;
     for (k = 0; k < 3; k++) o->g[k] = d->g[k];
     {
         double dd = 0;
@@ -197,17 +298,12 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
         o->joints[k].parent = d->joints[order[k]].parent < 0 ? -1 : o->desc_to_sorted[d->joints[order[k]].parent];
     }
     free(order);
-    for (k = 0; k < nj; k++)
-        if (!sb_inside_test(&in, o->joints[k].pos)) {
-            sb_fail("%s:%d: joint '%s' at (%g, %g, %g) is outside the mesh", d->path, o->joints[k].line, o->joints[k].name,
-                    o->joints[k].pos[0], o->joints[k].pos[1], o->joints[k].pos[2]);
-            goto done;
-        }
+    o->c = c;
+    if (joints_outside(d, o, m, &in)) goto done;
     o->seg_child = sb_alloc(sizeof(int) * (size_t)nj);
-    for (k = 1; k < nj; k++) o->seg_child[o->nseg++] = k;
+    for (k = 1; k < nj; k++) o->seg_child[o->nseg++] = k;   /* segment a ends at sorted joint a + 1 */
 
     /* 2. grid: cubes of edge c aligned to the origin (default: the root joint), one cell of margin */
-    o->c = c;
     {
         double org[3];
         for (k = 0; k < 3; k++) {
@@ -225,7 +321,6 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     o->gpos = sb_alloc(sizeof(double) * 3 * (size_t)ngv);
     o->gjoint = sb_alloc(sizeof(int) * (size_t)ngv);
     o->gvert = sb_alloc(sizeof(int) * (size_t)ngv);
-    gclaim = sb_alloc(sizeof(int) * (size_t)ngv);
     for (k = 0; k < o->gn[2]; k++)
         for (j = 0; j < o->gn[1]; j++)
             for (i = 0; i < o->gn[0]; i++) {
@@ -233,211 +328,237 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
                 o->gpos[3 * g] = o->gorg[0] + i * c;
                 o->gpos[3 * g + 1] = o->gorg[1] + j * c;
                 o->gpos[3 * g + 2] = o->gorg[2] + k * c;
-                o->gjoint[g] = -1; o->gvert[g] = -1; gclaim[g] = -1;
+                o->gjoint[g] = -1; o->gvert[g] = -1;
             }
 
-    /* 3. bones as lattice edge chains: snap joints to the nearest grid vertex,
-     * walk grid edges staying closest to the segment, move the chain onto it */
-    gsnap = sb_alloc(sizeof(int) * (size_t)nj);
-    if (o->nseg > 0) {
-        for (j = 0; j < nj; j++) {
-            int gi[3];
-            for (k = 0; k < 3; k++) gi[k] = (int)floor((o->joints[j].pos[k] - o->gorg[k]) / c + 0.5);
-            gsnap[j] = gidx(o, gi[0], gi[1], gi[2]);
-            for (i = 0; i < j; i++)
-                if (gsnap[i] == gsnap[j]) {
-                    int pc = o->joints[j].parent == i;
-                    double L = 0;
-                    for (k = 0; k < 3; k++) L += (o->joints[j].pos[k] - o->joints[i].pos[k]) * (o->joints[j].pos[k] - o->joints[i].pos[k]);
-                    if (pc) sb_fail("%s:%d: bone '%s'->'%s' (length %g) is too short for cell size %g: both ends snap to the same lattice vertex; use a cell below %g",
-                                    d->path, o->joints[j].line, o->joints[i].name, o->joints[j].name, sqrt(L), c, sqrt(L) * 0.7);
-                    else sb_fail("%s:%d: joints '%s' and '%s' snap to the same lattice vertex (distance %g, cell size %g); move one or use a smaller cell",
-                                 d->path, o->joints[j].line, o->joints[i].name, o->joints[j].name, sqrt(L), c);
-                    goto done;
-                }
-            /* a joint's vertex moves with its parent (the bone ending there), the root with itself */
-            o->gjoint[gsnap[j]] = o->joints[j].parent < 0 ? 0 : o->joints[j].parent;
-            gclaim[gsnap[j]] = -2 - j;
-            memcpy(o->gpos + 3 * gsnap[j], o->joints[j].pos, sizeof(double) * 3);
-        }
-        for (a = 0; a < o->nseg; a++) {
-            int ch = o->seg_child[a], pa = o->joints[ch].parent, cur[3], tgt[3], path[4096], L = 0, p;
-            double spos[4096];
-            const double *P = o->joints[pa].pos, *C = o->joints[ch].pos;
-            cur[0] = gsnap[pa] % o->gn[0]; cur[1] = (gsnap[pa] / o->gn[0]) % o->gn[1]; cur[2] = gsnap[pa] / (o->gn[0] * o->gn[1]);
-            tgt[0] = gsnap[ch] % o->gn[0]; tgt[1] = (gsnap[ch] / o->gn[0]) % o->gn[1]; tgt[2] = gsnap[ch] / (o->gn[0] * o->gn[1]);
-            path[L++] = gsnap[pa];
-            while (cur[0] != tgt[0] || cur[1] != tgt[1] || cur[2] != tgt[2]) {
-                int bestax = -1;
-                double bd = HUGE_VAL;
-                for (k = 0; k < 3; k++) {
-                    double q[3], dd;
-                    int nx[3] = {cur[0], cur[1], cur[2]}, gn;
-                    if (cur[k] == tgt[k]) continue;
-                    nx[k] += tgt[k] > cur[k] ? 1 : -1;
-                    gn = gidx(o, nx[0], nx[1], nx[2]);
-                    q[0] = o->gorg[0] + nx[0] * c; q[1] = o->gorg[1] + nx[1] * c; q[2] = o->gorg[2] + nx[2] * c;
-                    dd = seg_dist(q, P, C);
-                    /* steer around vertices other bones already own (a large penalty, not a ban:
-                     * if every step is taken the conflict is reported below) */
-                    if (gn != gsnap[ch] && gclaim[gn] != -1) dd += 1e6 * c;
-                    if (dd < bd - 1e-12 * c) { bd = dd; bestax = k; }
-                }
-                cur[bestax] += tgt[bestax] > cur[bestax] ? 1 : -1;
-                if (L >= 4095) { sb_fail("%s: bone too long for the lattice", d->path); goto done; }
-                path[L++] = gidx(o, cur[0], cur[1], cur[2]);
-            }
-            {   /* where the chain's vertices go on the segment: the projection of each grid vertex
-                 * (smallest moves, so the least cell distortion), kept strictly increasing with a
-                 * minimum gap of a quarter of the even spacing */
-                double L2 = 0, gap = 0.25 / (double)(L - 1);
-                for (k = 0; k < 3; k++) L2 += (C[k] - P[k]) * (C[k] - P[k]);
-                spos[0] = 0; spos[L - 1] = 1;
-                for (p = 1; p < L - 1; p++) {
-                    double dp = 0;
-                    for (k = 0; k < 3; k++) dp += (o->gpos[3 * path[p] + k] - P[k]) * (C[k] - P[k]);
-                    spos[p] = dp / L2;
-                    if (spos[p] < spos[p - 1] + gap) spos[p] = spos[p - 1] + gap;
-                    if (spos[p] > 1 - (double)(L - 1 - p) * gap) spos[p] = 1 - (double)(L - 1 - p) * gap;
-                }
-            }
-            for (p = 1; p < L - 1; p++) {
-                int g = path[p];
-                if (gclaim[g] != -1) {
-                    const char *other = gclaim[g] <= -2 ? o->joints[-2 - gclaim[g]].name : o->joints[o->seg_child[gclaim[g]]].name;
-                    sb_fail("%s:%d: bone '%s'->'%s' and %s '%s' claim the same lattice vertex near (%g, %g, %g); move a joint or change the cell size (now %g)",
-                            d->path, o->joints[ch].line, o->joints[pa].name, o->joints[ch].name, gclaim[g] <= -2 ? "joint" : "the bone ending at",
-                            other, o->gpos[3 * g], o->gpos[3 * g + 1], o->gpos[3 * g + 2], c);
-                    goto done;
-                }
-                gclaim[g] = a;
-                o->gjoint[g] = pa;
-                for (k = 0; k < 3; k++) o->gpos[3 * g + k] = P[k] + (C[k] - P[k]) * spos[p];
-            }
-        }
-    }
-
-    /* 4. which quadrature points of each grid cell are inside the mesh */
-    inbits = sb_alloc((size_t)ngc * (size_t)npt);
-    mindet = sb_alloc(sizeof(double) * (size_t)ngc);
+    /* 3. inside fraction of every quadrature point's box (the octant of its sub-box,
+     * edge hb = c / 2n). Cells no triangle's bounding box touches are wholly inside or
+     * outside (one point test). In the others, +x rays on a grid of lines at most
+     * (bbox extent)/2000 apart give the inside length along x exactly; a point's
+     * fraction = mean inside length / hb over the lines through its box. */
     o->cell_fill = sb_alloc(sizeof(double) * (size_t)ngc);
     keep = sb_alloc(sizeof(int) * (size_t)ngc);
-    for (a = 0; a < ngc; a++) {
-        int g[8], q = 0, sx, sy, sz, gp;
-        const double *xc[8];
-        double vin = 0, vall = 0;
-        static const double gp2[2] = {0.21132486540518711775, 0.78867513459481288225};  /* 2-point Gauss on [0,1] */
-        cell_corners(o, a, g);
-        for (k = 0; k < 8; k++) xc[k] = o->gpos + 3 * g[k];
-        mindet[a] = HUGE_VAL;
-        /* inversion check independent of the quadrature: Jacobian on a 9x9x9 grid including the corners */
-        for (k = 0; k < 729; k++) {
-            double t[3], p[3], J[3][3], D;
-            t[0] = (k % 9) / 8.0; t[1] = (k / 9 % 9) / 8.0; t[2] = (k / 81) / 8.0;
-            corners_point(xc, t, p, J);
-            D = det3(J);
-            if (D < mindet[a]) mindet[a] = D;
-        }
-        for (sz = 0; sz < n; sz++) for (sy = 0; sy < n; sy++) for (sx = 0; sx < n; sx++)
-            for (gp = 0; gp < 8; gp++, q++) {
-                double t[3], p[3], J[3][3], D;
-                t[0] = (sx + gp2[gp & 1]) / n; t[1] = (sy + gp2[(gp >> 1) & 1]) / n; t[2] = (sz + gp2[(gp >> 2) & 1]) / n;
-                corners_point(xc, t, p, J);
-                D = det3(J);
-                if (D < mindet[a]) mindet[a] = D;
-                inbits[(size_t)a * (size_t)npt + (size_t)q] = (unsigned char)sb_inside_test(&in, p);
-                vall += D;
-                if (inbits[(size_t)a * (size_t)npt + (size_t)q]) vin += D;
+    fidx = sb_alloc(sizeof(int) * (size_t)ngc);
+    {
+        int nx = o->gn[0] - 1, ny = o->gn[1] - 1, nz = o->gn[2] - 1, cap = 256, cy, cz, nsurf = 0, t, mm;
+        double *xs = sb_alloc(sizeof(double) * (size_t)cap), hb = c / (2 * n), ext = 0, inv;
+        unsigned char *rowsurf = sb_alloc((size_t)(ny * nz));
+        for (k = 0; k < 3; k++) ext = fmax(ext, m->hi[k] - m->lo[k]);
+        mm = (int)ceil(hb / (ext / 2000));
+        mm = mm < 1 ? 1 : mm > 64 ? 64 : mm;
+        inv = 1.0 / ((double)mm * mm * hb);
+        for (a = 0; a < ngc; a++) fidx[a] = -3;
+        for (t = 0; t < m->nt; t++) {   /* surface cells: inside a triangle's bounding box */
+            int lo3[3], hi3[3], x, y, z;
+            for (k = 0; k < 3; k++) {
+                const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1], *v2 = m->v + 3 * m->tri[3 * t + 2];
+                double l = fmin(v0[k], fmin(v1[k], v2[k])), h = fmax(v0[k], fmax(v1[k], v2[k]));
+                lo3[k] = (int)floor((l - o->gorg[k]) / c - 1e-9); hi3[k] = (int)floor((h - o->gorg[k]) / c + 1e-9);
+                lo3[k] = lo3[k] < 0 ? 0 : lo3[k]; hi3[k] = hi3[k] > o->gn[k] - 2 ? o->gn[k] - 2 : hi3[k];
             }
-        o->cell_fill[a] = vall > 0 ? vin / vall : 0;
-        keep[a] = vin > 0 && o->cell_fill[a] >= d->min_fill;
-        if ((a & 63) == 0) progress(o, t0, "inside test", a, ngc);
+            for (z = lo3[2]; z <= hi3[2]; z++) for (y = lo3[1]; y <= hi3[1]; y++) for (x = lo3[0]; x <= hi3[0]; x++)
+                fidx[x + nx * (y + ny * z)] = -4;
+        }
+        for (a = 0; a < ngc; a++) {
+            if (fidx[a] == -4) { fidx[a] = nsurf++; rowsurf[a / nx] = 1; }
+            else {
+                int g[8];
+                double p[3];
+                cell_corners(o, a, g);
+                for (k = 0; k < 3; k++) p[k] = o->gpos[3 * g[0] + k] + 0.5 * c;
+                fidx[a] = sb_inside_test(&in, p) ? -2 : -1;
+            }
+        }
+        for (a = 0, q = 0; a < ngc; a++) q += fidx[a] == -2;
+        if (q + nsurf / 4 > 65535) {   /* more kept cells than a 65535-vertex lattice can have: stop before the costly part */
+            sb_fail("%s: cell size %g is too small for this mesh (%d cells inside, %d on the surface; a lattice holds at most 65535 vertices): "
+                    "use a cell of about %.3g or more", d->path, c, q, nsurf, c * pow((q + nsurf / 4) / 50000.0, 1.0 / 3.0));
+            free(xs); free(rowsurf);
+            goto done;
+        }
+        frac = sb_alloc(sizeof(double) * (size_t)npt * (size_t)(nsurf ? nsurf : 1));
+        for (cz = 0; cz < nz; cz++) {
+            for (cy = 0; cy < ny; cy++) {
+                const double *c0 = o->gpos + 3 * gidx(o, 0, cy, cz);
+                int py, pz, u, v;
+                if (!rowsurf[cy + ny * cz]) continue;
+                for (pz = 0; pz < 2 * n; pz++) for (v = 0; v < mm; v++) for (py = 0; py < 2 * n; py++) for (u = 0; u < mm; u++) {
+                    double y = c0[1] + (py + (u + 0.5) / mm) * hb, z = c0[2] + (pz + (v + 0.5) / mm) * hb;
+                    int nxs = sb_inside_ray(&in, y, z, xs, cap), e;
+                    if (nxs > cap) { cap = nxs; free(xs); xs = sb_alloc(sizeof(double) * (size_t)cap); sb_inside_ray(&in, y, z, xs, cap); }
+                    for (e = 1; e < nxs; e++) {   /* sort the crossings (few) */
+                        double xv = xs[e];
+                        int f = e;
+                        for (; f > 0 && xs[f - 1] > xv; f--) xs[f] = xs[f - 1];
+                        xs[f] = xv;
+                    }
+                    /* inside = an odd number of crossings beyond x, within the mesh's x range */
+                    for (e = nxs - 1; e >= 1; e -= 2) {
+                        double xa = xs[e - 1] > m->lo[0] ? xs[e - 1] : m->lo[0], xb = xs[e] < m->hi[0] ? xs[e] : m->hi[0];
+                        int px, p0, p1, nb = 2 * n;
+                        if (!(xb > xa)) continue;
+                        p0 = (int)floor((xa - c0[0]) / hb); p1 = (int)floor((xb - c0[0]) / hb);
+                        p0 = p0 < 0 ? 0 : p0; p1 = p1 > nb * nx - 1 ? nb * nx - 1 : p1;
+                        for (px = p0; px <= p1; px++) {
+                            int i = px / nb, bx = px % nb, gc = i + nx * (cy + ny * cz), qq;
+                            double b0, b1, len;
+                            if (fidx[gc] < 0) { px = (i + 1) * nb - 1; continue; }   /* not a surface cell: skip it */
+                            b0 = o->gpos[3 * gidx(o, i, cy, cz)] + bx * hb; b1 = b0 + hb;
+                            len = (xb < b1 ? xb : b1) - (xa > b0 ? xa : b0);
+                            if (len <= 0) continue;
+                            qq = (((pz >> 1) * n + (py >> 1)) * n + (bx >> 1)) * 8 + (bx & 1) + 2 * (py & 1) + 4 * (pz & 1);
+                            frac[(size_t)fidx[gc] * (size_t)npt + (size_t)qq] += len * inv;
+                        }
+                    }
+                }
+            }
+            progress(o, t0, "inside test", cz, nz);
+        }
+        for (a = 0; a < ngc; a++) {
+            double sum = 0;
+            if (fidx[a] >= 0) {
+                double *f = frac + (size_t)fidx[a] * (size_t)npt;
+                for (q = 0; q < npt; q++) { f[q] = f[q] > 1 ? 1 : f[q]; sum += f[q]; }   /* round-off */
+            } else sum = fidx[a] == -2 ? npt : 0;
+            o->cell_fill[a] = sum / npt;   /* cubes: equal weights */
+            keep[a] = sum >= 1.0 && o->cell_fill[a] >= d->min_fill;   /* at least one quadrature point's worth inside */
+        }
+        free(xs); free(rowsurf);
     }
 
-    /* 5. surface embedding: each mesh vertex in a (preferably kept) cell */
+    /* 4. cells a bone needs: those holding a joint or a bone sample inside the mesh */
+    for (a = 0; a < o->nseg; a++) {
+        int s, ns = seg_samples(o, a);
+        for (s = 0; s <= ns; s++) {
+            double p[3];
+            seg_point(o, a, (double)s / ns, p);
+            if (s == 0 || s == ns || sb_inside_test(&in, p)) keep[cell_of(o, p)] = 1;
+        }
+    }
+
+    /* 5. surface embedding: each mesh vertex in its grid cell (t = offset / c), preferring a
+     * kept neighbour when the vertex lies on a cell face; that cell is kept */
     o->ns = m->nv;
     o->emb_cell = sb_alloc(sizeof(int) * (size_t)m->nv);
     o->emb_t = sb_alloc(sizeof(double) * 3 * (size_t)m->nv);
     for (i = 0; i < m->nv; i++) {
         const double *q = m->v + 3 * i;
-        int gi[3], found = -1, pass, di, dj, dk;
-        double t[3], tf[3] = {0, 0, 0};
-        for (k = 0; k < 3; k++) gi[k] = (int)floor((q[k] - o->gorg[k]) / c);
-        /* pass 0: kept cells nearby, pass 1: any cell nearby, pass 2: any cell within 2 (bone snapping
-         * moves vertices by up to ~0.9 cell) */
-        for (pass = 0; pass < 3 && found < 0; pass++)
-            for (dk = 0; dk < 5 && found < 0; dk++) for (dj = 0; dj < 5 && found < 0; dj++) for (di = 0; di < 5 && found < 0; di++) {
-                static const int off[5] = {0, -1, 1, -2, 2};
-                int ci = gi[0] + off[di], cj = gi[1] + off[dj], ck = gi[2] + off[dk], gc, g[8];
-                if ((pass < 2) && (di > 2 || dj > 2 || dk > 2)) continue;
-                const double *xc[8];
-                if (ci < 0 || cj < 0 || ck < 0 || ci >= o->gn[0] - 1 || cj >= o->gn[1] - 1 || ck >= o->gn[2] - 1) continue;
-                gc = ci + (o->gn[0] - 1) * (cj + (o->gn[1] - 1) * ck);
-                if ((pass == 0) != (keep[gc] != 0) && pass < 2) continue;
-                cell_corners(o, gc, g);
-                for (k = 0; k < 8; k++) xc[k] = o->gpos + 3 * g[k];
-                if (inverse_trilinear((const double *const *)xc, q, c, t)) { found = gc; memcpy(tf, t, sizeof t); }
+        int gc = cell_of(o, q), nx = o->gn[0] - 1, ny = o->gn[1] - 1, g0[3], best = -1, alt;
+        double t0c[3], tb[3];
+        g0[0] = gc % nx; g0[1] = gc / nx % ny; g0[2] = gc / (nx * ny);
+        for (k = 0; k < 3; k++) t0c[k] = (q[k] - o->gpos[3 * gidx(o, g0[0], g0[1], g0[2]) + k]) / c;
+        for (alt = 0; alt < 8 && best < 0; alt++) {   /* alt bit k: the neighbour across face k the vertex lies on */
+            int gi[3] = {g0[0], g0[1], g0[2]}, ok = 1, cc;
+            double t[3];
+            for (k = 0; k < 3; k++) {
+                t[k] = t0c[k];
+                if (alt >> k & 1) {
+                    if (t0c[k] < 1e-12 && gi[k] > 0) { gi[k]--; t[k] = 1; }
+                    else if (t0c[k] > 1 - 1e-12 && gi[k] < o->gn[k] - 2) { gi[k]++; t[k] = 0; }
+                    else ok = 0;
+                }
+                t[k] = t[k] < 0 ? 0 : t[k] > 1 ? 1 : t[k];
             }
-        if (found < 0) {
-            sb_fail("%s: mesh vertex %d at (%g, %g, %g) lies in no lattice cell: the lattice folds there after moving vertices onto "
-                    "the bones; try another cell size (e.g. %g or %g) or move the joints nearer lattice vertices",
-                    d->mesh_path, i + 1, q[0], q[1], q[2], c * 0.8, c * 1.2);
-            goto done;
+            if (!ok) continue;
+            if (alt == 0) memcpy(tb, t, sizeof t);
+            cc = gi[0] + nx * (gi[1] + ny * gi[2]);
+            if (keep[cc]) { best = cc; memcpy(tb, t, sizeof t); }
         }
-        keep[found] = 1;
-        o->emb_cell[i] = found;   /* grid cell for now; renumbered below */
-        memcpy(o->emb_t + 3 * i, tf, sizeof tf);
+        if (best < 0) best = gc;   /* no kept candidate: keep its own cell (tb holds its coordinates) */
+        keep[best] = 1;
+        o->emb_cell[i] = best;   /* grid cell for now; renumbered below */
+        memcpy(o->emb_t + 3 * i, tb, sizeof tb);
     }
 
-    /* 6. kept cells must not be inverted by the bone snapping */
+    /* 6. lattice vertices = corners of kept cells */
+    used = sb_alloc((size_t)ngv);
     for (a = 0; a < ngc; a++)
-        /* a zero Jacobian at a corner is expected where a bone chain turns (three chain vertices
-         * on one straight segment are corners of one face): only a negative one beyond round-off fails */
-        if (keep[a] && !(mindet[a] > -1e-9 * c * c * c)) {
-            int g[8];
-            double ctr[3] = {0, 0, 0};
-            cell_corners(o, a, g);
-            for (k = 0; k < 8; k++) for (j = 0; j < 3; j++) ctr[j] += o->gpos[3 * g[k] + j] / 8;
-            sb_fail("%s: lattice cell near (%.3g, %.3g, %.3g) is inverted after moving skeleton vertices onto the bones "
-                    "(Jacobian %.3g <= 0 inside the cell); try another cell size (e.g. %g or %g) or move the joints nearer lattice vertices",
-                    d->path, ctr[0], ctr[1], ctr[2], mindet[a], c * 0.8, c * 1.2);
+        if (keep[a]) { int g[8]; cell_corners(o, a, g); for (k = 0; k < 8; k++) used[g[k]] = 1; }
+
+    /* 7. bones: radius (given, or automatic = half the flesh thickness, at most a quarter of
+     * the bone's length), then capture (a) the rasterized chain: the grid vertex nearest each
+     * sample, (b) every lattice vertex within the radius. Several claims: the nearest segment
+     * wins (ties: the lower sorted joint index, i.e. the bone processed first). */
+    o->seg_r = sb_alloc(sizeof(double) * (size_t)(o->nseg + 1));
+    o->seg_flesh = sb_alloc(sizeof(double) * (size_t)(o->nseg + 1));
+    o->seg_auto = sb_alloc(sizeof(int) * (size_t)(o->nseg + 1));
+    o->seg_nv = sb_alloc(sizeof(int) * (size_t)(o->nseg + 1));
+    o->seg_ncap = sb_alloc(sizeof(int) * (size_t)(o->nseg + 1));
+    bestd = sb_alloc(sizeof(double) * (size_t)ngv);
+    bestseg = sb_alloc(sizeof(int) * (size_t)ngv);
+    mark = sb_alloc(sizeof(int) * (size_t)ngv);
+    for (i = 0; i < ngv; i++) { bestd[i] = HUGE_VAL; bestseg[i] = -1; mark[i] = -1; }
+    for (a = 0; a < o->nseg; a++) {
+        const sb_joint *J = &o->joints[o->seg_child[a]];
+        const double *P = seg_p(o, a), *C = seg_c(o, a);
+        double r, L = 0, lo[3], hi[3];
+        int s, ns = seg_samples(o, a), ilo[3], ihi[3], x, y, z;
+        for (k = 0; k < 3; k++) L += (C[k] - P[k]) * (C[k] - P[k]);
+        L = sqrt(L);
+        o->seg_flesh[a] = flesh_thickness(o, m, &in, a);
+        if (J->bone_r >= 0) r = J->bone_r;
+        else if (d->bone_radius >= 0) r = d->bone_radius;
+        else { r = fmax(fmin(0.5 * o->seg_flesh[a], 0.25 * L), 1.25 * c); o->seg_auto[a] = 1; }
+        o->seg_r[a] = r;
+        for (s = 0; s <= ns; s++) {
+            double p[3], dd;
+            int g;
+            seg_point(o, a, (double)s / ns, p);
+            g = vertex_near(o, p);
+            if (!used[g]) continue;
+            dd = seg_dist(o->gpos + 3 * g, P, C);
+            if (mark[g] != a) { mark[g] = a; o->seg_ncap[a]++; }
+            if (dd < bestd[g]) { bestd[g] = dd; bestseg[g] = a; }
+        }
+        for (k = 0; k < 3; k++) {
+            lo[k] = fmin(P[k], C[k]) - r; hi[k] = fmax(P[k], C[k]) + r;
+            ilo[k] = (int)ceil((lo[k] - o->gorg[k]) / c - 1e-9); ihi[k] = (int)floor((hi[k] - o->gorg[k]) / c + 1e-9);
+            if (ilo[k] < 0) ilo[k] = 0;
+            if (ihi[k] > o->gn[k] - 1) ihi[k] = o->gn[k] - 1;
+        }
+        for (z = ilo[2]; z <= ihi[2]; z++) for (y = ilo[1]; y <= ihi[1]; y++) for (x = ilo[0]; x <= ihi[0]; x++) {
+            int g = gidx(o, x, y, z);
+            double dd;
+            if (!used[g]) continue;
+            dd = seg_dist(o->gpos + 3 * g, P, C);
+            if (!(dd <= r + 1e-9 * c)) continue;
+            if (mark[g] != a) { mark[g] = a; o->seg_ncap[a]++; }
+            if (dd < bestd[g]) { bestd[g] = dd; bestseg[g] = a; }
+        }
+    }
+    for (i = 0; i < ngv; i++)
+        if (bestseg[i] >= 0) o->gjoint[i] = o->joints[o->seg_child[bestseg[i]]].parent;   /* a bone moves with its parent joint */
+    /* pins override */
+    for (a = 0; a < d->npin; a++)
+        for (i = 0; i < ngv; i++)
+            if (used[i] && sb_region_has(o, &d->pins[a].r, o->gpos + 3 * i)) { o->gjoint[i] = o->desc_to_sorted[d->pins[a].joint]; bestseg[i] = -2; }
+
+    /* 8. lattice vertices, free-first order */
+    {
+        int nskel = 0, nfree = 0;
+        cellno = sb_alloc(sizeof(int) * (size_t)ngc);
+        for (i = 0; i < ngv; i++) if (used[i]) { if (o->gjoint[i] < 0) nfree++; else nskel++; }
+        if (nfree + nskel > 65535) {
+            sb_fail("%s: %d lattice vertices (max 65535); use a larger cell (about %.3g)", d->path, nfree + nskel, c * pow((nfree + nskel) / 55000.0, 1.0 / 3.0));
             goto done;
         }
-
-    o->min_jac = HUGE_VAL;
-    for (a = 0; a < ngc; a++) if (keep[a] && mindet[a] / (c * c * c) < o->min_jac) o->min_jac = mindet[a] / (c * c * c);
-
-    /* 7. lattice vertices, pins, free-first order */
-    {
-        unsigned char *used = sb_alloc((size_t)ngv);
-        int nskel = 0, nfree = 0, *cellno = sb_alloc(sizeof(int) * (size_t)ngc);
-        for (a = 0; a < ngc; a++)
-            if (keep[a]) { int g[8]; cell_corners(o, a, g); for (k = 0; k < 8; k++) used[g[k]] = 1; }
-        for (i = 0; i < ngv; i++)
-            if (gclaim[i] != -1 && !used[i]) {
-                sb_fail("%s: a bone passes through (%g, %g, %g), which is outside the mesh's lattice; keep bones inside the mesh",
-                        d->path, o->gpos[3 * i], o->gpos[3 * i + 1], o->gpos[3 * i + 2]);
-                free(used); free(cellno); goto done;
-            }
-        for (a = 0; a < d->npin; a++)
-            for (i = 0; i < ngv; i++)
-                if (used[i] && gclaim[i] == -1) {
-                    sb_region r = d->pins[a].r;
-                    if (sb_region_has(o, &r, o->gpos + 3 * i)) o->gjoint[i] = o->desc_to_sorted[d->pins[a].joint];
-                }
-        for (i = 0; i < ngv; i++) if (used[i]) { if (o->gjoint[i] < 0) nfree++; else nskel++; }
-        if (nfree + nskel > 65535) { sb_fail("%s: %d lattice vertices (max 65535); use a larger cell", d->path, nfree + nskel); free(used); free(cellno); goto done; }
-        if (nskel == 0) { sb_fail("%s: no skeleton vertices: add a bone (two joints) or a 'pin' region", d->path); free(used); free(cellno); goto done; }
-        if (nfree == 0) { sb_fail("%s: no free vertices: every lattice vertex is on the skeleton", d->path); free(used); free(cellno); goto done; }
+        if (nskel == 0) { sb_fail("%s: no skeleton vertices: add a bone (two joints) or a 'pin' region", d->path); goto done; }
+        if (nfree == 0) {
+            sb_fail("%s: no free vertices: the bones (and pins) hold every lattice vertex; use smaller bone radii ('bone_radius R') or a smaller cell (now %g)", d->path, c);
+            goto done;
+        }
         o->nv = nfree + nskel; o->nf = nfree;
         o->v_grid = sb_alloc(sizeof(int) * (size_t)o->nv);
         o->x = sb_alloc(sizeof(double) * 3 * (size_t)o->nv);
+        o->vseg = sb_alloc(sizeof(int) * (size_t)o->nv);
         nfree = 0; nskel = o->nf;
         for (i = 0; i < ngv; i++)
             if (used[i]) {
                 int v = o->gjoint[i] < 0 ? nfree++ : nskel++;
                 o->gvert[i] = v; o->v_grid[v] = i;
                 memcpy(o->x + 3 * v, o->gpos + 3 * i, sizeof(double) * 3);
+                o->vseg[v] = o->gjoint[i] < 0 ? -1 : bestseg[i];
+                if (o->vseg[v] >= 0) o->seg_nv[o->vseg[v]]++;
             }
         for (a = 0; a < ngc; a++) if (keep[a]) o->nc++;
         o->cells = sb_alloc(sizeof(int) * 8 * (size_t)o->nc);
@@ -456,48 +577,55 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
             free(o->cell_fill);
             o->cell_fill = fill;
         }
-        free(used); free(cellno);
+    }
+    for (a = 0; a < o->nseg; a++)   /* cannot happen while the joints are inside (their cells are kept); a safety net */
+        if (o->seg_ncap[a] == 0)
+            fprintf(stderr, "sinew-bake: warning: %s:%d: bone '%s'->'%s' captures no lattice vertex; its flesh follows the neighbouring bones\n",
+                    d->path, o->joints[o->seg_child[a]].line, o->joints[o->joints[o->seg_child[a]].parent].name, o->joints[o->seg_child[a]].name);
+
+    /* 9. sanity check: every kept cell is an undistorted cube (Jacobian c^3 at its centre
+     * and corners); the grid is never moved, so a failure is an internal error */
+    o->min_jac = HUGE_VAL;
+    for (a = 0; a < o->nc; a++) {
+        const double *xc[8];
+        for (k = 0; k < 8; k++) xc[k] = o->x + 3 * o->cells[8 * a + k];
+        for (k = 0; k < 9; k++) {
+            double t[3], p[3], J[3][3], D;
+            int e;
+            for (e = 0; e < 3; e++) t[e] = k == 8 ? 0.5 : (k >> e & 1);
+            corners_point(xc, t, p, J);
+            D = det3(J) / (c * c * c);
+            if (D < o->min_jac) o->min_jac = D;
+            if (!(fabs(D - 1) < 1e-6)) { sb_fail("%s: internal error: lattice cell %d is not a cube (Jacobian %g of c^3)", d->path, a, D); goto done; }
+        }
     }
 
-    /* 8. frames (seed 003 §3.3): two nearest bone-moving joints, blend weight from distances */
+    /* 10. frames (seed 003 §3.3): skeleton vertices move with their joint; free vertices
+     * and cell centres by the rule in frame_at */
     o->fb1 = sb_alloc(sizeof(int) * (size_t)o->nv);
     o->fb2 = sb_alloc(sizeof(int) * (size_t)o->nv);
     o->fw = sb_alloc(sizeof(double) * (size_t)o->nv);
-    {
-        double *jd = sb_alloc(sizeof(double) * (size_t)nj), B = d->blend > 0 ? d->blend : c;
-        for (i = 0; i < o->nv; i++) {
-            const double *p = o->x + 3 * i;
-            int g = o->v_grid[i], b1 = 0, b2 = 0;
-            double d1 = HUGE_VAL, d2 = HUGE_VAL, w = 0;
-            if (i >= o->nf) { o->fb1[i] = o->fb2[i] = o->gjoint[g]; o->fw[i] = 0; continue; }
-            for (j = 0; j < nj; j++) jd[j] = HUGE_VAL;
-            for (a = 0; a < o->nseg; a++) {
-                int ch = o->seg_child[a], pa = o->joints[ch].parent;
-                double dd = seg_dist(p, o->joints[pa].pos, o->joints[ch].pos);
-                if (dd < jd[pa]) jd[pa] = dd;
-            }
-            for (j = 0; j < nj; j++) {
-                if (jd[j] < d1) { d2 = d1; b2 = b1; d1 = jd[j]; b1 = j; }
-                else if (jd[j] < d2) { d2 = jd[j]; b2 = j; }
-            }
-            if (d2 < HUGE_VAL) {
-                /* w = 1/2 at equal distance, falling smoothly (smoothstep) to 0 when the
-                 * second bone is B farther than the first: continuous across the switch */
-                double s = 1.0 - (d2 - d1) / B;
-                s = s < 0 ? 0 : s > 1 ? 1 : s;
-                w = 0.5 * s * s * (3 - 2 * s);
-            } else b2 = b1;
-            if (w == 0) b2 = b1;
-            for (a = 0; a < d->nfr; a++)
-                if (sb_region_has(o, &d->frules[a].r, p)) {
-                    b1 = o->desc_to_sorted[d->frules[a].j1]; b2 = o->desc_to_sorted[d->frules[a].j2]; w = d->frules[a].w;
-                }
-            o->fb1[i] = b1; o->fb2[i] = b2; o->fw[i] = w;
-        }
-        free(jd);
+    o->cfb1 = sb_alloc(sizeof(int) * (size_t)o->nc);
+    o->cfb2 = sb_alloc(sizeof(int) * (size_t)o->nc);
+    o->cfw = sb_alloc(sizeof(double) * (size_t)o->nc);
+    jd = sb_alloc(sizeof(double) * (size_t)nj);
+    for (i = 0; i < o->nv; i++) {
+        if (i >= o->nf) { o->fb1[i] = o->fb2[i] = o->gjoint[o->v_grid[i]]; o->fw[i] = 0; continue; }
+        frame_at(d, o, o->x + 3 * i, B, jd, &o->fb1[i], &o->fb2[i], &o->fw[i]);
+    }
+    for (a = 0; a < o->nc; a++) {
+        double p[3];
+        for (k = 0; k < 3; k++) p[k] = o->x[3 * o->cells[8 * a] + k] + 0.5 * c;
+        frame_at(d, o, p, B, jd, &o->cfb1[a], &o->cfb2[a], &o->cfw[a]);
     }
 
-    /* 9. block sparsity pattern: vertices sharing a cell */
+    /* 11. limits at rest positions, later rules override */
+    o->limit = sb_alloc(sizeof(double) * (size_t)o->nv);
+    for (a = 0; a < d->nlr; a++)
+        for (i = 0; i < o->nv; i++)
+            if (sb_region_has(o, &d->lrules[a].r, o->x + 3 * i)) o->limit[i] = d->lrules[a].dist;
+
+    /* 12. block sparsity pattern: vertices sharing a cell */
     {
         int *cnt = sb_alloc(sizeof(int) * (size_t)(o->nv + 1)), *tmp = sb_alloc(sizeof(int) * 27 * 8 * (size_t)o->nv);
         int *vc = sb_alloc(sizeof(int) * 8 * (size_t)o->nv);   /* cells per vertex (<= 8) */
@@ -518,10 +646,11 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     }
     o->M = sb_alloc(sizeof(double) * (size_t)o->nbptr[o->nv]);
     o->S = sb_alloc(sizeof(double) * 9 * (size_t)o->nbptr[o->nv]);
-    o->T = sb_alloc(sizeof(double) * (size_t)o->nbptr[o->nv]);
+    o->T = sb_alloc(sizeof(double) * (size_t)o->nbptr[o->nv]);   /* twist retired: stays 0 */
+    o->Se = sb_alloc(sizeof(double) * 576 * (size_t)o->nc);
 
-    /* 10. integrals */
-    if (sb_integrate(d, o, inbits)) goto done;
+    /* 13. integrals */
+    if (sb_integrate_frac(d, o, frac, fidx)) goto done;
 
     o->nt = m->nt;
     o->tri = sb_alloc(sizeof(int) * 3 * (size_t)m->nt);
@@ -530,7 +659,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
 done:
     if (!quiet && sb_now() - t0 > 1.0) fprintf(stderr, "\n");
     sb_inside_free(&in);
-    free(gsnap); free(gclaim); free(keep); free(inbits); free(mindet);
+    free(keep); free(frac); free(fidx); free(used); free(bestd); free(bestseg); free(mark); free(cellno); free(jd);
     return rc;
 }
 
@@ -539,5 +668,46 @@ void sb_model_free(sb_model *o)
     free(o->joints); free(o->desc_to_sorted); free(o->seg_child); free(o->gpos); free(o->gjoint); free(o->gvert);
     free(o->v_grid); free(o->x); free(o->cells); free(o->cell_grid); free(o->cell_fill); free(o->fb1); free(o->fb2); free(o->fw);
     free(o->nbptr); free(o->nb); free(o->M); free(o->S); free(o->T); free(o->emb_cell); free(o->emb_t); free(o->tri);
+    free(o->Se); free(o->cfb1); free(o->cfb2); free(o->cfw); free(o->limit); free(o->vseg);
+    free(o->seg_r); free(o->seg_flesh); free(o->seg_auto); free(o->seg_nv); free(o->seg_ncap);
     memset(o, 0, sizeof *o);
+}
+
+int sb_model_check(const sb_model *o, const sb_mesh *m, sb_check *r)
+{
+    double maxS = 0, maxx = 0, trans = 0, rot = 0, worst = 0;
+    int i, e, k, a, b;
+    memset(r, 0, sizeof *r);
+    r->vol_ratio = o->mesh_volume > 0 ? o->inside_volume / o->mesh_volume : 0;
+    /* embedding with t quantized to Q15 as the blob stores it */
+    for (i = 0; i < o->ns && i < m->nv; i++) {
+        double t[3], p[3], dd = 0;
+        for (k = 0; k < 3; k++) t[k] = floor(o->emb_t[3 * i + k] * 32768.0 + 0.5) / 32768.0;
+        sb_cell_point(o, o->emb_cell[i], t, p);
+        for (k = 0; k < 3; k++) dd += (p[k] - m->v[3 * i + k]) * (p[k] - m->v[3 * i + k]);
+        worst = fmax(worst, sqrt(dd));
+    }
+    r->emb_err = worst / o->bbox_diag;
+    /* null space of the elastic stiffness: translations (block row sums) and rest rotations */
+    for (e = 0; e < o->nbptr[o->nv]; e++) for (k = 0; k < 9; k++) maxS = fmax(maxS, fabs(o->S[9 * (size_t)e + (size_t)k]));
+    for (i = 0; i < o->nv; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->x[3 * i + k] * o->unit));
+    for (i = 0; i < o->nv; i++)
+        for (a = 0; a < 3; a++) {
+            double ts[3] = {0, 0, 0}, rs[3] = {0, 0, 0};
+            for (e = o->nbptr[i]; e < o->nbptr[i + 1]; e++) {
+                const double *x = o->x + 3 * o->nb[e], *S = o->S + 9 * (size_t)e + 3 * (size_t)a;
+                for (b = 0; b < 3; b++) {   /* rotation about axis b: u = e_b x x (metres) */
+                    double u[3] = {0, 0, 0}, rr[3];
+                    u[b] = 1;
+                    ts[b] += S[b];
+                    rr[0] = u[1] * x[2] - u[2] * x[1]; rr[1] = u[2] * x[0] - u[0] * x[2]; rr[2] = u[0] * x[1] - u[1] * x[0];
+                    for (k = 0; k < 3; k++) rs[b] += S[k] * rr[k] * o->unit;
+                }
+            }
+            for (b = 0; b < 3; b++) { trans = fmax(trans, fabs(ts[b])); rot = fmax(rot, fabs(rs[b])); }
+        }
+    r->trans = maxS > 0 ? trans / maxS : 1;
+    r->rot = maxS > 0 && maxx > 0 ? rot / (maxS * maxx) : 1;
+    r->ok = fabs(r->vol_ratio - 1) <= 0.01 && r->emb_err <= 1e-5 && r->trans <= 1e-12 && r->rot <= 1e-11;
+    return r->ok ? 0 : -1;
 }

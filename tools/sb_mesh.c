@@ -37,52 +37,121 @@ static int edge_cmp(const void *x, const void *y)
     return p->face < q->face ? -1 : p->face > q->face;
 }
 
+/* edge set: open addressing on the unordered pair (a, b) */
+typedef struct { uint64_t *k; size_t cap; } eset_t;
+static uint64_t ekey(int a, int b) { return a < b ? ((uint64_t)(unsigned)a << 32 | (unsigned)b) : ((uint64_t)(unsigned)b << 32 | (unsigned)a); }
+static size_t eslot(const eset_t *s, uint64_t key)
+{
+    size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 17) & (s->cap - 1);
+    while (s->k[h] && s->k[h] != key + 1) h = (h + 1) & (s->cap - 1);
+    return h;
+}
+static int ehas(const eset_t *s, int a, int b) { return s->k[eslot(s, ekey(a, b))] != 0; }
+static void eadd(eset_t *s, int a, int b) { uint64_t key = ekey(a, b); s->k[eslot(s, key)] = key + 1; }
+
+/* Triangulate polygon p[0..n) as a fan from corner s0 whose diagonals are all new
+ * (neither a polygon edge of the mesh nor a diagonal made earlier): a fan whose
+ * diagonal repeats an edge makes that edge shared by 4 triangles. The first such
+ * start is taken (s0 = 0 when possible: a plain fan from the first corner). */
+static int fan_start(const eset_t *es, const int *p, int n)
+{
+    int s0, k;
+    for (s0 = 0; s0 < n; s0++) {
+        for (k = 2; k < n - 1; k++) if (ehas(es, p[s0], p[(s0 + k) % n])) break;
+        if (k >= n - 1) return s0;
+    }
+    return -1;
+}
+
 int sb_mesh_load_obj(const char *path, sb_mesh *m)
 {
     FILE *f = fopen(path, "r");
     char line[4096];
-    int lineno = 0, capv = 1024, capt = 1024, k, i;
+    int lineno = 0, capv = 1024, k, i;
+    int *pidx = NULL, *pstart = NULL, *pline = NULL, np = 0, capi = 4096, capp = 1024, ntri = 0;
     memset(m, 0, sizeof *m);
     if (!f) return sb_fail("%s: cannot open mesh: %s", path, strerror(errno));
     m->v = malloc(sizeof(double) * 3 * (size_t)capv);
-    m->tri = malloc(sizeof(int) * 3 * (size_t)capt);
-    if (!m->v || !m->tri) { fclose(f); return sb_fail("out of memory"); }
+    pidx = malloc(sizeof(int) * (size_t)capi);
+    pstart = malloc(sizeof(int) * (size_t)(capp + 1));
+    pline = malloc(sizeof(int) * (size_t)capp);
+    if (!m->v || !pidx || !pstart || !pline) { fclose(f); free(pidx); free(pstart); free(pline); return sb_fail("out of memory"); }
+    pstart[0] = 0;
+#define MESH_FAIL(...) do { fclose(f); free(pidx); free(pstart); free(pline); return sb_fail(__VA_ARGS__); } while (0)
     while (fgets(line, sizeof line, f)) {
         char *tok[64], *s;
         int nt = 0;
         lineno++;
-        if (!strchr(line, '\n') && !feof(f)) { fclose(f); return sb_fail("%s:%d: line too long", path, lineno); }
+        if (!strchr(line, '\n') && !feof(f)) MESH_FAIL("%s:%d: line too long", path, lineno);
         for (s = strtok(line, " \t\r\n"); s && nt < 64; s = strtok(NULL, " \t\r\n")) tok[nt++] = s;
         if (nt == 0 || tok[0][0] == '#') continue;
         if (!strcmp(tok[0], "v")) {
             double p[3];
-            if (nt < 4 || nt > 5) { fclose(f); return sb_fail("%s:%d: malformed vertex (want 'v x y z')", path, lineno); }
+            if (nt < 4 || nt > 5) MESH_FAIL("%s:%d: malformed vertex (want 'v x y z')", path, lineno);
             for (k = 0; k < 3; k++)
-                if (!parse_real(tok[1 + k], &p[k])) { fclose(f); return sb_fail("%s:%d: malformed vertex coordinate '%s'", path, lineno, tok[1 + k]); }
-            if (m->nv == capv) { capv *= 2; m->v = realloc(m->v, sizeof(double) * 3 * (size_t)capv); if (!m->v) { fclose(f); return sb_fail("out of memory"); } }
+                if (!parse_real(tok[1 + k], &p[k])) MESH_FAIL("%s:%d: malformed vertex coordinate '%s'", path, lineno, tok[1 + k]);
+            if (m->nv == capv) { capv *= 2; m->v = realloc(m->v, sizeof(double) * 3 * (size_t)capv); if (!m->v) MESH_FAIL("out of memory"); }
             memcpy(m->v + 3 * m->nv, p, sizeof p);
             m->nv++;
         } else if (!strcmp(tok[0], "f")) {
-            int idx[64];
-            if (nt < 4) { fclose(f); return sb_fail("%s:%d: malformed face (fewer than 3 vertices)", path, lineno); }
-            for (k = 1; k < nt; k++) {
-                idx[k - 1] = parse_index(tok[k], m->nv);
-                if (idx[k - 1] < 0) { fclose(f); return sb_fail("%s:%d: malformed face: bad or out-of-range vertex index '%s'", path, lineno, tok[k]); }
+            int n = nt - 1, a, b;
+            if (nt < 4) MESH_FAIL("%s:%d: malformed face (fewer than 3 vertices)", path, lineno);
+            if (pstart[np] + n > capi) { capi = 2 * capi + n; pidx = realloc(pidx, sizeof(int) * (size_t)capi); if (!pidx) MESH_FAIL("out of memory"); }
+            if (np == capp) {
+                capp *= 2;
+                pstart = realloc(pstart, sizeof(int) * (size_t)(capp + 1)); pline = realloc(pline, sizeof(int) * (size_t)capp);
+                if (!pstart || !pline) MESH_FAIL("out of memory");
             }
-            for (k = 2; k < nt - 1; k++) {   /* fan keeps the polygon's orientation */
-                if (m->nt == capt) { capt *= 2; m->tri = realloc(m->tri, sizeof(int) * 3 * (size_t)capt); if (!m->tri) { fclose(f); return sb_fail("out of memory"); } }
-                m->tri[3 * m->nt] = idx[0]; m->tri[3 * m->nt + 1] = idx[k - 1]; m->tri[3 * m->nt + 2] = idx[k];
-                if (idx[0] == idx[k - 1] || idx[k] == idx[k - 1] || idx[0] == idx[k]) { fclose(f); return sb_fail("%s:%d: degenerate face (repeated vertex)", path, lineno); }
-                m->nt++;
+            for (k = 0; k < n; k++) {
+                int v = parse_index(tok[k + 1], m->nv);
+                if (v < 0) MESH_FAIL("%s:%d: malformed face: bad or out-of-range vertex index '%s'", path, lineno, tok[k + 1]);
+                pidx[pstart[np] + k] = v;
             }
+            for (a = 0; a < n; a++)
+                for (b = a + 1; b < n; b++)
+                    if (pidx[pstart[np] + a] == pidx[pstart[np] + b]) MESH_FAIL("%s:%d: degenerate face (repeated vertex)", path, lineno);
+            pline[np] = lineno;
+            pstart[np + 1] = pstart[np] + n;
+            np++;
+            ntri += n - 2;
         } else if (!strcmp(tok[0], "vt") || !strcmp(tok[0], "vn") || !strcmp(tok[0], "vp") || !strcmp(tok[0], "o") ||
                    !strcmp(tok[0], "g") || !strcmp(tok[0], "s") || !strcmp(tok[0], "usemtl") || !strcmp(tok[0], "mtllib")) {
             continue;   /* attributes the bake does not need */
         } else {
-            fclose(f);
-            return sb_fail("%s:%d: malformed OBJ: unsupported statement '%s'", path, lineno, tok[0]);
+            MESH_FAIL("%s:%d: malformed OBJ: unsupported statement '%s'", path, lineno, tok[0]);
         }
     }
+#undef MESH_FAIL
+    {   /* triangulate: every polygon edge of the mesh first, then each polygon's diagonals as they are made */
+        eset_t es;
+        size_t need = 2 * ((size_t)pstart[np] + (size_t)ntri) + 16;
+        int p;
+        es.cap = 16;
+        while (es.cap < need) es.cap *= 2;
+        es.k = sb_alloc(sizeof(uint64_t) * es.cap);
+        for (p = 0; p < np; p++) {
+            int n = pstart[p + 1] - pstart[p], *q = pidx + pstart[p];
+            for (k = 0; k < n; k++) eadd(&es, q[k], q[(k + 1) % n]);
+        }
+        m->tri = malloc(sizeof(int) * 3 * (size_t)(ntri > 0 ? ntri : 1));
+        if (!m->tri) { fclose(f); free(es.k); free(pidx); free(pstart); free(pline); return sb_fail("out of memory"); }
+        for (p = 0; p < np; p++) {
+            int n = pstart[p + 1] - pstart[p], *q = pidx + pstart[p], s0 = n > 3 ? fan_start(&es, q, n) : 0;
+            if (s0 < 0) {
+                int ln = pline[p];
+                fclose(f); free(es.k); free(pidx); free(pstart); free(pline);
+                return sb_fail("%s:%d: cannot triangulate this %d-sided face: from every corner, a fan would repeat an edge "
+                               "that already exists (split the face in the modelling tool)", path, ln, n);
+            }
+            for (k = 2; k < n; k++) {   /* fan (s0, s0+k-1, s0+k): keeps the polygon's orientation */
+                m->tri[3 * m->nt] = q[s0]; m->tri[3 * m->nt + 1] = q[(s0 + k - 1) % n]; m->tri[3 * m->nt + 2] = q[(s0 + k) % n];
+                if (k < n - 1) eadd(&es, q[s0], q[(s0 + k) % n]);
+                m->nt++;
+            }
+        }
+        free(es.k);
+    }
+    free(pidx); free(pstart); free(pline);
     fclose(f);
     if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
     if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices; a blob holds at most 65535 surface vertices", path, m->nv);
@@ -141,8 +210,8 @@ void sb_inside_init(sb_inside *in, const sb_mesh *m)
     int i, k, y, z, *cnt;
     memset(in, 0, sizeof *in);
     in->m = m;
-    /* about 4 triangles per bin on average for a closed surface */
-    in->ny = in->nz = (int)ceil(sqrt((double)m->nt / 4.0)) + 1;
+    /* about one triangle per bin on average for a closed surface */
+    in->ny = in->nz = (int)ceil(sqrt((double)m->nt)) + 1;
     in->y0 = m->lo[1]; in->z0 = m->lo[2];
     in->dy = (m->hi[1] - m->lo[1]) / in->ny * (1.0 + 1e-9) + 1e-30;
     in->dz = (m->hi[2] - m->lo[2]) / in->nz * (1.0 + 1e-9) + 1e-30;
@@ -197,21 +266,21 @@ static double edge_fn(const double *a, const double *b, double qy, double qz, in
     return swap ? -e : e;
 }
 
-int sb_inside_test(const sb_inside *in, const double q[3])
+int sb_inside_ray(const sb_inside *in, double qy, double qz, double *xs, int max)
 {
     const sb_mesh *m = in->m;
-    int by, bz, b, t, crossings = 0;
-    if (q[0] < m->lo[0] || q[0] > m->hi[0] || q[1] < m->lo[1] || q[1] > m->hi[1] || q[2] < m->lo[2] || q[2] > m->hi[2]) return 0;
-    by = (int)floor((q[1] - in->y0) / in->dy); bz = (int)floor((q[2] - in->z0) / in->dz);
+    int by, bz, b, t, n = 0;
+    if (qy < m->lo[1] || qy > m->hi[1] || qz < m->lo[2] || qz > m->hi[2]) return 0;
+    by = (int)floor((qy - in->y0) / in->dy); bz = (int)floor((qz - in->z0) / in->dz);
     if (by < 0 || bz < 0 || by >= in->ny || bz >= in->nz) return 0;
     b = by * in->nz + bz;
     for (t = in->start[b]; t < in->start[b + 1]; t++) {
         int i = in->tris[t], k, pos = 0, neg = 0, tie;
         const double *v[3];
-        double e[3], area, xh;
+        double e[3], area;
         for (k = 0; k < 3; k++) v[k] = m->v + 3 * m->tri[3 * i + k];
         for (k = 0; k < 3; k++) {
-            e[k] = edge_fn(v[k], v[(k + 1) % 3], q[1], q[2], &tie);
+            e[k] = edge_fn(v[k], v[(k + 1) % 3], qy, qz, &tie);
             if (e[k] > 0 || (e[k] == 0 && tie)) pos++;
             if (e[k] < 0 || (e[k] == 0 && !tie)) neg++;
         }
@@ -219,8 +288,66 @@ int sb_inside_test(const sb_inside *in, const double q[3])
         area = e[0] + e[1] + e[2];
         if (area == 0.0) continue;
         /* x of the ray's hit from barycentrics (e[k] weights the vertex opposite edge k) */
-        xh = (e[1] * v[0][0] + e[2] * v[1][0] + e[0] * v[2][0]) / area;
-        if (xh > q[0]) crossings++;
+        if (n < max) xs[n] = (e[1] * v[0][0] + e[2] * v[1][0] + e[0] * v[2][0]) / area;
+        n++;
     }
+    return n;
+}
+
+int sb_inside_test(const sb_inside *in, const double q[3])
+{
+    const sb_mesh *m = in->m;
+    double xs[256], *buf = xs;
+    int n, k, crossings = 0;
+    if (q[0] < m->lo[0] || q[0] > m->hi[0]) return 0;
+    n = sb_inside_ray(in, q[1], q[2], xs, 256);
+    if (n > 256) { buf = sb_alloc(sizeof(double) * (size_t)n); sb_inside_ray(in, q[1], q[2], buf, n); }
+    for (k = 0; k < n; k++) if (buf[k] > q[0]) crossings++;
+    if (buf != xs) free(buf);
     return crossings & 1;
+}
+
+/* closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5) */
+static void closest_tri(const double p[3], const double a[3], const double b[3], const double c[3], double out[3])
+{
+    double ab[3], ac[3], ap[3], bp[3], cp[3], d1 = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, d6 = 0, va, vb, vc, v, w, den;
+    int k;
+    for (k = 0; k < 3; k++) { ab[k] = b[k] - a[k]; ac[k] = c[k] - a[k]; ap[k] = p[k] - a[k]; bp[k] = p[k] - b[k]; cp[k] = p[k] - c[k]; }
+    for (k = 0; k < 3; k++) { d1 += ab[k] * ap[k]; d2 += ac[k] * ap[k]; d3 += ab[k] * bp[k]; d4 += ac[k] * bp[k]; d5 += ab[k] * cp[k]; d6 += ac[k] * cp[k]; }
+    if (d1 <= 0 && d2 <= 0) { memcpy(out, a, sizeof(double) * 3); return; }
+    if (d3 >= 0 && d4 <= d3) { memcpy(out, b, sizeof(double) * 3); return; }
+    vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) { v = d1 / (d1 - d3); for (k = 0; k < 3; k++) out[k] = a[k] + v * ab[k]; return; }
+    if (d6 >= 0 && d5 <= d6) { memcpy(out, c, sizeof(double) * 3); return; }
+    vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) { w = d2 / (d2 - d6); for (k = 0; k < 3; k++) out[k] = a[k] + w * ac[k]; return; }
+    va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (k = 0; k < 3; k++) out[k] = b[k] + w * (c[k] - b[k]);
+        return;
+    }
+    den = 1 / (va + vb + vc);
+    v = vb * den; w = vc * den;
+    for (k = 0; k < 3; k++) out[k] = a[k] + ab[k] * v + ac[k] * w;
+}
+
+double sb_mesh_closest(const sb_mesh *m, const double p[3], double out[3])
+{
+    double best = HUGE_VAL;
+    int t, k;
+    for (t = 0; t < m->nt; t++) {
+        const double *a = m->v + 3 * m->tri[3 * t], *b = m->v + 3 * m->tri[3 * t + 1], *c = m->v + 3 * m->tri[3 * t + 2];
+        double lo, q[3], d2 = 0;
+        /* cheap rejection: distance to the triangle's bounding box */
+        for (k = 0, lo = 0; k < 3; k++) {
+            double mn = fmin(a[k], fmin(b[k], c[k])), mx = fmax(a[k], fmax(b[k], c[k])), e = p[k] < mn ? mn - p[k] : p[k] > mx ? p[k] - mx : 0;
+            lo += e * e;
+        }
+        if (lo >= best) continue;
+        closest_tri(p, a, b, c, q);
+        for (k = 0; k < 3; k++) d2 += (q[k] - p[k]) * (q[k] - p[k]);
+        if (d2 < best) { best = d2; memcpy(out, q, sizeof q); }
+    }
+    return sqrt(best);
 }

@@ -3,33 +3,80 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: sinew-bake DESCRIPTION -o OUT.blob [--c-array OUT.c [--name SYMBOL]]\n"
-            "                  [--flavour fixed|float|double] [--quiet]\n"
-            "       (-o may be left out when --c-array is given)\n"
+            "                  [--flavour fixed|float|double] [--quiet] [--check]\n"
+            "       (-o may be left out when --c-array or --check is given)\n"
             "Bakes a character (OBJ mesh + text description, see tools/DESCRIPTION.md) into a\n"
             "Sinew blob (runtime/BLOB.md).\n"
             "  -o OUT.blob       binary blob (written to OUT.blob.tmp, then renamed)\n"
             "  --c-array OUT.c   also write the blob as an 8-aligned C99 array\n"
             "  --name SYMBOL     C symbol of the array (default sinew_blob); SYMBOL_size holds the size\n"
             "  --flavour F       fixed (default, int32 Q formats), float (float32), double (float64, host/tests)\n"
-            "  --quiet           no summary or progress\n"
+            "  --quiet           no summary or progress (warnings still go to stderr)\n"
+            "  --check           check the model (interior volume within 1%% of the mesh volume, embedding\n"
+            "                    error <= 1e-5 of the bbox diagonal, rigid translations and rotations in the\n"
+            "                    null space of S), print one 'check:' line (also with --quiet); on failure\n"
+            "                    exit 1 and write nothing\n"
             "  --help            this text\n");
+}
+
+/* per bone: radius and the lattice vertices it captures and moves */
+static void bone_summary(const sb_model *o)
+{
+    int a;
+    if (!o->nseg) return;
+    printf("  bones     %-24s %9s  %-20s %8s %6s\n", "(radius in mesh units)", "radius", "", "captured", "moved");
+    for (a = 0; a < o->nseg; a++) {
+        const sb_joint *C = &o->joints[o->seg_child[a]], *P = &o->joints[C->parent];
+        char nm[2 * SB_NAME_MAX + 4], how[40];
+        snprintf(nm, sizeof nm, "%s->%s", P->name, C->name);
+        if (o->seg_auto[a]) snprintf(how, sizeof how, "auto (flesh %.3g)", o->seg_flesh[a]);
+        else snprintf(how, sizeof how, "given");
+        printf("            %-24s %9.3g  %-20s %8d %6d\n", nm, o->seg_r[a], how, o->seg_ncap[a], o->seg_nv[a]);
+    }
+}
+
+/* --check: the model against the mesh it was baked from */
+static int run_check(const char *desc, const sb_model *o, double secs)
+{
+    sb_desc d;
+    sb_mesh m;
+    sb_check r;
+    memset(&m, 0, sizeof m);
+    if (sb_desc_load(desc, &d) || sb_mesh_load_obj(d.mesh_path, &m)) {
+        fprintf(stderr, "sinew-bake: error: --check: %s\n", sb_error());
+        sb_mesh_free(&m); sb_desc_free(&d);
+        return -1;
+    }
+    sb_model_check(o, &m, &r);
+    printf("check: cell %g: lattice %d vertices (%d free, %d skeleton), %d cells; volume ratio %.5f; embedding %.2e; "
+           "null space: translations %.1e, rotations %.1e; %.2f s: %s\n",
+           o->c, o->nv, o->nf, o->nv - o->nf, o->nc, r.vol_ratio, r.emb_err, r.trans, r.rot, secs, r.ok ? "ok" : "FAILED");
+    if (!r.ok)
+        fprintf(stderr, "sinew-bake: error: --check failed: %s%s%s%s\n", fabs(r.vol_ratio - 1) > 0.01 ? "interior volume off by more than 1%; " : "",
+                r.emb_err > 1e-5 ? "embedding error above 1e-5 of the diagonal; " : "", r.trans > 1e-12 ? "translations not in the null space; " : "",
+                r.rot > 1e-11 ? "rotations not in the null space" : "");
+    sb_mesh_free(&m); sb_desc_free(&d);
+    return r.ok ? 0 : -1;
 }
 
 int main(int argc, char **argv)
 {
     const char *desc = NULL, *out = NULL, *carray = NULL, *name = "sinew_blob";
-    int flavour = SB_FIXED, quiet = 0, i;
+    int flavour = SB_FIXED, quiet = 0, check = 0, i;
+    double t0;
     sb_model o;
     sb_blob b;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
         else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) quiet = 1;
+        else if (!strcmp(a, "--check")) check = 1;
         else if (!strcmp(a, "-o") || !strcmp(a, "--c-array") || !strcmp(a, "--name") || !strcmp(a, "--flavour")) {
             if (i + 1 >= argc) { fprintf(stderr, "sinew-bake: %s needs a value\n", a); return 2; }
             if (!strcmp(a, "-o")) out = argv[++i];
@@ -46,14 +93,18 @@ int main(int argc, char **argv)
         else if (!desc) desc = a;
         else { fprintf(stderr, "sinew-bake: more than one description given ('%s')\n", a); return 2; }
     }
-    if (!desc || (!out && !carray)) { usage(stderr); return 2; }
+    if (!desc || (!out && !carray && !check)) { usage(stderr); return 2; }
     if (carray) {   /* check the symbol before any work or output */
         const char *c;
         for (c = name; *c; c++)
             if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || *c == '_' || (c != name && *c >= '0' && *c <= '9'))) break;
         if (*c || !*name) { fprintf(stderr, "sinew-bake: --name '%s' is not a C identifier\n", name); return 2; }
     }
+    t0 = sb_now();
     if (sb_bake_file(desc, flavour, quiet, &o, &b)) { fprintf(stderr, "sinew-bake: error: %s\n", sb_error()); return 1; }
+    t0 = sb_now() - t0;
+    if (!quiet) bone_summary(&o);
+    if (check && run_check(desc, &o, t0)) { sb_blob_free(&b); sb_model_free(&o); return 1; }
     if ((out && sb_write_file(out, b.bytes, b.size)) || (carray && sb_write_c_array(carray, name, b.bytes, b.size))) {
         fprintf(stderr, "sinew-bake: error: %s\n", sb_error());
         if (out) remove(out);   /* all or nothing */

@@ -78,3 +78,28 @@ $(BUILD)/tests/test_bake%: tests/test_bake%.c $(TOOLS_LIB) $(TOOLS_HDR) tests/sn
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itools -Itests -Iruntime/src -o $@ $< $(TOOLS_LIB) -lm
 TEST_BINS += $(BAKE_TESTS)
+
+# ---- the beast (tools/examples/beast): humanoid, 32k-vertex surface ----
+BEAST_DEPS = tools/examples/beast/beast.sinew tools/examples/beast/beast.obj $(BAKE)
+$(EX)/beast.blob: $(BEAST_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/beast/beast.sinew -o $@ --quiet
+$(EX)/beast_float.blob: $(BEAST_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/beast/beast.sinew -o $@ --flavour float --quiet
+$(EX)/beast_double.blob: $(BEAST_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/beast/beast.sinew -o $@ --flavour double --quiet
+BEAST_BLOBS = $(EX)/beast.blob $(EX)/beast_float.blob $(EX)/beast_double.blob
+TEST_DEPS += $(BEAST_BLOBS)
+all: $(BEAST_BLOBS)
+
+# ---- diag (tools/examples/diag): synthetic character, bones at 30/45/60 degrees ----
+DIAG_DEPS = tools/examples/diag/diag.sinew tools/examples/diag/diag.obj $(BAKE)
+$(EX)/diag.blob: $(DIAG_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/diag/diag.sinew -o $@ --quiet
+$(EX)/diag_float.blob: $(DIAG_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/diag/diag.sinew -o $@ --flavour float --quiet
+all: $(EX)/diag.blob $(EX)/diag_float.blob

@@ -43,6 +43,85 @@ int sn_clip_parse_q16(const char *s, size_t n, int32_t *out) {
     return 0;
 }
 
+/* ---- keys more than 180 degrees apart (integer only) ---- */
+#define Q30 ((int64_t)1 << 30)
+#define DEG(d) ((int64_t)(d) << 16)
+
+static int64_t mul30(int64_t a, int64_t b) { return a * b / Q30; }
+
+/* sin, cos of half of deg (Q16.16 degrees) in Q30: quadrant + Taylor series */
+static void half_sincos(int64_t deg, int64_t *s, int64_t *c) {
+    int64_t r = deg % DEG(720), f, x, x2, ts, tc, ss = 0, cc = 0;
+    int q, n;
+    if (r < 0) r += DEG(720);
+    q = (int)(r / DEG(180));
+    f = r % DEG(180);
+    x = f * 1686629713 / DEG(180);   /* radians of the half angle in [0, pi/2), Q30 */
+    x2 = mul30(x, x);
+    ts = x; tc = Q30;
+    for (n = 0; n < 7; n++) {
+        ss += ts; cc += tc;
+        ts = -mul30(ts, x2) / ((2 * n + 2) * (2 * n + 3));
+        tc = -mul30(tc, x2) / ((2 * n + 1) * (2 * n + 2));
+    }
+    switch (q) {
+    case 0: *s = ss; *c = cc; break;
+    case 1: *s = cc; *c = -ss; break;
+    case 2: *s = -ss; *c = -cc; break;
+    default: *s = -cc; *c = ss; break;
+    }
+}
+
+static uint64_t isqrt64(uint64_t v) {
+    uint64_t r = 0, b = (uint64_t)1 << 62;
+    while (b > v) b >>= 2;
+    for (; b; b >>= 2)
+        if (v >= r + b) { v -= r + b; r = (r >> 1) + b; } else r >>= 1;
+    return r;
+}
+
+/* Unit axis in Q30 (the axis is non-zero). */
+static void unit_axis(const int32_t v[3], int64_t n[3]) {
+    int64_t a[3], m = 0, l;
+    int i;
+    for (i = 0; i < 3; i++) { a[i] = v[i]; if ((a[i] < 0 ? -a[i] : a[i]) > m) m = a[i] < 0 ? -a[i] : a[i]; }
+    while (m < ((int64_t)1 << 28)) { for (i = 0; i < 3; i++) a[i] *= 2; m *= 2; }
+    while (m >= ((int64_t)1 << 29)) { for (i = 0; i < 3; i++) a[i] /= 2; m /= 2; }
+    l = (int64_t)isqrt64((uint64_t)(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]));
+    for (i = 0; i < 3; i++) n[i] = a[i] * Q30 / l;
+}
+
+/* Turn between keys a and b as written (Q16.16 degrees) and the turn the
+ * shorter-arc slerp makes; 1 when they differ (written turn > 180), also when
+ * it is 180 (the way round is then up to rounding). */
+static int long_turn(const sn_clip_key *a, const sn_clip_key *b, int64_t *apart, int64_t *taken) {
+    int64_t na[3], nb[3], cosax, sa, ca, sb, cb, d, lo, hi;
+    unit_axis(a->v, na); unit_axis(b->v, nb);
+    cosax = (na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) / Q30;
+    if (a->v[3] == 0 || b->v[3] == 0 || cosax > Q30 - 64 || cosax < -(Q30 - 64)) {
+        /* one axis (a zero angle has any axis): exact in degrees */
+        d = (int64_t)b->v[3] - (cosax < -(Q30 - 64) && a->v[3] && b->v[3] ? -(int64_t)a->v[3] : (int64_t)a->v[3]);
+        *apart = d < 0 ? -d : d;
+        *taken = *apart % DEG(360);
+        if (*taken > DEG(180)) *taken = DEG(360) - *taken;
+        return *apart >= DEG(180);
+    }
+    /* q_a . q_b = cos(turn / 2); below 0 the slerp flips q_b */
+    half_sincos(a->v[3], &sa, &ca); half_sincos(b->v[3], &sb, &cb);
+    d = mul30(ca, cb) + mul30(cosax, mul30(sa, sb));
+    if (d > Q30 >> 14) return 0;
+    if (d >= -(Q30 >> 14)) { *apart = *taken = DEG(180); return 1; }   /* 180 to ~0.01 degree */
+    lo = DEG(180); hi = DEG(360);       /* turn with cos(turn / 2) = d, by bisection */
+    while (hi - lo > 1) {
+        int64_t mid = (lo + hi) / 2, s, c;
+        half_sincos(mid, &s, &c);
+        if (c > d) lo = mid; else hi = mid;
+    }
+    *apart = lo;
+    *taken = DEG(360) - lo;
+    return 1;
+}
+
 /* ---- tokens of one line ---- */
 #define MAX_TOK 8
 typedef struct { const char *p[MAX_TOK]; size_t n[MAX_TOK]; int count; } toks;
@@ -118,6 +197,20 @@ static int add_key(pstate *ps, int ci, const sn_clip_key *k, const char *tok, si
     if (ch->count && k->t <= c->keys[at - 1].t)
         return fail(ps, "key times of a channel must strictly increase; not after the previous key:", tok, tokn);
     if (c->n_keys >= SN_CLIP_MAX_KEYS) return fail(ps, "too many keys (limit SN_CLIP_MAX_KEYS)", 0, 0);
+    if (ch->kind == SN_CLIP_ROT && ch->count) {
+        int64_t apart, taken;
+        if (long_turn(&c->keys[at - 1], k, &apart, &taken)) {
+            if (c->n_warnings < SN_CLIP_MAX_WARNINGS) {
+                sn_clip_warning *w = &c->warn[c->n_warnings];
+                w->line = ps->line;
+                w->channel = (uint16_t)ci;
+                w->t_a = c->keys[at - 1].t; w->t_b = k->t;
+                w->apart = apart > INT32_MAX ? INT32_MAX : (int32_t)apart;
+                w->taken = (int32_t)taken;
+            }
+            if (c->n_warnings < UINT32_MAX) c->n_warnings++;
+        }
+    }
     memmove(&c->keys[at + 1], &c->keys[at], (size_t)(c->n_keys - at) * sizeof c->keys[0]);
     c->keys[at] = *k;
     c->n_keys++;
@@ -179,6 +272,42 @@ static int parse_line(pstate *ps, const char *s, size_t n) {
         return add_key(ps, ci, &key, t.p[k0], t.n[k0]);
     }
     return fail(ps, "unknown keyword (expected duration, loop, rot, move):", t.p[0], t.n[0]);
+}
+
+/* Q16.16 v >= 0 as a decimal with at most `dec` places, trailing zeros cut. */
+static void m_q16(msgbuf *m, int64_t v, int dec) {
+    int64_t scale = 1, f;
+    int i;
+    char d[12];
+    for (i = 0; i < dec; i++) scale *= 10;
+    v = (v * scale + 32768) >> 16;          /* rounded, in units of 10^-dec */
+    m_uint(m, (uint32_t)(v / scale));
+    f = v % scale;
+    if (!f) return;
+    for (i = dec; i-- > 0; f /= 10) d[i] = (char)('0' + f % 10);
+    for (i = dec; i > 0 && d[i - 1] == '0'; i--) {}
+    m_str(m, ".", 1); m_str(m, d, (size_t)i);
+}
+
+size_t sn_clip_warning_str(const sn_clip *clip, uint32_t i, char *buf, size_t len) {
+    msgbuf m;
+    const sn_clip_warning *w;
+    m.buf = buf; m.cap = buf ? len : 0; m.len = 0;
+    if (m.cap) buf[0] = 0;
+    if (i >= clip->n_warnings || i >= SN_CLIP_MAX_WARNINGS) return 0;
+    w = &clip->warn[i];
+    m_cstr(&m, "joint '"); m_cstr(&m, w->channel < SN_CLIP_MAX_CHANNELS ? clip->chan[w->channel].name : "?");
+    m_cstr(&m, "': keys at "); m_q16(&m, w->t_a, 4);
+    m_cstr(&m, " s and "); m_q16(&m, w->t_b, 4);
+    m_cstr(&m, " s are "); m_q16(&m, w->apart, 2);
+    if (w->apart == DEG(180) && w->taken == DEG(180)) {
+        m_cstr(&m, " degrees apart; which way the interpolation turns is up to rounding; add an intermediate key");
+        return m.len;
+    }
+    m_cstr(&m, " degrees apart; the interpolation takes the short way (a turn of ");
+    m_q16(&m, w->taken, 2);
+    m_cstr(&m, " degrees); add an intermediate key to turn the long way");
+    return m.len;
 }
 
 int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t errlen) {

@@ -33,8 +33,12 @@
 #endif
 /// Longest joint name (bytes, without the NUL), as in the blob.
 #define SN_CLIP_NAME_MAX 31
-/// A good size for the error buffer.
-#define SN_CLIP_ERR_LEN 160
+#ifndef SN_CLIP_MAX_WARNINGS
+/// Most warnings kept in a parsed clip (more are only counted).
+#define SN_CLIP_MAX_WARNINGS 8
+#endif
+/// A good size for the error buffer (and for sn_clip_warning_str).
+#define SN_CLIP_ERR_LEN 256
 
 /// Channel kinds.
 enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1 };
@@ -51,6 +55,18 @@ typedef struct sn_clip_channel {
     uint8_t  kind;                       ///< SN_CLIP_ROT or SN_CLIP_MOVE
 } sn_clip_channel;
 
+/// Two consecutive keys of a rotation channel more than 180 degrees apart as
+/// written: the slerp takes the short way, not the turn the text describes.
+/// Also exactly 180 apart (apart == taken == 180): the way round is up to rounding.
+typedef struct sn_clip_warning {
+    uint32_t line;       ///< line of the second key
+    uint16_t channel;    ///< index into chan[]
+    uint16_t reserved;
+    int32_t  t_a, t_b;   ///< the two key times, Q16.16 s
+    int32_t  apart;      ///< turn as written, Q16.16 degrees (> 180)
+    int32_t  taken;      ///< turn the interpolation makes, Q16.16 degrees (<= 180)
+} sn_clip_warning;
+
 /// A parsed clip. Plain data: may be copied, or stored in ROM once parsed.
 typedef struct sn_clip {
     int32_t  duration;        ///< Q16.16 seconds, > 0
@@ -58,14 +74,22 @@ typedef struct sn_clip {
     uint8_t  bound;           ///< set by sn_clip_bind
     uint16_t n_channels, n_keys;
     uint32_t error_line;      ///< line of the last parse error (0: none / not line-specific)
+    uint32_t n_warnings;      ///< warnings found (the first SN_CLIP_MAX_WARNINGS are in warn[])
+    sn_clip_warning warn[SN_CLIP_MAX_WARNINGS];
     sn_clip_channel chan[SN_CLIP_MAX_CHANNELS];
     sn_clip_key     keys[SN_CLIP_MAX_KEYS];
 } sn_clip;
 
 /// Parse clip text (len bytes, need not be NUL-terminated) into *clip.
 /// Returns 0 on success; otherwise 1 with "line N: what" in err (always
-/// NUL-terminated when errlen > 0) and clip->error_line = N.
+/// NUL-terminated when errlen > 0) and clip->error_line = N. A clip that
+/// parses may still carry warnings (clip->n_warnings, sn_clip_warning_str).
 int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t errlen);
+
+/// Text of warning i (< min(n_warnings, SN_CLIP_MAX_WARNINGS)) without its
+/// line: "joint 'J': keys at A s and B s are D degrees apart; ...". Always
+/// NUL-terminated when len > 0; returns the text length (0 for a bad i).
+size_t sn_clip_warning_str(const sn_clip *clip, uint32_t i, char *buf, size_t len);
 
 /// Resolve joint names against a blob's skeleton. Returns 0, or 1 with a
 /// message naming the first joint the blob lacks.

@@ -52,12 +52,34 @@ run "trot float sheet (72 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --f
 # The README picture.
 run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
     --compare "$OUT/demo.png" --size 400x300 $FRONT
+
+# The beast (tools/examples/beast, 32k surface vertices): baked here if
+# missing or stale; walk and violent-motion sheets, and the head turned 90
+# degrees about the neck axis: rest | unwarped | warped.
+BEAST_SRC=tools/examples/beast
+BEAST=$BUILD/examples/beast.blob
+for f in "$BEAST_SRC/beast.sinew" "$BEAST_SRC/beast.obj" "$BUILD/sinew-bake"; do
+    if [ ! -f "$BEAST" ] || [ "$f" -nt "$BEAST" ]; then
+        echo "== bake the beast"
+        mkdir -p "$BUILD/examples"
+        "$BUILD/sinew-bake" "$BEAST_SRC/beast.sinew" -o "$BEAST" --quiet
+        break
+    fi
+done
+BEASTVIEW="--view 25,10 --size 280x300"
+run "beast walk sheet (144 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/walk.clip" --frames 144 \
+    --sheet "$OUT/beast_walk_sheet.png" --title "beast walk (fixed point)" $BEASTVIEW
+run "beast violent sheet (480 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/violent.clip" --frames 480 \
+    --sheet "$OUT/beast_violent_sheet.png" --title "head 180 deg in 0.1 s, then 170, chest 170" $BEASTVIEW
+run "beast head_turn compare (180 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/head_turn.clip" --frames 180 \
+    --compare "$OUT/beast_head_turn_compare.png" --view 50,10 --size 800x600
 rm -f "$OUT/run.out"
 
 echo
 echo "Time of one sn_step in microseconds on this machine (CPU = thread CPU time,"
-echo "unaffected by other processes). The asset:"
+echo "unaffected by other processes). The assets:"
 "$PLAY" "$COW" --frames 1 2>/dev/null | grep 'lattice vertices' | sed "s|^$BUILD/|  |"
+"$PLAY" "$BEAST" --frames 1 2>/dev/null | grep 'lattice vertices' | sed "s|^$BUILD/|  |"
 printf '  %-38s %9s %9s %9s %9s\n' "run" "median" "p99" "CPU med" "CPU p99"
 cat "$log"
 echo

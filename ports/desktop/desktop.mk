@@ -2,11 +2,12 @@
 # and `make demo`.
 #   $(BUILD)/sinew-play        fixed runtime ($(SN_LIB_FIXED))
 #   $(BUILD)/sinew-play-float  same source, -DSN_FLOAT, float runtime
+#   $(BUILD)/sinew-plot        line plots of the players' --stats-csv files
 # ports/common (clip parser) is shared with the bare-metal port.
 DESK_INC  = $(if $(SN_INC),$(SN_INC),-Iruntime/include) -Iruntime/src -Iports/common -Iports/desktop
 DESK_HDRS = runtime/include/sinew.h runtime/src/sn_format.h ports/common/sn_clip.h \
-            ports/desktop/raster.h ports/desktop/png.h
-PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c \
+            ports/desktop/raster.h ports/desktop/png.h ports/desktop/plot.h
+PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c ports/desktop/plot.c \
             ports/common/sn_clip.c ports/common/sn_clip_pose.c
 DEMO_DIR  = $(BUILD)/demo
 COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip
@@ -25,6 +26,14 @@ $(BUILD)/tests/test_desktop_raster: tests/test_desktop_raster.c ports/desktop/ra
 	$(CC) $(HOST_CFLAGS) $(DESK_INC) -Itests tests/test_desktop_raster.c ports/desktop/raster.c -o $@ -lm
 
 TEST_BINS += $(BUILD)/tests/test_clip $(BUILD)/tests/test_png $(BUILD)/tests/test_desktop_raster
+
+# sinew-plot: plots of --stats-csv files (no runtime).
+PLOT_SRCS = ports/desktop/plot_csv.c ports/desktop/plot.c ports/desktop/raster.c ports/desktop/png.c
+all: $(BUILD)/sinew-plot
+$(BUILD)/sinew-plot: $(PLOT_SRCS) ports/desktop/plot.h ports/desktop/raster.h ports/desktop/png.h
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLOT_SRCS) -o $@ -lm
+TEST_DEPS += $(BUILD)/sinew-plot
 
 # The player needs the runtime libraries (runtime/runtime.mk).
 ifdef SN_LIB_FIXED

@@ -8,6 +8,7 @@
 #include "sn_clip.h"
 #include "raster.h"
 #include "png.h"
+#include "plot.h"
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -21,9 +22,11 @@
 #ifdef SN_FLOAT
 #define PROG "sinew-play-float"
 static float F(sn_real v) { return v; }
+static double D(sn_real v) { return v; }
 #else
 #define PROG "sinew-play"
 static float F(sn_real v) { return (float)v / 65536.0f; }
+static double D(sn_real v) { return (double)v / 65536.0; }
 #endif
 
 static void usage(FILE *f) {
@@ -35,18 +38,24 @@ static void usage(FILE *f) {
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
+        "  --obj-frames LIST  with --obj-dir: only these frames, e.g. 0,10,20-30 (0: before the first step)\n"
         "  --png FILE         picture of the last frame\n"
-        "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid\n"
+        "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid of 320x240 (or --size) cells\n"
         "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
         "  --heat D           colour the flesh by its distance from rigid skinning (red at D mesh units)\n"
-        "  --size WxH         picture size for --png (default 640x480)\n"
+        "  --size WxH         size of --png (default 640x480), of the sheet's cells (320x240), of --plot (800x500)\n"
         "  --view AZ,EL       camera azimuth, elevation in degrees (default 30,15)\n"
-        "  --frame-box X0,Y0,Z0,X1,Y1,Z1  box the camera frames, model space (mesh units relative to the root joint; default: rest surface)\n"
+        "  --frame-box X0,Y0,Z0,X1,Y1,Z1  box the camera frames, model space (mesh units relative to the root joint;\n"
+        "                     default: the skinned surface over the whole run)\n"
         "  --title TEXT       caption on the pictures\n"
+        "  --health N         every N steps a line: frame, displacement (cells), energy (J), saturations\n"
+        "  --stats-csv FILE   per step: frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps\n"
+        "  --plot FILE        line plot (PNG) of energy and displacement per step (see also sinew-plot)\n"
         "  --hash             end with 'hash: <16 hex>' (sn_state_hash of the final state)\n"
-        "  --quiet            only errors, timing and hash\n"
+        "  --quiet            only errors, warnings, timing, health and hash\n"
         "  --help\n"
+        "The run ends with a health line (saturations, bound steps, limit clamps, largest displacement and energy).\n"
         "Exit status: 0 ok, 1 bad input or failed output (nothing partial written), 2 usage.\n");
 }
 
@@ -116,13 +125,13 @@ typedef struct {
     uint32_t *edges, n_edges;   /* lattice cell edges (vertex pairs) */
     sn_vec3 *surf, *latt;       /* scratch outputs */
     float *pos, *lpos;          /* float copies */
-    float lo[3], hi[3];         /* rest surface box: the camera's frame */
-    float flo[3], fhi[3];       /* box the camera frames (default: lo, hi) */
+    float lo[3], hi[3];         /* skinned surface box over the run (ground at lo[1]) */
+    float flo[3], fhi[3];       /* box the camera frames (default: lo, hi plus a margin) */
     float az, el;
     int lattice;
-    /* --heat: colour by distance from the rigidly skinned lattice */
+    /* rigid skinning by the lattice frames: --heat and the camera's box */
     float heat;                 /* mesh units drawn at full colour; 0 = off */
-    float *rest;                /* lattice rest positions, model space, mesh units */
+    float *rest, *skin;         /* lattice rest / skinned positions, model space, mesh units */
     const unsigned char *frames, *cells, *embed;
     float *dev, *col;           /* per lattice vertex (3), per surface vertex (3) */
     const sn_xform *pose;       /* pose of the state being drawn */
@@ -187,7 +196,7 @@ static const unsigned char *section(const unsigned char *bytes, int sec, uint32_
 
 /* Rest lattice, frames, cells and embedding from the validated blob
  * (runtime/BLOB.md). Reals are little-endian like this host. */
-static int heat_setup(scene *s, const unsigned char *bytes) {
+static int skin_setup(scene *s, const unsigned char *bytes) {
     const unsigned char *rest = section(bytes, SN_SEC_REST, NULL);
     float unit = (float)ldexp(1.0, (int)(signed char)bytes[SN_H_LEN_SHIFT]);
     uint32_t i;
@@ -195,9 +204,10 @@ static int heat_setup(scene *s, const unsigned char *bytes) {
     s->cells = section(bytes, SN_SEC_CELLS, NULL);
     s->embed = section(bytes, SN_SEC_EMBED, NULL);
     s->rest = malloc((size_t)s->info.vertices * 3 * sizeof(float));
+    s->skin = malloc((size_t)s->info.vertices * 3 * sizeof(float));
     s->dev = malloc((size_t)s->info.vertices * 3 * sizeof(float));
     s->col = malloc(((size_t)s->info.surface_vertices + 1) * 3 * sizeof(float));
-    if (!s->rest || !s->dev || !s->col) return -1;
+    if (!s->rest || !s->skin || !s->dev || !s->col) return -1;
     for (i = 0; i < 3 * s->info.vertices; i++) {
 #ifdef SN_FLOAT
         float v;
@@ -241,31 +251,61 @@ static void fq_rotate(fq q, const float v[3], float o[3]) {   /* v + 2w(u x v) +
     o[2] = v[2] + q.w * tz + (q.x * ty - q.y * tx);
 }
 
-/* Per surface vertex: how far the simulated flesh is from where rigid
- * skinning by the lattice frames (R_i x_i + c_i, BLOB.md FRAMES) would put it:
- * the secondary motion (plus the static sag under gravity). */
-static void heat_colours(scene *s) {
-    uint32_t i, k;
+/* Lattice rigidly skinned by its frames under pose (R_i x_i + c_i, BLOB.md
+ * FRAMES) into s->skin. */
+static void skin_lattice(scene *s, const sn_xform *pose) {
+    uint32_t i;
     for (i = 0; i < s->info.vertices; i++) {
         const unsigned char *f = s->frames + 4 * (size_t)i;
-        const sn_xform *b1 = &s->pose[f[0]], *b2 = &s->pose[f[1]];
+        const sn_xform *b1 = &pose[f[0]], *b2 = &pose[f[1]];
         float w = (float)(f[2] | f[3] << 8) / 32768.0f, r[3];
         fq q = fq_slerp(to_fq(b1->rot), to_fq(b2->rot), w);
         fq_rotate(q, s->rest + 3 * i, r);
-        s->dev[3 * i] = s->lpos[3 * i] - (r[0] + (1 - w) * F(b1->pos.x) + w * F(b2->pos.x));
-        s->dev[3 * i + 1] = s->lpos[3 * i + 1] - (r[1] + (1 - w) * F(b1->pos.y) + w * F(b2->pos.y));
-        s->dev[3 * i + 2] = s->lpos[3 * i + 2] - (r[2] + (1 - w) * F(b1->pos.z) + w * F(b2->pos.z));
+        s->skin[3 * i] = r[0] + (1 - w) * F(b1->pos.x) + w * F(b2->pos.x);
+        s->skin[3 * i + 1] = r[1] + (1 - w) * F(b1->pos.y) + w * F(b2->pos.y);
+        s->skin[3 * i + 2] = r[2] + (1 - w) * F(b1->pos.z) + w * F(b2->pos.z);
     }
+}
+
+/* Surface vertex i interpolated from per-lattice-vertex vectors v (3 each). */
+static void embed_vec(const scene *s, const float *v, uint32_t i, float out[3]) {
+    const unsigned char *e = s->embed + 8 * (size_t)i;
+    const unsigned char *cell = s->cells + SN_ELEM_CELLS * (size_t)(e[0] | e[1] << 8);
+    float t[3];
+    uint32_t k;
+    out[0] = out[1] = out[2] = 0;
+    for (k = 0; k < 3; k++) t[k] = (float)(e[2 + 2 * k] | e[3 + 2 * k] << 8) / 32768.0f;
+    for (k = 0; k < 8; k++) {
+        uint32_t c = cell[2 * k] | (uint32_t)cell[2 * k + 1] << 8;
+        float n = (k & 1 ? t[0] : 1 - t[0]) * (k & 2 ? t[1] : 1 - t[1]) * (k & 4 ? t[2] : 1 - t[2]);
+        out[0] += n * v[3 * c]; out[1] += n * v[3 * c + 1]; out[2] += n * v[3 * c + 2];
+    }
+}
+
+/* Grow lo, hi by the surface rigidly skinned under pose. */
+static void skinned_box(scene *s, const sn_xform *pose, float lo[3], float hi[3]) {
+    uint32_t i, k;
+    skin_lattice(s, pose);
     for (i = 0; i < s->info.surface_vertices; i++) {
-        const unsigned char *e = s->embed + 8 * (size_t)i;
-        const unsigned char *cell = s->cells + SN_ELEM_CELLS * (size_t)(e[0] | e[1] << 8);
-        float t[3], d[3] = {0, 0, 0}, m;
-        for (k = 0; k < 3; k++) t[k] = (float)(e[2 + 2 * k] | e[3 + 2 * k] << 8) / 32768.0f;
-        for (k = 0; k < 8; k++) {
-            uint32_t v = cell[2 * k] | (uint32_t)cell[2 * k + 1] << 8;
-            float n = (k & 1 ? t[0] : 1 - t[0]) * (k & 2 ? t[1] : 1 - t[1]) * (k & 4 ? t[2] : 1 - t[2]);
-            d[0] += n * s->dev[3 * v]; d[1] += n * s->dev[3 * v + 1]; d[2] += n * s->dev[3 * v + 2];
+        float p[3];
+        embed_vec(s, s->skin, i, p);
+        for (k = 0; k < 3; k++) {
+            if (p[k] < lo[k]) lo[k] = p[k];
+            if (p[k] > hi[k]) hi[k] = p[k];
         }
+    }
+}
+
+/* Per surface vertex: how far the simulated flesh is from where rigid
+ * skinning by the lattice frames would put it: the secondary motion (plus
+ * the static sag under gravity). */
+static void heat_colours(scene *s) {
+    uint32_t i;
+    skin_lattice(s, s->pose);
+    for (i = 0; i < 3 * s->info.vertices; i++) s->dev[i] = s->lpos[i] - s->skin[i];
+    for (i = 0; i < s->info.surface_vertices; i++) {
+        float d[3], m;
+        embed_vec(s, s->dev, i, d);
         m = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / s->heat;
         if (m > 1) m = 1;
         s->col[3 * i] = cow_colour[0] + m * (0.95f - cow_colour[0]);
@@ -284,7 +324,7 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     fetch(s, inst);
     if (s->heat > 0) heat_colours(s);
     rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
-    cam.ground_y = s->lo[1];   /* the ground stays under the hooves */
+    cam.ground_y = s->lo[1];   /* the ground stays under the feet */
     rs_clear(&big, &cam);
     if (s->heat > 0) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
     else rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
@@ -303,16 +343,57 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
 }
 
 typedef struct {
-    const char *blob_path, *clip_path, *obj_dir, *png, *sheet, *compare, *title;
-    long frames, iterations;
-    int unwarped, hash, lattice, quiet, w, h;
+    const char *blob_path, *clip_path, *obj_dir, *obj_frames, *png, *sheet, *compare, *title, *stats_csv, *plot;
+    long frames, iterations, health;
+    int unwarped, hash, lattice, quiet, w, h, have_size;
     float az, el, box[6], heat;
     int have_box;
 } options;
 
+#define MAX_FRAMES 10000000L
+
+/* --obj-frames list "0,10,20-30": checks the syntax and, when sel is given,
+ * that every frame is in 0..n and marks it in sel[0..n]. 0 or -1 (err). */
+static int frame_list(const char *v, long n, unsigned char *sel, char *err, size_t errlen) {
+    const char *p = v;
+    if (!*v) { snprintf(err, errlen, "empty list (want e.g. 0,10,20-30)"); return -1; }
+    for (;;) {
+        long a, b, k;
+        char *end;
+        const char *item = p;
+        size_t len = strcspn(p, ",");
+        if (!len) { snprintf(err, errlen, "empty item in '%s' (want e.g. 0,10,20-30)", v); return -1; }
+        if (*p < '0' || *p > '9') goto syntax;
+        a = strtol(p, &end, 10);
+        b = a;
+        if (*end == '-') {
+            if (end[1] < '0' || end[1] > '9') goto syntax;
+            b = strtol(end + 1, &end, 10);
+        }
+        if (end != p + len) goto syntax;
+        if (a > MAX_FRAMES || b > MAX_FRAMES) { snprintf(err, errlen, "frame number too large in '%.*s'", (int)len, item); return -1; }
+        if (b < a) { snprintf(err, errlen, "range '%.*s' runs backwards", (int)len, item); return -1; }
+        if (sel) {
+            if (b > n) {
+                snprintf(err, errlen, "frame %ld is after the last frame of this run (%ld; see --frames)", b, n);
+                return -1;
+            }
+            for (k = a; k <= b; k++) sel[k] = 1;
+        }
+        p += len;
+        if (!*p) return 0;
+        p++;
+        continue;
+    syntax:
+        snprintf(err, errlen, "bad item '%.*s' (want N or A-B, e.g. 0,10,20-30)", (int)len, item);
+        return -1;
+    }
+}
+
 static int parse_args(int argc, char **argv, options *o) {
-    static const char *const valued[] = {"--clip", "--obj-dir", "--png", "--sheet", "--compare", "--title",
-                                         "--frames", "--iterations", "--size", "--view", "--frame-box", "--heat", NULL};
+    static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
+                                         "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
+                                         "--stats-csv", "--plot", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -327,20 +408,29 @@ static int parse_args(int argc, char **argv, options *o) {
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); exit(0); }
         else if (!strcmp(a, "--clip")) o->clip_path = v;
         else if (!strcmp(a, "--obj-dir")) o->obj_dir = v;
+        else if (!strcmp(a, "--obj-frames")) {
+            char e[256];
+            if (frame_list(v, 0, NULL, e, sizeof e)) { fprintf(stderr, PROG ": --obj-frames: %s\n", e); return 2; }
+            o->obj_frames = v;
+        }
+        else if (!strcmp(a, "--stats-csv")) o->stats_csv = v;
+        else if (!strcmp(a, "--plot")) o->plot = v;
         else if (!strcmp(a, "--png")) o->png = v;
         else if (!strcmp(a, "--sheet")) o->sheet = v;
         else if (!strcmp(a, "--compare")) o->compare = v;
         else if (!strcmp(a, "--title")) o->title = v;
-        else if (!strcmp(a, "--frames") || !strcmp(a, "--iterations")) {
+        else if (!strcmp(a, "--frames") || !strcmp(a, "--iterations") || !strcmp(a, "--health")) {
             long n = strtol(v, &end, 10);
-            if (!*v || *end || n < 0 || n > 10000000L || (a[2] == 'i' && n < 1)) {
+            if (!*v || *end || n < 0 || n > MAX_FRAMES || (a[2] != 'f' && n < 1)) {
                 fprintf(stderr, PROG ": %s: bad number '%s'\n", a, v); return 2;
             }
-            if (a[2] == 'f') o->frames = n; else o->iterations = n;
+            if (a[2] == 'f') o->frames = n; else if (a[2] == 'i') o->iterations = n; else o->health = n;
         } else if (!strcmp(a, "--size")) {
-            if (sscanf(v, "%dx%d", &o->w, &o->h) != 2 || o->w < 16 || o->h < 16 || o->w > 4096 || o->h > 4096) {
+            char c;
+            if (sscanf(v, "%dx%d%c", &o->w, &o->h, &c) != 2 || o->w < 16 || o->h < 16 || o->w > 4096 || o->h > 4096) {
                 fprintf(stderr, PROG ": --size: want WxH (16..4096), got '%s'\n", v); return 2;
             }
+            o->have_size = 1;
         } else if (!strcmp(a, "--frame-box")) {
             float *b = o->box;
             if (sscanf(v, "%f,%f,%f,%f,%f,%f", b, b + 1, b + 2, b + 3, b + 4, b + 5) != 6 ||
@@ -365,6 +455,13 @@ static int parse_args(int argc, char **argv, options *o) {
         else { fprintf(stderr, PROG ": more than one blob given ('%s')\n", a); return 2; }
     }
     if (!o->blob_path) { usage(stderr); return 2; }
+    if (o->plot && o->have_size && (o->w < 240 || o->h < 180)) {
+        fprintf(stderr, PROG ": --size: the plot needs at least 240x180\n"); return 2;
+    }
+    if (o->obj_frames && !o->obj_dir) { fprintf(stderr, PROG ": --obj-frames needs --obj-dir\n"); return 2; }
+    if (o->sheet && o->have_size && (o->w > 2048 || o->h > 2048)) {
+        fprintf(stderr, PROG ": --size: sheet cells are at most 2048x2048 (the sheet is 4x3 cells)\n"); return 2;
+    }
     return 0;
 }
 
@@ -388,6 +485,47 @@ static int write_obj(scene *s, const char *path, char *err, size_t errlen) {
 #define SHEET_COLS 4
 #define SHEET_ROWS 3
 
+/* Health of one step (sn_stats after it). */
+typedef struct { double disp, energy; uint32_t saturations, bound_steps, limit_clamps; } frame_stat;
+
+/* --stats-csv: one row per step, atomically. */
+static int write_stats_csv(const char *path, const frame_stat *f, long n, double h, char *err, size_t errlen) {
+    size_t cap = (size_t)n * 120 + 128, len = 0;
+    char *buf = malloc(cap);
+    long k;
+    int r;
+    if (!buf) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
+    len += (size_t)snprintf(buf, cap, "frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps\n");
+    for (k = 0; k < n; k++)
+        len += (size_t)snprintf(buf + len, cap - len, "%ld,%.6f,%.9g,%.9g,%u,%u,%u\n", k + 1, (double)(k + 1) * h,
+                                f[k].disp, f[k].energy, f[k].saturations, f[k].bound_steps, f[k].limit_clamps);
+    r = write_file_atomic(path, buf, len, err, errlen);
+    free(buf);
+    return r;
+}
+
+/* --plot: energy above displacement, per step. */
+static int write_plot(const char *path, const frame_stat *f, long n, double h, int w, int hh, const char *title,
+                      char *err, size_t errlen) {
+    double *x = malloc(((size_t)n + 1) * 3 * sizeof(double)), *e = x ? x + n + 1 : NULL, *d = x ? x + 2 * (n + 1) : NULL;
+    plot_series se, sd;
+    plot_panel p[2];
+    rs_image im;
+    long k;
+    int r = -1;
+    memset(&im, 0, sizeof im);
+    if (!x || rs_image_alloc(&im, w, hh)) { snprintf(err, errlen, "%s: out of memory", path); free(x); return -1; }
+    for (k = 0; k < n; k++) { x[k] = (double)(k + 1) * h; e[k] = f[k].energy; d[k] = f[k].disp; }
+    se.x = sd.x = x; se.n = sd.n = (int)n; se.y = e; sd.y = d; se.label = sd.label = NULL;
+    p[0].title = "energy (J)"; p[0].s = &se; p[0].ns = 1; p[0].log_y = 0;
+    p[1].title = "largest displacement (cells)"; p[1].s = &sd; p[1].ns = 1; p[1].log_y = 0;
+    if (plot_draw(&im, title, "time (s)", p, 2)) snprintf(err, errlen, "%s: picture too small for the plot or out of memory", path);
+    else r = png_write(path, im.rgb, im.w, im.h, err, errlen);
+    rs_image_free(&im);
+    free(x);
+    return r;
+}
+
 int main(int argc, char **argv) {
     options o;
     scene s;
@@ -405,6 +543,9 @@ int main(int argc, char **argv) {
     uint32_t i, t;
     rs_image sheet, panel, cmp;
     long sheet_at[SHEET_COLS * SHEET_ROWS];
+    unsigned char *obj_sel = NULL;   /* --obj-frames: frames to write, 0..n_frames */
+    frame_stat *fst = NULL;          /* per step, for --stats-csv and --plot */
+    int pictures = 0;
     int r = parse_args(argc, argv, &o);
     if (r) return r;
     srand((unsigned)getpid());   /* distinct temp-file names for concurrent players */
@@ -430,6 +571,13 @@ int main(int argc, char **argv) {
         if (!text) { die("%s", err); goto done; }
         if (sn_clip_parse(&clip, text, cn, err, sizeof err)) { free(text); die("%s: %s", o.clip_path, err); goto done; }
         free(text);
+        for (i = 0; i < clip.n_warnings && i < SN_CLIP_MAX_WARNINGS; i++) {
+            sn_clip_warning_str(&clip, i, err, sizeof err);
+            fprintf(stderr, PROG ": warning: %s:%u: %s\n", o.clip_path, clip.warn[i].line, err);
+        }
+        if (clip.n_warnings > SN_CLIP_MAX_WARNINGS)
+            fprintf(stderr, PROG ": warning: %s: %u more keys 180 degrees or more apart\n", o.clip_path,
+                    clip.n_warnings - SN_CLIP_MAX_WARNINGS);
         if (sn_clip_bind(&clip, s.blob, err, sizeof err)) {
             fprintf(stderr, PROG ": %s does not fit %s: %s\n", o.clip_path, o.blob_path, err);
             goto done;
@@ -444,8 +592,15 @@ int main(int argc, char **argv) {
         goto done;
     }
 
+    if (o.obj_frames) {
+        if (!(obj_sel = calloc((size_t)n_frames + 1, 1))) { die("out of memory"); goto done; }
+        if (frame_list(o.obj_frames, n_frames, obj_sel, err, sizeof err)) { die("--obj-frames: %s", err); rc = 2; goto done; }
+    }
+
     /* outputs: check up front so a bad path fails before the run, not after */
     if (o.png && probe_writable(o.png, err, sizeof err)) { die("%s", err); goto done; }
+    if (o.stats_csv && probe_writable(o.stats_csv, err, sizeof err)) { die("%s", err); goto done; }
+    if (o.plot && probe_writable(o.plot, err, sizeof err)) { die("%s", err); goto done; }
     if (o.sheet && probe_writable(o.sheet, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare && probe_writable(o.compare, err, sizeof err)) { die("%s", err); goto done; }
     if (o.obj_dir) {
@@ -482,9 +637,11 @@ int main(int argc, char **argv) {
     times = malloc(((size_t)n_frames + 1) * sizeof(double));
     cpu = malloc(((size_t)n_frames + 1) * sizeof(double));
     if (!local || !xf || !rest_xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times || !cpu) { die("out of memory"); goto done; }
+    if ((o.stats_csv || o.plot) && !(fst = malloc(((size_t)n_frames + 1) * sizeof *fst))) { die("out of memory"); goto done; }
     for (t = 0; t < s.info.triangles; t++) sn_get_triangle(s.blob, t, s.tri + 3 * t);
+    pictures = o.png || o.sheet || o.compare;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
-    if (o.heat > 0 && heat_setup(&s, bytes)) { die("out of memory"); goto done; }
+    if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
     for (i = 0; i < s.info.joints; i++) {
         local[i].x = local[i].y = local[i].z = 0;
@@ -496,11 +653,14 @@ int main(int argc, char **argv) {
     }
     sn_pose_from_local(s.blob, local, NULL, rest_xf);
     s.pose = rest_xf;
-    if ((o.png || o.sheet || o.compare) && !s.info.triangles) {
+    if (pictures && !s.info.triangles) {
         fprintf(stderr, PROG ": %s has no triangles: cannot draw pictures\n", o.blob_path); goto done;
     }
-    /* the camera frames the rest surface, the same for every frame */
-    {
+    /* the camera frames the surface at rest and rigidly skinned in every
+       pose of the run (each distinct clip time once), the same for every frame */
+    if (pictures) {
+        long n_pose = 0;
+        float m = 0;
         int lat = s.lattice;
         s.lattice = 0;
         fetch(&s, inst);
@@ -511,10 +671,24 @@ int main(int argc, char **argv) {
                 if (s.pos[3 * i + (uint32_t)k] < s.lo[k]) s.lo[k] = s.pos[3 * i + (uint32_t)k];
                 if (s.pos[3 * i + (uint32_t)k] > s.hi[k]) s.hi[k] = s.pos[3 * i + (uint32_t)k];
             }
-        for (k = 0; k < 3; k++) {
-            s.flo[k] = o.have_box ? o.box[k] : s.lo[k];
-            s.fhi[k] = o.have_box ? o.box[3 + k] : s.hi[k];
+        if (have_clip && !o.have_box) {
+            int32_t hq = sn_clip_timestep_q16(s.blob);
+            n_pose = (long)(((int64_t)clip.duration + hq - 1) / hq);
+            if (n_pose > n_frames) n_pose = n_frames;
+            for (k = 1; k <= n_pose; k++) {
+                sn_clip_pose(&clip, s.blob, (uint32_t)k, local, xf);
+                skinned_box(&s, xf, s.lo, s.hi);
+            }
         }
+        /* a margin for the flesh's lag and sag: 3% of the largest extent */
+        for (k = 0; k < 3; k++) if (s.hi[k] - s.lo[k] > m) m = s.hi[k] - s.lo[k];
+        for (k = 0; k < 3; k++) {
+            s.flo[k] = o.have_box ? o.box[k] : s.lo[k] - 0.03f * m;
+            s.fhi[k] = o.have_box ? o.box[3 + k] : s.hi[k] + 0.03f * m;
+        }
+        if (!o.quiet && !o.have_box)
+            printf("camera box: %.3g,%.3g,%.3g,%.3g,%.3g,%.3g (surface at rest and in %ld clip poses, plus 3%%)\n",
+                   s.flo[0], s.flo[1], s.flo[2], s.fhi[0], s.fhi[1], s.fhi[2], n_pose);
     }
     if (!o.quiet)
         printf("%s: %u lattice vertices (%u free), %u cells, %u joints, %u surface vertices, %u triangles, "
@@ -526,7 +700,7 @@ int main(int argc, char **argv) {
 
     /* contact sheet: 12 frames spread over the run */
     if (o.sheet) {
-        int pw = 320, ph = 240;
+        int pw = o.have_size ? o.w : 320, ph = o.have_size ? o.h : 240;
         if (rs_image_alloc(&sheet, SHEET_COLS * pw, SHEET_ROWS * ph) || rs_image_alloc(&panel, pw, ph)) { die("out of memory"); goto done; }
         for (k = 0; k < SHEET_COLS * SHEET_ROWS; k++)
             sheet_at[k] = (long)(((double)k + 1) * (double)n_frames / (SHEET_COLS * SHEET_ROWS) + 0.5);
@@ -536,6 +710,13 @@ int main(int argc, char **argv) {
                 if (render(&s, inst, &panel, "t = 0.00 s", k == 0 ? o.title : NULL)) { die("out of memory"); goto done; }
                 rs_blit(&sheet, (int)(k % SHEET_COLS) * panel.w, (int)(k / SHEET_COLS) * panel.h, &panel);
             }
+    }
+
+    /* frame 0 (the state before the first step) only when asked for */
+    if (obj_sel && obj_sel[0]) {
+        snprintf(path, sizeof path, "%s/frame_%04d.obj", o.obj_dir, 0);
+        fetch(&s, inst);
+        if (write_obj(&s, path, err, sizeof err)) { die("%s", err); goto done; }
     }
 
     /* run */
@@ -553,7 +734,19 @@ int main(int argc, char **argv) {
         times[k - 1] = t1 - t0;
         cpu[k - 1] = c1 - c0;
         if (inst2) { sn_set_pose(inst2, xf, s.info.joints); sn_step(inst2); }
-        if (o.obj_dir) {
+        if (fst || (o.health && k % o.health == 0)) {
+            sn_stats hs;
+            sn_get_stats(inst, &hs);
+            if (fst) {
+                fst[k - 1].disp = D(hs.disp); fst[k - 1].energy = D(hs.energy);
+                fst[k - 1].saturations = hs.saturations; fst[k - 1].bound_steps = hs.bound_steps;
+                fst[k - 1].limit_clamps = hs.limit_clamps;
+            }
+            if (o.health && k % o.health == 0)
+                printf("health frame %ld: t %.3f s, disp %.4g cells, energy %.4g J, saturations %u\n",
+                       k, (double)k * h_s, F(hs.disp), F(hs.energy), hs.saturations);
+        }
+        if (o.obj_dir && (!obj_sel || obj_sel[k])) {
             snprintf(path, sizeof path, "%s/frame_%04ld.obj", o.obj_dir, k);
             fetch(&s, inst);
             if (write_obj(&s, path, err, sizeof err)) { die("%s", err); goto done; }
@@ -581,10 +774,28 @@ int main(int argc, char **argv) {
                "thread CPU time: median %.1f us, p99 %.1f us\n",
                times[n_frames / 2], times[p99], times[n_frames - 1], n_frames,
                SN_FLAVOUR ? "float" : "fixed", stats.iterations, stats.saturations, cpu[n_frames / 2], cpu[p99]);
+        printf("health: saturations %u, bound steps %u, limit clamps %u (last step; %u steps with clamps), "
+               "largest displacement %.4g cells, largest energy %.4g J (last %.4g J)\n",
+               stats.saturations, stats.bound_steps, stats.limit_clamps, stats.limit_steps,
+               F(stats.disp_max), F(stats.energy_max), F(stats.energy));
         if (stats.saturations)
-            fprintf(stderr, PROG ": warning: %u fixed-point values were clamped (saturated) in this run; "
-                    "the motion is not trustworthy\n", stats.saturations);
+            fprintf(stderr, PROG ": warning: %u %s values were clamped (saturated) in this run; "
+                    "the motion is not trustworthy\n", stats.saturations, SN_FLAVOUR ? "runaway float" : "fixed-point");
+        if (stats.bound_steps)
+            fprintf(stderr, PROG ": warning: a baked bound was exceeded in %u of %ld steps\n", stats.bound_steps, n_frames);
     } else printf("step: no steps run\n");
+    if (o.stats_csv) {
+        if (write_stats_csv(o.stats_csv, fst, n_frames, h_s, err, sizeof err)) { die("%s", err); goto done; }
+        if (!o.quiet) printf("wrote %s\n", o.stats_csv);
+    }
+    if (o.plot) {
+        char ttl[160];
+        snprintf(ttl, sizeof ttl, "%s", o.title ? o.title : o.clip_path ? o.clip_path : o.blob_path);
+        if (write_plot(o.plot, fst, n_frames, h_s, o.have_size ? o.w : 800, o.have_size ? o.h : 500, ttl, err, sizeof err)) {
+            die("%s", err); goto done;
+        }
+        if (!o.quiet) printf("wrote %s\n", o.plot);
+    }
 
     /* pictures */
     if (o.png) {
@@ -635,6 +846,6 @@ done:
     rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp);
     free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
-    free(s.rest); free(s.dev); free(s.col);
+    free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
     return rc;
 }

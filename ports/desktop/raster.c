@@ -31,25 +31,50 @@ static void norm3(float v[3]) {
 void rs_camera_frame(rs_camera *cam, const float lo[3], const float hi[3], int w, int h,
                      float azimuth_deg, float elevation_deg) {
     const float fov = 30.0f * 3.14159265f / 180.0f;   /* vertical; mild perspective */
-    float c[3], r = 0, d, az = azimuth_deg * 3.14159265f / 180.0f, el = elevation_deg * 3.14159265f / 180.0f;
-    float worldup[3] = {0, 1, 0};
-    int i;
+    const float fill = 0.97f;                          /* of the half width / height */
+    float c[3], r = 0, d = 0, az = azimuth_deg * 3.14159265f / 180.0f, el = elevation_deg * 3.14159265f / 180.0f;
+    float worldup[3] = {0, 1, 0}, ty = tanf(0.5f * fov), tx = ty * (float)w / (float)h;
+    float u0 = 0, u1 = 0, v0 = 0, v1 = 0;
+    int i, k;
     for (i = 0; i < 3; i++) {
         float e = 0.5f * (hi[i] - lo[i]);
         c[i] = 0.5f * (hi[i] + lo[i]);
         r += e * e;
     }
     r = sqrtf(r);
-    /* fit the bounding sphere, scaled down a little: the box corners are empty */
-    d = 0.80f * r / sinf(0.5f * fov * ((float)w < (float)h ? (float)w / (float)h : 1.0f));
     cam->fwd[0] = -sinf(az) * cosf(el);
     cam->fwd[1] = -sinf(el);
     cam->fwd[2] = -cosf(az) * cosf(el);
-    for (i = 0; i < 3; i++) cam->eye[i] = c[i] - d * cam->fwd[i];
     cross3(cam->fwd, worldup, cam->right); norm3(cam->right);
     cross3(cam->right, cam->fwd, cam->up);
-    cam->focal = 0.5f * (float)h / tanf(0.5f * fov);
-    cam->cx = 0.5f * (float)w; cam->cy = 0.5f * (float)h;
+    /* nearest distance at which every box corner projects inside `fill` */
+    for (k = 0; k < 8; k++) {
+        float p[3], x, y, z, dx, dy;
+        for (i = 0; i < 3; i++) p[i] = ((k >> i) & 1 ? hi[i] : lo[i]) - c[i];
+        x = fabsf(dot3(p, cam->right)); y = fabsf(dot3(p, cam->up)); z = dot3(p, cam->fwd);
+        dx = x / (fill * tx) - z;
+        dy = y / (fill * ty) - z;
+        if (dx > d) d = dx;
+        if (dy > d) d = dy;
+    }
+    if (d < 1.05f * r) d = 1.05f * r;   /* the eye stays outside the box */
+    if (!(d > 1e-6f)) d = 1;            /* an empty box */
+    for (i = 0; i < 3; i++) cam->eye[i] = c[i] - d * cam->fwd[i];
+    /* then zoom and shift the lens so the projected box is centred and
+       fills `fill` of the width or the height (perspective makes it lopsided) */
+    for (k = 0; k < 8; k++) {
+        float q[3], z, u, v;
+        for (i = 0; i < 3; i++) q[i] = ((k >> i) & 1 ? hi[i] : lo[i]) - cam->eye[i];
+        z = dot3(q, cam->fwd);
+        u = dot3(q, cam->right) / z; v = dot3(q, cam->up) / z;
+        if (!k || u < u0) u0 = u;
+        if (!k || u > u1) u1 = u;
+        if (!k || v < v0) v0 = v;
+        if (!k || v > v1) v1 = v;
+    }
+    cam->focal = fminf(fill * (float)w / fmaxf(u1 - u0, 1e-6f), fill * (float)h / fmaxf(v1 - v0, 1e-6f));
+    cam->cx = 0.5f * (float)w - cam->focal * 0.5f * (u0 + u1);
+    cam->cy = 0.5f * (float)h + cam->focal * 0.5f * (v0 + v1);
     cam->ground_y = lo[1];
     cam->scale = cam->focal / d;
 }

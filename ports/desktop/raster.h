@@ -23,8 +23,10 @@ int  rs_image_alloc(rs_image *im, int w, int h);   /* 0 or -1 (memory) */
 void rs_image_free(rs_image *im);
 
 /// Camera looking at the centre of box [lo, hi] from azimuth / elevation
-/// (degrees; azimuth 0 looks along -z, y is up), so the box fits with a margin.
-/// The ground plane is put at lo[1]. Use the rest box for every frame.
+/// (degrees; azimuth 0 looks along -z, y is up; vertical field of view 30
+/// degrees or a little less), the projected box centred and filling 97% of
+/// the width or the height.
+/// The ground plane is put at lo[1]. Use one box for every frame.
 void rs_camera_frame(rs_camera *cam, const float lo[3], const float hi[3], int w, int h,
                      float azimuth_deg, float elevation_deg);
 

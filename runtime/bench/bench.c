@@ -78,20 +78,26 @@ static void pose(const sn_blob *blob, uint32_t nJ, int k, sn_quat *local, sn_xfo
     sn_pose_from_local(blob, local, &root, out);
 }
 
-/* Exact arithmetic of one sn_step, in scalar multiply-adds, counted from the
- * code of runtime/src/sn_step.c (commit 628d221) and the blob's counts:
- *   rhs        12 nV + 36 nF + 24 nnz + 21 nnzFF
- *   skeleton   9 (nV - nF)
- *   CG start   66 nF + 24 nnzFF      (matvec + preconditioner + 1 dot)
- *   CG iter    78 nF + 24 nnzFF      (matvec 36 nF + 24 nnzFF: rotate in, S^ pass
- *              nF + 2 nnzFF blocks, rotate out, M^ pass, combine; precond 27 nF;
- *              2 dots, 2 axpys, 1 direction update 15 nF)
+/* Arithmetic of one sn_step, in scalar multiply-adds, counted from the code
+ * of runtime/src/sn_solve.c (format 2.0, per-cell stiffness) and the blob's
+ * counts (nC cells, fc free cell corners, nnz mass blocks, nnzFF of them
+ * free-free):
+ *   cell product   576 = 8 diagonal + 2 x 28 off-diagonal 3x3 blocks
+ *   rhs            nC (16*9 + 2*576 + 24) + 9 fc  + mass 3 nF + 3 nnz + 3 nnzFF
+ *                  + gravity 9 nF + kinetic energy 6 nF + w 3 nV
+ *   skeleton       9 (nV - nF)
+ *   matvec         nC 576 + 18 fc + mass 3 nF + 6 nnzFF + combine 6 nF
+ *   CG start       matvec + precondition 27 nF + 1 dot 3 nF
+ *   CG iteration   matvec + 27 nF + 2 dots + 2 axpys + direction 3 nF
+ *   health         9 nF (skinned positions) + 3 nF
  * A "block multiply-add" is one 3x3 block times a 3-vector = 9 multiply-adds.
- * Not counted: the frames (nJ quaternion->matrix, one slerp per blended vertex)
- * and the O(n) adds/clamps/shifts. */
-static double step_macs(uint32_t nV, uint32_t nF, uint32_t nnz, uint32_t nnzff, uint32_t iters) {
-    return 12.0 * nV + 36.0 * nF + 24.0 * nnz + 21.0 * nnzff + 9.0 * (nV - nF) + 66.0 * nF +
-           24.0 * nnzff + (double)iters * (78.0 * nF + 24.0 * nnzff);
+ * Not counted: the frames (nJ quaternion->matrix, one slerp per blended
+ * vertex or cell) and the O(n) adds/clamps/shifts. */
+static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint32_t nnz, uint32_t nnzff,
+                        uint32_t iters) {
+    double mv = 576.0 * nC + 18.0 * fc + 3.0 * nF + 6.0 * nnzff + 6.0 * nF;
+    double rhs = nC * (144.0 + 1152.0 + 24.0) + 9.0 * fc + 3.0 * nF + 3.0 * nnz + 3.0 * nnzff + 15.0 * nF + 3.0 * nV;
+    return rhs + 9.0 * (nV - nF) + mv + 30.0 * nF + (double)iters * (mv + 27.0 * nF + 21.0 * nF) + 12.0 * nF;
 }
 
 static uint32_t rd32(const unsigned char *p) {
@@ -109,7 +115,7 @@ static int bench_blob(const char *path, int only_steps) {
     sn_xform *xf;
     sn_vec3 *surf;
     sn_status st;
-    uint32_t nnzff = 0, e, blended = 0, i;
+    uint32_t nnzff = 0, e, blended = 0, i, fc = 0;
     int k, warm = 30, n = 400;
     double *ts, sum = 0, macs;
     if (!bytes) { fprintf(stderr, "sn_bench: cannot read %s\n", path); return 1; }
@@ -146,7 +152,9 @@ static int bench_blob(const char *path, int only_steps) {
         const unsigned char *cols = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_COLS);
         const unsigned char *fr = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_FRAMES);
         for (e = 0; e < info.offdiag_blocks; e++) nnzff += (uint32_t)(cols[2 * e] | (cols[2 * e + 1] << 8)) < info.free_vertices;
+        const unsigned char *cl = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_CELLS);
         for (i = 0; i < info.vertices; i++) blended += fr[4 * i] != fr[4 * i + 1] && (fr[4 * i + 2] | fr[4 * i + 3]);
+        for (i = 0; i < 8 * info.cells; i++) fc += (uint32_t)(cl[2 * i] | (cl[2 * i + 1] << 8)) < info.free_vertices;
     }
     for (k = 0; k < warm + n; k++) {
         double t0;
@@ -162,7 +170,8 @@ static int bench_blob(const char *path, int only_steps) {
         double t0 = now();
         int rep = 50;
         for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
-        macs = step_macs(info.vertices, info.free_vertices, info.offdiag_blocks, nnzff, info.cg_iters_default);
+        macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, info.offdiag_blocks, nnzff,
+                         info.cg_iters_default);
         printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
                "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u\n",
                path, FLAV, info.blob_bytes, (unsigned)need, info.vertices, info.free_vertices, info.joints,

@@ -148,8 +148,9 @@ size_t sn_instance_size(const sn_blob *blob);
 
 /// Initialise an instance in caller memory (mem 8-byte aligned, mem_size >=
 /// sn_instance_size(blob)); the instance starts at rest with the rest pose.
-/// SN_ERR_INDEX if a lattice vertex has more than 26 stored neighbours (a
-/// property of hex lattices the overflow-free arithmetic relies on).
+/// SN_ERR_INDEX if a free lattice vertex has more than 26 stored mass
+/// neighbours or is a corner of more than 8 cells (properties of hex lattices
+/// the overflow-free arithmetic relies on).
 sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out);
 
 /// Back to rest: rest pose, zero displacement and velocity, cleared warm start
@@ -159,6 +160,11 @@ void sn_reset(sn_instance *inst);
 /// Set the pose for the next sn_step: one transform per joint (rest model space
 /// to world). The first pose after init/reset also becomes the previous pose,
 /// so it causes no velocity jump.
+/// Quaternion signs are tracked (q is negated when it is nearer -q_previous),
+/// so frames between two bones interpolate the way the joint really turned,
+/// past 180° too: feed poses continuously, a joint turning less than 180° per
+/// step. A pose far from the last one (a teleport, a cut) should follow
+/// sn_reset.
 sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints);
 
 /// Forward kinematics: local joint rotations (each about the joint's rest
@@ -198,12 +204,20 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
 /// Surface triangle t as three surface vertex indices; SN_ERR_ARG if out of range.
 sn_status sn_get_triangle(const sn_blob *blob, uint32_t t, uint32_t idx[3]);
 
-/// Diagnostics of an instance.
+/// Diagnostics of an instance: a health report per step and since init/reset.
+/// Counters saturate at UINT32_MAX instead of wrapping.
 typedef struct sn_stats {
     uint32_t steps;        ///< steps since init/reset
-    uint32_t saturations;  ///< fixed point: values clamped since init/reset (0 in a healthy run)
+    uint32_t saturations;  ///< values clamped to their format since init/reset (fixed: format range; float: runaway guard); 0 in a healthy run
     uint32_t iterations;   ///< CG iterations per step in force
     uint32_t mode;         ///< sn_mode in force
+    uint32_t bound_steps;  ///< steps since init/reset in which a baked bound was exceeded (a clamp, or displacement over the blob's bound)
+    uint32_t limit_clamps; ///< lattice vertices pulled back to their baked distance limit in the last step
+    uint32_t limit_steps;  ///< steps since init/reset with at least one limit clamp
+    sn_real  disp;         ///< largest free-vertex distance from its skinned (rigidly warped) position after the last step, in cells (Q16.16 / float)
+    sn_real  disp_max;     ///< largest disp since init/reset
+    sn_real  energy;       ///< elastic + kinetic energy after the last step, joules (Q16.16 / float); kinetic uses the lumped mass
+    sn_real  energy_max;   ///< largest energy since init/reset
 } sn_stats;
 /// Read the diagnostics.
 void sn_get_stats(const sn_instance *inst, sn_stats *out);

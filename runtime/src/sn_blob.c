@@ -14,7 +14,12 @@
  * -> SECTION (table) -> INDEX / VALUE / SECTION (contents, padding).
  *
  * Numeric bounds (fixed flavour, stored integers): matrix entries
- * |e| <= 2^27; rest and joint coordinates |x| <= 2^27 (Q22: 32 internal
+ * |e| <= 2^27 (mass, preconditioner, every cell stiffness block);
+ * frac_S, frac_M <= 59 and frac_P <= 50 (the step shifts by frac - k + 3 and
+ * frac_P + k - 3 with k <= 15: every shift <= 62); frac_E in [-40, 60];
+ * ENERGY > 0; CELL in (0, 2^27] (Q22); DISP_BOUND > 0; limits in [0, 2^28]
+ * (Q22, the state clamp); cell corners distinct; cell frames as vertex
+ * frames; only known header flags; rest and joint coordinates |x| <= 2^27 (Q22: 32 internal
  * units) and at most 16384 mesh units (|x| <= 2^(36 - len_shift)); a1, b1 in [0, 2^28] (Q24: [0, 16]); |gravity| <= 2^27 (Q22);
  * timestep > 0. Float flavour: every real finite, and the same bounds as
  * true values (the stored integer divided by 2^Q of its format; matrices
@@ -131,12 +136,9 @@ static sn_status sn_check_contents(const sn_view *v) {
     }
     /* matrices */
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_MDIAG], v->nF, E, 0), SN_ERR_VALUE);
-    SN_CHK(sn_reals_ok(v->sec[SN_SEC_SDIAG], 6 * v->nF, E, 0), SN_ERR_VALUE);
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_PRECOND], 6 * v->nF, E, 0), SN_ERR_VALUE);
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_MLUMP], v->nF, E, 0), SN_ERR_VALUE);
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_MOFF], v->nnz, E, 0), SN_ERR_VALUE);
-    /* 9*nnz fits: the section size check bounded nnz*36 by total_size */
-    SN_CHK(sn_reals_ok(v->sec[SN_SEC_SOFF], 9 * v->nnz, E, 0), SN_ERR_VALUE);
     /* sparsity: rowptr monotone 0..nnz; per row columns strictly increasing,
      * > row (upper triangle), < nV */
     {
@@ -155,9 +157,29 @@ static sn_status sn_check_contents(const sn_view *v) {
             }
         }
     }
-    /* cells: corners < nV */
+    /* cells: corners < nV and pairwise distinct (a cell's 24 rows are its
+     * own: no vertex gets two rows of one cell); frames as FRAMES; stiffness
+     * entries |e| <= 2^27 (36*9*nC fits: the section size bounded it) */
     s = v->sec[SN_SEC_CELLS];
-    for (i = 0; i < 8 * v->nC; i++) SN_CHK(sn_rd_u16(s + 2 * (size_t)i) < v->nV, SN_ERR_INDEX);
+    for (i = 0; i < v->nC; i++) {
+        const unsigned char *c = s + (size_t)i * SN_ELEM_CELLS;
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(c + 2 * k);
+            SN_CHK(a < v->nV, SN_ERR_INDEX);
+            for (j = 0; j < k; j++) SN_CHK(sn_rd_u16(c + 2 * j) != a, SN_ERR_INDEX);
+        }
+    }
+    s = v->sec[SN_SEC_CFRAMES];
+    for (i = 0; i < v->nC; i++) {
+        const unsigned char *f = s + (size_t)i * SN_ELEM_CFRAMES;
+        SN_CHK(f[0] < v->nJ && f[1] < v->nJ, SN_ERR_INDEX);
+        SN_CHK(sn_rd_u16(f + 2) <= 32768u, SN_ERR_VALUE);
+    }
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_CELLK], SN_CELL_BLOCKS * 9 * v->nC, E, 0), SN_ERR_VALUE);
+    /* limits: 0 <= L <= 2^28 (Q22: 64 internal units, the state clamp) */
+    s = v->sec[SN_SEC_LIMIT];
+    for (i = 0; i < v->nL; i++)
+        SN_CHK(sn_real_ok(s + (size_t)i * SN_REAL_BYTES, 0, SN_LIM, SN_Q_LEN), SN_ERR_VALUE);
     /* embedding: cell < nC, trilinear coordinates in [0, 1] (Q15) */
     s = v->sec[SN_SEC_EMBED];
     for (i = 0; i < v->nS; i++) {
@@ -200,7 +222,8 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (total < SN_HEADER_BYTES) return SN_ERR_HEADER;
     if (total > size) return SN_ERR_TRUNCATED;
     if (sn_rd_u32(p + SN_H_HEADER_SIZE) != SN_HEADER_BYTES || p[SN_H_NSECTIONS] != SN_SEC_COUNT ||
-        p[SN_H_RESERVED0] != 0 || sn_rd_u32(p + SN_H_RESERVED1) != 0)
+        (p[SN_H_FLAGS] & ~SN_FLAG_REST_MODELLED) != 0 || p[SN_H_RESERVED1] != 0 ||
+        p[SN_H_RESERVED1 + 1] != 0 || p[SN_H_RESERVED1 + 2] != 0)
         return SN_ERR_HEADER;
 #if !defined(SN_VALIDATE_NO_CHECKSUM)
     if (sn_crc32(p + 16, total - 16) != sn_rd_u32(p + SN_H_CRC32)) return SN_ERR_CHECKSUM;
@@ -212,9 +235,13 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (v.nJ < 1 || v.nJ > SN_MAX_JOINTS || v.nS > SN_MAX_SURFACE) return SN_ERR_HEADER;
     if (v.cg_default < 1 || v.cg_default > v.cg_max || v.cg_max > SN_MAX_CG_ITERS)
         return SN_ERR_HEADER;
-    if (v.len_shift < -24 || v.len_shift > 24 || v.frac_S > 60 || v.frac_M > 60 || v.frac_P > 60)
+    /* shifts the step takes: frac_S - k + 3 and frac_M - k + 3 (k in 0..15),
+     * frac_P + k - 3: all must stay <= 62 for sn_rshr64 */
+    if (v.len_shift < -24 || v.len_shift > 24 || v.frac_S > 59 || v.frac_M > 59 || v.frac_P > 50 ||
+        v.frac_E < -40 || v.frac_E > 60 || (SN_FLAVOUR != SN_FLAVOUR_FIXED && v.frac_E != 0))
         return SN_ERR_HEADER;
-    if (v.instance_bytes < SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ)) return SN_ERR_HEADER;
+    if (v.nC < 1 || v.nC > SN_MAX_VERTICES) return SN_ERR_HEADER;
+    if (v.instance_bytes < SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ, v.nC)) return SN_ERR_HEADER;
 
     /* physics scalars */
     {
@@ -225,7 +252,11 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             !sn_real_ok(r + SN_R_TIMESTEP * SN_REAL_BYTES, 0, INT32_MAX, 16) ||
             !(v.timestep > 0) ||
             !sn_real_ok(r + SN_R_MASS_SCALE * SN_REAL_BYTES, INT32_MIN, INT32_MAX, 0) ||
-            !sn_real_zero(r + SN_R_RESERVED * SN_REAL_BYTES))
+            !sn_real_ok(r + SN_R_ENERGY * SN_REAL_BYTES, 0, INT32_MAX, 0) || !(v.energy > 0) ||
+            !sn_real_ok(r + SN_R_CELL * SN_REAL_BYTES, 1, SN_ENTRY_LIM, SN_Q_LEN) || !(v.cell > 0) ||
+            !sn_real_ok(r + SN_R_DISP_BOUND * SN_REAL_BYTES, 1, INT32_MAX, 16) || !(v.disp_bound > 0) ||
+            !sn_real_zero(r + SN_R_RESERVED10 * SN_REAL_BYTES) ||
+            !sn_real_zero(r + SN_R_RESERVED11 * SN_REAL_BYTES))
             return SN_ERR_VALUE;
     }
 
@@ -236,27 +267,29 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     cnt[SN_SEC_REST] = v.nV;
     cnt[SN_SEC_FRAMES] = v.nV;
     cnt[SN_SEC_MDIAG] = v.nF;
-    cnt[SN_SEC_SDIAG] = v.nF;
     cnt[SN_SEC_PRECOND] = v.nF;
     cnt[SN_SEC_MLUMP] = v.nF;
     cnt[SN_SEC_ROWPTR] = v.nF + 1;
     cnt[SN_SEC_COLS] = v.nnz;
     cnt[SN_SEC_MOFF] = v.nnz;
-    cnt[SN_SEC_SOFF] = v.nnz;
     cnt[SN_SEC_CELLS] = v.nC;
+    cnt[SN_SEC_CFRAMES] = v.nC;
+    cnt[SN_SEC_CELLK] = v.nC;
+    cnt[SN_SEC_LIMIT] = 0; /* 0 or nF: taken from the table below */
     cnt[SN_SEC_EMBED] = v.nS;
     cnt[SN_SEC_TRIS] = v.nT;
     {
-        static const uint8_t elem[SN_SEC_COUNT] = {
+        static const uint16_t elem[SN_SEC_COUNT] = {
             SN_ELEM_JOINTS(SN_REAL_BYTES), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(SN_REAL_BYTES),
-            SN_ELEM_FRAMES, SN_ELEM_MDIAG(SN_REAL_BYTES), SN_ELEM_SDIAG(SN_REAL_BYTES),
+            SN_ELEM_FRAMES, SN_ELEM_MDIAG(SN_REAL_BYTES),
             SN_ELEM_PRECOND(SN_REAL_BYTES), SN_ELEM_MLUMP(SN_REAL_BYTES), SN_ELEM_ROWPTR,
-            SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_SOFF(SN_REAL_BYTES),
-            SN_ELEM_CELLS, SN_ELEM_EMBED, SN_ELEM_TRIS};
+            SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_CELLS, SN_ELEM_CFRAMES,
+            SN_ELEM_CELLK(SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
             uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
+            if (k == SN_SEC_LIMIT && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -266,6 +299,7 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             if (!sn_zero_bytes(p + prev_end, off - prev_end)) return SN_ERR_SECTION;
             prev_end = off + sz;
         }
+        v.nL = cnt[SN_SEC_LIMIT];
         if (!sn_zero_bytes(p + prev_end, total - prev_end)) return SN_ERR_SECTION;
     }
 
@@ -296,18 +330,25 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->frac_S = p[SN_H_FRAC_S];
     v->frac_M = p[SN_H_FRAC_M];
     v->frac_P = p[SN_H_FRAC_P];
+    v->frac_E = p[SN_H_FRAC_E] < 128 ? (int)p[SN_H_FRAC_E] : (int)p[SN_H_FRAC_E] - 256;
     v->a1 = SN_RD_REAL(r + SN_R_A1 * SN_REAL_BYTES);
     v->b1 = SN_RD_REAL(r + SN_R_B1 * SN_REAL_BYTES);
     v->grav[0] = SN_RD_REAL(r + SN_R_GRAV_X * SN_REAL_BYTES);
     v->grav[1] = SN_RD_REAL(r + SN_R_GRAV_Y * SN_REAL_BYTES);
     v->grav[2] = SN_RD_REAL(r + SN_R_GRAV_Z * SN_REAL_BYTES);
     v->timestep = SN_RD_REAL(r + SN_R_TIMESTEP * SN_REAL_BYTES);
+    v->energy = SN_RD_REAL(r + SN_R_ENERGY * SN_REAL_BYTES);
+    v->cell = SN_RD_REAL(r + SN_R_CELL * SN_REAL_BYTES);
+    v->disp_bound = SN_RD_REAL(r + SN_R_DISP_BOUND * SN_REAL_BYTES);
+    v->flags = p[SN_H_FLAGS];
+    v->nL = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
     int k;
     for (k = 0; k < SN_SEC_COUNT; k++)
         v->sec[k] = v->base + sn_rd_u32(v->base + SN_H_SECTIONS + k * SN_SECTION_ENTRY);
+    v->nL = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_LIMIT * SN_SECTION_ENTRY + 8);
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */

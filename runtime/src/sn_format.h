@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 1.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 2.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -13,7 +13,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 1
+#define SN_FORMAT_MAJOR 2
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -37,7 +37,7 @@
 #define SN_H_FLAVOUR       24   /* u8  SN_FLAVOUR_* */
 #define SN_H_REAL_SIZE     25   /* u8  4 or 8: bytes per real */
 #define SN_H_NSECTIONS     26   /* u8  == SN_SEC_COUNT */
-#define SN_H_RESERVED0     27   /* u8  0 */
+#define SN_H_FLAGS         27   /* u8  SN_FLAG_* bits; others 0 */
 #define SN_H_ONE           28   /* u32 1.0 in the flavour (SN_ONE_*; 0 for float64) */
 #define SN_H_N_VERTICES    32   /* u32 lattice vertices nV (free first, then skeleton) */
 #define SN_H_N_FREE        36   /* u32 free vertices nF, 1 <= nF < nV */
@@ -45,7 +45,7 @@
 #define SN_H_N_JOINTS      44   /* u32 nJ, 1..255 */
 #define SN_H_N_SURFACE     48   /* u32 nS surface vertices, <= 65535 */
 #define SN_H_N_TRIANGLES   52   /* u32 nT */
-#define SN_H_N_OFFDIAG     56   /* u32 nnz off-diagonal blocks */
+#define SN_H_N_OFFDIAG     56   /* u32 nnz off-diagonal mass blocks */
 #define SN_H_INSTANCE_BYTES 60  /* u32 instance memory the runtime needs */
 #define SN_H_CG_DEFAULT    64   /* u16 default CG iterations, >= 1 */
 #define SN_H_CG_MAX        66   /* u16 max CG iterations, >= default, <= 256 */
@@ -54,8 +54,9 @@
 #define SN_H_FRAC_M        70   /* u8  fractional bits of mass entries (fixed) */
 #define SN_H_FRAC_P        71   /* u8  fractional bits of preconditioner entries (fixed) */
 #define SN_H_ONE_HI        72   /* u32 high word of 1.0 for float64, else 0 */
-#define SN_H_RESERVED1     76   /* u32 0 */
-/* physics scalars: 8 reals, at SN_H_REALS + i*real_size */
+#define SN_H_FRAC_E        76   /* i8  fractional bits of the ENERGY real (fixed flavour; 0 otherwise), -40..60 */
+#define SN_H_RESERVED1     77   /* u8[3] 0 */
+/* physics scalars: SN_H_NREALS reals, at SN_H_REALS + i*real_size */
 #define SN_H_REALS         80
 #define SN_R_A1             0   /* h*alpha (Rayleigh mass term), fixed Q24, >= 0 */
 #define SN_R_B1             1   /* beta/h (Rayleigh stiffness term), fixed Q24, >= 0 */
@@ -64,9 +65,17 @@
 #define SN_R_GRAV_Z         4
 #define SN_R_TIMESTEP       5   /* h in seconds, fixed Q16.16 */
 #define SN_R_MASS_SCALE     6   /* m0 in kg (informational), fixed Q16.16 */
-#define SN_R_RESERVED       7   /* 0 */
-#define SN_H_SECTIONS     144   /* section table: SN_SEC_COUNT x {u32 offset, u32 size, u32 count, u32 elem_size} */
+#define SN_R_ENERGY         7   /* joules per internal energy unit, m0 (U unit)^2 / h^2, fixed Q frac_E, > 0 */
+#define SN_R_CELL           8   /* lattice cell edge in internal length units, fixed Q22, > 0 */
+#define SN_R_DISP_BOUND     9   /* health bound on the distance of a free vertex from its skinned position, cells, fixed Q16.16, > 0 */
+#define SN_R_RESERVED10    10   /* 0 */
+#define SN_R_RESERVED11    11   /* 0 */
+#define SN_H_NREALS        12
+#define SN_H_SECTIONS     176   /* section table: SN_SEC_COUNT x {u32 offset, u32 size, u32 count, u32 elem_size} */
 #define SN_SECTION_ENTRY   16
+
+/* header flags */
+#define SN_FLAG_REST_MODELLED 1u /* the modelled shape is the rest-pose equilibrium: the runtime adds -m^_i R_i g^ (NUMERICS.md) */
 #define SN_HEADER_BYTES   (SN_H_SECTIONS + SN_SEC_COUNT * SN_SECTION_ENTRY)
 
 /* ---- sections, in this order; each starts 8-byte aligned; size = count*elem_size
@@ -79,14 +88,16 @@ enum {
     SN_SEC_FRAMES,       /* nV  x {u8 bone1, u8 bone2, u16 w Q15 (0..32768)}; R_i = slerp(R_b1, R_b2, w), c_i = (1-w)t_b1 + w t_b2
                             skeleton vertices: bone1 = the joint whose transform moves them, bone2 = bone1, w = 0 */
     SN_SEC_MDIAG,        /* nF  x R      M^_ii (Q frac_M) */
-    SN_SEC_SDIAG,        /* nF  x R[6]   S^_ii symmetric: xx yy zz xy xz yz (Q frac_S) */
-    SN_SEC_PRECOND,      /* nF  x R[6]   inverse of (1+a1) M^_ii I + (1+b1) S^_ii, symmetric (Q frac_P) */
+    SN_SEC_PRECOND,      /* nF  x R[6]   inverse of (1+a1) M^_ii I + (1+b1) S^_ii, symmetric xx yy zz xy xz yz (Q frac_P); S^_ii = sum over cells of S^_e,ii */
     SN_SEC_MLUMP,        /* nF  x R      row sums of M^ over all nV columns (Q frac_M) */
     SN_SEC_ROWPTR,       /* (nF+1) x u32 row i's off-diagonal blocks are [rowptr[i], rowptr[i+1]); rowptr[0]=0, rowptr[nF]=nnz */
-    SN_SEC_COLS,         /* nnz x u16   column vertex; within a row strictly increasing, > i (upper triangle + all skeleton columns) */
+    SN_SEC_COLS,         /* nnz x u16   column vertex; within a row strictly increasing, > i (upper triangle + all skeleton columns) of the mass pattern */
     SN_SEC_MOFF,         /* nnz x R     M^_ij (Q frac_M) */
-    SN_SEC_SOFF,         /* nnz x R[9]  S^_ij row-major (Q frac_S); S^_ji = S^_ij^T is not stored */
-    SN_SEC_CELLS,        /* nC  x u16[8] corner vertices, corner k at (k&1, k>>1&1, k>>2&1) of the cell box */
+    SN_SEC_CELLS,        /* nC  x u16[8] corner vertices, corner k at (k&1, k>>1&1, k>>2&1) of the cell box; distinct */
+    SN_SEC_CFRAMES,      /* nC  x {u8 bone1, u8 bone2, u16 w Q15}: cell frame R_e = slerp(R_b1, R_b2, w) (seed 003 end of 3.3) */
+    SN_SEC_CELLK,        /* nC  x 36 x R[9]: the cell's stiffness S^_e, upper blocks (a <= b) in order (0,0) (0,1) .. (0,7) (1,1) .. (7,7),
+                            block (a,b)[3i+j] = S^_e[3a+i][3b+j] (Q frac_S); S^_e,ba = S^_e,ab^T */
+    SN_SEC_LIMIT,        /* nF x R, or count 0 (no limits): largest distance of free vertex i from its skinned position, internal units (Q22), 0 = none */
     SN_SEC_EMBED,        /* nS  x {u16 cell, u16 t[3] Q15 (0..32768)} trilinear coordinates in the cell */
     SN_SEC_TRIS,         /* nT  x u16[3] surface vertex indices, counter-clockwise seen from outside */
     SN_SEC_COUNT
@@ -98,14 +109,16 @@ enum {
 #define SN_ELEM_REST(R)    (3 * (R))
 #define SN_ELEM_FRAMES      4
 #define SN_ELEM_MDIAG(R)   (R)
-#define SN_ELEM_SDIAG(R)   (6 * (R))
 #define SN_ELEM_PRECOND(R) (6 * (R))
 #define SN_ELEM_MLUMP(R)   (R)
 #define SN_ELEM_ROWPTR      4
 #define SN_ELEM_COLS        2
 #define SN_ELEM_MOFF(R)    (R)
-#define SN_ELEM_SOFF(R)    (9 * (R))
 #define SN_ELEM_CELLS       16
+#define SN_ELEM_CFRAMES      4
+#define SN_ELEM_CELLK(R)   (36 * 9 * (R))
+#define SN_ELEM_LIMIT(R)   (R)
+#define SN_CELL_BLOCKS      36
 #define SN_ELEM_EMBED       8
 #define SN_ELEM_TRIS        6
 
@@ -127,8 +140,8 @@ enum {
 /* Instance memory the runtime needs for a blob (bytes, multiple of 8). The
  * runtime owns this formula; the host tool writes its value into the header
  * and the validator rejects a header value smaller than it. */
-#define SN_INSTANCE_BYTES(nV, nF, nJ) \
+#define SN_INSTANCE_BYTES(nV, nF, nJ, nC) \
     (((uint32_t)512u + 76u * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
-      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 7u) & ~7u)
+      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

@@ -158,17 +158,26 @@ void sn_qtomat(const sn_q q[4], sn_q R[9]);
 void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]);
 /* Slerp along the shorter arc, t in [0,1] (fixed: Q30), result unit. */
 void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
+/* Slerp along the path from a to b without the shorter-arc flip (a joint
+ * wound past 180 degrees keeps its way), unless a.b < -cos 30 degrees
+ * (more than 300 degrees of rotation), where the shorter arc is taken. */
+void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
 /* Integer square root: floor(sqrt(x)). */
 uint32_t sn_isqrt64(uint64_t x);
+#if defined(SN_FLOAT)
+/* 1/sqrt(x) for x > 0 (no libm). */
+float sn_frsqrt(float x);
+#endif
 
 /* ---- validated blob, decoded once (pointers into the read-only blob) ---- */
 typedef struct sn_view {
     const unsigned char *base;
     const unsigned char *sec[SN_SEC_COUNT];
-    uint32_t nV, nF, nC, nJ, nS, nT, nnz;
-    uint32_t cg_default, cg_max, instance_bytes, total;
-    int len_shift, frac_S, frac_M, frac_P;
+    uint32_t nV, nF, nC, nJ, nS, nT, nnz, nL; /* nL: LIMIT entries, 0 or nF */
+    uint32_t cg_default, cg_max, instance_bytes, total, flags;
+    int len_shift, frac_S, frac_M, frac_P, frac_E;
     sn_q a1, b1, grav[3], timestep;
+    sn_q energy, cell, disp_bound; /* health scalars (NUMERICS.md) */
 } sn_view;
 
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */

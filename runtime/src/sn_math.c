@@ -48,6 +48,7 @@ const char *sn_status_str(sn_status s) {
 #define SN_Q30 ((int64_t)1 << 30)
 #define SN_PI_2_Q30 ((int64_t)1686629713) /* pi/2 * 2^30 */
 #define SN_PI_4_Q30 ((int64_t)843314857)  /* pi/4 * 2^30 */
+#define SN_COS30_Q30 ((int64_t)929887697) /* cos(30 deg) * 2^30 */
 
 /* Round-to-nearest right shift for any int64 except INT64_MIN (magnitude in
  * uint64, so also valid above the 2^62 bound of sn_rshr64). */
@@ -214,34 +215,40 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
  * so no intermediate overflows for any input. Exact shortcuts: t == 0 -> a,
  * t == 1 -> b (sign chosen for the shorter arc), a == b -> a.
  * Error for unit inputs: <= ~4 LSB per component (test: <= 8). */
-void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
     int64_t A[4], B[4], v[4], o[4], d = 0, tt, th, ph, sp, cp, k;
     uint64_t n2 = 0, s;
-    int i, same = 1;
+    int i, same = 1, flip;
     for (i = 0; i < 4; i++) {
         A[i] = sn_clamp64(a[i], SN_Q30);
         B[i] = sn_clamp64(b[i], SN_Q30);
         d += A[i] * B[i];
         same &= a[i] == b[i];
     }
-    if (d < 0)
+    d = sn_rshr64(d, 30); /* signed cos of the 4-D angle, Q30 */
+    if (d > SN_Q30) d = SN_Q30;
+    if (d < -SN_Q30) d = -SN_Q30;
+    flip = path ? d < -SN_COS30_Q30 : d < 0;
+    if (flip) {
         for (i = 0; i < 4; i++) B[i] = -B[i];
+        d = -d;
+    }
     tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
     if (same || tt == 0 || tt == SN_Q30) {
         for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == SN_Q30 && !same ? B[i] : A[i]);
         return;
     }
-    d = sn_rshr64(d < 0 ? -d : d, 30);
-    if (d > SN_Q30) d = SN_Q30;
     for (i = 0; i < 4; i++) {
         v[i] = sn_clamp64(B[i] - sn_rshr64(A[i] * d, 30), (int64_t)INT32_MAX);
         n2 += (uint64_t)(v[i] * v[i]); /* < 2^62 each */
     }
     s = sn_isqrt64(n2);
     if (n2 - s * s > s) s++;
-    th = sn_atan2_pos((int64_t)s, d);
-    ph = sn_rshr64(th * tt, 30); /* [0, pi/2] */
-    if (ph > SN_PI_4_Q30) sn_sincos_red(ph - SN_PI_2_Q30, 1, &sp, &cp);
+    th = sn_atan2_pos((int64_t)s, d < 0 ? -d : d);
+    if (d < 0) th = 2 * SN_PI_2_Q30 - th; /* path: the obtuse side, (pi/2, pi] */
+    ph = sn_rshr64(th * tt, 30); /* [0, pi] */
+    if (ph > 3 * SN_PI_4_Q30) sn_sincos_red(ph - 2 * SN_PI_2_Q30, 2, &sp, &cp);
+    else if (ph > SN_PI_4_Q30) sn_sincos_red(ph - SN_PI_2_Q30, 1, &sp, &cp);
     else sn_sincos_red(ph, 0, &sp, &cp);
     if (s == 0) k = tt;
     else k = (sp * SN_Q30 + (int64_t)(s >> 1)) / (int64_t)s;
@@ -250,6 +257,12 @@ void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
     if (!sn_unit(o, 4, out)) {
         for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
     }
+}
+void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    sn_qslerp_core(a, b, t, 0, out);
+}
+void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    sn_qslerp_core(a, b, t, 1, out);
 }
 
 /* ---- public helpers (fixed) ---- */
@@ -326,7 +339,7 @@ sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v) {
 
 /* 1/sqrt(x) for x > 0: bit-level first guess, 3 Newton steps (error after
  * 3 steps ~3e-11 before float rounding, i.e. ~1 ulp). x <= 0 -> 0. */
-static float sn_frsqrt(float x) {
+float sn_frsqrt(float x) {
     uint32_t i;
     float y;
     int k;
@@ -415,35 +428,45 @@ static float sn_fatan2_pos(float y, float x) {
     return swap ? SN_FPI_2 - a : a;
 }
 
-void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
     float B[4], v[4], o[4], d = 0.0f, n2 = 0.0f, s, th, ph, sp, cp, k;
-    int i, same = 1;
+    int i, same = 1, flip;
     for (i = 0; i < 4; i++) {
         d += a[i] * b[i];
         same &= a[i] == b[i];
     }
-    for (i = 0; i < 4; i++) B[i] = d < 0.0f ? -b[i] : b[i];
+    if (!(d <= 1.0f)) d = d > 1.0f ? 1.0f : 0.0f; /* also NaN -> 0 */
+    if (d < -1.0f) d = -1.0f;
+    flip = path ? d < -0.86602540378443865f : d < 0.0f;
+    for (i = 0; i < 4; i++) B[i] = flip ? -b[i] : b[i];
+    if (flip) d = -d;
     if (!(t > 0.0f)) t = 0.0f; /* also NaN -> 0 */
     if (t > 1.0f) t = 1.0f;
     if (same || t == 0.0f || t == 1.0f) {
         for (i = 0; i < 4; i++) out[i] = t == 1.0f && !same ? B[i] : a[i];
         return;
     }
-    d = sn_fabs(d);
-    if (d > 1.0f) d = 1.0f;
     for (i = 0; i < 4; i++) {
         v[i] = B[i] - a[i] * d;
         n2 += v[i] * v[i];
     }
     s = n2 * sn_frsqrt(n2);
-    th = sn_fatan2_pos(s, d);
+    th = sn_fatan2_pos(s, sn_fabs(d));
+    if (d < 0.0f) th = 2.0f * SN_FPI_2 - th; /* path: the obtuse side */
     ph = th * t;
-    if (ph > SN_FPI_4) sn_fsincos_red(ph - SN_FPI_2, 1, &sp, &cp);
+    if (ph > 3.0f * SN_FPI_4) sn_fsincos_red(ph - 2.0f * SN_FPI_2, 2, &sp, &cp);
+    else if (ph > SN_FPI_4) sn_fsincos_red(ph - SN_FPI_2, 1, &sp, &cp);
     else sn_fsincos_red(ph, 0, &sp, &cp);
     k = s > 1e-20f ? sp / s : t;
     k = k < 0.0f ? 0.0f : (k > 1.0f ? 1.0f : k);
     for (i = 0; i < 4; i++) o[i] = a[i] * cp + v[i] * k;
     if (!sn_funit(o, 4, out)) memcpy(out, a, 4 * sizeof(float));
+}
+void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    sn_qslerp_core(a, b, t, 0, out);
+}
+void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
+    sn_qslerp_core(a, b, t, 1, out);
 }
 
 /* Axis (any non-zero length; zero -> identity), angle in degrees. The half

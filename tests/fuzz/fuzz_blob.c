@@ -3,9 +3,14 @@
  * undefined behaviour (built with -fsanitize=address,undefined
  * -fno-sanitize-recover=all, so any finding aborts the run).
  *
- * For each mutated blob: validate; if accepted, initialise an instance, pose
- * it (sn_pose_from_local + sn_set_pose), step twice with 2 CG iterations, and
- * read everything back (lattice, surface, normals, hash, accessors).
+ * For each mutated blob: validate; if accepted, initialise an instance (init
+ * may refuse only with SN_ERR_INDEX, as sinew.h documents: a vertex in more
+ * mass rows or cells than a hex lattice has), pose it (sn_pose_from_local +
+ * sn_set_pose), step twice with 2 CG iterations (teleporting back to the rest
+ * pose for the second), and read everything back (lattice, surface, normals,
+ * hash, accessors, stats). Every section of format 2.0 (CFRAMES, CELLK, LIMIT
+ * included) gets its bits flipped and its boundaries cut; crafted cases push
+ * CELLK and every other matrix to the validator's bounds (see crafted_all).
  *
  * Two builds of the same file (tests/fuzz/fuzz.mk... see runtime/runtime.mk):
  *   test_runtime_fuzz     -DSN_VALIDATE_NO_CHECKSUM: the checksum is skipped so
@@ -18,6 +23,7 @@
  *   blob       default $BUILD/examples/cow.blob (fixed) or cow_float.blob
  *              (float); if missing, the hand-built test blob (sn_tblob.h)
  *   --all      every bit of the blob (slow for a 200 KB blob: ~1.5 M cases)
+ *   env SN_FUZZ_TRACE=1: name each case on stderr before it runs (finds the case behind a sanitizer abort)
  *   default    every bit of the header and section table, every bit of the
  *              first and last 16 bytes of each section, plus N (default 600)
  *              random bits inside each section; truncations: every size
@@ -67,9 +73,12 @@ static size_t g_mem_size;
 static char g_case[128];
 static uint64_t g_rng;
 static int g_pose; /* 0: 25 degrees about one axis; 1: (1,1,1) onto -x, root far away */
+static int g_steps = 2, g_iters = 2; /* crafted cases: more steps, every CG iteration */
+static sn_stats g_last_stats;       /* stats of the last exercise() */
+static int g_finite;                /* its lattice was finite (always, in fixed) */
 
 static struct {
-    unsigned long flips, flips_ok, stepped, trunc, trunc_ok, trunc_total, trunc_total_ok, huge;
+    unsigned long flips, flips_ok, stepped, trunc, trunc_ok, trunc_total, trunc_total_ok, huge, init_index;
     unsigned long by_status[SN_STATUS_COUNT];
 } g;
 
@@ -97,6 +106,7 @@ static void exercise(const sn_blob *blob) {
     sn_quat *local;
     sn_xform *xf;
     sn_vec3 *surf, *nrm, *lat, root, r;
+    sn_status ist;
     int s;
 
     sn_blob_get_info(blob, &info);
@@ -118,8 +128,13 @@ static void exercise(const sn_blob *blob) {
         g_mem_size = need;
         if (!g_mem) { fprintf(stderr, "out of memory\n"); exit(2); }
     }
-    if (sn_instance_init(g_mem, need, blob, &inst) != SN_OK) {
-        printf("FAIL: init refused an accepted blob (%s)\n", g_case);
+    ist = sn_instance_init(g_mem, need, blob, &inst);
+    if (ist == SN_ERR_INDEX) { /* documented (sinew.h): a vertex in more mass rows / cells than a hex lattice allows */
+        g.init_index++;
+        return;
+    }
+    if (ist != SN_OK) {
+        printf("FAIL: init refused an accepted blob (%s): %s\n", g_case, sn_status_str(ist));
         exit(1);
     }
     local = (sn_quat *)malloc(sizeof *local * info.joints);
@@ -141,10 +156,21 @@ static void exercise(const sn_blob *blob) {
     root.z = 0;
     sn_pose_from_local(blob, local, &root, xf);
     (void)sn_set_pose(inst, xf, info.joints);
-    (void)sn_set_iterations(inst, info.cg_iters_max < 2 ? info.cg_iters_max : 2);
+    (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
     (void)sn_set_mode(inst, SN_MODE_WARPED);
-    for (s = 0; s < 2; s++) sn_step(inst);
+    for (s = 0; s < g_steps; s++) {
+        if (s == g_steps / 2) { /* teleport back to the rest pose halfway: a second violent jump */
+            for (j = 0; j < info.joints; j++) { local[j].x = local[j].y = local[j].z = 0; local[j].w = REAL(1.0f, 1 << 30); }
+            sn_pose_from_local(blob, local, NULL, xf);
+            (void)sn_set_pose(inst, xf, info.joints);
+        }
+        sn_step(inst);
+    }
     (void)sn_get_lattice(inst, lat, 0, info.vertices);
+    sn_get_stats(inst, &g_last_stats);
+    g_finite = 1;
+    for (j = 0; j < info.vertices; j++)
+        if (!(lat[j].x == lat[j].x && lat[j].y == lat[j].y && lat[j].z == lat[j].z)) g_finite = 0;
     (void)sn_get_surface(inst, surf, 0, info.surface_vertices);
     if (info.triangles) (void)sn_get_normals(inst, surf, nrm);
     (void)sn_state_hash(inst);
@@ -152,9 +178,12 @@ static void exercise(const sn_blob *blob) {
     free(local); free(xf); free(surf); free(nrm); free(lat);
 }
 
+static int g_trace; /* env SN_FUZZ_TRACE: name every case on stderr before it runs (to find a sanitizer abort's case) */
 static sn_status run_case(size_t size) {
     const sn_blob *blob;
-    sn_status st = sn_blob_validate(g_work, size, &blob);
+    sn_status st;
+    if (g_trace) fprintf(stderr, "case: %s\n", g_case);
+    st = sn_blob_validate(g_work, size, &blob);
     if ((int)st >= 0 && st < SN_STATUS_COUNT) g.by_status[st]++;
     if (st == SN_OK) exercise(blob);
     return st;
@@ -245,7 +274,80 @@ static size_t craft_far_joint(void) {
     return total;
 }
 
-static int run_crafted(const char *name, size_t (*make)(void), int posetype) {
+/* ---- extreme matrices: every entry the validator lets through at its bound ----
+ * A stored matrix entry is at most 2^27 in magnitude (fixed: the integer;
+ * float: the value) and the state is clamped to 2^28 (NUMERICS.md "Fixed
+ * point"), so a cell row product of 24 terms is < 2^60.6 and a vertex in 8
+ * cells sums < 2^63.6 unless the runtime scales: these blobs drive every
+ * accumulator there under UBSan (signed overflow aborts the run). */
+
+/* Set the n reals at p to +-2^27 by a sign pattern: 0 all +, 1 alternating, 2 pseudo-random. */
+static void set_max(unsigned char *p, uint32_t n, int pattern) {
+    uint32_t i, x = 12345u;
+    for (i = 0; i < n; i++) {
+        int neg = pattern == 1 ? (int)(i & 1u) : pattern == 2 ? (int)((x = x * 1103515245u + 12345u) >> 31) : 0;
+#if defined(SN_FLOAT)
+        tb_real(p + 4 * (size_t)i, neg ? -134217728.0 : 134217728.0, 0);
+#else
+        tb_u32(p + 4 * (size_t)i, neg ? (uint32_t)0xF8000000u : (uint32_t)0x08000000u);
+#endif
+    }
+}
+static uint32_t sec_n(const unsigned char *b, int k) { return rd32(b + SN_H_SECTIONS + 16 * k + 4) / 4; }
+
+static size_t craft_cellk(int pattern, int frac) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0);
+    set_max(b + tb_sec(b, SN_SEC_CELLK), sec_n(b, SN_SEC_CELLK), pattern);
+    b[SN_H_FRAC_S] = (unsigned char)frac;
+    tb_u16(b + SN_H_CG_DEFAULT, 256);
+    tb_u16(b + SN_H_CG_MAX, 256);
+    tb_fix_crc(b);
+    return total;
+}
+static size_t craft_cellk_plus(void) { return craft_cellk(0, TB_FRAC); }
+static size_t craft_cellk_alt_q0(void) { return craft_cellk(1, 0); }
+static size_t craft_cellk_rand_q59(void) { return craft_cellk(2, 59); }
+
+/* Every matrix at the bound, damping and gravity at theirs, fractions 0,
+ * limits at 2^28, ENERGY as large as Q(-40) allows, DISP_BOUND 1 LSB. */
+static size_t craft_all_max(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0);
+    static const int secs[5] = {SN_SEC_MDIAG, SN_SEC_PRECOND, SN_SEC_MLUMP, SN_SEC_MOFF, SN_SEC_CELLK};
+    int k;
+    for (k = 0; k < 5; k++) set_max(b + tb_sec(b, secs[k]), sec_n(b, secs[k]), k & 1 ? 2 : 1);
+    b[SN_H_FRAC_S] = b[SN_H_FRAC_M] = b[SN_H_FRAC_P] = 0;
+    tb_real(b + SN_H_REALS + 4 * SN_R_A1, 16.0, SN_Q_COEF);
+    tb_real(b + SN_H_REALS + 4 * SN_R_B1, 16.0, SN_Q_COEF);
+    for (k = 0; k < 3; k++) tb_real(b + SN_H_REALS + 4 * (SN_R_GRAV_X + k), k == 1 ? -32.0 : 32.0, SN_Q_LEN);
+    for (k = 0; k < TB_NF; k++) tb_real(b + tb_sec(b, SN_SEC_LIMIT) + 4 * k, 64.0, SN_Q_LEN);
+#if defined(SN_FLOAT)
+    tb_real(b + SN_H_REALS + 4 * SN_R_ENERGY, 2.0e9, 0); /* float: the validator's cap 2^31 */
+    tb_real(b + SN_H_REALS + 4 * SN_R_DISP_BOUND, ldexp(1.0, -16), 0);
+#else
+    b[SN_H_FRAC_E] = (unsigned char)(256 - 40);
+    tb_u32(b + SN_H_REALS + 4 * SN_R_ENERGY, 0x7FFFFFFFu);
+    tb_u32(b + SN_H_REALS + 4 * SN_R_DISP_BOUND, 1);
+#endif
+    tb_u16(b + SN_H_CG_DEFAULT, 256);
+    tb_u16(b + SN_H_CG_MAX, 256);
+    tb_fix_crc(b);
+    return total;
+}
+
+/* Limits of 1 LSB on every free vertex, no REST_MODELLED: the limit stage clamps everything every step. */
+static size_t craft_limits_tiny(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0), k;
+    for (k = 0; k < TB_NF; k++) tb_u32(b + tb_sec(b, SN_SEC_LIMIT) + 4 * k, REAL(0x34000000u /* 1.2e-7f */, 1u));
+    b[SN_H_FLAGS] = 0;
+    tb_fix_crc(b);
+    return total;
+}
+
+/* expect: 0 nothing, 1 the state must reach the clamp (saturations > 0), 2 limits must clamp */
+static int run_crafted(const char *name, size_t (*make)(void), int posetype, int steps, int expect) {
     pid_t pid;
     int status = 0;
     fflush(stdout);
@@ -259,22 +361,42 @@ static int run_crafted(const char *name, size_t (*make)(void), int posetype) {
         st = sn_blob_validate(g_craft.b, n, &blob);
         if (st != SN_OK) { printf("  crafted %s: rejected (%s)\n", name, sn_status_str(st)); fflush(stdout); _exit(3); }
         g_pose = posetype;
+        g_steps = steps;
+        g_iters = 256;
         exercise(blob);
+        printf("  crafted %s: %d steps: saturations %u, bound steps %u, limit clamps %u (steps %u), disp max %g cells, energy max %g J%s\n", name,
+               steps, g_last_stats.saturations, g_last_stats.bound_steps, g_last_stats.limit_clamps, g_last_stats.limit_steps,
+               (double)g_last_stats.disp_max / REAL(1.0, 65536.0), (double)g_last_stats.energy_max / REAL(1.0, 65536.0),
+               g_finite ? "" : ", NON-FINITE lattice");
+        fflush(stdout);
+        if (!g_finite) _exit(5);
+        if (expect == 1 && g_last_stats.saturations == 0) _exit(4);
+        if (expect == 2 && g_last_stats.limit_clamps == 0) _exit(4);
         _exit(0);
     }
     if (pid < 0 || waitpid(pid, &status, 0) != pid) { printf("FAIL: crafted %s: fork failed\n", name); return 1; }
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) { printf("  crafted %s: ok\n", name); return 0; }
-    printf("FAIL: crafted %s: %s (exit %d, signal %d) -- see the sanitizer report above\n", name,
-           WIFEXITED(status) && WEXITSTATUS(status) == 3 ? "rejected by the validator" : "sanitizer finding",
+    printf("FAIL: crafted %s: %s (exit %d, signal %d)\n", name,
+           WIFEXITED(status) && WEXITSTATUS(status) == 3 ? "rejected by the validator"
+           : WIFEXITED(status) && WEXITSTATUS(status) == 4 ? "did not reach the bound it was built to reach"
+           : WIFEXITED(status) && WEXITSTATUS(status) == 5 ? "non-finite lattice"
+           : "sanitizer finding -- see the report above",
            WIFEXITED(status) ? WEXITSTATUS(status) : -1, WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     return 1;
 }
 
+#define N_CRAFTED 7
 static int crafted_all(void) {
     int fails = 0;
-    fails += run_crafted("2000 triangles on one vertex (normals)", craft_valence, 0);
+    fails += run_crafted("2000 triangles on one vertex (normals)", craft_valence, 0, 2, 0);
     fails += run_crafted("joint at (16384,16384,16384) mesh units rotated onto an axis (pose_from_local)",
-                         craft_far_joint, 1);
+                         craft_far_joint, 1, 2, 0);
+    fails += run_crafted("CELLK all +2^27, frac_S 26, 256 CG iterations, far pose and back", craft_cellk_plus, 1, 40, 1);
+    fails += run_crafted("CELLK +-2^27 alternating, frac_S 0", craft_cellk_alt_q0, 1, 40, 1);
+    fails += run_crafted("CELLK +-2^27 random signs, frac_S 59", craft_cellk_rand_q59, 1, 40, 0);
+    fails += run_crafted("every matrix at +-2^27, fractions 0, a1 = b1 = 16, |g| = 32, LIMIT 2^28, ENERGY max, DISP_BOUND 1 LSB",
+                         craft_all_max, 1, 40, 1);
+    fails += run_crafted("LIMIT 1 LSB on every free vertex", craft_limits_tiny, 0, 10, 2);
     return fails;
 }
 
@@ -343,8 +465,8 @@ static int fuzz_one(const char *name, int all, unsigned long per_section) {
         for (i = 0; i < 2000; i++) truncate_to((size_t)(rnd64() % g_size), 1);
     }
 
-    printf("  fuzz: flips %lu: accepted %lu (stepped %lu, instance > 16 MB %lu), rejected %lu\n", g.flips,
-           g.flips_ok, g.stepped, g.huge, g.flips - g.flips_ok);
+    printf("  fuzz: flips %lu: accepted %lu (stepped %lu, instance > 16 MB %lu, init SN_ERR_INDEX %lu), rejected %lu\n", g.flips,
+           g.flips_ok, g.stepped, g.huge, g.init_index, g.flips - g.flips_ok);
     printf("  fuzz: truncations (size only) %lu: accepted %lu; (total_size patched) %lu: accepted %lu\n",
            g.trunc, g.trunc_ok, g.trunc_total, g.trunc_total_ok);
     printf("  fuzz: statuses:");
@@ -373,7 +495,7 @@ int main(int argc, char **argv) {
         if (strcmp(argv[i], "--all") == 0) all = 1;
         else if (strcmp(argv[i], "--crafted") == 0) { /* only the crafted cases */
             i = crafted_all();
-            printf("%d passed, %d failed\n", 2 - i, i);
+            printf("%d passed, %d failed\n", N_CRAFTED - i, i);
             return i != 0;
         }
         else if (strcmp(argv[i], "--per-section") == 0 && i + 1 < argc) per_section = strtoul(argv[++i], NULL, 0);
@@ -381,6 +503,7 @@ int main(int argc, char **argv) {
         else path = argv[i];
     }
     if (getenv("SN_TEST_SEED")) seed = strtoul(getenv("SN_TEST_SEED"), NULL, 0);
+    g_trace = getenv("SN_FUZZ_TRACE") != NULL;
     g_rng = 0x9E3779B97F4A7C15ull ^ (uint64_t)seed;
     printf("  seed: %lu (set SN_TEST_SEED to change)\n", seed);
 #ifdef HAVE_SAN_CB
@@ -394,7 +517,7 @@ int main(int argc, char **argv) {
         fails += fuzz_one("hand-built (tests/fuzz/sn_tblob.h)", 1, 0);
         runs++;
         fails += crafted_all();
-        runs += 2;
+        runs += N_CRAFTED;
         free(g_orig);
         sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
         path = defpath;

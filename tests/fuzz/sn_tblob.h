@@ -2,13 +2,17 @@
  * runtime's own tests (validator, accessors, fuzz seed). Not the host tool:
  * it shares only the layout constants of sn_format.h.
  *
- * The asset: 2 hexahedral cells along x (3x2x2 = 12 lattice vertices), the
- * x = 0 face (4 vertices) bound rigidly to the root joint (skeleton), 8 free
- * vertices framed by root/tip; consistent trilinear mass, a graph-Laplacian
- * stiffness (3x3 blocks = scalar x I, PSD, translations in the null space),
- * its block-Jacobi preconditioner, 4 embedded surface vertices, 2 triangles.
- * Flavour follows SN_FLOAT of the including file (fixed: Q formats of
- * NUMERICS.md; float: true values).
+ * The asset (format 2.0): 2 hexahedral cells along x (3x2x2 = 12 lattice
+ * vertices), the x = 0 face (4 vertices) bound rigidly to the root joint
+ * (skeleton), 8 free vertices framed by root/tip, cell frames root/tip
+ * blended at the cell centres; consistent trilinear mass; per cell a
+ * stiffness CELLK from axial springs between all 28 corner pairs (symmetric
+ * PSD, rigid translations and rotations in its null space), the block-Jacobi
+ * preconditioner of the assembled diagonal; LIMIT on every free vertex
+ * (0.25 internal units on odd vertices, none on even ones); the
+ * REST_MODELLED flag; 4 embedded surface vertices, 2 triangles. Flavour
+ * follows SN_FLOAT of the including file (fixed: Q formats of NUMERICS.md;
+ * float: true values).
  */
 #ifndef SN_TBLOB_H
 #define SN_TBLOB_H
@@ -26,6 +30,7 @@
 #define TB_NT 2
 #define TB_FRAC 26   /* frac_S = frac_P */
 #define TB_FRAC_M 24 /* lumped mass rows reach 3.4 */
+#define TB_FRAC_E 16 /* ENERGY: 16.7 J per internal unit */
 
 static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
 static void tb_u32(unsigned char *p, uint32_t v) {
@@ -75,14 +80,15 @@ static int tb_vid(int ix, int iy, int iz) {
  * cap must be >= 4096. */
 static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     const int R = 4;
-    double X[TB_NV][3], M[TB_NV][TB_NV], S[TB_NV][TB_NV], m0 = 0.0;
-    const double a1 = 1.0 / 60.0, b1 = 0.06, k = 0.05, cell = 0.5;
+    double X[TB_NV][3], M[TB_NV][TB_NV], K[TB_NC][24][24], Sd[TB_NV][9], m0 = 0.0;
+    const double a1 = 1.0 / 60.0, b1 = 0.06, k = 0.05, cell = 0.5, h = 1.0 / 60.0;
     int corner[TB_NC][8];
     uint32_t off, cnt[SN_SEC_COUNT], elem[SN_SEC_COUNT], secoff[SN_SEC_COUNT];
-    int c, i, j, a, bb, d, sec, nnz = 0;
+    int c, i, j, a, bb, d, e, sec, nnz = 0;
     memset(b, 0, cap);
     memset(M, 0, sizeof M);
-    memset(S, 0, sizeof S);
+    memset(K, 0, sizeof K);
+    memset(Sd, 0, sizeof Sd);
     for (i = 0; i < 3; i++)
         for (j = 0; j < 2; j++)
             for (d = 0; d < 2; d++) {
@@ -93,18 +99,26 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
             }
     for (c = 0; c < TB_NC; c++)
         for (a = 0; a < 8; a++) corner[c][a] = tb_vid(c + (a & 1), (a >> 1) & 1, (a >> 2) & 1);
-    /* consistent trilinear hex mass V/216 * prod(1 + [same coordinate]); Laplacian stiffness */
+    /* consistent trilinear hex mass V/216 * prod(1 + [same coordinate]);
+     * cell stiffness: axial springs k n n^T between every pair of corners */
     for (c = 0; c < TB_NC; c++)
         for (a = 0; a < 8; a++)
             for (bb = 0; bb < 8; bb++) {
-                double m = cell * cell * cell / 216.0;
+                double m = cell * cell * cell / 216.0, n[3], l = 0;
                 for (d = 0; d < 3; d++) m *= 1.0 + (((a >> d) & 1) == ((bb >> d) & 1));
                 M[corner[c][a]][corner[c][bb]] += m;
-                if (a != bb) {
-                    S[corner[c][a]][corner[c][bb]] -= k;
-                    S[corner[c][a]][corner[c][a]] += k;
-                }
+                if (a == bb) continue;
+                for (d = 0; d < 3; d++) { n[d] = X[corner[c][bb]][d] - X[corner[c][a]][d]; l += n[d] * n[d]; }
+                for (i = 0; i < 3; i++)
+                    for (j = 0; j < 3; j++) {
+                        double kk = k * n[i] * n[j] / l;
+                        K[c][3 * a + i][3 * bb + j] -= kk;
+                        K[c][3 * a + i][3 * a + j] += kk;
+                    }
             }
+    for (c = 0; c < TB_NC; c++)
+        for (a = 0; a < 8; a++)
+            for (i = 0; i < 9; i++) Sd[corner[c][a]][i] += K[c][3 * a + i / 3][3 * a + i % 3];
     for (i = 0; i < TB_NV; i++) m0 = M[i][i] > m0 ? M[i][i] : m0;
     for (i = 0; i < TB_NV; i++)
         for (j = 0; j < TB_NV; j++) M[i][j] /= m0;
@@ -116,14 +130,15 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_REST] = TB_NV;         elem[SN_SEC_REST] = (uint32_t)SN_ELEM_REST(R);
     cnt[SN_SEC_FRAMES] = TB_NV;       elem[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
     cnt[SN_SEC_MDIAG] = TB_NF;        elem[SN_SEC_MDIAG] = (uint32_t)SN_ELEM_MDIAG(R);
-    cnt[SN_SEC_SDIAG] = TB_NF;        elem[SN_SEC_SDIAG] = (uint32_t)SN_ELEM_SDIAG(R);
     cnt[SN_SEC_PRECOND] = TB_NF;      elem[SN_SEC_PRECOND] = (uint32_t)SN_ELEM_PRECOND(R);
     cnt[SN_SEC_MLUMP] = TB_NF;        elem[SN_SEC_MLUMP] = (uint32_t)SN_ELEM_MLUMP(R);
     cnt[SN_SEC_ROWPTR] = TB_NF + 1;   elem[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
     cnt[SN_SEC_COLS] = (uint32_t)nnz; elem[SN_SEC_COLS] = SN_ELEM_COLS;
     cnt[SN_SEC_MOFF] = (uint32_t)nnz; elem[SN_SEC_MOFF] = (uint32_t)SN_ELEM_MOFF(R);
-    cnt[SN_SEC_SOFF] = (uint32_t)nnz; elem[SN_SEC_SOFF] = (uint32_t)SN_ELEM_SOFF(R);
     cnt[SN_SEC_CELLS] = TB_NC;        elem[SN_SEC_CELLS] = SN_ELEM_CELLS;
+    cnt[SN_SEC_CFRAMES] = TB_NC;      elem[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
+    cnt[SN_SEC_CELLK] = TB_NC;        elem[SN_SEC_CELLK] = (uint32_t)SN_ELEM_CELLK(R);
+    cnt[SN_SEC_LIMIT] = TB_NF;        elem[SN_SEC_LIMIT] = (uint32_t)SN_ELEM_LIMIT(R);
     cnt[SN_SEC_EMBED] = TB_NS;        elem[SN_SEC_EMBED] = SN_ELEM_EMBED;
     cnt[SN_SEC_TRIS] = TB_NT;         elem[SN_SEC_TRIS] = SN_ELEM_TRIS;
     off = SN_HEADER_BYTES;
@@ -152,30 +167,41 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         }
     }
     {
-        uint32_t e = 0;
+        static const int sym[6] = {0, 4, 8, 1, 2, 5}; /* xx yy zz xy xz yz of a row-major 3x3 */
+        uint32_t q = 0;
         for (i = 0; i < TB_NF; i++) {
-            double ms = 0.0, p = (1.0 + a1) * M[i][i] + (1.0 + b1) * S[i][i];
+            double ms = 0.0, A[9], P[9], det;
+            for (d = 0; d < 9; d++) A[d] = (1.0 + b1) * Sd[i][d] + (d % 4 == 0 ? (1.0 + a1) * M[i][i] : 0.0);
+            det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * A[7] - A[4] * A[6]);
+            P[0] = (A[4] * A[8] - A[5] * A[7]) / det; P[1] = (A[2] * A[7] - A[1] * A[8]) / det; P[2] = (A[1] * A[5] - A[2] * A[4]) / det;
+            P[4] = (A[0] * A[8] - A[2] * A[6]) / det; P[5] = (A[2] * A[3] - A[0] * A[5]) / det; P[8] = (A[0] * A[4] - A[1] * A[3]) / det;
             tb_real(b + secoff[SN_SEC_MDIAG] + i * R, M[i][i], TB_FRAC_M);
-            for (d = 0; d < 3; d++) {
-                tb_real(b + secoff[SN_SEC_SDIAG] + (6 * i + d) * R, S[i][i], TB_FRAC);
-                tb_real(b + secoff[SN_SEC_PRECOND] + (6 * i + d) * R, 1.0 / p, TB_FRAC);
-            }
+            for (d = 0; d < 6; d++) tb_real(b + secoff[SN_SEC_PRECOND] + (6 * i + d) * R, P[sym[d]], TB_FRAC);
             for (j = 0; j < TB_NV; j++) ms += M[i][j];
             tb_real(b + secoff[SN_SEC_MLUMP] + i * R, ms, TB_FRAC_M);
-            tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * i, e);
+            tb_real(b + secoff[SN_SEC_LIMIT] + i * R, (i & 1) ? 0.25 : 0.0, SN_Q_LEN);
+            tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * i, q);
             for (j = i + 1; j < TB_NV; j++) {
                 if (M[i][j] == 0.0) continue;
-                tb_u16(b + secoff[SN_SEC_COLS] + 2 * e, (uint32_t)j);
-                tb_real(b + secoff[SN_SEC_MOFF] + e * R, M[i][j], TB_FRAC_M);
-                for (d = 0; d < 3; d++)
-                    tb_real(b + secoff[SN_SEC_SOFF] + (9 * e + 4 * (uint32_t)d) * R, S[i][j], TB_FRAC);
-                e++;
+                tb_u16(b + secoff[SN_SEC_COLS] + 2 * q, (uint32_t)j);
+                tb_real(b + secoff[SN_SEC_MOFF] + q * R, M[i][j], TB_FRAC_M);
+                q++;
             }
         }
-        tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * TB_NF, e);
+        tb_u32(b + secoff[SN_SEC_ROWPTR] + 4 * TB_NF, q);
     }
-    for (c = 0; c < TB_NC; c++)
+    for (c = 0; c < TB_NC; c++) {
+        unsigned char *f = b + secoff[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * c;
+        unsigned char *ck = b + secoff[SN_SEC_CELLK] + (uint32_t)SN_ELEM_CELLK(R) * (uint32_t)c;
         for (a = 0; a < 8; a++) tb_u16(b + secoff[SN_SEC_CELLS] + 16 * c + 2 * a, (uint32_t)corner[c][a]);
+        f[0] = 0;
+        f[1] = 1;
+        tb_u16(f + 2, (uint32_t)((c + 0.5) * cell * 32768.0 + 0.5)); /* cell centre x */
+        e = 0;
+        for (a = 0; a < 8; a++)
+            for (bb = a; bb < 8; bb++, e++)
+                for (d = 0; d < 9; d++) tb_real(ck + (9 * e + d) * R, K[c][3 * a + d / 3][3 * bb + d % 3], TB_FRAC);
+    }
     {
         static const uint16_t emb[TB_NS][4] = {
             {0, 16384, 0, 32768}, {1, 32768, 0, 32768}, {1, 32768, 32768, 32768}, {0, 16384, 32768, 32768}};
@@ -195,6 +221,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     b[SN_H_FLAVOUR] = SN_FLAVOUR;
     b[SN_H_REAL_SIZE] = 4;
     b[SN_H_NSECTIONS] = SN_SEC_COUNT;
+    b[SN_H_FLAGS] = SN_FLAG_REST_MODELLED;
     tb_u32(b + SN_H_ONE, SN_FLAVOUR ? SN_ONE_FLOAT32 : SN_ONE_FIXED);
     tb_u32(b + SN_H_N_VERTICES, TB_NV);
     tb_u32(b + SN_H_N_FREE, TB_NF);
@@ -203,18 +230,35 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC));
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);
     b[SN_H_LEN_SHIFT] = (unsigned char)(len_shift & 0xFF);
     b[SN_H_FRAC_S] = b[SN_H_FRAC_P] = TB_FRAC;
     b[SN_H_FRAC_M] = TB_FRAC_M;
+#if !defined(SN_FLOAT)
+    b[SN_H_FRAC_E] = TB_FRAC_E;
+#endif
     tb_real(b + SN_H_REALS + SN_R_A1 * R, a1, SN_Q_COEF);
     tb_real(b + SN_H_REALS + SN_R_B1 * R, b1, SN_Q_COEF);
     tb_real(b + SN_H_REALS + SN_R_GRAV_Y * R, -9.81 / 3600.0, SN_Q_LEN);
-    tb_real(b + SN_H_REALS + SN_R_TIMESTEP * R, 1.0 / 60.0, 16);
+    tb_real(b + SN_H_REALS + SN_R_TIMESTEP * R, h, 16);
     tb_real(b + SN_H_REALS + SN_R_MASS_SCALE * R, m0, 16);
+    /* m0 (U unit)^2 / h^2, taking U unit = 1 m whatever len_shift is */
+    tb_real(b + SN_H_REALS + SN_R_ENERGY * R, m0 / (h * h), TB_FRAC_E);
+    tb_real(b + SN_H_REALS + SN_R_CELL * R, cell, SN_Q_LEN);
+    tb_real(b + SN_H_REALS + SN_R_DISP_BOUND * R, 2.0, 16);
     tb_fix_crc(b);
     return off;
+}
+
+/* Make the LIMIT section empty (count 0, size 0, bytes zeroed: a valid blob
+ * without the limit stage); CRC recomputed. */
+static void tb_drop_limit(unsigned char *b) {
+    unsigned char *e = b + SN_H_SECTIONS + 16 * SN_SEC_LIMIT;
+    memset(b + tb_sec(b, SN_SEC_LIMIT), 0, tb_rd32(e + 4));
+    tb_u32(e + 4, 0);
+    tb_u32(e + 8, 0);
+    tb_fix_crc(b);
 }
 #endif

@@ -1,4 +1,4 @@
-/* snref.c -- double-precision reference of runtime/NUMERICS.md.
+/* snref.c -- double-precision reference of runtime/NUMERICS.md (blob format 2.0).
  * Shares no arithmetic with the runtime: only sn_format.h constants. */
 #include "snref.h"
 #include "../../runtime/src/sn_format.h"
@@ -10,10 +10,9 @@
 #include <string.h>
 
 typedef struct snref_band snref_band;
-static snref_band *band_build(snref_state *s, int which, size_t max_doubles);
+static snref_band *band_build(snref_state *s, int which, double reg, size_t max_doubles);
 static void band_solve(const snref_band *B, const double *r, double *x);
 static void band_free(snref_band *B);
-static const double *band_key(const snref_band *B);
 
 /* ---------------- small linear algebra ---------------- */
 
@@ -27,19 +26,6 @@ static void matT_vec(const double A[9], const double x[3], double y[3]) {
     y[1] = A[1] * x[0] + A[4] * x[1] + A[7] * x[2];
     y[2] = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
 }
-static void mat_mul_(const double A[9], const double B[9], double C[9]) {
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-/* C = A B^T */
-static void mat_mulT_(const double A[9], const double B[9], double C[9]) {
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] + A[3 * i + 2] * B[3 * j + 2];
-}
 static int mat_inv(const double A[9], double B[9]) {
     double d = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6])
              + A[2] * (A[3] * A[7] - A[4] * A[6]);
@@ -48,6 +34,12 @@ static int mat_inv(const double A[9], double B[9]) {
     B[3] = (A[5] * A[6] - A[3] * A[8]) / d; B[4] = (A[0] * A[8] - A[2] * A[6]) / d; B[5] = (A[2] * A[3] - A[0] * A[5]) / d;
     B[6] = (A[3] * A[7] - A[4] * A[6]) / d; B[7] = (A[1] * A[6] - A[0] * A[7]) / d; B[8] = (A[0] * A[4] - A[1] * A[3]) / d;
     return 0;
+}
+static double dot(const double *a, const double *b, unsigned n) {
+    double r = 0;
+    unsigned i;
+    for (i = 0; i < n; i++) r += a[i] * b[i];
+    return r;
 }
 
 /* ---------------- quaternions ---------------- */
@@ -65,21 +57,30 @@ void snref_quat_mul(const double a[4], const double b[4], double o[4]) {
     r[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
     memcpy(o, r, sizeof r);
 }
-/* Shorter arc; sin formula, linear blend when nearly parallel. */
-void snref_quat_slerp(const double a[4], const double b[4], double t, double o[4]) {
-    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], bb[4], wa, wb, n;
+/* Slerp of unit-normalized a, b; shorter = 1: always the shorter arc; 0:
+ * along the path a -> b unless a.b < -cos 30 deg (NUMERICS step 2). Sin
+ * formula; linear blend when nearly parallel. */
+static void slerp_(const double ai[4], const double bi[4], double t, int shorter, double o[4]) {
+    double a[4], b[4], na = 0, nb = 0, d = 0, wa, wb, n;
     int k;
-    for (k = 0; k < 4; k++) bb[k] = d < 0 ? -b[k] : b[k];
-    d = fabs(d);
+    for (k = 0; k < 4; k++) { na += ai[k] * ai[k]; nb += bi[k] * bi[k]; }
+    na = sqrt(na); nb = sqrt(nb);
+    for (k = 0; k < 4; k++) { a[k] = ai[k] / na; b[k] = bi[k] / nb; d += a[k] * b[k]; }
+    if (d < 0 && (shorter || d < -0.86602540378443865)) {
+        for (k = 0; k < 4; k++) b[k] = -b[k];
+        d = -d;
+    }
     if (d > 1.0 - 1e-12) { wa = 1.0 - t; wb = t; }
     else {
         double th = acos(d), st = sin(th);
         wa = sin((1.0 - t) * th) / st; wb = sin(t * th) / st;
     }
-    for (k = 0; k < 4; k++) o[k] = wa * a[k] + wb * bb[k];
+    for (k = 0; k < 4; k++) o[k] = wa * a[k] + wb * b[k];
     n = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2] + o[3] * o[3]);
     for (k = 0; k < 4; k++) o[k] /= n;
 }
+void snref_quat_slerp(const double a[4], const double b[4], double t, double o[4]) { slerp_(a, b, t, 1, o); }
+void snref_quat_slerp_path(const double a[4], const double b[4], double t, double o[4]) { slerp_(a, b, t, 0, o); }
 /* Normalizes first, so a quantized input quaternion gives an orthonormal R. */
 void snref_quat_to_mat(const double qi[4], double R[9]) {
     double n = sqrt(qi[0] * qi[0] + qi[1] * qi[1] + qi[2] * qi[2] + qi[3] * qi[3]);
@@ -109,7 +110,7 @@ uint32_t snref_crc32(const unsigned char *p, size_t n) {
 
 typedef struct { const unsigned char *d; int flavour; unsigned rs; } rdr;
 
-/* Read real number idx of an array at p; fixed values are scaled by 2^-q. */
+/* Read the real at p; fixed values are scaled by 2^-q. */
 static double rd_real(const rdr *r, const unsigned char *p, int q) {
     if (r->flavour == SN_FLAVOUR_FIXED) {
         uint32_t u = rd_u32(p);
@@ -130,23 +131,68 @@ static double rd_real(const rdr *r, const unsigned char *p, int q) {
 
 #define FAIL(...) do { if (err) snprintf(err, errn, __VA_ARGS__); snref_free(m); return -1; } while (0)
 
+/* Free-free neighbour graph from CELLS (for the band ordering). */
+static int build_adjacency(snref_model *m) {
+    unsigned nF = m->nF, e, a, b, i, *cnt = calloc(nF + 1, sizeof *cnt), *list;
+    size_t tot = 0;
+    if (!cnt) return -1;
+    for (e = 0; e < m->nC; e++)
+        for (a = 0; a < 8; a++)
+            if (m->cells[8 * e + a] < nF) cnt[m->cells[8 * e + a]] += 7;
+    m->adjp = calloc(nF + 1, sizeof *m->adjp);
+    for (i = 0; i < nF; i++) tot += cnt[i];
+    list = malloc((tot + 1) * sizeof *list);
+    if (!m->adjp || !list) { free(cnt); free(list); return -1; }
+    for (i = 0; i < nF; i++) m->adjp[i + 1] = m->adjp[i] + cnt[i];
+    memset(cnt, 0, nF * sizeof *cnt);
+    for (e = 0; e < m->nC; e++)
+        for (a = 0; a < 8; a++) {
+            unsigned va = m->cells[8 * e + a];
+            if (va >= nF) continue;
+            for (b = 0; b < 8; b++) {
+                unsigned vb = m->cells[8 * e + b];
+                if (b != a && vb < nF) list[m->adjp[va] + cnt[va]++] = vb;
+            }
+        }
+    /* sort and dedupe each row in place */
+    m->adj = malloc((tot + 1) * sizeof *m->adj);
+    if (!m->adj) { free(cnt); free(list); return -1; }
+    {
+        unsigned w = 0, start;
+        for (i = 0; i < nF; i++) {
+            unsigned k, j, *row = list + m->adjp[i], n = cnt[i];
+            for (k = 1; k < n; k++)
+                for (j = k; j > 0 && row[j - 1] > row[j]; j--) { unsigned t = row[j]; row[j] = row[j - 1]; row[j - 1] = t; }
+            start = w;
+            for (k = 0; k < n; k++) if (k == 0 || row[k] != row[k - 1]) m->adj[w++] = row[k];
+            m->adjp[i] = start;
+        }
+        m->adjp[nF] = w;
+    }
+    free(cnt); free(list);
+    return 0;
+}
+
 int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t errn) {
     const unsigned char *d = (const unsigned char *)data;
     rdr r;
-    unsigned sec_off[SN_SEC_COUNT], sec_cnt[SN_SEC_COUNT], i, k;
+    unsigned sec_off[SN_SEC_COUNT], i, k;
     uint32_t total;
     unsigned R;
     memset(m, 0, sizeof *m);
     if (size < SN_HEADER_BYTES) FAIL("truncated header");
     if (d[0] != SN_MAGIC0 || d[1] != SN_MAGIC1 || d[2] != SN_MAGIC2 || d[3] != SN_MAGIC3) FAIL("bad magic");
-    if (rd_u16(d + SN_H_VER_MAJOR) != SN_FORMAT_MAJOR) FAIL("version");
+    if (rd_u16(d + SN_H_VER_MAJOR) != SN_FORMAT_MAJOR) FAIL("version %u", rd_u16(d + SN_H_VER_MAJOR));
     if (rd_u32(d + SN_H_ENDIAN) != SN_ENDIAN_MARK) FAIL("endian");
+    if (rd_u32(d + SN_H_HEADER_SIZE) != SN_HEADER_BYTES || d[SN_H_NSECTIONS] != SN_SEC_COUNT) FAIL("header size / sections");
     total = rd_u32(d + SN_H_TOTAL_SIZE);
     if (total > size || total < SN_HEADER_BYTES) FAIL("total size %u > %zu", (unsigned)total, size);
     if (snref_crc32(d + 16, total - 16) != rd_u32(d + SN_H_CRC32)) FAIL("crc mismatch");
     m->flavour = d[SN_H_FLAVOUR];
     m->real_size = R = d[SN_H_REAL_SIZE];
     if (m->flavour > 2 || R != (m->flavour == 2 ? 8u : 4u)) FAIL("flavour %d real size %u", m->flavour, R);
+    m->flags = d[SN_H_FLAGS];
+    if (m->flags & ~SN_FLAG_REST_MODELLED) FAIL("unknown flags 0x%x", m->flags);
     r.d = d; r.flavour = m->flavour; r.rs = R;
     m->nV = rd_u32(d + SN_H_N_VERTICES); m->nF = rd_u32(d + SN_H_N_FREE);
     m->nC = rd_u32(d + SN_H_N_CELLS); m->nJ = rd_u32(d + SN_H_N_JOINTS);
@@ -155,6 +201,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
     m->cg_default = rd_u16(d + SN_H_CG_DEFAULT); m->cg_max = rd_u16(d + SN_H_CG_MAX);
     m->len_shift = (int)(signed char)d[SN_H_LEN_SHIFT];
     m->frac_S = d[SN_H_FRAC_S]; m->frac_M = d[SN_H_FRAC_M]; m->frac_P = d[SN_H_FRAC_P];
+    m->frac_E = (int)(signed char)d[SN_H_FRAC_E];
     m->unit = ldexp(1.0, m->len_shift);
     if (m->nF < 1 || m->nF >= m->nV || m->nV > SN_MAX_VERTICES || m->nJ < 1 || m->nJ > SN_MAX_JOINTS)
         FAIL("counts nV %u nF %u nJ %u", m->nV, m->nF, m->nJ);
@@ -167,31 +214,39 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         m->grav[2] = rd_real(&r, rp + SN_R_GRAV_Z * R, SN_Q_LEN);
         m->h = rd_real(&r, rp + SN_R_TIMESTEP * R, 16);
         m->m0 = rd_real(&r, rp + SN_R_MASS_SCALE * R, 16);
+        m->energy = rd_real(&r, rp + SN_R_ENERGY * R, m->frac_E);
+        m->cell = rd_real(&r, rp + SN_R_CELL * R, SN_Q_LEN);
+        m->disp_bound = rd_real(&r, rp + SN_R_DISP_BOUND * R, 16);
+        if (!(m->energy > 0) || !(m->cell > 0) || !(m->disp_bound > 0))
+            FAIL("health scalars energy %g cell %g disp_bound %g", m->energy, m->cell, m->disp_bound);
     }
     {
-        const unsigned expect_cnt[SN_SEC_COUNT] = { m->nJ, m->nJ, m->nV, m->nV, m->nF, m->nF, m->nF, m->nF,
-            m->nF + 1, m->nnz, m->nnz, m->nnz, m->nC, m->nS, m->nT };
+        const unsigned expect_cnt[SN_SEC_COUNT] = { m->nJ, m->nJ, m->nV, m->nV, m->nF, m->nF, m->nF,
+            m->nF + 1, m->nnz, m->nnz, m->nC, m->nC, m->nC, m->nF, m->nS, m->nT };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
-            SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_SDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R),
-            SN_ELEM_ROWPTR, SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_SOFF(R), SN_ELEM_CELLS, SN_ELEM_EMBED,
-            SN_ELEM_TRIS };
+            SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
+            SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(R),
+            SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS };
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
             uint32_t off = rd_u32(e), sz = rd_u32(e + 4), cnt = rd_u32(e + 8), el = rd_u32(e + 12);
-            if (cnt != expect_cnt[i] || el != expect_el[i] || (uint64_t)cnt * el != sz
-                || (uint64_t)off + sz > total)
+            int cnt_ok = cnt == expect_cnt[i] || (i == SN_SEC_LIMIT && cnt == 0);
+            if (!cnt_ok || el != expect_el[i] || (uint64_t)cnt * el != sz || (uint64_t)off + sz > total)
                 FAIL("section %u: off %u size %u count %u elem %u", i, (unsigned)off, (unsigned)sz,
                      (unsigned)cnt, (unsigned)el);
-            sec_off[i] = off; sec_cnt[i] = cnt;
+            sec_off[i] = off;
+            if (i == SN_SEC_LIMIT) m->nlimit = cnt;
         }
     }
-    (void)sec_cnt;
 #define ALLOC(p, n) do { p = calloc((size_t)(n) + 1, sizeof *(p)); if (!p) FAIL("out of memory"); } while (0)
     ALLOC(m->jparent, m->nJ); ALLOC(m->jrest, 3 * m->nJ); ALLOC(m->jname, m->nJ);
     ALLOC(m->rest, 3 * m->nV); ALLOC(m->fb1, m->nV); ALLOC(m->fb2, m->nV); ALLOC(m->fw, m->nV);
-    ALLOC(m->mdiag, m->nF); ALLOC(m->sdiag, 9 * m->nF); ALLOC(m->precond, 9 * m->nF); ALLOC(m->mlump, m->nF);
-    ALLOC(m->rowptr, m->nF + 1); ALLOC(m->cols, m->nnz); ALLOC(m->moff, m->nnz); ALLOC(m->soff, 9 * m->nnz);
-    ALLOC(m->cells, 8 * m->nC); ALLOC(m->ecell, m->nS); ALLOC(m->et, 3 * m->nS); ALLOC(m->tris, 3 * m->nT);
+    ALLOC(m->mdiag, m->nF); ALLOC(m->precond, 9 * m->nF); ALLOC(m->mlump, m->nF);
+    ALLOC(m->rowptr, m->nF + 1); ALLOC(m->cols, m->nnz); ALLOC(m->moff, m->nnz);
+    ALLOC(m->cells, 8 * m->nC); ALLOC(m->cb1, m->nC); ALLOC(m->cb2, m->nC); ALLOC(m->cw, m->nC);
+    ALLOC(m->cellk, (size_t)576 * m->nC); ALLOC(m->sdiag, 9 * m->nF);
+    ALLOC(m->ecell, m->nS); ALLOC(m->et, 3 * m->nS); ALLOC(m->tris, 3 * m->nT);
+    if (m->nlimit) ALLOC(m->limit, m->nF);
     for (i = 0; i < m->nJ; i++) {
         const unsigned char *e = d + sec_off[SN_SEC_JOINTS] + i * SN_ELEM_JOINTS(R);
         unsigned par = rd_u16(e);
@@ -205,19 +260,19 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         const unsigned char *e = d + sec_off[SN_SEC_FRAMES] + 4 * i;
         for (k = 0; k < 3; k++) m->rest[3 * i + k] = rd_real(&r, d + sec_off[SN_SEC_REST] + (3 * i + k) * R, SN_Q_LEN);
         m->fb1[i] = e[0]; m->fb2[i] = e[1]; m->fw[i] = rd_u16(e + 2) / 32768.0;
-        if ((unsigned)m->fb1[i] >= m->nJ || (unsigned)m->fb2[i] >= m->nJ) FAIL("frame bones of vertex %u", i);
+        if ((unsigned)m->fb1[i] >= m->nJ || (unsigned)m->fb2[i] >= m->nJ || rd_u16(e + 2) > 32768u)
+            FAIL("frame of vertex %u", i);
     }
     for (i = 0; i < m->nF; i++) {
         static const int sym[6][2] = { { 0, 0 }, { 1, 1 }, { 2, 2 }, { 0, 1 }, { 0, 2 }, { 1, 2 } };
         m->mdiag[i] = rd_real(&r, d + sec_off[SN_SEC_MDIAG] + i * R, (int)m->frac_M);
         m->mlump[i] = rd_real(&r, d + sec_off[SN_SEC_MLUMP] + i * R, (int)m->frac_M);
         for (k = 0; k < 6; k++) {
-            double s = rd_real(&r, d + sec_off[SN_SEC_SDIAG] + (6 * i + k) * R, (int)m->frac_S);
             double p = rd_real(&r, d + sec_off[SN_SEC_PRECOND] + (6 * i + k) * R, (int)m->frac_P);
             int a = sym[k][0], b = sym[k][1];
-            m->sdiag[9 * i + 3 * a + b] = m->sdiag[9 * i + 3 * b + a] = s;
             m->precond[9 * i + 3 * a + b] = m->precond[9 * i + 3 * b + a] = p;
         }
+        if (m->limit) m->limit[i] = rd_real(&r, d + sec_off[SN_SEC_LIMIT] + i * R, SN_Q_LEN);
     }
     for (i = 0; i <= m->nF; i++) m->rowptr[i] = rd_u32(d + sec_off[SN_SEC_ROWPTR] + 4 * i);
     if (m->rowptr[0] != 0 || m->rowptr[m->nF] != m->nnz) FAIL("rowptr ends");
@@ -230,13 +285,32 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
                 FAIL("column %u of row %u", m->cols[e], i);
         }
     }
-    for (i = 0; i < m->nnz; i++) {
-        m->moff[i] = rd_real(&r, d + sec_off[SN_SEC_MOFF] + i * R, (int)m->frac_M);
-        for (k = 0; k < 9; k++) m->soff[9 * i + k] = rd_real(&r, d + sec_off[SN_SEC_SOFF] + (9 * i + k) * R, (int)m->frac_S);
-    }
-    for (i = 0; i < 8 * m->nC; i++) {
-        m->cells[i] = rd_u16(d + sec_off[SN_SEC_CELLS] + 2 * i);
-        if (m->cells[i] >= m->nV) FAIL("cell corner");
+    for (i = 0; i < m->nnz; i++) m->moff[i] = rd_real(&r, d + sec_off[SN_SEC_MOFF] + i * R, (int)m->frac_M);
+    for (i = 0; i < m->nC; i++) {
+        const unsigned char *cf = d + sec_off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * i;
+        const unsigned char *ck = d + sec_off[SN_SEC_CELLK] + (size_t)SN_ELEM_CELLK(R) * i;
+        double *K = m->cellk + (size_t)576 * i;
+        unsigned a, b, blk = 0, q;
+        for (a = 0; a < 8; a++) {
+            m->cells[8 * i + a] = rd_u16(d + sec_off[SN_SEC_CELLS] + 16 * i + 2 * a);
+            if (m->cells[8 * i + a] >= m->nV) FAIL("cell %u corner", i);
+            for (b = 0; b < a; b++) if (m->cells[8 * i + a] == m->cells[8 * i + b]) FAIL("cell %u repeats a corner", i);
+        }
+        m->cb1[i] = cf[0]; m->cb2[i] = cf[1]; m->cw[i] = rd_u16(cf + 2) / 32768.0;
+        if ((unsigned)m->cb1[i] >= m->nJ || (unsigned)m->cb2[i] >= m->nJ || rd_u16(cf + 2) > 32768u) FAIL("cell %u frame", i);
+        /* upper blocks (a <= b) in row order; block (a,b)[3i+j] = S[3a+i][3b+j], S_ba = S_ab^T */
+        for (a = 0; a < 8; a++)
+            for (b = a; b < 8; b++, blk++)
+                for (q = 0; q < 9; q++) {
+                    double x = rd_real(&r, ck + (9 * blk + q) * R, (int)m->frac_S);
+                    K[24 * (3 * a + q / 3) + 3 * b + q % 3] = x;
+                    K[24 * (3 * b + q % 3) + 3 * a + q / 3] = x;
+                }
+        for (a = 0; a < 8; a++) {
+            unsigned va = m->cells[8 * i + a];
+            if (va >= m->nF) continue;
+            for (q = 0; q < 9; q++) m->sdiag[9 * va + q] += K[24 * (3 * a + q / 3) + 3 * a + q % 3];
+        }
     }
     for (i = 0; i < m->nS; i++) {
         const unsigned char *e = d + sec_off[SN_SEC_EMBED] + 8 * i;
@@ -248,6 +322,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         m->tris[i] = rd_u16(d + sec_off[SN_SEC_TRIS] + 2 * i);
         if (m->tris[i] >= m->nS) FAIL("triangle index");
     }
+    if (build_adjacency(m) != 0) FAIL("out of memory");
     return 0;
 #undef ALLOC
 }
@@ -274,16 +349,19 @@ int snref_load_file(snref_model *m, const char *path, char *err, size_t errn) {
 
 void snref_free(snref_model *m) {
     free(m->jparent); free(m->jrest); free(m->jname); free(m->rest); free(m->fb1); free(m->fb2); free(m->fw);
-    free(m->mdiag); free(m->sdiag); free(m->precond); free(m->mlump); free(m->rowptr); free(m->cols);
-    free(m->moff); free(m->soff); free(m->cells); free(m->ecell); free(m->et); free(m->tris);
+    free(m->mdiag); free(m->precond); free(m->mlump); free(m->rowptr); free(m->cols); free(m->moff);
+    free(m->cells); free(m->cb1); free(m->cb2); free(m->cw); free(m->cellk); free(m->limit); free(m->sdiag);
+    free(m->adjp); free(m->adj); free(m->ecell); free(m->et); free(m->tris);
     memset(m, 0, sizeof *m);
 }
 
 /* ---------------- state ---------------- */
 
-/* scratch layout in s->work (each nV*3 unless noted) */
-enum { W_F, W_B, W_R, W_Z, W_D, W_AD, W_T1, W_T2, W_WV, W_X, W_PRE /* nF*9 */, W_COUNT = 20 };
+/* scratch arrays in s->work, each 3*nV doubles (S_PRE spans three: 9 nF) */
+enum { S_B, S_VSTAR, S_W, S_TMP, S_PP, S_PNEW, S_VNEW, S_DVS, S_R, S_Z, S_D, S_AD, S_X, S_PRE, S_COUNT = S_PRE + 3 };
 #define WK(s, k) ((s)->work + (size_t)(k) * 3 * (s)->m->nV)
+
+static const double I3[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
 
 int snref_init(snref_state *s, const snref_model *m) {
     memset(s, 0, sizeof *s);
@@ -293,14 +371,17 @@ int snref_init(snref_state *s, const snref_model *m) {
     s->dv = calloc(3 * (size_t)m->nV, sizeof *s->dv);
     s->R = calloc(9 * (size_t)m->nV, sizeof *s->R);
     s->c = calloc(3 * (size_t)m->nV, sizeof *s->c);
+    s->Rc = calloc(9 * (size_t)m->nC + 1, sizeof *s->Rc);
     s->jq = calloc(4 * (size_t)m->nJ, sizeof *s->jq);
     s->jt = calloc(3 * (size_t)m->nJ, sizeof *s->jt);
-    s->work = calloc(3 * (size_t)m->nV * W_COUNT, sizeof *s->work);
-    if (!s->p || !s->v || !s->dv || !s->R || !s->c || !s->jq || !s->jt || !s->work) { snref_release(s); return -1; }
+    s->work = calloc(3 * (size_t)m->nV * S_COUNT, sizeof *s->work);
+    if (!s->p || !s->v || !s->dv || !s->R || !s->c || !s->Rc || !s->jq || !s->jt || !s->work) { snref_release(s); return -1; }
     s->iters = m->cg_default;
     s->warm = 1;
     s->gscale = 1.0;
     s->hscale = 1.0;
+    s->dscale = 1.0;
+    s->path_slerp = 1;
     s->first_pose_moves_free = 1;
     snref_reset(s);
     return 0;
@@ -308,26 +389,37 @@ int snref_init(snref_state *s, const snref_model *m) {
 
 void snref_release(snref_state *s) {
     band_free(s->band);
-    free(s->p); free(s->v); free(s->dv); free(s->R); free(s->c); free(s->jq); free(s->jt); free(s->work);
+    free(s->p); free(s->v); free(s->dv); free(s->R); free(s->c); free(s->Rc); free(s->jq); free(s->jt); free(s->work);
     memset(s, 0, sizeof *s);
 }
 
+static unsigned root_joint(const snref_model *m) {
+    unsigned j;
+    for (j = 0; j < m->nJ; j++) if (m->jparent[j] < 0) return j;
+    return 0;
+}
+
+/* NUMERICS step 2: vertex frames (R_i, c_i) and cell frames R_e from the pose. */
 static void compute_frames(snref_state *s) {
     const snref_model *m = s->m;
-    unsigned i, root = 0, k;
-    for (i = 0; i < m->nJ; i++) if (m->jparent[i] < 0) { root = i; break; }
+    unsigned i, root = root_joint(m), k;
+    double q[4];
     for (i = 0; i < m->nV; i++) {
-        double q[4], w = m->fw[i];
+        double w = m->fw[i];
         int b1 = m->fb1[i], b2 = m->fb2[i];
         if (s->mode == SNREF_UNWARPED) {
-            static const double I[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-            memcpy(s->R + 9 * i, I, sizeof I);
+            memcpy(s->R + 9 * i, I3, sizeof I3);
             for (k = 0; k < 3; k++) s->c[3 * i + k] = s->jt[3 * root + k];
             continue;
         }
-        snref_quat_slerp(s->jq + 4 * b1, s->jq + 4 * b2, w, q);
+        slerp_(s->jq + 4 * b1, s->jq + 4 * b2, w, !s->path_slerp, q);
         snref_quat_to_mat(q, s->R + 9 * i);
         for (k = 0; k < 3; k++) s->c[3 * i + k] = (1.0 - w) * s->jt[3 * b1 + k] + w * s->jt[3 * b2 + k];
+    }
+    for (i = 0; i < m->nC; i++) {
+        if (s->mode == SNREF_UNWARPED) { memcpy(s->Rc + 9 * i, I3, sizeof I3); continue; }
+        slerp_(s->jq + 4 * m->cb1[i], s->jq + 4 * m->cb2[i], m->cw[i], !s->path_slerp, q);
+        snref_quat_to_mat(q, s->Rc + 9 * i);
     }
 }
 
@@ -343,31 +435,31 @@ static void skeleton_pos(const snref_state *s, unsigned k, double out[3]) {
 
 void snref_reset(snref_state *s) {
     const snref_model *m = s->m;
-    unsigned j;
-    unsigned root = 0;
-    for (j = 0; j < m->nJ; j++) if (m->jparent[j] < 0) { root = j; break; }
+    unsigned j, root = root_joint(m);
     for (j = 0; j < 3 * m->nV; j++) s->p[j] = m->rest[j] + m->jrest[3 * root + j % 3];
     memset(s->v, 0, 3 * m->nV * sizeof *s->v);
     memset(s->dv, 0, 3 * m->nV * sizeof *s->dv);
-    for (j = 0; j < m->nJ; j++) {
+    for (j = 0; j < m->nJ; j++) {   /* identity: also the tracking reference of the first pose */
         s->jq[4 * j] = s->jq[4 * j + 1] = s->jq[4 * j + 2] = 0; s->jq[4 * j + 3] = 1;
         s->jt[3 * j] = s->jt[3 * j + 1] = s->jt[3 * j + 2] = 0;
     }
     s->posed = 0;
     s->steps = 0;
+    s->e_el = s->e_kin = s->energy = s->energy_max = s->disp = s->disp_max = 0;
+    s->limit_clamps = s->limit_steps = s->bound_steps = 0;
     compute_frames(s);
 }
 
 void snref_set_pose(snref_state *s, const snref_xform *pose) {
     const snref_model *m = s->m;
-    unsigned j, k;
-    unsigned root = 0;
-    for (j = 0; j < m->nJ; j++) if (m->jparent[j] < 0) { root = j; break; }
+    unsigned j, k, root = root_joint(m);
     /* Poses act on model space; internal positions are relative to the root
      * joint's rest x0, so in internal units x -> R x + (R x0 + t)/U. */
     for (j = 0; j < m->nJ; j++) {
-        double Rj[9], y[3];
-        for (k = 0; k < 4; k++) s->jq[4 * j + k] = pose[j].q[k];
+        double Rj[9], y[3], d = 0, sg;
+        for (k = 0; k < 4; k++) d += pose[j].q[k] * s->jq[4 * j + k];
+        sg = (s->path_slerp && d < 0) ? -1.0 : 1.0;   /* step 1: track the previous pose's sign */
+        for (k = 0; k < 4; k++) s->jq[4 * j + k] = sg * pose[j].q[k];
         snref_quat_to_mat(pose[j].q, Rj);
         mat_vec(Rj, m->jrest + 3 * root, y);
         for (k = 0; k < 3; k++) s->jt[3 * j + k] = pose[j].t[k] / m->unit + y[k];
@@ -391,42 +483,123 @@ void snref_set_pose(snref_state *s, const snref_xform *pose) {
     compute_frames(s);
 }
 
-/* Baked coefficients after the optional time-step rescale. */
+/* Baked coefficients after the optional time-step and damping rescale. */
 static double sscale(const snref_state *s) { return s->hscale * s->hscale; }
-static double a1_of(const snref_state *s) { return s->m->a1 * s->hscale; }
-static double b1_of(const snref_state *s) { return s->m->b1 / s->hscale; }
+static double a1_of(const snref_state *s) { return s->m->a1 * s->hscale * s->dscale; }
+static double b1_of(const snref_state *s) { return s->m->b1 / s->hscale * s->dscale; }
 
-/* y_F = sum_j R_i S^_ij R_j^T x_j over j in F (and S if with_skel), free rows only. */
-static void ktilde_mul(const snref_state *s, const double *x, double *y, int with_skel) {
+/* ---------------- elastic terms, per cell ---------------- */
+
+#define KE(m, e) ((m)->cellk + (size_t)576 * (e))
+
+/* Cell model, NUMERICS step 4-5. For every cell: d_b = R_e^T (p_b - p_b0) -
+ * (x_b - x_b0), g = S^_e (d + R_e^T (w_b - w_b0)) (w may be NULL: 0), and
+ * out_a -= R_e g_a for free corners a (out may be NULL). Returns
+ * E_el = 1/2 sum_e d^T S^_e d. */
+static double cell_terms(const snref_state *s, const double *p, const double *w, double *out) {
     const snref_model *m = s->m;
-    double *loc = WK(s, W_T1);
-    unsigned i, e, n = with_skel ? m->nV : m->nF;
-    double sc = sscale(s);
-    for (i = 0; i < n; i++) matT_vec(s->R + 9 * i, x + 3 * i, loc + 3 * i);
-    memset(y, 0, 3 * m->nF * sizeof *y);
-    {
-        double *acc = WK(s, W_T2);
-        memset(acc, 0, 3 * m->nF * sizeof *acc);
-        for (i = 0; i < m->nF; i++) {
-            double t[3];
-            mat_vec(m->sdiag + 9 * i, loc + 3 * i, t);
-            acc[3 * i] += t[0]; acc[3 * i + 1] += t[1]; acc[3 * i + 2] += t[2];
-            for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
-                unsigned j = m->cols[e];
-                if (j >= n) continue;
-                mat_vec(m->soff + 9 * e, loc + 3 * j, t);
-                acc[3 * i] += t[0]; acc[3 * i + 1] += t[1]; acc[3 * i + 2] += t[2];
-                if (j < m->nF) {
-                    matT_vec(m->soff + 9 * e, loc + 3 * i, t);
-                    acc[3 * j] += t[0]; acc[3 * j + 1] += t[1]; acc[3 * j + 2] += t[2];
-                }
-            }
+    double E = 0, sc = sscale(s);
+    unsigned e, a, i, k;
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *Re = s->Rc + 9 * e, *K = KE(m, e);
+        double dd[24], dw[24], g[24];
+        for (a = 0; a < 8; a++) {
+            double u[3], x[3];
+            for (k = 0; k < 3; k++) u[k] = p[3 * cv[a] + k] - p[3 * cv[0] + k];
+            matT_vec(Re, u, x);
+            for (k = 0; k < 3; k++) dd[3 * a + k] = x[k] - (m->rest[3 * cv[a] + k] - m->rest[3 * cv[0] + k]);
+            if (w) {
+                for (k = 0; k < 3; k++) u[k] = w[3 * cv[a] + k] - w[3 * cv[0] + k];
+                matT_vec(Re, u, dw + 3 * a);
+            } else dw[3 * a] = dw[3 * a + 1] = dw[3 * a + 2] = 0;
         }
-        for (i = 0; i < m->nF; i++) {
-            mat_vec(s->R + 9 * i, acc + 3 * i, y + 3 * i);
-            y[3 * i] *= sc; y[3 * i + 1] *= sc; y[3 * i + 2] *= sc;
+        for (i = 0; i < 24; i++) {
+            double t = 0, tw = 0;
+            for (k = 0; k < 24; k++) { t += K[24 * i + k] * dd[k]; tw += K[24 * i + k] * dw[k]; }
+            E += 0.5 * sc * dd[i] * t;
+            g[i] = sc * (t + tw);
+        }
+        if (out)
+            for (a = 0; a < 8; a++) {
+                double y[3];
+                if (cv[a] >= m->nF) continue;
+                mat_vec(Re, g + 3 * a, y);
+                for (k = 0; k < 3; k++) out[3 * cv[a] + k] -= y[k];
+            }
+    }
+    return E;
+}
+
+/* VERTEX model force (seed 003 eq. 7): out_i -= R_i sum_j S_ij (R_i^T (p_j - c_i) - x_j), S = sum_e S^_e. */
+static void vertex_force(const snref_state *s, const double *p, double *out) {
+    const snref_model *m = s->m;
+    double sc = sscale(s);
+    unsigned e, a, b, k, i;
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *K = KE(m, e);
+        for (a = 0; a < 8; a++) {
+            unsigned va = cv[a];
+            const double *Ri = s->R + 9 * va, *ci = s->c + 3 * va;
+            double u[24], t[3] = { 0, 0, 0 }, y[3];
+            if (va >= m->nF) continue;
+            for (b = 0; b < 8; b++) {
+                double q[3];
+                for (k = 0; k < 3; k++) q[k] = p[3 * cv[b] + k] - ci[k];
+                matT_vec(Ri, q, u + 3 * b);
+                for (k = 0; k < 3; k++) u[3 * b + k] -= m->rest[3 * cv[b] + k];
+            }
+            for (i = 0; i < 3; i++)
+                for (k = 0; k < 24; k++) t[i] += K[24 * (3 * a + i) + k] * u[k];
+            mat_vec(Ri, t, y);
+            for (k = 0; k < 3; k++) out[3 * va + k] -= sc * y[k];
         }
     }
+}
+
+/* y (free rows) += c * sum_e Rl(a) S^_e,ab Rr(b)^T x_b.
+ * kind 0: step-matrix stiffness (CELL: Rl = Rr = R_e; VERTEX: R_a, R_b);
+ * kind 1: negated Jacobian of the static force (CELL: as kind 0; VERTEX: Rl = Rr = R_a).
+ * Skeleton columns only if with_skel. */
+static void stiff_mul(const snref_state *s, const double *x, double *y, int with_skel, int kind, double c) {
+    const snref_model *m = s->m;
+    unsigned e, a, b, k, i;
+    double sc = sscale(s) * c;
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *K = KE(m, e);
+        double loc[24];
+        int any = 0;
+        for (a = 0; a < 8; a++) any |= cv[a] < m->nF;
+        if (!any) continue;
+        if (s->force == SNREF_FORCE_CELL || kind == 0) {
+            for (b = 0; b < 8; b++) {
+                const double *Rr = s->force == SNREF_FORCE_CELL ? s->Rc + 9 * e : s->R + 9 * cv[b];
+                if (cv[b] >= m->nF && !with_skel) { loc[3 * b] = loc[3 * b + 1] = loc[3 * b + 2] = 0; continue; }
+                matT_vec(Rr, x + 3 * cv[b], loc + 3 * b);
+            }
+        }
+        for (a = 0; a < 8; a++) {
+            const double *Rl = s->force == SNREF_FORCE_CELL ? s->Rc + 9 * e : s->R + 9 * cv[a];
+            double t[3] = { 0, 0, 0 }, z[3];
+            if (cv[a] >= m->nF) continue;
+            if (s->force == SNREF_FORCE_VERTEX && kind == 1)
+                for (b = 0; b < 8; b++) {
+                    if (cv[b] >= m->nF && !with_skel) { loc[3 * b] = loc[3 * b + 1] = loc[3 * b + 2] = 0; continue; }
+                    matT_vec(Rl, x + 3 * cv[b], loc + 3 * b);
+                }
+            for (i = 0; i < 3; i++)
+                for (k = 0; k < 24; k++) t[i] += K[24 * (3 * a + i) + k] * loc[k];
+            mat_vec(Rl, t, z);
+            for (k = 0; k < 3; k++) y[3 * cv[a] + k] += sc * z[k];
+        }
+    }
+}
+
+void snref_kmul(const snref_state *s, const double *x, double *y, int with_skel) {
+    memset(y, 0, 3 * s->m->nF * sizeof *y);
+    stiff_mul(s, x, y, with_skel, 0, 1.0);
 }
 
 /* y_F = M^ x over free rows; columns F (and S if with_skel). */
@@ -445,90 +618,58 @@ static void mass_mul(const snref_state *s, const double *x, double *y, int with_
         }
 }
 
-/* Warped elastic force (seed 003 eq. 7), free rows, at positions p. */
-static void warped_force(const snref_state *s, const double *p, double *f) {
-    const snref_model *m = s->m;
-    double *acc = WK(s, W_T2);
-    unsigned i, e, k;
-    double sc = sscale(s);
-    memset(acc, 0, 3 * m->nF * sizeof *acc);
-    for (i = 0; i < m->nF; i++) {
-        const double *Ri = s->R + 9 * i, *ci = s->c + 3 * i;
-        double dd[3], t[3], u[3];
-        for (k = 0; k < 3; k++) u[k] = p[3 * i + k] - ci[k];
-        matT_vec(Ri, u, dd);
-        for (k = 0; k < 3; k++) dd[k] -= m->rest[3 * i + k];
-        mat_vec(m->sdiag + 9 * i, dd, t);
-        for (k = 0; k < 3; k++) acc[3 * i + k] += t[k];
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
-            unsigned j = m->cols[e];
-            for (k = 0; k < 3; k++) u[k] = p[3 * j + k] - ci[k];
-            matT_vec(Ri, u, dd);                       /* d_ij */
-            for (k = 0; k < 3; k++) dd[k] -= m->rest[3 * j + k];
-            mat_vec(m->soff + 9 * e, dd, t);
-            for (k = 0; k < 3; k++) acc[3 * i + k] += t[k];
-            if (j < m->nF) {
-                const double *Rj = s->R + 9 * j, *cj = s->c + 3 * j;
-                for (k = 0; k < 3; k++) u[k] = p[3 * i + k] - cj[k];
-                matT_vec(Rj, u, dd);                   /* d_ji */
-                for (k = 0; k < 3; k++) dd[k] -= m->rest[3 * i + k];
-                matT_vec(m->soff + 9 * e, dd, t);
-                for (k = 0; k < 3; k++) acc[3 * j + k] += t[k];
-            }
-        }
-    }
-    for (i = 0; i < m->nF; i++) {
-        mat_vec(s->R + 9 * i, acc + 3 * i, f + 3 * i);
-        for (k = 0; k < 3; k++) f[3 * i + k] *= -sc;
-    }
-}
-
+/* External load of step 5: m^_i g^ [- m^_i R_i g^ with REST_MODELLED]. */
 static void gravity_add(const snref_state *s, double *f) {
     const snref_model *m = s->m;
     unsigned i, k;
-    double g = s->gscale * sscale(s);
-    for (i = 0; i < m->nF; i++)
+    double g = s->gscale * sscale(s), rg[3];
+    for (i = 0; i < m->nF; i++) {
         for (k = 0; k < 3; k++) f[3 * i + k] += m->mlump[i] * m->grav[k] * g;
+        if (m->flags & SN_FLAG_REST_MODELLED) {
+            mat_vec(s->R + 9 * i, m->grav, rg);
+            for (k = 0; k < 3; k++) f[3 * i + k] -= m->mlump[i] * rg[k] * g;
+        }
+    }
 }
 
+void snref_force(const snref_state *s, const double *p, double *out) {
+    memset(out, 0, 3 * s->m->nF * sizeof *out);
+    if (s->force == SNREF_FORCE_CELL) cell_terms(s, p, NULL, out);
+    else vertex_force(s, p, out);
+}
+
+double snref_elastic(const snref_state *s, const double *p) { return cell_terms(s, p, NULL, NULL); }
+
 void snref_residual(const snref_state *s, double *out) {
-    warped_force(s, s->p, out);
+    snref_force(s, s->p, out);
     gravity_add(s, out);
 }
 
-static double dot(const double *a, const double *b, unsigned n) {
-    double r = 0;
-    unsigned i;
-    for (i = 0; i < n; i++) r += a[i] * b[i];
-    return r;
-}
-
-/* A x = (1+a1) M^_FF x + (1+b1) K~_FF x */
+/* A x = (1+a1) M^_FF x + (1+b1) K_FF x */
 static void a_mul(const snref_state *s, const double *x, double *y) {
-    const snref_model *m = s->m;
-    double *t = WK(s, W_X);
-    unsigned i, n = 3 * m->nF;
-    double ca = 1.0 + a1_of(s), cb = 1.0 + b1_of(s);
+    unsigned i, n = 3 * s->m->nF;
+    double ca = 1.0 + a1_of(s);
     mass_mul(s, x, y, 0);
-    ktilde_mul(s, x, t, 0);
-    for (i = 0; i < n; i++) y[i] = ca * y[i] + cb * t[i];
+    for (i = 0; i < n; i++) y[i] *= ca;
+    stiff_mul(s, x, y, 0, 0, 1.0 + b1_of(s));
 }
 
-/* Preconditioner blocks P_i (rest frame), from the blob unless h is rescaled. */
+/* Preconditioner blocks P_i (rest frame), from the blob unless h or damping is rescaled. */
 static const double *precond_blocks(snref_state *s) {
     const snref_model *m = s->m;
-    double *P = WK(s, W_PRE);
+    double *P = WK(s, S_PRE);
     unsigned i, k;
-    if (s->hscale == 1.0) return m->precond;
+    if (s->hscale == 1.0 && s->dscale == 1.0) return m->precond;
     for (i = 0; i < m->nF; i++) {
         double A[9];
         for (k = 0; k < 9; k++) A[k] = (1.0 + b1_of(s)) * sscale(s) * m->sdiag[9 * i + k];
-        A[0] += (1.0 + a1_of(s)) * m->mdiag[i]; A[4] += (1.0 + a1_of(s)) * m->mdiag[i]; A[8] += (1.0 + a1_of(s)) * m->mdiag[i];
+        for (k = 0; k < 3; k++) A[4 * k] += (1.0 + a1_of(s)) * m->mdiag[i];
         mat_inv(A, P + 9 * i);
     }
     return P;
 }
 
+/* z_i = R_i P_i R_i^T r_i (step 6: the vertex frame) */
 static void precond_apply(const snref_state *s, const double *P, const double *r, double *z) {
     unsigned i;
     for (i = 0; i < s->m->nF; i++) {
@@ -543,7 +684,7 @@ static void precond_apply(const snref_state *s, const double *P, const double *r
 static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     const snref_model *m = s->m;
     unsigned n = 3 * m->nF, it, i, maxit = iters ? iters : 20 * n + 100;
-    double *r = WK(s, W_R), *z = WK(s, W_Z), *d = WK(s, W_D), *Ad = WK(s, W_AD);
+    double *r = WK(s, S_R), *z = WK(s, S_Z), *d = WK(s, S_D), *Ad = WK(s, S_AD);
     const double *P = precond_blocks(s);
     double rz, bn = sqrt(dot(b, b, n));
     a_mul(s, x, Ad);
@@ -581,35 +722,223 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     return bn > 0 ? sqrt(dot(r, r, n)) / bn : 0.0;
 }
 
+/* ---------------- banded direct solver ---------------- */
 
-/* Exact step solve by a banded LU of A, cached while the frames (pose, mode,
- * time-step scale) are unchanged. Returns -1 if the band is too large. */
-static int exact_direct(snref_state *s, const double *b, double *x) {
-    const snref_model *m = s->m;
-    double key[64];
-    unsigned j, k = 0;
-    memset(key, 0, sizeof key);
-    /* A depends on the joint rotations only (frames), the mode and the h scale */
-    for (j = 0; j < m->nJ && k + 4 <= 60; j++) {
-        unsigned c;
-        for (c = 0; c < 4; c++) key[k++] = s->jq[4 * j + c];
+/* Reverse Cuthill-McKee order of the free vertices (bandwidth reduction for
+ * the banded direct solve). perm[new] = old, inv[old] = new. */
+static void rcm(const snref_model *m, unsigned *perm, unsigned *inv) {
+    unsigned nF = m->nF, i, head, tail = 0;
+    const unsigned *adjp = m->adjp, *adj = m->adj;
+    unsigned char *seen = calloc(nF, 1);
+#define DEG(u) (adjp[(u) + 1] - adjp[u])
+    while (tail < nF) {
+        /* new component: start at a min-degree vertex, then move to the last BFS level twice (pseudo-peripheral) */
+        unsigned start = nF, pass, k;
+        for (i = 0; i < nF; i++) if (!seen[i] && (start == nF || DEG(i) < DEG(start))) start = i;
+        for (pass = 0; pass < 2; pass++) {
+            unsigned h2 = tail, t2 = tail;
+            perm[t2++] = start; seen[start] = 1;
+            while (h2 < t2) {
+                unsigned u = perm[h2++];
+                for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[t2++] = adj[k]; }
+            }
+            for (k = tail; k < t2; k++) seen[perm[k]] = 0;
+            start = perm[t2 - 1];
+        }
+        head = tail;
+        perm[tail++] = start; seen[start] = 1;
+        while (head < tail) {
+            unsigned u = perm[head++], first = tail, a, b;
+            for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[tail++] = adj[k]; }
+            for (a = first + 1; a < tail; a++)     /* neighbours by increasing degree */
+                for (b = a; b > first && DEG(perm[b - 1]) > DEG(perm[b]); b--) { unsigned t = perm[b]; perm[b] = perm[b - 1]; perm[b - 1] = t; }
+        }
     }
-    key[60] = s->mode; key[61] = s->hscale; key[62] = m->nJ; key[63] = (double)m->nF;
-    if (m->nJ * 4 > 60) { band_free(s->band); s->band = NULL; } /* too many joints to key: no caching */
-    if (s->band && memcmp(band_key(s->band), key, sizeof key) == 0) { band_solve(s->band, b, x); return 0; }
-    band_free(s->band);
-    s->band = band_build(s, 1, (size_t)60000000);
-    if (!s->band) return -1;
-    memcpy((double *)band_key(s->band), key, sizeof key);
+#undef DEG
+    for (i = 0; i < nF / 2; i++) { unsigned t = perm[i]; perm[i] = perm[nF - 1 - i]; perm[nF - 1 - i] = t; }
+    for (i = 0; i < nF; i++) inv[perm[i]] = i;
+    free(seen);
+}
+
+/* Banded LU of a free-free system in RCM order. which = 0: the static
+ * matrix H (CELL: K~_FF; VERTEX: -J, row i R_i S^_ij R_i^T); which = 1: the
+ * step matrix A = (1+a1) M^_FF + (1+b1) K_FF. Assembled per cell. No
+ * pivoting: both are SPD or close to it. The frames and coefficients it was
+ * built from are kept, so a cached step factor is reused only while they hold. */
+struct snref_band {
+    unsigned n, nF, bw;
+    size_t W;
+    double *A;
+    unsigned *inv;
+    double *key;    /* R (nV*9), Rc (nC*9), coefficients */
+    size_t nkey;
+};
+
+static void band_free(snref_band *B) { if (B) { free(B->A); free(B->inv); free(B->key); free(B); } }
+
+static size_t band_key_len(const snref_state *s) { return 9 * (size_t)s->m->nV + 9 * (size_t)s->m->nC + 5; }
+static void band_key_fill(const snref_state *s, int which, double *key) {
+    size_t nV9 = 9 * (size_t)s->m->nV, nC9 = 9 * (size_t)s->m->nC;
+    memcpy(key, s->R, nV9 * sizeof *key);
+    memcpy(key + nV9, s->Rc, nC9 * sizeof *key);
+    key[nV9 + nC9] = which; key[nV9 + nC9 + 1] = s->force;
+    key[nV9 + nC9 + 2] = sscale(s); key[nV9 + nC9 + 3] = a1_of(s); key[nV9 + nC9 + 4] = b1_of(s);
+}
+
+static snref_band *band_build(snref_state *s, int which, double reg, size_t max_doubles) {
+    const snref_model *m = s->m;
+    unsigned nF = m->nF, n = 3 * nF, i, e, bw = 0, *perm = malloc(nF * sizeof *perm), *inv = malloc(nF * sizeof *inv);
+    size_t W, row, col;
+    double *A, sc = sscale(s), ca = 1.0 + a1_of(s), cb = which ? 1.0 + b1_of(s) : 1.0;
+    snref_band *B;
+    rcm(m, perm, inv);
+    free(perm);
+    for (i = 0; i < nF; i++)
+        for (e = m->adjp[i]; e < m->adjp[i + 1]; e++) {
+            unsigned j = m->adj[e], d = inv[i] > inv[j] ? inv[i] - inv[j] : inv[j] - inv[i];
+            if (d > bw) bw = d;
+        }
+    bw = 3 * bw + 2;
+    W = 2 * (size_t)bw + 1;
+    if ((size_t)n * W > max_doubles) { free(inv); return NULL; }
+    A = calloc((size_t)n * W, sizeof *A);
+    if (!A) { free(inv); return NULL; }
+#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *K = KE(m, e);
+        unsigned a, b, p, q, r2;
+        for (a = 0; a < 8; a++) {
+            const double *Rl = s->force == SNREF_FORCE_CELL ? s->Rc + 9 * e : s->R + 9 * cv[a];
+            if (cv[a] >= nF) continue;
+            for (b = 0; b < 8; b++) {
+                const double *Rr = s->force == SNREF_FORCE_CELL ? s->Rc + 9 * e : which ? s->R + 9 * cv[b] : Rl;
+                double T[9], Bk[9];
+                if (cv[b] >= nF) continue;
+                for (p = 0; p < 3; p++)      /* T = S^_ab Rr^T */
+                    for (q = 0; q < 3; q++) {
+                        double t = 0;
+                        for (r2 = 0; r2 < 3; r2++) t += K[24 * (3 * a + p) + 3 * b + r2] * Rr[3 * q + r2];
+                        T[3 * p + q] = t;
+                    }
+                for (p = 0; p < 3; p++)      /* Bk = Rl T */
+                    for (q = 0; q < 3; q++) Bk[3 * p + q] = Rl[3 * p] * T[q] + Rl[3 * p + 1] * T[3 + q] + Rl[3 * p + 2] * T[6 + q];
+                for (p = 0; p < 3; p++)
+                    for (q = 0; q < 3; q++) AB(3 * inv[cv[a]] + p, 3 * inv[cv[b]] + q) += cb * sc * Bk[3 * p + q];
+            }
+        }
+    }
+    if (!which && reg > 0)   /* proximal term of the static solve */
+        for (i = 0; i < nF; i++) { unsigned a; for (a = 0; a < 3; a++) AB(3 * inv[i] + a, 3 * inv[i] + a) += reg * m->mdiag[i]; }
+    if (which)
+        for (i = 0; i < nF; i++) {
+            unsigned a;
+            for (a = 0; a < 3; a++) AB(3 * inv[i] + a, 3 * inv[i] + a) += ca * m->mdiag[i];
+            for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
+                unsigned j = m->cols[e];
+                if (j >= nF) continue;
+                for (a = 0; a < 3; a++) {
+                    AB(3 * inv[i] + a, 3 * inv[j] + a) += ca * m->moff[e];
+                    AB(3 * inv[j] + a, 3 * inv[i] + a) += ca * m->moff[e];
+                }
+            }
+        }
+    for (row = 0; row < n; row++) {              /* in-place LU (L unit, multipliers below) */
+        double piv = AB(row, row);
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        for (col = row + 1; col <= end; col++) {
+            double l = AB(col, row) / piv;
+            size_t k;
+            AB(col, row) = l;
+            if (l == 0) continue;
+            for (k = row + 1; k <= end; k++) AB(col, k) -= l * AB(row, k);
+        }
+    }
+#undef AB
+    B = calloc(1, sizeof *B);
+    B->n = n; B->nF = nF; B->bw = bw; B->W = W; B->A = A; B->inv = inv;
+    B->nkey = band_key_len(s);
+    B->key = malloc(B->nkey * sizeof *B->key);
+    band_key_fill(s, which, B->key);
+    return B;
+}
+
+static void band_solve(const snref_band *B, const double *r, double *x) {
+    size_t n = B->n, bw = B->bw, W = B->W, row, k;
+    unsigned i, e;
+    double *y = malloc(n * sizeof *y);
+    const double *A = B->A;
+#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
+    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) y[3 * B->inv[i] + e] = r[3 * i + e];
+    for (row = 0; row < n; row++) {
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        for (k = row + 1; k <= end; k++) y[k] -= AB(k, row) * y[row];
+    }
+    for (row = n; row-- > 0;) {
+        size_t end = row + bw < n - 1 ? row + bw : n - 1;
+        double t = y[row];
+        for (k = row + 1; k <= end; k++) t -= AB(row, k) * y[k];
+        y[row] = t / AB(row, row);
+    }
+#undef AB
+    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) x[3 * i + e] = y[3 * B->inv[i] + e];
+    free(y);
+}
+
+/* Exact step solve by a banded LU of A, cached while the frames and
+ * coefficients are unchanged. Returns -1 if the band is too large. */
+static int exact_direct(snref_state *s, const double *b, double *x) {
+    double *key = malloc(band_key_len(s) * sizeof *key);
+    int hit;
+    band_key_fill(s, 1, key);
+    hit = s->band && memcmp(s->band->key, key, s->band->nkey * sizeof *key) == 0;
+    free(key);
+    if (!hit) {
+        band_free(s->band);
+        s->band = band_build(s, 1, 0.0, (size_t)60000000);
+        if (!s->band) return -1;
+    }
     band_solve(s->band, b, x);
     return 0;
+}
+
+/* ---------------- the step ---------------- */
+
+/* Step 8-9: limits, then the health report (disp over free vertices with m^_i >= 1/16). */
+static void limits_and_health(snref_state *s) {
+    const snref_model *m = s->m;
+    unsigned i, k, clamps = 0;
+    double dmax = 0;
+    for (i = 0; i < m->nF; i++) {
+        double sk[3], dl[3], n2 = 0, n;
+        mat_vec(s->R + 9 * i, m->rest + 3 * i, sk);
+        for (k = 0; k < 3; k++) { sk[k] += s->c[3 * i + k]; dl[k] = s->p[3 * i + k] - sk[k]; n2 += dl[k] * dl[k]; }
+        n = sqrt(n2);
+        if (m->limit && m->limit[i] > 0 && n > m->limit[i]) {
+            for (k = 0; k < 3; k++) {
+                double np = sk[k] + dl[k] * m->limit[i] / n;
+                s->v[3 * i + k] += np - s->p[3 * i + k];
+                s->p[3 * i + k] = np;
+            }
+            n = m->limit[i];
+            clamps++;
+        }
+        if (m->mlump[i] >= 1.0 / 16 && n > dmax) dmax = n;   /* step 9: vertices that carry flesh */
+    }
+    s->limit_clamps = clamps;
+    if (clamps) s->limit_steps++;
+    s->disp = dmax / m->cell;
+    if (s->disp > s->disp_max) s->disp_max = s->disp;
+    if (s->disp > m->disp_bound) s->bound_steps++;
+    s->energy = (s->e_el + s->e_kin) * m->energy / sscale(s);
+    if (s->energy > s->energy_max) s->energy_max = s->energy;
 }
 
 void snref_step(snref_state *s) {
     const snref_model *m = s->m;
     unsigned i, k, nF = m->nF, nV = m->nV;
-    double *f = WK(s, W_F), *b = WK(s, W_B), *vstar = WK(s, W_T1), *tmp = WK(s, W_Z);
-    double *w = WK(s, W_WV), *vnewS, *pnewS, *dvS;
+    double *b = WK(s, S_B), *vstar = WK(s, S_VSTAR), *w = WK(s, S_W), *tmp = WK(s, S_TMP), *pp = WK(s, S_PP);
+    double *pnewS = WK(s, S_PNEW), *vnewS = WK(s, S_VNEW), *dvS = WK(s, S_DVS);
     double a1 = a1_of(s), b1 = b1_of(s);
     if (!s->posed) { /* stepping at the rest pose without set_pose: identity pose */
         snref_xform *id = calloc(m->nJ, sizeof *id);
@@ -617,8 +946,7 @@ void snref_step(snref_state *s) {
         snref_set_pose(s, id);
         free(id);
     }
-    /* 3. skeleton: new positions and velocities (kept in the upper part of scratch arrays) */
-    pnewS = WK(s, W_D); vnewS = WK(s, W_AD); dvS = WK(s, W_R);
+    /* 3. skeleton: new positions and velocities */
     for (k = nF; k < nV; k++) {
         skeleton_pos(s, k, pnewS + 3 * k);
         for (i = 0; i < 3; i++) {
@@ -626,35 +954,29 @@ void snref_step(snref_state *s) {
             dvS[3 * k + i] = vnewS[3 * k + i] - s->v[3 * k + i];
         }
     }
-    /* 4. warped force at current free positions and new skeleton positions */
-    {
-        double *pp = WK(s, W_X);
-        memcpy(pp, s->p, 3 * nF * sizeof *pp);
-        memcpy(pp + 3 * nF, pnewS + 3 * nF, 3 * (nV - nF) * sizeof *pp);
-        warped_force(s, pp, f);
-    }
-    gravity_add(s, f);
-    /* 5. rhs */
+    memcpy(pp, s->p, 3 * nF * sizeof *pp);
+    memcpy(pp + 3 * nF, pnewS + 3 * nF, 3 * (nV - nF) * sizeof *pp);
+    /* 4-5. elastic force and -K~ w, per cell; w_F = (1+b1) v_F, w_S = b1 v'_S */
     for (i = 0; i < 3 * nF; i++) { vstar[i] = s->v[i]; w[i] = (1.0 + b1) * s->v[i]; }
     for (i = 3 * nF; i < 3 * nV; i++) { vstar[i] = vnewS[i]; w[i] = b1 * vnewS[i]; }
-    memcpy(b, f, 3 * nF * sizeof *b);
+    memset(b, 0, 3 * nF * sizeof *b);
+    if (s->force == SNREF_FORCE_CELL) s->e_el = cell_terms(s, pp, w, b);
+    else {
+        vertex_force(s, pp, b);
+        stiff_mul(s, w, b, 1, 0, -1.0);
+        s->e_el = cell_terms(s, pp, NULL, NULL);   /* the element energy as a measure only */
+    }
+    gravity_add(s, b);
     mass_mul(s, vstar, tmp, 1);
     for (i = 0; i < 3 * nF; i++) b[i] -= a1 * tmp[i];
-    {
-        double *kw = WK(s, W_F); /* f already consumed */
-        double *loc2 = calloc(3 * (size_t)nV, sizeof *loc2);
-        memcpy(loc2, w, 3 * nV * sizeof *loc2);
-        ktilde_mul(s, loc2, kw, 1);
-        for (i = 0; i < 3 * nF; i++) b[i] -= kw[i];
-        /* M^_FS (v'_S - v_S): mass product with free part zeroed */
-        memset(loc2, 0, 3 * nF * sizeof *loc2);
-        memcpy(loc2 + 3 * nF, dvS + 3 * nF, 3 * (nV - nF) * sizeof *loc2);
-        mass_mul(s, loc2, kw, 1);
-        for (i = 0; i < 3 * nF; i++) b[i] -= kw[i];
-        /* keep skeleton update before pcg reuses the scratch */
-        for (i = 3 * nF; i < 3 * nV; i++) { s->p[i] = pnewS[i]; s->v[i] = vnewS[i]; }
-        free(loc2);
-    }
+    /* M^_FS (v'_S - v_S): mass product with the free part zeroed */
+    memset(dvS, 0, 3 * nF * sizeof *dvS);
+    mass_mul(s, dvS, tmp, 1);
+    for (i = 0; i < 3 * nF; i++) b[i] -= tmp[i];
+    /* health: kinetic energy of the starting v, lumped mass (step 9) */
+    s->e_kin = 0;
+    for (i = 0; i < nF; i++) s->e_kin += 0.5 * m->mlump[i] * dot(s->v + 3 * i, s->v + 3 * i, 3);
+    for (i = 3 * nF; i < 3 * nV; i++) { s->p[i] = pnewS[i]; s->v[i] = vnewS[i]; }
     /* 6. solve */
     {
         double *x = s->dv;
@@ -664,6 +986,7 @@ void snref_step(snref_state *s) {
     }
     /* 7. update */
     for (i = 0; i < 3 * nF; i++) { s->v[i] += s->dv[i]; s->p[i] += s->v[i]; }
+    limits_and_health(s);
     s->steps++;
 }
 
@@ -671,6 +994,16 @@ void snref_get_lattice(const snref_state *s, double *out) {
     const snref_model *m = s->m;
     unsigned i;
     for (i = 0; i < 3 * m->nV; i++) out[i] = s->p[i] * m->unit;
+}
+
+void snref_get_skinned(const snref_state *s, double *out) {
+    const snref_model *m = s->m;
+    unsigned i, k;
+    for (i = 0; i < m->nV; i++) {
+        double y[3];
+        mat_vec(s->R + 9 * i, m->rest + 3 * i, y);
+        for (k = 0; k < 3; k++) out[3 * i + k] = (y[k] + s->c[3 * i + k]) * m->unit;
+    }
 }
 
 void snref_surface_from_lattice(const snref_model *m, const double *lat, double *out) {
@@ -695,33 +1028,10 @@ void snref_get_surface(const snref_state *s, double *out) {
 
 /* ---------------- static equilibrium (seed 003 eq. 10) ---------------- */
 
-/* J y over free rows: -R_i sum_j S^_ij R_i^T y_j (exact Jacobian of eq. 7). */
-static void jac_mul(const snref_state *s, const double *y, double *out) {
-    const snref_model *m = s->m;
-    double *acc = WK(s, W_T2);
-    unsigned i, e, k;
-    double sc = sscale(s);
-    memset(acc, 0, 3 * m->nF * sizeof *acc);
-    for (i = 0; i < m->nF; i++) {
-        double a[3], t[3];
-        matT_vec(s->R + 9 * i, y + 3 * i, a);
-        mat_vec(m->sdiag + 9 * i, a, t);
-        for (k = 0; k < 3; k++) acc[3 * i + k] += t[k];
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
-            unsigned j = m->cols[e];
-            if (j >= m->nF) continue;
-            matT_vec(s->R + 9 * i, y + 3 * j, a);      /* row i uses R_i on both sides */
-            mat_vec(m->soff + 9 * e, a, t);
-            for (k = 0; k < 3; k++) acc[3 * i + k] += t[k];
-            matT_vec(s->R + 9 * j, y + 3 * i, a);      /* row j uses R_j */
-            matT_vec(m->soff + 9 * e, a, t);
-            for (k = 0; k < 3; k++) acc[3 * j + k] += t[k];
-        }
-    }
-    for (i = 0; i < m->nF; i++) {
-        mat_vec(s->R + 9 * i, acc + 3 * i, out + 3 * i);
-        for (k = 0; k < 3; k++) out[3 * i + k] *= -sc;
-    }
+/* y = H x over free rows and columns (H: which = 0 of band_build). */
+static void hess_mul(const snref_state *s, const double *x, double *y) {
+    memset(y, 0, 3 * s->m->nF * sizeof *y);
+    stiff_mul(s, x, y, 0, 1, 1.0);
 }
 
 /* Dense LU with partial pivoting, solve A x = b in place (b -> x). */
@@ -753,7 +1063,7 @@ static int dense_solve(double *A, double *b, unsigned n) {
     return 0;
 }
 
-/* BiCGSTAB for -J x = r, right block-Jacobi preconditioning with (R_i S^_ii R_i^T)^-1. */
+/* BiCGSTAB for H x = r, right block-Jacobi preconditioning with R_i (S^_ii)^-1 R_i^T. */
 static void bicgstab(snref_state *s, const double *rhs, double *x, double tol) {
     const snref_model *m = s->m;
     unsigned n = 3 * m->nF, i, it;
@@ -765,251 +1075,115 @@ static void bicgstab(snref_state *s, const double *rhs, double *x, double tol) {
         double A[9];
         unsigned k;
         for (k = 0; k < 9; k++) A[k] = sscale(s) * m->sdiag[9 * i + k];
-        mat_inv(A, Pi + 9 * i);
+        if (mat_inv(A, Pi + 9 * i) != 0) memcpy(Pi + 9 * i, I3, sizeof I3);
     }
-#define PREC(in, out) precond_apply(s, Pi, in, out)
-    jac_mul(s, x, t);
-    for (i = 0; i < n; i++) r[i] = rhs[i] + t[i];   /* rhs - (-J) x */
+    hess_mul(s, x, t);
+    for (i = 0; i < n; i++) r[i] = rhs[i] - t[i];
     memcpy(r0, r, n * sizeof *r);
     for (it = 0; it < 20 * n + 1000; it++) {
         double rho1 = dot(r0, r, n), beta, tt;
         if (sqrt(dot(r, r, n)) <= tol * bn) break;
         beta = (rho1 / rho) * (alpha / omega);
         for (i = 0; i < n; i++) pv[i] = r[i] + beta * (pv[i] - omega * v[i]);
-        PREC(pv, ph);
-        jac_mul(s, ph, v);
-        for (i = 0; i < n; i++) v[i] = -v[i];
+        precond_apply(s, Pi, pv, ph);
+        hess_mul(s, ph, v);
         alpha = rho1 / dot(r0, v, n);
         for (i = 0; i < n; i++) sv[i] = r[i] - alpha * v[i];
-        PREC(sv, sh);
-        jac_mul(s, sh, t);
-        for (i = 0; i < n; i++) t[i] = -t[i];
+        precond_apply(s, Pi, sv, sh);
+        hess_mul(s, sh, t);
         tt = dot(t, t, n);
         omega = tt > 0 ? dot(t, sv, n) / tt : 0;
         for (i = 0; i < n; i++) { x[i] += alpha * ph[i] + omega * sh[i]; r[i] = sv[i] - omega * t[i]; }
         rho = rho1;
         if (omega == 0) break;
     }
-#undef PREC
     free(r); free(r0); free(pv); free(v); free(ph); free(sv); free(sh); free(t); free(Pi);
 }
 
-/* Reverse Cuthill-McKee order of the free vertices (bandwidth reduction for
- * the banded direct solve). perm[new] = old, inv[old] = new. */
-static void rcm(const snref_model *m, unsigned *perm, unsigned *inv) {
-    unsigned nF = m->nF, i, e, head = 0, tail = 0, *deg = calloc(nF, sizeof *deg), *adjp = calloc(nF + 1, sizeof *adjp), *adj;
-    unsigned char *seen = calloc(nF, 1);
-    for (i = 0; i < nF; i++)
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++)
-            if (m->cols[e] < nF) { deg[i]++; deg[m->cols[e]]++; }
-    for (i = 0; i < nF; i++) adjp[i + 1] = adjp[i] + deg[i];
-    adj = malloc((adjp[nF] + 1) * sizeof *adj);
-    memset(deg, 0, nF * sizeof *deg);
-    for (i = 0; i < nF; i++)
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
-            unsigned j = m->cols[e];
-            if (j >= nF) continue;
-            adj[adjp[i] + deg[i]++] = j; adj[adjp[j] + deg[j]++] = i;
-        }
-    while (tail < nF) {
-        /* new component: start at a min-degree vertex, then move to the last BFS level twice (pseudo-peripheral) */
-        unsigned start = nF, pass, k;
-        for (i = 0; i < nF; i++) if (!seen[i] && (start == nF || deg[i] < deg[start])) start = i;
-        for (pass = 0; pass < 2; pass++) {
-            unsigned h2 = tail, t2 = tail;
-            perm[t2++] = start; seen[start] = 1;
-            while (h2 < t2) {
-                unsigned u = perm[h2++];
-                for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[t2++] = adj[k]; }
-            }
-            for (k = tail; k < t2; k++) seen[perm[k]] = 0;
-            start = perm[t2 - 1];
-        }
-        head = tail;
-        perm[tail++] = start; seen[start] = 1;
-        while (head < tail) {
-            unsigned u = perm[head++], first = tail, a, b;
-            for (k = adjp[u]; k < adjp[u + 1]; k++) if (!seen[adj[k]]) { seen[adj[k]] = 1; perm[tail++] = adj[k]; }
-            for (a = first + 1; a < tail; a++)     /* neighbours by increasing degree */
-                for (b = a; b > first && deg[perm[b - 1]] > deg[perm[b]]; b--) { unsigned t = perm[b]; perm[b] = perm[b - 1]; perm[b - 1] = t; }
-        }
-    }
-    for (i = 0; i < nF / 2; i++) { unsigned t = perm[i]; perm[i] = perm[nF - 1 - i]; perm[nF - 1 - i] = t; }
-    for (i = 0; i < nF; i++) inv[perm[i]] = i;
-    free(deg); free(adjp); free(adj); free(seen);
-}
-
-/* Banded LU of a free-free system in RCM order. which = 0: -J (exact static
- * Jacobian, row i: R_i S^_ij R_i^T); which = 1: the step matrix A =
- * (1+a1) M^_FF + (1+b1) R_i S^_ij R_j^T. No pivoting: both are close to (or
- * congruent to) SPD matrices. */
-struct snref_band {
-    unsigned n, nF, bw;
-    size_t W;
-    double *A;
-    unsigned *inv;
-    double key[64]; /* pose of a cached step matrix */
-};
-
-static void band_free(snref_band *B) { if (B) { free(B->A); free(B->inv); free(B); } }
-static const double *band_key(const snref_band *B) { return B->key; }
-
-static snref_band *band_build(snref_state *s, int which, size_t max_doubles) {
-    const snref_model *m = s->m;
-    unsigned nF = m->nF, n = 3 * nF, i, e, bw = 0, *perm = malloc(nF * sizeof *perm), *inv = malloc(nF * sizeof *inv);
-    size_t W, row, col;
-    double *A, sc = sscale(s), ca = 1.0 + a1_of(s), cb = which ? 1.0 + b1_of(s) : 1.0;
-    snref_band *B;
-    rcm(m, perm, inv);
-    free(perm);
-    for (i = 0; i < nF; i++)
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++)
-            if (m->cols[e] < nF) {
-                unsigned d = inv[i] > inv[m->cols[e]] ? inv[i] - inv[m->cols[e]] : inv[m->cols[e]] - inv[i];
-                if (d > bw) bw = d;
-            }
-    bw = 3 * bw + 2;
-    W = 2 * (size_t)bw + 1;
-    if ((size_t)n * W > max_doubles) { free(inv); return NULL; }
-    A = calloc((size_t)n * W, sizeof *A);
-    if (!A) { free(inv); return NULL; }
-#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
-    for (i = 0; i < nF; i++) {
-        double RS[9], Bk[9], St[9];
-        unsigned a, b;
-        const double *Ri = s->R + 9 * i;
-        mat_mulT_(m->sdiag + 9 * i, Ri, RS); mat_mul_(Ri, RS, Bk);
-        for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[i] + a, 3 * inv[i] + b) += cb * sc * Bk[3 * a + b];
-        if (which) for (a = 0; a < 3; a++) AB(3 * inv[i] + a, 3 * inv[i] + a) += ca * m->mdiag[i];
-        for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
-            unsigned j = m->cols[e];
-            const double *Rj = s->R + 9 * j;
-            if (j >= nF) continue;
-            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) St[3 * a + b] = m->soff[9 * e + 3 * b + a];
-            /* row i */
-            mat_mulT_(m->soff + 9 * e, which ? Rj : Ri, RS); mat_mul_(Ri, RS, Bk);
-            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[i] + a, 3 * inv[j] + b) += cb * sc * Bk[3 * a + b];
-            /* row j */
-            mat_mulT_(St, which ? Ri : Rj, RS); mat_mul_(Rj, RS, Bk);
-            for (a = 0; a < 3; a++) for (b = 0; b < 3; b++) AB(3 * inv[j] + a, 3 * inv[i] + b) += cb * sc * Bk[3 * a + b];
-            if (which)
-                for (a = 0; a < 3; a++) {
-                    AB(3 * inv[i] + a, 3 * inv[j] + a) += ca * m->moff[e];
-                    AB(3 * inv[j] + a, 3 * inv[i] + a) += ca * m->moff[e];
-                }
-        }
-    }
-    for (row = 0; row < n; row++) {              /* in-place LU (L unit, multipliers below) */
-        double piv = AB(row, row);
-        size_t end = row + bw < n - 1 ? row + bw : n - 1;
-        for (col = row + 1; col <= end; col++) {
-            double l = AB(col, row) / piv;
-            size_t k;
-            AB(col, row) = l;
-            if (l == 0) continue;
-            for (k = row + 1; k <= end; k++) AB(col, k) -= l * AB(row, k);
-        }
-    }
-#undef AB
-    B = calloc(1, sizeof *B);
-    B->n = n; B->nF = nF; B->bw = bw; B->W = W; B->A = A; B->inv = inv;
-    return B;
-}
-
-static void band_solve(const snref_band *B, const double *r, double *x) {
-    size_t n = B->n, bw = B->bw, W = B->W, row, k;
-    unsigned i, e;
-    double *y = malloc(n * sizeof *y);
-    const double *A = B->A;
-#define AB(rr, cc) A[(size_t)(rr) * W + (cc) + bw - (rr)]
-    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) y[3 * B->inv[i] + e] = r[3 * i + e];
-    for (row = 0; row < n; row++) {
-        size_t end = row + bw < n - 1 ? row + bw : n - 1;
-        for (k = row + 1; k <= end; k++) y[k] -= AB(k, row) * y[row];
-    }
-    for (row = n; row-- > 0;) {
-        size_t end = row + bw < n - 1 ? row + bw : n - 1;
-        double t = y[row];
-        for (k = row + 1; k <= end; k++) t -= AB(row, k) * y[k];
-        y[row] = t / AB(row, row);
-    }
-#undef AB
-    for (i = 0; i < B->nF; i++) for (e = 0; e < 3; e++) x[3 * i + e] = y[3 * B->inv[i] + e];
-    free(y);
-}
-
+/* The static solve. CELL model: with the skeleton fixed and the frames fixed
+ * by the pose, d_e is affine in p, so Pi(p_F) = E_el - load.p_F is exactly
+ * quadratic; its gradient vanishes where
+ *     K~_FF p_F = -K~_FS p_S + sum_e (R_e S^_e (x_b - x_b0))_F + load_F,
+ * (K~ = sum_e R_e S^_e R_e^T when S^_e's null space holds the translations:
+ * then R_e^T p_b0 drops out), i.e. one Newton step from any p_F,
+ * H delta = f(p) + load with H = K~_FF, is the exact minimum. VERTEX model:
+ * eq. 7 is affine in p_F too; H = -J (row i: R_i S^_ij R_i^T).
+ * H can be singular: free flesh around a straight chain of skeleton vertices
+ * spins about it at no cost (no twist term since format 2.0). So each pass
+ * solves (H + eps D) delta = f + load, D = the mass diagonal, eps = 1e-10 of
+ * H's scale: iterative refinement converges to the exact minimum where H is
+ * regular (rate ~ eps cond H), and among the minimizers to the one nearest
+ * the start (the skinned shape) instead of one picked by round-off. */
 double snref_static(snref_state *s, unsigned dense_max) {
     const snref_model *m = s->m;
     unsigned n = 3 * m->nF, i, k, pass;
-    double *r = malloc(n * sizeof *r), *dx = malloc(n * sizeof *dx), g0, res = 0;
+    double *r = malloc(n * sizeof *r), *dx = malloc(n * sizeof *dx), g0, res = 0, prev = HUGE_VAL;
+    double *A = NULL, hs = 0, ms = 0, reg;
+    snref_band *B = NULL;
     if (!s->posed) {
         snref_xform *id = calloc(m->nJ, sizeof *id);
         for (i = 0; i < m->nJ; i++) id[i].q[3] = 1;
         snref_set_pose(s, id);
         free(id);
     }
+    for (i = 0; i < m->nF; i++) {
+        double t = sscale(s) * (m->sdiag[9 * i] + m->sdiag[9 * i + 4] + m->sdiag[9 * i + 8]) / 3;
+        if (t > hs) hs = t;
+        if (m->mdiag[i] > ms) ms = m->mdiag[i];
+    }
+    reg = ms > 0 ? 1e-10 * hs / ms : 0;
     for (k = m->nF; k < m->nV; k++) { skeleton_pos(s, k, s->p + 3 * k); s->v[3 * k] = s->v[3 * k + 1] = s->v[3 * k + 2] = 0; }
     snref_residual(s, r);
     g0 = sqrt(dot(r, r, n));
-    for (pass = 0; pass < 2; pass++) {   /* second pass: one step of iterative refinement */
-        snref_residual(s, r);
-        memset(dx, 0, n * sizeof *dx);
-        if (n <= dense_max) {
-            double *A = malloc((size_t)n * n * sizeof *A), *e = calloc(n, sizeof *e), *col = malloc(n * sizeof *col);
-            for (i = 0; i < n; i++) {           /* columns of -J */
-                e[i] = 1; jac_mul(s, e, col); e[i] = 0;
-                for (k = 0; k < n; k++) A[(size_t)k * n + i] = -col[k];
-            }
-            memcpy(dx, r, n * sizeof *dx);
-            dense_solve(A, dx, n);
-            free(A); free(e); free(col);
-        } else {
-            snref_band *B = band_build(s, 0, (size_t)60000000);
-            if (B) band_solve(B, r, dx); else bicgstab(s, r, dx, 1e-13);
-            band_free(B);
+    if (n <= dense_max) {
+        double *e = calloc(n, sizeof *e), *col = malloc(n * sizeof *col);
+        A = malloc((size_t)n * n * sizeof *A);
+        for (i = 0; i < n; i++) {           /* columns of H + eps D */
+            e[i] = 1; hess_mul(s, e, col); e[i] = 0;
+            for (k = 0; k < n; k++) A[(size_t)k * n + i] = col[k];
+            A[(size_t)i * n + i] += reg * m->mdiag[i / 3];
         }
+        free(e); free(col);
+    } else B = band_build(s, 0, reg, (size_t)60000000);
+    for (pass = 0; pass < 12; pass++) {
+        double rn;
+        snref_residual(s, r);
+        rn = sqrt(dot(r, r, n));
+        if (rn <= 1e-15 * g0 || (pass >= 3 && rn >= 0.5 * prev)) break;   /* converged, or refinement stopped helping */
+        prev = rn;
+        memset(dx, 0, n * sizeof *dx);
+        if (A) {
+            double *Ac = malloc((size_t)n * n * sizeof *Ac);
+            memcpy(Ac, A, (size_t)n * n * sizeof *Ac);
+            memcpy(dx, r, n * sizeof *dx);
+            dense_solve(Ac, dx, n);
+            free(Ac);
+        } else if (B) band_solve(B, r, dx);
+        else bicgstab(s, r, dx, 1e-13);
         for (i = 0; i < n; i++) s->p[i] += dx[i];
     }
     snref_residual(s, r);
     res = g0 > 0 ? sqrt(dot(r, r, n)) / g0 : 0;
     memset(s->v, 0, 3 * m->nF * sizeof *s->v);
     memset(s->dv, 0, 3 * m->nF * sizeof *s->dv);
+    free(A); band_free(B);
     free(r); free(dx);
     return res;
 }
 
 void snref_energy(const snref_state *s, double *kinetic, double *elastic) {
     const snref_model *m = s->m;
-    unsigned n = 3 * m->nF, i, k;
-    double *t = malloc(3 * (size_t)m->nV * sizeof *t), *u = calloc(3 * (size_t)m->nV, sizeof *u);
+    double *t = malloc(3 * (size_t)m->nV * sizeof *t);
     mass_mul(s, s->v, t, 0);
-    *kinetic = 0.5 * dot(s->v, t, n);
-    for (i = 0; i < m->nF; i++) {
-        double a[3];
-        for (k = 0; k < 3; k++) a[k] = s->p[3 * i + k] - s->c[3 * i + k];
-        matT_vec(s->R + 9 * i, a, u + 3 * i);
-        for (k = 0; k < 3; k++) u[3 * i + k] -= m->rest[3 * i + k];
-    }
-    /* skeleton u_k = R_b^T (t_b - c_k) = 0 by construction (w = 0), so only the FF block counts */
-    {
-        snref_state tmp = *s;
-        static const double I[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-        double *Rsave = malloc(9 * (size_t)m->nV * sizeof *Rsave);
-        for (i = 0; i < m->nV; i++) memcpy(Rsave + 9 * i, I, sizeof I);
-        tmp.R = Rsave;
-        ktilde_mul(&tmp, u, t, 0);
-        *elastic = 0.5 * dot(u, t, n);
-        free(Rsave);
-    }
-    free(t); free(u);
+    *kinetic = 0.5 * dot(s->v, t, 3 * m->nF);
+    *elastic = cell_terms(s, s->p, NULL, NULL);
+    free(t);
 }
 
-
-/* Solve the static system for an arbitrary load: -J x = load (free rows,
- * internal units), i.e. x = K^-1 load at the current frames; banded LU, or
- * BiCGSTAB if the band is too large. */
+/* Solve the static system for an arbitrary load: H x = load (free rows,
+ * internal units) at the current frames; banded LU, or BiCGSTAB if the band is too large. */
 void snref_solve_load(snref_state *s, const double *load, double *x) {
-    snref_band *B = band_build(s, 0, (size_t)60000000);
+    snref_band *B = band_build(s, 0, 0.0, (size_t)60000000);
     memset(x, 0, 3 * s->m->nF * sizeof *x);
     if (B) band_solve(B, load, x); else bicgstab(s, load, x, 1e-13);
     band_free(B);

@@ -1,4 +1,6 @@
-/* snref.h -- double-precision reference of the Sinew step (runtime/NUMERICS.md).
+/* snref.h -- double-precision reference of the Sinew step (runtime/NUMERICS.md,
+ * blob format 2.0: per-cell frames, element energy, tracked quaternions, path
+ * slerp, limits, health).
  *
  * Independent of the runtime: its own blob reader (only sn_format.h
  * constants), quaternion/slerp/rotation code, CG and static solver. Reads
@@ -25,28 +27,39 @@ typedef struct snref_model {
     int flavour;
     unsigned real_size;
     unsigned nV, nF, nC, nJ, nS, nT, nnz, cg_default, cg_max;
+    unsigned flags;       /* SN_FLAG_* */
+    unsigned nlimit;      /* 0 (no LIMIT stage) or nF */
     int len_shift;
     unsigned frac_S, frac_M, frac_P;
+    int frac_E;           /* fractional bits of ENERGY (fixed flavour) */
     double unit;          /* U in mesh units = 2^len_shift */
     double a1, b1, grav[3], h, m0;
+    double energy;        /* joules per internal energy unit (ENERGY) */
+    double cell;          /* cell edge, internal units (CELL) */
+    double disp_bound;    /* cells (DISP_BOUND) */
     int *jparent;         /* nJ, -1 = root */
     double *jrest;        /* nJ*3 internal units, model space */
     char (*jname)[32];
     double *rest;         /* nV*3 internal units */
-    int *fb1, *fb2;       /* nV frame bones */
-    double *fw;           /* nV frame weight */
+    int *fb1, *fb2;       /* nV vertex frame bones */
+    double *fw;           /* nV vertex frame weight */
     double *mdiag;        /* nF */
-    double *sdiag;        /* nF*9 full symmetric block */
     double *precond;      /* nF*9 full symmetric block */
     double *mlump;        /* nF */
-    unsigned *rowptr;     /* nF+1 */
+    unsigned *rowptr;     /* nF+1 (mass pattern) */
     unsigned *cols;       /* nnz */
     double *moff;         /* nnz */
-    double *soff;         /* nnz*9 row-major */
     unsigned *cells;      /* nC*8 */
+    int *cb1, *cb2;       /* nC cell frame bones (CFRAMES) */
+    double *cw;           /* nC cell frame weight */
+    double *cellk;        /* nC*576: S^_e as a full 24x24 row-major matrix, dof 3a+i (corner a) */
+    double *limit;        /* nF limits L_i (internal units, 0 = none); NULL when LIMIT is empty */
     unsigned *ecell;      /* nS */
     double *et;           /* nS*3 */
     unsigned *tris;       /* nT*3 */
+    /* derived at load */
+    double *sdiag;        /* nF*9: assembled diagonal block sum_e S^_e,ii */
+    unsigned *adjp, *adj; /* free-free neighbours (sharing a cell), CSR over nF */
 } snref_model;
 
 /* Load a blob of any flavour. Returns 0 on success, else writes a message to
@@ -58,6 +71,12 @@ int snref_load_file(snref_model *m, const char *path, char *err, size_t errn);
 void snref_free(snref_model *m);
 
 enum { SNREF_WARPED = 0, SNREF_UNWARPED = 1 };
+/* Elastic force model. CELL: NUMERICS.md step 4 (per-cell frames, element
+ * energy, K~ = sum_e R_e S^_e R_e^T). VERTEX: format 1.0 / seed 003 eq. 7 with
+ * per-vertex frames, f_i = -R_i sum_j S_ij (R_i^T (p_j - c_i) - x_j), S
+ * assembled from CELLK, step matrix block R_i S_ij R_j^T (kept to show what
+ * the per-cell model fixes; it has no energy). */
+enum { SNREF_FORCE_CELL = 0, SNREF_FORCE_VERTEX = 1 };
 
 typedef struct snref_state {
     const snref_model *m;
@@ -66,20 +85,31 @@ typedef struct snref_state {
     double *dv;    /* nF*3 warm start */
     double *R;     /* nV*9 vertex frames */
     double *c;     /* nV*3 frame origins */
-    double *jq;    /* nJ*4 current pose quaternions */
+    double *Rc;    /* nC*9 cell frames */
+    double *jq;    /* nJ*4 current pose quaternions, tracked (NUMERICS step 1) */
     double *jt;    /* nJ*3 current pose translations, internal units */
     double *work;  /* scratch */
     int posed;     /* a pose was set since init/reset */
     int mode;      /* SNREF_WARPED / SNREF_UNWARPED */
+    int force;     /* SNREF_FORCE_CELL (default) / SNREF_FORCE_VERTEX */
+    int path_slerp;/* 1 (default): tracked quaternions + path slerp (NUMERICS step 1-2); 0: no tracking, shorter arc (format 1.0) */
     unsigned iters;/* CG iterations per step */
     int exact;     /* 1: solve each step to convergence instead of N iterations */
     int warm;      /* 1 (default): warm-start CG from the previous dv */
     int first_pose_moves_free; /* 1 (default, as the runtime): the first pose places free vertices at R_i x_i + c_i */
     double gscale; /* multiplies the baked gravity (1 by default) */
     double hscale; /* step h' = hscale*h: S^,g^ scale by hscale^2, a1 by hscale, b1 by 1/hscale */
+    double dscale; /* multiplies a1 and b1 (Rayleigh damping; 1 by default, 0 = undamped) */
     unsigned steps;
     struct snref_band *band; /* cached factor of the step matrix (exact mode) */
     double last_cg_relres; /* |b - A dv| / |b| after the last step's solve */
+    /* health of the last step (NUMERICS step 8-9) */
+    double e_el, e_kin;      /* internal energy units: E_el of step 4, 1/2 sum m^_i |v_i|^2 of the starting v */
+    double energy, energy_max; /* (e_el + e_kin) * ENERGY, joules; max since reset */
+    double disp, disp_max;   /* max |p_i - s_i| / CELL after the step over free i with m^_i >= 1/16, cells; max since reset */
+    unsigned limit_clamps;   /* vertices pulled back in the last step */
+    unsigned limit_steps;    /* steps with a limit clamp since reset */
+    unsigned bound_steps;    /* steps with disp > DISP_BOUND since reset (the reference never saturates) */
 } snref_state;
 
 int snref_init(snref_state *s, const snref_model *m);
@@ -92,36 +122,50 @@ void snref_step(snref_state *s);
 /* Positions in mesh units (world). out has count*3 doubles. */
 void snref_get_lattice(const snref_state *s, double *out);
 void snref_get_surface(const snref_state *s, double *out);
+/* Rigidly framed ("skinned") lattice R_i x_i + c_i of the current frames, mesh units, nV*3. */
+void snref_get_skinned(const snref_state *s, double *out);
 /* Surface from arbitrary lattice positions (mesh units, nV*3). */
 void snref_surface_from_lattice(const snref_model *m, const double *lat, double *out);
 
-/* Static equilibrium of seed 003 eq. 10 at the current pose (skeleton fixed at
- * the pose, frames from the pose): f(p_F) + m^ g^ = 0, solved as one linear
- * system with the exact (non-symmetric) Jacobian -R_i S^_ij R_i^T. Dense LU
- * when 3 nF <= dense_max, else BiCGSTAB to a relative residual of 1e-12.
- * Otherwise banded LU in reverse Cuthill-McKee order (BiCGSTAB if the band
- * is too large). Writes the solution into the state's free positions (velocities zeroed).
- * Returns the final relative residual |f + m g| / |m g| (or / |f(p0)|). */
+/* Static equilibrium (seed 003 eq. 10) at the current pose: skeleton fixed at
+ * the pose, frames from the pose, f(p_F) + m^ g^ [- m^ R g^] = 0. CELL model:
+ * the minimum of E_el - load.p (quadratic in p, one linear solve with K~_FF);
+ * VERTEX model: one linear solve with the exact Jacobian of eq. 7. Dense LU
+ * when 3 nF <= dense_max, else banded LU in reverse Cuthill-McKee order
+ * (BiCGSTAB if the band is too large); Newton refinement passes until the
+ * residual stops falling. Writes the solution into the state (velocities
+ * zeroed). Returns the relative residual |f + load| / |f + load at the start|. */
 double snref_static(snref_state *s, unsigned dense_max);
 
-/* x = (-J)^-1 load at the current frames (free rows; the stiffness solve of
- * eq. 10 for an arbitrary load), and y = M^_FF x. Used for eigen-frequencies. */
+/* x = H^-1 load at the current frames (H = K~_FF for the CELL model, the
+ * negated Jacobian for VERTEX): the static solve for an arbitrary load (free
+ * rows, internal units). Used for eigen-frequencies. */
 void snref_solve_load(snref_state *s, const double *load, double *x);
 void snref_mass_mul(const snref_state *s, const double *x, double *y);
 
-/* Net force residual f + m^g^ (internal units) at the current positions, free rows. */
+/* Net force residual f + m^g^ [- m^ R g^] (internal units) at the current positions, free rows. */
 void snref_residual(const snref_state *s, double *out);
+/* Elastic force of the active model at positions p (nV*3), free rows. */
+void snref_force(const snref_state *s, const double *p, double *out);
+/* E_el = 1/2 sum_e d_e^T S^_e d_e at positions p (nV*3), current cell frames (NUMERICS step 4). */
+double snref_elastic(const snref_state *s, const double *p);
+/* y = K x, free rows: the stiffness of the step matrix (CELL: K~ = sum_e R_e S^_e R_e^T;
+ * VERTEX: R_i S_ij R_j^T); x has nV*3 entries, skeleton ones used iff with_skel. */
+void snref_kmul(const snref_state *s, const double *x, double *y, int with_skel);
 
-/* Energies in baked units (m0 * U^2 / h^2 ... only ratios matter):
- * kinetic 1/2 v^T M^ v over free rows (full consistent mass incl. coupling to
- * skeleton velocities) and warped elastic 1/2 sum u_i^T S^_ij u_j with
- * u_j = R_j^T (p_j - c_j) - x_j. */
+/* Energies in baked units (joules: times model energy / hscale^2):
+ * kinetic 1/2 v_F^T M^_FF v_F (consistent mass, free rows and columns) and
+ * the element energy E_el at the current positions. */
 void snref_energy(const snref_state *s, double *kinetic, double *elastic);
 
 /* Small quaternion helpers (double), exposed for tests. */
 void snref_quat_axis_angle(const double axis[3], double deg, double q[4]);
 void snref_quat_mul(const double a[4], const double b[4], double out[4]);
+/* Shorter-arc slerp (the generic one). */
 void snref_quat_slerp(const double a[4], const double b[4], double t, double out[4]);
+/* NUMERICS step 2: slerp along the path from a to b (no sign flip) unless
+ * a.b < -cos 30 deg, where the shorter arc is taken. */
+void snref_quat_slerp_path(const double a[4], const double b[4], double t, double out[4]);
 void snref_quat_to_mat(const double q[4], double R[9]);
 
 /* CRC-32 (zlib polynomial) of n bytes: the blob checksum (runtime/BLOB.md). */

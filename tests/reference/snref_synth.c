@@ -209,7 +209,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
     {
         unsigned *rowptr = calloc(nF + 1, sizeof *rowptr);
         unsigned *cols = NULL;
-        double *moff = NULL, *soff = NULL;
+        double *moff = NULL;
         size_t cap = 0;
         for (i = 0; i < nF; i++) {
             unsigned g = gid_of[i], ix = g % NX, iy = g / NX % NY, iz = g / NX / NY, o, list[27], lo[27], nl = 0, a, b2;
@@ -231,12 +231,10 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
             if (nnz + nl > cap) {
                 cap = 2 * (nnz + nl) + 64;
                 cols = realloc(cols, cap * sizeof *cols); moff = realloc(moff, cap * sizeof *moff);
-                soff = realloc(soff, cap * 9 * sizeof *soff);
             }
             for (a = 0; a < nl; a++) {
                 cols[nnz] = list[a];
                 moff[nnz] = M[g * 27 + lo[a]] / m0;
-                for (k = 0; k < 9; k++) soff[9 * nnz + k] = h2 * S[(g * 27 + lo[a]) * 9 + k] / m0;
                 nnz++;
             }
             rowptr[i + 1] = nnz;
@@ -247,14 +245,15 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_REST] = nV; el[SN_SEC_REST] = SN_ELEM_REST(R);
         cnt[SN_SEC_FRAMES] = nV; el[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
         cnt[SN_SEC_MDIAG] = nF; el[SN_SEC_MDIAG] = SN_ELEM_MDIAG(R);
-        cnt[SN_SEC_SDIAG] = nF; el[SN_SEC_SDIAG] = SN_ELEM_SDIAG(R);
         cnt[SN_SEC_PRECOND] = nF; el[SN_SEC_PRECOND] = SN_ELEM_PRECOND(R);
         cnt[SN_SEC_MLUMP] = nF; el[SN_SEC_MLUMP] = SN_ELEM_MLUMP(R);
         cnt[SN_SEC_ROWPTR] = nF + 1; el[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
         cnt[SN_SEC_COLS] = nnz; el[SN_SEC_COLS] = SN_ELEM_COLS;
         cnt[SN_SEC_MOFF] = nnz; el[SN_SEC_MOFF] = SN_ELEM_MOFF(R);
-        cnt[SN_SEC_SOFF] = nnz; el[SN_SEC_SOFF] = SN_ELEM_SOFF(R);
         cnt[SN_SEC_CELLS] = nC; el[SN_SEC_CELLS] = SN_ELEM_CELLS;
+        cnt[SN_SEC_CFRAMES] = nC; el[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
+        cnt[SN_SEC_CELLK] = nC; el[SN_SEC_CELLK] = SN_ELEM_CELLK(R);
+        cnt[SN_SEC_LIMIT] = bx->limit > 0 ? nF : 0; el[SN_SEC_LIMIT] = SN_ELEM_LIMIT(R);
         cnt[SN_SEC_EMBED] = nV; el[SN_SEC_EMBED] = SN_ELEM_EMBED;   /* surface = every lattice vertex */
         cnt[SN_SEC_TRIS] = 0; el[SN_SEC_TRIS] = SN_ELEM_TRIS;
         pos = SN_HEADER_BYTES;
@@ -272,11 +271,12 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         w_u32(&w, SN_H_ENDIAN, SN_ENDIAN_MARK);
         w_u32(&w, SN_H_TOTAL_SIZE, (uint32_t)pos); w_u32(&w, SN_H_HEADER_SIZE, SN_HEADER_BYTES);
         w_u8(&w, SN_H_FLAVOUR, (unsigned)bx->flavour); w_u8(&w, SN_H_REAL_SIZE, R); w_u8(&w, SN_H_NSECTIONS, SN_SEC_COUNT);
+        w_u8(&w, SN_H_FLAGS, bx->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
         w_u32(&w, SN_H_ONE, bx->flavour == SN_FLAVOUR_FLOAT32 ? SN_ONE_FLOAT32 : 0u);
         w_u32(&w, SN_H_ONE_HI, bx->flavour == SN_FLAVOUR_FLOAT64 ? SN_ONE_FLOAT64_HI : 0u);
         w_u32(&w, SN_H_N_VERTICES, nV); w_u32(&w, SN_H_N_FREE, nF); w_u32(&w, SN_H_N_CELLS, nC);
         w_u32(&w, SN_H_N_JOINTS, nJ); w_u32(&w, SN_H_N_SURFACE, nV); w_u32(&w, SN_H_N_TRIANGLES, 0);
-        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ));
+        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC));
         w_u16(&w, SN_H_CG_DEFAULT, bx->cg_default); w_u16(&w, SN_H_CG_MAX, 256);
         w_u8(&w, SN_H_LEN_SHIFT, (unsigned)(len_shift & 255));
         {
@@ -286,6 +286,9 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
             for (k = 0; k < 3; k++) w_real(&w, rp + (SN_R_GRAV_X + k) * R, h2 * bx->g[k] / U);
             w_real(&w, rp + SN_R_TIMESTEP * R, bx->h);
             w_real(&w, rp + SN_R_MASS_SCALE * R, m0);
+            w_real(&w, rp + SN_R_ENERGY * R, m0 * U * U / h2);          /* mesh unit = 1 m */
+            w_real(&w, rp + SN_R_CELL * R, bx->dx / U);
+            w_real(&w, rp + SN_R_DISP_BOUND * R, bx->disp_bound > 0 ? bx->disp_bound : 1.0);
         }
         for (k = 0; k < SN_SEC_COUNT; k++) {
             size_t e = SN_H_SECTIONS + k * SN_SECTION_ENTRY;
@@ -335,25 +338,33 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
             gj_solve(A, P, 3, 3);
             w_real(&w, off[SN_SEC_MDIAG] + i * R, md);
             w_real(&w, off[SN_SEC_MLUMP] + i * R, lump);
-            for (k = 0; k < 6; k++) {
-                w_real(&w, off[SN_SEC_SDIAG] + (6 * i + k) * R, Sd[3 * sym[k][0] + sym[k][1]]);
-                w_real(&w, off[SN_SEC_PRECOND] + (6 * i + k) * R, P[3 * sym[k][0] + sym[k][1]]);
-            }
+            for (k = 0; k < 6; k++) w_real(&w, off[SN_SEC_PRECOND] + (6 * i + k) * R, P[3 * sym[k][0] + sym[k][1]]);
+            if (bx->limit > 0) w_real(&w, off[SN_SEC_LIMIT] + i * R, bx->limit / U);
         }
         for (i = 0; i <= nF; i++) w_u32(&w, off[SN_SEC_ROWPTR] + 4 * i, rowptr[i]);
         for (i = 0; i < nnz; i++) {
             w_u16(&w, off[SN_SEC_COLS] + 2 * i, cols[i]);
             w_real(&w, off[SN_SEC_MOFF] + i * R, moff[i]);
-            for (k = 0; k < 9; k++) w_real(&w, off[SN_SEC_SOFF] + (9 * i + k) * R, soff[9 * i + k]);
         }
         {
             unsigned cx, cy, cz, a, c = 0;
-            for (cz = 0; cz < bx->nz; cz++) for (cy = 0; cy < bx->ny; cy++) for (cx = 0; cx < bx->nx; cx++, c++)
+            for (cz = 0; cz < bx->nz; cz++) for (cy = 0; cy < bx->ny; cy++) for (cx = 0; cx < bx->nx; cx++, c++) {
+                size_t cf = off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * c, ck = off[SN_SEC_CELLK] + SN_ELEM_CELLK(R) * c;
+                unsigned b2, blk = 0, q;
                 for (a = 0; a < 8; a++)
                     w_u16(&w, off[SN_SEC_CELLS] + 16 * c + 2 * a,
                           newid[GID(cx + (a & 1), cy + (a >> 1 & 1), cz + (a >> 2 & 1))]);
+                /* cell frame: root -> tip blended at the cell centre, as the free vertices are */
+                w_u8(&w, cf, 0); w_u8(&w, cf + 1, bx->two_joints ? 1u : 0u);
+                w_u16(&w, cf + 2, bx->two_joints ? (unsigned)lround(32768.0 * (cx + 0.5) / bx->nx) : 0u);
+                /* S^_e = h^2 Ke / m0, upper blocks (a <= b) in order */
+                for (a = 0; a < 8; a++)
+                    for (b2 = a; b2 < 8; b2++, blk++)
+                        for (q = 0; q < 9; q++)
+                            w_real(&w, ck + (9 * blk + q) * R, h2 * Ke[3 * a + q / 3][3 * b2 + q % 3] / m0);
+            }
         }
-        free(rowptr); free(cols); free(moff); free(soff);
+        free(rowptr); free(cols); free(moff);
     }
     w_u32(&w, SN_H_CRC32, snref_crc32(w.d + 16, w.n - 16));
     free(S); free(M); free(newid); free(gid_of);

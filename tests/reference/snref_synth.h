@@ -1,5 +1,6 @@
-/* snref_synth.h -- test-side writer of synthetic box-lattice blobs (float32 /
- * float64) with textbook trilinear hex elements, independent of the host tool.
+/* snref_synth.h -- test-side writer of synthetic box-lattice blobs (format
+ * 2.0, float32 / float64) with textbook trilinear hex elements (one CELLK
+ * matrix per cell), independent of the host tool.
  * Used to unit-test the reference and to measure element locking and its
  * fixes before (and independently of) the tool's own integration. */
 #ifndef SNREF_SYNTH_H
@@ -27,7 +28,10 @@ typedef struct snsyn_box {
      * resting at the centre of the clamp face). If two_joints, vertices with
      * ix == nx are skeleton vertices of joint 1 (child, resting at the centre of
      * the far face); free vertices blend frames by w = ix/nx. */
-    int two_joints;
+    int two_joints;           /* cell frames: root/tip blended at the cell centre, w = (cx + 1/2)/nx */
+    int rest_modelled;        /* header flag SN_FLAG_REST_MODELLED */
+    double limit;             /* > 0: LIMIT of every free vertex, mesh units; 0: empty LIMIT section */
+    double disp_bound;        /* DISP_BOUND in cells (0: 1 cell) */
 } snsyn_box;
 
 /* Build the blob; returns malloc'd bytes (8-byte aligned) and its size, NULL on error. */

@@ -40,5 +40,13 @@ if $CC -std=c99 -Wall -Wextra -Werror "$T/main.c" "$T/limb_acc.c" -o "$T/check" 
 out=$("$BAKE" tools/examples/limb/limb.sinew -o "$T/s.blob")
 echo "$out" | grep -q "lattice .* vertices (.* free, .* skeleton), .* cells" && echo "$out" | grep -q "blob .* bytes: JOINTS" && ok "summary lists counts and section bytes" || bad "summary"
 [ -z "$("$BAKE" tools/examples/limb/limb.sinew -o "$T/q.blob" --quiet 2>&1)" ] && ok "--quiet prints nothing" || bad "--quiet"
+echo "$out" | grep -q "bones .*radius.*captured.*moved" && echo "$out" | grep -Eq "shoulder->elbow +1.25 +auto \(flesh 1\) +27 +26" \
+    && ok "summary lists each bone's radius and vertices" || bad "bone summary"
+# --check: one line, also with --quiet; no output file needed
+out=$("$BAKE" tools/examples/limb/limb.sinew --check --quiet 2>&1)
+[ "$(echo "$out" | wc -l)" -eq 1 ] && echo "$out" | grep -Eq "^check: cell 1: lattice 99 vertices \(52 free, 47 skeleton\), 40 cells; volume ratio 1.0000.*: ok$" \
+    && ok "--check --quiet prints one check line" || { bad "--check line"; echo "$out"; }
+"$BAKE" tools/examples/limb/limb.sinew -o "$T/c.blob" --check --quiet > /dev/null && cmp -s "$T/c.blob" "$T/limb2.blob" && ok "--check with -o writes the same blob" || bad "--check -o"
+"$BAKE" --help | grep -q -- "--check" && ok "--help lists --check" || bad "--help --check"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -1,0 +1,160 @@
+/* sn_embed.c -- outputs: deformed lattice, embedded surface (trilinear in
+ * each cell, seed 000 §3.1) and area-weighted normals. */
+#include "sn_instance.h"
+
+/* ---- outputs ---- */
+
+static void to_public(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
+#if defined(SN_FLOAT)
+    out->x = h->origin[0] + int_to_pub(h, p[0]);
+    out->y = h->origin[1] + int_to_pub(h, p[1]);
+    out->z = h->origin[2] + int_to_pub(h, p[2]);
+#else
+    out->x = clamp32((int64_t)h->origin[0] + int_to_pub64(h, p[0]));
+    out->y = clamp32((int64_t)h->origin[1] + int_to_pub64(h, p[1]));
+    out->z = clamp32((int64_t)h->origin[2] + int_to_pub64(h, p[2]));
+#endif
+}
+
+sn_status sn_get_lattice(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count) {
+    const sn_ihdr *h;
+    const sn_q *pos;
+    uint32_t i;
+    if (!inst || !out) return SN_ERR_NULL;
+    h = chdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (first > h->v.nV || count > h->v.nV - first) return SN_ERR_ARG;
+    pos = CARR(h, o_pos, sn_q);
+    for (i = 0; i < count; i++) to_public(h, pos + 3 * (first + i), out + i);
+    return SN_OK;
+}
+
+sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count) {
+    const sn_ihdr *h;
+    const sn_q *pos;
+    const unsigned char *emb, *cells;
+    uint32_t s, k, a;
+    if (!inst || !out) return SN_ERR_NULL;
+    h = chdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (first > h->v.nS || count > h->v.nS - first) return SN_ERR_ARG;
+    pos = CARR(h, o_pos, sn_q);
+    emb = h->v.sec[SN_SEC_EMBED];
+    cells = h->v.sec[SN_SEC_CELLS];
+    for (s = 0; s < count; s++) {
+        const unsigned char *e = emb + (size_t)(first + s) * SN_ELEM_EMBED;
+        const unsigned char *cell = cells + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+        uint32_t t[3];
+        sn_q p[3];
+        sn_acc acc[3] = {0, 0, 0};
+        for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
+        /* trilinear basis phi_a at (t) over the 8 corners, corner a at bits (x, y, z) */
+        for (a = 0; a < 8; a++) {
+            uint32_t vtx = sn_rd_u16(cell + 2 * a);
+            uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
+            uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
+            uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
+#if defined(SN_FLOAT)
+            float w = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f); /* 2^45 */
+            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
+#else
+            /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
+            int64_t w = (int64_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15);
+            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
+#endif
+        }
+        {
+            uint32_t dummy = 0;
+            for (k = 0; k < 3; k++) p[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
+        }
+        to_public(h, p, out + s);
+    }
+    return SN_OK;
+}
+
+sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_vec3 *out) {
+    const sn_ihdr *h;
+    const unsigned char *tris;
+    uint32_t t, i, nS;
+    if (!inst || !positions || !out) return SN_ERR_NULL;
+    h = chdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (h->v.nT == 0) return SN_ERR_ARG;
+    tris = h->v.sec[SN_SEC_TRIS];
+    nS = h->v.nS;
+    memset(out, 0, (size_t)nS * sizeof *out);
+#if defined(SN_FLOAT)
+    for (t = 0; t < h->v.nT; t++) {
+        uint32_t a = sn_rd_u16(tris + 6 * t), b = sn_rd_u16(tris + 6 * t + 2), c = sn_rd_u16(tris + 6 * t + 4);
+        float e1[3], e2[3], n[3];
+        e1[0] = positions[b].x - positions[a].x; e1[1] = positions[b].y - positions[a].y; e1[2] = positions[b].z - positions[a].z;
+        e2[0] = positions[c].x - positions[a].x; e2[1] = positions[c].y - positions[a].y; e2[2] = positions[c].z - positions[a].z;
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        out[a].x += n[0]; out[a].y += n[1]; out[a].z += n[2];
+        out[b].x += n[0]; out[b].y += n[1]; out[b].z += n[2];
+        out[c].x += n[0]; out[c].y += n[1]; out[c].z += n[2];
+    }
+    for (i = 0; i < nS; i++) {
+        sn_q q[4];
+        /* normalize via the quaternion normalizer's vector path: (x,y,z,0) */
+        q[0] = out[i].x; q[1] = out[i].y; q[2] = out[i].z; q[3] = 0.0f;
+        if (q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f) { out[i].z = 1.0f; continue; }
+        sn_qnormalize(q);
+        out[i].x = q[0]; out[i].y = q[1]; out[i].z = q[2];
+    }
+#else
+    {
+        /* area-weighted sums in int32: a pre-pass picks one shift for the mesh
+         * so the largest face normal is <= 2^24 (128 faces per vertex fit);
+         * beyond that the sums saturate instead of overflowing */
+        int64_t maxn = 0;
+        int pass, shift = 0;
+        for (pass = 0; pass < 2; pass++) {
+            for (t = 0; t < h->v.nT; t++) {
+                uint32_t a = sn_rd_u16(tris + 6 * t), b = sn_rd_u16(tris + 6 * t + 2), c = sn_rd_u16(tris + 6 * t + 4);
+                int64_t e1[3], e2[3], n[3];
+                int k;
+                e1[0] = (int64_t)positions[b].x - positions[a].x; e1[1] = (int64_t)positions[b].y - positions[a].y;
+                e1[2] = (int64_t)positions[b].z - positions[a].z;
+                e2[0] = (int64_t)positions[c].x - positions[a].x; e2[1] = (int64_t)positions[c].y - positions[a].y;
+                e2[2] = (int64_t)positions[c].z - positions[a].z;
+                for (k = 0; k < 3; k++) { /* |e| <= 2^30 keeps cross products < 2^62 */
+                    e1[k] = e1[k] > (1 << 30) ? (1 << 30) : (e1[k] < -(1 << 30) ? -(1 << 30) : e1[k]);
+                    e2[k] = e2[k] > (1 << 30) ? (1 << 30) : (e2[k] < -(1 << 30) ? -(1 << 30) : e2[k]);
+                }
+                n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                if (pass == 0) {
+                    for (k = 0; k < 3; k++) {
+                        int64_t m = n[k] < 0 ? -n[k] : n[k];
+                        maxn = m > maxn ? m : maxn;
+                    }
+                } else {
+                    int32_t s0 = (int32_t)sn_rshr64(n[0], shift), s1 = (int32_t)sn_rshr64(n[1], shift),
+                            s2 = (int32_t)sn_rshr64(n[2], shift);
+                    out[a].x = pub_add(out[a].x, s0); out[a].y = pub_add(out[a].y, s1); out[a].z = pub_add(out[a].z, s2);
+                    out[b].x = pub_add(out[b].x, s0); out[b].y = pub_add(out[b].y, s1); out[b].z = pub_add(out[b].z, s2);
+                    out[c].x = pub_add(out[c].x, s0); out[c].y = pub_add(out[c].y, s1); out[c].z = pub_add(out[c].z, s2);
+                }
+            }
+            if (pass == 0) {
+                shift = bitlen64((uint64_t)maxn) - 24;
+                shift = shift < 0 ? 0 : shift;
+            }
+        }
+    }
+    for (i = 0; i < nS; i++) {
+        sn_q q[4];
+        q[0] = out[i].x; q[1] = out[i].y; q[2] = out[i].z; q[3] = 0;
+        if (q[0] == 0 && q[1] == 0 && q[2] == 0) { out[i].z = SN_ONE_ROT; continue; }
+        /* scale up to use the normalizer's precision, then normalize to Q30 */
+        sn_qnormalize(q);
+        out[i].x = q[0]; out[i].y = q[1]; out[i].z = q[2];
+    }
+#endif
+    return SN_OK;
+}
+

@@ -1,0 +1,235 @@
+/* sn_instance.c -- instance memory: layout, init, reset, settings, stats and
+ * the determinism hash. The layout is the single source of the instance
+ * size (SN_INSTANCE_BYTES in sn_format.h must match it). */
+#include "sn_instance.h"
+
+/* hdr | acc nF*3 acc | per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
+ * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per free: k (u8) */
+static void layout(sn_ihdr *h) {
+    uint32_t nV = h->v.nV, nF = h->v.nF, nJ = h->v.nJ, o = SN_HDR_BYTES;
+#define SN_TAKE_(field, bytes) do { h->field = o; o += (bytes); } while (0)
+    SN_TAKE_(o_acc, nF * 3u * 8u); /* 8 bytes per accumulator in both flavours */
+    SN_TAKE_(o_pq, nJ * 4u * 4u);
+    SN_TAKE_(o_pt, nJ * 3u * 4u);
+    SN_TAKE_(o_jR, nJ * 9u * 4u);
+    SN_TAKE_(o_jT, nJ * 3u * 4u);
+    SN_TAKE_(o_R, nV * 9u * 4u);
+    SN_TAKE_(o_c, nV * 3u * 4u);
+    SN_TAKE_(o_pos, nV * 3u * 4u);
+    SN_TAKE_(o_vel, nV * 3u * 4u);
+    SN_TAKE_(o_u, nV * 3u * 4u);
+    SN_TAKE_(o_x, nF * 3u * 4u);
+    SN_TAKE_(o_r, nF * 3u * 4u);
+    SN_TAKE_(o_d, nF * 3u * 4u);
+    SN_TAKE_(o_q, nF * 3u * 4u);
+    SN_TAKE_(o_ds, (nV - nF) * 3u * 4u);
+    SN_TAKE_(o_cR, h->v.nC * 9u * 4u);
+    SN_TAKE_(o_k, nF);
+#undef SN_TAKE_
+}
+
+#if !defined(SN_FLOAT)
+/* raw_pub = raw_int * 2^s with s = len_shift - 6 (fixed) */
+sn_q pub_to_int_sat(const sn_ihdr *h, int64_t pub, uint32_t *sat) {
+    int s = h->v.len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+    if (s >= 0) {
+        if (pub > SN_ACC_LIM) pub = SN_ACC_LIM;
+        if (pub < -SN_ACC_LIM) pub = -SN_ACC_LIM;
+        return sn_out(pub, s, sat);
+    } else {
+        int64_t lim = (int64_t)SN_LIM >> -s;
+        if (pub > lim) { (*sat)++; pub = lim; }
+        if (pub < -lim) { (*sat)++; pub = -lim; }
+        return (int32_t)(pub * ((int64_t)1 << -s));
+    }
+}
+int64_t int_to_pub64(const sn_ihdr *h, sn_q v) {
+    int s = h->v.len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+    return s >= 0 ? (int64_t)v * ((int64_t)1 << s) : sn_rshr64(v, -s);
+}
+#endif
+
+/* Structural limits the unclamped sums rely on (NUMERICS.md, overflow
+ * freedom), counted in the accumulator array (24 bytes per free vertex):
+ * each free vertex is the column of at most SN_MAX_ROW_BLOCKS mass rows and a
+ * corner of at most SN_MAX_VERTEX_CELLS cells. */
+static int structure_ok(sn_ihdr *h) {
+    uint16_t *cnt = ARR(h, o_acc, uint16_t);
+    const unsigned char *cols = h->v.sec[SN_SEC_COLS], *cells = h->v.sec[SN_SEC_CELLS];
+    uint32_t e, nF = h->v.nF;
+    memset(cnt, 0, 2u * nF * sizeof *cnt);
+    for (e = 0; e < h->v.nnz; e++) {
+        uint32_t j = sn_rd_u16(cols + 2 * e);
+        if (j < nF && ++cnt[j] > SN_MAX_ROW_BLOCKS) return 0;
+    }
+    for (e = 0; e < 8u * h->v.nC; e++) {
+        uint32_t a = sn_rd_u16(cells + 2 * e);
+        if (a < nF && ++cnt[nF + a] > SN_MAX_VERTEX_CELLS) return 0;
+    }
+    return 1;
+}
+
+sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out) {
+    sn_ihdr *h;
+    if (!mem || !blob || !out) return SN_ERR_NULL;
+    if (((uintptr_t)mem & 7u) != 0) return SN_ERR_ALIGN;
+    if (mem_size < sn_instance_size(blob)) return SN_ERR_MEMORY;
+    memset(mem, 0, sizeof(sn_ihdr));
+    h = (sn_ihdr *)mem;
+    sn_view_init(&h->v, blob);
+    layout(h);
+    if (!structure_ok(h)) return SN_ERR_INDEX;
+    h->magic = SN_INST_MAGIC;
+    h->iterations = h->v.cg_default;
+    h->mode = SN_MODE_WARPED;
+#if defined(SN_FLOAT)
+    {
+        int k;
+        h->to_pub = 1.0f;
+        for (k = 0; k < h->v.len_shift; k++) h->to_pub *= 2.0f;
+        for (k = 0; k < -h->v.len_shift; k++) h->to_pub *= 0.5f;
+        h->to_int = 1.0f / h->to_pub;
+    }
+#endif
+    {   /* Force-like CG vectors (b, r, q) of free vertex i carry k_i extra
+         * fractional bits. A row's forces scale with its diagonal block of A
+         * (mass + stiffness of the vertex's support), so a barely-inside vertex
+         * would otherwise have forces of a few LSBs that the preconditioner
+         * amplifies, while a stiff one needs the range. k_i = bits between
+         * this vertex's P_i = A_ii^-1 (trace) and the smallest, at most SN_KMAX. */
+        uint8_t *kk = ARR(h, o_k, uint8_t);
+        const unsigned char *P = h->v.sec[SN_SEC_PRECOND];
+        uint32_t i;
+#if !defined(SN_FLOAT)
+        int bmin = 64;
+        for (i = 0; i < h->v.nF; i++) {
+            int64_t tr = (int64_t)rd_real(P, 6 * i) + rd_real(P, 6 * i + 1) + rd_real(P, 6 * i + 2);
+            int b = bitlen64(tr > 0 ? (uint64_t)tr : 0u);
+            bmin = b < bmin ? b : bmin;
+        }
+#endif
+        for (i = 0; i < h->v.nF; i++) {
+#if defined(SN_FLOAT)
+            kk[i] = 0;
+            (void)P;
+#else
+            int64_t tr = (int64_t)rd_real(P, 6 * i) + rd_real(P, 6 * i + 1) + rd_real(P, 6 * i + 2);
+            int k = bitlen64(tr > 0 ? (uint64_t)tr : 0u) - bmin;
+            k = k < 0 ? 0 : (k > SN_KMAX ? SN_KMAX : k);
+            kk[i] = (uint8_t)k;
+#endif
+        }
+    }
+    *out = (sn_instance *)mem;
+    sn_reset(*out);
+    return SN_OK;
+}
+
+static void set_identity(sn_q *R, uint32_t n) {
+    uint32_t i, k;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 9; k++) R[9 * i + k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+}
+
+void sn_reset(sn_instance *inst) {
+    sn_ihdr *h = hdr_of(inst);
+    const sn_view *v = &h->v;
+    uint32_t i, k, nV = v->nV, nJ = v->nJ;
+    sn_q *pq = ARR(h, o_pq, sn_q), *pt = ARR(h, o_pt, sn_q);
+    sn_q *pos = ARR(h, o_pos, sn_q);
+    const unsigned char *j0 = v->sec[SN_SEC_JOINTS];
+    /* zero the state (everything after the header, before the k table) */
+    memset((unsigned char *)h + SN_HDR_BYTES, 0, h->o_k - SN_HDR_BYTES);
+    h->steps = h->saturations = h->have_prev = 0;
+    h->bound_steps = h->limit_clamps = h->limit_steps = 0;
+    h->disp = h->disp_max = h->energy = h->energy_max = 0;
+    /* rest pose: identity rotations (the quaternion tracking starts here), zero translations */
+    for (i = 0; i < nJ; i++) {
+        pq[4 * i + 3] = SN_ONE_ROT;
+        pt[3 * i] = pt[3 * i + 1] = pt[3 * i + 2] = 0;
+    }
+    /* origin = root joint rest position (model space) */
+    for (k = 0; k < 3; k++) {
+        sn_q x = rd_real(j0 + 8, k);
+#if defined(SN_FLOAT)
+        h->origin[k] = int_to_pub(h, x);
+#else
+        h->origin[k] = clamp32(int_to_pub64(h, x));
+#endif
+    }
+    for (i = 0; i < nV; i++)
+        for (k = 0; k < 3; k++) pos[3 * i + k] = rd_real(v->sec[SN_SEC_REST], 3 * i + k);
+    /* rest-pose frames so getters work before the first step */
+    set_identity(ARR(h, o_R, sn_q), nV);
+    set_identity(ARR(h, o_cR, sn_q), v->nC);
+}
+
+sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations) {
+    sn_ihdr *h;
+    if (!inst) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (iterations > h->v.cg_max) return SN_ERR_ARG;
+    h->iterations = iterations ? iterations : h->v.cg_default;
+    return SN_OK;
+}
+
+sn_status sn_set_mode(sn_instance *inst, sn_mode mode) {
+    sn_ihdr *h;
+    if (!inst) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (mode != SN_MODE_WARPED && mode != SN_MODE_UNWARPED) return SN_ERR_ARG;
+    h->mode = (uint32_t)mode;
+    return SN_OK;
+}
+
+void sn_get_stats(const sn_instance *inst, sn_stats *out) {
+    const sn_ihdr *h = chdr_of(inst);
+    memset(out, 0, sizeof *out);
+    out->steps = h->steps;
+    out->saturations = h->saturations;
+    out->iterations = h->iterations;
+    out->mode = h->mode;
+    out->bound_steps = h->bound_steps;
+    out->limit_clamps = h->limit_clamps;
+    out->limit_steps = h->limit_steps;
+    out->disp = h->disp;
+    out->disp_max = h->disp_max;
+    out->energy = h->energy;
+    out->energy_max = h->energy_max;
+}
+
+/* ---- determinism hash: FNV-1a 64 over little-endian bytes ---- */
+static uint64_t fnv_u32(uint64_t hsh, uint32_t x) {
+    int b;
+    for (b = 0; b < 4; b++) {
+        hsh ^= (x >> (8 * b)) & 0xFFu;
+        hsh *= 0x100000001B3ull;
+    }
+    return hsh;
+}
+static uint64_t fnv_q(uint64_t hsh, sn_q x) {
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    return fnv_u32(hsh, u);
+}
+
+uint64_t sn_state_hash(const sn_instance *inst) {
+    const sn_ihdr *h = chdr_of(inst);
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q), *x = CARR(h, o_x, sn_q);
+    const sn_q *pq = CARR(h, o_pq, sn_q);
+    uint64_t hsh = 0xCBF29CE484222325ull;
+    uint32_t i;
+    hsh = fnv_u32(hsh, h->steps);
+    hsh = fnv_u32(hsh, h->saturations);
+    hsh = fnv_u32(hsh, h->bound_steps);
+    hsh = fnv_u32(hsh, h->limit_steps);
+    for (i = 0; i < 3; i++) hsh = fnv_q(hsh, h->origin[i]);
+    hsh = fnv_q(hsh, h->energy);
+    for (i = 0; i < 4 * h->v.nJ; i++) hsh = fnv_q(hsh, pq[i]); /* tracked hemispheres */
+    for (i = 0; i < 3 * h->v.nV; i++) hsh = fnv_q(hsh, pos[i]);
+    for (i = 0; i < 3 * h->v.nV; i++) hsh = fnv_q(hsh, vel[i]);
+    for (i = 0; i < 3 * h->v.nF; i++) hsh = fnv_q(hsh, x[i]);
+    return hsh;
+}

@@ -1,0 +1,131 @@
+/* sn_instance.h -- the instance: header, array layout, and the stages of a
+ * step shared by the runtime files (runtime/NUMERICS.md "One step").
+ *
+ *   sn_instance.c  layout, init, reset, setters, stats, hash
+ *   sn_pose.c      pose input, forward kinematics, joint and frame transforms, skeleton
+ *   sn_solve.c     right-hand side, per-cell stiffness, mat-vec, preconditioner, PCG
+ *   sn_health.c    limits and the health report
+ *   sn_embed.c     outputs: lattice, surface, normals
+ *   sn_step.c      the step: the stages in order
+ */
+#ifndef SN_INSTANCE_H
+#define SN_INSTANCE_H
+
+#include "sn_internal.h"
+
+#define SN_INST_MAGIC 0x534E4932u /* "SNI2" */
+#define SN_HDR_BYTES 512u
+
+/* Instance header; arrays follow at fixed offsets computed from the blob. */
+typedef struct sn_ihdr {
+    uint32_t magic;
+    uint32_t steps, saturations, iterations, mode, have_prev;
+    uint32_t bound_steps, limit_clamps, limit_steps;
+    sn_view v;
+    sn_real origin[3];      /* public units: origin o of the stored positions */
+    sn_real disp, disp_max, energy, energy_max; /* health, public units */
+#if defined(SN_FLOAT)
+    float to_int, to_pub;   /* mesh units <-> internal units */
+#endif
+    /* byte offsets of the arrays from the instance start */
+    uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds,
+        o_k, o_cR;
+} sn_ihdr;
+
+typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
+
+#define ARR(h, off, T) ((T *)(void *)((unsigned char *)(h) + (h)->off))
+#define CARR(h, off, T) ((const T *)(const void *)((const unsigned char *)(h) + (h)->off))
+
+/* Force-like values of free vertex i are Q(SN_Q_FORCE + k_i), k_i in
+ * [0, SN_KMAX] (see sn_instance_init): the stiffest vertex gets Q19, three
+ * bits of headroom over the Q22 lengths for violent poses. */
+#define SN_Q_FORCE 19
+#define SN_KMAX 15
+#define SN_KREL(k) ((int)(k) + SN_Q_FORCE - SN_Q_LEN) /* bits relative to Q22 */
+
+/* A free vertex lies in at most this many cells (true of any hex lattice);
+ * the unclamped per-vertex accumulation of cell forces relies on it
+ * (checked by sn_instance_init). */
+#define SN_MAX_VERTEX_CELLS 8u
+
+#define RB (SN_REAL_BYTES)
+SN_INLINE sn_q rd_real(const unsigned char *sec, uint32_t idx) {
+    return SN_RD_REAL(sec + (size_t)idx * RB);
+}
+
+#if defined(SN_FLOAT)
+#define ONE_COEF 1.0f
+#else
+#define ONE_COEF ((int32_t)1 << SN_Q_COEF)
+#endif
+
+/* Scale by a Q24 coefficient: v * c >> 24 */
+SN_INLINE sn_q coef(sn_q v, sn_q c, uint32_t *sat) { return sn_mulq(v, c, SN_Q_COEF, sat); }
+
+SN_INLINE sn_ihdr *hdr_of(sn_instance *inst) { return (sn_ihdr *)(void *)inst; }
+SN_INLINE const sn_ihdr *chdr_of(const sn_instance *inst) {
+    return (const sn_ihdr *)(const void *)inst;
+}
+
+/* Saturating counter increment (stats never wrap). */
+SN_INLINE uint32_t sn_count(uint32_t c, uint32_t add) {
+    return c > UINT32_MAX - add ? UINT32_MAX : c + add;
+}
+
+#if !defined(SN_FLOAT)
+/* number of significant bits of x (0 for 0); fixed 6-step search */
+SN_INLINE int bitlen64(uint64_t x) {
+    int n = 0, s;
+    for (s = 32; s > 0; s >>= 1) {
+        uint64_t hi = x >> s;
+        int take = hi != 0;
+        n += take ? s : 0;
+        x = take ? hi : x;
+    }
+    return n + (x != 0);
+}
+SN_INLINE int32_t clamp32(int64_t x) {
+    return x > INT32_MAX ? INT32_MAX : (x < INT32_MIN ? INT32_MIN : (int32_t)x);
+}
+#endif
+
+/* ---- saturating public-vector arithmetic (fixed: int32 Q16.16 could overflow
+ * for extreme but valid inputs; float: plain) ---- */
+SN_INLINE sn_real pub_add(sn_real a, sn_real b) {
+#if defined(SN_FLOAT)
+    return a + b;
+#else
+    return clamp32((int64_t)a + b);
+#endif
+}
+SN_INLINE sn_real pub_sub(sn_real a, sn_real b) {
+#if defined(SN_FLOAT)
+    return a - b;
+#else
+    return clamp32((int64_t)a - b);
+#endif
+}
+
+/* ---- unit conversion between public (Q16.16 mesh) and internal (Q22 U) ---- */
+#if defined(SN_FLOAT)
+SN_INLINE sn_q pub_to_int(const sn_ihdr *h, float pub) { return pub * h->to_int; }
+SN_INLINE sn_real int_to_pub(const sn_ihdr *h, sn_q v) { return v * h->to_pub; }
+#else
+sn_q pub_to_int_sat(const sn_ihdr *h, int64_t pub, uint32_t *sat);
+int64_t int_to_pub64(const sn_ihdr *h, sn_q v);
+#endif
+
+/* ---- stages (NUMERICS.md "One step") ---- */
+void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vertex and cell frames */
+void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
+void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
+void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
+void sn_health(sn_ihdr *h, uint32_t sat_before, uint32_t *sat); /* 9 (disp; energy from sn_solve) */
+
+/* Twice the elastic + kinetic energy of the step's starting state in
+ * internal units (fixed: Q32, summed with saturation at 2^62), set by
+ * sn_solve; converted to joules by sn_health. */
+void sn_set_energy(sn_ihdr *h, sn_acc e2);
+
+#endif /* SN_INSTANCE_H */

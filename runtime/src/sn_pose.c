@@ -1,0 +1,204 @@
+/* sn_pose.c -- pose input and forward kinematics (public API), and steps
+ * 1-3 of the step: joint transforms, the origin, vertex and cell frames
+ * (seed 003 §3.3, per cell as its closing remark suggests), skeleton vertices
+ * (runtime/NUMERICS.md "One step"). */
+#include "sn_instance.h"
+
+sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
+    sn_ihdr *h;
+    uint32_t j;
+    sn_q *pq, *pt;
+    if (!inst || !joints) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (n_joints != h->v.nJ) return SN_ERR_ARG;
+    pq = ARR(h, o_pq, sn_q);
+    pt = ARR(h, o_pt, sn_q);
+    for (j = 0; j < n_joints; j++) {
+        sn_q q[4];
+        q[0] = joints[j].rot.x; q[1] = joints[j].rot.y; q[2] = joints[j].rot.z; q[3] = joints[j].rot.w;
+        sn_qnormalize(q);
+        {   /* track the hemisphere: q and -q are one rotation; keep the one
+             * nearer the joint's previous quaternion so frames interpolate
+             * the way the joint really turned (NUMERICS.md step 1) */
+            sn_acc dq = sn_mul(q[0], pq[4 * j]) + sn_mul(q[1], pq[4 * j + 1]) +
+                        sn_mul(q[2], pq[4 * j + 2]) + sn_mul(q[3], pq[4 * j + 3]);
+            if (dq < 0) { q[0] = -q[0]; q[1] = -q[1]; q[2] = -q[2]; q[3] = -q[3]; }
+        }
+        memcpy(pq + 4 * j, q, sizeof q);
+        pt[3 * j] = joints[j].pos.x;
+        pt[3 * j + 1] = joints[j].pos.y;
+        pt[3 * j + 2] = joints[j].pos.z;
+    }
+    return SN_OK;
+}
+
+/* ---- forward kinematics (public units) ---- */
+void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3 *root_offset,
+                        sn_xform *out) {
+    sn_view v;
+    uint32_t j;
+    sn_view_init(&v, blob);
+    for (j = 0; j < v.nJ; j++) {
+        sn_vec3 x, rx, d;
+        int32_t p = sn_joint_parent(blob, j);
+        sn_quat ql = local[j];
+        (void)sn_joint_rest(blob, j, &x);
+        {   /* normalize the caller's local rotation */
+            sn_q q[4];
+            q[0] = ql.x; q[1] = ql.y; q[2] = ql.z; q[3] = ql.w;
+            sn_qnormalize(q);
+            ql.x = q[0]; ql.y = q[1]; ql.z = q[2]; ql.w = q[3];
+        }
+        /* rotation about the joint's rest position: x -> Rl (x - xj) + xj */
+        rx = sn_quat_rotate(ql, x);
+        d.x = pub_sub(x.x, rx.x); d.y = pub_sub(x.y, rx.y); d.z = pub_sub(x.z, rx.z);
+        if (p < 0) {
+            out[j].rot = ql;
+            out[j].pos = d;
+            if (root_offset) {
+                out[j].pos.x = pub_add(out[j].pos.x, root_offset->x);
+                out[j].pos.y = pub_add(out[j].pos.y, root_offset->y);
+                out[j].pos.z = pub_add(out[j].pos.z, root_offset->z);
+            }
+        } else {
+            /* T_j = T_p o local: R = Rp Rl, t = Rp (xj - Rl xj) + tp */
+            const sn_xform *tp = &out[p];
+            sn_vec3 rd = sn_quat_rotate(tp->rot, d);
+            out[j].rot = sn_quat_mul(tp->rot, ql);
+            out[j].pos.x = pub_add(rd.x, tp->pos.x);
+            out[j].pos.y = pub_add(rd.y, tp->pos.y);
+            out[j].pos.z = pub_add(rd.z, tp->pos.z);
+        }
+    }
+}
+
+/* Frame of a vertex or cell from its (b1, b2, w) entry: R = slerp_path(q_b1,
+ * q_b2, w) and, for vertices (c != NULL), c = (1-w) T_b1 + w T_b2. */
+static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_q *c, uint32_t *sat) {
+    const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+    uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
+    if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I, c = root */
+        for (k = 0; k < 9; k++) R[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+        if (c) for (k = 0; k < 3; k++) c[k] = jT[k];
+    } else if (b1 == b2 || w == 0) {
+        memcpy(R, jR + 9 * b1, 9 * sizeof(sn_q));
+        if (c) memcpy(c, jT + 3 * b1, 3 * sizeof(sn_q));
+    } else {
+        sn_q q[4];
+#if defined(SN_FLOAT)
+        sn_q t = (float)w * (1.0f / 32768.0f);
+        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
+        if (c)
+            for (k = 0; k < 3; k++) c[k] = jT[3 * b1 + k] + t * (jT[3 * b2 + k] - jT[3 * b1 + k]);
+        (void)sat;
+#else
+        sn_q t = (sn_q)(w << (SN_Q_ROT - SN_Q_W));
+        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
+        if (c)
+            for (k = 0; k < 3; k++) {
+                int64_t a = jT[3 * b1 + k], b = jT[3 * b2 + k];
+                c[k] = sn_out(a * 32768 + (b - a) * (int64_t)w, SN_Q_W, sat);
+            }
+#endif
+        sn_qtomat(q, R);
+    }
+}
+
+/* Steps 1-2: rigid joint transforms, the origin, and the frames of every
+ * lattice vertex and cell for the current pose. */
+void sn_frames(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *pq = CARR(h, o_pq, sn_q), *pt = CARR(h, o_pt, sn_q);
+    sn_q *jR = ARR(h, o_jR, sn_q), *jT = ARR(h, o_jT, sn_q);
+    sn_q *R = ARR(h, o_R, sn_q), *c = ARR(h, o_c, sn_q), *pos = ARR(h, o_pos, sn_q);
+    sn_q *cR = ARR(h, o_cR, sn_q);
+    const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
+    sn_q xroot[3], rx[3], delta_int[3];
+    uint32_t i, j, k;
+    for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
+    for (j = 0; j < v->nJ; j++) sn_qtomat(pq + 4 * j, jR + 9 * j);
+    /* origin follows the root joint's world position R_0 x_root + t_0 */
+    sn_rot(jR, xroot, rx, sat);
+    for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+        float target = pt[k] + int_to_pub(h, rx[k]);
+        delta_int[k] = pub_to_int(h, target - h->origin[k]);
+        h->origin[k] = target;
+#else
+        int s = v->len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+        int64_t target = (int64_t)pt[k] + int_to_pub64(h, rx[k]);
+        int64_t delta = target - h->origin[k], exact;
+        delta_int[k] = pub_to_int_sat(h, delta, sat);
+        /* move the origin only by what the internal format represents exactly */
+        exact = s >= 0 ? (int64_t)delta_int[k] * ((int64_t)1 << s) : sn_rshr64(delta_int[k], -s);
+        h->origin[k] = clamp32((int64_t)h->origin[k] + exact);
+#endif
+    }
+    if (!h->have_prev) { delta_int[0] = delta_int[1] = delta_int[2] = 0; }
+    for (i = 0; i < v->nV; i++)
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            pos[3 * i + k] = sn_add(pos[3 * i + k], -delta_int[k], sat);
+#else
+            pos[3 * i + k] = sn_out((int64_t)pos[3 * i + k] - delta_int[k], 0, sat);
+#endif
+        }
+    /* effective translations: T_j = R_j x_root + (t_j - o), internal units */
+    for (j = 0; j < v->nJ; j++) {
+        sn_rot(jR + 9 * j, xroot, rx, sat);
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            jT[3 * j + k] = rx[k] + pub_to_int(h, pt[3 * j + k] - h->origin[k]);
+#else
+            sn_q tj = pub_to_int_sat(h, (int64_t)pt[3 * j + k] - h->origin[k], sat);
+            jT[3 * j + k] = sn_add(rx[k], tj, sat);
+#endif
+        }
+    }
+    for (i = 0; i < v->nV; i++)
+        frame_of(h, fr + 4 * i, R + 9 * i, c + 3 * i, sat);
+    for (i = 0; i < v->nC; i++)
+        frame_of(h, cfr + 4 * i, cR + 9 * i, NULL, sat);
+}
+
+/* New skeleton positions p'_k = R_b x_k + T_b into pos, ds = v'_k - v_k,
+ * vel_S = v'_k. First pose after init/reset: the flesh is placed rigidly by its
+ * frames (R_i x_i + c_i) and all velocities are zero. */
+void sn_skeleton(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+    const sn_q *R = CARR(h, o_R, sn_q), *c = CARR(h, o_c, sn_q);
+    sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q), *ds = ARR(h, o_ds, sn_q);
+    const unsigned char *fr = v->sec[SN_SEC_FRAMES], *rest = v->sec[SN_SEC_REST];
+    uint32_t i, k;
+    for (i = v->nF; i < v->nV; i++) {
+        uint32_t b = fr[4 * i];
+        sn_q x[3], p[3];
+        for (k = 0; k < 3; k++) x[k] = rd_real(rest, 3 * i + k);
+        sn_rot(jR + 9 * b, x, p, sat);
+        for (k = 0; k < 3; k++) {
+            sn_q pn = sn_add(p[k], jT[3 * b + k], sat);
+            sn_q vn = h->have_prev ? sn_add(pn, -pos[3 * i + k], sat) : 0;
+            ds[3 * (i - v->nF) + k] = sn_add(vn, -vel[3 * i + k], sat);
+            vel[3 * i + k] = vn;
+            pos[3 * i + k] = pn;
+        }
+    }
+    if (!h->have_prev) {
+        sn_q *x = ARR(h, o_x, sn_q);
+        for (i = 0; i < v->nF; i++) {
+            sn_q xr[3], p[3];
+            for (k = 0; k < 3; k++) xr[k] = rd_real(rest, 3 * i + k);
+            sn_rot(R + 9 * i, xr, p, sat);
+            for (k = 0; k < 3; k++) {
+                pos[3 * i + k] = sn_add(p[k], c[3 * i + k], sat);
+                vel[3 * i + k] = 0;
+                x[3 * i + k] = 0;
+            }
+        }
+        for (i = 0; i < 3 * (v->nV - v->nF); i++) ds[i] = 0;
+        h->have_prev = 1;
+    }
+}
+

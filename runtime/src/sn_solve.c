@@ -1,0 +1,410 @@
+/* sn_solve.c -- steps 4-7: the right-hand side with the per-cell warped
+ * elastic force (element energy, NUMERICS.md step 4), the mat-vec
+ * A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d, the rotated block-Jacobi
+ * preconditioner, and PCG with a fixed iteration count (seed 000 §4.2).
+ *
+ * Overflow freedom (fixed): a cell product row sums 8 blocks of 3 products,
+ * < 24 * 2^55 = 2^59.6, rounded to an int32 force (clamped) before it is
+ * rotated back; a free vertex's accumulator takes at most 8 rotated cell
+ * rows (sn_instance_init checks it), each |R t| <= sqrt(3) 2^58, so < 2^61.8.
+ * The mass pass is the assembled one of format 1 (<= 53 block products).
+ */
+#include "sn_instance.h"
+
+/* Overflow freedom without clamps (fixed): entries |e| <= 2^27 (validator),
+ * operands |x| <= 2^28 (every sn_q is clamped), so one block row is < 3*2^55. */
+SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
+    l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
+    l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
+    l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
+}
+/* l += D e, D symmetric stored xx yy zz xy xz yz */
+SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
+    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
+    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
+    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
+}
+SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
+    l[0] += sn_mul(m, e[0]);
+    l[1] += sn_mul(m, e[1]);
+    l[2] += sn_mul(m, e[2]);
+}
+/* acc_i += l at the end of row i */
+SN_INLINE void row_done(sn_acc *acc, const sn_acc l[3]) {
+    acc[0] += l[0];
+    acc[1] += l[1];
+    acc[2] += l[2];
+}
+
+/* acc += B^T e (scatter of the transposed block) */
+SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
+    acc[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) + sn_mul(rd_real(b, 6), e[2]);
+    acc[1] += sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 7), e[2]);
+    acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
+}
+/* acc += m e (scalar block) */
+SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
+    acc[0] += sn_mul(m, e[0]);
+    acc[1] += sn_mul(m, e[1]);
+    acc[2] += sn_mul(m, e[2]);
+}
+
+static void acc_zero(sn_acc *acc, uint32_t n3) {
+    uint32_t i;
+    for (i = 0; i < n3; i++) acc[i] = 0;
+}
+
+
+/* acc += R t (t rotated back out of a cell frame, kept at full precision) */
+SN_INLINE void rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
+    acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);
+    acc[1] += sn_mul(R[3], t[0]) + sn_mul(R[4], t[1]) + sn_mul(R[5], t[2]);
+    acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
+}
+
+/* l = S^_e u for one cell: the 36 stored upper blocks used as (a,b) and (b,a). */
+static void cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+    uint32_t a, b, n = 0;
+    acc_zero(l, 24);
+    for (a = 0; a < 8; a++) {
+        blk_row(l + 3 * a, K, u + 3 * a);
+        K += 9 * RB;
+        for (b = a + 1; b < 8; b++, K += 9 * RB) {
+            blk_row(l + 3 * a, K, u + 3 * b);
+            blk_mac_t(l + 3 * b, K, u + 3 * a);
+        }
+        n++;
+    }
+    (void)n;
+}
+
+/* Saturating sum of non-negative energy terms (fixed: at 2^62). */
+SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
+#if defined(SN_FLOAT)
+    return e + x;
+#else
+    const int64_t lim = (int64_t)1 << 62;
+    if (x < 0) x = 0;
+    return x > lim - e ? lim : e + x;
+#endif
+}
+/* Q44 energy term -> Q32 (fixed) */
+#if defined(SN_FLOAT)
+#define E_Q32(x) (x)
+#else
+#define E_Q32(x) sn_rshr64((x), 12)
+#endif
+
+/* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
+ * acc_a = sum_e R_e S^_e (d_e + R_e^T (w - w_a0))_a over free corners, and twice
+ * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per vertex. */
+static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
+    const unsigned char *rest = v->sec[SN_SEC_REST];
+    const sn_q *cR = CARR(h, o_cR, sn_q), *pos = CARR(h, o_pos, sn_q);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t e, k, c, nF = v->nF;
+    uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
+    acc_zero(acc, 3 * nF);
+    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
+        const sn_q *R = cR + 9 * e;
+        uint32_t a0 = sn_rd_u16(cl);
+        sn_q d[24], uu[24];
+        sn_acc ld[24], lu[24], ec = 0;
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            sn_q t[3], s[3], l[3];
+            for (c = 0; c < 3; c++) {
+                t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
+                s[c] = sn_add(w[3 * a + c], -w[3 * a0 + c], sat);
+            }
+            sn_rot_t(R, t, l, sat);
+            sn_rot_t(R, s, uu + 3 * k, sat);
+            for (c = 0; c < 3; c++) {
+                sn_q xr = sn_add(rd_real(rest, 3 * a + c), -rd_real(rest, 3 * a0 + c), sat);
+                d[3 * k + c] = sn_add(l[c], -xr, sat);
+            }
+        }
+        cell_mul(K, d, ld);
+        cell_mul(K, uu, lu);
+        for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
+        *e2 = energy_add(*e2, E_Q32(ec));
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            sn_q t[3];
+            int sh;
+            if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
+            sh = v->frac_S - SN_KREL(kk[a]);
+            for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c], sh, sat);
+            rot_acc(acc + 3 * a, R, t);
+        }
+    }
+}
+
+/* Right-hand side b (into r), NUMERICS.md step 5:
+ * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S)   */
+static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
+    const unsigned char *ml = v->sec[SN_SEC_MLUMP];
+    const sn_q *R = CARR(h, o_R, sn_q), *vel = CARR(h, o_vel, sn_q);
+    const sn_q *ds = CARR(h, o_ds, sn_q);
+    sn_q *u = ARR(h, o_u, sn_q);
+    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t i, k, nF = v->nF, nV = v->nV, esat = 0;
+    sn_q ck = (sn_q)(ONE_COEF + v->b1);
+    sn_acc e2 = 0;
+
+    /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v */
+    for (i = 0; i < nV; i++)
+        for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], i < nF ? ck : v->b1, sat);
+    cell_forces(h, u, acc, &e2, sat);
+    for (i = 0; i < 3 * nF; i++) b[i] = (sn_q)-sn_out(acc[i], SN_Q_ROT, sat); /* |.| <= SN_LIM */
+    /* kinetic energy with the lumped mass: sum m^_i |v_i|^2 (twice the energy) */
+    for (i = 0; i < nF; i++) {
+        sn_q mi = rd_real(ml, i);
+        sn_acc ek = 0;
+        for (k = 0; k < 3; k++) ek += sn_mul(vel[3 * i + k], sn_mulq(mi, vel[3 * i + k], v->frac_M, &esat));
+        e2 = energy_add(e2, E_Q32(ek));
+    }
+    sn_set_energy(h, e2);
+
+    /* mass pass: acc_i = M^_ij y_j, y = a1 v (free), a1 v' + (v' - v) (skeleton) */
+    acc_zero(acc, 3 * nF);
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        sn_q yi[3], yj[3];
+        sn_acc l[3] = {0, 0, 0};
+        for (k = 0; k < 3; k++) yi[k] = coef(vel[3 * i + k], v->a1, sat);
+        sca_row(l, rd_real(md, i), yi);
+        for (; e < end; e++) {
+            uint32_t j = sn_rd_u16(cols + 2 * e);
+            sn_q m = rd_real(mo, e);
+            for (k = 0; k < 3; k++) {
+                yj[k] = coef(vel[3 * j + k], v->a1, sat);
+                if (j >= nF) yj[k] = sn_add(yj[k], ds[3 * (j - nF) + k], sat);
+            }
+            sca_row(l, m, yj);
+            if (j < nF) sca_mac(acc + 3 * j, m, yi);
+        }
+        row_done(acc + 3 * i, l);
+    }
+    for (i = 0; i < nF; i++) {
+        sn_q mi = rd_real(ml, i), gi[3], gr[3];
+        /* rest shape = modelled shape: cancel gravity as the vertex frame turns it */
+        sn_rot(R + 9 * i, v->grav, gr, sat);
+        for (k = 0; k < 3; k++)
+            gi[k] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[k], -gr[k], sat) : v->grav[k];
+        for (k = 0; k < 3; k++) {
+            sn_q g = sn_mulq(mi, gi[k], v->frac_M - SN_KREL(kk[i]), sat);
+            sn_q ma = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
+            b[3 * i + k] = sn_add(sn_add(b[3 * i + k], g, sat), -ma, sat);
+        }
+    }
+}
+
+
+/* Symmetric mass pass over free-free blocks: acc = M^ y (y over free). */
+static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
+    const sn_view *v = &h->v;
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
+    uint32_t i, nF = v->nF;
+    acc_zero(acc, 3 * nF);
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        sn_acc l[3] = {0, 0, 0};
+        sca_row(l, rd_real(md, i), y + 3 * i);
+        for (; e < end; e++) {
+            uint32_t j = sn_rd_u16(cols + 2 * e);
+            sn_q m;
+            if (j >= nF) break;
+            m = rd_real(mo, e);
+            sca_row(l, m, y + 3 * j);
+            sca_mac(acc + 3 * j, m, y + 3 * i);
+        }
+        row_done(acc + 3 * i, l);
+    }
+}
+
+
+/* q = A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d  (free rows) */
+static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
+    const sn_q *cR = CARR(h, o_cR, sn_q);
+    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t e, i, k, c, nF = v->nF;
+    sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
+    acc_zero(acc, 3 * nF);
+    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
+        const sn_q *R = cR + 9 * e;
+        sn_q u[24];
+        sn_acc l[24];
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            if (a < nF) sn_rot_t(R, d + 3 * a, u + 3 * k, sat);
+            else u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0; /* skeleton: no unknown */
+        }
+        cell_mul(K, u, l);
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            sn_q t[3];
+            int sh;
+            if (a >= nF) continue;
+            sh = v->frac_S - SN_KREL(kk[a]);
+            for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
+            rot_acc(acc + 3 * a, R, t);
+        }
+    }
+    for (i = 0; i < 3 * nF; i++) q[i] = sn_out(acc[i], SN_Q_ROT, sat);
+    pass_M_ff(h, d, acc);
+    for (i = 0; i < nF; i++)
+        for (k = 0; k < 3; k++) {
+            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
+            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
+            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
+        }
+}
+
+/* z_i = R_i P_i R_i^T r_i  (rest-frame block Jacobi, rotated) */
+static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *R = CARR(h, o_R, sn_q);
+    const unsigned char *P = v->sec[SN_SEC_PRECOND];
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t i;
+    for (i = 0; i < v->nF; i++) {
+        sn_q t[3], s[3];
+        sn_acc a[3] = {0, 0, 0};
+        int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
+        sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
+        sym_row(a, P + (size_t)i * 6 * RB, t);
+        s[0] = sn_out(a[0], sh, sat);
+        s[1] = sn_out(a[1], sh, sat);
+        s[2] = sn_out(a[2], sh, sat);
+        sn_rot(R + 9 * i, s, z + 3 * i, sat);
+    }
+}
+
+/* ---- CG scalars ---- */
+#if defined(SN_FLOAT)
+typedef struct { float m; } sn_dotv;
+static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
+    sn_dotv r;
+    uint32_t i;
+    float s = 0.0f;
+    (void)kk;
+    for (i = 0; i < n; i++) s += a[i] * b[i];
+    r.m = s;
+    return r;
+}
+/* num/den, 0 when den <= 0 or num <= 0 (constant cost, no convergence branch) */
+static float ratio(sn_dotv num, sn_dotv den) {
+    return (den.m > 0.0f && num.m > 0.0f) ? num.m / den.m : 0.0f;
+}
+#define SN_Q_SCAL 0
+#else
+/* Block floating point dot product: value = m * 2^e. */
+typedef struct { int64_t m; int e; } sn_dotv;
+#define SN_Q_SCAL 28 /* alpha, beta in Q28 */
+
+/* a force-like (Q(19+k_i) per vertex), b velocity-like (Q22): sum of a.b in
+ * Q41, times 2^e. The bound uses the OR of the magnitudes (same bit length as
+ * their maximum, no compares); products are shifted right by s + k_i. */
+static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
+    sn_dotv r;
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
+    int s;
+    int64_t sum = 0;
+    for (i = 0; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    for (i = 0; i < nv; i++) {
+        int sh = s + kk[i];
+        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+    }
+    r.m = sum;
+    r.e = s;
+    return r;
+}
+/* num/den in Q28, 0 when den <= 0 or num <= 0; saturates at INT32_MAX. */
+static int32_t ratio(sn_dotv num, sn_dotv den) {
+    int e, bn, bd;
+    uint64_t n, d, q;
+    if (den.m <= 0 || num.m <= 0) return 0;
+    n = (uint64_t)num.m;
+    d = (uint64_t)den.m;
+    e = SN_Q_SCAL + num.e - den.e;
+    /* normalize den to [2^30, 2^31) and num to [2^61, 2^62) */
+    bd = bitlen64(d); /* den = d * 2^(bd-31): a larger true den lowers the exponent */
+    if (bd > 31) { d >>= (bd - 31); e -= bd - 31; } else { d <<= (31 - bd); e += 31 - bd; }
+    bn = bitlen64(n);
+    if (bn > 62) { n >>= (bn - 62); e += bn - 62; } else { n <<= (62 - bn); e -= 62 - bn; }
+    q = n / d; /* in [2^30, 2^32) */
+    if (e >= 0) return e > 0 || q > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)q;
+    if (e < -40) return 0;
+    q = (q + ((uint64_t)1 << (-e - 1))) >> -e;
+    return q > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)q;
+}
+#endif
+
+/* y += s * x (s in Q28 fixed) over n values */
+static void axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) {
+    uint32_t i;
+    for (i = 0; i < n; i++) y[i] = sn_add(y[i], sn_mulq(s, x[i], SN_Q_SCAL, sat), sat);
+}
+
+
+/* Steps 5-7: right-hand side, PCG warm-started from the previous step's
+ * solution with a fixed iteration count, update. */
+void sn_solve(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    uint32_t it, i, n3 = 3 * v->nF;
+    sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
+    sn_q *q = ARR(h, o_q, sn_q), *z = ARR(h, o_u, sn_q); /* z shares u: never live together */
+    sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    sn_dotv rz;
+
+    rhs(h, r, sat);
+    /* PCG, warm-started from the previous step's solution, fixed iterations */
+    matvec(h, x, q, sat);
+    for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    precond(h, r, z, sat);
+    memcpy(d, z, n3 * sizeof(sn_q));
+    rz = dot(r, z, kk, n3);
+    for (it = 0; it < h->iterations; it++) {
+        sn_dotv dq, rz1;
+        sn_q alpha, beta, nalpha;
+        matvec(h, d, q, sat);
+        dq = dot(q, d, kk, n3);
+        alpha = ratio(rz, dq);
+        nalpha = (sn_q)-alpha;
+        axpy(x, alpha, d, n3, sat);
+        axpy(r, nalpha, q, n3, sat);
+        precond(h, r, z, sat);
+        rz1 = dot(r, z, kk, n3);
+        beta = ratio(rz1, rz);
+        for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
+        rz = rz1;
+    }
+    /* v += dv, p += h v  (velocities are per step: h folded in) */
+    for (i = 0; i < n3; i++) {
+        vel[i] = sn_add(vel[i], x[i], sat);
+        pos[i] = sn_add(pos[i], vel[i], sat);
+    }
+}
