@@ -14,12 +14,12 @@ $(HEALTH_EX)/cow_%_float.blob: $(HEALTH_EX)/%/cow.sinew $(BAKE)
 .PRECIOUS: $(HEALTH_EX)/%/cow.sinew
 HEALTH_BLOBS = $(foreach v,limit farlimit rest,$(HEALTH_EX)/cow_$(v).blob $(HEALTH_EX)/cow_$(v)_float.blob)
 
-$(BUILD)/tests/health_runtime: tests/test_runtime_health.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(HEALTH_BLOBS)
+$(BUILD)/tests/health_runtime: tests/test_runtime_health.c $(PHYS_HDRS) $(REF_SRC) $(SN_LIB_FIXED) $(HEALTH_BLOBS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/tests/health_runtime_float: tests/test_runtime_health.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(HEALTH_BLOBS)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/health_runtime_float: tests/test_runtime_health.c $(PHYS_HDRS) $(REF_SRC) $(SN_LIB_FLOAT) $(HEALTH_BLOBS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 # run by tests/scripts/test_health.sh (the binaries take the blob paths)
 TEST_DEPS += $(BUILD)/tests/health_runtime $(BUILD)/tests/health_runtime_float $(BUILD)/examples/cow.blob \
              $(BUILD)/examples/cow_float.blob

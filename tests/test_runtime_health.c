@@ -14,6 +14,7 @@
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
+#include "reference/phys_util.h"
 
 #if defined(SN_FLOAT)
 #define R2D(x) ((double)(x))
@@ -34,20 +35,7 @@ typedef struct {
     sn_instance *inst;
 } ch_t;
 
-static unsigned char *load(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    unsigned char *p;
-    long n;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    p = malloc((size_t)n + 8);
-    if (!p || fread(p, 1, (size_t)n, f) != (size_t)n) { fclose(f); free(p); return NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return p;
-}
+static unsigned char *load(const char *path, size_t *size) { return pu_read(path, size); }
 
 static int open_ch(ch_t *c, unsigned char *bytes, size_t size) {
     memset(c, 0, sizeof *c);
@@ -80,16 +68,6 @@ static double violent(int step, double h) {
     return t >= 0.1 ? 180.0 : 1800.0 * t;
 }
 
-static uint32_t crc32_(const unsigned char *p, size_t n) {
-    uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        c ^= p[i];
-        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-    }
-    return ~c;
-}
 static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
@@ -217,7 +195,7 @@ int main(int argc, char **argv) {
             wr32(p, (uint32_t)(-(int32_t)rd32(p)));
 #endif
         }
-        wr32(bad + SN_H_CRC32, crc32_(bad + 16, size - 16));
+        wr32(bad + SN_H_CRC32, snref_crc32(bad + 16, size - 16));
         T_CHECK(open_ch(&c, bad, size) == 0, "negated-stiffness blob validates");
         for (s = 0; s < 300; s++) { set_pose(&c, -1, ax, 0); sn_step(c.inst); }
         sn_get_stats(c.inst, &st);

@@ -66,18 +66,16 @@ SN_INLINE void rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
 
 /* l = S^_e u for one cell: the 36 stored upper blocks used as (a,b) and (b,a). */
 static void cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
-    uint32_t a, b, n = 0;
+    uint32_t a, b;
     acc_zero(l, 24);
     for (a = 0; a < 8; a++) {
-        blk_row(l + 3 * a, K, u + 3 * a);
+        blk_row(l + 3 * a, K, u + 3 * a); /* diagonal block (a,a), stored in full */
         K += 9 * RB;
         for (b = a + 1; b < 8; b++, K += 9 * RB) {
             blk_row(l + 3 * a, K, u + 3 * b);
             blk_mac_t(l + 3 * b, K, u + 3 * a);
         }
-        n++;
     }
-    (void)n;
 }
 
 /* Saturating sum of non-negative energy terms (fixed: at 2^62). */
