@@ -306,6 +306,60 @@ int main(int argc, char **argv) {
             free(rb);
         }
     }
+    /* 6. Unusable poses are refused whole and change nothing: a (near-)zero
+     * quaternion in both flavours; NaN, infinity and translations beyond the
+     * fixed range in float. */
+    {
+        sn_quat local[256];
+        sn_xform xf[256], bad[256];
+        uint64_t h0, h1;
+        uint32_t j, k;
+        int cases = 0;
+        T_CHECK(open_ch(&c, bytes, size) == 0, "open cow for pose checks");
+        for (j = 0; j < c.info.joints; j++) {
+            sn_vec3 a = {D2R(0), D2R(1), D2R(0)};
+            local[j] = sn_quat_axis_angle(a, D2R(10.0 * j));
+        }
+        sn_pose_from_local(c.blob, local, NULL, xf);
+        T_CHECK(sn_set_pose(c.inst, xf, c.info.joints) == SN_OK, "a good pose is taken");
+        for (s = 0; s < 5; s++) sn_step(c.inst);
+        h0 = sn_state_hash(c.inst);
+        for (k = 0; k < 6; k++) {
+            memcpy(bad, xf, sizeof(sn_xform) * c.info.joints);
+            j = c.info.joints - 1;
+            switch (k) {
+            case 0: bad[j].rot.x = bad[j].rot.y = bad[j].rot.z = bad[j].rot.w = 0; break;
+#if defined(SN_FLOAT)
+            case 1: bad[j].rot.x = bad[j].rot.y = bad[j].rot.z = 0; bad[j].rot.w = 1e-30f; break;
+            case 2: bad[j].rot.w = (float)NAN; break;
+            case 3: bad[j].pos.x = (float)INFINITY; break;
+            case 4: bad[j].pos.y = 3.4e38f; break;
+            case 5: bad[j].pos.z = (float)NAN; break;
+#else
+            case 1: bad[j].rot.x = bad[j].rot.y = bad[j].rot.z = 0; bad[j].rot.w = 1; break; /* 1 LSB of Q30 */
+            default: continue;
+#endif
+            }
+            cases++;
+            T_CHECK(sn_set_pose(c.inst, bad, c.info.joints) == SN_ERR_ARG, "bad pose %u refused", k);
+            sn_step(c.inst);
+            sn_set_pose(c.inst, xf, c.info.joints);
+        }
+        /* the refused poses changed nothing: the same number of steps with the
+         * good pose gives the same state as a clean run */
+        h1 = sn_state_hash(c.inst);
+        {
+            ch_t c2;
+            T_CHECK(open_ch(&c2, bytes, size) == 0, "second instance");
+            sn_set_pose(c2.inst, xf, c.info.joints);
+            for (s = 0; s < 5 + cases; s++) sn_step(c2.inst);
+            T_CHECK(sn_state_hash(c2.inst) == h1, "refused poses left no trace (hash %016llx vs %016llx)",
+                    (unsigned long long)sn_state_hash(c2.inst), (unsigned long long)h1);
+            close_ch(&c2);
+        }
+        T_CHECK(h0 != h1, "the instance kept stepping");
+        close_ch(&c);
+    }
     free(bytes);
     return T_END();
 }

@@ -160,6 +160,9 @@ void sn_reset(sn_instance *inst);
 /// Set the pose for the next sn_step: one transform per joint (rest model space
 /// to world). The first pose after init/reset also becomes the previous pose,
 /// so it causes no velocity jump.
+/// SN_ERR_ARG, and nothing changes, if any joint's quaternion is shorter than
+/// 2^-10 in its largest component (no reliable direction) or, in float, any
+/// value is not finite or a translation is beyond +-32768 mesh units.
 /// Quaternion signs are tracked (q is negated when it is nearer -q_previous),
 /// so frames between two bones interpolate the way the joint really turned,
 /// past 180° too: feed poses continuously, a joint turning less than 180° per

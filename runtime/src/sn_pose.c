@@ -4,6 +4,27 @@
  * (runtime/NUMERICS.md "One step"). */
 #include "sn_instance.h"
 
+/* A usable joint transform: a quaternion whose largest component is at least
+ * 2^-10 (a shorter one has no reliable direction: normalizing it would turn a
+ * rounding error into a rotation) and, in float, every value finite and every
+ * translation within the fixed format's +-32768 mesh units. */
+static int xform_ok(const sn_xform *x) {
+    const sn_real r[4] = {x->rot.x, x->rot.y, x->rot.z, x->rot.w};
+    int k, big = 0;
+#if defined(SN_FLOAT)
+    const sn_real t[3] = {x->pos.x, x->pos.y, x->pos.z};
+    for (k = 0; k < 4; k++) {
+        if (!(r[k] - r[k] == 0.0f)) return 0; /* NaN or infinite */
+        big |= r[k] >= 1.0f / 1024.0f || r[k] <= -1.0f / 1024.0f;
+    }
+    for (k = 0; k < 3; k++)
+        if (!(t[k] <= 32768.0f && t[k] >= -32768.0f)) return 0; /* also NaN */
+#else
+    for (k = 0; k < 4; k++) big |= r[k] >= (1 << 20) || r[k] <= -(1 << 20); /* Q30 */
+#endif
+    return big;
+}
+
 sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
     sn_ihdr *h;
     uint32_t j;
@@ -12,6 +33,9 @@ sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     h = hdr_of(inst);
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (n_joints != h->v.nJ) return SN_ERR_ARG;
+    /* refuse the whole pose, changing nothing, if any joint is unusable */
+    for (j = 0; j < n_joints; j++)
+        if (!xform_ok(&joints[j])) return SN_ERR_ARG;
     pq = ARR(h, o_pq, sn_q);
     pt = ARR(h, o_pt, sn_q);
     for (j = 0; j < n_joints; j++) {
