@@ -402,6 +402,14 @@ static void test_quat_path(void) {
     }
 }
 
+/* |y'Jx - x'Jy| / sum |y_i (Jx)_i| for Jx = jx, Jy = jy: 0 for a symmetric J */
+static double asym_ratio(const double *x, const double *y, const double *jx, const double *jy, unsigned n) {
+    double a = 0, c = 0, aa = 0;
+    unsigned i;
+    for (i = 0; i < n; i++) { a += y[i] * jx[i]; c += x[i] * jy[i]; aa += fabs(y[i] * jx[i]); }
+    return fabs(a - c) / aa;
+}
+
 /* NUMERICS step 4: the per-cell force is -grad E_el, its Jacobian is K~ (symmetric
  * PSD), E_el is exactly quadratic in p; the format-1.0 force of eq. 7 is not
  * a gradient at a bent pose (its Jacobian is not symmetric). */
@@ -452,10 +460,8 @@ static void test_cell_energy(void) {
     /* symmetry: y'K~x = x'K~y; the eq. 7 (VERTEX) Jacobian R_i S_ij R_i^T is not symmetric at a bent pose */
     for (i = 0; i < n; i++) y[i] = urand(&st) - 0.5;
     {
-        double a = 0, c = 0, aa = 0;
         snref_kmul(&s, x, kx, 0); snref_kmul(&s, y, ky, 0);
-        for (i = 0; i < n; i++) { a += y[i] * kx[i]; c += x[i] * ky[i]; aa += fabs(y[i] * kx[i]); }
-        asym = fabs(a - c) / aa;
+        asym = asym_ratio(x, y, kx, ky, n);
         s.force = SNREF_FORCE_VERTEX;
         for (k = 0; k < 2; k++) {   /* Jacobian of eq. 7 by linearity: f(p + x) - f(p) */
             double *pp = malloc(3 * m.nV * sizeof *pp), *dir = k ? y : x, *out = k ? ky : kx;
@@ -465,9 +471,7 @@ static void test_cell_energy(void) {
             for (i = 0; i < n; i++) out[i] -= f0[i];
             free(pp);
         }
-        a = c = aa = 0;
-        for (i = 0; i < n; i++) { a += y[i] * kx[i]; c += x[i] * ky[i]; aa += fabs(y[i] * kx[i]); }
-        asymv = fabs(a - c) / aa;
+        asymv = asym_ratio(x, y, kx, ky, n);
         s.force = SNREF_FORCE_CELL;
     }
     T_NEAR(asym, 0, 1e-13, "K~ symmetric (round-off)");

@@ -90,14 +90,15 @@ void sn_set_energy(sn_ihdr *h, sn_acc e2) {
     if (h->energy > h->energy_max) h->energy_max = h->energy;
 }
 
-void sn_health(sn_ihdr *h, uint32_t sat_before, uint32_t *sat) {
+void sn_health(sn_ihdr *h, uint32_t step_clamps) {
     const sn_view *v = &h->v;
     const sn_q *pos = CARR(h, o_pos, sn_q);
     const unsigned char *ml = v->sec[SN_SEC_MLUMP];
 #if defined(SN_FLOAT)
     const sn_q mmin = 1.0f / 16.0f;
 #else
-    const sn_q mmin = (sn_q)(((int64_t)1 << v->frac_M) >> 4);
+    /* 1/16 in Q frac_M; any int32 is below it past Q35 (a hostile blob) */
+    const sn_q mmin = v->frac_M >= 35 ? INT32_MAX : (sn_q)(((int64_t)1 << v->frac_M) >> 4);
 #endif
     uint32_t i, k, local = 0;
     sn_len2 m2 = 0;
@@ -122,5 +123,5 @@ void sn_health(sn_ihdr *h, uint32_t sat_before, uint32_t *sat) {
 #endif
     h->disp = disp;
     if (disp > h->disp_max) h->disp_max = disp;
-    if (*sat != sat_before || disp > v->disp_bound) h->bound_steps = sn_count(h->bound_steps, 1);
+    if (step_clamps != 0 || disp > v->disp_bound) h->bound_steps = sn_count(h->bound_steps, 1);
 }

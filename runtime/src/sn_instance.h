@@ -121,7 +121,7 @@ void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vert
 void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
-void sn_health(sn_ihdr *h, uint32_t sat_before, uint32_t *sat); /* 9 (disp; energy from sn_solve) */
+void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 
 /* Twice the elastic + kinetic energy of the step's starting state in
  * internal units (fixed: Q32, summed with saturation at 2^62), set by

@@ -16,7 +16,7 @@ void sn_step(sn_instance *inst) {
     sn_skeleton(h, &sat);
     sn_solve(h, &sat);
     sn_limits(h, &sat);
-    sn_health(h, 0, &sat);
+    sn_health(h, sat);
     h->saturations = sn_count(h->saturations, sat);
     h->steps = sn_count(h->steps, 1);
 }
