@@ -1,13 +1,25 @@
 # Physics validation fragment (owner: physics validation). Included from tests/tests.mk.
-# The double-precision reference (tests/reference) shares no code with the runtime.
-REF_SRC  = tests/reference/snref.c tests/reference/snref_synth.c
-REF_HDR  = tests/reference/snref.h tests/reference/snref_synth.h runtime/src/sn_format.h tests/sn_test.h
+# The double-precision reference (tools/ref/snref.c: host-tool code since
+# sinew-bake --static solves with it; tests/reference: the test-only parts)
+# shares no code with the runtime.
+REF_SRC  = tools/ref/snref.c tests/reference/snref_synth.c
+REF_HDR  = tools/ref/snref.h tests/reference/snref_synth.h runtime/src/sn_format.h tests/sn_test.h
+REF_INC  = -Itools/ref
 
 $(BUILD)/tests/test_reference: tests/test_reference.c $(REF_SRC) $(REF_HDR)
 	@mkdir -p $(dir $@)
-	$(CC) $(HOST_CFLAGS) -Itests -o $@ tests/test_reference.c $(REF_SRC) -lm
+	$(CC) $(HOST_CFLAGS) -Itests $(REF_INC) -o $@ tests/test_reference.c $(REF_SRC) -lm
 
 TEST_BINS += $(BUILD)/tests/test_reference
+
+# Rig controls and forces in the reference (issue 10): no runtime; rigs
+# written by the tests' own writer (tests/rig_common.h) into a synthetic box
+# and the examples' limb.
+$(BUILD)/tests/test_rig_reference: tests/test_rig_reference.c tests/rig_common.h $(REF_SRC) $(REF_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itests $(REF_INC) -o $@ tests/test_rig_reference.c $(REF_SRC) -lm
+TEST_BINS += $(BUILD)/tests/test_rig_reference
+
 
 # make soak: the held-twist energy check of test_reference (limb twisted 170
 # degrees, damping off) over 600 s instead of make test's 60 s.
@@ -16,7 +28,7 @@ soak: $(BUILD)/tests/test_reference $(BUILD)/examples/limb_double.blob
 	SN_SOAK_SECONDS=$${SN_SOAK_SECONDS:-600} BUILD=$(BUILD) $(BUILD)/tests/test_reference --soak
 
 # Physics tests against the runtime: each built fixed and float (suffix _float).
-PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference
+PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference $(REF_INC)
 PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
 PHYS_TESTS  = cantilever runtime vibration rigid limb longrun
 
@@ -110,3 +122,39 @@ soak: soak-held
 soak-held: $(BUILD)/tests/test_physics_held $(BUILD)/tests/test_physics_held_float $(HELD_BLOBS)
 	BUILD=$(BUILD) $(BUILD)/tests/test_physics_held soak
 	BUILD=$(BUILD) $(BUILD)/tests/test_physics_held_float soak
+
+# Rigs in the runtime vs the reference (issue 10), fixed and float, on the
+# limb with the tests' rigs (and the limb without gravity, also as float64).
+RIG_RT_DEPS = tests/test_rig_runtime.c tests/rig_common.h $(REF_SRC) $(PHYS_HDRS)
+$(BUILD)/tests/test_rig_runtime: $(RIG_RT_DEPS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_rig_runtime_float: $(RIG_RT_DEPS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+$(PHYS_EX)/%_nograv_double.blob: $(PHYS_EX)/%_nograv/asset.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour double --quiet
+TEST_BINS += $(BUILD)/tests/test_rig_runtime $(BUILD)/tests/test_rig_runtime_float
+# tau white box: includes runtime/src/sn_rig.c (its static tau) and links the rest of the library
+$(BUILD)/tests/test_rig_tau: tests/test_rig_tau.c runtime/src/sn_rig.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_rig_tau_float: tests/test_rig_tau.c runtime/src/sn_rig.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_rig_tau $(BUILD)/tests/test_rig_tau_float
+TEST_DEPS += $(PHYS_EX)/limb_nograv_double.blob
+
+# The limb without its rigs (control and rig lines dropped): test_physics_limb
+# measures the elastic model itself; its pose-driven biceps would otherwise
+# switch on as the elbow bends (the rig is measured by test_rig_runtime).
+$(PHYS_EX)/limb_norig/limb.sinew: tools/examples/limb/limb.sinew tests/physics.mk
+	@mkdir -p $(@D)
+	sed -e 's|^mesh .*|mesh $(CURDIR)/tools/examples/limb/limb.obj|' -e '/^control /d' -e '/^rig /d' -e '/^tau /d' $< > $@
+$(PHYS_EX)/limb_norig.blob: $(PHYS_EX)/limb_norig/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(PHYS_EX)/limb_norig_float.blob: $(PHYS_EX)/limb_norig/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+$(PHYS_EX)/limb_norig_double.blob: $(PHYS_EX)/limb_norig/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour double --quiet
+TEST_DEPS += $(PHYS_EX)/limb_norig.blob $(PHYS_EX)/limb_norig_float.blob $(PHYS_EX)/limb_norig_double.blob

@@ -35,7 +35,7 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
     T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
             u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS)),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS)),
             "%s: instance bytes from SN_INSTANCE_BYTES", what);
     for (k = 0; k < SN_SEC_COUNT; k++) {
         uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);
@@ -53,6 +53,82 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
         }
         T_CHECK(bad == 0, "%s: %u bad column indices", what, (unsigned)bad);
     }
+}
+
+/* ---- the blob against an independent reading of the spec ----
+ * Everything below is transcribed from the prose (runtime/BLOB.md; the five
+ * format-3.0 rig sections from the layout comments of runtime/src/sn_format.h,
+ * which BLOB.md is to absorb) as literal numbers: it uses none of sn_format.h's
+ * macros, nor the tool's CRC, so a tool and a header that drift together from
+ * the spec are caught. The instance size is the README's formula ("instance
+ * memory ... = 512 + 76 joints + 84 vertices + 73 free + 12 skeleton + 36
+ * cells"), plus 4 bytes per control for format 3.0 (rig controls' values). */
+static uint32_t spec_crc32(const unsigned char *p, size_t n)
+{   /* BLOB.md "Checksum": reflected 0xEDB88320, init and final xor 0xFFFFFFFF, bitwise */
+    uint32_t c = 0xFFFFFFFFu;
+    size_t i;
+    int k;
+    for (i = 0; i < n; i++) { c ^= p[i]; for (k = 0; k < 8; k++) c = (c & 1u) ? (c >> 1) ^ 0xEDB88320u : c >> 1; }
+    return c ^ 0xFFFFFFFFu;
+}
+static void check_spec(const sb_blob *bl, int flavour, const char *what)
+{
+    const unsigned char *b = bl->bytes;
+    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 21u;
+    uint32_t total = u32(b + 16), nV = u32(b + 32), nF = u32(b + 36), nC = u32(b + 40), nJ = u32(b + 44), nS = u32(b + 48),
+             nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
+    /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
+    const uint32_t elem[21] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
+                               40 + 4 * R, 16, 2 * R, 2, 3 * R};
+    uint32_t want[21], inst;
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 3 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 3.0", what);
+    T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
+    T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
+    T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
+    T_CHECK(b[24] == flavour && b[25] == R && (b[27] & ~1u) == 0, "%s: spec: flavour %d, real size %u, flags", what, flavour, R);
+    T_CHECK(u32(b + 28) == (flavour == 0 ? 0x40000000u : flavour == 1 ? 0x3F800000u : 0u) &&
+            u32(b + 72) == (flavour == 2 ? 0x3FF00000u : 0u), "%s: spec: 1.0 in the flavour at 28 (and 72)", what);
+    T_CHECK(nV <= 65535 && nF >= 1 && nF < nV && nC >= 1 && nC <= 65535 && nJ >= 1 && nJ <= 255 && nS <= 65535,
+            "%s: spec: counts nV %u nF %u nC %u nJ %u nS %u", what, nV, nF, nC, nJ, nS);
+    T_CHECK(cgd >= 1 && cgd <= cgm && cgm <= 256, "%s: spec: 1 <= cg_default %u <= cg_max %u <= 256", what, cgd, cgm);
+    T_CHECK((signed char)b[68] >= -24 && (signed char)b[68] <= 24, "%s: spec: len_shift %d in -24..24", what, (signed char)b[68]);
+    if (flavour == 0)
+        T_CHECK(b[69] <= 59 && b[70] <= 59 && b[71] <= 50 && (signed char)b[76] >= -40 && (signed char)b[76] <= 60,
+                "%s: spec: frac_S %u <= 59, frac_M %u <= 59, frac_P %u <= 50, frac_E %d in -40..60", what, b[69], b[70], b[71], (signed char)b[76]);
+    else
+        T_CHECK(b[69] == 0 && b[70] == 0 && b[71] == 0 && b[76] == 0, "%s: spec: float flavours store fractions 0", what);
+    T_CHECK(b[77] == 0 && b[78] == 0 && b[79] == 0, "%s: spec: reserved1 zero", what);
+    {   /* physics scalars at 80 + i R: a1, b1 in [0, 16] (fixed Q24), h > 0 (Q16.16), reserved 10 and 11 zero */
+        double a1 = real_at(b, 80, 0, 24), b1 = real_at(b, 80, 1, 24), h = real_at(b, 80, 5, 16);
+        T_CHECK(a1 >= 0 && a1 <= 16 && b1 >= 0 && b1 <= 16 && h > 0 && real_at(b, 80, 10, 0) == 0 && real_at(b, 80, 11, 0) == 0,
+                "%s: spec: a1 %g, b1 %g in [0, 16], h %g > 0, reserved reals 0", what, a1, b1, h);
+    }
+    /* counts of the rig sections: CONTROLS nK, RIGS nR; samples and entries are the RIGS' running sums */
+    nK = u32(b + 176 + 16 * 16 + 8); nR = u32(b + 176 + 16 * 17 + 8);
+    for (k = 0; k < nR; k++) {
+        const unsigned char *r = b + u32(b + 176 + 16 * 17) + 16 * k;
+        T_CHECK(u32(r + 4) == nsamp && u32(r + 8) == nent, "%s: spec: rig %u's first sample/entry are the running sums", what, k);
+        nsamp += r[2]; nent += u32(r + 12);
+    }
+    {
+        const uint32_t w[21] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent};
+        memcpy(want, w, sizeof want);
+    }
+    want[13] = u32(b + 176 + 16 * 13 + 8) == 0 ? 0 : nF;   /* LIMIT: 0 or nF */
+    for (k = 0, prev = 176 + 16 * NSEC; k < NSEC; k++) {
+        const unsigned char *e = b + 176 + 16 * k;
+        uint32_t off = u32(e), size = u32(e + 4), cnt = u32(e + 8), es = u32(e + 12), i;
+        T_CHECK(es == elem[k] && cnt == want[k] && (uint64_t)size == (uint64_t)cnt * es && off % 8 == 0 && off >= prev &&
+                (uint64_t)off + size <= total, "%s: spec: section %u: offset %u size %u count %u (want %u) elem %u (want %u)",
+                what, k, off, size, cnt, want[k], es, elem[k]);
+        for (i = prev; i < off && i < total; i++) if (b[i]) break;
+        T_CHECK(i >= off || i >= total, "%s: spec: padding before section %u is zero", what, k);
+        prev = off + size;
+    }
+    for (k = prev; k < total; k++) if (b[k]) break;
+    T_CHECK(k == total, "%s: spec: trailing padding is zero", what);
+    inst = (512u + 76u * nJ + 84u * nV + 73u * nF + 12u * (nV - nF) + 36u * nC + 4u * nK + 7u) & ~7u;
+    T_CHECK(u32(b + 60) == inst, "%s: spec: instance bytes %u, README formula %u", what, u32(b + 60), inst);
 }
 
 /* Integer block-row sums of every cell's fixed stiffness (the 36 stored
@@ -114,6 +190,9 @@ int main(void)
         check_structure(&fx, SB_FIXED, what);
         check_structure(&fl, SB_FLOAT, what);
         check_structure(&db, SB_DOUBLE, what);
+        check_spec(&fx, SB_FIXED, what);
+        check_spec(&fl, SB_FLOAT, what);
+        check_spec(&db, SB_DOUBLE, what);
         {   /* fixed formats: the largest |entry| of each group lands in [2^26, 2^27] */
             static const int gS[1] = {SN_SEC_CELLK}, gM[3] = {SN_SEC_MDIAG, SN_SEC_MOFF, SN_SEC_MLUMP}, gP[1] = {SN_SEC_PRECOND};
             double ms = max_stored(fx.bytes, gS, 1), mm = max_stored(fx.bytes, gM, 3), mp = max_stored(fx.bytes, gP, 1);

@@ -131,6 +131,57 @@ int main(void) {
                 clip.error_line == SN_CLIP_MAX_CHANNELS + 3, "one channel too many: %s", err);
     }
 
+    /* control tracks: own channels (a control may share a joint's name),
+       interleaved with rotations, linear between keys, held outside them */
+    T_CHECK(parse(H "control breath 0.5 -1\nrot breath 0 0 1 0 10\ncontrol smile 0 0.25\n"
+                  "control breath 1.5 1 # inhale\ncontrol breath 2 0\nrot breath 1 0 1 0 20\n") == 0, "controls: %s", err);
+    T_CHECK(clip.n_channels == 3 && clip.n_keys == 6 && clip.chan[0].kind == SN_CLIP_CONTROL &&
+            clip.chan[1].kind == SN_CLIP_ROT && clip.chan[2].kind == SN_CLIP_CONTROL &&
+            strcmp(clip.chan[0].name, "breath") == 0 && strcmp(clip.chan[1].name, "breath") == 0 &&
+            clip.chan[0].count == 3 && clip.chan[1].count == 2 && clip.chan[2].count == 1 && clip.chan[0].joint == -1,
+            "control channels: %u channels, %u keys", clip.n_channels, clip.n_keys);
+    T_CHECK(clip.keys[clip.chan[0].first + 1].v[0] == 65536 && clip.keys[clip.chan[0].first + 1].t == 98304 &&
+            clip.keys[clip.chan[0].first + 1].v[1] == 0 && clip.keys[clip.chan[0].first + 1].v[3] == 0 &&
+            clip.keys[clip.chan[2].first].v[0] == 16384, "control keys");
+    T_CHECK(clip.n_warnings == 0, "control keys are never warned (%u)", clip.n_warnings);
+    {   /* interpolation, exactly: before/at/between/after keys, rounding half away from zero */
+        static const struct { int32_t t, want; } at[] = {
+            {-5, -65536}, {0, -65536}, {32768, -65536}, {32769, -65536 + 2}, {65536, 0}, {81920, 32768},
+            {98304, 65536}, {114688, 32768}, {131072, 0}, {0x7FFFFFFF, 0},
+        };
+        int k;
+        for (k = 0; k < (int)(sizeof at / sizeof at[0]); k++) {
+            int32_t v = sn_clip_control_at(&clip, 0, at[k].t);
+            T_CHECK(v == at[k].want, "control_at(breath, %d) = %d, want %d", at[k].t, v, at[k].want);
+        }
+        T_CHECK(sn_clip_control_at(&clip, 2, 0) == 16384 && sn_clip_control_at(&clip, 2, 131072) == 16384,
+                "one key: held everywhere");
+        T_CHECK(sn_clip_control_at(&clip, 1, 0) == 0 && sn_clip_control_at(&clip, 3, 0) == 0 &&
+                sn_clip_control_at(&clip, 9999, 0) == 0, "not a control channel: 0");
+        /* a random track against double: |error| <= 1 LSB (two roundings) */
+        for (k = 0, i = 0; i < 2000; i++) {
+            char text[256];
+            double v0 = (rand() % 200001 - 100000) / 100.0, v1 = (rand() % 200001 - 100000) / 100.0;
+            double t0 = (rand() % 1000) / 1000.0, t1 = t0 + (rand() % 1000 + 1) / 1000.0, d;
+            int32_t t = (int32_t)(t0 * 65536.0) + rand() % ((int32_t)((t1 - t0) * 65536.0) + 1), v;
+            sprintf(text, "sinew-clip 1\nduration 2\ncontrol c %.3f %.2f\ncontrol c %.3f %.2f\n", t0, v0, t1, v1);
+            if (parse(text)) { k++; continue; }
+            v = sn_clip_control_at(&clip, 0, t);
+            d = clip.keys[0].v[0] + (double)(clip.keys[1].v[0] - clip.keys[0].v[0]) *
+                (t <= clip.keys[0].t ? 0 : t >= clip.keys[1].t ? 1 : (double)(t - clip.keys[0].t) / (clip.keys[1].t - clip.keys[0].t));
+            if (fabs(v - d) > 1.0) k++;
+        }
+        T_CHECK(k == 0, "random control tracks: %d of 2000 off by more than 1 LSB from double", k);
+    }
+    /* more controls than channels: the shared channel limit */
+    {
+        static char big[8192];
+        size_t n = (size_t)sprintf(big, "sinew-clip 1\nduration 1\n");
+        for (i = 0; i <= SN_CLIP_MAX_CHANNELS; i++) n += (size_t)sprintf(big + n, "control c%d 0 1\n", i);
+        T_CHECK(sn_clip_parse(&clip, big, n, err, sizeof err) == 1 && strstr(err, "too many channels") &&
+                clip.error_line == SN_CLIP_MAX_CHANNELS + 3, "one control channel too many: %s", err);
+    }
+
     /* keys more than 180 degrees apart: warned, the clip still parses */
     warns(H "rot a 0 0 1 0 0\nrot a 1 0 1 0 270\n", 1, 4, 270, 90);
     warns(H "rot a 0 0 1 0 0\nrot a 1 0 1 0 180\n", 1, 4, 180, 180);      /* exactly 180: either way */
@@ -241,6 +292,20 @@ int main(void) {
     bad(H "rot a_joint_name_that_is_much_too_long 0 0 1 0 5\n", 3, "longer than 31 bytes");
     bad(H "rot a 0 0 1 0 5 # fine\nrot a 1 0 1 0 5 6 7 8 9 10\n", 4, "too many fields");
     bad(H "rot a 0 0 1 0 99999\n", 3, "number out of range");
+    /* control lines */
+    bad(H "control breath 0\n", 3, "usage: control <name> <time> <value>");
+    bad(H "control breath 0 1 2\n", 3, "usage: control");
+    bad(H "control\n", 3, "usage: control");
+    bad(H "control breath 0 deep\n", 3, "control value is not a number: 'deep'");
+    bad(H "control breath soon 1\n", 3, "key time is not a number: 'soon'");
+    bad(H "control breath 0 40000\n", 3, "number out of range");
+    bad(H "control breath -1 1\n", 3, "key time is negative");
+    bad(H "control breath 3 1\n", 3, "after the clip duration");
+    bad(H "control breath 1 1\nrot breath 0 0 1 0 5\ncontrol breath 1 0\n", 5, "strictly increase");
+    bad(H "control a_control_name_that_is_much_too_long 0 1\n", 3, "longer than 31 bytes");
+    bad("sinew-clip 1\ncontrol breath 0 1\nduration 1\n", 2, "'duration' must come before");
+    bad(H "controls breath 0 1\n", 3, "unknown keyword (expected duration, loop, rot, move, control)");
+    bad(H "control breath 0 1e3\n", 3, "control value is not a number: '1e3'");
     {
         static const char nul[] = "sinew-clip 1\nduration 1\nrot a\0 0 0 1 0 5\n";
         T_CHECK(sn_clip_parse(&clip, nul, sizeof nul - 1, err, sizeof err) == 1 && clip.error_line == 3 &&

@@ -4,7 +4,8 @@
  * blob, and the float64 blob), and the volume kept at the elbow by the warped
  * model versus global linear (unwarped) FEM, rigid skinning and the format-1.0
  * per-vertex warped force (reference only): per-cell frames must keep an
- * elastic joint, not turn into skinning. */
+ * elastic joint, not turn into skinning. The limb is baked without its biceps
+ * rig (tests/physics.mk, limb_norig): this measures the elastic model alone. */
 #include "sn_test.h"
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
@@ -91,8 +92,9 @@ int main(void) {
     unsigned nJ, nS, nV, k, mode;
     double *surf_ref, *surf_64, *skin, *surf_rt, *lat, *lat_rt, *rest_s, *rest_l, disp, V0, Vc0, Vcskin, elbow[3];
     printf("bent limb (%s runtime)\n", PU_FLAVOUR_NAME);
-    pu_example(path, sizeof path, "limb" PU_BLOB_SUFFIX);
-    pu_example(p64, sizeof p64, "limb_double");
+    /* the limb baked without its biceps rig (tests/physics.mk): the elastic model alone */
+    snprintf(path, sizeof path, "%s/physics/limb_norig%s.blob", pu_build(), PU_BLOB_SUFFIX);
+    snprintf(p64, sizeof p64, "%s/physics/limb_norig_double.blob", pu_build());
     if (pu_rt_open(&r, path) != 0 || pu_ref_open(&m, &s0, p64) != 0) { T_CHECK(0, "missing %s", path); return T_END(); }
     nJ = r.info.joints; nS = r.info.surface_vertices; nV = r.info.vertices;
     T_CHECK(nJ <= 16 && m.nT > 0, "limb has %u joints, %u triangles", nJ, m.nT);

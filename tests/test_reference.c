@@ -3,7 +3,7 @@
  * hanging bar whose FE nodal values are exact, rigid-motion invariance, energy
  * dissipation of backward Euler, agreement of its two static solvers. */
 #include "sn_test.h"
-#include "reference/snref.h"
+#include "snref.h"
 #include "reference/snref_synth.h"
 
 #include <string.h>

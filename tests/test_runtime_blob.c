@@ -106,7 +106,8 @@ static void test_header(void) {
     CASE(SN_ERR_ENDIAN, "byte-swapped endian mark", tb_u32(b + SN_H_ENDIAN, 0x04030201u));
     CASE(SN_ERR_ENDIAN, "wrong endian mark", tb_u32(b + SN_H_ENDIAN, 0x01020305u));
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
-    CASE(SN_ERR_VERSION, "major 3", tb_u16(b + SN_H_VER_MAJOR, 3));
+    CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
+    CASE(SN_ERR_VERSION, "major 4", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
     CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0200));
     CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
@@ -166,10 +167,13 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
     CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK) - 8));
     CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0)));
-    CASE(SN_OK, "instance_bytes larger", tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK)));
+    CASE(SN_ERR_HEADER, "instance_bytes larger than the formula (a blob cannot ask for memory)",
+         tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
+    CASE(SN_ERR_HEADER, "instance_bytes without the control values",
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0)));
 
     /* physics scalars */
 #define RL(i) (b + SN_H_REALS + 4 * (i))
@@ -353,6 +357,68 @@ static void test_contents(void) {
     CASE(SN_ERR_INDEX, "triangle index >= nS", tb_u16(SEC(SN_SEC_TRIS) + 2 * 5, TB_NS));
 }
 
+/* Rig sections (format 3.0): every rule of sn_check_rigs broken once. */
+#define CTL(i) (SEC(SN_SEC_CONTROLS) + SN_ELEM_CONTROLS(4) * (i))
+#define RIG(i) (SEC(SN_SEC_RIGS) + SN_ELEM_RIGS * (i))
+#define SMP(i) (SEC(SN_SEC_RIG_SAMPLES) + 8 * (i))
+static void test_rig_contents(void) {
+    CASE(SN_ERR_VALUE, "control name empty", CTL(0)[0] = 0);
+    CASE(SN_ERR_VALUE, "control name not NUL-terminated", memset(CTL(1), 'a', 32));
+    CASE(SN_ERR_VALUE, "control names equal", memcpy(CTL(1), "puff", 4));
+    CASE(SN_OK, "control named like a joint", memcpy(CTL(1), "tip\0", 4));
+    CASE(SN_ERR_VALUE, "control kind 2", CTL(0)[32] = 2);
+    CASE(SN_ERR_VALUE, "control reserved u16", CTL(1)[34] = 1);
+    CASE(SN_ERR_VALUE, "control reserved u32", CTL(0)[39] = 1);
+    CASE(SN_ERR_INDEX, "abstract control with a joint", CTL(0)[33] = 1);
+    CASE(SN_ERR_VALUE, "abstract control with an axis", tb_real(CTL(0) + 40, 1.0, SN_Q_ROT));
+    CASE(SN_ERR_VALUE, "abstract value0 beyond 16384", put_over(CTL(0) + 52, 1 << 30, 16));
+    CASE(SN_OK, "abstract value0 = -16384", put_at(CTL(0) + 52, -(1 << 30), 16));
+    CASE(SN_ERR_INDEX, "angle control joint >= nJ", CTL(1)[33] = TB_NJ);
+    CASE(SN_ERR_VALUE, "angle control with value0", tb_real(CTL(1) + 52, 1.0, 16));
+    CASE(SN_ERR_VALUE, "angle axis zero", tb_real(CTL(1) + 48, 0.0, SN_Q_ROT));
+    CASE(SN_ERR_VALUE, "angle axis 2% short", tb_real(CTL(1) + 48, 0.98, SN_Q_ROT));
+    CASE(SN_OK, "angle axis 0.1% short (within 2^-8 in |a|^2)", tb_real(CTL(1) + 48, 0.999, SN_Q_ROT));
+    CASE(SN_ERR_VALUE, "angle axis component beyond 1", put_over(CTL(1) + 48, 1 << 30, SN_Q_ROT));
+    CASE(SN_ERR_INDEX, "rig control >= nK", tb_u16(RIG(1), TB_NK));
+    CASE(SN_ERR_VALUE, "rig with 0 samples", RIG(2)[2] = 0);
+    CASE(SN_ERR_VALUE, "rig with 17 samples", RIG(2)[2] = 17);
+#if defined(SN_FLOAT)
+    CASE(SN_ERR_VALUE, "float rig frac != 0", RIG(0)[3] = 36);
+    CASE(SN_ERR_VALUE, "float rig force beyond SN_RIG_FLOAT_MAX",
+         tb_real(SEC(SN_SEC_RIG_FORCES) + 4, 2.0 * SN_RIG_FLOAT_MAX, 0));
+    CASE(SN_ERR_VALUE, "float rig force NaN", tb_u32(SEC(SN_SEC_RIG_FORCES), 0x7FC00000u));
+    CASE(SN_ERR_VALUE, "gamma inf", tb_u32(SMP(0), 0xFF800000u));
+    CASE(SN_ERR_VALUE, "eta NaN", tb_u32(SMP(1) + 4, 0x7FC00000u));
+#else
+    CASE(SN_ERR_VALUE, "rig frac 4", RIG(0)[3] = SN_RIG_FRAC_MIN - 1);
+    CASE(SN_ERR_VALUE, "rig frac 51", RIG(0)[3] = SN_RIG_FRAC_MAX + 1);
+    CASE(SN_ERR_VALUE, "rig frac -1", RIG(0)[3] = 0xFF);
+    CASE(SN_OK, "rig frac 5 with force INT32_MIN", RIG(0)[3] = SN_RIG_FRAC_MIN; tb_u32(SEC(SN_SEC_RIG_FORCES), 0x80000000u));
+    CASE(SN_OK, "rig frac 50", RIG(0)[3] = SN_RIG_FRAC_MAX);
+#endif
+    CASE(SN_ERR_INDEX, "first_sample not the running sum", tb_u32(RIG(1) + 4, 2));
+    CASE(SN_ERR_INDEX, "first_entry not the running sum", tb_u32(RIG(2) + 8, 5));
+    CASE(SN_ERR_INDEX, "entries past the section", tb_u32(RIG(2) + 12, 2));
+    CASE(SN_ERR_INDEX, "samples past the section", RIG(2)[2] = 2);
+    CASE(SN_ERR_INDEX, "entries short of the section", tb_u32(RIG(2) + 12, 0));
+    CASE(SN_ERR_VALUE, "gamma equal to the previous", tb_real(SMP(1), -1.0, 16));
+    CASE(SN_ERR_VALUE, "gamma decreasing", tb_real(SMP(4), -10.0, 16));
+    CASE(SN_OK, "gamma 1 LSB apart", put_at(SMP(1), -65535, 16));
+    CASE(SN_ERR_VALUE, "gamma beyond 16384", put_over(SMP(2), 1 << 30, 16));
+    CASE(SN_ERR_VALUE, "eta beyond 1", put_over(SMP(2) + 4, 1 << 30, SN_Q_ROT));
+    CASE(SN_OK, "eta = -1", put_at(SMP(2) + 4, -(1 << 30), SN_Q_ROT));
+    CASE(SN_ERR_INDEX, "rig vertex >= nF (a skeleton vertex)", tb_u16(SEC(SN_SEC_RIG_VERTS) + 2 * 5, TB_NF));
+    CASE(SN_ERR_INDEX, "rig vertices not increasing", tb_u16(SEC(SN_SEC_RIG_VERTS) + 2 * 1, 1));
+    CASE(SN_OK, "rig vertex repeated across rigs", tb_u16(SEC(SN_SEC_RIG_VERTS) + 2 * 6, 1));
+    CASE(SN_ERR_SECTION, "RIG_FORCES count != RIG_VERTS count",
+         tb_u32(TAB(SN_SEC_RIG_FORCES, 2), TB_NRE - 1); tb_u32(TAB(SN_SEC_RIG_FORCES, 1), 12 * (TB_NRE - 1)));
+    CASE(SN_ERR_SECTION, "CONTROLS count beyond SN_MAX_CONTROLS", tb_u32(TAB(SN_SEC_CONTROLS, 2), SN_MAX_CONTROLS + 1));
+    CASE(SN_ERR_SECTION, "RIGS elem_size", tb_u32(TAB(SN_SEC_RIGS, 3), 12));
+}
+#undef CTL
+#undef RIG
+#undef SMP
+
 static void test_accessors(int len_shift) {
     unsigned char *b = g_work.b;
     const sn_blob *blob = NULL;
@@ -368,7 +434,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)
@@ -415,6 +481,14 @@ static void test_accessors(int len_shift) {
         for (k = 0; k < SN_SEC_COUNT; k++)
             T_CHECK(v.sec[k] == b + tb_sec(b, k), "view section %d", k);
     }
+    T_CHECK(info.controls == TB_NK && info.rigs == TB_NR && info.rig_entries == TB_NRE, "info rig counts");
+    T_CHECK(sn_find_control(blob, "puff") == 0 && sn_find_control(blob, "bend") == 1 &&
+                sn_find_control(blob, "pu") == -1 && sn_find_control(blob, "tip") == -1 &&
+                sn_find_control(blob, NULL) == -1 && sn_find_control(NULL, "puff") == -1, "find_control");
+    T_CHECK(sn_control_name(blob, 1) && strcmp(sn_control_name(blob, 1), "bend") == 0 &&
+                sn_control_name(blob, 2) == NULL && sn_control_name(NULL, 0) == NULL, "control names");
+    T_CHECK(sn_control_kind_of(blob, 0) == SN_CONTROL_ABSTRACT && sn_control_kind_of(blob, 1) == SN_CONTROL_ANGLE &&
+                sn_control_kind_of(blob, 2) == -1, "control kinds");
     sn_blob_get_info(NULL, &info);
     T_CHECK(info.vertices == 0 && info.blob_bytes == 0, "info of NULL blob is zero");
 }
@@ -495,7 +569,9 @@ static void test_steps(void) {
         for (s = 0; s < 5; s++) sn_step(inst);
         sn_get_stats(inst, &st);
         T_CHECK(st.limit_clamps == TB_NF && st.limit_steps >= 4, "tiny limits: %u clamps in the last step, %u steps", st.limit_clamps, st.limit_steps);
-        T_CHECK(st.disp <= SN_FLOAT_OR(1e-6f / 0.5f * 1.001f, 1), "disp after the limit stage within L / CELL: %g", (double)st.disp);
+        /* float: p and s ~0.5 units carry ~1 ulp (6e-8) each, so |p - s| is good to
+         * ~1.2e-7 units = 2.4e-7 cells beyond L / CELL; fixed: 1 LSB of Q16.16 */
+        T_CHECK(st.disp <= SN_FLOAT_OR(1e-6f / 0.5f + 2.4e-7f, 1), "disp after the limit stage within L / CELL: %g", (double)st.disp);
     }
 }
 
@@ -506,6 +582,7 @@ int main(void) {
     T_FIGURE("%s test blob: %u bytes, header %d bytes", FLAV, g_total, SN_HEADER_BYTES);
     test_header();
     test_contents();
+    test_rig_contents();
     test_accessors(0);
     test_accessors(8);
     test_accessors(-3);

@@ -70,6 +70,34 @@ typedef struct sb_joint {
 } sb_joint;
 typedef struct sb_limitrule { sb_region r; double dist; } sb_limitrule;
 
+/* rig controls and rigs (seed 003 §3, §4.1-4.2; tools/DESCRIPTION.md "Rigs and controls") */
+enum { SB_CTL_ABSTRACT = 0, SB_CTL_ANGLE = 1, SB_CTL_TWIST = 2 };   /* TWIST bakes as an ANGLE about the bone axis */
+typedef struct sb_control {
+    char name[SB_NAME_MAX];
+    int kind;           /* SB_CTL_* */
+    int joint;          /* ANGLE/TWIST: joint index (description order in sb_desc, sorted order in sb_model); else -1 */
+    double axis[3];     /* ANGLE/TWIST: unit axis in rest model axes (TWIST: JOINT -> its only child) */
+    double value0;      /* ABSTRACT: value after init/reset (public units) */
+    int line;
+} sb_control;
+enum { SB_TPL_BUMP = 0, SB_TPL_RING = 1, SB_TPL_MUSCLE = 2, SB_TPL_UNIFORM = 3 };
+#define SB_TAU_MAX 16
+typedef struct sb_rigdef {
+    char name[SB_NAME_MAX];
+    int control;        /* index into the controls */
+    int tpl;            /* SB_TPL_* */
+    double s;           /* strength (dimensionless): force density s E_ref / L_ref (DESCRIPTION.md) */
+    /* template parameters, mesh units: bump: c[3] R [d[3]]; ring: c[3] axis[3] RADIUS WIDTH;
+     * muscle: a[3] b[3] R SHORTEN; uniform: d[3] */
+    double p[10];
+    int has_dir;        /* bump: a direction was given (else radial) */
+    sb_region r;        /* uniform: the region */
+    int ntau;           /* tau samples (gamma_k, eta_k), gamma strictly increasing; 0: default */
+    double tau_g[SB_TAU_MAX], tau_e[SB_TAU_MAX];
+    int tau_line;       /* line of the tau samples (0: default) */
+    int line;
+} sb_rigdef;
+
 typedef struct sb_desc {
     char path[1024];
     char mesh_path[1024];   /* resolved relative to the description's directory */
@@ -94,6 +122,8 @@ typedef struct sb_desc {
     double bone_radius;     /* 'bone_radius R': radius of every bone without a 'bone' line; < 0: automatic */
     sb_limitrule *lrules; int nlr;   /* 'limit REGION DIST' */
     int rest_modelled;      /* 'rest_shape modelled' (1) or 'sag' (0, default) */
+    sb_control *ctls; int nctl;      /* 'control' */
+    sb_rigdef *rigs; int nrig;       /* 'rig', 'tau' */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -156,6 +186,10 @@ typedef struct sb_model {
     int *seg_nv;            /* lattice vertices it moves (after nearest-bone ownership and pins) */
     int rest_modelled;      /* description 'rest_shape': 1 modelled, 0 sag */
     double mesh_volume;     /* m^3 (divergence theorem) */
+    /* rigs (sb_rig.c, sb_rig_build; zero until then; freed by sb_rig_free, which sb_model_free calls) */
+    int nctl, nrig;
+    struct sb_control *ctl; /* joints in sorted order, TWIST resolved to an axis */
+    struct sb_rig *rig;
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -185,13 +219,40 @@ typedef struct sb_check {
 } sb_check;
 int sb_model_check(const sb_model *o, const sb_mesh *m, sb_check *r);   /* 0 if every check passes */
 
+/* ---- rigs (sb_rig.c) ---- */
+/* A rig integrated at the rest shape: Q_i = int_Omega phi_i f dV over the interior
+ * (inside quadrature points only, as sb_integrate_frac weighs them, air 0), newtons,
+ * rest model axes, at eta = 1; only free vertices with |Q_i| >= 1e-9 max kept. */
+typedef struct sb_rig {
+    sb_rigdef def;          /* the description's rig (tau defaulted) */
+    double E_ref;           /* Pa: Young's modulus at the template centre */
+    double L_ref;           /* mesh units: the template's size in the magnitude unit */
+    double amp;             /* N/m^3 per unit of the template profile: s E_ref / (L_ref unit) */
+    double lo[3], hi[3];    /* support bounding box, mesh units */
+    int refine;             /* quadrature: each of the lattice rule's boxes split into refine^3 (edge <= feature/8) */
+    int n;                  /* entries */
+    int *vert;              /* n free vertex indices, strictly increasing */
+    double *Q;              /* n x 3, newtons */
+    double qmax;            /* largest |Q_i| over the entries, N */
+    double total[3];        /* sum of Q_i over every lattice vertex (skeleton included) = int f dV, N */
+} sb_rig;
+/* resolve controls, integrate every rig of d over o's interior (m: the mesh o was built from) */
+int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o);
+void sb_rig_free(sb_model *o);
+/* force density (N/m^3, rest model axes) of rig r at p (mesh units); 0 outside its support */
+void sb_rig_field(const sb_model *o, const sb_rig *r, const double p[3], double f[3]);
+/* tau_a(gamma): piecewise linear through the samples, clamped at the ends */
+double sb_rig_tau(const sb_rigdef *r, double gamma);
+const char *sb_rig_tpl_name(int tpl);
+
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };
 typedef struct sb_blob {
     unsigned char *bytes; size_t size;
-    uint32_t sec_off[16], sec_size[16];
+    uint32_t sec_off[32], sec_size[32];   /* >= SN_SEC_COUNT */
     int len_shift, frac_S, frac_M, frac_P;
     double m0;
+    int *rig_frac;          /* per rig (fixed flavour): fractional bits of its RIG_FORCES; else 0 */
 } sb_blob;
 int sb_blob_make(const sb_model *o, int flavour, sb_blob *b);
 void sb_blob_free(sb_blob *b);

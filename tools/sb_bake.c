@@ -1,11 +1,13 @@
 /* sb_bake.c -- the whole bake: description -> mesh -> model -> blob, with a summary. */
 #include "sb.h"
 #include "../runtime/src/sn_format.h"
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
-                                             "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS"};
+                                             "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
+                                             "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
@@ -24,7 +26,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
-    if (sb_build(&d, &m, o, quiet) || sb_blob_make(o, flavour, b)) {
+    if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
         sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
@@ -44,7 +46,23 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         printf("  units     len_shift %d, frac_S %d, frac_M %d, frac_P %d\n", b->len_shift, b->frac_S, b->frac_M, b->frac_P);
         printf("  blob      %lu bytes:", (unsigned long)b->size);
         for (k = 0; k < SN_SEC_COUNT; k++) printf("%s %s %u", k ? "," : "", sec_name[k], (unsigned)b->sec_size[k]);
-        printf("\n  time      %.2f s\n", sb_now() - t0);
+        printf("\n");
+        if (o->nctl || o->nrig) {
+            int nab = 0;
+            for (k = 0; k < o->nctl; k++) nab += o->ctl[k].kind == SB_CTL_ABSTRACT;
+            printf("  controls  %d (%d abstract, %d pose):", o->nctl, nab, o->nctl - nab);
+            for (k = 0; k < o->nctl; k++) printf(" %s", o->ctl[k].name);
+            printf("\n");
+        }
+        for (k = 0; k < o->nrig; k++) {
+            const sb_rig *r = &o->rig[k];
+            char fr[16];
+            if (flavour == SB_FIXED) snprintf(fr, sizeof fr, "%d", b->rig_frac[k]); else snprintf(fr, sizeof fr, "-");
+            printf("  rig       %-14s control %-12s %-7s s %-6g %4d entries, peak |Q_i| %.4g N (at eta 1), total |int f dV| %.4g N, frac %s\n",
+                   r->def.name, o->ctl[r->def.control].name, sb_rig_tpl_name(r->def.tpl), r->def.s, r->n, r->qmax,
+                   sqrt(r->total[0] * r->total[0] + r->total[1] * r->total[1] + r->total[2] * r->total[2]), fr);
+        }
+        printf("  time      %.2f s\n", sb_now() - t0);
     }
     sb_mesh_free(&m);
     sb_desc_free(&d);

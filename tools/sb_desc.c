@@ -52,6 +52,52 @@ static int find_mat(const sb_desc *d, const char *name)
     return -1;
 }
 
+static int find_ctl(const sb_desc *d, const char *name)
+{
+    int i;
+    for (i = 0; i < d->nctl; i++) if (!strcmp(d->ctls[i].name, name)) return i;
+    return -1;
+}
+static int find_rig(const sb_desc *d, const char *name)
+{
+    int i;
+    for (i = 0; i < d->nrig; i++) if (!strcmp(d->rigs[i].name, name)) return i;
+    return -1;
+}
+
+/* three numbers at tok[i..i+2] forming a non-zero vector, normalized if unit */
+static int vec3(ctx_t *c, int i, const char *what, int unit, double v[3])
+{
+    double n;
+    int k;
+    for (k = 0; k < 3; k++) if (num(c, i + k, &v[k])) return -1;
+    n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (unit) {
+        if (!(n > 1e-12)) return sb_fail("%s:%d: %s (%s %s %s) is the zero vector", c->path, c->line, what, c->tok[i], c->tok[i + 1], c->tok[i + 2]);
+        for (k = 0; k < 3; k++) v[k] /= n;
+    }
+    return 0;
+}
+
+/* tau samples: n pairs at tok[first..first+2n) */
+static int tau_samples(ctx_t *c, int first, sb_rigdef *r)
+{
+    int n = c->nt - first, k;
+    if (n <= 0) return sb_fail("%s:%d: 'tau' needs samples: GAMMA1 ETA1 [GAMMA2 ETA2 ...]", c->path, c->line);
+    if (n % 2) return sb_fail("%s:%d: tau samples come in pairs GAMMA ETA (got %d values)", c->path, c->line, n);
+    if (n / 2 > SB_TAU_MAX) return sb_fail("%s:%d: rig '%s': %d tau samples, at most %d", c->path, c->line, r->name, n / 2, SB_TAU_MAX);
+    for (k = 0; k < n / 2; k++) {
+        if (num(c, first + 2 * k, &r->tau_g[k]) || num(c, first + 2 * k + 1, &r->tau_e[k])) return -1;
+        if (fabs(r->tau_g[k]) >= 32767.0) return sb_fail("%s:%d: tau gamma %g out of range (|gamma| < 32767)", c->path, c->line, r->tau_g[k]);
+        if (fabs(r->tau_e[k]) > 1e6) return sb_fail("%s:%d: tau eta %g out of range (|eta| <= 1e6)", c->path, c->line, r->tau_e[k]);
+        if (k > 0 && !(r->tau_g[k] > r->tau_g[k - 1]))
+            return sb_fail("%s:%d: rig '%s': tau gammas must be strictly increasing (%g after %g)", c->path, c->line, r->name, r->tau_g[k], r->tau_g[k - 1]);
+    }
+    r->ntau = n / 2;
+    r->tau_line = c->line;
+    return 0;
+}
+
 /* region at tok[first]: all | box x0 y0 z0 x1 y1 z1 | sphere cx cy cz r | bone JOINT.
  * Returns the number of tokens used, -1 on error. */
 static int region(ctx_t *c, const sb_desc *d, int first, int tail, sb_region *r)
@@ -223,6 +269,96 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (r.dist < 0) return sb_fail("%s:%d: limit distance must be >= 0 (0 = no limit)", c->path, c->line);
         GROW(d->lrules, d->nlr);
         d->lrules[d->nlr++] = r;
+    } else if (!strcmp(kw, "control")) {
+        sb_control *k_;
+        if (c->nt < 2) return sb_fail("%s:%d: missing value: 'control NAME [DEFAULT]', 'control NAME angle JOINT AX AY AZ' or 'control NAME twist JOINT'", c->path, c->line);
+        if (strlen(c->tok[1]) >= SB_NAME_MAX) return sb_fail("%s:%d: control names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
+        if (find_ctl(d, c->tok[1]) >= 0) return sb_fail("%s:%d: control '%s' declared twice", c->path, c->line, c->tok[1]);
+        if (d->nctl >= 256) return sb_fail("%s:%d: more than 256 controls", c->path, c->line);
+        GROW(d->ctls, d->nctl);
+        k_ = &d->ctls[d->nctl];
+        strcpy(k_->name, c->tok[1]);
+        k_->line = c->line;
+        k_->joint = -1;
+        if (c->nt >= 3 && (!strcmp(c->tok[2], "angle") || !strcmp(c->tok[2], "twist"))) {
+            int tw = !strcmp(c->tok[2], "twist");
+            if (c->nt != (tw ? 4 : 7))
+                return sb_fail("%s:%d: %s: 'control NAME %s' takes %s", c->path, c->line, c->nt < (tw ? 4 : 7) ? "missing value" : "too many values",
+                               c->tok[2], tw ? "JOINT" : "JOINT AX AY AZ");
+            k_->joint = find_joint(d, c->tok[3]);
+            if (k_->joint < 0) return sb_fail("%s:%d: unknown joint '%s' (declare joints before using them)", c->path, c->line, c->tok[3]);
+            k_->kind = tw ? SB_CTL_TWIST : SB_CTL_ANGLE;
+            if (!tw && vec3(c, 4, "angle axis", 1, k_->axis)) return -1;
+        } else {
+            if (c->nt > 3) return sb_fail("%s:%d: too many values: 'control NAME [DEFAULT]' (or 'control NAME angle|twist ...'), extra '%s'", c->path, c->line, c->tok[3]);
+            k_->kind = SB_CTL_ABSTRACT;
+            if (c->nt == 3) {
+                if (num(c, 2, &k_->value0)) return sb_fail("%s:%d: '%s' is neither a default value nor 'angle'/'twist'", c->path, c->line, c->tok[2]);
+                if (fabs(k_->value0) >= 32767.0) return sb_fail("%s:%d: control default %g out of range (|value| < 32767)", c->path, c->line, k_->value0);
+            }
+        }
+        d->nctl++;
+    } else if (!strcmp(kw, "rig")) {
+        sb_rigdef r;
+        int nt_all = c->nt, tau_at = -1, np, want, opt;
+        const char *t;
+        memset(&r, 0, sizeof r);
+        for (k = 1; k < c->nt; k++) if (!strcmp(c->tok[k], "tau")) { tau_at = k; break; }
+        if (tau_at >= 0) c->nt = tau_at;   /* parse the rig part first */
+        if (c->nt < 5) { c->nt = nt_all; return sb_fail("%s:%d: missing value: 'rig NAME CONTROL TEMPLATE STRENGTH PARAMS... [tau G1 E1 ...]'", c->path, c->line); }
+        if (strlen(c->tok[1]) >= SB_NAME_MAX) { c->nt = nt_all; return sb_fail("%s:%d: rig names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1); }
+        if (find_rig(d, c->tok[1]) >= 0) { c->nt = nt_all; return sb_fail("%s:%d: rig '%s' declared twice", c->path, c->line, c->tok[1]); }
+        if (d->nrig >= 4096) { c->nt = nt_all; return sb_fail("%s:%d: more than 4096 rigs", c->path, c->line); }
+        strcpy(r.name, c->tok[1]);
+        r.line = c->line;
+        r.control = find_ctl(d, c->tok[2]);
+        if (r.control < 0) { c->nt = nt_all; return sb_fail("%s:%d: unknown control '%s' (declare controls before the rigs that use them)", c->path, c->line, c->tok[2]); }
+        t = c->tok[3];
+        if (!strcmp(t, "bump")) { r.tpl = SB_TPL_BUMP; want = 4; opt = 3; }
+        else if (!strcmp(t, "ring")) { r.tpl = SB_TPL_RING; want = 8; opt = 0; }
+        else if (!strcmp(t, "muscle")) { r.tpl = SB_TPL_MUSCLE; want = 7; opt = 1; }
+        else if (!strcmp(t, "uniform")) { r.tpl = SB_TPL_UNIFORM; want = 3; opt = -1; }
+        else { c->nt = nt_all; return sb_fail("%s:%d: unknown rig template '%s' (want bump, ring, muscle or uniform)", c->path, c->line, t); }
+        if (num(c, 4, &r.s)) { c->nt = nt_all; return -1; }
+        if (fabs(r.s) > 1e6) { c->nt = nt_all; return sb_fail("%s:%d: rig strength %g out of range (|s| <= 1e6)", c->path, c->line, r.s); }
+        np = c->nt - 5;
+        if (r.tpl == SB_TPL_UNIFORM) {
+            if (np < 4) { c->nt = nt_all; return sb_fail("%s:%d: missing value: 'rig NAME CONTROL uniform STRENGTH DX DY DZ REGION'", c->path, c->line); }
+            if (vec3(c, 5, "force direction", 1, r.p)) { c->nt = nt_all; return -1; }
+            if (region(c, d, 8, 0, &r.r) < 0) { c->nt = nt_all; return -1; }
+        } else {
+            static const char *usage[3] = {"CX CY CZ RADIUS [DX DY DZ]", "CX CY CZ AX AY AZ RADIUS WIDTH", "AX AY AZ BX BY BZ RADIUS [SHORTEN]"};
+            if (np != want && np != want + opt) {
+                c->nt = nt_all;
+                return sb_fail("%s:%d: %s: 'rig NAME CONTROL %s STRENGTH %s' (got %d parameter(s) after the strength)", c->path, c->line,
+                               np < want ? "missing value" : "wrong number of values", t, usage[r.tpl], np);
+            }
+            for (k = 0; k < np; k++) if (num(c, 5 + k, &r.p[k])) { c->nt = nt_all; return -1; }
+            if (r.tpl == SB_TPL_BUMP) {
+                if (!(r.p[3] > 0)) { c->nt = nt_all; return sb_fail("%s:%d: bump radius must be positive (got %g)", c->path, c->line, r.p[3]); }
+                if (np == 7) { r.has_dir = 1; if (vec3(c, 9, "bump direction", 1, r.p + 4)) { c->nt = nt_all; return -1; } }
+            } else if (r.tpl == SB_TPL_RING) {
+                if (vec3(c, 8, "ring axis", 1, r.p + 3)) { c->nt = nt_all; return -1; }
+                if (!(r.p[6] > 0) || !(r.p[7] > 0)) { c->nt = nt_all; return sb_fail("%s:%d: ring radius and width must be positive (got %g, %g)", c->path, c->line, r.p[6], r.p[7]); }
+            } else {
+                double L2 = 0;
+                for (k = 0; k < 3; k++) L2 += (r.p[3 + k] - r.p[k]) * (r.p[3 + k] - r.p[k]);
+                if (!(L2 > 1e-24)) { c->nt = nt_all; return sb_fail("%s:%d: muscle ends coincide (a zero-length segment)", c->path, c->line); }
+                if (!(r.p[6] > 0)) { c->nt = nt_all; return sb_fail("%s:%d: muscle radius must be positive (got %g)", c->path, c->line, r.p[6]); }
+                if (np == 7) r.p[7] = 0.5;
+                if (r.p[7] < 0) { c->nt = nt_all; return sb_fail("%s:%d: muscle SHORTEN must be >= 0 (got %g)", c->path, c->line, r.p[7]); }
+            }
+        }
+        c->nt = nt_all;
+        if (tau_at >= 0 && tau_samples(c, tau_at + 1, &r)) return -1;
+        GROW(d->rigs, d->nrig);
+        d->rigs[d->nrig++] = r;
+    } else if (!strcmp(kw, "tau")) {
+        int ri;
+        if (c->nt < 2) return sb_fail("%s:%d: missing value: 'tau RIG GAMMA1 ETA1 [GAMMA2 ETA2 ...]'", c->path, c->line);
+        ri = find_rig(d, c->tok[1]);
+        if (ri < 0) return sb_fail("%s:%d: unknown rig '%s' (declare the rig before its tau)", c->path, c->line, c->tok[1]);
+        if (tau_samples(c, 2, &d->rigs[ri])) return -1;
     } else if (!strcmp(kw, "rest_shape")) {
         if (nargs(c, 1)) return -1;
         if (!strcmp(c->tok[1], "modelled")) d->rest_modelled = 1;
@@ -288,6 +424,34 @@ int sb_desc_load(const char *path, sb_desc *d)
     for (i = 0; i < d->nj; i++)
         if (d->joints[i].bone_line && d->joints[i].parent < 0)
             return sb_fail("%s:%d: '%s' is the root: a bone is named by its child joint", path, d->joints[i].bone_line, d->joints[i].name);
+    for (i = 0; i < d->nctl; i++) {   /* twist axis: JOINT -> its only child */
+        sb_control *k_ = &d->ctls[i];
+        int nch = 0, ch = -1, k;
+        double n = 0;
+        if (k_->kind != SB_CTL_TWIST) continue;
+        for (j = 0; j < d->nj; j++) if (d->joints[j].parent == k_->joint) { nch++; ch = j; }
+        if (nch != 1)
+            return sb_fail("%s:%d: control '%s': twist needs joint '%s' to have exactly one child (it has %d); use 'control %s angle %s AX AY AZ'",
+                           path, k_->line, k_->name, d->joints[k_->joint].name, nch, k_->name, d->joints[k_->joint].name);
+        for (k = 0; k < 3; k++) { k_->axis[k] = d->joints[ch].pos[k] - d->joints[k_->joint].pos[k]; n += k_->axis[k] * k_->axis[k]; }
+        n = sqrt(n);
+        if (!(n > 1e-12)) return sb_fail("%s:%d: control '%s': joint '%s' and its child '%s' coincide: no twist axis", path, k_->line, k_->name, d->joints[k_->joint].name, d->joints[ch].name);
+        for (k = 0; k < 3; k++) k_->axis[k] /= n;
+    }
+    for (i = 0; i < d->nrig; i++) {   /* tau: angle controls need explicit samples; abstract default (0,0) (1,1) */
+        sb_rigdef *r = &d->rigs[i];
+        if (r->ntau) continue;
+        if (d->ctls[r->control].kind != SB_CTL_ABSTRACT)
+            return sb_fail("%s:%d: rig '%s' is driven by the pose control '%s' and needs tau samples (angles in degrees): "
+                           "'tau %s G1 E1 G2 E2 ...' or '... tau G1 E1 ...' at the end of the rig line", path, r->line, r->name, d->ctls[r->control].name, r->name);
+        r->ntau = 2; r->tau_g[0] = 0; r->tau_e[0] = 0; r->tau_g[1] = 1; r->tau_e[1] = 1;
+    }
+    for (i = 0; i < d->nrig; i++) {
+        double m = 0;
+        int k;
+        for (k = 0; k < d->rigs[i].ntau; k++) m = fmax(m, fabs(d->rigs[i].tau_e[k]));
+        if (!(m > 0)) return sb_fail("%s:%d: rig '%s': every tau eta is 0 (the rig would never act)", path, d->rigs[i].tau_line ? d->rigs[i].tau_line : d->rigs[i].line, d->rigs[i].name);
+    }
     for (i = 0; i < d->nj; i++) {   /* cycle check: walking up must reach the root within nj steps */
         int p = i, steps = 0;
         while (p >= 0 && steps <= d->nj) { p = d->joints[p].parent; steps++; }
@@ -299,5 +463,6 @@ int sb_desc_load(const char *path, sb_desc *d)
 void sb_desc_free(sb_desc *d)
 {
     free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins); free(d->lrules);
+    free(d->ctls); free(d->rigs);
     memset(d, 0, sizeof *d);
 }

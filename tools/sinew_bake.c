@@ -1,5 +1,6 @@
 /* sinew_bake.c -- command line of the host tool. */
 #include "sb.h"
+#include "sb_static.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,7 +23,17 @@ static void usage(FILE *f)
             "                    error <= 1e-5 of the bbox diagonal, rigid translations and rotations in the\n"
             "                    null space of S), print one 'check:' line (also with --quiet); on failure\n"
             "                    exit 1 and write nothing\n"
-            "  --help            this text\n");
+            "  --help            this text\n"
+            "Static equilibrium (seed 003 eq. 10; tools/DESCRIPTION.md \"Static equilibrium\"):\n"
+            "       sinew-bake DESCRIPTION --static POSE [--controls NAME=VALUE,...] [-o OUT.obj] [--png OUT.png]\n"
+            "                  [--view AZ,EL] [--quiet]\n"
+            "  --static POSE     rest | FILE.clip@SECONDS | JOINT:AX,AY,AZ,DEG[+JOINT:...] (local rotations);\n"
+            "                    solves the baked model's static shape in double precision with the rigs on\n"
+            "                    (and off, for comparison) and writes the surface as OBJ (-o, default\n"
+            "                    <description>_static.obj, the description's coordinates) and a picture\n"
+            "                    rigs off | rigs on (--png, default the OBJ name with .png); no blob is written\n"
+            "  --controls LIST   abstract control values, e.g. breath=0.5,smile=1 (pose controls follow the pose)\n"
+            "  --view AZ,EL      picture azimuth, elevation in degrees (default 30,15)\n");
 }
 
 /* per bone: radius and the lattice vertices it captures and moves */
@@ -69,6 +80,7 @@ int main(int argc, char **argv)
 {
     const char *desc = NULL, *out = NULL, *carray = NULL, *name = "sinew_blob";
     int flavour = SB_FIXED, quiet = 0, check = 0, i;
+    sb_static_opts st = { NULL, NULL, NULL, NULL, 30, 15, 0 };
     double t0;
     sb_model o;
     sb_blob b;
@@ -77,7 +89,15 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
         else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) quiet = 1;
         else if (!strcmp(a, "--check")) check = 1;
-        else if (!strcmp(a, "-o") || !strcmp(a, "--c-array") || !strcmp(a, "--name") || !strcmp(a, "--flavour")) {
+        else if (!strcmp(a, "--static") || !strcmp(a, "--controls") || !strcmp(a, "--png") || !strcmp(a, "--view")) {
+            if (i + 1 >= argc) { fprintf(stderr, "sinew-bake: %s needs a value\n", a); return 2; }
+            if (!strcmp(a, "--static")) st.pose = argv[++i];
+            else if (!strcmp(a, "--controls")) st.controls = argv[++i];
+            else if (!strcmp(a, "--png")) st.png = argv[++i];
+            else if (sscanf(argv[++i], "%lf,%lf", &st.az, &st.el) != 2) {
+                fprintf(stderr, "sinew-bake: --view: want AZ,EL in degrees, got '%s'\n", argv[i]); return 2;
+            }
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--c-array") || !strcmp(a, "--name") || !strcmp(a, "--flavour")) {
             if (i + 1 >= argc) { fprintf(stderr, "sinew-bake: %s needs a value\n", a); return 2; }
             if (!strcmp(a, "-o")) out = argv[++i];
             else if (!strcmp(a, "--c-array")) carray = argv[++i];
@@ -93,6 +113,12 @@ int main(int argc, char **argv)
         else if (!desc) desc = a;
         else { fprintf(stderr, "sinew-bake: more than one description given ('%s')\n", a); return 2; }
     }
+    if (st.pose || st.controls || st.png) {   /* --static: its own command (sb_static.c) */
+        if (!desc || !st.pose) { fprintf(stderr, "sinew-bake: %s\n", desc ? "--controls and --png need --static POSE" : "--static needs a DESCRIPTION"); return 2; }
+        if (carray || check) { fprintf(stderr, "sinew-bake: --static writes no blob: --c-array and --check do not apply\n"); return 2; }
+        st.obj = out; st.quiet = quiet;
+        return sb_static_run(desc, &st);
+    }
     if (!desc || (!out && !carray && !check)) { usage(stderr); return 2; }
     if (carray) {   /* check the symbol before any work or output */
         const char *c;
@@ -104,14 +130,15 @@ int main(int argc, char **argv)
     if (sb_bake_file(desc, flavour, quiet, &o, &b)) { fprintf(stderr, "sinew-bake: error: %s\n", sb_error()); return 1; }
     t0 = sb_now() - t0;
     if (!quiet) bone_summary(&o);
-    if (check && run_check(desc, &o, t0)) { sb_blob_free(&b); sb_model_free(&o); return 1; }
+    if (check && run_check(desc, &o, t0)) { sb_blob_free(&b); sb_rig_free(&o); sb_model_free(&o); return 1; }
     if ((out && sb_write_file(out, b.bytes, b.size)) || (carray && sb_write_c_array(carray, name, b.bytes, b.size))) {
         fprintf(stderr, "sinew-bake: error: %s\n", sb_error());
         if (out) remove(out);   /* all or nothing */
-        sb_blob_free(&b); sb_model_free(&o);
+        sb_blob_free(&b); sb_rig_free(&o); sb_model_free(&o);
         return 1;
     }
     sb_blob_free(&b);
+    sb_rig_free(&o);
     sb_model_free(&o);
     return 0;
 }

@@ -1,6 +1,6 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_blob.c tools/sb_bake.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_blob.c tools/sb_bake.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h runtime/src/sn_format.h
@@ -14,8 +14,30 @@ $(TOOLS_LIB): $(TOOLS_LIB_OBJ)
 	rm -f $@
 	ar rcs $@ $(TOOLS_LIB_OBJ)
 
-$(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB)
-	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) -lm
+# sinew-bake --static (tools/sb_static.c): the double-precision reference
+# model (tools/ref/snref.c), the clip parser (ports/common/sn_clip.c: no
+# runtime calls) and the desktop rasterizer and PNG writer.
+STATIC_SRC = tools/sb_static.c tools/ref/snref.c ports/common/sn_clip.c ports/desktop/raster.c ports/desktop/png.c
+STATIC_OBJ = $(BUILD)/tools/static/sb_static.o $(BUILD)/tools/static/snref.o $(BUILD)/tools/static/sn_clip.o \
+             $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
+STATIC_INC = -Itools -Itools/ref -Iruntime/include -Iruntime/src -Iports/common -Iports/desktop
+STATIC_HDR = tools/sb_static.h tools/ref/snref.h ports/common/sn_clip.h ports/desktop/raster.h ports/desktop/png.h $(TOOLS_HDR)
+$(BUILD)/tools/static/%.o: tools/%.c $(STATIC_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
+$(BUILD)/tools/static/%.o: tools/ref/%.c $(STATIC_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
+$(BUILD)/tools/static/%.o: ports/common/%.c $(STATIC_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
+$(BUILD)/tools/static/%.o: ports/desktop/%.c $(STATIC_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
+$(BUILD)/tools/sinew_bake.o: tools/sb_static.h
+
+$(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
+	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_bake.o $(STATIC_OBJ) $(TOOLS_LIB) -lm
 
 # ---- baked examples ----
 EX = $(BUILD)/examples

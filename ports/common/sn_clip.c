@@ -271,7 +271,44 @@ static int parse_line(pstate *ps, const char *s, size_t n) {
         if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
         return add_key(ps, ci, &key, t.p[k0], t.n[k0]);
     }
-    return fail(ps, "unknown keyword (expected duration, loop, rot, move):", t.p[0], t.n[0]);
+    if (tok_is(&t, 0, "control")) {
+        int ci;
+        sn_clip_key key;
+        memset(&key, 0, sizeof key);
+        if (!ps->have_duration) return fail(ps, "'duration' must come before the first key", 0, 0);
+        if (nt != 4) return fail(ps, "usage: control <name> <time> <value>", 0, 0);
+        if (t.n[1] > SN_CLIP_NAME_MAX) return fail(ps, "control name longer than 31 bytes:", t.p[1], t.n[1]);
+        if (num(ps, &t, 2, "key time is not a number:", &key.t)) return 1;
+        if (num(ps, &t, 3, "control value is not a number:", &key.v[0])) return 1;
+        ci = channel(c, SN_CLIP_CONTROL, t.p[1], t.n[1]);
+        if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
+        return add_key(ps, ci, &key, t.p[2], t.n[2]);
+    }
+    return fail(ps, "unknown keyword (expected duration, loop, rot, move, control):", t.p[0], t.n[0]);
+}
+
+int32_t sn_clip_control_at(const sn_clip *clip, uint32_t c, int32_t t) {
+    const sn_clip_channel *ch;
+    const sn_clip_key *k;
+    uint32_t i, n;
+    int64_t d, p;
+    int32_t u;
+    if (c >= clip->n_channels || c >= SN_CLIP_MAX_CHANNELS) return 0;
+    ch = &clip->chan[c];
+    n = ch->count;
+    if (ch->kind != SN_CLIP_CONTROL || !n || (uint32_t)ch->first + n > clip->n_keys ||
+        (uint32_t)ch->first + n > SN_CLIP_MAX_KEYS) return 0;
+    k = &clip->keys[ch->first];
+    if (t <= k[0].t) return k[0].v[0];
+    if (t >= k[n - 1].t) return k[n - 1].v[0];
+    for (i = 0; i + 2 < n && k[i + 1].t <= t; i++) {}
+    /* as the root translation (sn_clip_pose.c): weight of key i+1 in Q30, then
+       a + (b - a) u rounded half away from zero */
+    u = (int32_t)(((int64_t)(t - k[i].t) << 30) / ((int64_t)k[i + 1].t - k[i].t));
+    d = (int64_t)k[i + 1].v[0] - k[i].v[0];
+    p = d * u;
+    p = p >= 0 ? (p + (1 << 29)) / (1 << 30) : -((-p + (1 << 29)) / (1 << 30));
+    return (int32_t)(k[i].v[0] + p);
 }
 
 /* Q16.16 v >= 0 as a decimal with at most `dec` places, trailing zeros cut. */

@@ -1,4 +1,5 @@
-/* sn_clip.h -- keyframed skeleton clips for Sinew players (format: CLIP.md).
+/* sn_clip.h -- keyframed skeleton clips for Sinew players (format: CLIP.md):
+ * joint rotations, the root translation and rig control tracks.
  *
  * Portable C99 for desktop and bare metal: no allocation, no stdio, no libm,
  * no strtod; only <string.h>. Numbers are parsed by our own decimal reader
@@ -11,10 +12,12 @@
  *   if (sn_clip_bind(&clip, blob, err, sizeof err)) fail(err);
  *   per step k: sn_clip_pose(&clip, blob, k, local_scratch, xforms);
  *               sn_set_pose(inst, xforms, n_joints);
+ *               sn_clip_controls(&clip, blob, k, inst);   // control tracks
  *
  * sn_clip_parse needs nothing else; sn_clip_bind / sn_clip_pose call the
  * runtime (sn_find_joint, sn_quat_axis_angle, sn_quat_slerp,
- * sn_pose_from_local) and live in sn_clip_pose.c.
+ * sn_pose_from_local, sn_find_control, sn_set_control) and live in
+ * sn_clip_pose.c.
  */
 #ifndef SN_CLIP_H
 #define SN_CLIP_H
@@ -24,14 +27,15 @@
 #include "sinew.h"
 
 #ifndef SN_CLIP_MAX_CHANNELS
-/// Most channels in one clip (rotation channels + the root translation channel).
+/// Most channels in one clip (rotation channels + the root translation channel
+/// + control channels).
 #define SN_CLIP_MAX_CHANNELS 64
 #endif
 #ifndef SN_CLIP_MAX_KEYS
 /// Most keys in one clip, all channels together.
 #define SN_CLIP_MAX_KEYS 1024
 #endif
-/// Longest joint name (bytes, without the NUL), as in the blob.
+/// Longest joint or control name (bytes, without the NUL), as in the blob.
 #define SN_CLIP_NAME_MAX 31
 #ifndef SN_CLIP_MAX_WARNINGS
 /// Most warnings kept in a parsed clip (more are only counted).
@@ -40,19 +44,21 @@
 /// A good size for the error buffer (and for sn_clip_warning_str).
 #define SN_CLIP_ERR_LEN 256
 
-/// Channel kinds.
-enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1 };
+/// Channel kinds: a joint's rotation, the root translation, a rig control.
+enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1, SN_CLIP_CONTROL = 2 };
 
 /// One key. Q16.16 throughout: t seconds; v = axis x,y,z + angle degrees
-/// (rotation) or x,y,z mesh units (root translation, v[3] = 0).
+/// (rotation), x,y,z mesh units (root translation, v[3] = 0), or the
+/// control's value in v[0] (control, v[1..3] = 0).
 typedef struct sn_clip_key { int32_t t; int32_t v[4]; } sn_clip_key;
 
 /// One channel: keys[first .. first+count) with strictly increasing t.
 typedef struct sn_clip_channel {
-    char     name[SN_CLIP_NAME_MAX + 1]; ///< joint name ("" for the root translation)
-    int32_t  joint;                      ///< joint index after sn_clip_bind, else -1
+    char     name[SN_CLIP_NAME_MAX + 1]; ///< joint or control name ("" for the root translation)
+    int32_t  joint;                      ///< after sn_clip_bind: joint index (ROT, MOVE: 0) or
+                                         ///< control index (CONTROL; -1: not in the blob); else -1
     uint16_t first, count;
-    uint8_t  kind;                       ///< SN_CLIP_ROT or SN_CLIP_MOVE
+    uint8_t  kind;                       ///< SN_CLIP_ROT, SN_CLIP_MOVE or SN_CLIP_CONTROL
 } sn_clip_channel;
 
 /// Two consecutive keys of a rotation channel more than 180 degrees apart as
@@ -91,15 +97,26 @@ int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t
 /// NUL-terminated when len > 0; returns the text length (0 for a bad i).
 size_t sn_clip_warning_str(const sn_clip *clip, uint32_t i, char *buf, size_t len);
 
-/// Resolve joint names against a blob's skeleton. Returns 0, or 1 with a
-/// message naming the first joint the blob lacks.
+/// Resolve joint names against a blob's skeleton and control names against
+/// its controls. Refuses (1, message) a blob whose timestep clip time cannot
+/// step (sn_clip_timestep_q16 0). Returns 0, or 1 with a message naming the first joint the
+/// blob lacks or the first control channel that names a pose control (read
+/// from the pose by sn_step; a clip keys its joint instead). A control the
+/// blob lacks is not an error: its channel keeps joint = -1 and is ignored
+/// (sn_clip_unbound_controls counts them; players warn).
 int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen);
+
+/// Control channels of a bound clip whose control is not in the blob.
+uint32_t sn_clip_unbound_controls(const sn_clip *clip);
 
 /// Clip time of step k in Q16.16 seconds: k*h (h = the blob timestep rounded
 /// to Q16.16), wrapped (loop) or clamped to the duration. Integer only.
 int32_t sn_clip_time(const sn_clip *clip, int32_t h_q16, uint32_t step);
 
-/// Blob timestep as Q16.16 seconds (either flavour).
+/// Blob timestep as Q16.16 seconds (either flavour), rounded; 0 when clip
+/// time cannot step it (h < 2^-17 s rounds to 0, h >= 32768 s overflows
+/// Q16.16; the float validator accepts both). sn_clip_bind refuses such a
+/// blob, so after a successful bind it is >= 1 and safe to divide by.
 int32_t sn_clip_timestep_q16(const sn_blob *blob);
 
 /// Local joint rotations at clip time t (Q16.16 s): slerp between the two
@@ -113,6 +130,18 @@ void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
 /// local (scratch) and out have one entry per blob joint.
 void sn_clip_pose(const sn_clip *clip, const sn_blob *blob, uint32_t step,
                   sn_quat *local, sn_xform *out);
+
+/// Value of control channel c (kind SN_CLIP_CONTROL, with keys) at clip time
+/// t (Q16.16 s), Q16.16: linear between the two surrounding keys (weight in
+/// Q30, rounded half away from zero, as the root translation), the first /
+/// last key held outside them. 0 for a channel that is not a control channel
+/// or has no keys. Integer only; needs no runtime (in sn_clip.c).
+int32_t sn_clip_control_at(const sn_clip *clip, uint32_t c, int32_t t);
+
+/// Control tracks for step k: every bound control channel's value at
+/// sn_clip_time(k), set with sn_set_control (fixed: the Q16.16 value as is;
+/// float: value / 65536). Returns the number of controls set.
+uint32_t sn_clip_controls(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst);
 
 /// Own decimal reader (exported for tests): optional sign, digits, optional
 /// '.' and digits; no exponent. Rounds to nearest Q16.16 (half away from

@@ -26,8 +26,24 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
     if (errlen) err[0] = 0;
     sn_blob_get_info(blob, &info);
     clip->bound = 0;
+    if (sn_clip_timestep_q16(blob) <= 0) {
+        put(err, errlen, &len, "the blob's timestep is outside what clip time (Q16.16 seconds) can step: "
+                               "a clip needs 2^-17 s <= h < 32768 s");
+        return 1;
+    }
     for (c = 0; c < clip->n_channels; c++) {
         sn_clip_channel *ch = &clip->chan[c];
+        if (ch->kind == SN_CLIP_CONTROL) {   /* a control the blob lacks: ignored (joint -1) */
+            ch->joint = sn_find_control(blob, ch->name);
+            if (ch->joint >= 0 && sn_control_kind_of(blob, (uint32_t)ch->joint) != SN_CONTROL_ABSTRACT) {
+                put(err, errlen, &len, "clip control '");
+                put(err, errlen, &len, ch->name);
+                put(err, errlen, &len, "' is a pose control of the blob (read from the pose by sn_step): "
+                                       "key its joint instead");
+                return 1;
+            }
+            continue;
+        }
         ch->joint = ch->kind == SN_CLIP_MOVE ? 0 : sn_find_joint(blob, ch->name);
         if (ch->joint < 0) {
             put(err, errlen, &len, "clip joint '");
@@ -46,13 +62,21 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
     return 0;
 }
 
+/* The validator accepts any h > 0 (float: up to 32768 s), but clip time is
+ * Q16.16: h below 2^-17 s rounds to 0 (a player dividing by it died with
+ * SIGFPE) and h >= 32768 s overflows int32 (the float conversion was UB).
+ * Such a timestep gives 0 here, and sn_clip_bind refuses the blob. */
 int32_t sn_clip_timestep_q16(const sn_blob *blob) {
     sn_blob_info info;
     sn_blob_get_info(blob, &info);
 #ifdef SN_FLOAT
-    return (int32_t)(info.timestep * 65536.0f + 0.5f);
+    if (!(info.timestep >= 0.5f / 65536.0f && info.timestep < 32768.0f)) return 0; /* also NaN */
+    {
+        float q = info.timestep * 65536.0f + 0.5f;   /* in [1, 2^31]: 2^31 when h rounds up to 32768 */
+        return q >= 2147483648.0f ? 0 : (int32_t)q;
+    }
 #else
-    return info.timestep;
+    return info.timestep > 0 ? info.timestep : 0;
 #endif
 }
 
@@ -102,7 +126,7 @@ void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
         const sn_clip_channel *ch = &clip->chan[c];
         const sn_clip_key *a, *b;
         int32_t u;
-        if (!ch->count || ch->joint < 0 || (uint32_t)ch->joint >= info.joints) continue;
+        if (!ch->count || ch->kind == SN_CLIP_CONTROL || ch->joint < 0 || (uint32_t)ch->joint >= info.joints) continue;
         segment(clip, ch, t, &a, &b, &u);
         if (ch->kind == SN_CLIP_MOVE) {
             root->x = from_q16(lerp_q16(a->v[0], b->v[0], u));
@@ -122,4 +146,25 @@ void sn_clip_pose(const sn_clip *clip, const sn_blob *blob, uint32_t step,
     int32_t t = sn_clip_time(clip, sn_clip_timestep_q16(blob), step);
     sn_clip_sample(clip, blob, t, local, &root);
     sn_pose_from_local(blob, local, &root, out);
+}
+
+/* ---- control tracks ---- */
+uint32_t sn_clip_unbound_controls(const sn_clip *clip) {
+    uint32_t c, n = 0;
+    for (c = 0; c < clip->n_channels; c++)
+        if (clip->chan[c].kind == SN_CLIP_CONTROL && clip->chan[c].joint < 0) n++;
+    return n;
+}
+
+uint32_t sn_clip_controls(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst) {
+    sn_blob_info info;
+    uint32_t c, n = 0;
+    int32_t t = sn_clip_time(clip, sn_clip_timestep_q16(blob), step);
+    sn_blob_get_info(blob, &info);
+    for (c = 0; c < clip->n_channels; c++) {
+        const sn_clip_channel *ch = &clip->chan[c];
+        if (ch->kind != SN_CLIP_CONTROL || !ch->count || ch->joint < 0 || (uint32_t)ch->joint >= info.controls) continue;
+        if (sn_set_control(inst, (uint32_t)ch->joint, from_q16(sn_clip_control_at(clip, c, t))) == SN_OK) n++;
+    }
+    return n;
 }

@@ -65,6 +65,7 @@ void sn_det_pose(sn_det *d) {
     if (d->clip) sn_clip_pose(d->clip, d->blob, d->k + 1u, d->local, d->xf);
     else builtin_pose(d);
     (void)sn_set_pose(d->inst, d->xf, d->n_joints);
+    if (d->clip) (void)sn_clip_controls(d->clip, d->blob, d->k + 1u, d->inst); /* rig control tracks */
 }
 
 void sn_det_step(sn_det *d) {

@@ -73,6 +73,41 @@ run "beast violent sheet (480 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/violen
     --sheet "$OUT/beast_violent_sheet.png" --title "head 180 deg in 0.1 s, then 170, chest 170" $BEASTVIEW
 run "beast head_turn compare (180 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/head_turn.clip" --frames 180 \
     --compare "$OUT/beast_head_turn_compare.png" --view 50,10 --size 800x600
+
+# Rig forces (seed 003; rig controls in CLIP.md): rest | rigs off | rigs on,
+# the rigs-on flesh coloured by its distance from the rigs-off run (--heat).
+# Abstract controls are switched off by holding them at 0; rigs driven by a
+# pose control (the biceps follow the elbow) only by a blob baked without
+# them: the description with its 'rig' lines removed.
+norig() {   # example -> $BUILD/examples/norig/<example>.blob
+    src=tools/examples/$1/$1.sinew; dir=$BUILD/examples/norig; out=$dir/$1.blob
+    for f in "$src" "tools/examples/$1/$1.obj" "$BUILD/sinew-bake"; do
+        if [ ! -f "$out" ] || [ "$f" -nt "$out" ]; then
+            echo "== bake $1 without its rigs"
+            mkdir -p "$dir"
+            sed -e '/^[[:space:]]*rig[[:space:]]/d' -e "s|^mesh .*|mesh $PWD/tools/examples/$1/$1.obj|" "$src" > "$dir/$1.sinew"
+            "$BUILD/sinew-bake" "$dir/$1.sinew" -o "$out" --quiet
+            break
+        fi
+    done
+}
+norig limb
+norig beast
+LIMB=$BUILD/examples/limb.blob
+MUZZLE="--frame-box 8.2,0.4,-1.0,9.8,2.2,1.0"
+run "cow breathe in (120 steps)" "$PLAY" "$COW" --clip "$CLIPS/breathe.clip" --frames 120 \
+    --compare-rigs "$OUT/cow_breath_in_rigs.png" --heat 0.15 --view 20,20
+run "cow breathe out (240 steps)" "$PLAY" "$COW" --clip "$CLIPS/breathe.clip" --frames 240 \
+    --compare-rigs "$OUT/cow_breath_out_rigs.png" --heat 0.15 --view 20,20 \
+    --plot "$OUT/cow_breathe_plot.png" --size 800x600 --title "cow breathing: breath 0, +1, -1, 0 (breathe.clip)"
+run "cow smile (90 steps)" "$PLAY" "$COW" --clip "$CLIPS/smile.clip" --frames 90 \
+    --compare-rigs "$OUT/cow_smile_rigs.png" --heat 0.1 --view 40,15 $MUZZLE
+run "cow nostrils flared (210 steps)" "$PLAY" "$COW" --clip "$CLIPS/smile.clip" --frames 210 \
+    --compare-rigs "$OUT/cow_nostrils_rigs.png" --heat 0.05 --view 75,10 $MUZZLE
+run "limb biceps (150 steps)" "$PLAY" "$LIMB" --clip tools/examples/limb/flex.clip --frames 150 \
+    --compare-rigs "$OUT/limb_biceps_rigs.png" --rig-off-blob "$BUILD/examples/norig/limb.blob" --heat 0.1 --view 0,10
+run "beast flex and breathe (150 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/flex.clip" --frames 150 \
+    --compare-rigs "$OUT/beast_rigs.png" --rig-off-blob "$BUILD/examples/norig/beast.blob" --heat 3 --view 10,10 --size 600x450
 rm -f "$OUT/run.out"
 
 echo

@@ -10,7 +10,8 @@ DESK_HDRS = runtime/include/sinew.h runtime/src/sn_format.h ports/common/sn_clip
 PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c ports/desktop/plot.c \
             ports/common/sn_clip.c ports/common/sn_clip_pose.c
 DEMO_DIR  = $(BUILD)/demo
-COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip
+COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip tools/examples/cow/breathe.clip \
+            tools/examples/cow/smile.clip
 
 # Tests that need no runtime.
 $(BUILD)/tests/test_clip: tests/test_clip.c ports/common/sn_clip.c ports/common/sn_clip.h tests/sn_test.h
@@ -65,5 +66,6 @@ TEST_DEPS += $(BUILD)/sinew-play $(BUILD)/sinew-play-float
 endif
 
 # make demo: bake the cow, play both clips in both flavours, write pictures.
-demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob $(COW_CLIPS)
+demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
+      $(BUILD)/examples/limb.blob $(COW_CLIPS)
 	@BUILD=$(BUILD) sh ports/desktop/demo.sh

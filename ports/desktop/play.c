@@ -34,6 +34,10 @@ static void usage(FILE *f) {
         "usage: " PROG " BLOB [options]\n"
         "Plays a clip on a baked Sinew character and reports the step time.\n"
         "  --clip CLIP        keyframed skeleton clip (ports/common/CLIP.md); default: rest pose\n"
+        "  --control NAME=V   hold abstract rig control NAME at V for the whole run, over the clip's track\n"
+        "                     (repeatable; V a decimal as in clips, |V| < 32768)\n"
+        "  --rigs on|off      off: every abstract control held at 0, the clip's control tracks ignored\n"
+        "                     (pose-driven rigs stay on: bake the description without its rig lines for those)\n"
         "  --frames N         steps to run (default: one clip length, or 60 without a clip)\n"
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5\n"
@@ -42,6 +46,11 @@ static void usage(FILE *f) {
         "  --png FILE         picture of the last frame\n"
         "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid of 320x240 (or --size) cells\n"
         "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n"
+        "  --compare-rigs FILE  rest | rigs off | rigs on at the last frame; rigs off = a second instance with\n"
+        "                     every abstract control at 0, of --rig-off-blob if given; with --heat D the rigs-on\n"
+        "                     panel is coloured by its distance from the rigs-off one (red at D mesh units)\n"
+        "  --rig-off-blob B   the same character baked without its rigs (same lattice and surface), for\n"
+        "                     the rigs-off panel of --compare-rigs (pose-driven rigs cannot be switched off)\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
         "  --heat D           colour the flesh by its distance from rigid skinning (red at D mesh units)\n"
         "  --size WxH         size of --png (default 640x480), of the sheet's cells (320x240), of --plot (800x500)\n"
@@ -50,8 +59,9 @@ static void usage(FILE *f) {
         "                     default: the skinned surface over the whole run)\n"
         "  --title TEXT       caption on the pictures\n"
         "  --health N         every N steps a line: frame, displacement (cells), energy (J), saturations\n"
-        "  --stats-csv FILE   per step: frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps\n"
-        "  --plot FILE        line plot (PNG) of energy and displacement per step (see also sinew-plot)\n"
+        "  --stats-csv FILE   per step: frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps,\n"
+        "                     then ctl_NAME per rig control (abstract: value; pose: degrees, as measured)\n"
+        "  --plot FILE        line plot (PNG) of energy, displacement and the rig controls per step (see also sinew-plot)\n"
         "  --hash             end with 'hash: <16 hex>' (sn_state_hash of the final state)\n"
         "  --quiet            only errors, warnings, timing, health and hash\n"
         "  --help\n"
@@ -135,6 +145,7 @@ typedef struct {
     const unsigned char *frames, *cells, *embed;
     float *dev, *col;           /* per lattice vertex (3), per surface vertex (3) */
     const sn_xform *pose;       /* pose of the state being drawn */
+    const float *ref;           /* --compare-rigs --heat: colour by the distance from this surface */
 } scene;
 
 static int cmp_edge(const void *a, const void *b) {
@@ -313,6 +324,18 @@ static void heat_colours(scene *s) {
         s->col[3 * i + 2] = cow_colour[2] + m * (0.05f - cow_colour[2]);
     }
 }
+/* Per surface vertex: distance from s->ref (the rigs-off surface). */
+static void ref_colours(scene *s) {
+    uint32_t i;
+    for (i = 0; i < s->info.surface_vertices; i++) {
+        float dx = s->pos[3 * i] - s->ref[3 * i], dy = s->pos[3 * i + 1] - s->ref[3 * i + 1];
+        float dz = s->pos[3 * i + 2] - s->ref[3 * i + 2], m = sqrtf(dx * dx + dy * dy + dz * dz) / s->heat;
+        if (m > 1) m = 1;
+        s->col[3 * i] = cow_colour[0] + m * (0.95f - cow_colour[0]);
+        s->col[3 * i + 1] = cow_colour[1] + m * (0.12f - cow_colour[1]);
+        s->col[3 * i + 2] = cow_colour[2] + m * (0.05f - cow_colour[2]);
+    }
+}
 static const uint8_t ink[3] = {25, 28, 38};
 
 /* Render the instance into out (w x h) at 2x2 supersampling. */
@@ -322,7 +345,8 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     uint32_t e, v;
     if (rs_image_alloc(&big, 2 * out->w, 2 * out->h)) return -1;
     fetch(s, inst);
-    if (s->heat > 0) heat_colours(s);
+    if (s->heat > 0 && s->ref) ref_colours(s);
+    else if (s->heat > 0) heat_colours(s);
     rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
     cam.ground_y = s->lo[1];   /* the ground stays under the feet */
     rs_clear(&big, &cam);
@@ -342,8 +366,12 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     return 0;
 }
 
+#define MAX_HELD 64
 typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *obj_frames, *png, *sheet, *compare, *title, *stats_csv, *plot;
+    const char *compare_rigs, *rig_off_blob;
+    const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
+    int n_held, rigs_off;
     long frames, iterations, health;
     int unwarped, hash, lattice, quiet, w, h, have_size;
     float az, el, box[6], heat;
@@ -393,7 +421,7 @@ static int frame_list(const char *v, long n, unsigned char *sel, char *err, size
 static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
-                                         "--stats-csv", "--plot", NULL};
+                                         "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -418,6 +446,24 @@ static int parse_args(int argc, char **argv, options *o) {
         else if (!strcmp(a, "--png")) o->png = v;
         else if (!strcmp(a, "--sheet")) o->sheet = v;
         else if (!strcmp(a, "--compare")) o->compare = v;
+        else if (!strcmp(a, "--compare-rigs")) o->compare_rigs = v;
+        else if (!strcmp(a, "--rig-off-blob")) o->rig_off_blob = v;
+        else if (!strcmp(a, "--rigs")) {
+            if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --rigs: want on or off, got '%s'\n", v); return 2; }
+            o->rigs_off = !strcmp(v, "off");
+        } else if (!strcmp(a, "--control")) {
+            const char *eq = strchr(v, '=');
+            int32_t q;
+            if (!eq || eq == v || (size_t)(eq - v) > SN_CLIP_NAME_MAX) {
+                fprintf(stderr, PROG ": --control: want NAME=VALUE (name 1..%d bytes), got '%s'\n", SN_CLIP_NAME_MAX, v); return 2;
+            }
+            if (sn_clip_parse_q16(eq + 1, strlen(eq + 1), &q)) {
+                fprintf(stderr, PROG ": --control %s: the value must be a decimal with |x| < 32768 (as in clips), got '%s'\n", v, eq + 1);
+                return 2;
+            }
+            if (o->n_held >= MAX_HELD) { fprintf(stderr, PROG ": --control: at most %d\n", MAX_HELD); return 2; }
+            o->held[o->n_held++] = v;
+        }
         else if (!strcmp(a, "--title")) o->title = v;
         else if (!strcmp(a, "--frames") || !strcmp(a, "--iterations") || !strcmp(a, "--health")) {
             long n = strtol(v, &end, 10);
@@ -459,6 +505,10 @@ static int parse_args(int argc, char **argv, options *o) {
         fprintf(stderr, PROG ": --size: the plot needs at least 240x180\n"); return 2;
     }
     if (o->obj_frames && !o->obj_dir) { fprintf(stderr, PROG ": --obj-frames needs --obj-dir\n"); return 2; }
+    if (o->rigs_off && o->n_held) { fprintf(stderr, PROG ": --rigs off holds every control at 0: it cannot go with --control\n"); return 2; }
+    if (o->rig_off_blob && !o->compare_rigs) { fprintf(stderr, PROG ": --rig-off-blob needs --compare-rigs\n"); return 2; }
+    if (o->compare && o->compare_rigs) { fprintf(stderr, PROG ": --compare and --compare-rigs: one at a time\n"); return 2; }
+    if (o->compare_rigs && o->rigs_off) { fprintf(stderr, PROG ": --compare-rigs shows rigs off next to rigs on: not with --rigs off\n"); return 2; }
     if (o->sheet && o->have_size && (o->w > 2048 || o->h > 2048)) {
         fprintf(stderr, PROG ": --size: sheet cells are at most 2048x2048 (the sheet is 4x3 cells)\n"); return 2;
     }
@@ -489,16 +539,23 @@ static int write_obj(scene *s, const char *path, char *err, size_t errlen) {
 typedef struct { double disp, energy; uint32_t saturations, bound_steps, limit_clamps; } frame_stat;
 
 /* --stats-csv: one row per step, atomically. */
-static int write_stats_csv(const char *path, const frame_stat *f, long n, double h, char *err, size_t errlen) {
-    size_t cap = (size_t)n * 120 + 128, len = 0;
+static int write_stats_csv(const char *path, const frame_stat *f, long n, double h, const sn_blob *blob,
+                           uint32_t nc, const double *ctl, char *err, size_t errlen) {
+    size_t cap = (size_t)n * (120 + 20 * (size_t)nc) + 128 + 40 * (size_t)nc, len = 0;
     char *buf = malloc(cap);
     long k;
+    uint32_t c;
     int r;
     if (!buf) { snprintf(err, errlen, "%s: out of memory", path); return -1; }
-    len += (size_t)snprintf(buf, cap, "frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps\n");
-    for (k = 0; k < n; k++)
-        len += (size_t)snprintf(buf + len, cap - len, "%ld,%.6f,%.9g,%.9g,%u,%u,%u\n", k + 1, (double)(k + 1) * h,
+    len += (size_t)snprintf(buf, cap, "frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps");
+    for (c = 0; c < nc; c++) len += (size_t)snprintf(buf + len, cap - len, ",ctl_%s", sn_control_name(blob, c));
+    len += (size_t)snprintf(buf + len, cap - len, "\n");
+    for (k = 0; k < n; k++) {
+        len += (size_t)snprintf(buf + len, cap - len, "%ld,%.6f,%.9g,%.9g,%u,%u,%u", k + 1, (double)(k + 1) * h,
                                 f[k].disp, f[k].energy, f[k].saturations, f[k].bound_steps, f[k].limit_clamps);
+        for (c = 0; c < nc; c++) len += (size_t)snprintf(buf + len, cap - len, ",%.9g", ctl[(size_t)k * nc + c]);
+        len += (size_t)snprintf(buf + len, cap - len, "\n");
+    }
     r = write_file_atomic(path, buf, len, err, errlen);
     free(buf);
     return r;
@@ -506,24 +563,78 @@ static int write_stats_csv(const char *path, const frame_stat *f, long n, double
 
 /* --plot: energy above displacement, per step. */
 static int write_plot(const char *path, const frame_stat *f, long n, double h, int w, int hh, const char *title,
-                      char *err, size_t errlen) {
-    double *x = malloc(((size_t)n + 1) * 3 * sizeof(double)), *e = x ? x + n + 1 : NULL, *d = x ? x + 2 * (n + 1) : NULL;
-    plot_series se, sd;
-    plot_panel p[2];
+                      const sn_blob *blob, uint32_t nc, const double *ctl, char *err, size_t errlen) {
+    double *x = malloc(((size_t)n + 1) * (3 + (size_t)nc) * sizeof(double)), *e = x ? x + n + 1 : NULL, *d = x ? x + 2 * (n + 1) : NULL;
+    plot_series se, sd, *sc = nc ? malloc(nc * sizeof *sc) : NULL;
+    plot_panel p[4];
     rs_image im;
     long k;
-    int r = -1;
+    uint32_t c, na = 0, np = 0;
+    int r = -1, npan = 2;
     memset(&im, 0, sizeof im);
-    if (!x || rs_image_alloc(&im, w, hh)) { snprintf(err, errlen, "%s: out of memory", path); free(x); return -1; }
+    if (!x || (nc && !sc) || rs_image_alloc(&im, w, hh)) { snprintf(err, errlen, "%s: out of memory", path); free(x); free(sc); return -1; }
     for (k = 0; k < n; k++) { x[k] = (double)(k + 1) * h; e[k] = f[k].energy; d[k] = f[k].disp; }
     se.x = sd.x = x; se.n = sd.n = (int)n; se.y = e; sd.y = d; se.label = sd.label = NULL;
     p[0].title = "energy (J)"; p[0].s = &se; p[0].ns = 1; p[0].log_y = 0;
     p[1].title = "largest displacement (cells)"; p[1].s = &sd; p[1].ns = 1; p[1].log_y = 0;
-    if (plot_draw(&im, title, "time (s)", p, 2)) snprintf(err, errlen, "%s: picture too small for the plot or out of memory", path);
+    /* rig controls: abstract ones (unitless) in one panel, pose ones (degrees) in another */
+    for (c = 0; c < nc; c++) na += sn_control_kind_of(blob, c) == SN_CONTROL_ABSTRACT;
+    np = nc - na;
+    for (c = 0; c < nc; c++) {
+        int abstract = sn_control_kind_of(blob, c) == SN_CONTROL_ABSTRACT;
+        uint32_t at = abstract ? 0 : na;
+        double *y = x + (size_t)(3 + c) * (size_t)(n + 1);
+        uint32_t m;
+        for (m = 0; m < c; m++) if ((sn_control_kind_of(blob, m) == SN_CONTROL_ABSTRACT) == abstract) at++;
+        for (k = 0; k < n; k++) y[k] = ctl[(size_t)k * nc + c];
+        sc[at].x = x; sc[at].y = y; sc[at].n = (int)n; sc[at].label = sn_control_name(blob, c);
+    }
+    if (na) { p[npan].title = "abstract rig controls"; p[npan].s = sc; p[npan].ns = (int)na; p[npan].log_y = 0; npan++; }
+    if (np) { p[npan].title = "pose rig controls (degrees)"; p[npan].s = sc + na; p[npan].ns = (int)np; p[npan].log_y = 0; npan++; }
+    if (plot_draw(&im, title, "time (s)", p, npan)) snprintf(err, errlen, "%s: picture too small for the plot or out of memory", path);
     else r = png_write(path, im.rgb, im.w, im.h, err, errlen);
     rs_image_free(&im);
     free(x);
+    free(sc);
     return r;
+}
+
+/* --control NAME=VALUE resolved against the blob. */
+typedef struct { uint32_t c; int32_t q16; } held_control;
+
+/* "a b c" list of the blob's controls for messages. */
+static void control_list(const sn_blob *blob, uint32_t nc, char *buf, size_t len) {
+    uint32_t c;
+    size_t n = 0;
+    buf[0] = 0;
+    if (!nc) { snprintf(buf, len, "it has none"); return; }
+    n += (size_t)snprintf(buf, len, "controls:");
+    for (c = 0; c < nc && n < len; c++)
+        n += (size_t)snprintf(buf + n, len - n, " %s%s", sn_control_name(blob, c),
+                              sn_control_kind_of(blob, c) == SN_CONTROL_ABSTRACT ? "" : " (pose)");
+}
+
+static sn_real real_of_q16(int32_t v) {
+#ifdef SN_FLOAT
+    return (sn_real)v / 65536.0f;
+#else
+    return v;
+#endif
+}
+
+/* Every abstract control of inst to 0. */
+static void controls_zero(sn_instance *in, const sn_blob *blob, uint32_t nc) {
+    uint32_t c;
+    for (c = 0; c < nc; c++)
+        if (sn_control_kind_of(blob, c) == SN_CONTROL_ABSTRACT) sn_set_control(in, c, 0);
+}
+
+/* Controls for step k: the clip's tracks, then the held values over them. */
+static void controls_step(sn_instance *in, const sn_blob *blob, const sn_clip *clip, uint32_t k,
+                          const held_control *held, int n_held) {
+    int i;
+    if (clip) sn_clip_controls(clip, blob, k, in);
+    for (i = 0; i < n_held; i++) sn_set_control(in, held[i].c, real_of_q16(held[i].q16));
 }
 
 int main(int argc, char **argv) {
@@ -546,6 +657,13 @@ int main(int argc, char **argv) {
     unsigned char *obj_sel = NULL;   /* --obj-frames: frames to write, 0..n_frames */
     frame_stat *fst = NULL;          /* per step, for --stats-csv and --plot */
     int pictures = 0;
+    held_control held[MAX_HELD];     /* --control, resolved */
+    uint32_t n_ctl = 0, n_ctl2 = 0;  /* rig controls of the blob, of the rigs-off instance's blob */
+    double *fctl = NULL;             /* per step and control, for --stats-csv and --plot */
+    void *bytes2 = NULL;             /* --rig-off-blob */
+    const sn_blob *blob2 = NULL;
+    float *refpos = NULL;            /* --compare-rigs --heat: the rigs-off surface */
+    int hc;
     int r = parse_args(argc, argv, &o);
     if (r) return r;
     srand((unsigned)getpid());   /* distinct temp-file names for concurrent players */
@@ -584,6 +702,49 @@ int main(int argc, char **argv) {
         }
         have_clip = 1;
     }
+
+    /* rig controls: --control values, the clip's control tracks, --rigs off */
+    n_ctl = s.info.controls;
+    for (hc = 0; hc < o.n_held; hc++) {
+        const char *eq = strchr(o.held[hc], '=');
+        char name[SN_CLIP_NAME_MAX + 1], cl[1024];
+        int32_t c;
+        memcpy(name, o.held[hc], (size_t)(eq - o.held[hc]));
+        name[eq - o.held[hc]] = 0;
+        sn_clip_parse_q16(eq + 1, strlen(eq + 1), &held[hc].q16);   /* checked by parse_args */
+        c = sn_find_control(s.blob, name);
+        if (c < 0) {
+            control_list(s.blob, n_ctl, cl, sizeof cl);
+            fprintf(stderr, PROG ": --control %s: %s has no control '%s' (%s)\n", o.held[hc], o.blob_path, name, cl);
+            goto done;
+        }
+        if (sn_control_kind_of(s.blob, (uint32_t)c) != SN_CONTROL_ABSTRACT) {
+            fprintf(stderr, PROG ": --control %s: '%s' is a pose control of %s (degrees, read from the pose by sn_step): "
+                    "it cannot be held; pose its joint instead\n", o.held[hc], name, o.blob_path);
+            goto done;
+        }
+        held[hc].c = (uint32_t)c;
+    }
+    if (have_clip)
+        for (i = 0; i < clip.n_channels; i++)
+            if (clip.chan[i].kind == SN_CLIP_CONTROL && clip.chan[i].joint < 0) {
+                char cl[1024];
+                control_list(s.blob, n_ctl, cl, sizeof cl);
+                fprintf(stderr, PROG ": warning: %s: control '%s' is not in %s (%s): its keys are ignored\n",
+                        o.clip_path, clip.chan[i].name, o.blob_path, cl);
+            }
+    if ((o.rigs_off || (o.compare_rigs && !o.rig_off_blob)) && s.info.rigs) {
+        char cl[512];
+        size_t n = 0;
+        cl[0] = 0;
+        for (i = 0; i < n_ctl && n < sizeof cl; i++)
+            if (sn_control_kind_of(s.blob, i) != SN_CONTROL_ABSTRACT)
+                n += (size_t)snprintf(cl + n, sizeof cl - n, "%s%s", n ? ", " : "", sn_control_name(s.blob, i));
+        if (n)
+            fprintf(stderr, PROG ": note: %s: rigs driven by the pose controls (%s) stay on with every abstract control "
+                    "at 0%s\n", o.blob_path, cl, o.compare_rigs ? "; for a rig-free panel give --rig-off-blob (the description "
+                    "baked without its rig lines)" : "; for a rig-free run bake the description without its rig lines");
+    }
     n_frames = o.frames >= 0 ? o.frames
              : have_clip ? (long)((((int64_t)clip.duration + sn_clip_timestep_q16(s.blob) - 1) / sn_clip_timestep_q16(s.blob)))
              : 60;
@@ -603,6 +764,7 @@ int main(int argc, char **argv) {
     if (o.plot && probe_writable(o.plot, err, sizeof err)) { die("%s", err); goto done; }
     if (o.sheet && probe_writable(o.sheet, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare && probe_writable(o.compare, err, sizeof err)) { die("%s", err); goto done; }
+    if (o.compare_rigs && probe_writable(o.compare_rigs, err, sizeof err)) { die("%s", err); goto done; }
     if (o.obj_dir) {
         snprintf(path, sizeof path, "%s/frame_0000.obj", o.obj_dir);
         if (probe_writable(path, err, sizeof err)) { die("%s", err); goto done; }
@@ -622,6 +784,37 @@ int main(int argc, char **argv) {
         if (!mem2 || sn_instance_init(mem2, need, s.blob, &inst2) != SN_OK) { die("cannot create the comparison instance"); goto done; }
         if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
         sn_set_mode(inst2, o.unwarped ? SN_MODE_WARPED : SN_MODE_UNWARPED);
+        if (o.rigs_off) controls_zero(inst2, s.blob, n_ctl);
+    }
+    if (o.rigs_off) controls_zero(inst, s.blob, n_ctl);
+    if (o.compare_rigs) {   /* the rigs-off instance, stepped in lockstep: abstract controls 0 */
+        const sn_blob *b2 = s.blob;
+        size_t need2 = need;
+        n_ctl2 = n_ctl;
+        if (o.rig_off_blob) {
+            size_t n2 = 0;
+            sn_blob_info i2;
+            if (!(bytes2 = read_file(o.rig_off_blob, &n2, err, sizeof err))) { die("%s", err); goto done; }
+            if ((st = sn_blob_validate(bytes2, n2, &blob2)) != SN_OK) {
+                fprintf(stderr, PROG ": %s: invalid blob: %s\n", o.rig_off_blob, sn_status_str(st)); goto done;
+            }
+            sn_blob_get_info(blob2, &i2);
+            if (i2.joints != s.info.joints || i2.vertices != s.info.vertices || i2.free_vertices != s.info.free_vertices ||
+                i2.surface_vertices != s.info.surface_vertices || i2.triangles != s.info.triangles ||
+                i2.timestep != s.info.timestep) {
+                fprintf(stderr, PROG ": --rig-off-blob %s is not %s without its rigs: the skeleton, lattice, surface or "
+                        "timestep differ\n", o.rig_off_blob, o.blob_path);
+                goto done;
+            }
+            b2 = blob2;
+            need2 = sn_instance_size(blob2);
+            n_ctl2 = i2.controls;
+        }
+        mem2 = malloc(need2);
+        if (!mem2 || sn_instance_init(mem2, need2, b2, &inst2) != SN_OK) { die("cannot create the rigs-off instance"); goto done; }
+        if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
+        if (o.unwarped) sn_set_mode(inst2, SN_MODE_UNWARPED);
+        controls_zero(inst2, b2, n_ctl2);
     }
 
     /* scratch */
@@ -638,8 +831,9 @@ int main(int argc, char **argv) {
     cpu = malloc(((size_t)n_frames + 1) * sizeof(double));
     if (!local || !xf || !rest_xf || !s.surf || !s.latt || !s.pos || !s.lpos || !s.tri || !times || !cpu) { die("out of memory"); goto done; }
     if ((o.stats_csv || o.plot) && !(fst = malloc(((size_t)n_frames + 1) * sizeof *fst))) { die("out of memory"); goto done; }
+    if ((o.stats_csv || o.plot) && n_ctl && !(fctl = malloc(((size_t)n_frames + 1) * n_ctl * sizeof *fctl))) { die("out of memory"); goto done; }
     for (t = 0; t < s.info.triangles; t++) sn_get_triangle(s.blob, t, s.tri + 3 * t);
-    pictures = o.png || o.sheet || o.compare;
+    pictures = o.png || o.sheet || o.compare || o.compare_rigs;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
@@ -726,6 +920,7 @@ int main(int argc, char **argv) {
         else memcpy(xf, rest_xf, s.info.joints * sizeof *xf);
         s.pose = xf;
         sn_set_pose(inst, xf, s.info.joints);
+        if (!o.rigs_off) controls_step(inst, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held);
         c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
         t0 = now_us(CLOCK_MONOTONIC);
         sn_step(inst);
@@ -733,7 +928,11 @@ int main(int argc, char **argv) {
         c1 = now_us(CLOCK_THREAD_CPUTIME_ID);
         times[k - 1] = t1 - t0;
         cpu[k - 1] = c1 - c0;
-        if (inst2) { sn_set_pose(inst2, xf, s.info.joints); sn_step(inst2); }
+        if (inst2) {
+            if (o.compare && !o.rigs_off) controls_step(inst2, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held);
+            sn_set_pose(inst2, xf, s.info.joints);
+            sn_step(inst2);
+        }
         if (fst || (o.health && k % o.health == 0)) {
             sn_stats hs;
             sn_get_stats(inst, &hs);
@@ -742,6 +941,12 @@ int main(int argc, char **argv) {
                 fst[k - 1].saturations = hs.saturations; fst[k - 1].bound_steps = hs.bound_steps;
                 fst[k - 1].limit_clamps = hs.limit_clamps;
             }
+            if (fctl)
+                for (i = 0; i < n_ctl; i++) {
+                    sn_real v = 0;
+                    sn_get_control(inst, i, &v);
+                    fctl[(size_t)(k - 1) * n_ctl + i] = D(v);
+                }
             if (o.health && k % o.health == 0)
                 printf("health frame %ld: t %.3f s, disp %.4g cells, energy %.4g J, saturations %u\n",
                        k, (double)k * h_s, F(hs.disp), F(hs.energy), hs.saturations);
@@ -785,13 +990,14 @@ int main(int argc, char **argv) {
             fprintf(stderr, PROG ": warning: a baked bound was exceeded in %u of %ld steps\n", stats.bound_steps, n_frames);
     } else printf("step: no steps run\n");
     if (o.stats_csv) {
-        if (write_stats_csv(o.stats_csv, fst, n_frames, h_s, err, sizeof err)) { die("%s", err); goto done; }
+        if (write_stats_csv(o.stats_csv, fst, n_frames, h_s, s.blob, n_ctl, fctl, err, sizeof err)) { die("%s", err); goto done; }
         if (!o.quiet) printf("wrote %s\n", o.stats_csv);
     }
     if (o.plot) {
         char ttl[160];
         snprintf(ttl, sizeof ttl, "%s", o.title ? o.title : o.clip_path ? o.clip_path : o.blob_path);
-        if (write_plot(o.plot, fst, n_frames, h_s, o.have_size ? o.w : 800, o.have_size ? o.h : 500, ttl, err, sizeof err)) {
+        if (write_plot(o.plot, fst, n_frames, h_s, o.have_size ? o.w : 800, o.have_size ? o.h : 500, ttl,
+                       s.blob, n_ctl, fctl, err, sizeof err)) {
             die("%s", err); goto done;
         }
         if (!o.quiet) printf("wrote %s\n", o.plot);
@@ -840,6 +1046,53 @@ int main(int argc, char **argv) {
         if (png_write(o.compare, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
         if (!o.quiet) printf("wrote %s\n", o.compare);
     }
+    if (o.compare_rigs) {
+        rs_image pane;
+        void *mem0 = malloc(need);
+        sn_instance *rest = NULL;
+        const uint8_t line[3] = {255, 255, 255};
+        char lab[64], lab_on[160];
+        float heat = s.heat;
+        size_t n = 0;
+        int pw = o.w * 3 / 4 > 240 ? o.w * 3 / 4 : 240, ph = pw * 3 / 4;
+        memset(&pane, 0, sizeof pane);
+        if (!mem0 || sn_instance_init(mem0, need, s.blob, &rest) != SN_OK ||
+            rs_image_alloc(&cmp, 3 * pw, ph) || rs_image_alloc(&pane, pw, ph) ||
+            (heat > 0 && !(refpos = malloc(((size_t)s.info.surface_vertices + 1) * 3 * sizeof(float))))) {
+            free(mem0); rs_image_free(&pane); die("out of memory"); goto done;
+        }
+        snprintf(lab, sizeof lab, "t = %.2f s", (double)n_frames * h_s);
+        lab_on[0] = 0;   /* the controls that are not 0 */
+        for (i = 0; i < n_ctl && n < sizeof lab_on; i++) {
+            sn_real v = 0;
+            sn_get_control(inst, i, &v);
+            if (D(v) != 0)
+                n += (size_t)snprintf(lab_on + n, sizeof lab_on - n, "%s%s %.3g", n ? ", " : "", sn_control_name(s.blob, i), D(v));
+        }
+        if (!n) snprintf(lab_on, sizeof lab_on, "controls 0");
+        s.heat = 0;
+        s.pose = rest_xf;
+        render(&s, rest, &pane, "rest", NULL);
+        rs_blit(&cmp, 0, 0, &pane);
+        s.pose = xf;
+        render(&s, inst2, &pane, o.rig_off_blob ? "rigs off (baked without)" : "rigs off (controls 0)", lab);
+        rs_blit(&cmp, pw, 0, &pane);
+        if (heat > 0) {   /* colour the rigs-on flesh by how far the rigs moved it */
+            memcpy(refpos, s.pos, (size_t)s.info.surface_vertices * 3 * sizeof(float));
+            s.ref = refpos;
+            s.heat = heat;
+        }
+        render(&s, inst, &pane, "rigs on", lab_on);
+        rs_blit(&cmp, 2 * pw, 0, &pane);
+        s.ref = NULL;
+        s.heat = heat;
+        rs_fill(&cmp, pw - 1, 0, 2, ph, line);
+        rs_fill(&cmp, 2 * pw - 1, 0, 2, ph, line);
+        rs_image_free(&pane);
+        free(mem0);
+        if (png_write(o.compare_rigs, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
+        if (!o.quiet) printf("wrote %s\n", o.compare_rigs);
+    }
     if (o.hash) printf("hash: %016llx\n", (unsigned long long)sn_state_hash(inst));
     rc = 0;
 done:
@@ -847,5 +1100,6 @@ done:
     free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
+    free(fctl); free(bytes2); free(refpos);
     return rc;
 }

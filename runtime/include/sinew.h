@@ -40,7 +40,7 @@ extern "C" {
 #endif
 
 /// Version of this header and of the blob format it reads (major.minor).
-#define SN_VERSION_MAJOR 1
+#define SN_VERSION_MAJOR 3
 #define SN_VERSION_MINOR 0
 
 #if defined(SN_FLOAT)
@@ -123,6 +123,9 @@ typedef struct sn_blob_info {
     uint32_t cg_iters_max;      ///< largest accepted override
     uint32_t instance_bytes;    ///< == sn_instance_size()
     uint32_t blob_bytes;        ///< total blob size
+    uint32_t controls;          ///< control parameters (sn_find_control), abstract and pose-driven
+    uint32_t rigs;              ///< rig force fields driven by the controls
+    uint32_t rig_entries;       ///< (rig, free vertex) force entries: the rigs' per-step cost
     sn_real  timestep;          ///< h in seconds (fixed: Q16.16)
 } sn_blob_info;
 
@@ -229,6 +232,35 @@ void sn_get_stats(const sn_instance *inst, sn_stats *out);
 /// (free positions, velocities, warm start, skeleton state, step count), the
 /// same on every platform. Used by the determinism tests.
 uint64_t sn_state_hash(const sn_instance *inst);
+
+/* ---- rig controls (seed 003 §3-4: Theta = (alpha, beta), rig forces eq. 11-12) ----
+ * A rig is a force field on the flesh, baked by the host tool, whose strength
+ * follows one control through a piecewise-linear map (clamped at its first
+ * and last sample). Abstract controls (beta: "breath", "smile") are set by
+ * the game; pose controls (alpha) are read from the pose inside sn_step: the
+ * angle of a joint's rotation relative to its parent about a baked axis (the
+ * twist part of a swing-twist decomposition, in (-180, 180] degrees), so a
+ * biceps can bulge as the elbow bends with nothing to drive. Rig forces turn
+ * with the skeleton (each vertex's frame) and cost the same every step. */
+
+/// Kinds of control parameter.
+typedef enum sn_control_kind {
+    SN_CONTROL_ABSTRACT = 0, ///< set by the game with sn_set_control (fixed: Q16.16, unitless / float)
+    SN_CONTROL_ANGLE = 1     ///< read from the pose by sn_step: degrees (fixed: Q16.16 / float)
+} sn_control_kind;
+/// Index of the control called name, or -1.
+int32_t sn_find_control(const sn_blob *blob, const char *name);
+/// Name of control c (NUL-terminated, at most 31 chars), or NULL if c is out of range.
+const char *sn_control_name(const sn_blob *blob, uint32_t c);
+/// Kind of control c (sn_control_kind), or -1 if c is out of range.
+int32_t sn_control_kind_of(const sn_blob *blob, uint32_t c);
+/// Set abstract control c for the following steps (kept until set again or
+/// sn_reset restores the baked value). SN_ERR_ARG, and nothing changes, if c
+/// is out of range, is a pose control, or (float) value is not finite.
+sn_status sn_set_control(sn_instance *inst, uint32_t c, sn_real value);
+/// Current value of control c: an abstract control as set, a pose control as
+/// the last step measured it (0 before the first step). SN_ERR_ARG if c is out of range.
+sn_status sn_get_control(const sn_instance *inst, uint32_t c, sn_real *value);
 
 /* ---- small math helpers (integer-only in the fixed flavour, deterministic) ---- */
 

@@ -83,10 +83,106 @@ static int sn_zero_bytes(const unsigned char *p, uint32_t n) {
     return 1;
 }
 
+#define SN_CHK(cond, err) do { if (!(cond)) return (err); } while (0)
+
+/* n names of 32 bytes, stride bytes apart: non-empty, NUL-terminated,
+ * NUL-padded, unique (padded: equal names <=> equal 32 bytes; no memcmp: libc) */
+static int sn_names_ok(const unsigned char *s, uint32_t n, uint32_t stride) {
+    uint32_t i, j, k;
+    for (j = 0; j < n; j++) {
+        const unsigned char *a = s + (size_t)j * stride;
+        for (k = 0; k < 32 && a[k]; k++) {}
+        if (k == 0 || k == 32 || !sn_zero_bytes(a + k, 32 - k)) return 0;
+        for (i = 0; i < j; i++) {
+            const unsigned char *o = s + (size_t)i * stride;
+            uint32_t diff = 0;
+            for (k = 0; k < 32; k++) diff |= (uint32_t)(a[k] ^ o[k]);
+            if (diff == 0) return 0;
+        }
+    }
+    return 1;
+}
+
+/* Rig sections (format 3.0). Bounds and the arithmetic they feed (sn_rig.c):
+ * control values and gammas |g| <= 2^30 (Q16.16: 16384; float the same), so
+ * gamma differences fit 2^31 and the tau fraction floor(d 2^30 / D), d <= D,
+ * is exact in uint64; etas |eta| <= 2^30 (Q30: 1), so eta * Q < 2^61 for any
+ * int32 Q and the rounding shift 30 + frac - 19 - k (frac in [5, 50], k in
+ * [0, 15]) is in [1, 61]; angle axes unit within 2^-8 (Q30), so v.a of a unit
+ * quaternion stays below 2^30.1 for the twist's atan2 (any magnitude <=
+ * 2^40 is accepted there); float forces |Q| <= SN_RIG_FLOAT_MAX, finite. */
+static sn_status sn_check_rigs(const sn_view *v) {
+    const unsigned char *s = v->sec[SN_SEC_CONTROLS];
+    const int32_t G = (int32_t)1 << 30;
+    uint32_t i, k, ns = 0, ne = 0;
+    SN_CHK(sn_names_ok(s, v->nK, SN_ELEM_CONTROLS(SN_REAL_BYTES)), SN_ERR_VALUE);
+    for (i = 0; i < v->nK; i++) {
+        const unsigned char *c = s + (size_t)i * SN_ELEM_CONTROLS(SN_REAL_BYTES);
+        const unsigned char *ax = c + 40, *val = c + 40 + 3 * SN_REAL_BYTES;
+        uint32_t kind = c[32], joint = c[33];
+        SN_CHK(kind <= SN_CTL_ANGLE && sn_rd_u16(c + 34) == 0 && sn_rd_u32(c + 36) == 0, SN_ERR_VALUE);
+        if (kind == SN_CTL_ABSTRACT) {
+            SN_CHK(joint == 0, SN_ERR_INDEX);
+            SN_CHK(sn_real_zero(ax) && sn_real_zero(ax + SN_REAL_BYTES) && sn_real_zero(ax + 2 * SN_REAL_BYTES),
+                   SN_ERR_VALUE);
+            SN_CHK(sn_real_ok(val, -G, G, 16), SN_ERR_VALUE);
+        } else {
+            SN_CHK(joint < v->nJ, SN_ERR_INDEX);
+            SN_CHK(sn_reals_ok(ax, 3, G, SN_Q_ROT) && sn_real_zero(val), SN_ERR_VALUE);
+            {
+#if defined(SN_FLOAT)
+                float a0 = sn_rd_f32(ax), a1 = sn_rd_f32(ax + 4), a2 = sn_rd_f32(ax + 8);
+                float n2 = a0 * a0 + a1 * a1 + a2 * a2;
+                SN_CHK(n2 >= 1.0f - 1.0f / 256 && n2 <= 1.0f + 1.0f / 256, SN_ERR_VALUE);
+#else
+                int64_t a0 = sn_rd_i32(ax), a1 = sn_rd_i32(ax + 4), a2 = sn_rd_i32(ax + 8);
+                int64_t n2 = a0 * a0 + a1 * a1 + a2 * a2; /* each <= 2^60 */
+                const int64_t one = (int64_t)1 << 60, tol = (int64_t)1 << 52;
+                SN_CHK(n2 >= one - tol && n2 <= one + tol, SN_ERR_VALUE);
+#endif
+            }
+        }
+    }
+    /* rigs: samples and entries are consecutive runs in rig order */
+    s = v->sec[SN_SEC_RIGS];
+    for (i = 0; i < v->nR; i++) {
+        const unsigned char *r = s + (size_t)i * SN_ELEM_RIGS;
+        uint32_t n = r[2], cnt = sn_rd_u32(r + 12);
+        int frac = r[3] < 128 ? (int)r[3] : (int)r[3] - 256;
+        const unsigned char *g, *vx;
+        SN_CHK(sn_rd_u16(r) < v->nK, SN_ERR_INDEX);
+        SN_CHK(n >= 1 && n <= SN_RIG_MAX_SAMPLES, SN_ERR_VALUE);
+#if defined(SN_FLOAT)
+        SN_CHK(frac == 0, SN_ERR_VALUE);
+#else
+        SN_CHK(frac >= SN_RIG_FRAC_MIN && frac <= SN_RIG_FRAC_MAX, SN_ERR_VALUE);
+#endif
+        SN_CHK(sn_rd_u32(r + 4) == ns && n <= v->nRS - ns, SN_ERR_INDEX);
+        SN_CHK(sn_rd_u32(r + 8) == ne && cnt <= v->nRE - ne, SN_ERR_INDEX);
+        g = v->sec[SN_SEC_RIG_SAMPLES] + (size_t)ns * SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES);
+        for (k = 0; k < n; k++) {
+            const unsigned char *e = g + (size_t)k * SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES);
+            SN_CHK(sn_real_ok(e, -G, G, 16) && sn_real_ok(e + SN_REAL_BYTES, -G, G, SN_Q_ROT), SN_ERR_VALUE);
+            if (k > 0) SN_CHK(SN_RD_REAL(e) > SN_RD_REAL(e - SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES)), SN_ERR_VALUE);
+        }
+        vx = v->sec[SN_SEC_RIG_VERTS] + 2 * (size_t)ne;
+        for (k = 0; k < cnt; k++) {
+            uint32_t a = sn_rd_u16(vx + 2 * k);
+            SN_CHK(a < v->nF && (k == 0 || a > sn_rd_u16(vx + 2 * k - 2)), SN_ERR_INDEX);
+        }
+        ns += n;
+        ne += cnt;
+    }
+    SN_CHK(ns == v->nRS && ne == v->nRE, SN_ERR_INDEX);
+#if defined(SN_FLOAT)
+    SN_CHK(sn_reals_ok(v->sec[SN_SEC_RIG_FORCES], 3 * v->nRE, (int32_t)SN_RIG_FLOAT_MAX, 0), SN_ERR_VALUE);
+#endif
+    return SN_OK;
+}
+
 static void sn_view_header(sn_view *v, const unsigned char *p);
 static void sn_view_sections(sn_view *v);
 
-#define SN_CHK(cond, err) do { if (!(cond)) return (err); } while (0)
 
 /* Section contents, given a header and table already checked. */
 static sn_status sn_check_contents(const sn_view *v) {
@@ -108,20 +204,7 @@ static sn_status sn_check_contents(const sn_view *v) {
         SN_CHK(sn_rd_u16(e + 2) == 0 && sn_rd_u32(e + 4) == 0, SN_ERR_VALUE);
         SN_CHK(sn_reals_ok(e + 8, 3, X, SN_Q_LEN), SN_ERR_VALUE);
     }
-    /* names: non-empty, NUL-terminated, NUL-padded, unique */
-    s = v->sec[SN_SEC_JOINT_NAMES];
-    for (j = 0; j < v->nJ; j++) {
-        const unsigned char *n = s + (size_t)j * SN_JOINT_NAME_MAX;
-        for (k = 0; k < SN_JOINT_NAME_MAX && n[k]; k++) {}
-        SN_CHK(k > 0 && k < SN_JOINT_NAME_MAX, SN_ERR_VALUE);
-        SN_CHK(sn_zero_bytes(n + k, SN_JOINT_NAME_MAX - k), SN_ERR_VALUE);
-        for (i = 0; i < j; i++) { /* padded: equal names <=> equal 32 bytes */
-            const unsigned char *o = s + (size_t)i * SN_JOINT_NAME_MAX;
-            uint32_t diff = 0;
-            for (k = 0; k < SN_JOINT_NAME_MAX; k++) diff |= (uint32_t)(n[k] ^ o[k]); /* no memcmp: libc */
-            SN_CHK(diff != 0, SN_ERR_VALUE);
-        }
-    }
+    SN_CHK(sn_names_ok(v->sec[SN_SEC_JOINT_NAMES], v->nJ, SN_JOINT_NAME_MAX), SN_ERR_VALUE);
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_REST], 3 * v->nV, X, SN_Q_LEN), SN_ERR_VALUE);
     /* frames: bones < nJ, w <= 1 (Q15); skeleton vertices rigid to bone1 */
     s = v->sec[SN_SEC_FRAMES];
@@ -190,7 +273,7 @@ static sn_status sn_check_contents(const sn_view *v) {
     /* triangles: surface vertex indices < nS */
     s = v->sec[SN_SEC_TRIS];
     for (i = 0; i < 3 * v->nT; i++) SN_CHK(sn_rd_u16(s + 2 * (size_t)i) < v->nS, SN_ERR_INDEX);
-    return SN_OK;
+    return sn_check_rigs(v);
 }
 
 sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
@@ -241,7 +324,6 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         v.frac_E < -40 || v.frac_E > 60 || (SN_FLAVOUR != SN_FLAVOUR_FIXED && v.frac_E != 0))
         return SN_ERR_HEADER;
     if (v.nC < 1 || v.nC > SN_MAX_VERTICES) return SN_ERR_HEADER;
-    if (v.instance_bytes < SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ, v.nC)) return SN_ERR_HEADER;
 
     /* physics scalars */
     {
@@ -278,13 +360,33 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     cnt[SN_SEC_LIMIT] = 0; /* 0 or nF: taken from the table below */
     cnt[SN_SEC_EMBED] = v.nS;
     cnt[SN_SEC_TRIS] = v.nT;
+    /* rig sections: counts from the table, bounded (cost per step, u16/u32 indices) */
+    {
+        const unsigned char *t = p + SN_H_SECTIONS + 8;
+        v.nK = sn_rd_u32(t + SN_SEC_CONTROLS * SN_SECTION_ENTRY);
+        v.nR = sn_rd_u32(t + SN_SEC_RIGS * SN_SECTION_ENTRY);
+        v.nRS = sn_rd_u32(t + SN_SEC_RIG_SAMPLES * SN_SECTION_ENTRY);
+        v.nRE = sn_rd_u32(t + SN_SEC_RIG_VERTS * SN_SECTION_ENTRY);
+        if (v.nK > SN_MAX_CONTROLS || v.nR > SN_MAX_RIGS || v.nRS > SN_MAX_RIGS * SN_RIG_MAX_SAMPLES ||
+            v.nRE > SN_MAX_RIGS * (uint32_t)SN_MAX_VERTICES)
+            return SN_ERR_SECTION;
+        cnt[SN_SEC_CONTROLS] = v.nK;
+        cnt[SN_SEC_RIGS] = v.nR;
+        cnt[SN_SEC_RIG_SAMPLES] = v.nRS;
+        cnt[SN_SEC_RIG_VERTS] = v.nRE;
+        cnt[SN_SEC_RIG_FORCES] = v.nRE; /* one force per vertex entry */
+    }
+    /* the instance size is the runtime's formula (one source: sn_format.h) */
+    if (v.instance_bytes != SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ, v.nC, v.nK)) return SN_ERR_HEADER;
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
             SN_ELEM_JOINTS(SN_REAL_BYTES), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(SN_REAL_BYTES),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(SN_REAL_BYTES),
             SN_ELEM_PRECOND(SN_REAL_BYTES), SN_ELEM_MLUMP(SN_REAL_BYTES), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_CELLS, SN_ELEM_CFRAMES,
-            SN_ELEM_CELLK(SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS};
+            SN_ELEM_CELLK(SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS,
+            SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
+            SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -341,7 +443,7 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->cell = SN_RD_REAL(r + SN_R_CELL * SN_REAL_BYTES);
     v->disp_bound = SN_RD_REAL(r + SN_R_DISP_BOUND * SN_REAL_BYTES);
     v->flags = p[SN_H_FLAGS];
-    v->nL = 0;
+    v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
@@ -349,6 +451,10 @@ static void sn_view_sections(sn_view *v) {
     for (k = 0; k < SN_SEC_COUNT; k++)
         v->sec[k] = v->base + sn_rd_u32(v->base + SN_H_SECTIONS + k * SN_SECTION_ENTRY);
     v->nL = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_LIMIT * SN_SECTION_ENTRY + 8);
+    v->nK = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CONTROLS * SN_SECTION_ENTRY + 8);
+    v->nR = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIGS * SN_SECTION_ENTRY + 8);
+    v->nRS = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIG_SAMPLES * SN_SECTION_ENTRY + 8);
+    v->nRE = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIG_VERTS * SN_SECTION_ENTRY + 8);
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */
@@ -377,6 +483,9 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->instance_bytes = v.instance_bytes;
     info->blob_bytes = v.total;
     info->timestep = v.timestep;
+    info->controls = v.nK;
+    info->rigs = v.nR;
+    info->rig_entries = v.nRE;
 }
 
 static const unsigned char *sn_section(const sn_blob *blob, int k) {

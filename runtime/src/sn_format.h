@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 2.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 3.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -13,7 +13,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 2
+#define SN_FORMAT_MAJOR 3
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -100,6 +100,20 @@ enum {
     SN_SEC_LIMIT,        /* nF x R, or count 0 (no limits): largest distance of free vertex i from its skinned position, internal units (Q22), 0 = none */
     SN_SEC_EMBED,        /* nS  x {u16 cell, u16 t[3] Q15 (0..32768)} trilinear coordinates in the cell */
     SN_SEC_TRIS,         /* nT  x u16[3] surface vertex indices, counter-clockwise seen from outside */
+    /* ---- rig forces (seed 003 §4, eq. 11-12), format 3.0; all five may have count 0 ---- */
+    SN_SEC_CONTROLS,     /* nK x {char name[32] (NUL-terminated, NUL-padded, unique, non-empty), u8 kind (SN_CTL_*),
+                            u8 joint (ANGLE: < nJ; ABSTRACT: 0), u16 0, u32 0,
+                            R axis[3] (ANGLE: unit axis in rest model axes, fixed Q30; ABSTRACT: 0),
+                            R value0 (ABSTRACT: value after init/reset, public units; ANGLE: 0)}; nK <= SN_MAX_CONTROLS */
+    SN_SEC_RIGS,         /* nR x {u16 control (< nK), u8 n_samples (1..SN_RIG_MAX_SAMPLES), i8 frac (fixed: SN_RIG_FRAC_MIN..MAX, else 0),
+                            u32 first_sample, u32 first_entry, u32 n_entries}; rig a's samples and entries follow rig a-1's
+                            (first_sample/first_entry are running sums starting at 0; the totals are the next sections' counts) */
+    SN_SEC_RIG_SAMPLES,  /* sum of n_samples x {R gamma (public control units: fixed Q16.16), R eta (fixed Q30, |eta| <= 1)};
+                            gamma strictly increasing within a rig. tau_a(gamma) = piecewise-linear eta, clamped at the ends */
+    SN_SEC_RIG_VERTS,    /* sum of n_entries x u16 free vertex (< nF), strictly increasing within a rig */
+    SN_SEC_RIG_FORCES,   /* sum of n_entries x R[3]: the rig's generalized force Q^a_i at eta = 1 in the vertex's rest frame,
+                            in the units of the right-hand side (h^2 Q / (m0 U), NUMERICS.md) (fixed: Q frac of the rig;
+                            float: |.| <= SN_RIG_FLOAT_MAX) */
     SN_SEC_COUNT
 };
 
@@ -121,6 +135,24 @@ enum {
 #define SN_CELL_BLOCKS      36
 #define SN_ELEM_EMBED       8
 #define SN_ELEM_TRIS        6
+#define SN_ELEM_CONTROLS(R) (40 + 4 * (R))
+#define SN_ELEM_RIGS        16
+#define SN_ELEM_RIG_SAMPLES(R) (2 * (R))
+#define SN_ELEM_RIG_VERTS   2
+#define SN_ELEM_RIG_FORCES(R) (3 * (R))
+
+/* control kinds (CONTROLS.kind) */
+#define SN_CTL_ABSTRACT 0   /* set by the game: sn_set_control */
+#define SN_CTL_ANGLE    1   /* read from the pose each step: angle (degrees) of joint's rotation relative to its parent about axis */
+#define SN_CONTROL_NAME_MAX 32
+#define SN_MAX_CONTROLS 256u
+#define SN_MAX_RIGS 4096u
+#define SN_RIG_MAX_SAMPLES 16u
+/* fixed: eta (Q30) x Q (Q frac) >> (30 + frac - 19 - k_i), k_i in [0,15]: the shift stays in [1, 61] */
+#define SN_RIG_FRAC_MIN 5
+#define SN_RIG_FRAC_MAX 50
+/* float: |Q| bound so eta * Q summed over every rig stays finite */
+#define SN_RIG_FLOAT_MAX 1048576.0f
 
 #define SN_JOINT_NAME_MAX 32
 #define SN_MAX_JOINTS 255
@@ -140,8 +172,8 @@ enum {
 /* Instance memory the runtime needs for a blob (bytes, multiple of 8). The
  * runtime owns this formula; the host tool writes its value into the header
  * and the validator rejects a header value smaller than it. */
-#define SN_INSTANCE_BYTES(nV, nF, nJ, nC) \
+#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK) \
     (((uint32_t)512u + 76u * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
-      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 7u) & ~7u)
+      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

@@ -4,7 +4,7 @@
 #include "sn_instance.h"
 
 /* hdr | acc nF*3 acc | per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
- * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per free: k (u8) */
+ * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value | per free: k (u8) */
 static void layout(sn_ihdr *h) {
     uint32_t nV = h->v.nV, nF = h->v.nF, nJ = h->v.nJ, o = SN_HDR_BYTES;
 #define SN_TAKE_(field, bytes) do { h->field = o; o += (bytes); } while (0)
@@ -24,6 +24,7 @@ static void layout(sn_ihdr *h) {
     SN_TAKE_(o_q, nF * 3u * 4u);
     SN_TAKE_(o_ds, (nV - nF) * 3u * 4u);
     SN_TAKE_(o_cR, h->v.nC * 9u * 4u);
+    SN_TAKE_(o_ctl, h->v.nK * 4u);
     SN_TAKE_(o_k, nF);
 #undef SN_TAKE_
 }
@@ -162,6 +163,7 @@ void sn_reset(sn_instance *inst) {
     /* rest-pose frames so getters work before the first step */
     set_identity(ARR(h, o_R, sn_q), nV);
     set_identity(ARR(h, o_cR, sn_q), v->nC);
+    sn_controls_reset(h);
 }
 
 sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations) {
@@ -231,5 +233,6 @@ uint64_t sn_state_hash(const sn_instance *inst) {
     for (i = 0; i < 3 * h->v.nV; i++) hsh = fnv_q(hsh, pos[i]);
     for (i = 0; i < 3 * h->v.nV; i++) hsh = fnv_q(hsh, vel[i]);
     for (i = 0; i < 3 * h->v.nF; i++) hsh = fnv_q(hsh, x[i]);
+    for (i = 0; i < h->v.nK; i++) hsh = fnv_q(hsh, CARR(h, o_ctl, sn_q)[i]); /* control values (none: unchanged) */
     return hsh;
 }

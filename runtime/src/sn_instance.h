@@ -4,6 +4,7 @@
  *   sn_instance.c  layout, init, reset, setters, stats, hash
  *   sn_pose.c      pose input, forward kinematics, joint and frame transforms, skeleton
  *   sn_solve.c     right-hand side, per-cell stiffness, mat-vec, preconditioner, PCG
+ *   sn_rig.c       controls, tau maps, rig forces (seed 003 §4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
  *   sn_step.c      the step: the stages in order
@@ -29,7 +30,7 @@ typedef struct sn_ihdr {
 #endif
     /* byte offsets of the arrays from the instance start */
     uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds,
-        o_k, o_cR;
+        o_k, o_cR, o_ctl;
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -121,6 +122,8 @@ void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vert
 void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
+void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */
+void sn_controls_reset(sn_ihdr *h);                 /* abstract controls to their baked values */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 
 /* Twice the elastic + kinetic energy of the step's starting state in

@@ -162,6 +162,10 @@ void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
  * wound past 180 degrees keeps its way), unless a.b < -cos 30 degrees
  * (more than 300 degrees of rotation), where the shorter arc is taken. */
 void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
+/* Angle (public degrees: fixed Q16.16) of the rotation q about the unit
+ * axis a (Q30 / float): the twist of a swing-twist decomposition,
+ * 2 atan2(v.a, w) with q's sign chosen so w >= 0, in (-180, 180]. */
+sn_real sn_twist_deg(const sn_q q[4], const sn_q a[3]);
 /* Integer square root: floor(sqrt(x)). */
 uint32_t sn_isqrt64(uint64_t x);
 #if defined(SN_FLOAT)
@@ -174,6 +178,7 @@ typedef struct sn_view {
     const unsigned char *base;
     const unsigned char *sec[SN_SEC_COUNT];
     uint32_t nV, nF, nC, nJ, nS, nT, nnz, nL; /* nL: LIMIT entries, 0 or nF */
+    uint32_t nK, nR, nRS, nRE; /* controls, rigs, rig samples, rig entries (section counts) */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;
     int len_shift, frac_S, frac_M, frac_P, frac_E;
     sn_q a1, b1, grav[3], timestep;

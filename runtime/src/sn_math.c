@@ -265,6 +265,22 @@ void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
     sn_qslerp_core(a, b, t, 1, out);
 }
 
+/* Twist angle of q about unit axis a (Q30 each), public degrees Q16.16:
+ * s = v.a, q's sign taken so w >= 0 (w == 0: s >= 0), angle = 2 atan2(s, w).
+ * |s|, |w| <= ~2^30.1 for unit inputs (validated axes), inside the CORDIC's
+ * range; radians Q30 -> degrees: * 360/pi in Q16 (7509872, relative error
+ * 7e-8 < 1 LSB at 180 degrees). Error <= ~2 LSB (Q16.16) plus the CORDIC's. */
+sn_real sn_twist_deg(const sn_q q[4], const sn_q a[3]) {
+    int64_t s = sn_rshr64((int64_t)q[0] * a[0] + (int64_t)q[1] * a[1] + (int64_t)q[2] * a[2], 30);
+    int64_t w = q[3], half;
+    int neg;
+    if (w < 0 || (w == 0 && s < 0)) { w = -w; s = -s; }
+    neg = s < 0;
+    half = sn_atan2_pos(neg ? -s : s, w); /* [0, pi/2] Q30 */
+    half = sn_rshr64(half * 7509872, 30);  /* degrees of the full angle, Q16.16 */
+    return (int32_t)(neg ? -half : half);
+}
+
 /* ---- public helpers (fixed) ---- */
 
 /* Axis (Q16.16, any non-zero length; zero -> identity) and angle (Q16.16
@@ -472,6 +488,17 @@ void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
 /* Axis (any non-zero length; zero -> identity), angle in degrees. The half
  * angle is reduced to |r| <= 45 degrees (exactly, for |angle| < 2e7; larger
  * or non-finite angles are treated as 0). */
+/* Twist angle of q about unit axis a in degrees (float twin of the fixed one). */
+sn_real sn_twist_deg(const sn_q q[4], const sn_q a[3]) {
+    float sv = q[0] * a[0] + q[1] * a[1] + q[2] * a[2], w = q[3], half;
+    int neg;
+    if (w < 0.0f || (w == 0.0f && sv < 0.0f)) { w = -w; sv = -sv; }
+    neg = sv < 0.0f;
+    half = sn_fatan2_pos(neg ? -sv : sv, w);
+    half *= 114.591559026164646f; /* 2 * 180 / pi */
+    return neg ? -half : half;
+}
+
 sn_quat sn_quat_axis_angle(sn_vec3 axis, sn_real angle_degrees) {
     float c[3], u[3], half = 0.5f * angle_degrees, s, co, qv[4];
     long n;

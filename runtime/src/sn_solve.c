@@ -144,7 +144,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
 }
 
 /* Right-hand side b (into r), NUMERICS.md step 5:
- * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S)   */
+ * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S) + f_rig */
 static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
@@ -205,6 +205,7 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
             b[3 * i + k] = sn_add(sn_add(b[3 * i + k], g, sat), -ma, sat);
         }
     }
+    sn_rigs(h, b, sat); /* + R_i sum_a tau_a Q^a_i (seed 003 eq. 12) */
 }
 
 

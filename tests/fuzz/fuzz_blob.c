@@ -8,8 +8,8 @@
  * mass rows or cells than a hex lattice has), pose it (sn_pose_from_local +
  * sn_set_pose), step twice with 2 CG iterations (teleporting back to the rest
  * pose for the second), and read everything back (lattice, surface, normals,
- * hash, accessors, stats). Every section of format 2.0 (CFRAMES, CELLK, LIMIT
- * included) gets its bits flipped and its boundaries cut; crafted cases push
+ * hash, accessors, stats). Every section of format 3.0 (CFRAMES, CELLK, LIMIT
+ * and the rig sections included) gets its bits flipped and its boundaries cut; crafted cases push
  * CELLK and every other matrix to the validator's bounds (see crafted_all).
  *
  * Two builds of the same file (tests/fuzz/fuzz.mk... see runtime/runtime.mk):
@@ -117,6 +117,11 @@ static void exercise(const sn_blob *blob) {
         if (n) (void)sn_find_joint(blob, n);
     }
     (void)sn_find_joint(blob, "no such joint");
+    for (j = 0; j < info.controls; j++) {
+        const char *n = sn_control_name(blob, j);
+        (void)sn_control_kind_of(blob, j);
+        if (n) (void)sn_find_control(blob, n);
+    }
     for (j = 0; j < info.triangles && j < 8; j++) (void)sn_get_triangle(blob, j, idx);
     if (need > (16u << 20)) { /* a flipped high bit of instance_bytes: valid, but too big to bother */
         g.huge++;
@@ -129,6 +134,12 @@ static void exercise(const sn_blob *blob) {
         if (!g_mem) { fprintf(stderr, "out of memory\n"); exit(2); }
     }
     ist = sn_instance_init(g_mem, need, blob, &inst);
+    if (ist == SN_OK) /* abstract controls at the extremes of their type (tau clamps) */
+        for (j = 0; j < info.controls; j++) {
+            sn_real cv;
+            (void)sn_set_control(inst, j, (j & 1) ? REAL(-3.0e38f, -INT32_MAX) : REAL(3.0e38f, INT32_MAX));
+            (void)sn_get_control(inst, j, &cv);
+        }
     if (ist == SN_ERR_INDEX) { /* documented (sinew.h): a vertex in more mass rows / cells than a hex lattice allows */
         g.init_index++;
         return;
@@ -243,6 +254,7 @@ static size_t craft_valence(void) {
         tb_u16(b + off + 6 * t + 4, 2 + (t & 1));
     }
     total = off + 6 * nT;
+    tb_drop_rigs(b, total);
     tb_u32(b + SN_H_N_TRIANGLES, nT);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 4, 6 * nT);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 8, nT);
@@ -336,6 +348,28 @@ static size_t craft_all_max(void) {
     return total;
 }
 
+/* Rig values at the validator's bounds: every force at the type's extreme
+ * with the smallest frac (fixed: INT32_MIN at Q5, the largest product and
+ * the smallest shift), etas at +-1, gammas 1 LSB apart at +-2^30, the angle
+ * axis at the 2^-8 norm tolerance; controls are then set to both extremes
+ * of their type by exercise(). The step must saturate, never overflow. */
+static size_t craft_rig_max(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0), k;
+    uint32_t smp = tb_sec(b, SN_SEC_RIG_SAMPLES), f = tb_sec(b, SN_SEC_RIG_FORCES), rg = tb_sec(b, SN_SEC_RIGS);
+    uint32_t ctl = tb_sec(b, SN_SEC_CONTROLS) + SN_ELEM_CONTROLS(4);
+    for (k = 0; k < 3 * TB_NRE; k++) tb_u32(b + f + 4 * k, REAL(0x49800000u /* 2^20 */, (k & 1) ? 0x80000000u : 0x7FFFFFFFu));
+    for (k = 0; k < TB_NR; k++) b[rg + SN_ELEM_RIGS * k + 3] = (unsigned char)REAL(0, SN_RIG_FRAC_MIN);
+    /* rig 0: gammas -2^30, -2^30 + 1 LSB, 2^30; etas -1, 1, -1 */
+    tb_u32(b + smp, REAL(0xC6800000u /* -16384 */, 0xC0000000u));
+    tb_u32(b + smp + 8, REAL(0xC67FFFFFu, 0xC0000001u));
+    tb_u32(b + smp + 16, REAL(0x46800000u, 0x40000000u));
+    for (k = 0; k < 3; k++) tb_u32(b + smp + 8 * k + 4, REAL((k & 1) ? 0x3F800000u : 0xBF800000u, (k & 1) ? 0x40000000u : 0xC0000000u));
+    tb_real(b + ctl + 40, 0.0625, SN_Q_ROT); /* axis (1/16, 0, 1): |axis|^2 = 1 + 2^-8 */
+    tb_fix_crc(b);
+    return total;
+}
+
 /* Limits of 1 LSB on every free vertex, no REST_MODELLED: the limit stage clamps everything every step. */
 static size_t craft_limits_tiny(void) {
     unsigned char *b = g_craft.b;
@@ -385,7 +419,7 @@ static int run_crafted(const char *name, size_t (*make)(void), int posetype, int
     return 1;
 }
 
-#define N_CRAFTED 7
+#define N_CRAFTED 8
 static int crafted_all(void) {
     int fails = 0;
     fails += run_crafted("2000 triangles on one vertex (normals)", craft_valence, 0, 2, 0);
@@ -397,6 +431,8 @@ static int crafted_all(void) {
     fails += run_crafted("every matrix at +-2^27, fractions 0, a1 = b1 = 16, |g| = 32, LIMIT 2^28, ENERGY max, DISP_BOUND 1 LSB",
                          craft_all_max, 1, 40, 1);
     fails += run_crafted("LIMIT 1 LSB on every free vertex", craft_limits_tiny, 0, 10, 2);
+    fails += run_crafted("rig forces, etas, gammas and axes at their bounds, controls at their type's extremes",
+                         craft_rig_max, 1, 20, 1);
     return fails;
 }
 

@@ -10,7 +10,12 @@
  * PSD, rigid translations and rotations in its null space), the block-Jacobi
  * preconditioner of the assembled diagonal; LIMIT on every free vertex
  * (0.25 internal units on odd vertices, none on even ones); the
- * REST_MODELLED flag; 4 embedded surface vertices, 2 triangles. Flavour
+ * REST_MODELLED flag; 4 embedded surface vertices, 2 triangles. Rigs
+ * (format 3.0): an abstract control "puff" (baked value 0.25) and a pose
+ * control "bend" (the tip's angle about z); rig 0 on puff, samples
+ * (-1,-1) (0,0) (1,1), pushing free vertices 1, 3, 5 along +y; rig 1 on
+ * bend, samples (0 deg, 0) (90 deg, 1), pulling 0, 4, 7 along -x; rig 2 on
+ * puff, one sample (eta 0.5 everywhere), on vertex 2 along +z. Flavour
  * follows SN_FLOAT of the including file (fixed: Q formats of NUMERICS.md;
  * float: true values).
  */
@@ -31,6 +36,11 @@
 #define TB_FRAC 26   /* frac_S = frac_P */
 #define TB_FRAC_M 24 /* lumped mass rows reach 3.4 */
 #define TB_FRAC_E 16 /* ENERGY: 16.7 J per internal unit */
+#define TB_NK 2      /* controls */
+#define TB_NR 3      /* rigs */
+#define TB_NRS 6     /* rig samples */
+#define TB_NRE 7     /* rig entries */
+#define TB_RIG_FRAC 36 /* rig forces ~2e-2 internal units: 2^30.4 at Q36 */
 
 static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
 static void tb_u32(unsigned char *p, uint32_t v) {
@@ -141,6 +151,11 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_LIMIT] = TB_NF;        elem[SN_SEC_LIMIT] = (uint32_t)SN_ELEM_LIMIT(R);
     cnt[SN_SEC_EMBED] = TB_NS;        elem[SN_SEC_EMBED] = SN_ELEM_EMBED;
     cnt[SN_SEC_TRIS] = TB_NT;         elem[SN_SEC_TRIS] = SN_ELEM_TRIS;
+    cnt[SN_SEC_CONTROLS] = TB_NK;     elem[SN_SEC_CONTROLS] = (uint32_t)SN_ELEM_CONTROLS(R);
+    cnt[SN_SEC_RIGS] = TB_NR;         elem[SN_SEC_RIGS] = SN_ELEM_RIGS;
+    cnt[SN_SEC_RIG_SAMPLES] = TB_NRS; elem[SN_SEC_RIG_SAMPLES] = (uint32_t)SN_ELEM_RIG_SAMPLES(R);
+    cnt[SN_SEC_RIG_VERTS] = TB_NRE;   elem[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
+    cnt[SN_SEC_RIG_FORCES] = TB_NRE;  elem[SN_SEC_RIG_FORCES] = (uint32_t)SN_ELEM_RIG_FORCES(R);
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -211,6 +226,38 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         for (i = 0; i < TB_NT; i++)
             for (d = 0; d < 3; d++) tb_u16(b + secoff[SN_SEC_TRIS] + 6 * i + 2 * d, tri[i][d]);
     }
+    {   /* controls and rigs */
+        static const int rig_ctl[TB_NR] = {0, 1, 0}, rig_ns[TB_NR] = {3, 2, 1}, rig_ne[TB_NR] = {3, 3, 1};
+        static const double smp[TB_NRS][2] = {{-1, -1}, {0, 0}, {1, 1}, {0, 0}, {90, 1}, {0, 0.5}};
+        static const int vx[TB_NRE] = {1, 3, 5, 0, 4, 7, 2};
+        static const double fdir[TB_NR][3] = {{0, 2e-2, 0}, {-1.5e-2, 0, 0}, {0, 0, 1e-2}};
+        unsigned char *c0 = b + secoff[SN_SEC_CONTROLS], *c1 = c0 + elem[SN_SEC_CONTROLS];
+        uint32_t ns = 0, ne = 0;
+        memcpy(c0, "puff", 4);
+        tb_real(c0 + 40 + 3 * R, 0.25, 16);
+        memcpy(c1, "bend", 4);
+        c1[32] = SN_CTL_ANGLE;
+        c1[33] = 1;
+        tb_real(c1 + 40 + 2 * R, 1.0, SN_Q_ROT); /* axis z */
+        for (i = 0; i < TB_NR; i++) {
+            unsigned char *r = b + secoff[SN_SEC_RIGS] + SN_ELEM_RIGS * i;
+            tb_u16(r, (uint32_t)rig_ctl[i]);
+            r[2] = (unsigned char)rig_ns[i];
+            r[3] = SN_FLAVOUR ? 0 : TB_RIG_FRAC;
+            tb_u32(r + 4, ns);
+            tb_u32(r + 8, ne);
+            tb_u32(r + 12, (uint32_t)rig_ne[i]);
+            for (j = 0; j < rig_ns[i]; j++, ns++) {
+                tb_real(b + secoff[SN_SEC_RIG_SAMPLES] + 2 * R * ns, smp[ns][0], 16);
+                tb_real(b + secoff[SN_SEC_RIG_SAMPLES] + 2 * R * ns + R, smp[ns][1], SN_Q_ROT);
+            }
+            for (j = 0; j < rig_ne[i]; j++, ne++) {
+                tb_u16(b + secoff[SN_SEC_RIG_VERTS] + 2 * ne, (uint32_t)vx[ne]);
+                for (d = 0; d < 3; d++)
+                    tb_real(b + secoff[SN_SEC_RIG_FORCES] + (3 * ne + d) * R, fdir[i][d], TB_RIG_FRAC);
+            }
+        }
+    }
     /* header */
     b[0] = 'S'; b[1] = 'N'; b[2] = 'W'; b[3] = 'B';
     tb_u16(b + SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
@@ -230,7 +277,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK));
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);
     b[SN_H_LEN_SHIFT] = (unsigned char)(len_shift & 0xFF);
@@ -254,11 +301,23 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
 
 /* Make the LIMIT section empty (count 0, size 0, bytes zeroed: a valid blob
  * without the limit stage); CRC recomputed. */
-static void tb_drop_limit(unsigned char *b) {
+static inline void tb_drop_limit(unsigned char *b) {
     unsigned char *e = b + SN_H_SECTIONS + 16 * SN_SEC_LIMIT;
     memset(b + tb_sec(b, SN_SEC_LIMIT), 0, tb_rd32(e + 4));
     tb_u32(e + 4, 0);
     tb_u32(e + 8, 0);
     tb_fix_crc(b);
+}
+/* Empty the five rig sections, placing them (8-aligned) at offset at (the
+ * end of what the caller keeps); instance bytes follow nK = 0. No CRC. */
+static inline void tb_drop_rigs(unsigned char *b, uint32_t at) {
+    int k;
+    at = (at + 7u) & ~7u;
+    for (k = SN_SEC_CONTROLS; k <= SN_SEC_RIG_FORCES; k++) {
+        tb_u32(b + SN_H_SECTIONS + 16 * k, at);
+        tb_u32(b + SN_H_SECTIONS + 16 * k + 4, 0);
+        tb_u32(b + SN_H_SECTIONS + 16 * k + 8, 0);
+    }
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0));
 }
 #endif

@@ -256,6 +256,12 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_LIMIT] = bx->limit > 0 ? nF : 0; el[SN_SEC_LIMIT] = SN_ELEM_LIMIT(R);
         cnt[SN_SEC_EMBED] = nV; el[SN_SEC_EMBED] = SN_ELEM_EMBED;   /* surface = every lattice vertex */
         cnt[SN_SEC_TRIS] = 0; el[SN_SEC_TRIS] = SN_ELEM_TRIS;
+        /* format 3.0: no rigs here (snsyn_with_rigs adds them) */
+        cnt[SN_SEC_CONTROLS] = 0; el[SN_SEC_CONTROLS] = SN_ELEM_CONTROLS(R);
+        cnt[SN_SEC_RIGS] = 0; el[SN_SEC_RIGS] = SN_ELEM_RIGS;
+        cnt[SN_SEC_RIG_SAMPLES] = 0; el[SN_SEC_RIG_SAMPLES] = SN_ELEM_RIG_SAMPLES(R);
+        cnt[SN_SEC_RIG_VERTS] = 0; el[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
+        cnt[SN_SEC_RIG_FORCES] = 0; el[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(R);
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;
@@ -276,7 +282,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         w_u32(&w, SN_H_ONE_HI, bx->flavour == SN_FLAVOUR_FLOAT64 ? SN_ONE_FLOAT64_HI : 0u);
         w_u32(&w, SN_H_N_VERTICES, nV); w_u32(&w, SN_H_N_FREE, nF); w_u32(&w, SN_H_N_CELLS, nC);
         w_u32(&w, SN_H_N_JOINTS, nJ); w_u32(&w, SN_H_N_SURFACE, nV); w_u32(&w, SN_H_N_TRIANGLES, 0);
-        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC));
+        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC, 0));
         w_u16(&w, SN_H_CG_DEFAULT, bx->cg_default); w_u16(&w, SN_H_CG_MAX, 256);
         w_u8(&w, SN_H_LEN_SHIFT, (unsigned)(len_shift & 255));
         {
@@ -371,4 +377,115 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
     *size = w.n;
     return w.d;
 #undef GID
+}
+
+/* ---------------- rig sections (format 3.0) ---------------- */
+
+static uint32_t rs_u32(const unsigned char *p) {
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static void ws_u32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+static void ws_u16(unsigned char *p, unsigned v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
+/* one real of the flavour; fixed: round(x 2^q) to nearest (ties away from zero), clamped to int32 */
+static void ws_real(unsigned char *p, int flavour, double x, int q) {
+    if (flavour == SN_FLAVOUR_FIXED) {
+        double v = ldexp(x, q);
+        int64_t iv;
+        v = v < 0 ? -floor(-v + 0.5) : floor(v + 0.5);
+        if (v > 2147483647.0) v = 2147483647.0;
+        if (v < -2147483648.0) v = -2147483648.0;
+        iv = (int64_t)v;
+        ws_u32(p, (uint32_t)iv);
+    } else if (flavour == SN_FLAVOUR_FLOAT32) {
+        float f = (float)x;
+        uint32_t u;
+        memcpy(&u, &f, 4);
+        ws_u32(p, u);
+    } else {
+        uint64_t u;
+        memcpy(&u, &x, 8);
+        ws_u32(p, (uint32_t)u); ws_u32(p + 4, (uint32_t)(u >> 32));
+    }
+}
+
+int snsyn_rig_frac(double maxabs) {
+    int f = 30;
+    if (maxabs > 0) f = (int)floor(log2(134217728.0 / maxabs));
+    if (f < SN_RIG_FRAC_MIN) f = SN_RIG_FRAC_MIN;
+    if (f > SN_RIG_FRAC_MAX) f = SN_RIG_FRAC_MAX;
+    return f;
+}
+
+unsigned char *snsyn_with_rigs(const unsigned char *blob, size_t size, const snsyn_control *ctl, unsigned nk,
+                               const snsyn_rig *rig, unsigned nr, size_t *out_size) {
+    unsigned R, k, a, i, ns = 0, ne = 0;
+    int flavour;
+    size_t end, off[SN_SEC_COUNT], cnt[SN_SEC_COUNT], el[SN_SEC_COUNT], pos;
+    unsigned char *o;
+    uint32_t ib;
+    if (size < SN_HEADER_BYTES || blob[SN_H_NSECTIONS] != SN_SEC_COUNT) return NULL;
+    flavour = blob[SN_H_FLAVOUR];
+    R = blob[SN_H_REAL_SIZE];
+    for (a = 0; a < nr; a++) {
+        if (rig[a].control >= nk || rig[a].n_samples < 1 || rig[a].n_samples > SN_RIG_MAX_SAMPLES) return NULL;
+        ns += rig[a].n_samples; ne += rig[a].n_entries;
+    }
+    {   /* end of TRIS: the rig sections follow it */
+        const unsigned char *e = blob + SN_H_SECTIONS + SN_SEC_TRIS * SN_SECTION_ENTRY;
+        end = (size_t)rs_u32(e) + rs_u32(e + 4);
+    }
+    cnt[SN_SEC_CONTROLS] = nk; el[SN_SEC_CONTROLS] = SN_ELEM_CONTROLS(R);
+    cnt[SN_SEC_RIGS] = nr; el[SN_SEC_RIGS] = SN_ELEM_RIGS;
+    cnt[SN_SEC_RIG_SAMPLES] = ns; el[SN_SEC_RIG_SAMPLES] = SN_ELEM_RIG_SAMPLES(R);
+    cnt[SN_SEC_RIG_VERTS] = ne; el[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
+    cnt[SN_SEC_RIG_FORCES] = ne; el[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(R);
+    pos = end;
+    for (k = SN_SEC_CONTROLS; k < SN_SEC_COUNT; k++) {
+        pos = (pos + 7) & ~(size_t)7;
+        off[k] = pos;
+        pos += cnt[k] * el[k];
+    }
+    pos = (pos + 7) & ~(size_t)7;
+    o = calloc(pos + 8, 1);
+    if (!o) return NULL;
+    memcpy(o, blob, end);
+    for (k = SN_SEC_CONTROLS; k < SN_SEC_COUNT; k++) {
+        unsigned char *e = o + SN_H_SECTIONS + k * SN_SECTION_ENTRY;
+        ws_u32(e, (uint32_t)off[k]); ws_u32(e + 4, (uint32_t)(cnt[k] * el[k]));
+        ws_u32(e + 8, (uint32_t)cnt[k]); ws_u32(e + 12, (uint32_t)el[k]);
+    }
+    for (i = 0; i < nk; i++) {
+        unsigned char *e = o + off[SN_SEC_CONTROLS] + el[SN_SEC_CONTROLS] * i;
+        double n = sqrt(ctl[i].axis[0] * ctl[i].axis[0] + ctl[i].axis[1] * ctl[i].axis[1] + ctl[i].axis[2] * ctl[i].axis[2]);
+        strncpy((char *)e, ctl[i].name, 31);
+        e[32] = (unsigned char)ctl[i].kind;
+        e[33] = ctl[i].kind == SN_CTL_ANGLE ? (unsigned char)ctl[i].joint : 0;
+        for (k = 0; k < 3; k++) ws_real(e + 40 + k * R, flavour, ctl[i].kind == SN_CTL_ANGLE && n > 0 ? ctl[i].axis[k] / n : 0.0, 30);
+        ws_real(e + 40 + 3 * R, flavour, ctl[i].kind == SN_CTL_ABSTRACT ? ctl[i].value0 : 0.0, 16);
+    }
+    ns = ne = 0;
+    for (a = 0; a < nr; a++) {
+        unsigned char *e = o + off[SN_SEC_RIGS] + SN_ELEM_RIGS * a;
+        double mx = 0;
+        int frac = 0;
+        for (i = 0; i < 3 * rig[a].n_entries; i++) if (fabs(rig[a].force[i]) > mx) mx = fabs(rig[a].force[i]);
+        if (flavour == SN_FLAVOUR_FIXED) frac = rig[a].frac ? rig[a].frac : snsyn_rig_frac(mx);
+        ws_u16(e, rig[a].control); e[2] = (unsigned char)rig[a].n_samples; e[3] = (unsigned char)(frac & 255);
+        ws_u32(e + 4, ns); ws_u32(e + 8, ne); ws_u32(e + 12, rig[a].n_entries);
+        for (i = 0; i < rig[a].n_samples; i++, ns++) {
+            unsigned char *sp = o + off[SN_SEC_RIG_SAMPLES] + el[SN_SEC_RIG_SAMPLES] * ns;
+            ws_real(sp, flavour, rig[a].gamma[i], 16);
+            ws_real(sp + R, flavour, rig[a].eta[i], 30);
+        }
+        for (i = 0; i < rig[a].n_entries; i++, ne++) {
+            ws_u16(o + off[SN_SEC_RIG_VERTS] + 2 * ne, rig[a].verts[i]);
+            for (k = 0; k < 3; k++) ws_real(o + off[SN_SEC_RIG_FORCES] + el[SN_SEC_RIG_FORCES] * ne + k * R, flavour, rig[a].force[3 * i + k], frac);
+        }
+    }
+    ib = SN_INSTANCE_BYTES(rs_u32(o + SN_H_N_VERTICES), rs_u32(o + SN_H_N_FREE), rs_u32(o + SN_H_N_JOINTS), rs_u32(o + SN_H_N_CELLS), nk);
+    ws_u32(o + SN_H_INSTANCE_BYTES, ib);   /* the validator wants exactly the runtime's formula */
+    ws_u32(o + SN_H_TOTAL_SIZE, (uint32_t)pos);
+    ws_u32(o + SN_H_CRC32, snref_crc32(o + 16, pos - 16));
+    *out_size = pos;
+    return o;
 }

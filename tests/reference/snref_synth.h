@@ -1,5 +1,5 @@
 /* snref_synth.h -- test-side writer of synthetic box-lattice blobs (format
- * 2.0, float32 / float64) with textbook trilinear hex elements (one CELLK
+ * 3.0 without rigs, float32 / float64; snsyn_with_rigs adds rig sections to any blob) with textbook trilinear hex elements (one CELLK
  * matrix per cell), independent of the host tool.
  * Used to unit-test the reference and to measure element locking and its
  * fixes before (and independently of) the tool's own integration. */
@@ -41,5 +41,34 @@ unsigned char *snsyn_build(const snsyn_box *b, size_t *size);
  * Ke 24x24 (dof 3a+i, corner a at (a&1, a>>1&1, a>>2&1)), Me 8x8 scalar. */
 void snsyn_hex(double dx, double dy, double dz, double lambda, double mu, int integration,
                double Ke[24][24], double Me[8][8]);
+
+/* ---- rig sections (format 3.0), for any blob of any flavour (fixed included) ----
+ * snsyn_with_rigs returns a malloc'd copy of blob (8-aligned allocation,
+ * size *out_size) whose rig sections (CONTROLS .. RIG_FORCES) are replaced
+ * by the ones given: placed after TRIS, section table, total size,
+ * instance_bytes (= SN_INSTANCE_BYTES with nk controls) and CRC updated.
+ * Forces are in the right-hand side's units (internal, sn_format.h); fixed
+ * blobs store each rig's forces in Q frac, frac = the given one or (0) the
+ * largest that keeps |stored| <= 2^27 (snsyn_rig_frac), within
+ * SN_RIG_FRAC_MIN..MAX. NULL on a bad argument. Independent of the host tool
+ * (the tests' second writer of these sections). */
+typedef struct snsyn_control {
+    const char *name;         /* <= 31 bytes */
+    int kind;                 /* SN_CTL_ABSTRACT / SN_CTL_ANGLE */
+    unsigned joint;           /* ANGLE: the joint */
+    double axis[3];           /* ANGLE: axis (normalized here) */
+    double value0;            /* ABSTRACT: value after init/reset */
+} snsyn_control;
+typedef struct snsyn_rig {
+    unsigned control, n_samples;
+    double gamma[16], eta[16];/* tau samples, gamma strictly increasing, |eta| <= 1 */
+    unsigned n_entries;
+    const unsigned *verts;    /* n_entries free vertices, strictly increasing */
+    const double *force;      /* n_entries x 3, vertex rest frame, right-hand-side units */
+    int frac;                 /* fixed: forces' fraction bits, 0 = automatic */
+} snsyn_rig;
+int snsyn_rig_frac(double maxabs);
+unsigned char *snsyn_with_rigs(const unsigned char *blob, size_t size, const snsyn_control *ctl, unsigned nk,
+                               const snsyn_rig *rig, unsigned nr, size_t *out_size);
 
 #endif

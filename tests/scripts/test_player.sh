@@ -173,8 +173,12 @@ for p in "$PLAY $BLOB" "$PLAYF $BLOBF"; do
     out=$("$1" "$2" --clip "$CLIP" --frames 25 --health 10 --quiet --stats-csv "$TMP/out/h.csv" 2>&1)
     n=$(echo "$out" | grep -cE '^health frame (10|20): t [0-9.]+ s, disp [-0-9.e+]+ cells, energy [-0-9.e+]+ J, saturations [0-9]+$')
     [ "$n" -eq 2 ] && ok || bad "$1 --health 10 over 25 steps: $n lines, want 2: $out"
-    [ "$(head -n 1 "$TMP/out/h.csv")" = "frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps" ] && ok || bad "$1 CSV header: $(head -n 1 "$TMP/out/h.csv")"
-    rows=$(awk -F, 'NR > 1 && NF == 7 && $1 == NR - 1' "$TMP/out/h.csv" | wc -l)
+    # then one ctl_NAME column per rig control of the blob (test_player_rig.sh)
+    case "$(head -n 1 "$TMP/out/h.csv")" in
+        frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps|frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps,ctl_*) ok ;;
+        *) bad "$1 CSV header: $(head -n 1 "$TMP/out/h.csv")" ;;
+    esac
+    rows=$(awk -F, 'NR == 1 { nf = NF } NR > 1 && NF == nf && NF >= 7 && $1 == NR - 1' "$TMP/out/h.csv" | wc -l)
     [ "$rows" -eq 25 ] && [ "$(wc -l < "$TMP/out/h.csv")" -eq 26 ] && ok || bad "$1 --stats-csv: $rows good rows of $(wc -l < "$TMP/out/h.csv") lines, want 25 + header"
 done
 "$PLAYF" "$BLOBF" --clip "$CLIP" --frames 30 --stats-csv "$TMP/out/f.csv" --quiet > /dev/null 2>&1

@@ -1,6 +1,6 @@
 /* snref.h -- double-precision reference of the Sinew step (runtime/NUMERICS.md,
- * blob format 2.0: per-cell frames, element energy, tracked quaternions, path
- * slerp, limits, health).
+ * blob format 3.0: per-cell frames, element energy, tracked quaternions, path
+ * slerp, limits, health, rig controls and rig forces).
  *
  * Independent of the runtime: its own blob reader (only sn_format.h
  * constants), quaternion/slerp/rotation code, CG and static solver. Reads
@@ -58,6 +58,18 @@ typedef struct snref_model {
     double *et;           /* nS*3 */
     unsigned *tris;       /* nT*3 */
     /* derived at load */
+    /* rigs (format 3.0; all counts may be 0): controls, rigs, tau samples, entries */
+    unsigned nK, nR, nRS, nRE;
+    char (*kname)[32];    /* nK control names */
+    int *kkind;           /* SN_CTL_ABSTRACT / SN_CTL_ANGLE */
+    int *kjoint;          /* ANGLE: the joint whose rotation relative to its parent is measured */
+    double *kaxis;        /* nK*3 ANGLE: unit axis, rest model axes */
+    double *kvalue0;      /* ABSTRACT: value after init/reset (public units) */
+    unsigned *rctl, *rns, *rfs, *rfe, *rne; /* per rig: control, samples, first sample, first entry, entries */
+    int *rfrac;           /* per rig: fixed-point fraction of its forces (fixed flavour) */
+    double *rgamma, *reta;/* nRS tau samples (gamma public units, eta) */
+    unsigned *rvert;      /* nRE free vertices */
+    double *rforce;       /* nRE*3 Q^a_i at eta = 1, vertex rest frame, right-hand-side units (internal) */
     double *sdiag;        /* nF*9: assembled diagonal block sum_e S^_e,ii */
     unsigned *adjp, *adj; /* free-free neighbours (sharing a cell), CSR over nF */
 } snref_model;
@@ -110,6 +122,12 @@ typedef struct snref_state {
     unsigned limit_clamps;   /* vertices pulled back in the last step */
     unsigned limit_steps;    /* steps with a limit clamp since reset */
     unsigned bound_steps;    /* steps with disp > DISP_BOUND since reset (the reference never saturates) */
+    /* rigs: current control values (abstract: as set, value0 after init/reset;
+     * pose: from the pose at every snref_set_pose, so already before the first
+     * step, where the runtime reports 0) and a multiplier of every rig force
+     * (1 by default; 0 = rigs off, for with/without comparisons) */
+    double *ctl;
+    double rig_scale;
 } snref_state;
 
 int snref_init(snref_state *s, const snref_model *m);
@@ -128,7 +146,8 @@ void snref_get_skinned(const snref_state *s, double *out);
 void snref_surface_from_lattice(const snref_model *m, const double *lat, double *out);
 
 /* Static equilibrium (seed 003 eq. 10) at the current pose: skeleton fixed at
- * the pose, frames from the pose, f(p_F) + m^ g^ [- m^ R g^] = 0. CELL model:
+ * the pose, frames from the pose, f(p_F) + m^ g^ [- m^ R g^] + f_rig = 0 (the
+ * rig force at the current controls, times rig_scale). CELL model:
  * the minimum of E_el - load.p (quadratic in p, one linear solve with K~_FF);
  * VERTEX model: one linear solve with the exact Jacobian of eq. 7. Dense LU
  * when 3 nF <= dense_max, else banded LU in reverse Cuthill-McKee order
@@ -143,7 +162,7 @@ double snref_static(snref_state *s, unsigned dense_max);
 void snref_solve_load(snref_state *s, const double *load, double *x);
 void snref_mass_mul(const snref_state *s, const double *x, double *y);
 
-/* Net force residual f + m^g^ [- m^ R g^] (internal units) at the current positions, free rows. */
+/* Net force residual f + m^g^ [- m^ R g^] + f_rig (internal units) at the current positions, free rows. */
 void snref_residual(const snref_state *s, double *out);
 /* Elastic force of the active model at positions p (nV*3), free rows. */
 void snref_force(const snref_state *s, const double *p, double *out);
@@ -157,6 +176,25 @@ void snref_kmul(const snref_state *s, const double *x, double *y, int with_skel)
  * kinetic 1/2 v_F^T M^_FF v_F (consistent mass, free rows and columns) and
  * the element energy E_el at the current positions. */
 void snref_energy(const snref_state *s, double *kinetic, double *elastic);
+
+/* ---- rig controls and forces (format 3.0; sinew.h "rig controls") ----
+ * Index of the control called name, or -1. */
+int snref_find_control(const snref_model *m, const char *name);
+/* Set abstract control c (kept until set again or reset). -1, and nothing
+ * changes, if c is out of range, a pose control, or value is not finite. */
+int snref_set_control(snref_state *s, unsigned c, double value);
+/* Current value of control c (0 if out of range). */
+double snref_get_control(const snref_state *s, unsigned c);
+/* Pose control formula: the angle (degrees, [-180, 180]) of rotation q (x,y,z,w;
+ * need not be unit) about unit axis A: q's sign chosen so w >= 0 (w == 0:
+ * v.A >= 0), 2 atan2(v.A, w). Applied to q_rel = conj(q_parent) q_J (root: q_J). */
+double snref_twist_angle(const double q[4], const double axis[3]);
+/* tau_a(gamma): piecewise-linear through rig a's samples, clamped at the ends. */
+double snref_tau(const snref_model *m, unsigned a, double gamma);
+/* out (free rows, internal units) += rig_scale R_i sum_a tau_a(gamma_c(a)) Q^a_i
+ * at the current frames and controls: the rig term of the step's right-hand
+ * side and of the static equilibrium (both include it already). */
+void snref_rig_add(const snref_state *s, double *out);
 
 /* Small quaternion helpers (double), exposed for tests. */
 void snref_quat_axis_angle(const double axis[3], double deg, double q[4]);

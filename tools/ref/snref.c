@@ -1,5 +1,7 @@
-/* snref.c -- double-precision reference of runtime/NUMERICS.md (blob format 2.0).
- * Shares no arithmetic with the runtime: only sn_format.h constants. */
+/* snref.c -- double-precision reference of runtime/NUMERICS.md (blob format 3.0:
+ * format 2.0's step plus rig controls and forces).
+ * Shares no arithmetic with the runtime: only sn_format.h constants. Host-tool
+ * code since sinew-bake --static solves with it; the tests use it as their reference. */
 #include "snref.h"
 #include "../../runtime/src/sn_format.h"
 
@@ -13,6 +15,7 @@ typedef struct snref_band snref_band;
 static snref_band *band_build(snref_state *s, int which, double reg, size_t max_doubles);
 static void band_solve(const snref_band *B, const double *r, double *x);
 static void band_free(snref_band *B);
+static double sscale(const snref_state *s);
 
 /* ---------------- small linear algebra ---------------- */
 
@@ -173,6 +176,68 @@ static int build_adjacency(snref_model *m) {
     return 0;
 }
 
+/* Format 3.0 rig sections (sn_format.h): controls, rigs, tau samples, vertex
+ * lists and forces, all converted to double (fixed: gamma and value0 Q16.16,
+ * eta and the axis Q30, forces Q frac of their rig). Structural checks only:
+ * enough that the reference never reads out of bounds. */
+static int load_rigs(snref_model *m, const rdr *r, const unsigned *sec_off, char *err, size_t errn) {
+    const unsigned char *d = r->d;
+    unsigned R = r->rs, i, k, fixed = m->flavour == SN_FLAVOUR_FIXED;
+    unsigned long tot_s = 0, tot_e = 0;
+#define ALLOC(p, n) do { p = calloc((size_t)(n) + 1, sizeof *(p)); if (!p) FAIL("out of memory"); } while (0)
+    ALLOC(m->kname, m->nK); ALLOC(m->kkind, m->nK); ALLOC(m->kjoint, m->nK); ALLOC(m->kaxis, 3 * m->nK); ALLOC(m->kvalue0, m->nK);
+    ALLOC(m->rctl, m->nR); ALLOC(m->rns, m->nR); ALLOC(m->rfrac, m->nR); ALLOC(m->rfs, m->nR); ALLOC(m->rfe, m->nR); ALLOC(m->rne, m->nR);
+    ALLOC(m->rgamma, m->nRS); ALLOC(m->reta, m->nRS); ALLOC(m->rvert, m->nRE); ALLOC(m->rforce, 3 * (size_t)m->nRE);
+#undef ALLOC
+    for (i = 0; i < m->nK; i++) {
+        const unsigned char *e = d + sec_off[SN_SEC_CONTROLS] + (size_t)SN_ELEM_CONTROLS(R) * i;
+        unsigned j;
+        memcpy(m->kname[i], e, 32);
+        if (!m->kname[i][0] || m->kname[i][31]) FAIL("control %u: name", i);
+        for (j = 0; j < i; j++) if (!strcmp(m->kname[i], m->kname[j])) FAIL("control %u: repeated name '%s'", i, m->kname[i]);
+        m->kkind[i] = e[32];
+        m->kjoint[i] = e[33];
+        if (m->kkind[i] != SN_CTL_ABSTRACT && m->kkind[i] != SN_CTL_ANGLE) FAIL("control %u: kind %d", i, m->kkind[i]);
+        if (m->kkind[i] == SN_CTL_ANGLE && (unsigned)m->kjoint[i] >= m->nJ) FAIL("control %u: joint %d", i, m->kjoint[i]);
+        for (k = 0; k < 3; k++) m->kaxis[3 * i + k] = rd_real(r, e + 40 + k * R, 30);
+        m->kvalue0[i] = rd_real(r, e + 40 + 3 * R, 16);
+        if (m->kkind[i] == SN_CTL_ANGLE) {
+            double n = sqrt(dot(m->kaxis + 3 * i, m->kaxis + 3 * i, 3));
+            if (!(n > 0.5 && n < 2)) FAIL("control %u: axis length %g", i, n);
+            for (k = 0; k < 3; k++) m->kaxis[3 * i + k] /= n;   /* unit (fixed: Q30 rounding) */
+        }
+    }
+    for (i = 0; i < m->nR; i++) {
+        const unsigned char *e = d + sec_off[SN_SEC_RIGS] + SN_ELEM_RIGS * i;
+        m->rctl[i] = rd_u16(e); m->rns[i] = e[2]; m->rfrac[i] = (int)(signed char)e[3];
+        m->rfs[i] = rd_u32(e + 4); m->rfe[i] = rd_u32(e + 8); m->rne[i] = rd_u32(e + 12);
+        if (m->rctl[i] >= m->nK) FAIL("rig %u: control %u", i, m->rctl[i]);
+        if (m->rns[i] < 1 || m->rns[i] > SN_RIG_MAX_SAMPLES) FAIL("rig %u: %u samples", i, m->rns[i]);
+        if (m->rfs[i] != tot_s || m->rfe[i] != tot_e) FAIL("rig %u: first sample/entry not the running sums", i);
+        if (fixed && (m->rfrac[i] < SN_RIG_FRAC_MIN || m->rfrac[i] > SN_RIG_FRAC_MAX)) FAIL("rig %u: frac %d", i, m->rfrac[i]);
+        tot_s += m->rns[i]; tot_e += m->rne[i];
+        if (tot_s > m->nRS || tot_e > m->nRE) FAIL("rig %u: samples/entries beyond their sections", i);
+    }
+    if (tot_s != m->nRS || tot_e != m->nRE) FAIL("rig totals %lu samples, %lu entries; sections hold %u, %u", tot_s, tot_e, m->nRS, m->nRE);
+    for (i = 0; i < m->nR; i++) {
+        unsigned a = m->rfs[i], e2 = m->rfe[i];
+        for (k = a; k < a + m->rns[i]; k++) {
+            const unsigned char *e = d + sec_off[SN_SEC_RIG_SAMPLES] + (size_t)SN_ELEM_RIG_SAMPLES(R) * k;
+            m->rgamma[k] = rd_real(r, e, 16);
+            m->reta[k] = rd_real(r, e + R, 30);
+            if (k > a && !(m->rgamma[k] > m->rgamma[k - 1])) FAIL("rig %u: gamma samples not increasing", i);
+        }
+        for (k = e2; k < e2 + m->rne[i]; k++) {
+            const unsigned char *e = d + sec_off[SN_SEC_RIG_FORCES] + (size_t)SN_ELEM_RIG_FORCES(R) * k;
+            unsigned c;
+            m->rvert[k] = rd_u16(d + sec_off[SN_SEC_RIG_VERTS] + 2 * k);
+            if (m->rvert[k] >= m->nF || (k > e2 && m->rvert[k] <= m->rvert[k - 1])) FAIL("rig %u: vertex list", i);
+            for (c = 0; c < 3; c++) m->rforce[3 * k + c] = rd_real(r, e + c * R, fixed ? m->rfrac[i] : 0);
+        }
+    }
+    return 0;
+}
+
 int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t errn) {
     const unsigned char *d = (const unsigned char *)data;
     rdr r;
@@ -221,12 +286,20 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             FAIL("health scalars energy %g cell %g disp_bound %g", m->energy, m->cell, m->disp_bound);
     }
     {
+        /* the rig sections' counts are their own (RIGS' running sums are checked below) */
+#define SEC_CNT(k) rd_u32(d + SN_H_SECTIONS + (k) * SN_SECTION_ENTRY + 8)
         const unsigned expect_cnt[SN_SEC_COUNT] = { m->nJ, m->nJ, m->nV, m->nV, m->nF, m->nF, m->nF,
-            m->nF + 1, m->nnz, m->nnz, m->nC, m->nC, m->nC, m->nF, m->nS, m->nT };
+            m->nF + 1, m->nnz, m->nnz, m->nC, m->nC, m->nC, m->nF, m->nS, m->nT,
+            SEC_CNT(SN_SEC_CONTROLS), SEC_CNT(SN_SEC_RIGS), SEC_CNT(SN_SEC_RIG_SAMPLES),
+            SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_RIG_VERTS) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(R),
-            SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS };
+            SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS, SN_ELEM_CONTROLS(R), SN_ELEM_RIGS,
+            SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R) };
+#undef SEC_CNT
+        typedef char sec_count_check[SN_SEC_COUNT == 21 ? 1 : -1];   /* format 3.0: update the tables above */
+        (void)sizeof(sec_count_check);
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
             uint32_t off = rd_u32(e), sz = rd_u32(e + 4), cnt = rd_u32(e + 8), el = rd_u32(e + 12);
@@ -237,6 +310,10 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             sec_off[i] = off;
             if (i == SN_SEC_LIMIT) m->nlimit = cnt;
         }
+        m->nK = expect_cnt[SN_SEC_CONTROLS]; m->nR = expect_cnt[SN_SEC_RIGS];
+        m->nRS = expect_cnt[SN_SEC_RIG_SAMPLES]; m->nRE = expect_cnt[SN_SEC_RIG_VERTS];
+        if (m->nK > SN_MAX_CONTROLS || m->nR > SN_MAX_RIGS || (m->nR && !m->nK))
+            FAIL("rig counts: %u controls, %u rigs", m->nK, m->nR);
     }
 #define ALLOC(p, n) do { p = calloc((size_t)(n) + 1, sizeof *(p)); if (!p) FAIL("out of memory"); } while (0)
     ALLOC(m->jparent, m->nJ); ALLOC(m->jrest, 3 * m->nJ); ALLOC(m->jname, m->nJ);
@@ -322,6 +399,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         m->tris[i] = rd_u16(d + sec_off[SN_SEC_TRIS] + 2 * i);
         if (m->tris[i] >= m->nS) FAIL("triangle index");
     }
+    if (load_rigs(m, &r, sec_off, err, errn) != 0) return -1;
     if (build_adjacency(m) != 0) FAIL("out of memory");
     return 0;
 #undef ALLOC
@@ -352,6 +430,9 @@ void snref_free(snref_model *m) {
     free(m->mdiag); free(m->precond); free(m->mlump); free(m->rowptr); free(m->cols); free(m->moff);
     free(m->cells); free(m->cb1); free(m->cb2); free(m->cw); free(m->cellk); free(m->limit); free(m->sdiag);
     free(m->adjp); free(m->adj); free(m->ecell); free(m->et); free(m->tris);
+    free(m->kname); free(m->kkind); free(m->kjoint); free(m->kaxis); free(m->kvalue0);
+    free(m->rctl); free(m->rns); free(m->rfrac); free(m->rfs); free(m->rfe); free(m->rne);
+    free(m->rgamma); free(m->reta); free(m->rvert); free(m->rforce);
     memset(m, 0, sizeof *m);
 }
 
@@ -375,7 +456,9 @@ int snref_init(snref_state *s, const snref_model *m) {
     s->jq = calloc(4 * (size_t)m->nJ, sizeof *s->jq);
     s->jt = calloc(3 * (size_t)m->nJ, sizeof *s->jt);
     s->work = calloc(3 * (size_t)m->nV * S_COUNT, sizeof *s->work);
-    if (!s->p || !s->v || !s->dv || !s->R || !s->c || !s->Rc || !s->jq || !s->jt || !s->work) { snref_release(s); return -1; }
+    s->ctl = calloc((size_t)m->nK + 1, sizeof *s->ctl);
+    if (!s->p || !s->v || !s->dv || !s->R || !s->c || !s->Rc || !s->jq || !s->jt || !s->work || !s->ctl) { snref_release(s); return -1; }
+    s->rig_scale = 1.0;
     s->iters = m->cg_default;
     s->warm = 1;
     s->gscale = 1.0;
@@ -390,6 +473,7 @@ int snref_init(snref_state *s, const snref_model *m) {
 void snref_release(snref_state *s) {
     band_free(s->band);
     free(s->p); free(s->v); free(s->dv); free(s->R); free(s->c); free(s->Rc); free(s->jq); free(s->jt); free(s->work);
+    free(s->ctl);
     memset(s, 0, sizeof *s);
 }
 
@@ -421,6 +505,70 @@ static void compute_frames(snref_state *s) {
         slerp_(s->jq + 4 * m->cb1[i], s->jq + 4 * m->cb2[i], m->cw[i], !s->path_slerp, q);
         snref_quat_to_mat(q, s->Rc + 9 * i);
     }
+    /* pose controls (alpha) follow the pose, whatever the stepping mode */
+    for (i = 0; i < m->nK; i++) {
+        int j = m->kjoint[i], p;
+        double rel[4], cq[4];
+        if (m->kkind[i] != SN_CTL_ANGLE) continue;
+        p = m->jparent[j];
+        if (p < 0) memcpy(rel, s->jq + 4 * j, sizeof rel);
+        else {
+            cq[0] = -s->jq[4 * p]; cq[1] = -s->jq[4 * p + 1]; cq[2] = -s->jq[4 * p + 2]; cq[3] = s->jq[4 * p + 3];
+            snref_quat_mul(cq, s->jq + 4 * j, rel);
+        }
+        s->ctl[i] = snref_twist_angle(rel, m->kaxis + 3 * i);
+    }
+}
+
+/* ---------------- rig controls and forces (seed 003 eq. 11-12) ---------------- */
+
+double snref_twist_angle(const double q[4], const double axis[3]) {
+    double va = q[0] * axis[0] + q[1] * axis[1] + q[2] * axis[2], w = q[3];
+    if (w < 0 || (w == 0 && va < 0)) { w = -w; va = -va; }   /* the sign with w >= 0 (w = 0: v.A >= 0) */
+    return 2.0 * atan2(va, w) * (180.0 / 3.14159265358979323846);
+}
+
+int snref_find_control(const snref_model *m, const char *name) {
+    unsigned i;
+    for (i = 0; i < m->nK; i++) if (!strcmp(m->kname[i], name)) return (int)i;
+    return -1;
+}
+
+int snref_set_control(snref_state *s, unsigned c, double value) {
+    if (c >= s->m->nK || s->m->kkind[c] != SN_CTL_ABSTRACT || !(value == value) || fabs(value) > 1e300) return -1;
+    s->ctl[c] = value;
+    return 0;
+}
+
+double snref_get_control(const snref_state *s, unsigned c) { return c < s->m->nK ? s->ctl[c] : 0.0; }
+
+/* tau_a (seed 003 after eq. 12): eta_0 at or below the first sample, the last
+ * eta at or above the last, linear in between. */
+double snref_tau(const snref_model *m, unsigned a, double g) {
+    const double *G = m->rgamma + m->rfs[a], *E = m->reta + m->rfs[a];
+    unsigned n = m->rns[a], k;
+    if (g <= G[0]) return E[0];
+    if (g >= G[n - 1]) return E[n - 1];
+    for (k = 0; k + 1 < n && g > G[k + 1]; k++) {}
+    return E[k] + (E[k + 1] - E[k]) * ((g - G[k]) / (G[k + 1] - G[k]));
+}
+
+/* out (free rows) += rig_scale * h'^2/h^2 * R_i sum_a tau_a(gamma_c(a)) Q^a_i (NUMERICS step 5). */
+void snref_rig_add(const snref_state *s, double *out) {
+    const snref_model *m = s->m;
+    unsigned a, k, c;
+    double sc = s->rig_scale * sscale(s);
+    if (sc == 0) return;
+    for (a = 0; a < m->nR; a++) {
+        double t = sc * snref_tau(m, a, s->ctl[m->rctl[a]]);
+        if (t == 0) continue;
+        for (k = m->rfe[a]; k < m->rfe[a] + m->rne[a]; k++) {
+            unsigned i = m->rvert[k];
+            double y[3];
+            mat_vec(s->R + 9 * i, m->rforce + 3 * k, y);
+            for (c = 0; c < 3; c++) out[3 * i + c] += t * y[c];
+        }
+    }
 }
 
 /* Skeleton vertex positions for the current pose (bone1 of each vertex). */
@@ -447,6 +595,7 @@ void snref_reset(snref_state *s) {
     s->steps = 0;
     s->e_el = s->e_kin = s->energy = s->energy_max = s->disp = s->disp_max = 0;
     s->limit_clamps = s->limit_steps = s->bound_steps = 0;
+    for (j = 0; j < m->nK; j++) s->ctl[j] = m->kkind[j] == SN_CTL_ABSTRACT ? m->kvalue0[j] : 0.0;
     compute_frames(s);
 }
 
@@ -643,6 +792,7 @@ double snref_elastic(const snref_state *s, const double *p) { return cell_terms(
 void snref_residual(const snref_state *s, double *out) {
     snref_force(s, s->p, out);
     gravity_add(s, out);
+    snref_rig_add(s, out);
 }
 
 /* A x = (1+a1) M^_FF x + (1+b1) K_FF x */
@@ -967,6 +1117,7 @@ void snref_step(snref_state *s) {
         s->e_el = cell_terms(s, pp, NULL, NULL);   /* the element energy as a measure only */
     }
     gravity_add(s, b);
+    snref_rig_add(s, b);
     mass_mul(s, vstar, tmp, 1);
     for (i = 0; i < 3 * nF; i++) b[i] -= a1 * tmp[i];
     /* M^_FS (v'_S - v_S): mass product with the free part zeroed */
