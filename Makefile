@@ -22,6 +22,7 @@ include tools/tools.mk
 include ports/desktop/desktop.mk
 include ports/baremetal/baremetal.mk
 include tests/tests.mk
+include tests/fuzz/fuzz.mk
 
 clean:
 	rm -rf $(BUILD)

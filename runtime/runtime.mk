@@ -47,6 +47,12 @@ endef
 $(foreach t,$(SN_TESTS),$(eval $(call SN_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(SN_TESTS),$(BUILD)/tests/test_runtime_$(t) $(BUILD)/tests/test_runtime_$(t)_float)
 
+# ---- constant cost: the probe tests/scripts/test_cost.sh runs under callgrind ----
+$(BUILD)/tests/cost_probe: tests/cost_probe.c $(SN_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+TEST_DEPS += $(BUILD)/tests/cost_probe
+
 # ---- hostile blobs (tests/fuzz): the runtime sources compiled into the
 # fuzzer with ASan + UBSan; _ck keeps the checksum (every flip must fail) ----
 SN_FUZZ_CFLAGS = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \

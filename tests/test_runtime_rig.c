@@ -3,8 +3,8 @@
  * abstract control "puff", a pose control "bend" = the tip's angle about z,
  * three rigs). Built fixed and float.
  *
- *  - API contract: set/get, refusals (pose control, out of range, NaN), reset,
- *    controls on memory that is not an instance.
+ *  - API contract: set/get, refusals (pose control, out of range, NaN), reset;
+ *    sn_step / sn_get_stats / controls on memory that is not an instance.
  *  - Pose control vs a double swing-twist reference over random rotations.
  *  - tau through the physics: from rest, one step's displacement is
  *    homogeneous of degree 1 in the right-hand side (CG from a zero warm
@@ -98,8 +98,13 @@ static void test_api(const sn_blob *blob) {
     T_CHECK(sn_get_control(inst, 0, &v) == SN_OK && v == R_(0.25), "reset restores the baked value");
     {   /* memory that is not an instance */
         static union { uint64_t a; unsigned char m[256]; } junk;
+        sn_stats st;
         T_CHECK(sn_set_control((sn_instance *)(void *)junk.m, 0, R_(1)) == SN_ERR_INSTANCE &&
                     sn_get_control((sn_instance *)(void *)junk.m, 0, &v) == SN_ERR_INSTANCE, "not an instance");
+        T_CHECK(sn_step((sn_instance *)(void *)junk.m) == SN_ERR_INSTANCE && sn_step(NULL) == SN_ERR_NULL,
+                "sn_step refuses memory that is not an instance");
+        T_CHECK(sn_get_stats((sn_instance *)(void *)junk.m, &st) == SN_ERR_INSTANCE && st.steps == 0,
+                "sn_get_stats refuses it too (zeroed)");
     }
 }
 

@@ -7,6 +7,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Bounds on the OBJ's coordinates (mesh units).
+ * SB_MESH_COORD_MAX: |coordinate| <= 1e9. Beyond it a double holds a vertex
+ * no closer than 1.2e-7 mesh units (ulp(1e9)), already the Q22 resolution of
+ * a one-unit model (2^-23), so the baked rest shape would be rounding noise;
+ * and 1e308 made the bounding box infinite and the inside test's bins
+ * (int)floor(NaN). SB_MESH_EXTENT_MAX: the mesh's extent along each axis is
+ * at most 32768. A blob holds positions within 16384 mesh units of the root
+ * joint (runtime/BLOB.md, Validation 7: 2^27 stored Q22 and 2^(36 - len_shift)
+ * for len_shift > 9 are both 16384 mesh units, so the public Q16.16 values
+ * cannot overflow), so a wider mesh can never bake into a valid blob. */
+#define SB_MESH_COORD_MAX 1e9
+#define SB_MESH_EXTENT_MAX 32768.0
+
 static int parse_real(const char *s, double *out)
 {
     char *end;
@@ -69,6 +82,7 @@ int sb_mesh_load_obj(const char *path, sb_mesh *m)
     char line[4096];
     int lineno = 0, capv = 1024, k, i;
     int *pidx = NULL, *pstart = NULL, *pline = NULL, np = 0, capi = 4096, capp = 1024, ntri = 0;
+    int vmin[3] = {0, 0, 0}, vmax[3] = {0, 0, 0}, vline_lo[3] = {0, 0, 0}, vline_hi[3] = {0, 0, 0};
     memset(m, 0, sizeof *m);
     if (!f) return sb_fail("%s: cannot open mesh: %s", path, strerror(errno));
     m->v = malloc(sizeof(double) * 3 * (size_t)capv);
@@ -90,7 +104,15 @@ int sb_mesh_load_obj(const char *path, sb_mesh *m)
             if (nt < 4 || nt > 5) MESH_FAIL("%s:%d: malformed vertex (want 'v x y z')", path, lineno);
             for (k = 0; k < 3; k++)
                 if (!parse_real(tok[1 + k], &p[k])) MESH_FAIL("%s:%d: malformed vertex coordinate '%s'", path, lineno, tok[1 + k]);
+                else if (fabs(p[k]) > SB_MESH_COORD_MAX)
+                    MESH_FAIL("%s:%d: vertex coordinate '%s' is out of range: |coordinate| must be at most %g mesh units "
+                              "(move the mesh near the origin, or scale it and the description's 'unit')",
+                              path, lineno, tok[1 + k], SB_MESH_COORD_MAX);
             if (m->nv == capv) { capv *= 2; m->v = realloc(m->v, sizeof(double) * 3 * (size_t)capv); if (!m->v) MESH_FAIL("out of memory"); }
+            for (k = 0; k < 3; k++) {   /* lines of the extreme vertices, for the extent message */
+                if (m->nv == 0 || p[k] < m->v[3 * vmin[k] + k]) { vmin[k] = m->nv; vline_lo[k] = lineno; }
+                if (m->nv == 0 || p[k] > m->v[3 * vmax[k] + k]) { vmax[k] = m->nv; vline_hi[k] = lineno; }
+            }
             memcpy(m->v + 3 * m->nv, p, sizeof p);
             m->nv++;
         } else if (!strcmp(tok[0], "f")) {
@@ -181,6 +203,13 @@ int sb_mesh_load_obj(const char *path, sb_mesh *m)
             if (m->v[3 * i + k] < m->lo[k]) m->lo[k] = m->v[3 * i + k];
             if (m->v[3 * i + k] > m->hi[k]) m->hi[k] = m->v[3 * i + k];
         }
+    for (k = 0; k < 3; k++)
+        if (m->hi[k] - m->lo[k] > SB_MESH_EXTENT_MAX)
+            return sb_fail("%s:%d: vertex at %c = %g is %g mesh units from the vertex at line %d (%c = %g): a mesh may span at "
+                           "most %g mesh units along each axis (a blob holds positions within 16384 mesh units of the root "
+                           "joint): scale the mesh down and the description's 'unit' up",
+                           path, vline_hi[k], "xyz"[k], m->hi[k], m->hi[k] - m->lo[k], vline_lo[k], "xyz"[k], m->lo[k],
+                           SB_MESH_EXTENT_MAX);
     if (sb_mesh_volume(m) <= 0.0)
         return sb_fail("%s: mesh encloses a non-positive volume: faces must be counter-clockwise seen from outside", path);
     return 0;

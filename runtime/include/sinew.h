@@ -169,9 +169,22 @@ void sn_reset(sn_instance *inst);
 /// Quaternion signs are tracked (q is negated when it is nearer -q_previous),
 /// so frames between two bones interpolate the way the joint really turned,
 /// past 180° too: feed poses continuously, a joint turning less than 180° per
-/// step. A pose far from the last one (a teleport, a cut) should follow
-/// sn_reset.
+/// step. A pose far from the last one (a teleport, a cut) goes through
+/// sn_teleport (keeps the motion) or sn_reset (back to rest).
 sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints);
+
+/// Teleport: a discontinuous pose change (respawn, camera cut, root snapped
+/// across the map). Like sn_set_pose, but the flesh is carried rigidly with
+/// the skeleton: every lattice vertex keeps its offset from its frame
+/// (p' = R'_i R_i^T (p - c_i) + c'_i), its velocity and warm start turn by the
+/// same rotation, and the instance's origin jumps to the new root position,
+/// so local deformation and jiggle survive the jump with no saturation and
+/// no velocity spike. The new pose is also the previous pose of the next step
+/// (call sn_set_pose with the following pose as usual). Before the first
+/// step after init/reset it is sn_set_pose. Refusals as sn_set_pose.
+/// Without it, sn_set_pose with a large jump is bounded but not rigid: the
+/// origin moves at most 64 internal units per step, clamping (counted) the rest.
+sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_joints);
 
 /// Forward kinematics: local joint rotations (each about the joint's rest
 /// position, axes of the rest/model frame, relative to its parent) plus a
@@ -181,8 +194,9 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local,
                         const sn_vec3 *root_offset, sn_xform *out);
 
 /// Advance one timestep h with the current pose. Cost is fixed by the blob and
-/// the iteration count: no data-dependent loop exits.
-void sn_step(sn_instance *inst);
+/// the iteration count: no data-dependent loop exits. SN_ERR_NULL or
+/// SN_ERR_INSTANCE (nothing happens) if inst is not an initialised instance.
+sn_status sn_step(sn_instance *inst);
 
 /// Override the CG iteration count (1..cg_iters_max); 0 restores the blob default.
 sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations);
@@ -224,9 +238,11 @@ typedef struct sn_stats {
     sn_real  disp_max;     ///< largest disp since init/reset
     sn_real  energy;       ///< elastic + kinetic energy after the last step, joules (Q16.16 / float); kinetic uses the lumped mass
     sn_real  energy_max;   ///< largest energy since init/reset
+    uint32_t cg_clamps;    ///< CG step ratios (alpha, beta) clamped at 8 since init/reset (fixed; 0 in float): rounding-floor noise of a converged solve, not a fault
 } sn_stats;
-/// Read the diagnostics.
-void sn_get_stats(const sn_instance *inst, sn_stats *out);
+/// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
+/// if inst is not an initialised instance.
+sn_status sn_get_stats(const sn_instance *inst, sn_stats *out);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
 /// (free positions, velocities, warm start, skeleton state, step count), the

@@ -142,7 +142,7 @@ void sn_reset(sn_instance *inst) {
     /* zero the state (everything after the header, before the k table) */
     memset((unsigned char *)h + SN_HDR_BYTES, 0, h->o_k - SN_HDR_BYTES);
     h->steps = h->saturations = h->have_prev = 0;
-    h->bound_steps = h->limit_clamps = h->limit_steps = 0;
+    h->bound_steps = h->limit_clamps = h->limit_steps = h->cg_clamps = 0;
     h->disp = h->disp_max = h->energy = h->energy_max = 0;
     /* rest pose: identity rotations (the quaternion tracking starts here), zero translations */
     for (i = 0; i < nJ; i++) {
@@ -186,9 +186,12 @@ sn_status sn_set_mode(sn_instance *inst, sn_mode mode) {
     return SN_OK;
 }
 
-void sn_get_stats(const sn_instance *inst, sn_stats *out) {
-    const sn_ihdr *h = chdr_of(inst);
+sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
+    const sn_ihdr *h;
+    if (!inst || !out) return SN_ERR_NULL;
+    h = chdr_of(inst);
     memset(out, 0, sizeof *out);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     out->steps = h->steps;
     out->saturations = h->saturations;
     out->iterations = h->iterations;
@@ -196,10 +199,12 @@ void sn_get_stats(const sn_instance *inst, sn_stats *out) {
     out->bound_steps = h->bound_steps;
     out->limit_clamps = h->limit_clamps;
     out->limit_steps = h->limit_steps;
+    out->cg_clamps = h->cg_clamps;
     out->disp = h->disp;
     out->disp_max = h->disp_max;
     out->energy = h->energy;
     out->energy_max = h->energy_max;
+    return SN_OK;
 }
 
 /* ---- determinism hash: FNV-1a 64 over little-endian bytes ---- */

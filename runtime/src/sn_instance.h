@@ -21,7 +21,7 @@
 typedef struct sn_ihdr {
     uint32_t magic;
     uint32_t steps, saturations, iterations, mode, have_prev;
-    uint32_t bound_steps, limit_clamps, limit_steps;
+    uint32_t bound_steps, limit_clamps, limit_steps, cg_clamps;
     sn_view v;
     sn_real origin[3];      /* public units: origin o of the stored positions */
     sn_real disp, disp_max, energy, energy_max; /* health, public units */

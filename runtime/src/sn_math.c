@@ -213,17 +213,18 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
  * out = normalize(a cos(t theta) + v sin(t theta)/|v|).
  * Components clamped to +-2^30 and the ratio sin(t theta)/|v| to [0,1],
  * so no intermediate overflows for any input. Exact shortcuts: t == 0 -> a,
- * t == 1 -> b (sign chosen for the shorter arc), a == b -> a.
+ * t == 1 -> b (sign chosen for the shorter arc); no shortcut on the values
+ * (a == b takes the full path, to within 1-2 LSB of a), so the cost of a
+ * step does not depend on the pose.
  * Error for unit inputs: <= ~4 LSB per component (test: <= 8). */
 static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
     int64_t A[4], B[4], v[4], o[4], d = 0, tt, th, ph, sp, cp, k;
     uint64_t n2 = 0, s;
-    int i, same = 1, flip;
+    int i, flip;
     for (i = 0; i < 4; i++) {
         A[i] = sn_clamp64(a[i], SN_Q30);
         B[i] = sn_clamp64(b[i], SN_Q30);
         d += A[i] * B[i];
-        same &= a[i] == b[i];
     }
     d = sn_rshr64(d, 30); /* signed cos of the 4-D angle, Q30 */
     if (d > SN_Q30) d = SN_Q30;
@@ -234,8 +235,8 @@ static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, s
         d = -d;
     }
     tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
-    if (same || tt == 0 || tt == SN_Q30) {
-        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == SN_Q30 && !same ? B[i] : A[i]);
+    if (tt == 0 || tt == SN_Q30) { /* t is the blob's frame weight: not a pose-dependent branch */
+        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == SN_Q30 ? B[i] : A[i]);
         return;
     }
     for (i = 0; i < 4; i++) {

@@ -129,46 +129,35 @@ static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_q *c,
     }
 }
 
-/* Steps 1-2: rigid joint transforms, the origin, and the frames of every
- * lattice vertex and cell for the current pose. */
-void sn_frames(sn_ihdr *h, uint32_t *sat) {
+/* Joint rotations R_j from the pose quaternions, and the root joint's world
+ * position R_0 x_root + t_0 in public units (the origin the step follows). */
+static void joint_rotations(sn_ihdr *h, sn_real target[3], uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *pq = CARR(h, o_pq, sn_q), *pt = CARR(h, o_pt, sn_q);
-    sn_q *jR = ARR(h, o_jR, sn_q), *jT = ARR(h, o_jT, sn_q);
-    sn_q *R = ARR(h, o_R, sn_q), *c = ARR(h, o_c, sn_q), *pos = ARR(h, o_pos, sn_q);
-    sn_q *cR = ARR(h, o_cR, sn_q);
-    const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
-    sn_q xroot[3], rx[3], delta_int[3];
-    uint32_t i, j, k;
+    sn_q *jR = ARR(h, o_jR, sn_q), xroot[3], rx[3];
+    uint32_t j, k;
     for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
     for (j = 0; j < v->nJ; j++) sn_qtomat(pq + 4 * j, jR + 9 * j);
-    /* origin follows the root joint's world position R_0 x_root + t_0 */
     sn_rot(jR, xroot, rx, sat);
     for (k = 0; k < 3; k++) {
 #if defined(SN_FLOAT)
-        float target = pt[k] + int_to_pub(h, rx[k]);
-        delta_int[k] = pub_to_int(h, target - h->origin[k]);
-        h->origin[k] = target;
+        target[k] = pt[k] + int_to_pub(h, rx[k]);
 #else
-        int s = v->len_shift - (SN_Q_LEN - SN_LEN_FRAC);
-        int64_t target = (int64_t)pt[k] + int_to_pub64(h, rx[k]);
-        int64_t delta = target - h->origin[k], exact;
-        delta_int[k] = pub_to_int_sat(h, delta, sat);
-        /* move the origin only by what the internal format represents exactly */
-        exact = s >= 0 ? (int64_t)delta_int[k] * ((int64_t)1 << s) : sn_rshr64(delta_int[k], -s);
-        h->origin[k] = clamp32((int64_t)h->origin[k] + exact);
+        target[k] = clamp32((int64_t)pt[k] + int_to_pub64(h, rx[k]));
 #endif
     }
-    if (!h->have_prev) { delta_int[0] = delta_int[1] = delta_int[2] = 0; }
-    for (i = 0; i < v->nV; i++)
-        for (k = 0; k < 3; k++) {
-#if defined(SN_FLOAT)
-            pos[3 * i + k] = sn_add(pos[3 * i + k], -delta_int[k], sat);
-#else
-            pos[3 * i + k] = sn_out((int64_t)pos[3 * i + k] - delta_int[k], 0, sat);
-#endif
-        }
-    /* effective translations: T_j = R_j x_root + (t_j - o), internal units */
+}
+
+/* Effective joint translations T_j = R_j x_root + (t_j - o) (internal units),
+ * then the frames of every lattice vertex and cell. */
+static void joint_frames(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *pt = CARR(h, o_pt, sn_q), *jR = CARR(h, o_jR, sn_q);
+    sn_q *jT = ARR(h, o_jT, sn_q), *R = ARR(h, o_R, sn_q), *c = ARR(h, o_c, sn_q);
+    sn_q *cR = ARR(h, o_cR, sn_q), xroot[3], rx[3];
+    const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
+    uint32_t i, j, k;
+    for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
     for (j = 0; j < v->nJ; j++) {
         sn_rot(jR + 9 * j, xroot, rx, sat);
         for (k = 0; k < 3; k++) {
@@ -184,6 +173,149 @@ void sn_frames(sn_ihdr *h, uint32_t *sat) {
         frame_of(h, fr + 4 * i, R + 9 * i, c + 3 * i, sat);
     for (i = 0; i < v->nC; i++)
         frame_of(h, cfr + 4 * i, cR + 9 * i, NULL, sat);
+}
+
+/* Steps 1-2: rigid joint transforms, the origin, and the frames of every
+ * lattice vertex and cell for the current pose. */
+void sn_frames(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    sn_q *pos = ARR(h, o_pos, sn_q);
+    sn_real target[3];
+    sn_q delta_int[3];
+    uint32_t i, k;
+    joint_rotations(h, target, sat);
+    /* origin follows the root joint's world position */
+    for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+        delta_int[k] = pub_to_int(h, target[k] - h->origin[k]);
+        h->origin[k] = target[k];
+#else
+        int s = v->len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+        int64_t delta = (int64_t)target[k] - h->origin[k], exact;
+        delta_int[k] = pub_to_int_sat(h, delta, sat);
+        /* move the origin only by what the internal format represents exactly */
+        exact = s >= 0 ? (int64_t)delta_int[k] * ((int64_t)1 << s) : sn_rshr64(delta_int[k], -s);
+        h->origin[k] = clamp32((int64_t)h->origin[k] + exact);
+#endif
+    }
+    if (!h->have_prev) { delta_int[0] = delta_int[1] = delta_int[2] = 0; }
+    for (i = 0; i < v->nV; i++)
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            pos[3 * i + k] = sn_add(pos[3 * i + k], -delta_int[k], sat);
+#else
+            pos[3 * i + k] = sn_out((int64_t)pos[3 * i + k] - delta_int[k], 0, sat);
+#endif
+        }
+    joint_frames(h, sat);
+}
+
+/* M = A B^T of two rotations (Q30); entries of a product of unit rotations
+ * stay within [-1, 1], the clamp only guards rounding (not a state clamp). */
+static void mul_abt(const sn_q *A, const sn_q *B, sn_q *M) {
+    uint32_t r, c;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) {
+            sn_acc m = sn_mul(A[3 * r], B[3 * c]) + sn_mul(A[3 * r + 1], B[3 * c + 1]) +
+                       sn_mul(A[3 * r + 2], B[3 * c + 2]);
+#if defined(SN_FLOAT)
+            M[3 * r + c] = m;
+#else
+            m = sn_rshr64(m, SN_Q_ROT);
+            M[3 * r + c] = (sn_q)(m > SN_ONE_ROT ? SN_ONE_ROT : (m < -SN_ONE_ROT ? -SN_ONE_ROT : m));
+#endif
+        }
+}
+/* out = M a, rounded once (the product is kept at full precision) */
+static void carry(const sn_q *M, const sn_q a[3], sn_q out[3], uint32_t *sat) {
+    uint32_t k;
+    for (k = 0; k < 3; k++)
+        out[k] = sn_out(sn_mul(M[3 * k], a[0]) + sn_mul(M[3 * k + 1], a[1]) + sn_mul(M[3 * k + 2], a[2]),
+                        SN_Q_ROT, sat);
+}
+
+sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
+    sn_ihdr *h;
+    const sn_view *v;
+    sn_q *pq, *pt, *R, *c, *pos, *vel, *x, *jR;
+    sn_q d0[4], q0old[4], Rroot[9];
+    sn_real target[3];
+    uint32_t i, j, k, sat = 0;
+    if (!inst || !joints) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (n_joints != h->v.nJ) return SN_ERR_ARG;
+    for (j = 0; j < n_joints; j++)
+        if (!xform_ok(&joints[j])) return SN_ERR_ARG;
+    if (!h->have_prev) return sn_set_pose(inst, joints, n_joints); /* nothing to carry yet */
+    v = &h->v;
+    pq = ARR(h, o_pq, sn_q); pt = ARR(h, o_pt, sn_q); jR = ARR(h, o_jR, sn_q);
+    R = ARR(h, o_R, sn_q); c = ARR(h, o_c, sn_q);
+    pos = ARR(h, o_pos, sn_q); vel = ARR(h, o_vel, sn_q); x = ARR(h, o_x, sn_q);
+    memcpy(q0old, pq, sizeof q0old);
+    memcpy(Rroot, jR, sizeof Rroot); /* the root's rotation of the state's frames */
+    /* New quaternions. The root keeps the sign nearest its old one; every
+     * other joint the sign nearest its old quaternion carried by the root's
+     * turn D = q0' conj(q0), so the winding between bones is kept. */
+    for (j = 0; j < n_joints; j++) {
+        sn_q q[4], ref[4];
+        sn_acc dq;
+        q[0] = joints[j].rot.x; q[1] = joints[j].rot.y; q[2] = joints[j].rot.z; q[3] = joints[j].rot.w;
+        sn_qnormalize(q);
+        if (j == 0) {
+            memcpy(ref, q0old, sizeof ref);
+        } else {
+            sn_qmul(d0, pq + 4 * j, ref);
+        }
+        dq = sn_mul(q[0], ref[0]) + sn_mul(q[1], ref[1]) + sn_mul(q[2], ref[2]) + sn_mul(q[3], ref[3]);
+        if (dq < 0) { q[0] = -q[0]; q[1] = -q[1]; q[2] = -q[2]; q[3] = -q[3]; }
+        if (j == 0) {
+            sn_q cq[4];
+            cq[0] = -q0old[0]; cq[1] = -q0old[1]; cq[2] = -q0old[2]; cq[3] = q0old[3];
+            sn_qmul(q, cq, d0);
+        }
+        memcpy(pq + 4 * j, q, sizeof q);
+        pt[3 * j] = joints[j].pos.x;
+        pt[3 * j + 1] = joints[j].pos.y;
+        pt[3 * j + 2] = joints[j].pos.z;
+    }
+    /* the origin jumps to the new root position exactly: nothing is shifted */
+    joint_rotations(h, target, &sat);
+    for (k = 0; k < 3; k++) h->origin[k] = target[k];
+    /* each vertex keeps its offset from its frame, p' = M (p - c) + c', and its
+     * velocity and warm start turn with it, v' = M v, with M = R' R^T (the
+     * root's turn in the unwarped mode, whose frames do not rotate). Pass 1:
+     * pos <- M (p - c) with the old frames (frame_of reads only the new jR
+     * for R'); pass 2, after the new translations and frames: pos += c'. */
+    {
+        const unsigned char *fr = v->sec[SN_SEC_FRAMES];
+        for (i = 0; i < v->nV; i++) {
+            sn_q Rn[9], cn[3], M[9], off[3];
+            frame_of(h, fr + 4 * i, Rn, cn, &sat);
+            if (h->mode == SN_MODE_UNWARPED) mul_abt(jR, Rroot, M);
+            else mul_abt(Rn, R + 9 * i, M);
+            {   /* unturned (the same frame bits): exactly I, so a pure move is exact */
+                const sn_q *a = h->mode == SN_MODE_UNWARPED ? jR : Rn, *b = h->mode == SN_MODE_UNWARPED ? Rroot : R + 9 * i;
+                uint32_t diff = 0;
+                for (k = 0; k < 9; k++) diff |= a[k] != b[k]; /* no memcmp: libc */
+                if (!diff)
+                    for (k = 0; k < 9; k++) M[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+            }
+            for (k = 0; k < 3; k++) off[k] = sn_add(pos[3 * i + k], -c[3 * i + k], &sat);
+            carry(M, off, pos + 3 * i, &sat);
+            memcpy(off, vel + 3 * i, sizeof off);
+            carry(M, off, vel + 3 * i, &sat);
+            if (i < v->nF) {
+                memcpy(off, x + 3 * i, sizeof off);
+                carry(M, off, x + 3 * i, &sat);
+            }
+        }
+        joint_frames(h, &sat); /* T_j for the new origin, R', c', cell frames */
+        for (i = 0; i < v->nV; i++)
+            for (k = 0; k < 3; k++) pos[3 * i + k] = sn_add(pos[3 * i + k], c[3 * i + k], &sat);
+    }
+    h->saturations = sn_count(h->saturations, sat);
+    return SN_OK;
 }
 
 /* New skeleton positions p'_k = R_b x_k + T_b into pos, ds = v'_k - v_k,

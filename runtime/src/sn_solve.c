@@ -81,7 +81,7 @@ static void cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
 /* Saturating sum of non-negative energy terms (fixed: at 2^62). */
 SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
 #if defined(SN_FLOAT)
-    return e + x;
+    return e + (x > 0.0f ? x : 0.0f); /* a term below 0 (a hostile, indefinite Se) counts 0, as in fixed */
 #else
     const int64_t lim = (int64_t)1 << 62;
     if (x < 0) x = 0;
@@ -307,7 +307,8 @@ static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) 
     return r;
 }
 /* num/den, 0 when den <= 0 or num <= 0 (constant cost, no convergence branch) */
-static float ratio(sn_dotv num, sn_dotv den) {
+static float ratio(sn_dotv num, sn_dotv den, uint32_t *clamps) {
+    (void)clamps;
     return (den.m > 0.0f && num.m > 0.0f) ? num.m / den.m : 0.0f;
 }
 #define SN_Q_SCAL 0
@@ -340,8 +341,11 @@ static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) 
     r.e = s;
     return r;
 }
-/* num/den in Q28, 0 when den <= 0 or num <= 0; saturates at INT32_MAX. */
-static int32_t ratio(sn_dotv num, sn_dotv den) {
+/* num/den in Q28, 0 when den <= 0 or num <= 0 (converged: not a clamp);
+ * saturates at INT32_MAX (a ratio beyond 8), counted in *clamps. That
+ * happens in healthy runs (beta = rz'/rz when rz is at the rounding floor
+ * of a converged step), so it is its own statistic, not a saturation. */
+static int32_t ratio(sn_dotv num, sn_dotv den, uint32_t *clamps) {
     int e, bn, bd;
     uint64_t n, d, q;
     if (den.m <= 0 || num.m <= 0) return 0;
@@ -354,10 +358,11 @@ static int32_t ratio(sn_dotv num, sn_dotv den) {
     bn = bitlen64(n);
     if (bn > 62) { n >>= (bn - 62); e += bn - 62; } else { n <<= (62 - bn); e -= 62 - bn; }
     q = n / d; /* in [2^30, 2^32) */
-    if (e >= 0) return e > 0 || q > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)q;
-    if (e < -40) return 0;
-    q = (q + ((uint64_t)1 << (-e - 1))) >> -e;
-    return q > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)q;
+    if (e > 0) q = (uint64_t)INT32_MAX + 1u;
+    else if (e < -40) q = 0;
+    else if (e < 0) q = (q + ((uint64_t)1 << (-e - 1))) >> -e;
+    if (q > (uint64_t)INT32_MAX) { (*clamps)++; return INT32_MAX; }
+    return (int32_t)q;
 }
 #endif
 
@@ -378,6 +383,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
+    uint32_t clamps = 0;
 
     rhs(h, r, sat);
     /* PCG, warm-started from the previous step's solution, fixed iterations */
@@ -391,13 +397,13 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         sn_q alpha, beta, nalpha;
         matvec(h, d, q, sat);
         dq = dot(q, d, kk, n3);
-        alpha = ratio(rz, dq);
+        alpha = ratio(rz, dq, &clamps);
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
         precond(h, r, z, sat);
         rz1 = dot(r, z, kk, n3);
-        beta = ratio(rz1, rz);
+        beta = ratio(rz1, rz, &clamps);
         for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
         rz = rz1;
     }
@@ -406,4 +412,5 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         vel[i] = sn_add(vel[i], x[i], sat);
         pos[i] = sn_add(pos[i], vel[i], sat);
     }
+    h->cg_clamps = sn_count(h->cg_clamps, clamps);
 }

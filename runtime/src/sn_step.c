@@ -9,9 +9,12 @@
  */
 #include "sn_instance.h"
 
-void sn_step(sn_instance *inst) {
-    sn_ihdr *h = hdr_of(inst);
+sn_status sn_step(sn_instance *inst) {
+    sn_ihdr *h;
     uint32_t sat = 0;
+    if (!inst) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
     sn_solve(h, &sat);
@@ -19,4 +22,5 @@ void sn_step(sn_instance *inst) {
     sn_health(h, sat);
     h->saturations = sn_count(h->saturations, sat);
     h->steps = sn_count(h->steps, 1);
+    return SN_OK;
 }

@@ -99,6 +99,12 @@ base | sed 's/^mesh box.obj/mesh bad.obj/' > "$T/m.sinew"
 { cat "$T/box.obj"; echo "f 1 2 x"; } > "$T/bad.obj";                       expect obj-bad-index "bad.obj:[0-9]+: malformed face" "$T/m.sinew"
 { cat "$T/box.obj"; echo "f 1 2 9999"; } > "$T/bad.obj";                    expect obj-index-range "bad.obj:[0-9]+: malformed face: bad or out-of-range vertex index '9999'" "$T/m.sinew"
 { cat "$T/box.obj"; echo "v 1 nan 2"; } > "$T/bad.obj";                     expect obj-nan "bad.obj:[0-9]+: malformed vertex coordinate 'nan'" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "v 1 inf 2"; } > "$T/bad.obj";                     expect obj-inf "bad.obj:[0-9]+: malformed vertex coordinate 'inf'" "$T/m.sinew"
+# absurd coordinates (issue 16 item 7): |x| > 1e9 refused with file:line; 1e308 used to reach (int)floor(NaN)
+{ cat "$T/box.obj"; echo "v 1e308 0 0"; } > "$T/bad.obj";                   expect obj-1e308 "bad.obj:172: vertex coordinate '1e308' is out of range: \|coordinate\| must be at most 1e\+09" "$T/m.sinew"
+{ cat "$T/box.obj"; echo "v 0 -1.5e9 0"; } > "$T/bad.obj";                  expect obj-minus-1.5e9 "bad.obj:172: vertex coordinate '-1.5e9' is out of range" "$T/m.sinew"
+# a mesh wider than 32768 mesh units can never bake (a blob holds positions within 16384 of the root)
+awk '$1 == "v" && $2 > 0 { $2 = 40000 } { print }' "$T/box.obj" > "$T/bad.obj"; expect obj-extent "bad.obj:[0-9]+: vertex at x = 40000 is 40001 mesh units from the vertex at line [0-9]+ \(x = -1\): a mesh may span at most 32768" "$T/m.sinew"
 { cat "$T/box.obj"; echo "bogus 1 2 3"; } > "$T/bad.obj";                   expect obj-statement "bad.obj:[0-9]+: malformed OBJ: unsupported statement 'bogus'" "$T/m.sinew"
 grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | sed 1d >> "$T/bad.obj"; expect mesh-open "bad.obj: mesh is not closed" "$T/m.sinew"
 grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | awk '{ print $1, $2, $4, $3 }' >> "$T/bad.obj"; expect mesh-inside-out "bad.obj: mesh encloses a non-positive volume" "$T/m.sinew"

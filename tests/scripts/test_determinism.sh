@@ -6,6 +6,8 @@
 # the Cortex-M4 image (QEMU mps2-an386) and the desktop player. Float
 # flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
 # and sinew-play-float).
+# Every platform must also give the hash committed in tests/expected_hashes.txt
+# (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
 # emulator is a loud SKIPPED line (a failure when CI is set).
 . ports/cross/port_lib.sh
@@ -152,4 +154,22 @@ EOF2
     rm -f "$L/trace_ref.log"
 fi
 agree "float flavour" "$float" 3
+
+# ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
+# with each other is not enough; a change that alters every platform alike
+# must be made on purpose (`make update-hashes`, commit the file) ----
+expect_hash() {  # label list key
+    want=$(sed -n "s/^$3 \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt 2>/dev/null)
+    got=$(printf '%s' "$2" | awk '{print $2}' | sort | uniq -c | sort -rn | awk 'NR==1 {print $2}')
+    if [ -z "$want" ]; then bad "$1: no '$3' hash in tests/expected_hashes.txt (make update-hashes)"
+    elif [ -z "$got" ]; then bad "$1: no hash to compare with the committed $want"
+    elif [ "$got" = "$want" ]; then ok "$1: hash $got = tests/expected_hashes.txt"
+    else bad "$1: every platform gives $got, tests/expected_hashes.txt says $want: if the change is meant to alter the simulation, run 'make update-hashes' and commit tests/expected_hashes.txt with it"; fi
+}
+if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
+    expect_hash "fixed flavour" "$fixed" fixed
+    expect_hash "float flavour" "$float" float
+else
+    echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
+fi
 finish

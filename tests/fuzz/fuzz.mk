@@ -1,0 +1,109 @@
+# libFuzzer harnesses (issue 16 item 5). Included from the top-level Makefile
+# after tests/tests.mk. Built with clang -fsanitize=fuzzer,address,undefined
+# when clang is on PATH (under CI=true tests/scripts/test_fuzz.sh fails
+# without it; .ci/install-deps.sh installs clang and libclang-rt-14-dev).
+#
+#   $(FUZZ_DIR)/fuzz_blob_fixed   validator + instance + step, fixed runtime (tests/fuzz/lf_blob.c)
+#   $(FUZZ_DIR)/fuzz_blob_float   the same, float runtime (-DSN_FLOAT)
+#   $(FUZZ_DIR)/fuzz_clip         clip parser + sampler (ports/common; tests/fuzz/lf_clip.c)
+#   $(FUZZ_DIR)/fuzz_desc         description reader (tools/sb_desc.c; tests/fuzz/lf_desc.c)
+#   $(FUZZ_DIR)/fuzz_obj          OBJ reader + inside test (tools/sb_mesh.c; tests/fuzz/lf_obj.c)
+#
+# Seeds: tests/fuzz/corpus/<harness>/ (in the tree: clips, descriptions, OBJs)
+# plus $(FUZZ_DIR)/seeds/<harness>/ generated at build time (blobs of the
+# test writer tests/fuzz/sn_tblob.h, the baked examples' blobs, the example
+# clips/descriptions/meshes), so the blob seeds always follow sn_format.h.
+#
+#   make test            runs each harness FUZZ_SECONDS (default 10) s from a fresh work dir
+#   make fuzz            the long campaign: FUZZ_SECONDS (default 600) s per harness,
+#                        new inputs kept in $(FUZZ_DIR)/work/<harness>/ across runs;
+#                        FUZZ_HARNESSES="fuzz_obj fuzz_desc" picks some
+#   make fuzz-seeds      copy the generated blob seeds into tests/fuzz/corpus/ (after a format change)
+# A finding is saved as $(FUZZ_DIR)/artifacts/<harness>-crash-*; replay it with
+# `$(FUZZ_DIR)/<harness> FILE` (fuzz_clip also needs SN_LF_BLOB=$(BUILD)/examples/cow.blob).
+FUZZ_DIR   = $(BUILD)/fuzz
+FUZZ_CC   ?= clang
+FUZZ_HAVE := $(shell command -v $(FUZZ_CC) 2>/dev/null)
+LF_CFLAGS  = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined \
+             -fno-sanitize-recover=all -Itests/fuzz
+LF_RT      = $(SN_INC) -Iruntime/src $(SN_SRCS)
+LF_NAMES   = fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj
+LF_BINS    = $(addprefix $(FUZZ_DIR)/,$(LF_NAMES))
+LF_SEEDS   = $(addprefix $(FUZZ_DIR)/seeds/,$(addsuffix /.stamp,$(LF_NAMES)))
+
+$(FUZZ_DIR)/fuzz_blob_fixed: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h $(SN_SRCS) $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -o $@ $< $(LF_RT) -lm
+$(FUZZ_DIR)/fuzz_blob_float: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h $(SN_SRCS) $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -DSN_FLOAT -o $@ $< $(LF_RT) -lm
+$(FUZZ_DIR)/fuzz_clip: tests/fuzz/lf_clip.c tests/fuzz/lf_common.h ports/common/sn_clip.c ports/common/sn_clip_pose.c \
+                       ports/common/sn_clip.h $(SN_SRCS) $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -Iports/common -o $@ $< ports/common/sn_clip.c ports/common/sn_clip_pose.c $(LF_RT) -lm
+$(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h tools/sb_desc.c tools/sb_util.c tools/sb.h
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_desc.c tools/sb_util.c -lm
+$(FUZZ_DIR)/fuzz_obj: tests/fuzz/lf_obj.c tests/fuzz/lf_common.h tools/sb_mesh.c tools/sb_util.c tools/sb.h
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_mesh.c tools/sb_util.c -lm
+
+# ---- generated seeds ----
+$(FUZZ_DIR)/lf_seed_blob_fixed: tests/fuzz/lf_seed_blob.c tests/fuzz/sn_tblob.h $(SN_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(FUZZ_DIR)/lf_seed_blob_float: tests/fuzz/lf_seed_blob.c tests/fuzz/sn_tblob.h $(SN_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+# a writer that falls behind the format only costs its seeds (reported), not the build
+$(FUZZ_DIR)/seeds/fuzz_blob_fixed/.stamp: $(FUZZ_DIR)/lf_seed_blob_fixed $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob
+	@rm -rf $(@D) && mkdir -p $(@D)
+	-$(FUZZ_DIR)/lf_seed_blob_fixed $(@D)
+	cp $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob $(@D)/
+	@touch $@
+$(FUZZ_DIR)/seeds/fuzz_blob_float/.stamp: $(FUZZ_DIR)/lf_seed_blob_float $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob
+	@rm -rf $(@D) && mkdir -p $(@D)
+	-$(FUZZ_DIR)/lf_seed_blob_float $(@D)
+	cp $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob $(@D)/
+	@touch $@
+$(FUZZ_DIR)/seeds/fuzz_clip/.stamp: $(wildcard tools/examples/*/*.clip)
+	@rm -rf $(@D) && mkdir -p $(@D)
+	for f in tools/examples/*/*.clip; do cp $$f $(@D)/$$(basename $$(dirname $$f))_$$(basename $$f); done
+	@touch $@
+$(FUZZ_DIR)/seeds/fuzz_desc/.stamp: $(wildcard tools/examples/*/*.sinew)
+	@rm -rf $(@D) && mkdir -p $(@D)
+	for f in tools/examples/*/*.sinew; do cp $$f $(@D)/; done
+	@touch $@
+# the examples' meshes are 0.1-3 MB: only the small ones (limb, diag) seed the OBJ reader
+$(FUZZ_DIR)/seeds/fuzz_obj/.stamp: tools/examples/limb/limb.obj tools/examples/diag/diag.obj
+	@rm -rf $(@D) && mkdir -p $(@D)
+	cp tools/examples/limb/limb.obj tools/examples/diag/diag.obj $(@D)/
+	@touch $@
+
+.PHONY: fuzz fuzz-bins fuzz-seeds
+fuzz-bins: $(LF_BINS) $(LF_SEEDS) $(EX)/cow.blob
+fuzz: fuzz-bins
+	BUILD=$(BUILD) FUZZ_SECONDS=$${FUZZ_SECONDS:-600} FUZZ_KEEP=1 sh tests/scripts/test_fuzz.sh $(FUZZ_HARNESSES)
+fuzz-seeds: $(LF_SEEDS)
+	for h in fuzz_blob_fixed fuzz_blob_float; do mkdir -p tests/fuzz/corpus/$$h; \
+	  cp $(FUZZ_DIR)/seeds/$$h/tblob_*.blob tests/fuzz/corpus/$$h/; done
+
+# make test: the short run (tests/scripts/test_fuzz.sh) needs the harnesses
+# and their seeds; without clang the script reports SKIPPED (a failure under CI).
+ifneq ($(FUZZ_HAVE),)
+test: fuzz-bins
+endif
+
+# blob_patch: sets a header real and fixes the CRC (tests/scripts/test_player_timestep.sh)
+$(BUILD)/tests/blob_patch: tests/fuzz/blob_patch.c runtime/src/sn_format.h
+	@mkdir -p $(@D)
+	$(CC) -std=c99 -Wall -Wextra -Werror $(CFLAGS) -Iruntime/src -o $@ $< -lm
+test: $(BUILD)/tests/blob_patch
+
+# ---- expected state hashes (tests/expected_hashes.txt, checked by
+# tests/scripts/test_determinism.sh): rewrite them on purpose after a change
+# meant to alter the simulation. (Kept in this fragment so the Makefile
+# gains a single include line.)
+.PHONY: update-hashes
+update-hashes: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(EX)/cow.blob $(EX)/cow_float.blob
+	BUILD=$(BUILD) sh tests/scripts/update_hashes.sh

@@ -1,0 +1,36 @@
+#!/bin/sh
+# update_hashes.sh -- rewrite tests/expected_hashes.txt, the committed state
+# hashes tests/scripts/test_determinism.sh checks every platform against
+# (`make update-hashes`). Run it only for a change meant to alter the
+# simulation (blob format, arithmetic, baked matrices, the clip), after
+# checking the new motion, and commit the file with that change; the suite
+# then catches any later change that alters every platform alike.
+# The hashes are the desktop players' (sinew-play, sinew-play-float) on the
+# cow and its trot clip for 1000 steps: test_determinism.sh requires every
+# platform to agree with them. (Not named test_*.sh: the suite does not run it.)
+BUILD=${BUILD:-build}
+STEPS=1000
+CLIP=${COW_CLIP:-tools/examples/cow/trot.clip}
+OUT=tests/expected_hashes.txt
+hash_of() { sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }
+T=$(mktemp "${TMPDIR:-/tmp}/sinew_hash.XXXXXX") || exit 1
+trap 'rm -f "$T"' EXIT
+"$BUILD/sinew-play" "$BUILD/examples/cow.blob" --clip "$CLIP" --frames $STEPS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+fixed=$(hash_of "$T")
+"$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" --clip "$CLIP" --frames $STEPS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+float=$(hash_of "$T")
+[ -n "$fixed" ] && [ -n "$float" ] || { echo "update_hashes: a player printed no hash"; exit 1; }
+old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
+old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
+cat > "$OUT" <<EOT
+# Expected sn_state_hash of the cow (tools/examples/cow/cow.sinew) after
+# $STEPS steps of tools/examples/cow/trot.clip, checked by
+# tests/scripts/test_determinism.sh on every platform (fixed: x86-64, i686,
+# armhf, big-endian MIPS, Cortex-M4, sinew-play; float: the desktop builds
+# and sinew-play-float). A change that alters every platform alike fails
+# there until this file is updated on purpose: \`make update-hashes\`
+# (tests/scripts/update_hashes.sh), then commit it with the change.
+fixed $fixed
+float $float
+EOT
+echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float ($OUT)"
