@@ -21,6 +21,7 @@ include runtime/runtime.mk
 include tools/tools.mk
 include ports/desktop/desktop.mk
 include ports/baremetal/baremetal.mk
+include integration.mk
 include tests/tests.mk
 include tests/fuzz/fuzz.mk
 

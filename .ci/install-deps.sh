@@ -9,11 +9,14 @@ set -euo pipefail
 # uses the i686-linux-gnu cross compiler (runs natively on x86-64).
 # The libc6-dev-*-cross packages are only Recommends of the cross gcc packages
 # and --no-install-recommends would leave the cross compilers without headers.
+# cmake, pkg-config, g++ and clang (ThreadSanitizer: libclang-rt-14-dev) are
+# for tests/scripts/test_integration.sh (CMake package, pkg-config, C++, threads).
 # clang + libclang-rt-14-dev (libFuzzer, ASan/UBSan runtimes) + llvm
 # (llvm-symbolizer: readable sanitizer reports): tests/fuzz/fuzz.mk's libFuzzer
 # harnesses, which must run under CI (tests/scripts/test_fuzz.sh).
 PKGS=(
     make gcc g++ binutils clang valgrind libclang-rt-14-dev llvm
+    cmake pkg-config
     gcc-arm-none-eabi binutils-arm-none-eabi libnewlib-arm-none-eabi
     qemu-system-arm qemu-user
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross

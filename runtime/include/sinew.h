@@ -9,6 +9,18 @@
  * A blob is baked for one flavour; loading it into the other is an error
  * (SN_ERR_FLAVOUR).
  *
+ * Threads. The runtime has no mutable global state (no statics written, no
+ * locks, no thread-local storage): everything a call changes is in the
+ * instance passed to it. So:
+ *   - one instance is used by one thread at a time (calls on the same
+ *     instance from two threads at once need the caller's own lock);
+ *   - different instances can be stepped on different threads at once, with
+ *     no synchronisation, and give exactly the results of stepping them one
+ *     after another;
+ *   - a blob is shared read-only by any number of instances and threads
+ *     (it is never written after sn_blob_validate; it can sit in ROM).
+ * tests/integration/threads checks this (8 threads, also under ThreadSanitizer).
+ *
  * Units and number formats of the public API (fixed flavour / float flavour):
  *   lengths      sn_real, Q16.16 mesh units        / float mesh units
  *   quaternions  sn_real, Q30 (1.0 = 1<<30)         / float
