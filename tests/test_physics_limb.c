@@ -10,40 +10,6 @@
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
 
-/* signed volume of the closed surface (divergence theorem), mesh units^3 */
-static double surf_volume(const snref_model *m, const double *p) {
-    double v = 0;
-    unsigned t;
-    for (t = 0; t < m->nT; t++) {
-        const double *a = p + 3 * m->tris[3 * t], *b = p + 3 * m->tris[3 * t + 1], *c = p + 3 * m->tris[3 * t + 2];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-    }
-    return v / 6;
-}
-
-/* volume of the lattice cells whose rest centre lies within rad of point e
- * (each hex as 6 tetrahedra around its 0-7 diagonal) */
-static double cells_volume(const snref_model *m, const double *lat, const double e[3], double rad) {
-    static const int tet[6][2] = { { 1, 3 }, { 3, 2 }, { 2, 6 }, { 6, 4 }, { 4, 5 }, { 5, 1 } };
-    double v = 0;
-    unsigned c, k;
-    for (c = 0; c < m->nC; c++) {
-        const unsigned *cv = m->cells + 8 * c;
-        double ctr[3] = { 0, 0, 0 }, d2 = 0;
-        for (k = 0; k < 8; k++) { int q; for (q = 0; q < 3; q++) ctr[q] += (m->rest[3 * cv[k] + q] + m->jrest[q]) * m->unit / 8; }
-        for (k = 0; k < 3; k++) d2 += (ctr[k] - e[k]) * (ctr[k] - e[k]);
-        if (d2 > rad * rad) continue;
-        for (k = 0; k < 6; k++) {
-            const double *p0 = lat + 3 * cv[0], *p1 = lat + 3 * cv[tet[k][0]], *p2 = lat + 3 * cv[tet[k][1]], *p3 = lat + 3 * cv[7];
-            double a[3], b[3], d[3];
-            int q;
-            for (q = 0; q < 3; q++) { a[q] = p1[q] - p0[q]; b[q] = p2[q] - p0[q]; d[q] = p3[q] - p0[q]; }
-            v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0])) / 6;
-        }
-    }
-    return v;
-}
-
 /* the limb bent: elbow 90 degrees about z (forearm up), the rest identity */
 static void bent_pose(const sn_blob *b, unsigned nJ, sn_xform *out) {
     sn_quat local[16];
@@ -105,15 +71,15 @@ int main(void) {
     rest_s = malloc(3 * nS * sizeof *rest_s); rest_l = malloc(3 * nV * sizeof *rest_l);
     snref_get_surface(&s0, rest_s);
     snref_get_lattice(&s0, rest_l);
-    V0 = surf_volume(&m, rest_s);
+    V0 = snref_surface_volume(&m, rest_s);
     {
         int32_t e = sn_find_joint(r.blob, "elbow");
         for (k = 0; k < 3; k++) elbow[k] = e >= 0 ? m.jrest[3 * e + k] * m.unit : 0;
     }
-    Vc0 = cells_volume(&m, rest_l, elbow, 1.5);
+    Vc0 = snref_cells_volume(&m, rest_l, elbow, 1.5);
     T_CHECK(V0 > 0 && Vc0 > 0, "rest volumes %g %g (outward triangles)", V0, Vc0);
     ref_static(path, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, surf_ref, NULL, skin, lat_rt);
-    Vcskin = cells_volume(&m, lat_rt, elbow, 1.5);
+    Vcskin = snref_cells_volume(&m, lat_rt, elbow, 1.5);
     ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, surf_64, NULL, NULL, NULL);
     disp = pu_maxdist(surf_64, skin, nS);
     T_FIGURE("limb, elbow 90 deg: max elastic displacement (static surface - rigidly framed surface) %.4f mesh units; blob quantization (static, %s blob vs float64) %.2e of it",
@@ -136,8 +102,8 @@ int main(void) {
         e_ref = pu_maxdist(surf_rt, surf_ref, nS) / disp;
         e_64 = pu_maxdist(surf_rt, surf_64, nS) / disp;
         d1 = d2 / disp;
-        Vrt = surf_volume(&m, surf_rt); Vref = surf_volume(&m, surf_ref);
-        Vc_rt = cells_volume(&m, lat_rt, elbow, 1.5); Vc_ref = cells_volume(&m, lat, elbow, 1.5);
+        Vrt = snref_surface_volume(&m, surf_rt); Vref = snref_surface_volume(&m, surf_ref);
+        Vc_rt = snref_cells_volume(&m, lat_rt, elbow, 1.5); Vc_ref = snref_cells_volume(&m, lat, elbow, 1.5);
         T_FIGURE("limb %s, %s runtime settled (1200 steps): vs static solve same blob %.3e, vs float64 blob %.3e of the max displacement; still moving %.1e; saturations %u",
                  mode ? "UNWARPED" : "warped", PU_FLAVOUR_NAME, e_ref, e_64, d1, st.saturations);
         T_FIGURE("limb %s volume change: whole surface runtime %+.2f%% (static %+.2f%%), elbow cells (centre within 1.5 of the elbow) runtime %+.2f%% (static %+.2f%%)",
@@ -151,14 +117,14 @@ int main(void) {
         }
     }
     {
-        double Vskin = surf_volume(&m, skin), *s1 = malloc(3 * nS * sizeof *s1), *l1 = malloc(3 * nV * sizeof *l1);
+        double Vskin = snref_surface_volume(&m, skin), *s1 = malloc(3 * nS * sizeof *s1), *l1 = malloc(3 * nV * sizeof *l1);
         double *sk = malloc(3 * nV * sizeof *sk), *s2 = malloc(3 * nS * sizeof *s2), *l2 = malloc(3 * nV * sizeof *l2);
         double Vc1, Vc2, e1, e2, cell = m.cell * m.unit;
         T_FIGURE("limb volume change of the rigidly framed (skinned) lattice: surface %+.2f%%, elbow cells %+.2f%%", 100 * (Vskin / V0 - 1), 100 * (Vcskin / Vc0 - 1));
         /* static shapes of both force models on the float64 blob, and their distance from skinning near the elbow */
         ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_CELL, s2, l2, s1, sk);   /* s1: scratch for the skinned surface */
         ref_static(p64, pose, nJ, SNREF_WARPED, SNREF_FORCE_VERTEX, s1, l1, NULL, NULL);
-        Vc1 = cells_volume(&m, l1, elbow, 1.5); Vc2 = cells_volume(&m, l2, elbow, 1.5);
+        Vc1 = snref_cells_volume(&m, l1, elbow, 1.5); Vc2 = snref_cells_volume(&m, l2, elbow, 1.5);
         e1 = e2 = 0;
         for (k = 0; k < nV; k++) {
             double d1 = 0, d2 = 0, dr = 0;

@@ -381,38 +381,8 @@ static void test_moving(asset *A) {
     pu_rt_close(&r);
 }
 
-/* 5. biceps: volume at a 90-degree elbow with and without the bulge */
-static double surf_volume(const snref_model *m, const double *p) {
-    double v = 0;
-    unsigned t;
-    for (t = 0; t < m->nT; t++) {
-        const double *a = p + 3 * m->tris[3 * t], *b = p + 3 * m->tris[3 * t + 1], *c = p + 3 * m->tris[3 * t + 2];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-    }
-    return v / 6;
-}
-/* test_physics_limb's measure: cells whose rest centre is within rad of e (6 tetrahedra each) */
-static double cells_volume(const snref_model *m, const double *lat, const double e[3], double rad) {
-    static const int tet[6][2] = { { 1, 3 }, { 3, 2 }, { 2, 6 }, { 6, 4 }, { 4, 5 }, { 5, 1 } };
-    double v = 0;
-    unsigned c, k;
-    for (c = 0; c < m->nC; c++) {
-        const unsigned *cv = m->cells + 8 * c;
-        double ctr[3] = { 0, 0, 0 }, d2 = 0;
-        for (k = 0; k < 8; k++) { int q; for (q = 0; q < 3; q++) ctr[q] += (m->rest[3 * cv[k] + q] + m->jrest[q]) * m->unit / 8; }
-        for (k = 0; k < 3; k++) d2 += (ctr[k] - e[k]) * (ctr[k] - e[k]);
-        if (d2 > rad * rad) continue;
-        for (k = 0; k < 6; k++) {
-            const double *p0 = lat + 3 * cv[0], *p1 = lat + 3 * cv[tet[k][0]], *p2 = lat + 3 * cv[tet[k][1]], *p3 = lat + 3 * cv[7];
-            double a[3], b[3], d[3];
-            int q;
-            for (q = 0; q < 3; q++) { a[q] = p1[q] - p0[q]; b[q] = p2[q] - p0[q]; d[q] = p3[q] - p0[q]; }
-            v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0])) / 6;
-        }
-    }
-    return v;
-}
-
+/* 5. biceps: volume at a 90-degree elbow with and without the bulge
+ * (snref_cells_volume: test_physics_limb's elbow-cell measure) */
 typedef struct vols { double surf, cells; } vols;
 
 /* static (reference, float64 blob) and settled runtime volumes at elbow 90 */
@@ -434,9 +404,9 @@ static void biceps_case(const char *what, const unsigned char *rt_blob, size_t n
     s.rig_scale = rig;
     snref_static(&s, 0);
     snref_get_lattice(&s, lat); snref_get_surface(&s, surf);
-    vs->surf = surf_volume(&m, surf) / v0->surf - 1; vs->cells = cells_volume(&m, lat, elbow, 1.5) / v0->cells - 1;
+    vs->surf = snref_surface_volume(&m, surf) / v0->surf - 1; vs->cells = snref_cells_volume(&m, lat, elbow, 1.5) / v0->cells - 1;
     rt_settle(&r, pose, 0, 1200, surf, lat, NULL);   /* breath 0: its push off (tau(0) = 0), the bulge alone */
-    vr->surf = surf_volume(&m, surf) / v0->surf - 1; vr->cells = cells_volume(&m, lat, elbow, 1.5) / v0->cells - 1;
+    vr->surf = snref_surface_volume(&m, surf) / v0->surf - 1; vr->cells = snref_cells_volume(&m, lat, elbow, 1.5) / v0->cells - 1;
     T_FIGURE("biceps, limb elbow 90 deg, %s: elbow cells %+.2f%% (static %+.2f%%), whole limb %+.2f%% (static %+.2f%%) [%s runtime settled]",
              what, 100 * vr->cells, 100 * vs->cells, 100 * vr->surf, 100 * vs->surf, PU_FLAVOUR_NAME);
     free(lat); free(surf);
@@ -452,7 +422,7 @@ static void test_biceps(asset *A) {
     snref_init(&s, m);
     snref_get_lattice(&s, lat); snref_get_surface(&s, surf);
     for (k = 0; k < 3; k++) elbow[k] = m->jrest[3 * A->elbow + k] * m->unit;
-    v0.surf = surf_volume(m, surf); v0.cells = cells_volume(m, lat, elbow, 1.5);
+    v0.surf = snref_surface_volume(m, surf); v0.cells = snref_cells_volume(m, lat, elbow, 1.5);
     snref_release(&s);
     free(lat); free(surf);
     biceps_case("no rig", A->rt0, A->nrt0, A->d640, A->nd640, 0, elbow, &v0, &off_s, &off_r);

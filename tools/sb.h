@@ -208,6 +208,9 @@ int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits);
 /* the same with inside fractions: per grid cell fidx = -1 (outside), -2 (inside) or k >= 0:
  * frac[k * npt + q] is the inside fraction of quadrature point q's box */
 int sb_integrate_frac(const sb_desc *d, sb_model *o, const double *frac, const int *fidx);
+/* inside fractions of the quadrature boxes (subdivision n) of the grid cells with
+ * slot[gc] >= 0, added into frac[slot * 8n^3 + q] (sb_lattice.c; t0 >= 0 prints progress) */
+void sb_box_fractions(const sb_model *o, const sb_mesh *m, const sb_inside *in, int n, const int *slot, double *frac, double t0);
 /* checks of a built model (sinew-bake --check, tests): interior volume vs mesh
  * volume (= mass vs rho*V at uniform density), embedding error, null space of S */
 typedef struct sb_check {

@@ -170,10 +170,10 @@ static void rig_geometry(const sb_model *o, sb_rig *rg, double centre[3])
     }
 }
 
-/* Inside fractions of the quadrature point boxes of kept cell ci, as sb_lattice.c
- * step 3 computes them: +x rays on mm x mm lines per box, fraction = mean inside
- * length / box edge. Cells with fill 0 or 1 need no rays. Rays are cast per grid
- * row (cy, cz) for every marked cell of the row at once. */
+/* Inside fractions of the quadrature point boxes of the kept cells a rig
+ * needs, by the lattice build's own routine (sb_box_fractions; the build frees
+ * its fractions once the matrices are integrated). Cells with fill 0 or 1 need
+ * no rays. */
 typedef struct {
     int npt;
     int *slot;        /* per kept cell: -1 (use fill), or index into frac */
@@ -182,65 +182,27 @@ typedef struct {
 
 static void fracs_build(const sb_desc *d, const sb_mesh *m, const sb_model *o, const unsigned char *need, fracs_t *F)
 {
-    int n = d->subdiv, npt = n * n * n * 8, nx = o->gn[0] - 1, ny = o->gn[1] - 1, nz = o->gn[2] - 1, ngc = nx * ny * nz;
-    int ci, ns = 0, k, cap = 256, mm, row, *kept = sb_alloc(sizeof(int) * (size_t)ngc);
-    double c = o->c, hb = c / (2 * n), ext = 0, inv, *xs = sb_alloc(sizeof(double) * (size_t)cap);
-    unsigned char *rowmark = sb_alloc((size_t)(ny * nz));
+    int n = d->subdiv, npt = n * n * n * 8, ngc = (o->gn[0] - 1) * (o->gn[1] - 1) * (o->gn[2] - 1);
+    int ci, ns = 0, k, *gslot = sb_alloc(sizeof(int) * (size_t)ngc);
     sb_inside in;
     F->npt = npt;
     F->slot = sb_alloc(sizeof(int) * (size_t)(o->nc ? o->nc : 1));
-    for (k = 0; k < ngc; k++) kept[k] = -1;
+    for (k = 0; k < ngc; k++) gslot[k] = -1;
     for (ci = 0; ci < o->nc; ci++) {
         F->slot[ci] = -1;
         if (need[ci] && o->cell_fill[ci] > 0 && o->cell_fill[ci] < 1) {
             F->slot[ci] = ns++;
-            kept[o->cell_grid[ci]] = ci;
-            rowmark[o->cell_grid[ci] / nx] = 1;
+            gslot[o->cell_grid[ci]] = F->slot[ci];
         }
     }
     F->frac = sb_alloc(sizeof(double) * (size_t)npt * (size_t)(ns ? ns : 1));
-    if (ns == 0) { free(kept); free(xs); free(rowmark); return; }
-    sb_inside_init(&in, m);
-    for (k = 0; k < 3; k++) ext = fmax(ext, m->hi[k] - m->lo[k]);
-    mm = (int)ceil(hb / (ext / 2000));
-    mm = mm < 1 ? 1 : mm > 64 ? 64 : mm;
-    inv = 1.0 / ((double)mm * mm * hb);
-    for (row = 0; row < ny * nz; row++) {
-        int cy = row % ny, cz = row / ny, py, pz, u, v;
-        const double *c0 = o->gpos + 3 * (size_t)(o->gn[0] * (cy + o->gn[1] * cz));
-        if (!rowmark[row]) continue;
-        for (pz = 0; pz < 2 * n; pz++) for (v = 0; v < mm; v++) for (py = 0; py < 2 * n; py++) for (u = 0; u < mm; u++) {
-            double y = c0[1] + (py + (u + 0.5) / mm) * hb, z = c0[2] + (pz + (v + 0.5) / mm) * hb;
-            int nxs = sb_inside_ray(&in, y, z, xs, cap), e;
-            if (nxs > cap) { cap = nxs; free(xs); xs = sb_alloc(sizeof(double) * (size_t)cap); sb_inside_ray(&in, y, z, xs, cap); }
-            for (e = 1; e < nxs; e++) {
-                double xv = xs[e];
-                int f = e;
-                for (; f > 0 && xs[f - 1] > xv; f--) xs[f] = xs[f - 1];
-                xs[f] = xv;
-            }
-            for (e = nxs - 1; e >= 1; e -= 2) {
-                double xa = xs[e - 1] > m->lo[0] ? xs[e - 1] : m->lo[0], xb = xs[e] < m->hi[0] ? xs[e] : m->hi[0];
-                int px, p0, p1, nb = 2 * n;
-                if (!(xb > xa)) continue;
-                p0 = (int)floor((xa - c0[0]) / hb); p1 = (int)floor((xb - c0[0]) / hb);
-                p0 = p0 < 0 ? 0 : p0; p1 = p1 > nb * nx - 1 ? nb * nx - 1 : p1;
-                for (px = p0; px <= p1; px++) {
-                    int i = px / nb, bx = px % nb, gc = i + nx * row, qq;
-                    double b0, b1, len;
-                    if (kept[gc] < 0) { px = (i + 1) * nb - 1; continue; }
-                    b0 = o->gpos[3 * (size_t)(i + o->gn[0] * (cy + o->gn[1] * cz))] + bx * hb; b1 = b0 + hb;
-                    len = (xb < b1 ? xb : b1) - (xa > b0 ? xa : b0);
-                    if (len <= 0) continue;
-                    qq = (((pz >> 1) * n + (py >> 1)) * n + (bx >> 1)) * 8 + (bx & 1) + 2 * (py & 1) + 4 * (pz & 1);
-                    F->frac[(size_t)F->slot[kept[gc]] * (size_t)npt + (size_t)qq] += len * inv;
-                }
-            }
-        }
+    if (ns) {
+        sb_inside_init(&in, m);
+        sb_box_fractions(o, m, &in, n, gslot, F->frac, -1);
+        sb_inside_free(&in);
     }
     for (k = 0; k < ns * npt; k++) F->frac[k] = F->frac[k] > 1 ? 1 : F->frac[k];
-    sb_inside_free(&in);
-    free(kept); free(xs); free(rowmark);
+    free(gslot);
 }
 
 void sb_rig_free(sb_model *o)

@@ -372,15 +372,6 @@ static double maxdist(const double *a, const double *b, unsigned n, unsigned *at
     return mx;
 }
 
-static double surf_volume(const snref_model *m, const double *p) {
-    double v = 0;
-    unsigned t;
-    for (t = 0; t < m->nT; t++) {
-        const double *a = p + 3 * m->tris[3 * t], *b = p + 3 * m->tris[3 * t + 1], *c = p + 3 * m->tris[3 * t + 2];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-    }
-    return v / 6;
-}
 
 /* default output name: the description's stem + suffix, in the current directory */
 static void default_name(const char *desc, const char *suffix, char *out, size_t n) {
@@ -495,7 +486,7 @@ int sb_static_run(const char *desc, const sb_static_opts *opt) {
     {
         unsigned at = 0;
         double cellmu = m.cell * m.unit, d = maxdist(s_on, s_off, m.nS, &at), v0, v1;
-        v0 = surf_volume(&m, s_off); v1 = surf_volume(&m, s_on);
+        v0 = snref_surface_volume(&m, s_off); v1 = snref_surface_volume(&m, s_on);
         if (!q) {
             if (m.nR) printf("static: rigs move the surface by up to %.4g mesh units (%.3g cells) at surface vertex %u; volume %+.2f%% of the rigs-off shape\n",
                              d, d / cellmu, at, 100 * (v1 / v0 - 1));

@@ -25,34 +25,44 @@ static int xform_ok(const sn_xform *x) {
     return big;
 }
 
-sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
-    sn_ihdr *h;
+/* The checks sn_set_pose and sn_teleport share: the whole pose is refused,
+ * changing nothing, if any joint is unusable. */
+static sn_status pose_ok(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
     uint32_t j;
-    sn_q *pq, *pt;
     if (!inst || !joints) return SN_ERR_NULL;
-    h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
-    if (n_joints != h->v.nJ) return SN_ERR_ARG;
-    /* refuse the whole pose, changing nothing, if any joint is unusable */
+    if (hdr_of(inst)->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (n_joints != hdr_of(inst)->v.nJ) return SN_ERR_ARG;
     for (j = 0; j < n_joints; j++)
         if (!xform_ok(&joints[j])) return SN_ERR_ARG;
-    pq = ARR(h, o_pq, sn_q);
-    pt = ARR(h, o_pt, sn_q);
+    return SN_OK;
+}
+
+/* Joint j's new pose: its quaternion normalized, with the sign (q and -q are
+ * one rotation) nearer ref, and its translation. */
+static void store_joint(sn_ihdr *h, uint32_t j, const sn_xform *x, const sn_q ref[4]) {
+    sn_q *pq = ARR(h, o_pq, sn_q), *pt = ARR(h, o_pt, sn_q), q[4];
+    sn_acc dq;
+    q[0] = x->rot.x; q[1] = x->rot.y; q[2] = x->rot.z; q[3] = x->rot.w;
+    sn_qnormalize(q);
+    dq = sn_mul(q[0], ref[0]) + sn_mul(q[1], ref[1]) + sn_mul(q[2], ref[2]) + sn_mul(q[3], ref[3]);
+    if (dq < 0) { q[0] = -q[0]; q[1] = -q[1]; q[2] = -q[2]; q[3] = -q[3]; }
+    memcpy(pq + 4 * j, q, sizeof q);
+    pt[3 * j] = x->pos.x;
+    pt[3 * j + 1] = x->pos.y;
+    pt[3 * j + 2] = x->pos.z;
+}
+
+sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
+    sn_status st = pose_ok(inst, joints, n_joints);
+    uint32_t j;
+    if (st != SN_OK) return st;
+    /* track the hemisphere: keep the sign nearer the joint's previous
+     * quaternion so frames interpolate the way the joint really turned
+     * (NUMERICS.md step 1) */
     for (j = 0; j < n_joints; j++) {
-        sn_q q[4];
-        q[0] = joints[j].rot.x; q[1] = joints[j].rot.y; q[2] = joints[j].rot.z; q[3] = joints[j].rot.w;
-        sn_qnormalize(q);
-        {   /* track the hemisphere: q and -q are one rotation; keep the one
-             * nearer the joint's previous quaternion so frames interpolate
-             * the way the joint really turned (NUMERICS.md step 1) */
-            sn_acc dq = sn_mul(q[0], pq[4 * j]) + sn_mul(q[1], pq[4 * j + 1]) +
-                        sn_mul(q[2], pq[4 * j + 2]) + sn_mul(q[3], pq[4 * j + 3]);
-            if (dq < 0) { q[0] = -q[0]; q[1] = -q[1]; q[2] = -q[2]; q[3] = -q[3]; }
-        }
-        memcpy(pq + 4 * j, q, sizeof q);
-        pt[3 * j] = joints[j].pos.x;
-        pt[3 * j + 1] = joints[j].pos.y;
-        pt[3 * j + 2] = joints[j].pos.z;
+        sn_q prev[4];
+        memcpy(prev, CARR(hdr_of(inst), o_pq, sn_q) + 4 * j, sizeof prev);
+        store_joint(hdr_of(inst), j, &joints[j], prev);
     }
     return SN_OK;
 }
@@ -237,19 +247,16 @@ static void carry(const sn_q *M, const sn_q a[3], sn_q out[3], uint32_t *sat) {
 sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
     sn_ihdr *h;
     const sn_view *v;
-    sn_q *pq, *pt, *R, *c, *pos, *vel, *x, *jR;
+    sn_q *pq, *R, *c, *pos, *vel, *x, *jR;
     sn_q d0[4], q0old[4], Rroot[9];
     sn_real target[3];
     uint32_t i, j, k, sat = 0;
-    if (!inst || !joints) return SN_ERR_NULL;
+    sn_status st = pose_ok(inst, joints, n_joints);
+    if (st != SN_OK) return st;
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
-    if (n_joints != h->v.nJ) return SN_ERR_ARG;
-    for (j = 0; j < n_joints; j++)
-        if (!xform_ok(&joints[j])) return SN_ERR_ARG;
     if (!h->have_prev) return sn_set_pose(inst, joints, n_joints); /* nothing to carry yet */
     v = &h->v;
-    pq = ARR(h, o_pq, sn_q); pt = ARR(h, o_pt, sn_q); jR = ARR(h, o_jR, sn_q);
+    pq = ARR(h, o_pq, sn_q); jR = ARR(h, o_jR, sn_q);
     R = ARR(h, o_R, sn_q); c = ARR(h, o_c, sn_q);
     pos = ARR(h, o_pos, sn_q); vel = ARR(h, o_vel, sn_q); x = ARR(h, o_x, sn_q);
     memcpy(q0old, pq, sizeof q0old);
@@ -257,27 +264,16 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     /* New quaternions. The root keeps the sign nearest its old one; every
      * other joint the sign nearest its old quaternion carried by the root's
      * turn D = q0' conj(q0), so the winding between bones is kept. */
-    for (j = 0; j < n_joints; j++) {
-        sn_q q[4], ref[4];
-        sn_acc dq;
-        q[0] = joints[j].rot.x; q[1] = joints[j].rot.y; q[2] = joints[j].rot.z; q[3] = joints[j].rot.w;
-        sn_qnormalize(q);
-        if (j == 0) {
-            memcpy(ref, q0old, sizeof ref);
-        } else {
-            sn_qmul(d0, pq + 4 * j, ref);
-        }
-        dq = sn_mul(q[0], ref[0]) + sn_mul(q[1], ref[1]) + sn_mul(q[2], ref[2]) + sn_mul(q[3], ref[3]);
-        if (dq < 0) { q[0] = -q[0]; q[1] = -q[1]; q[2] = -q[2]; q[3] = -q[3]; }
-        if (j == 0) {
-            sn_q cq[4];
-            cq[0] = -q0old[0]; cq[1] = -q0old[1]; cq[2] = -q0old[2]; cq[3] = q0old[3];
-            sn_qmul(q, cq, d0);
-        }
-        memcpy(pq + 4 * j, q, sizeof q);
-        pt[3 * j] = joints[j].pos.x;
-        pt[3 * j + 1] = joints[j].pos.y;
-        pt[3 * j + 2] = joints[j].pos.z;
+    store_joint(h, 0, &joints[0], q0old);
+    {
+        sn_q cq[4];
+        cq[0] = -q0old[0]; cq[1] = -q0old[1]; cq[2] = -q0old[2]; cq[3] = q0old[3];
+        sn_qmul(pq, cq, d0);
+    }
+    for (j = 1; j < n_joints; j++) {
+        sn_q ref[4];
+        sn_qmul(d0, pq + 4 * j, ref); /* the old quaternion (still stored) carried by D */
+        store_joint(h, j, &joints[j], ref);
     }
     /* the origin jumps to the new root position exactly: nothing is shifted */
     joint_rotations(h, target, &sat);

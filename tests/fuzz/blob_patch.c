@@ -12,22 +12,13 @@
 #include <math.h>
 
 #include "sn_format.h"
+#include "sb.h" /* sb_crc32: the host tool's CRC-32 (tools/sb_util.c) */
 
 static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 static void wr32(unsigned char *p, uint32_t v) {
     p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24);
-}
-static uint32_t crc32_bytes(const unsigned char *p, size_t n) {
-    uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        c ^= p[i];
-        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-    }
-    return ~c;
 }
 
 int main(int argc, char **argv) {
@@ -57,7 +48,7 @@ int main(int argc, char **argv) {
     wr32(b + SN_H_REALS + 4 * SN_R_TIMESTEP, u);
     total = rd32(b + SN_H_TOTAL_SIZE);
     if (total < 16 || total > (uint32_t)n) { fprintf(stderr, "%s: bad total_size\n", argv[1]); return 2; }
-    wr32(b + SN_H_CRC32, crc32_bytes(b + 16, total - 16));
+    wr32(b + SN_H_CRC32, sb_crc32(b + 16, total - 16));
     if (!(f = fopen(argv[2], "wb")) || fwrite(b, 1, (size_t)n, f) != (size_t)n) { perror(argv[2]); return 2; }
     fclose(f);
     free(b);

@@ -95,9 +95,9 @@ test: fuzz-bins
 endif
 
 # blob_patch: sets a header real and fixes the CRC (tests/scripts/test_player_timestep.sh)
-$(BUILD)/tests/blob_patch: tests/fuzz/blob_patch.c runtime/src/sn_format.h
+$(BUILD)/tests/blob_patch: tests/fuzz/blob_patch.c runtime/src/sn_format.h tools/sb_util.c tools/sb.h
 	@mkdir -p $(@D)
-	$(CC) -std=c99 -Wall -Wextra -Werror $(CFLAGS) -Iruntime/src -o $@ $< -lm
+	$(CC) -std=c99 -Wall -Wextra -Werror $(CFLAGS) -Iruntime/src -Itools -o $@ $< tools/sb_util.c -lm
 test: $(BUILD)/tests/blob_patch
 
 # ---- expected state hashes (tests/expected_hashes.txt, checked by

@@ -1170,6 +1170,37 @@ void snref_surface_from_lattice(const snref_model *m, const double *lat, double 
     }
 }
 
+double snref_surface_volume(const snref_model *m, const double *p) {
+    double v = 0;
+    unsigned t;
+    for (t = 0; t < m->nT; t++) {
+        const double *a = p + 3 * m->tris[3 * t], *b = p + 3 * m->tris[3 * t + 1], *c = p + 3 * m->tris[3 * t + 2];
+        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return v / 6;
+}
+
+double snref_cells_volume(const snref_model *m, const double *lat, const double e[3], double rad) {
+    static const int tet[6][2] = { { 1, 3 }, { 3, 2 }, { 2, 6 }, { 6, 4 }, { 4, 5 }, { 5, 1 } };
+    double v = 0;
+    unsigned c, k;
+    for (c = 0; c < m->nC; c++) {
+        const unsigned *cv = m->cells + 8 * c;
+        double ctr[3] = { 0, 0, 0 }, d2 = 0;
+        for (k = 0; k < 8; k++) { int q; for (q = 0; q < 3; q++) ctr[q] += (m->rest[3 * cv[k] + q] + m->jrest[q]) * m->unit / 8; }
+        for (k = 0; k < 3; k++) d2 += (ctr[k] - e[k]) * (ctr[k] - e[k]);
+        if (d2 > rad * rad) continue;
+        for (k = 0; k < 6; k++) {
+            const double *p0 = lat + 3 * cv[0], *p1 = lat + 3 * cv[tet[k][0]], *p2 = lat + 3 * cv[tet[k][1]], *p3 = lat + 3 * cv[7];
+            double a[3], b[3], d[3];
+            int q;
+            for (q = 0; q < 3; q++) { a[q] = p1[q] - p0[q]; b[q] = p2[q] - p0[q]; d[q] = p3[q] - p0[q]; }
+            v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0])) / 6;
+        }
+    }
+    return v;
+}
+
 void snref_get_surface(const snref_state *s, double *out) {
     double *lat = malloc(3 * (size_t)s->m->nV * sizeof *lat);
     snref_get_lattice(s, lat);

@@ -144,6 +144,13 @@ void snref_get_surface(const snref_state *s, double *out);
 void snref_get_skinned(const snref_state *s, double *out);
 /* Surface from arbitrary lattice positions (mesh units, nV*3). */
 void snref_surface_from_lattice(const snref_model *m, const double *lat, double *out);
+/* Signed volume enclosed by the surface triangles at positions p (nS*3, mesh
+ * units): divergence theorem, mesh units^3. */
+double snref_surface_volume(const snref_model *m, const double *p);
+/* Volume of the lattice cells (positions lat, nV*3) whose rest centre lies
+ * within rad of point e (mesh units, model space + the root's rest): each hex
+ * as 6 tetrahedra around its 0-7 diagonal. */
+double snref_cells_volume(const snref_model *m, const double *lat, const double e[3], double rad);
 
 /* Static equilibrium (seed 003 eq. 10) at the current pose: skeleton fixed at
  * the pose, frames from the pose, f(p_F) + m^ g^ [- m^ R g^] + f_rig = 0 (the
