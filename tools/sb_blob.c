@@ -396,9 +396,16 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             else put_real(&w, kat, blk[k], 0);
         }
     }
-    for (i = 0; i < nlim; i++)
-        /* beyond 64 internal units the state clamps anyway (NUMERICS.md) */
-        put_real(&w, off[SN_SEC_LIMIT] + (size_t)i * (size_t)rs, fmin(o->limit[i] / U, 64.0), SN_Q_LEN);
+    {   /* beyond 64 internal units the state clamps anyway (NUMERICS.md): say so once */
+        int beyond = 0;
+        for (i = 0; i < nlim; i++) {
+            beyond |= o->limit[i] / U > 64.0;
+            put_real(&w, off[SN_SEC_LIMIT] + (size_t)i * (size_t)rs, fmin(o->limit[i] / U, 64.0), SN_Q_LEN);
+        }
+        if (beyond && !o->quiet)
+            fprintf(stderr, "sinew-bake: warning: a limit beyond %g mesh units (64 internal units, the state's range) acts as that bound\n",
+                    64.0 * U);
+    }
     for (i = 0; i < o->ns; i++) {
         size_t at = off[SN_SEC_EMBED] + 8 * (size_t)i;
         put_u16(&w, at, (unsigned)o->emb_cell[i]);

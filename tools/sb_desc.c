@@ -23,6 +23,18 @@ static int num(ctx_t *c, int i, double *out)
     return 0;
 }
 
+/* A length or a position in mesh units. A mesh spans at most 32768 units
+ * and lies within 1e9 of its origin (sb_mesh.c), so anything farther is a
+ * typo; the bound also keeps every grid index the lattice computes from it in
+ * int range. */
+#define SB_MAX_LEN 1e9
+static int len_num(ctx_t *c, int i, double *out)
+{
+    if (num(c, i, out)) return -1;
+    if (fabs(*out) > SB_MAX_LEN) return sb_fail("%s:%d: '%s' is beyond %g mesh units", c->path, c->line, c->tok[i], SB_MAX_LEN);
+    return 0;
+}
+
 static int inum(ctx_t *c, int i, int lo, int hi, int *out)
 {
     double v = 0;
@@ -117,7 +129,7 @@ static int region(ctx_t *c, const sb_desc *d, int first, int tail, sb_region *r)
         return sb_fail("%s:%d: %s: '%s %s' takes %d value(s) followed by %d more", c->path, c->line,
                        c->nt < first + n + tail ? "missing value" : "too many values", c->tok[0], kind, n - 1, tail);
     if (r->kind == SB_RG_BOX || r->kind == SB_RG_SPHERE)
-        for (k = 0; k < n - 1; k++) if (num(c, first + 1 + k, &r->a[k])) return -1;
+        for (k = 0; k < n - 1; k++) if (len_num(c, first + 1 + k, &r->a[k])) return -1;
     if (r->kind == SB_RG_BOX)
         for (k = 0; k < 3; k++) if (r->a[k] > r->a[k + 3]) return sb_fail("%s:%d: box lower corner above upper corner", c->path, c->line);
     if (r->kind == SB_RG_SPHERE && r->a[3] <= 0) return sb_fail("%s:%d: sphere radius must be positive", c->path, c->line);
@@ -149,15 +161,15 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         seen[0] = 1;
     } else if (!strcmp(kw, "unit")) {
         if (nargs(c, 1) || num(c, 1, &d->unit)) return -1;
-        if (d->unit <= 0) return sb_fail("%s:%d: unit (metres per mesh unit) must be positive", c->path, c->line);
+        if (!(d->unit >= 1e-9 && d->unit <= 1e9)) return sb_fail("%s:%d: unit (metres per mesh unit) must be in [1e-9, 1e9]", c->path, c->line);
         seen[1] = 1;
     } else if (!strcmp(kw, "cell")) {
-        if (nargs(c, 1) || num(c, 1, &d->cell)) return -1;
+        if (nargs(c, 1) || len_num(c, 1, &d->cell)) return -1;
         if (d->cell <= 0) return sb_fail("%s:%d: cell size must be positive", c->path, c->line);
         seen[2] = 1;
     } else if (!strcmp(kw, "origin")) {
         if (nargs(c, 3)) return -1;
-        for (k = 0; k < 3; k++) if (num(c, 1 + k, &d->origin[k])) return -1;
+        for (k = 0; k < 3; k++) if (len_num(c, 1 + k, &d->origin[k])) return -1;
         d->has_origin = 1;
     } else if (!strcmp(kw, "subdiv")) {
         if (nargs(c, 1) || inum(c, 1, 1, 16, &d->subdiv)) return -1;
@@ -168,7 +180,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (nargs(c, 1) || num(c, 1, &d->min_fill)) return -1;
         if (d->min_fill < 0 || d->min_fill >= 1) return sb_fail("%s:%d: min_fill must be in [0, 1)", c->path, c->line);
     } else if (!strcmp(kw, "blend")) {
-        if (nargs(c, 1) || num(c, 1, &d->blend)) return -1;
+        if (nargs(c, 1) || len_num(c, 1, &d->blend)) return -1;
         if (d->blend <= 0) return sb_fail("%s:%d: blend width must be positive", c->path, c->line);
     } else if (!strcmp(kw, "joint")) {
         sb_joint *j;
@@ -182,7 +194,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         j = &d->joints[d->nj];
         strcpy(j->name, c->tok[1]);
         strcpy(j->parent_name, c->tok[2]);
-        for (k = 0; k < 3; k++) if (num(c, 3 + k, &j->pos[k])) return -1;
+        for (k = 0; k < 3; k++) if (len_num(c, 3 + k, &j->pos[k])) return -1;
         j->line = c->line;
         j->parent = -1;
         j->bone_r = -1;
@@ -230,13 +242,17 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (d->alpha < 0 || d->beta < 0) return sb_fail("%s:%d: Rayleigh coefficients must be >= 0", c->path, c->line);
     } else if (!strcmp(kw, "timestep")) {
         if (nargs(c, 1) || num(c, 1, &d->h)) return -1;
-        if (d->h <= 0 || d->h > 1) return sb_fail("%s:%d: timestep must be in (0, 1] seconds", c->path, c->line);
+        /* below 2^-16 s the players' Q16.16 clip clock cannot step it */
+        if (d->h < 1.0 / 65536 || d->h > 1) return sb_fail("%s:%d: timestep must be in [1/65536, 1] seconds", c->path, c->line);
     } else if (!strcmp(kw, "iterations")) {
         if (nargs(c, 2) || inum(c, 1, 1, 256, &d->cg_def) || inum(c, 2, 1, 256, &d->cg_max)) return -1;
         if (d->cg_max < d->cg_def) return sb_fail("%s:%d: max iterations below the default", c->path, c->line);
     } else if (!strcmp(kw, "gravity")) {
         if (nargs(c, 3)) return -1;
-        for (k = 0; k < 3; k++) if (num(c, 1 + k, &d->g[k])) return -1;
+        for (k = 0; k < 3; k++) {
+            if (num(c, 1 + k, &d->g[k])) return -1;
+            if (fabs(d->g[k]) > 1e4) return sb_fail("%s:%d: gravity component '%s' is beyond 1e4 m/s^2", c->path, c->line, c->tok[1 + k]);
+        }
     } else if (!strcmp(kw, "twist")) {
         /* seed 000 eq. 25-26 stood in for 3-D bones; bones have volume now (DESCRIPTION.md) */
         return sb_fail("%s:%d: 'twist' is retired: bones now have volume (every lattice vertex within a bone's radius moves "
@@ -250,7 +266,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (j < 0) return sb_fail("%s:%d: unknown joint '%s' (declare joints before using them)", c->path, c->line, c->tok[1]);
         if (!strcmp(c->tok[2], "auto")) r = -1;
         else {
-            if (num(c, 2, &r)) return -1;
+            if (len_num(c, 2, &r)) return -1;
             if (r < 0) return sb_fail("%s:%d: bone radius must be >= 0 (or 'auto')", c->path, c->line);
         }
         d->joints[j].bone_r = r;
@@ -259,13 +275,13 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (nargs(c, 1)) return -1;
         if (!strcmp(c->tok[1], "auto")) d->bone_radius = -1;
         else {
-            if (num(c, 1, &d->bone_radius)) return -1;
+            if (len_num(c, 1, &d->bone_radius)) return -1;
             if (d->bone_radius < 0) return sb_fail("%s:%d: bone radius must be >= 0 (or 'auto')", c->path, c->line);
         }
     } else if (!strcmp(kw, "limit")) {
         sb_limitrule r;
         if ((n = region(c, d, 1, 1, &r.r)) < 0) return -1;
-        if (num(c, 1 + n, &r.dist)) return -1;
+        if (len_num(c, 1 + n, &r.dist)) return -1;
         if (r.dist < 0) return sb_fail("%s:%d: limit distance must be >= 0 (0 = no limit)", c->path, c->line);
         GROW(d->lrules, d->nlr);
         d->lrules[d->nlr++] = r;

@@ -363,12 +363,18 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     {
         double org[3];
         for (k = 0; k < 3; k++) {
-            int lo, hi;
+            double lo, hi;
             org[k] = d->has_origin ? d->origin[k] : o->joints[0].pos[k];
-            lo = (int)floor((m->lo[k] - org[k]) / c) - 1;
-            hi = (int)ceil((m->hi[k] - org[k]) / c) + 1;
+            lo = floor((m->lo[k] - org[k]) / c) - 1;
+            hi = ceil((m->hi[k] - org[k]) / c) + 1;
+            /* in double first: a tiny cell or a far origin must not overflow an int */
+            if (!(hi - lo + 1 <= 4e6) || !(fabs(lo) <= 1e9) || !(fabs(hi) <= 1e9)) {
+                sb_fail("%s: cell size %g (grid origin %g mesh units away on axis %d) gives a grid of %.3g vertices along one axis: "
+                        "use a larger cell or an origin near the mesh", d->path, c, fabs(org[k] - m->lo[k]), k, hi - lo + 1);
+                goto done;
+            }
             o->gorg[k] = org[k] + lo * c;
-            o->gn[k] = hi - lo + 1;
+            o->gn[k] = (int)(hi - lo) + 1;
         }
     }
     if ((double)o->gn[0] * o->gn[1] * o->gn[2] > 4e6) { sb_fail("%s: cell size %g is too small for this mesh (grid over 4 million vertices)", d->path, c); goto done; }
@@ -524,9 +530,9 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
         }
         for (k = 0; k < 3; k++) {
             lo[k] = fmin(P[k], C[k]) - r; hi[k] = fmax(P[k], C[k]) + r;
-            ilo[k] = (int)ceil((lo[k] - o->gorg[k]) / c - 1e-9); ihi[k] = (int)floor((hi[k] - o->gorg[k]) / c + 1e-9);
-            if (ilo[k] < 0) ilo[k] = 0;
-            if (ihi[k] > o->gn[k] - 1) ihi[k] = o->gn[k] - 1;
+            /* clamped in double before the conversion: a huge radius must not overflow an int */
+            ilo[k] = (int)fmax(0.0, fmin(o->gn[k], ceil((lo[k] - o->gorg[k]) / c - 1e-9)));
+            ihi[k] = (int)fmin(o->gn[k] - 1, fmax(-1.0, floor((hi[k] - o->gorg[k]) / c + 1e-9)));
         }
         for (z = ilo[2]; z <= ihi[2]; z++) for (y = ilo[1]; y <= ihi[1]; y++) for (x = ilo[0]; x <= ihi[0]; x++) {
             int g = gidx(o, x, y, z);

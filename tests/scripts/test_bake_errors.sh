@@ -102,6 +102,15 @@ base | sed 's/^mesh box.obj/mesh bad.obj/' > "$T/m.sinew"
 { cat "$T/box.obj"; echo "v 1 inf 2"; } > "$T/bad.obj";                     expect obj-inf "bad.obj:[0-9]+: malformed vertex coordinate 'inf'" "$T/m.sinew"
 # absurd coordinates (issue 16 item 7): |x| > 1e9 refused with file:line; 1e308 used to reach (int)floor(NaN)
 { cat "$T/box.obj"; echo "v 1e308 0 0"; } > "$T/bad.obj";                   expect obj-1e308 "bad.obj:172: vertex coordinate '1e308' is out of range: \|coordinate\| must be at most 1e\+09" "$T/m.sinew"
+# absurd description numbers (issue 16 item 7): refused at their line, before any int conversion
+{ base | sed 's/^cell 1$/cell 1e-300/'; } > "$T/n1.sinew";          expect cell-tiny "cell size 1e-300 .*gives a grid of" "$T/n1.sinew"
+{ base; echo "origin 1e300 0 0"; } > "$T/n2.sinew";                  expect origin-far "n2.sinew:8: '1e300' is beyond 1e\+09 mesh units" "$T/n2.sinew"
+{ base; echo "bone b 1e300"; } > "$T/n3.sinew";                      expect bone-huge "n3.sinew:8: '1e300' is beyond 1e\+09 mesh units" "$T/n3.sinew"
+{ base; echo "limit all 1e300"; } > "$T/n4.sinew";                   expect limit-huge "n4.sinew:8: '1e300' is beyond 1e\+09 mesh units" "$T/n4.sinew"
+{ base; echo "timestep 1e-7"; } > "$T/n5.sinew";                     expect h-tiny "n5.sinew:8: timestep must be in \[1/65536, 1\] seconds" "$T/n5.sinew"
+{ base | sed 's/^unit 0.1$/unit 1e300/'; } > "$T/n6.sinew";          expect unit-huge "n6.sinew:2: unit \(metres per mesh unit\) must be in" "$T/n6.sinew"
+{ base; echo "gravity 0 -1e300 0"; } > "$T/n7.sinew";                expect g-huge "n7.sinew:8: gravity component '-1e300' is beyond 1e4" "$T/n7.sinew"
+{ base; echo "region box -1e300 0 0 1 1 1 flesh"; } > "$T/n8.sinew"; expect region-far "n8.sinew:8: '-1e300' is beyond 1e\+09 mesh units" "$T/n8.sinew"
 { cat "$T/box.obj"; echo "v 0 -1.5e9 0"; } > "$T/bad.obj";                  expect obj-minus-1.5e9 "bad.obj:172: vertex coordinate '-1.5e9' is out of range" "$T/m.sinew"
 # a mesh wider than 32768 mesh units can never bake (a blob holds positions within 16384 of the root)
 awk '$1 == "v" && $2 > 0 { $2 = 40000 } { print }' "$T/box.obj" > "$T/bad.obj"; expect obj-extent "bad.obj:[0-9]+: vertex at x = 40000 is 40001 mesh units from the vertex at line [0-9]+ \(x = -1\): a mesh may span at most 32768" "$T/m.sinew"
