@@ -100,7 +100,8 @@ static int tau_samples(ctx_t *c, int first, sb_rigdef *r)
     if (n / 2 > SB_TAU_MAX) return sb_fail("%s:%d: rig '%s': %d tau samples, at most %d", c->path, c->line, r->name, n / 2, SB_TAU_MAX);
     for (k = 0; k < n / 2; k++) {
         if (num(c, first + 2 * k, &r->tau_g[k]) || num(c, first + 2 * k + 1, &r->tau_e[k])) return -1;
-        if (fabs(r->tau_g[k]) >= 32767.0) return sb_fail("%s:%d: tau gamma %g out of range (|gamma| < 32767)", c->path, c->line, r->tau_g[k]);
+        /* the runtime validates |gamma| <= 16384 (sn_blob.c: differences fit 2^31 in Q16.16) */
+        if (fabs(r->tau_g[k]) > 16384.0) return sb_fail("%s:%d: tau gamma %g out of range (|gamma| <= 16384)", c->path, c->line, r->tau_g[k]);
         if (fabs(r->tau_e[k]) > 1e6) return sb_fail("%s:%d: tau eta %g out of range (|eta| <= 1e6)", c->path, c->line, r->tau_e[k]);
         if (k > 0 && !(r->tau_g[k] > r->tau_g[k - 1]))
             return sb_fail("%s:%d: rig '%s': tau gammas must be strictly increasing (%g after %g)", c->path, c->line, r->name, r->tau_g[k], r->tau_g[k - 1]);
@@ -310,7 +311,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
             k_->kind = SB_CTL_ABSTRACT;
             if (c->nt == 3) {
                 if (num(c, 2, &k_->value0)) return sb_fail("%s:%d: '%s' is neither a default value nor 'angle'/'twist'", c->path, c->line, c->tok[2]);
-                if (fabs(k_->value0) >= 32767.0) return sb_fail("%s:%d: control default %g out of range (|value| < 32767)", c->path, c->line, k_->value0);
+                if (fabs(k_->value0) > 16384.0) return sb_fail("%s:%d: control default %g out of range (|value| <= 16384)", c->path, c->line, k_->value0);
             }
         }
         d->nctl++;
@@ -349,7 +350,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
                 return sb_fail("%s:%d: %s: 'rig NAME CONTROL %s STRENGTH %s' (got %d parameter(s) after the strength)", c->path, c->line,
                                np < want ? "missing value" : "wrong number of values", t, usage[r.tpl], np);
             }
-            for (k = 0; k < np; k++) if (num(c, 5 + k, &r.p[k])) { c->nt = nt_all; return -1; }
+            for (k = 0; k < np; k++) if (len_num(c, 5 + k, &r.p[k])) { c->nt = nt_all; return -1; }
             if (r.tpl == SB_TPL_BUMP) {
                 if (!(r.p[3] > 0)) { c->nt = nt_all; return sb_fail("%s:%d: bump radius must be positive (got %g)", c->path, c->line, r.p[3]); }
                 if (np == 7) { r.has_dir = 1; if (vec3(c, 9, "bump direction", 1, r.p + 4)) { c->nt = nt_all; return -1; } }

@@ -268,8 +268,7 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
         /* refinement: each quadrature box (edge hb = c/2n, inside fraction frac_q) split
          * into rr^3 mini-boxes with 2x2x2 Gauss points each so that the mini-box edge is
          * <= lmin/8: a rig can be much smaller than a cell (the cow's nostrils) */
-        rr = (int)ceil(hb / (lmin / 8) - 1e-9);
-        rr = rr < 1 ? 1 : rr > 8 ? 8 : rr;
+        rr = (int)fmin(8.0, fmax(1.0, ceil(hb / (lmin / 8) - 1e-9))); /* clamped before the int conversion */
         rg->refine = rr;
         for (ci = 0; ci < o->nc; ci++) {
             const double *x0 = o->x + 3 * o->cells[8 * ci], *fr = F.slot[ci] >= 0 ? F.frac + (size_t)F.slot[ci] * (size_t)npt : NULL;

@@ -111,6 +111,8 @@ base | sed 's/^mesh box.obj/mesh bad.obj/' > "$T/m.sinew"
 { base | sed 's/^unit 0.1$/unit 1e300/'; } > "$T/n6.sinew";          expect unit-huge "n6.sinew:2: unit \(metres per mesh unit\) must be in" "$T/n6.sinew"
 { base; echo "gravity 0 -1e300 0"; } > "$T/n7.sinew";                expect g-huge "n7.sinew:8: gravity component '-1e300' is beyond 1e4" "$T/n7.sinew"
 { base; echo "region box -1e300 0 0 1 1 1 flesh"; } > "$T/n8.sinew"; expect region-far "n8.sinew:8: '-1e300' is beyond 1e\+09 mesh units" "$T/n8.sinew"
+{ base; echo "control x"; echo "rig r x bump 0.1  2 0 0 0.5  tau 0 0 20000 1"; } > "$T/n9.sinew"; expect tau-far "n9.sinew:9: tau gamma 20000 out of range \(\|gamma\| <= 16384\)" "$T/n9.sinew"
+{ base; echo "control x"; echo "rig r x bump 0.1  2 0 0 1e300"; } > "$T/n10.sinew"; expect rig-radius-huge "n10.sinew:9: '1e300' is beyond 1e\+09 mesh units" "$T/n10.sinew"
 { cat "$T/box.obj"; echo "v 0 -1.5e9 0"; } > "$T/bad.obj";                  expect obj-minus-1.5e9 "bad.obj:172: vertex coordinate '-1.5e9' is out of range" "$T/m.sinew"
 # a mesh wider than 32768 mesh units can never bake (a blob holds positions within 16384 of the root)
 awk '$1 == "v" && $2 > 0 { $2 = 40000 } { print }' "$T/box.obj" > "$T/bad.obj"; expect obj-extent "bad.obj:[0-9]+: vertex at x = 40000 is 40001 mesh units from the vertex at line [0-9]+ \(x = -1\): a mesh may span at most 32768" "$T/m.sinew"
