@@ -366,7 +366,7 @@ static void test_examples(void)
     sb_blob b;
     int a;
     if (sb_bake_file("tools/examples/cow/cow.sinew", SB_FIXED, 1, &o, &b)) { T_CHECK(0, "bake cow: %s", sb_error()); return; }
-    T_CHECK(o.nctl == 3 && o.nrig == 5, "cow: 3 controls (breath, smile, nostrils), 5 rigs: got %d, %d", o.nctl, o.nrig);
+    T_CHECK(o.nctl == 4 && o.nrig == 6, "cow: 4 controls (breath, smile, nostrils, belly), 6 rigs: got %d, %d", o.nctl, o.nrig);
     for (a = 0; a < o.nrig; a++) {
         const sb_rigdef *r = &o.rig[a].def;
         T_CHECK(sb_rig_tau(r, o.ctl[r->control].value0) == 0, "cow rig '%s': tau(default) = 0: the cow's other tests see no rig force", r->name);

@@ -10,6 +10,7 @@ if ! have arm-none-eabi-gcc || ! have qemu-system-arm; then
     echo "SKIPPED: bench-baremetal needs arm-none-eabi-gcc and qemu-system-arm (make deps)"; exit 0
 fi
 B=$BUILD/baremetal
+mkdir -p "$B"   # a fresh build directory has none yet
 assets=cow
 if pmake -n "$BUILD/examples/limb_blob.c" >/dev/null 2>&1; then
     assets="$assets limb"

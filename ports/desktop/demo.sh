@@ -104,6 +104,8 @@ run "cow smile (90 steps)" "$PLAY" "$COW" --clip "$CLIPS/smile.clip" --frames 90
     --compare-rigs "$OUT/cow_smile_rigs.png" --heat 0.1 --view 40,15 $MUZZLE
 run "cow nostrils flared (210 steps)" "$PLAY" "$COW" --clip "$CLIPS/smile.clip" --frames 210 \
     --compare-rigs "$OUT/cow_nostrils_rigs.png" --heat 0.05 --view 75,10 $MUZZLE
+run "cow belly held in (60 steps)" "$PLAY" "$COW" --clip "$CLIPS/belly.clip" --frames 60 \
+    --compare-rigs "$OUT/cow_belly_rigs.png" --heat 0.1 --view 20,5
 run "limb biceps (150 steps)" "$PLAY" "$LIMB" --clip tools/examples/limb/flex.clip --frames 150 \
     --compare-rigs "$OUT/limb_biceps_rigs.png" --rig-off-blob "$BUILD/examples/norig/limb.blob" --heat 0.1 --view 0,10
 run "beast flex and breathe (150 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/flex.clip" --frames 150 \

@@ -11,7 +11,7 @@ PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c port
             ports/common/sn_clip.c ports/common/sn_clip_pose.c
 DEMO_DIR  = $(BUILD)/demo
 COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip tools/examples/cow/breathe.clip \
-            tools/examples/cow/smile.clip
+            tools/examples/cow/smile.clip tools/examples/cow/belly.clip
 
 # Tests that need no runtime.
 $(BUILD)/tests/test_clip: tests/test_clip.c ports/common/sn_clip.c ports/common/sn_clip.h tests/sn_test.h

@@ -92,10 +92,10 @@ echo "  figure: cow, breath 1 vs no rig after 45 steps of a head turn (float): s
 awk -v d="$d" 'BEGIN { exit !(d != "" && d > 0.01) }' && ok || bad "breath 1 moved the surface by only '$d' mesh units"
 
 # unknown control in a clip: a warning naming it and the blob's controls, exit 0
-expect 0 "warning: .*turn_bogus.clip: control 'bogus' is not in .*controls: breath smile nostrils.*ignored" \
+expect 0 "warning: .*turn_bogus.clip: control 'bogus' is not in .*controls: breath smile nostrils belly.*ignored" \
     "$PLAY" "$COW" --clip "$TMP/turn_bogus.clip" --frames 2 --quiet
 # --control: unknown name, pose control, syntax
-expect 1 "--control bogus=1: .* has no control 'bogus' \(controls: breath smile nostrils\)" "$PLAY" "$COW" --control bogus=1 --frames 1
+expect 1 "--control bogus=1: .* has no control 'bogus' \(controls: breath smile nostrils belly\)" "$PLAY" "$COW" --control bogus=1 --frames 1
 expect 1 "'elbow_bend' is a pose control" "$PLAY" "$LIMB" --control elbow_bend=45 --frames 1
 expect 2 "--control: want NAME=VALUE" "$PLAY" "$COW" --control breath
 expect 2 "--control: want NAME=VALUE" "$PLAY" "$COW" --control =1
@@ -122,7 +122,7 @@ expect 1 "bad4.clip: line 3: key time is after the clip duration" "$PLAYF" "$COW
 
 # --stats-csv: one column per control; the track's values step by step
 "$PLAY" "$COW" --clip "$TMP/turn_ramp.clip" --frames 60 --stats-csv "$TMP/ramp.csv" --quiet > /dev/null 2>&1
-head -1 "$TMP/ramp.csv" | grep -q ',limit_clamps,ctl_breath,ctl_smile,ctl_nostrils$' && ok ||
+head -1 "$TMP/ramp.csv" | grep -q ',limit_clamps,ctl_breath,ctl_smile,ctl_nostrils,ctl_belly$' && ok ||
     bad "stats csv header: $(head -1 "$TMP/ramp.csv")"
 # breath = -t up to 1 s, then -1 (the clip holds its end); smile, nostrils 0
 awk -F, 'NR > 1 { w = $2 < 1 ? -$2 : -1; e = $8 - w; if (e < -1e-3 || e > 1e-3 || $9 != 0 || $10 != 0) bad = 1; n++ }
