@@ -61,13 +61,24 @@ SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h $(SN_SRCS) $(SN_HDRS
 $(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+# the range-checking build's checks fire (no library: sn_internal.h inline code)
+$(BUILD)/tests/test_runtime_range: tests/test_runtime_range.c $(SN_TEST_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_range
+# the same hostile blobs through the range-checking build (every derived
+# shift, conversion and int64 sum bound asserted: sn_internal.h SN_RANGE)
+$(BUILD)/tests/test_runtime_fuzz_range: $(SN_FUZZ_DEPS) tests/fuzz/range_fail.c
+	@mkdir -p $(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
 $(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
 $(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
-TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float
+TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float \
+             $(BUILD)/tests/test_runtime_fuzz_range
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
 $(BUILD)/bench/sn_bench: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FIXED)

@@ -4,7 +4,8 @@
  * three rigs). Built fixed and float.
  *
  *  - API contract: set/get, refusals (pose control, out of range, NaN), reset;
- *    sn_step / sn_get_stats / controls on memory that is not an instance.
+ *    sn_step / sn_get_stats / sn_reset / sn_state_hash / controls on memory
+ *    that is not an instance.
  *  - Pose control vs a double swing-twist reference over random rotations.
  *  - tau through the physics: from rest, one step's displacement is
  *    homogeneous of degree 1 in the right-hand side (CG from a zero warm
@@ -105,6 +106,9 @@ static void test_api(const sn_blob *blob) {
                 "sn_step refuses memory that is not an instance");
         T_CHECK(sn_get_stats((sn_instance *)(void *)junk.m, &st) == SN_ERR_INSTANCE && st.steps == 0,
                 "sn_get_stats refuses it too (zeroed)");
+        T_CHECK(sn_reset((sn_instance *)(void *)junk.m) == SN_ERR_INSTANCE && sn_reset(NULL) == SN_ERR_NULL &&
+                    sn_state_hash((sn_instance *)(void *)junk.m) == 0 && sn_state_hash(NULL) == 0,
+                "sn_reset refuses it, sn_state_hash gives 0");
     }
 }
 

@@ -169,8 +169,10 @@ size_t sn_instance_size(const sn_blob *blob);
 sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out);
 
 /// Back to rest: rest pose, zero displacement and velocity, cleared warm start
-/// and counters. Keeps iteration count and mode.
-void sn_reset(sn_instance *inst);
+/// and counters, abstract controls at their baked values. Keeps iteration
+/// count and mode. SN_ERR_NULL / SN_ERR_INSTANCE (nothing happens) if inst is
+/// not an initialised instance.
+sn_status sn_reset(sn_instance *inst);
 
 /// Set the pose for the next sn_step: one transform per joint (rest model space
 /// to world). The first pose after init/reset also becomes the previous pose,
@@ -257,8 +259,9 @@ typedef struct sn_stats {
 sn_status sn_get_stats(const sn_instance *inst, sn_stats *out);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
-/// (free positions, velocities, warm start, skeleton state, step count), the
-/// same on every platform. Used by the determinism tests.
+/// (free positions, velocities, warm start, skeleton state, step count, control
+/// values), the same on every platform. Used by the determinism tests. 0 if
+/// inst is NULL or not an initialised instance.
 uint64_t sn_state_hash(const sn_instance *inst);
 
 /* ---- rig controls (seed 003 §3-4: Theta = (alpha, beta), rig forces eq. 11-12) ----

@@ -122,7 +122,7 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
         }
     }
     *out = (sn_instance *)mem;
-    sn_reset(*out);
+    (void)sn_reset(*out);
     return SN_OK;
 }
 
@@ -132,13 +132,22 @@ static void set_identity(sn_q *R, uint32_t n) {
         for (k = 0; k < 9; k++) R[9 * i + k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
 }
 
-void sn_reset(sn_instance *inst) {
-    sn_ihdr *h = hdr_of(inst);
-    const sn_view *v = &h->v;
-    uint32_t i, k, nV = v->nV, nJ = v->nJ;
-    sn_q *pq = ARR(h, o_pq, sn_q), *pt = ARR(h, o_pt, sn_q);
-    sn_q *pos = ARR(h, o_pos, sn_q);
-    const unsigned char *j0 = v->sec[SN_SEC_JOINTS];
+sn_status sn_reset(sn_instance *inst) {
+    sn_ihdr *h;
+    const sn_view *v;
+    uint32_t i, k, nV, nJ;
+    sn_q *pq, *pt, *pos;
+    const unsigned char *j0;
+    if (!inst) return SN_ERR_NULL;
+    h = hdr_of(inst);
+    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    v = &h->v;
+    nV = v->nV;
+    nJ = v->nJ;
+    pq = ARR(h, o_pq, sn_q);
+    pt = ARR(h, o_pt, sn_q);
+    pos = ARR(h, o_pos, sn_q);
+    j0 = v->sec[SN_SEC_JOINTS];
     /* zero the state (everything after the header, before the k table) */
     memset((unsigned char *)h + SN_HDR_BYTES, 0, h->o_k - SN_HDR_BYTES);
     h->steps = h->saturations = h->have_prev = 0;
@@ -164,6 +173,7 @@ void sn_reset(sn_instance *inst) {
     set_identity(ARR(h, o_R, sn_q), nV);
     set_identity(ARR(h, o_cR, sn_q), v->nC);
     sn_controls_reset(h);
+    return SN_OK;
 }
 
 sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations) {
@@ -223,11 +233,13 @@ static uint64_t fnv_q(uint64_t hsh, sn_q x) {
 }
 
 uint64_t sn_state_hash(const sn_instance *inst) {
-    const sn_ihdr *h = chdr_of(inst);
-    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q), *x = CARR(h, o_x, sn_q);
-    const sn_q *pq = CARR(h, o_pq, sn_q);
+    const sn_ihdr *h;
+    const sn_q *pos, *vel, *x, *pq;
     uint64_t hsh = 0xCBF29CE484222325ull;
     uint32_t i;
+    if (!inst || chdr_of(inst)->magic != SN_INST_MAGIC) return 0;
+    h = chdr_of(inst);
+    pos = CARR(h, o_pos, sn_q); vel = CARR(h, o_vel, sn_q); x = CARR(h, o_x, sn_q); pq = CARR(h, o_pq, sn_q);
     hsh = fnv_u32(hsh, h->steps);
     hsh = fnv_u32(hsh, h->saturations);
     hsh = fnv_u32(hsh, h->bound_steps);

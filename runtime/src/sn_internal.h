@@ -96,8 +96,26 @@ SN_INLINE sn_acc sn_mul(sn_q a, sn_q b) {
  * build where that is not so (the result would not be bit-identical).
  * Requires |x| <= 2^62 and s <= 62; s <= 0 returns x unchanged. */
 typedef char sn_arithmetic_shift_required_[(((int64_t)-3) >> 1) == -2 ? 1 : -1];
+
+/* Range-checking build (-DSN_RANGE_CHECK; in the spirit of Opus'
+ * fixed_debug.h): every rounding shift, accumulator conversion and int64
+ * sum whose bound NUMERICS.md derives asserts that bound, calling
+ * sn_range_fail, which the test program defines (the runtime has no I/O).
+ * Off in every other build: the checks compile to nothing. */
+#if defined(SN_RANGE_CHECK) && !defined(SN_FLOAT)
+void sn_range_fail(const char *what, const char *file, int line, long long value);
+#define SN_RANGE(cond, what, value) \
+    do { if (!(cond)) sn_range_fail((what), __FILE__, __LINE__, (long long)(value)); } while (0)
+#else
+#define SN_RANGE(cond, what, value) do { } while (0)
+#endif
+/* |x| <= 2^b for an int64 (b < 63) */
+#define SN_WITHIN(x, b) ((x) <= ((int64_t)1 << (b)) && (x) >= -((int64_t)1 << (b)))
+
 SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
     if (s <= 0) return x;
+    SN_RANGE(s <= 62, "rounding shift beyond 62", s);
+    SN_RANGE(x <= INT64_MAX - ((int64_t)1 << (s - 1)), "rounding add overflows int64", x);
     return (x + ((int64_t)1 << (s - 1))) >> s;
 }
 
@@ -112,7 +130,10 @@ SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
     if (a < -SN_FLIM) { (*sat)++; return -SN_FLIM; }
     return a;
 #else
-    int64_t v = sn_rshr64(a, s);
+    int64_t v;
+    SN_RANGE(a <= (int64_t)6521908912666391106 && a >= -(int64_t)6521908912666391106, /* 2^62.5 */
+             "accumulator beyond 2^62.5 reaches sn_out", a);
+    v = sn_rshr64(a, s);
     if (v > SN_LIM) { (*sat)++; return SN_LIM; }
     if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
     return (int32_t)v;

@@ -76,6 +76,7 @@ static void cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
             blk_mac_t(l + 3 * b, K, u + 3 * a);
         }
     }
+    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
 }
 
 /* Saturating sum of non-negative energy terms (fixed: at 2^62). */
@@ -163,7 +164,10 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     for (i = 0; i < nV; i++)
         for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], i < nF ? ck : v->b1, sat);
     cell_forces(h, u, acc, &e2, sat);
-    for (i = 0; i < 3 * nF; i++) b[i] = (sn_q)-sn_out(acc[i], SN_Q_ROT, sat); /* |.| <= SN_LIM */
+    for (i = 0; i < 3 * nF; i++) {
+        SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
+        b[i] = (sn_q)-sn_out(acc[i], SN_Q_ROT, sat); /* |.| <= SN_LIM */
+    }
     /* kinetic energy with the lumped mass: sum m^_i |v_i|^2 (twice the energy) */
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
@@ -264,7 +268,10 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
             rot_acc(acc + 3 * a, R, t);
         }
     }
-    for (i = 0; i < 3 * nF; i++) q[i] = sn_out(acc[i], SN_Q_ROT, sat);
+    for (i = 0; i < 3 * nF; i++) {
+        SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
+        q[i] = sn_out(acc[i], SN_Q_ROT, sat);
+    }
     pass_M_ff(h, d, acc);
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) {
@@ -337,6 +344,7 @@ static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) 
         int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
         for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
     }
+    SN_RANGE(SN_WITHIN(sum, 62), "block-floating dot product beyond 2^62", sum);
     r.m = sum;
     r.e = s;
     return r;
