@@ -120,7 +120,8 @@ SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
 }
 
 /* Accumulator -> value: round-shift by s, clamp to +-SN_LIM and count clamps
- * into *sat. Float: clamp to +-SN_FLIM internal units (s ignored).
+ * into *sat. Float: clamp to +-SN_FLIM internal units (s ignored); a NaN
+ * becomes 0 (counted), so it never enters the state.
  * Fixed: requires |a| < 2^62.5 so the rounding add cannot overflow; every
  * caller's sum is bounded below that (NUMERICS.md, overflow freedom). */
 SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
@@ -128,6 +129,7 @@ SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
     (void)s;
     if (a > SN_FLIM) { (*sat)++; return SN_FLIM; }
     if (a < -SN_FLIM) { (*sat)++; return -SN_FLIM; }
+    if (!(a == a)) { (*sat)++; return 0.0f; } /* NaN never enters the state: counted, replaced by 0 */
     return a;
 #else
     int64_t v;

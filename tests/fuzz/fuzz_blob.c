@@ -72,7 +72,9 @@ static void *g_mem;
 static size_t g_mem_size;
 static char g_case[128];
 static uint64_t g_rng;
-static int g_pose; /* 0: 25 degrees about one axis; 1: (1,1,1) onto -x, root far away */
+static int g_pose; /* 0: 25 degrees about one axis; 1: (1,1,1) onto -x, root far away;
+                    * 2: 180 degrees about (1,1,0) (w = 0), root at (-30000, 30000, -30000) */
+static int g_ctl_baked; /* 1: leave the controls at their baked values (default: the type's extremes) */
 static int g_steps = 2, g_iters = 2; /* crafted cases: more steps, every CG iteration */
 static sn_stats g_last_stats;       /* stats of the last exercise() */
 static int g_finite;                /* its lattice was finite (always, in fixed) */
@@ -134,7 +136,7 @@ static void exercise(const sn_blob *blob) {
         if (!g_mem) { fprintf(stderr, "out of memory\n"); exit(2); }
     }
     ist = sn_instance_init(g_mem, need, blob, &inst);
-    if (ist == SN_OK) /* abstract controls at the extremes of their type (tau clamps) */
+    if (ist == SN_OK && !g_ctl_baked) /* abstract controls at the extremes of their type (tau clamps) */
         for (j = 0; j < info.controls; j++) {
             sn_real cv;
             (void)sn_set_control(inst, j, (j & 1) ? REAL(-3.0e38f, -INT32_MAX) : REAL(3.0e38f, INT32_MAX));
@@ -156,15 +158,21 @@ static void exercise(const sn_blob *blob) {
     if (!local || !xf || !surf || !nrm || !lat) { fprintf(stderr, "out of memory\n"); exit(2); }
     for (j = 0; j < info.joints; j++) {
         sn_vec3 ax;
+        if (g_pose == 2) { /* a half turn: w = 0, the extreme quaternion */
+            ax.x = ax.y = REAL(1.0f, 65536);
+            ax.z = 0;
+            local[j] = sn_quat_axis_angle(ax, REAL(180.0f, 180 << 16));
+            continue;
+        }
         ax.x = g_pose ? 0 : REAL(0.3f, 19661);
         ax.y = g_pose ? REAL(-1.0f, -65536) : REAL(1.0f, 65536);
         ax.z = g_pose ? REAL(1.0f, 65536) : REAL(-0.2f, -13107);
         /* 125.26 degrees about (0,-1,1) takes (1,1,1) to -sqrt(3) x */
         local[j] = sn_quat_axis_angle(ax, g_pose ? REAL(125.26439f, 8209327) : REAL(25.0f, 25 << 16));
     }
-    root.x = g_pose ? REAL(30000.0f, 30000 << 16) : REAL(0.5f, 32768);
-    root.y = REAL(-0.25f, -16384);
-    root.z = 0;
+    root.x = g_pose == 2 ? REAL(-30000.0f, -30000 * 65536) : g_pose ? REAL(30000.0f, 30000 << 16) : REAL(0.5f, 32768);
+    root.y = g_pose == 2 ? REAL(30000.0f, 30000 << 16) : REAL(-0.25f, -16384);
+    root.z = g_pose == 2 ? REAL(-30000.0f, -30000 * 65536) : 0;
     sn_pose_from_local(blob, local, &root, xf);
     (void)sn_set_pose(inst, xf, info.joints);
     (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
