@@ -373,6 +373,20 @@ static void test_status(void) {
     T_CHECK(sn_status_str(SN_STATUS_COUNT) != NULL && sn_status_str((sn_status)-1) != NULL, "out of range");
 }
 
+/* sn_out keeps every state value in range: clamps counted; in float a NaN
+ * becomes 0 (counted) and an infinity the clamp, so neither enters the state. */
+static void test_out_guard(void) {
+    uint32_t sat = 0;
+#if defined(SN_FLOAT)
+    T_CHECK(sn_out(NAN, 0, &sat) == 0.0f && sat == 1, "float: NaN -> 0, counted");
+    T_CHECK(sn_out(INFINITY, 0, &sat) == SN_FLIM && sn_out(-INFINITY, 0, &sat) == -SN_FLIM && sat == 3, "float: +-inf -> +-clamp, counted");
+    T_CHECK(sn_out(1.5f, 0, &sat) == 1.5f && sat == 3, "float: a finite value passes unchanged");
+#else
+    T_CHECK(sn_out((int64_t)SN_LIM << 4, 4, &sat) == SN_LIM && sat == 0, "fixed: exactly the limit passes");
+    T_CHECK(sn_out(((int64_t)SN_LIM + 1) << 4, 4, &sat) == SN_LIM && sat == 1, "fixed: beyond the limit clamps, counted");
+#endif
+}
+
 int main(void) {
     g_rng = 0x9E3779B97F4A7C15ull ^ (uint64_t)T_SEED();
     printf("  flavour: %s\n", FLAV);
@@ -384,5 +398,6 @@ int main(void) {
     test_rotate();
     test_slerp();
     test_status();
+    test_out_guard();
     return T_END();
 }
