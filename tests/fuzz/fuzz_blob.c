@@ -11,6 +11,12 @@
  * hash, accessors, stats). Every section of format 3.0 (CFRAMES, CELLK, LIMIT
  * and the rig sections included) gets its bits flipped and its boundaries cut; crafted cases push
  * CELLK and every other matrix to the validator's bounds (see crafted_all).
+ * The extreme-valid matrix (matrix_all, issue 16 item 1) sets every header
+ * field, scalar and bounded section value to its minimum and its maximum
+ * (and the combinations the arithmetic makes), requires the validator to
+ * accept it, and steps it with violent poses in a child; the sweeps
+ * (sweep_all) step every value of the integer header fields and check that
+ * one past either end is refused. Prints the matrix (fields x {min, max}).
  *
  * Two builds of the same file (tests/fuzz/fuzz.mk... see runtime/runtime.mk):
  *   test_runtime_fuzz     -DSN_VALIDATE_NO_CHECKSUM: the checksum is skipped so
@@ -19,10 +25,11 @@
  *                         (CRC-32 detects every single-bit error; bytes 0..15,
  *                         outside the CRC, are magic/version/endian/CRC).
  *
- * Usage: test_runtime_fuzz [blob] [--all] [--per-section N] [--seed S]
+ * Usage: test_runtime_fuzz [blob] [--all] [--per-section N] [--seed S] [--crafted | --matrix]
  *   blob       default $BUILD/examples/cow.blob (fixed) or cow_float.blob
  *              (float); if missing, the hand-built test blob (sn_tblob.h)
  *   --all      every bit of the blob (slow for a 200 KB blob: ~1.5 M cases)
+ *   --crafted  only the crafted cases; --matrix only the extreme-valid matrix and sweeps
  *   env SN_FUZZ_TRACE=1: name each case on stderr before it runs (finds the case behind a sanitizer abort)
  *   default    every bit of the header and section table, every bit of the
  *              first and last 16 bytes of each section, plus N (default 600)
@@ -444,6 +451,620 @@ static int crafted_all(void) {
     return fails;
 }
 
+/* ---- the extreme-valid matrix (issue 16 item 1) ----
+ * Every header field and scalar the validator bounds, and the section values
+ * it bounds, set to its minimum and to its maximum (one row each), plus rows
+ * for the combinations the arithmetic makes (shift = frac -+ k_i ...: the
+ * fractions with len_shift, with the k_i spread 0/15 and with every entry of
+ * the matrices they scale at +-2^27). Each cell: the hand-built blob edited,
+ * CRC fixed, validated (must be accepted: the test's claim is "valid at the
+ * bound"), then, in a forked child under ASan+UBSan, exercise()d twice: pose 1
+ * ((1,1,1) onto -x, root 30000 mesh units away, teleport back halfway,
+ * controls at their type's extremes) and pose 2 (half turns, w = 0, root at
+ * (-30000, 30000, -30000), controls left at their baked values), MX_STEPS
+ * steps each with every CG iteration the blob allows. Printed: ok with the
+ * saturation count (state clamps over both runs), or the failure.
+ * Float: the same values as true values (matrices at Q0) where the flavour
+ * has them; frac_E and rig frac must be 0 there (those cells say n/a). */
+#define MX_STEPS 12
+#define E27 134217728.0 /* 2^27 */
+
+/* one real: the stored integer in fixed, the value f in float */
+static void put(unsigned char *p, int32_t fixed_raw, double f) {
+#if defined(SN_FLOAT)
+    (void)fixed_raw;
+    tb_real(p, f, 0);
+#else
+    (void)f;
+    tb_u32(p, (uint32_t)fixed_raw);
+#endif
+}
+static unsigned char *hreal(unsigned char *b, int r) { return b + SN_H_REALS + 4 * r; }
+static unsigned char *secp(unsigned char *b, int k) { return b + tb_sec(b, k); }
+/* every real of section k at +-2^27 by sign pattern (0 all +, 1 alternating, 2 random, 3 all -) */
+static void sec_max(unsigned char *b, int k, int pattern) {
+    uint32_t i, n = sec_n(b, k);
+    if (pattern < 3) { set_max(secp(b, k), n, pattern); return; }
+    for (i = 0; i < n; i++) put(secp(b, k) + 4 * i, -(int32_t)0x08000000, -E27);
+}
+/* scale the n reals at p by 2^-d (rest coordinates into a smaller box) */
+static void scale_down(unsigned char *p, uint32_t n, int d) {
+    uint32_t i;
+    for (i = 0; i < n; i++) {
+#if defined(SN_FLOAT)
+        float v;
+        uint32_t u = rd32(p + 4 * i);
+        memcpy(&v, &u, 4);
+        tb_real(p + 4 * i, ldexp(v, -d), 0);
+#else
+        tb_u32(p + 4 * i, (uint32_t)((int32_t)rd32(p + 4 * i) / ((int32_t)1 << d)));
+#endif
+    }
+}
+/* len_shift with the coordinates scaled into the validator's box
+ * |x| <= 2^(36 - ls) (Q22) when ls > 9 (the blob's largest is 1.0 = 2^22) */
+static void set_ls(unsigned char *b, int ls) {
+    b[SN_H_LEN_SHIFT] = (unsigned char)(ls & 0xFF);
+    if (ls > 14) {
+        scale_down(secp(b, SN_SEC_REST), 3 * TB_NV, ls - 14);
+        scale_down(secp(b, SN_SEC_JOINTS) + SN_ELEM_JOINTS(4) + 8, 3, ls - 14);
+    }
+}
+/* the coordinate bound of the validator for len_shift ls (stored integer, Q22; float: value) */
+static int32_t xbound(int ls) { return ls > 9 ? (int32_t)1 << (36 - ls) : (int32_t)1 << 27; }
+/* k_i spread: odd free vertices' preconditioner at 2^27 (trace 3 * 2^27: k = 15),
+ * even ones 1 LSB on the diagonal (the smallest trace, k = 0) */
+static void kspread(unsigned char *b) {
+    int i, d;
+    for (i = 0; i < TB_NF; i++)
+        for (d = 0; d < 6; d++)
+            put(secp(b, SN_SEC_PRECOND) + 4 * (6 * i + d), (i & 1) ? 0x08000000 : d < 3 ? 1 : 0,
+                (i & 1) ? E27 : d < 3 ? ldexp(1.0, -40) : 0.0);
+}
+static void all_cg(unsigned char *b) {
+    tb_u16(b + SN_H_CG_DEFAULT, 256);
+    tb_u16(b + SN_H_CG_MAX, 256);
+}
+static void mass_max(unsigned char *b, int pat) {
+    sec_max(b, SN_SEC_MDIAG, pat);
+    sec_max(b, SN_SEC_MLUMP, pat);
+    sec_max(b, SN_SEC_MOFF, pat == 0 || pat == 3 ? pat : 2);
+}
+
+/* ---- the edits: hi = 0 the minimum, 1 the maximum ---- */
+static void e_len_shift(unsigned char *b, int hi) { set_ls(b, hi ? 24 : -24); }
+static void e_frac_s(unsigned char *b, int hi) {
+    b[SN_H_FRAC_S] = (unsigned char)(hi ? 59 : 0);
+    sec_max(b, SN_SEC_CELLK, 2);
+    kspread(b);
+    all_cg(b);
+}
+static void e_frac_s_ls(unsigned char *b, int hi) { e_frac_s(b, hi); set_ls(b, hi ? 24 : -24); }
+static void e_frac_m(unsigned char *b, int hi) {
+    b[SN_H_FRAC_M] = (unsigned char)(hi ? 59 : 0);
+    mass_max(b, 2);
+    kspread(b);
+    all_cg(b);
+}
+static void e_frac_p(unsigned char *b, int hi) {
+    b[SN_H_FRAC_P] = (unsigned char)(hi ? 50 : 0);
+    sec_max(b, SN_SEC_PRECOND, 2);
+    all_cg(b);
+}
+static void e_frac_p_k(unsigned char *b, int hi) {
+    b[SN_H_FRAC_P] = (unsigned char)(hi ? 50 : 0);
+    kspread(b);
+    all_cg(b);
+}
+static void e_fracs_all(unsigned char *b, int hi) { /* S, M, P together with every matrix at 2^27 and k 0/15 */
+    b[SN_H_FRAC_S] = b[SN_H_FRAC_M] = (unsigned char)(hi ? 59 : 0);
+    b[SN_H_FRAC_P] = (unsigned char)(hi ? 50 : 0);
+    sec_max(b, SN_SEC_CELLK, 1);
+    mass_max(b, 1);
+    kspread(b);
+    all_cg(b);
+}
+static void e_frac_e(unsigned char *b, int hi) {
+#if !defined(SN_FLOAT)
+    b[SN_H_FRAC_E] = (unsigned char)((hi ? 60 : -40) & 0xFF);
+    tb_u32(hreal(b, SN_R_ENERGY), 0x7FFFFFFFu);
+#else
+    (void)b; (void)hi;
+#endif
+}
+static void e_frac_e_1lsb(unsigned char *b, int hi) {
+#if !defined(SN_FLOAT)
+    b[SN_H_FRAC_E] = (unsigned char)((hi ? 60 : -40) & 0xFF);
+    tb_u32(hreal(b, SN_R_ENERGY), 1u);
+#else
+    (void)b; (void)hi;
+#endif
+}
+static void e_a1(unsigned char *b, int hi) {
+    put(hreal(b, SN_R_A1), hi ? 1 << 28 : 0, hi ? 16.0 : 0.0);
+    mass_max(b, 2);
+    b[SN_H_FRAC_M] = 0;
+}
+static void e_b1(unsigned char *b, int hi) {
+    put(hreal(b, SN_R_B1), hi ? 1 << 28 : 0, hi ? 16.0 : 0.0);
+    sec_max(b, SN_SEC_CELLK, 2);
+    b[SN_H_FRAC_S] = 0;
+}
+static void e_a1b1(unsigned char *b, int hi) {
+    e_fracs_all(b, 0);
+    put(hreal(b, SN_R_A1), hi ? 1 << 28 : 0, hi ? 16.0 : 0.0);
+    put(hreal(b, SN_R_B1), hi ? 1 << 28 : 0, hi ? 16.0 : 0.0);
+}
+static void e_grav(unsigned char *b, int axis, int hi) {
+    put(hreal(b, SN_R_GRAV_X + axis), hi ? 0x08000000 : -0x08000000, hi ? 32.0 : -32.0);
+}
+static void e_gx(unsigned char *b, int hi) { e_grav(b, 0, hi); }
+static void e_gy(unsigned char *b, int hi) { e_grav(b, 1, hi); }
+static void e_gz(unsigned char *b, int hi) { e_grav(b, 2, hi); }
+static void e_g_mass(unsigned char *b, int hi) { /* m^ g^ with the mass at 2^27, frac_M 0, k 0/15, both flags */
+    int k;
+    for (k = 0; k < 3; k++) e_grav(b, k, hi);
+    mass_max(b, hi ? 0 : 3);
+    b[SN_H_FRAC_M] = 0;
+    kspread(b);
+    b[SN_H_FLAGS] = (unsigned char)(hi ? SN_FLAG_REST_MODELLED : 0);
+}
+static void e_timestep(unsigned char *b, int hi) {
+#if defined(SN_FLOAT)
+    uint32_t u = hi ? 0x47000000u /* 32768 */ : 1u /* the smallest subnormal, 1.4e-45 */;
+    tb_u32(hreal(b, SN_R_TIMESTEP), u);
+#else
+    tb_u32(hreal(b, SN_R_TIMESTEP), hi ? 0x7FFFFFFFu : 1u);
+#endif
+}
+static void e_mass_scale(unsigned char *b, int hi) {
+    put(hreal(b, SN_R_MASS_SCALE), hi ? INT32_MAX : INT32_MIN, hi ? 2147483648.0 : -2147483648.0);
+}
+static void e_energy(unsigned char *b, int hi) {
+#if defined(SN_FLOAT)
+    tb_u32(hreal(b, SN_R_ENERGY), hi ? 0x4F000000u /* 2^31 */ : 1u /* 1.4e-45 */);
+#else
+    tb_u32(hreal(b, SN_R_ENERGY), hi ? 0x7FFFFFFFu : 1u);
+#endif
+}
+static void e_cell(unsigned char *b, int hi) { put(hreal(b, SN_R_CELL), hi ? 0x08000000 : 1, hi ? 32.0 : ldexp(1.0, -22)); }
+static void e_disp_bound(unsigned char *b, int hi) {
+    put(hreal(b, SN_R_DISP_BOUND), hi ? INT32_MAX : 1, hi ? 32768.0 : ldexp(1.0, -16));
+}
+static void e_cg_default(unsigned char *b, int hi) {
+    tb_u16(b + SN_H_CG_DEFAULT, hi ? 256 : 1);
+    tb_u16(b + SN_H_CG_MAX, 256);
+}
+static void e_cg_max(unsigned char *b, int hi) {
+    tb_u16(b + SN_H_CG_DEFAULT, 1);
+    tb_u16(b + SN_H_CG_MAX, hi ? 256 : 1);
+}
+static void e_limit(unsigned char *b, int hi) {
+    int i;
+    for (i = 0; i < TB_NF; i++) put(secp(b, SN_SEC_LIMIT) + 4 * i, hi ? 1 << 28 : 0, hi ? 64.0 : 0.0);
+}
+/* rigs: every force at the type's extreme (fixed: +-INT32 alternating, or all
+ * one sign; float: +-SN_RIG_FLOAT_MAX), the frac of every rig at the bound,
+ * k 0/15 (shift 30 + frac - 19 - k from 1 to 61), etas +-1 */
+static void rig_forces(unsigned char *b, int sign) {
+    uint32_t k;
+    for (k = 0; k < 3 * TB_NRE; k++) {
+        int neg = sign ? sign < 0 : (int)(k & 1u);
+        put(secp(b, SN_SEC_RIG_FORCES) + 4 * k, neg ? INT32_MIN : INT32_MAX,
+            neg ? -(double)SN_RIG_FLOAT_MAX : (double)SN_RIG_FLOAT_MAX);
+    }
+}
+static void rig_frac(unsigned char *b, int frac) {
+    int k;
+    (void)frac; /* float: the frac byte must be 0 */
+    for (k = 0; k < TB_NR; k++) secp(b, SN_SEC_RIGS)[SN_ELEM_RIGS * k + 3] = (unsigned char)REAL(0, frac);
+}
+static void rig_etas(unsigned char *b, int pattern) { /* 0 all -1, 1 all +1, 2 alternating */
+    uint32_t k;
+    for (k = 0; k < TB_NRS; k++) {
+        int neg = pattern == 2 ? (int)(k & 1u) : !pattern;
+        put(secp(b, SN_SEC_RIG_SAMPLES) + 8 * k + 4, neg ? -(1 << 30) : 1 << 30, neg ? -1.0 : 1.0);
+    }
+}
+static void e_rig_frac(unsigned char *b, int hi) {
+    rig_frac(b, hi ? SN_RIG_FRAC_MAX : SN_RIG_FRAC_MIN);
+    rig_forces(b, 0);
+    rig_etas(b, 2);
+    kspread(b);
+}
+static void e_rig_force(unsigned char *b, int hi) {
+    rig_frac(b, SN_RIG_FRAC_MIN);
+    rig_forces(b, hi ? 1 : -1);
+    rig_etas(b, 1);
+    kspread(b);
+}
+static void e_ctl_value(unsigned char *b, int hi) { /* the abstract control's baked value (pose 2 keeps it) */
+    put(secp(b, SN_SEC_CONTROLS) + 40 + 12, hi ? 1 << 30 : -(1 << 30), hi ? 16384.0 : -16384.0);
+    rig_forces(b, 0);
+    rig_frac(b, SN_RIG_FRAC_MIN);
+}
+/* gammas: min = the first samples of each rig 1 LSB apart at -2^30, max = the
+ * last ones 1 LSB apart at +2^30 (rig 1, two samples, spans -2^30..2^30 both times) */
+static void e_gamma(unsigned char *b, int hi) {
+    static const int ns[TB_NR] = {3, 2, 1};
+    int r, j, s = 0;
+    for (r = 0; r < TB_NR; r++)
+        for (j = 0; j < ns[r]; j++, s++) {
+            int32_t g = r == 1 ? (j ? 1 << 30 : -(1 << 30)) : hi ? (1 << 30) - (ns[r] - 1 - j) : -(1 << 30) + j;
+            double gf = r == 1 ? (j ? 16384.0 : -16384.0) : hi ? 16384.0 - (ns[r] - 1 - j) / 65536.0 : -16384.0 + j / 65536.0;
+#if defined(SN_FLOAT)
+            if (r != 1 && ns[r] > 1) gf = hi ? 16384.0 - (ns[r] - 1 - j) / 512.0 : -16384.0 + j / 1024.0; /* float spacing at 2^14 */
+#endif
+            put(secp(b, SN_SEC_RIG_SAMPLES) + 8 * s, g, gf);
+        }
+    rig_etas(b, 2);
+    rig_forces(b, 0);
+    rig_frac(b, SN_RIG_FRAC_MIN);
+}
+static void e_eta(unsigned char *b, int hi) { rig_etas(b, hi); rig_forces(b, 0); rig_frac(b, SN_RIG_FRAC_MIN); }
+/* the angle control's axis at the norm tolerance |a|^2 = 1 -+ 2^-8 (Q30:
+ * 2^60 -+ 2^52). diag 0: along z; each component is also bounded by 1 (Q30:
+ * 2^30), so the maximum is z = 1 plus the largest x within the tolerance
+ * (2^-4); diag 1: (c, c, c) with c the smallest / largest accepted. */
+static void axis_at(unsigned char *b, int hi, int diag) {
+    unsigned char *ax = secp(b, SN_SEC_CONTROLS) + SN_ELEM_CONTROLS(4) + 40;
+    double n2 = hi ? 1.0 + 1.0 / 256 : 1.0 - 1.0 / 256;
+    int k, xz = hi && !diag; /* z = 1, solve for x */
+#if defined(SN_FLOAT)
+    /* float: the validator squares and sums in float; step until accepted */
+    float c = xz ? 0.0625f : (float)sqrt(n2 / (diag ? 3.0 : 1.0)), z;
+    for (;;) {
+        float m2 = diag ? c * c + c * c + c * c : xz ? c * c + 1.0f : c * c;
+        if (hi ? m2 <= 1.0f + 1.0f / 256 : m2 >= 1.0f - 1.0f / 256) break;
+        c = nextafterf(c, hi ? 0.0f : 2.0f);
+    }
+    if (hi) { /* then the largest still accepted */
+        for (;;) {
+            float d = nextafterf(c, 2.0f), m2 = diag ? d * d + d * d + d * d : xz ? d * d + 1.0f : d * d;
+            if (m2 > 1.0f + 1.0f / 256 || d > 1.0f) break;
+            c = d;
+        }
+    }
+    z = xz ? 1.0f : c;
+    tb_real(ax, (diag || xz) ? c : 0.0f, 0);
+    tb_real(ax + 4, diag ? c : 0.0f, 0);
+    tb_real(ax + 8, z, 0);
+    (void)k;
+#else
+    /* the largest (hi) / smallest (lo) component with the norm within the tolerance */
+    int64_t one = (int64_t)1 << 60, tol = (int64_t)1 << 52;
+    int64_t base = xz ? one : 0, n = diag ? 3 : 1;
+    int64_t c = xz ? ((int64_t)1 << 26) : (int64_t)(sqrt(ldexp(n2, 60) / (double)n));
+    while (base + n * c * c > one + tol) c--;
+    while (base + n * c * c < one - tol) c++;
+    if (hi) while (base + n * (c + 1) * (c + 1) <= one + tol && c + 1 <= ((int64_t)1 << 30)) c++;
+    else while (base + n * (c - 1) * (c - 1) >= one - tol) c--;
+    for (k = 0; k < 3; k++)
+        tb_u32(ax + 4 * k, (uint32_t)(int32_t)(diag ? c : k == 0 ? (xz ? c : 0) : k == 2 ? (xz ? (int64_t)1 << 30 : c) : 0));
+#endif
+    rig_forces(b, 0);
+    rig_frac(b, SN_RIG_FRAC_MIN);
+}
+static void e_axis_z(unsigned char *b, int hi) { axis_at(b, hi, 0); }
+static void e_axis_diag(unsigned char *b, int hi) { axis_at(b, hi, 1); }
+/* rest and joint coordinates at the box bound (every coordinate -X / +X, or
+ * each vertex's sign kept: the largest lattice the box holds) */
+static void coords(unsigned char *b, int ls, int hi, int keep_sign, int joints) {
+    int32_t X = xbound(ls);
+    double Xf = ldexp((double)X, -22);
+    uint32_t i, n = joints ? 3 * TB_NJ : 3 * TB_NV;
+    set_ls(b, ls); /* the part not set below must fit the box too */
+    for (i = 0; i < n; i++) {
+        unsigned char *p = joints ? secp(b, SN_SEC_JOINTS) + SN_ELEM_JOINTS(4) * (i / 3) + 8 + 4 * (i % 3)
+                                  : secp(b, SN_SEC_REST) + 4 * i;
+        int neg = !hi;
+        if (keep_sign) {
+#if defined(SN_FLOAT)
+            neg = (rd32(p) >> 31) != 0 || (i % 3 == 0 && rd32(p) == 0);
+#else
+            neg = (int32_t)rd32(p) < 0 || (i % 3 == 0 && rd32(p) == 0);
+#endif
+            if (hi) neg = !neg;
+        }
+        put(p, neg ? -X : X, neg ? -Xf : Xf);
+    }
+}
+static void e_rest(unsigned char *b, int hi) { coords(b, 0, hi, 0, 0); }
+static void e_rest_box(unsigned char *b, int hi) { coords(b, hi ? 9 : -24, 1, 1, 0); }
+static void e_rest_ls24(unsigned char *b, int hi) { coords(b, 24, hi, 1, 0); }
+static void e_joint(unsigned char *b, int hi) { coords(b, 0, hi, 0, 1); }
+static void e_joint_ls(unsigned char *b, int hi) { coords(b, hi ? 24 : -24, hi, 0, 1); }
+/* everything at once */
+static void e_all(unsigned char *b, int hi) {
+    e_fracs_all(b, hi);
+    e_frac_e(b, !hi);
+    e_a1b1(b, hi);
+    b[SN_H_FRAC_S] = b[SN_H_FRAC_M] = (unsigned char)(hi ? 59 : 0);
+    b[SN_H_FRAC_P] = (unsigned char)(hi ? 50 : 0);
+    e_gx(b, hi); e_gy(b, !hi); e_gz(b, hi);
+    e_timestep(b, hi);
+    e_cell(b, hi);
+    e_disp_bound(b, hi);
+    e_limit(b, hi);
+    e_rig_frac(b, hi);
+    e_axis_diag(b, hi);
+    coords(b, hi ? 24 : -24, hi, 1, 0);
+    coords(b, hi ? 24 : -24, hi, 0, 1);
+}
+
+typedef struct {
+    const char *field, *lo, *hi; /* row label; what min and max mean (fixed / float) */
+    void (*edit)(unsigned char *b, int hi);
+    int fixed_only;
+} mx_row;
+static const mx_row g_rows[] = {
+    {"len_shift", "-24", "24 (coords in box)", e_len_shift, 0},
+    {"frac_S, CELLK +-2^27, k 0/15", "0", "59", e_frac_s, 0},
+    {"frac_S x len_shift", "0, -24", "59, 24", e_frac_s_ls, 0},
+    {"frac_M, M +-2^27, k 0/15", "0", "59", e_frac_m, 0},
+    {"frac_P, P +-2^27 (k 0)", "0", "50", e_frac_p, 0},
+    {"frac_P, k 0/15", "0", "50", e_frac_p_k, 0},
+    {"frac_S,M,P all, matrices 2^27, k 0/15", "0,0,0", "59,59,50", e_fracs_all, 0},
+    {"frac_E, ENERGY max", "-40", "60", e_frac_e, 1},
+    {"frac_E, ENERGY 1 LSB", "-40", "60", e_frac_e_1lsb, 1},
+    {"a1, M +-2^27, frac_M 0", "0", "16", e_a1, 0},
+    {"b1, CELLK +-2^27, frac_S 0", "0", "16", e_b1, 0},
+    {"a1 = b1, every matrix 2^27, fracs 0", "0", "16", e_a1b1, 0},
+    {"gravity x", "-32", "32", e_gx, 0},
+    {"gravity y", "-32", "32", e_gy, 0},
+    {"gravity z", "-32", "32", e_gz, 0},
+    {"gravity xyz, M -+2^27, frac_M 0, k 0/15", "-32, no REST_MOD", "32, REST_MOD", e_g_mass, 0},
+    {"timestep", "1 LSB / 1.4e-45", "max / 32768", e_timestep, 0},
+    {"MASS_SCALE", "INT32_MIN", "INT32_MAX", e_mass_scale, 0},
+    {"ENERGY", "1 LSB / 1.4e-45", "max / 2^31", e_energy, 0},
+    {"CELL", "1 LSB / 2^-22", "2^27 / 32", e_cell, 0},
+    {"DISP_BOUND", "1 LSB / 2^-16", "max / 32768", e_disp_bound, 0},
+    {"cg_default (cg_max 256)", "1", "256", e_cg_default, 0},
+    {"cg_max (cg_default 1)", "1", "256", e_cg_max, 0},
+    {"LIMIT (all free vertices)", "0", "2^28 / 64", e_limit, 0},
+    {"rig frac, forces +-INT32, k 0/15", "5", "50", e_rig_frac, 0},
+    {"rig forces (frac 5, k 0/15)", "INT32_MIN", "INT32_MAX", e_rig_force, 0},
+    {"control value0 (baked, abstract)", "-2^30", "2^30", e_ctl_value, 0},
+    {"gammas (1 LSB apart)", "-2^30", "2^30", e_gamma, 0},
+    {"etas", "-1", "1", e_eta, 0},
+    {"angle axis z, |a|^2", "1 - 2^-8", "1 + 2^-8 (x 2^-4)", e_axis_z, 0},
+    {"angle axis (1,1,1), |a|^2", "1 - 2^-8", "1 + 2^-8", e_axis_diag, 0},
+    {"rest coords, len_shift 0", "all -2^27", "all +2^27", e_rest, 0},
+    {"rest coords, box corners", "ls -24, +-2^27", "ls 9, +-2^27", e_rest_box, 0},
+    {"rest coords, len_shift 24", "all -2^12", "all +2^12", e_rest_ls24, 0},
+    {"joint coords, len_shift 0", "all -2^27", "all +2^27", e_joint, 0},
+    {"joint coords, len_shift -+24", "-2^27, ls -24", "+2^12, ls 24", e_joint_ls, 0},
+    {"everything at once", "all min", "all max", e_all, 0},
+};
+#define N_ROWS ((int)(sizeof g_rows / sizeof g_rows[0]))
+
+static const mx_row *g_mx_row;
+static int g_mx_hi;
+static size_t craft_matrix(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0);
+    g_mx_row->edit(b, g_mx_hi);
+    tb_fix_crc(b);
+    return total;
+}
+
+typedef struct {
+    int rc; /* 0 ok, 3 rejected (status in st), 5 non-finite lattice, 6 non-finite stats */
+    int st;
+    unsigned long sat, limit_clamps, cg_clamps;
+} mx_result;
+
+/* One cell of the matrix in a child; the result through a pipe. */
+static void mx_cell(const mx_row *row, int hi, char *out, size_t outn, int *fail) {
+    int fd[2], status = 0;
+    pid_t pid;
+    mx_result r;
+    memset(&r, 0, sizeof r);
+    if (row->fixed_only && SN_FLAVOUR != SN_FLAVOUR_FIXED) { snprintf(out, outn, "n/a (float: 0)"); return; }
+    fflush(stdout);
+    if (pipe(fd) != 0) { snprintf(out, outn, "FAIL pipe"); (*fail)++; return; }
+    pid = fork();
+    if (pid == 0) {
+        const sn_blob *blob;
+        size_t n;
+        int pass;
+        close(fd[0]);
+        g_mx_row = row;
+        g_mx_hi = hi;
+        n = craft_matrix();
+        g_work = g_craft.b;
+        sprintf(g_case, "matrix: %s at %s (%s)", row->field, hi ? "max" : "min", hi ? row->hi : row->lo);
+        r.st = (int)sn_blob_validate(g_craft.b, n, &blob);
+        if (r.st != SN_OK) r.rc = 3;
+        for (pass = 0; pass < 2 && r.rc == 0; pass++) {
+            g_pose = pass ? 2 : 1;
+            g_ctl_baked = pass;
+            g_steps = MX_STEPS;
+            g_iters = 256;
+            exercise(blob);
+            r.sat += g_last_stats.saturations;
+            r.limit_clamps += g_last_stats.limit_steps;
+            r.cg_clamps += g_last_stats.cg_clamps;
+            if (!g_finite) r.rc = 5;
+#if defined(SN_FLOAT)
+            else if (!(g_last_stats.disp_max - g_last_stats.disp_max == 0.0f) ||
+                     !(g_last_stats.energy_max - g_last_stats.energy_max == 0.0f))
+                r.rc = 6;
+#endif
+        }
+        if (write(fd[1], &r, sizeof r) != (ssize_t)sizeof r) _exit(2);
+        _exit(0);
+    }
+    close(fd[1]);
+    if (pid < 0) { close(fd[0]); snprintf(out, outn, "FAIL fork"); (*fail)++; return; }
+    if (read(fd[0], &r, sizeof r) != (ssize_t)sizeof r) r.rc = -1;
+    close(fd[0]);
+    waitpid(pid, &status, 0);
+    if (r.rc == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        snprintf(out, outn, "FAIL sanitizer/crash (exit %d sig %d)", WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+                 WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+        (*fail)++;
+    } else if (r.rc == 3) {
+        snprintf(out, outn, "FAIL rejected %s", sn_status_str((sn_status)r.st));
+        (*fail)++;
+    } else if (r.rc == 5) {
+        snprintf(out, outn, "FAIL non-finite lattice");
+        (*fail)++;
+    } else if (r.rc == 6) {
+        snprintf(out, outn, "FAIL non-finite stats");
+        (*fail)++;
+    } else {
+        snprintf(out, outn, "ok, sat %lu", r.sat);
+    }
+}
+
+/* ---- sweep: every value of the small integer header fields, not only the
+ * ends (a shift that goes negative or past 62 at an inner value would show
+ * here), each with the combination that stresses it most; one child per
+ * field, the same two violent runs per value ---- */
+static int g_sw_val;
+static void s_len_shift(unsigned char *b, int v) { set_ls(b, v); }
+static void s_frac_s(unsigned char *b, int v) { e_frac_s(b, 0); b[SN_H_FRAC_S] = (unsigned char)v; }
+static void s_frac_m(unsigned char *b, int v) { e_frac_m(b, 0); b[SN_H_FRAC_M] = (unsigned char)v; }
+static void s_frac_p(unsigned char *b, int v) { e_frac_p_k(b, 0); b[SN_H_FRAC_P] = (unsigned char)v; }
+static void s_frac_e(unsigned char *b, int v) { e_frac_e(b, 0); b[SN_H_FRAC_E] = (unsigned char)(v & 0xFF); }
+static void s_rig_frac(unsigned char *b, int v) { e_rig_frac(b, 0); rig_frac(b, v); }
+typedef struct {
+    const char *field;
+    void (*edit)(unsigned char *b, int v);
+    int lo, hi, fixed_only;
+} sw_row;
+static const sw_row g_sweeps[] = {
+    {"len_shift", s_len_shift, -24, 24, 0},
+    {"frac_S (CELLK +-2^27, k 0/15)", s_frac_s, 0, 59, 1}, /* float: the fractions scale nothing (k = 0) */
+    {"frac_M (M +-2^27, k 0/15)", s_frac_m, 0, 59, 1},
+    {"frac_P (k 0/15)", s_frac_p, 0, 50, 1},
+    {"frac_E (ENERGY max)", s_frac_e, -40, 60, 1},
+    {"rig frac (forces +-INT32, k 0/15)", s_rig_frac, SN_RIG_FRAC_MIN, SN_RIG_FRAC_MAX, 1},
+};
+static const sw_row *g_sw;
+static size_t craft_sweep(void) {
+    unsigned char *b = g_craft.b;
+    uint32_t total = tb_build(b, sizeof g_craft.b, 0);
+    g_sw->edit(b, g_sw_val);
+    tb_fix_crc(b);
+    return total;
+}
+typedef struct {
+    int rc, val, st, n;
+    unsigned long sat_min, sat_max;
+} sw_result;
+static int sweep_one(const sw_row *row) {
+    int fd[2], status = 0;
+    pid_t pid;
+    sw_result r;
+    memset(&r, 0, sizeof r);
+    if (row->fixed_only && SN_FLAVOUR != SN_FLAVOUR_FIXED) {
+        printf("  %-36s %4d..%-4d n/a in float (must be 0, or scales nothing)\n", row->field, row->lo, row->hi);
+        return 0;
+    }
+    { /* the range is the validator's: one past either end is refused */
+        int ends[2], e;
+        ends[0] = row->lo - 1;
+        ends[1] = row->hi + 1;
+        g_sw = row;
+        for (e = 0; e < 2; e++) {
+            const sn_blob *blob;
+            size_t n;
+            g_sw_val = ends[e];
+            n = craft_sweep();
+            if (sn_blob_validate(g_craft.b, n, &blob) == SN_OK) {
+                printf("FAIL: sweep %s: the validator accepts %d, outside the range this test proves safe\n", row->field,
+                       ends[e]);
+                return 1;
+            }
+        }
+    }
+    fflush(stdout);
+    if (pipe(fd) != 0) return 1;
+    pid = fork();
+    if (pid == 0) {
+        close(fd[0]);
+        g_sw = row;
+        r.sat_min = ~0ul;
+        for (g_sw_val = row->lo; g_sw_val <= row->hi && r.rc == 0; g_sw_val++) {
+            const sn_blob *blob;
+            size_t n = craft_sweep();
+            unsigned long sat = 0;
+            int pass;
+            g_work = g_craft.b;
+            sprintf(g_case, "sweep: %s = %d", row->field, g_sw_val);
+            r.val = g_sw_val;
+            r.st = (int)sn_blob_validate(g_craft.b, n, &blob);
+            if (r.st != SN_OK) { r.rc = 3; break; }
+            for (pass = 0; pass < 2; pass++) {
+                g_pose = pass ? 2 : 1;
+                g_ctl_baked = pass;
+                g_steps = MX_STEPS;
+                g_iters = 256;
+                exercise(blob);
+                sat += g_last_stats.saturations;
+                if (!g_finite) r.rc = 5;
+            }
+            r.sat_min = sat < r.sat_min ? sat : r.sat_min;
+            r.sat_max = sat > r.sat_max ? sat : r.sat_max;
+            r.n++;
+        }
+        if (write(fd[1], &r, sizeof r) != (ssize_t)sizeof r) _exit(2);
+        _exit(0);
+    }
+    close(fd[1]);
+    if (pid < 0) { close(fd[0]); return 1; }
+    if (read(fd[0], &r, sizeof r) != (ssize_t)sizeof r) r.rc = -1;
+    close(fd[0]);
+    waitpid(pid, &status, 0);
+    if (r.rc == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        printf("FAIL: sweep %s: sanitizer finding or crash (exit %d, signal %d; the case is named above)\n", row->field,
+               WIFEXITED(status) ? WEXITSTATUS(status) : -1, WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+        return 1;
+    }
+    if (r.rc == 3) {
+        printf("FAIL: sweep %s = %d: rejected (%s)\n", row->field, r.val, sn_status_str((sn_status)r.st));
+        return 1;
+    }
+    if (r.rc == 5) {
+        printf("FAIL: sweep %s = %d: non-finite lattice\n", row->field, r.val);
+        return 1;
+    }
+    printf("  %-36s %4d..%-4d %d values ok, saturations %lu..%lu\n", row->field, row->lo, row->hi, r.n, r.sat_min, r.sat_max);
+    return 0;
+}
+static int sweep_all(void) {
+    int i, fails = 0;
+    printf("  sweep (%s): every value of each integer header field, %d steps x 2 violent poses per value\n", FLAV, MX_STEPS);
+    for (i = 0; i < (int)(sizeof g_sweeps / sizeof g_sweeps[0]); i++) fails += sweep_one(&g_sweeps[i]);
+    return fails;
+}
+
+static int matrix_all(void) {
+    int i, fails = 0;
+    clock_t t0 = clock();
+    struct timespec w0, w1;
+    clock_gettime(CLOCK_MONOTONIC, &w0);
+    printf("  matrix (%s): each field at its bound, validated, stepped %d steps x 2 violent poses under ASan+UBSan\n", FLAV,
+           MX_STEPS);
+    printf("  %-40s %-22s %-24s | %-22s %s\n", "field", "min", "", "max", "");
+    for (i = 0; i < N_ROWS; i++) {
+        char lo[64], hi[64];
+        mx_cell(&g_rows[i], 0, lo, sizeof lo, &fails);
+        mx_cell(&g_rows[i], 1, hi, sizeof hi, &fails);
+        printf("  %-40s %-22s %-24s | %-22s %s\n", g_rows[i].field, g_rows[i].lo, lo, g_rows[i].hi, hi);
+    }
+#if defined(SN_VALIDATE_NO_CHECKSUM) /* the _ck build steps the same code: the sweeps run once per flavour */
+    fails += sweep_all();
+#endif
+    clock_gettime(CLOCK_MONOTONIC, &w1);
+    printf("  figure: extreme-valid matrix %s: %d fields x {min, max} + sweeps, %d failed, %.1f s wall (%.2f s cpu in the parent)\n", FLAV,
+           N_ROWS, fails, (double)(w1.tv_sec - w0.tv_sec) + 1e-9 * (double)(w1.tv_nsec - w0.tv_nsec),
+           (double)(clock() - t0) / CLOCKS_PER_SEC);
+    return fails;
+}
+
 /* Fuzz one blob (g_orig, g_size); returns the number of failed checks. */
 static int fuzz_one(const char *name, int all, unsigned long per_section) {
     size_t n;
@@ -535,11 +1156,19 @@ int main(int argc, char **argv) {
     unsigned long per_section = 400, seed = 12345;
     static union { uint64_t a; unsigned char b[8192]; } tb;
 
+#ifdef HAVE_SAN_CB
+    __sanitizer_set_death_callback(on_death); /* before --crafted / --matrix return */
+#endif
     for (i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--all") == 0) all = 1;
         else if (strcmp(argv[i], "--crafted") == 0) { /* only the crafted cases */
             i = crafted_all();
             printf("%d passed, %d failed\n", N_CRAFTED - i, i);
+            return i != 0;
+        }
+        else if (strcmp(argv[i], "--matrix") == 0) { /* only the extreme-valid matrix */
+            i = matrix_all();
+            printf("%d passed, %d failed\n", i == 0, i != 0);
             return i != 0;
         }
         else if (strcmp(argv[i], "--per-section") == 0 && i + 1 < argc) per_section = strtoul(argv[++i], NULL, 0);
@@ -550,9 +1179,6 @@ int main(int argc, char **argv) {
     g_trace = getenv("SN_FUZZ_TRACE") != NULL;
     g_rng = 0x9E3779B97F4A7C15ull ^ (uint64_t)seed;
     printf("  seed: %lu (set SN_TEST_SEED to change)\n", seed);
-#ifdef HAVE_SAN_CB
-    __sanitizer_set_death_callback(on_death);
-#endif
     if (!path) { /* default: the hand-built blob exhaustively, then the cow sampled */
         g_size = tb_build(tb.b, sizeof tb.b, 3);
         g_orig = (unsigned char *)malloc(g_size);
@@ -562,6 +1188,8 @@ int main(int argc, char **argv) {
         runs++;
         fails += crafted_all();
         runs += N_CRAFTED;
+        fails += matrix_all() != 0;
+        runs++;
         free(g_orig);
         sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
         path = defpath;
