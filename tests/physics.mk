@@ -30,7 +30,7 @@ soak: $(BUILD)/tests/test_reference $(BUILD)/examples/limb_double.blob
 # Physics tests against the runtime: each built fixed and float (suffix _float).
 PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference $(REF_INC)
 PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
-PHYS_TESTS  = cantilever runtime vibration rigid limb longrun teleport
+PHYS_TESTS  = cantilever runtime vibration rigid limb longrun teleport soak
 
 define PHYS_TEST_RULE
 $(BUILD)/tests/test_physics_$(1): tests/test_physics_$(1).c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
@@ -42,6 +42,14 @@ $(BUILD)/tests/test_physics_$(1)_float: tests/test_physics_$(1).c $(REF_SRC) $(P
 endef
 $(foreach t,$(PHYS_TESTS),$(eval $(call PHYS_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)
+
+# make soak-adversarial: test_physics_soak (issue 16 item 6) run long, fixed and
+# float: SN_SOAK_STEPS abuse steps per asset (make test runs a short slice),
+# a recovery check every SN_SOAK_ROUND steps.
+.PHONY: soak-adversarial
+soak-adversarial: $(BUILD)/tests/test_physics_soak $(BUILD)/tests/test_physics_soak_float $(EX)/cow.blob $(EX)/cow_float.blob $(EX)/beast.blob $(EX)/beast_float.blob
+	SN_SOAK_STEPS=$${SN_SOAK_STEPS:-200000} SN_SOAK_ROUND=$${SN_SOAK_ROUND:-10000} BUILD=$(BUILD) $(BUILD)/tests/test_physics_soak
+	SN_SOAK_STEPS=$${SN_SOAK_STEPS:-200000} SN_SOAK_ROUND=$${SN_SOAK_ROUND:-10000} BUILD=$(BUILD) $(BUILD)/tests/test_physics_soak_float
 
 # Beam 4 re-baked with a small time step (h = 1/960 s) for the free-vibration test.
 PHYS_EX = $(BUILD)/physics
