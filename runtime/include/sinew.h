@@ -193,7 +193,9 @@ sn_status sn_set_pose(sn_instance *inst, const sn_xform *joints, uint32_t n_join
 /// (p' = R'_i R_i^T (p - c_i) + c'_i), its velocity and warm start turn by the
 /// same rotation, and the instance's origin jumps to the new root position,
 /// so local deformation and jiggle survive the jump with no saturation and
-/// no velocity spike. The new pose is also the previous pose of the next step
+/// no velocity spike (from a healthy state, whose flesh lies within the
+/// format's range of its frames; a state already torn apart by clamped
+/// steps clamps again, counted, as any step would). The new pose is also the previous pose of the next step
 /// (call sn_set_pose with the following pose as usual). Before the first
 /// step after init/reset it is sn_set_pose. Refusals as sn_set_pose.
 /// Without it, sn_set_pose with a large jump is bounded but not rigid: the
