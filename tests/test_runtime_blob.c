@@ -575,6 +575,20 @@ static void test_steps(void) {
     }
 }
 
+/* The writers' macro equals the runtime's layout (the one source of the
+ * instance size) over counts spanning every term. */
+static void test_instance_size_formula(void) {
+    static const uint32_t nv[] = {2, 12, 233, 65535}, nf[] = {1, 8, 126, 65534}, nj[] = {1, 2, 15, 255};
+    static const uint32_t nc[] = {1, 2, 106, 65535}, nk[] = {0, 1, 3, 256};
+    int a, b, c, d, e, bad = 0, n = 0;
+    for (a = 0; a < 4; a++) for (b = 0; b < 4; b++) for (c = 0; c < 4; c++) for (d = 0; d < 4; d++) for (e = 0; e < 4; e++) {
+        if (nf[b] >= nv[a]) continue;
+        n++;
+        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e]) != sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e]);
+    }
+    T_CHECK(n > 300 && bad == 0, "SN_INSTANCE_BYTES == the runtime layout's size for %d count sets (%d differ)", n, bad);
+}
+
 int main(void) {
     (void)t_seed; /* no random inputs here */
     printf("  flavour: %s\n", FLAV);
@@ -588,5 +602,6 @@ int main(void) {
     test_accessors(-3);
     test_rest_rounding();
     test_steps();
+    test_instance_size_formula();
     return T_END();
 }

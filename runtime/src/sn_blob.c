@@ -376,8 +376,8 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         cnt[SN_SEC_RIG_VERTS] = v.nRE;
         cnt[SN_SEC_RIG_FORCES] = v.nRE; /* one force per vertex entry */
     }
-    /* the instance size is the runtime's formula (one source: sn_format.h) */
-    if (v.instance_bytes != SN_INSTANCE_BYTES(v.nV, v.nF, v.nJ, v.nC, v.nK)) return SN_ERR_HEADER;
+    /* the instance size is the runtime's layout (one source: sn_instance.c) */
+    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK)) return SN_ERR_HEADER;
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
             SN_ELEM_JOINTS(SN_REAL_BYTES), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(SN_REAL_BYTES),

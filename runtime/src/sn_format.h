@@ -169,9 +169,10 @@ enum {
 #define SN_Q_W   15   /* frame weights, trilinear coordinates */
 #define SN_Q_COEF 24  /* a1, b1 */
 
-/* Instance memory the runtime needs for a blob (bytes, multiple of 8). The
- * runtime owns this formula; the host tool writes its value into the header
- * and the validator rejects a header value smaller than it. */
+/* Instance memory the runtime needs for a blob (bytes, multiple of 8), for
+ * writers (the host tool, the tests' blob writers). The runtime's layout
+ * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
+ * the header to equal it, and test_runtime_blob checks this macro against it. */
 #define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK) \
     (((uint32_t)512u + 76u * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
       12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + 7u) & ~7u)

@@ -1,32 +1,42 @@
 /* sn_instance.c -- instance memory: layout, init, reset, settings, stats and
  * the determinism hash. The layout is the single source of the instance
- * size (SN_INSTANCE_BYTES in sn_format.h must match it). */
+ * size: the validator asks sn_instance_bytes for it, and writers' macro
+ * SN_INSTANCE_BYTES (sn_format.h) is tested against it. */
 #include "sn_instance.h"
 
 /* hdr | acc nF*3 acc | per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
- * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value | per free: k (u8) */
+ * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value | per free: k (u8)
+ * Array offsets into off[] in the order of SN_LAYOUT_ARRAYS; returns the
+ * total, rounded up to 8. Counts are validated (nV <= 65535 ...): no wrap. */
+#define SN_LAYOUT_ARRAYS 18
+static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
+                               uint32_t off[SN_LAYOUT_ARRAYS]) {
+    const uint32_t bytes[SN_LAYOUT_ARRAYS] = {
+        nF * 3u * 8u, /* acc: 8 bytes per accumulator in both flavours */
+        nJ * 4u * 4u, nJ * 3u * 4u, nJ * 9u * 4u, nJ * 3u * 4u,          /* pq pt jR jT */
+        nV * 9u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, /* R c pos vel u */
+        nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u,          /* x r d q */
+        (nV - nF) * 3u * 4u, nC * 9u * 4u, nK * 4u, nF};                 /* ds cR ctl k */
+    uint32_t o = SN_HDR_BYTES, i;
+    for (i = 0; i < SN_LAYOUT_ARRAYS; i++) {
+        off[i] = o;
+        o += bytes[i];
+    }
+    return (o + 7u) & ~7u;
+}
+
+uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK) {
+    uint32_t off[SN_LAYOUT_ARRAYS];
+    return layout_offsets(nV, nF, nJ, nC, nK, off);
+}
+
 static void layout(sn_ihdr *h) {
-    uint32_t nV = h->v.nV, nF = h->v.nF, nJ = h->v.nJ, o = SN_HDR_BYTES;
-#define SN_TAKE_(field, bytes) do { h->field = o; o += (bytes); } while (0)
-    SN_TAKE_(o_acc, nF * 3u * 8u); /* 8 bytes per accumulator in both flavours */
-    SN_TAKE_(o_pq, nJ * 4u * 4u);
-    SN_TAKE_(o_pt, nJ * 3u * 4u);
-    SN_TAKE_(o_jR, nJ * 9u * 4u);
-    SN_TAKE_(o_jT, nJ * 3u * 4u);
-    SN_TAKE_(o_R, nV * 9u * 4u);
-    SN_TAKE_(o_c, nV * 3u * 4u);
-    SN_TAKE_(o_pos, nV * 3u * 4u);
-    SN_TAKE_(o_vel, nV * 3u * 4u);
-    SN_TAKE_(o_u, nV * 3u * 4u);
-    SN_TAKE_(o_x, nF * 3u * 4u);
-    SN_TAKE_(o_r, nF * 3u * 4u);
-    SN_TAKE_(o_d, nF * 3u * 4u);
-    SN_TAKE_(o_q, nF * 3u * 4u);
-    SN_TAKE_(o_ds, (nV - nF) * 3u * 4u);
-    SN_TAKE_(o_cR, h->v.nC * 9u * 4u);
-    SN_TAKE_(o_ctl, h->v.nK * 4u);
-    SN_TAKE_(o_k, nF);
-#undef SN_TAKE_
+    uint32_t off[SN_LAYOUT_ARRAYS];
+    (void)layout_offsets(h->v.nV, h->v.nF, h->v.nJ, h->v.nC, h->v.nK, off);
+    h->o_acc = off[0]; h->o_pq = off[1]; h->o_pt = off[2]; h->o_jR = off[3]; h->o_jT = off[4];
+    h->o_R = off[5]; h->o_c = off[6]; h->o_pos = off[7]; h->o_vel = off[8]; h->o_u = off[9];
+    h->o_x = off[10]; h->o_r = off[11]; h->o_d = off[12]; h->o_q = off[13];
+    h->o_ds = off[14]; h->o_cR = off[15]; h->o_ctl = off[16]; h->o_k = off[17];
 }
 
 #if !defined(SN_FLOAT)

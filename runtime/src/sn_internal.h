@@ -208,6 +208,10 @@ typedef struct sn_view {
     sn_q energy, cell, disp_bound; /* health scalars (NUMERICS.md) */
 } sn_view;
 
+/* Instance bytes for these counts: the runtime's layout (sn_instance.c), the
+ * one source of the size (SN_INSTANCE_BYTES in sn_format.h is tested equal). */
+uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK);
+
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob);
 
