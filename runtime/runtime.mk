@@ -70,7 +70,7 @@ TEST_BINS += $(BUILD)/tests/test_runtime_range
 # shift, conversion and int64 sum bound asserted: sn_internal.h SN_RANGE)
 $(BUILD)/tests/test_runtime_fuzz_range: $(SN_FUZZ_DEPS) tests/fuzz/range_fail.c
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -DSN_FUZZ_PER_SECTION=100 -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
 $(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm

@@ -14,7 +14,7 @@
 # test writer tests/fuzz/sn_tblob.h, the baked examples' blobs, the example
 # clips/descriptions/meshes), so the blob seeds always follow sn_format.h.
 #
-#   make test            runs each harness FUZZ_SECONDS (default 10) s from a fresh work dir
+#   make test            runs each harness FUZZ_SECONDS (default 6) s from a fresh work dir
 #   make fuzz            the long campaign: FUZZ_SECONDS (default 600) s per harness,
 #                        new inputs kept in $(FUZZ_DIR)/work/<harness>/ across runs;
 #                        FUZZ_HARNESSES="fuzz_obj fuzz_desc" picks some

@@ -32,7 +32,8 @@
  *   --crafted  only the crafted cases; --matrix only the extreme-valid matrix and sweeps
  *   env SN_FUZZ_TRACE=1: name each case on stderr before it runs (finds the case behind a sanitizer abort)
  *   default    every bit of the header and section table, every bit of the
- *              first and last 16 bytes of each section, plus N (default 600)
+ *              first and last 16 bytes of each section, plus N (default
+ *              SN_FUZZ_PER_SECTION: 400; the range-checking build 100)
  *              random bits inside each section; truncations: every size
  *              (size only), and total_size patched to the cut for every size
  *              up to 4 KB, every section boundary +-16, and 2000 random sizes.
@@ -1149,11 +1150,15 @@ static int fuzz_one(const char *name, int all, unsigned long per_section) {
     return fails;
 }
 
+#ifndef SN_FUZZ_PER_SECTION
+#define SN_FUZZ_PER_SECTION 400
+#endif
+
 int main(int argc, char **argv) {
     const char *path = NULL, *bdir = getenv("BUILD");
     char defpath[512];
     int all = 0, i, fails = 0, runs = 0;
-    unsigned long per_section = 400, seed = 12345;
+    unsigned long per_section = SN_FUZZ_PER_SECTION, seed = 12345;
     static union { uint64_t a; unsigned char b[8192]; } tb;
 
 #ifdef HAVE_SAN_CB

@@ -1,6 +1,6 @@
 #!/bin/sh
 # libFuzzer harnesses (tests/fuzz/fuzz.mk, issue 16 item 5): each runs for
-# FUZZ_SECONDS (default 10) from its seeds (tests/fuzz/corpus/<harness>/ and
+# FUZZ_SECONDS (default 6) from its seeds (tests/fuzz/corpus/<harness>/ and
 # the generated $BUILD/fuzz/seeds/<harness>/) under ASan + UBSan. A harness
 # passes when libFuzzer ends without a finding; a finding is saved as
 # $BUILD/fuzz/artifacts/<harness>-crash-* (replay: $BUILD/fuzz/<harness> FILE).
@@ -13,7 +13,7 @@
 # Without clang the harnesses are not built: SKIPPED, a failure under CI=true.
 BUILD=${BUILD:-build}
 FD=$BUILD/fuzz
-SECS=${FUZZ_SECONDS:-10}
+SECS=${FUZZ_SECONDS:-6}
 NAMES=${*:-fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj}
 pass=0; fail=0
 
