@@ -14,17 +14,6 @@
 
 #define MAXJ 32
 
-static sn_quat to_sn(const double q[4]) {
-    sn_quat r;
-#if defined(SN_FLOAT)
-    r.x = (float)q[0]; r.y = (float)q[1]; r.z = (float)q[2]; r.w = (float)q[3];
-#else
-    r.x = (sn_real)lround(ldexp(q[0], SN_QUAT_FRAC)); r.y = (sn_real)lround(ldexp(q[1], SN_QUAT_FRAC));
-    r.z = (sn_real)lround(ldexp(q[2], SN_QUAT_FRAC)); r.w = (sn_real)lround(ldexp(q[3], SN_QUAT_FRAC));
-#endif
-    return r;
-}
-
 static int finite3(const double *p, unsigned n) {
     unsigned i;
     for (i = 0; i < 3 * n; i++) if (!(p[i] == p[i]) || fabs(p[i]) > 1e30) return 0;
@@ -80,7 +69,7 @@ static void run(const char *name, unsigned steps, unsigned hold, unsigned long l
             for (j = 0; j < 3; j++) off[j] = (1 - u) * off_from[j] + u * off_to[j];
             seg_left--;
         }
-        for (j = 0; j < nJ; j++) local[j] = to_sn(cur[j]);
+        for (j = 0; j < nJ; j++) local[j] = pu_quat(cur[j]);
         o.x = pu_rlen(off[0]); o.y = pu_rlen(off[1]); o.z = pu_rlen(off[2]);
         sn_pose_from_local(r.blob, local, &o, pose);
         sn_set_pose(r.inst, pose, nJ);

@@ -55,29 +55,6 @@
 #define QONE 1073741824.0   /* 2^30 */
 #endif
 
-static sn_quat to_sn(const double q[4]) {
-    sn_quat r;
-#if defined(SN_FLOAT)
-    r.x = (float)q[0]; r.y = (float)q[1]; r.z = (float)q[2]; r.w = (float)q[3];
-#else
-    r.x = (sn_real)lround(ldexp(q[0], SN_QUAT_FRAC)); r.y = (sn_real)lround(ldexp(q[1], SN_QUAT_FRAC));
-    r.z = (sn_real)lround(ldexp(q[2], SN_QUAT_FRAC)); r.w = (sn_real)lround(ldexp(q[3], SN_QUAT_FRAC));
-#endif
-    return r;
-}
-
-/* x -> G x, G = rotation qg about the world origin, then translation tg */
-static void move_pose(const sn_xform *in, unsigned n, sn_quat qg, const double tg[3], sn_xform *out) {
-    unsigned j;
-    for (j = 0; j < n; j++) {
-        sn_vec3 p = sn_quat_rotate(qg, in[j].pos);
-        out[j].rot = sn_quat_mul(qg, in[j].rot);
-        out[j].pos.x = pu_rlen(pu_len(p.x) + tg[0]);
-        out[j].pos.y = pu_rlen(pu_len(p.y) + tg[1]);
-        out[j].pos.z = pu_rlen(pu_len(p.z) + tg[2]);
-    }
-}
-
 /* An extreme but valid quaternion (its largest component >= 2^-10). */
 static sn_quat extreme_quat(unsigned long long *st) {
     double c[4];
@@ -226,7 +203,7 @@ static void try_invalid(soak_ctx *c, const sn_xform *x, unsigned long long *st) 
 static void teleport(soak_ctx *c, const sn_xform *x, sn_quat qg, const double tg[3]) {
     sn_xform xm[MAXJ];
     sn_stats a, b;
-    move_pose(x, c->r.info.joints, qg, tg, xm);
+    pu_move_pose(x, c->r.info.joints, qg, tg, xm);
     sn_get_stats(c->r.inst, &a);
     if (sn_teleport(c->r.inst, xm, c->r.info.joints) != SN_OK) c->f.refusals++;
     sn_get_stats(c->r.inst, &b);
@@ -309,7 +286,7 @@ static void run(const char *name, unsigned long long total, unsigned long long r
                 double q[4];
                 for (k = 0; k < 3; k++) tg[k] = (2 * pu_rand(&st) - 1) * JUMP;
                 pu_random_quat(&st, 360, q);
-                qg = to_sn(q);
+                qg = pu_quat(q);
             } else if (kind == 2) {     /* 180 degree flip about a random axis */
                 double q[4], ax[3] = { 0, 0, 0 };
                 pu_random_quat(&st, 360, q);
@@ -335,7 +312,7 @@ static void run(const char *name, unsigned long long total, unsigned long long r
                 sn_quat local[MAXJ];
                 sn_vec3 o;
                 double w = (kind == 0 && smooth) ? (double)(s + 1) / seg : 1.0, off[3];
-                for (j = 0; j < nJ; j++) { snref_quat_slerp(from[j], to[j], w, cur[j]); local[j] = to_sn(cur[j]); }
+                for (j = 0; j < nJ; j++) { snref_quat_slerp(from[j], to[j], w, cur[j]); local[j] = pu_quat(cur[j]); }
                 for (k = 0; k < 3; k++) off[k] = (1 - w) * off_from[k] + w * off_to[k];
                 o.x = pu_rlen(off[0]); o.y = pu_rlen(off[1]); o.z = pu_rlen(off[2]);
                 sn_pose_from_local(c.r.blob, local, &o, x);
@@ -343,10 +320,10 @@ static void run(const char *name, unsigned long long total, unsigned long long r
                     double q[4];
                     for (k = 0; k < 3; k++) tg[k] = (2 * pu_rand(&st) - 1) * JUMP;
                     pu_random_quat(&st, 360, q);
-                    qg = to_sn(q);
+                    qg = pu_quat(q);
                     teleport(&c, x, qg, tg);
                 }
-                move_pose(x, nJ, qg, tg, xm);
+                pu_move_pose(x, nJ, qg, tg, xm);
                 if (kind == 3)              /* extreme quaternions on about half the joints */
                     for (j = 0; j < nJ; j++)
                         if (pu_rand(&st) < 0.5) xm[j].rot = extreme_quat(&st);
@@ -380,7 +357,7 @@ static void run(const char *name, unsigned long long total, unsigned long long r
             double q[4];
             for (k = 0; k < 3; k++) tg[k] = (2 * pu_rand(&st) - 1) * JUMP;
             pu_random_quat(&st, 360, q);
-            qg = to_sn(q);
+            qg = pu_quat(q);
             teleport(&c, rest, qg, tg);
         }
     }

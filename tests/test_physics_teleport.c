@@ -22,17 +22,6 @@
 #define K1 60      /* steps after it */
 #define JUMP 30000.0
 
-/* x -> G x with G = rotation qg (about the origin) then translation tg */
-static void move_pose(const sn_xform *in, unsigned n, sn_quat qg, const double tg[3], sn_xform *out) {
-    unsigned j;
-    for (j = 0; j < n; j++) {
-        sn_vec3 p = sn_quat_rotate(qg, in[j].pos);
-        out[j].rot = sn_quat_mul(qg, in[j].rot);
-        out[j].pos.x = pu_rlen(pu_len(p.x) + tg[0]);
-        out[j].pos.y = pu_rlen(pu_len(p.y) + tg[1]);
-        out[j].pos.z = pu_rlen(pu_len(p.z) + tg[2]);
-    }
-}
 static void qmat(sn_quat q, double R[9]) {
     double x = pu_q(q.x), y = pu_q(q.y), z = pu_q(q.z), w = pu_q(q.w);
     R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - z * w); R[2] = 2 * (x * z + y * w);
@@ -77,14 +66,14 @@ static void run(const char *path, double turn_deg) {
     pu_rt_surface(&a, sa);
     sn_get_stats(b.inst, &st);
     T_FIGURE("[%s] saturations in the %d trot steps before the jump: %u", fl, K0, st.saturations);
-    move_pose(x, a.info.joints, qg, tg, xm);
+    pu_move_pose(x, a.info.joints, qg, tg, xm);
     T_CHECK(sn_teleport(b.inst, xm, b.info.joints) == SN_OK, "teleport accepted");
     pu_rt_surface(&b, sb);
     e_jump = moved_err(sa, sb, nS, R, tg);
     for (k = K0; k < K0 + K1; k++) {
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
-        move_pose(x, b.info.joints, qg, tg, xm);
+        pu_move_pose(x, b.info.joints, qg, tg, xm);
         sn_set_pose(b.inst, xm, b.info.joints); sn_step(b.inst);
     }
     pu_rt_surface(&a, sa);
@@ -123,7 +112,7 @@ static void run(const char *path, double turn_deg) {
             pu_cow_pose(a.blob, a.info.joints, k, h, x);
             sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
         }
-        move_pose(x, a.info.joints, qg, tg, xm);
+        pu_move_pose(x, a.info.joints, qg, tg, xm);
         sn_set_pose(a.inst, xm, a.info.joints); sn_step(a.inst);
         sn_step(a.inst);
         pu_rt_surface(&a, sa);

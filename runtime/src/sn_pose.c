@@ -286,8 +286,8 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     {
         const unsigned char *fr = v->sec[SN_SEC_FRAMES];
         for (i = 0; i < v->nV; i++) {
-            sn_q Rn[9], cn[3], M[9], off[3];
-            frame_of(h, fr + 4 * i, Rn, cn, &sat);
+            sn_q Rn[9], M[9], off[3];
+            frame_of(h, fr + 4 * i, Rn, NULL, &sat); /* R' only: the new c' comes with the new T_j */
             if (h->mode == SN_MODE_UNWARPED) mul_abt(jR, Rroot, M);
             else mul_abt(Rn, R + 9 * i, M);
             {   /* unturned (the same frame bits): exactly I, so a pure move is exact */

@@ -13,6 +13,31 @@ static inline sn_quat pu_axis_angle(double ax, double ay, double az, double deg)
     return sn_quat_axis_angle(a, pu_rang(deg));
 }
 
+/* A double quaternion (x, y, z, w) in runtime numbers (Q30 rounded / float). */
+static inline sn_quat pu_quat(const double q[4]) {
+    sn_quat r;
+#if defined(SN_FLOAT)
+    r.x = (float)q[0]; r.y = (float)q[1]; r.z = (float)q[2]; r.w = (float)q[3];
+#else
+    r.x = (sn_real)lround(ldexp(q[0], SN_QUAT_FRAC)); r.y = (sn_real)lround(ldexp(q[1], SN_QUAT_FRAC));
+    r.z = (sn_real)lround(ldexp(q[2], SN_QUAT_FRAC)); r.w = (sn_real)lround(ldexp(q[3], SN_QUAT_FRAC));
+#endif
+    return r;
+}
+
+/* A whole pose moved rigidly: x -> G x, G = rotation qg about the world
+ * origin, then translation tg (mesh units). */
+static inline void pu_move_pose(const sn_xform *in, unsigned n, sn_quat qg, const double tg[3], sn_xform *out) {
+    unsigned j;
+    for (j = 0; j < n; j++) {
+        sn_vec3 p = sn_quat_rotate(qg, in[j].pos);
+        out[j].rot = sn_quat_mul(qg, in[j].rot);
+        out[j].pos.x = pu_rlen(pu_len(p.x) + tg[0]);
+        out[j].pos.y = pu_rlen(pu_len(p.y) + tg[1]);
+        out[j].pos.z = pu_rlen(pu_len(p.z) + tg[2]);
+    }
+}
+
 static inline sn_quat pu_qident(void) {
     sn_quat q;
     memset(&q, 0, sizeof q);
