@@ -148,9 +148,8 @@ sn_status sn_reset(sn_instance *inst) {
     uint32_t i, k, nV, nJ;
     sn_q *pq, *pt, *pos;
     const unsigned char *j0;
-    if (!inst) return SN_ERR_NULL;
+    SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     v = &h->v;
     nV = v->nV;
     nJ = v->nJ;
@@ -188,9 +187,8 @@ sn_status sn_reset(sn_instance *inst) {
 
 sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations) {
     sn_ihdr *h;
-    if (!inst) return SN_ERR_NULL;
+    SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (iterations > h->v.cg_max) return SN_ERR_ARG;
     h->iterations = iterations ? iterations : h->v.cg_default;
     return SN_OK;
@@ -198,9 +196,8 @@ sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations) {
 
 sn_status sn_set_mode(sn_instance *inst, sn_mode mode) {
     sn_ihdr *h;
-    if (!inst) return SN_ERR_NULL;
+    SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (mode != SN_MODE_WARPED && mode != SN_MODE_UNWARPED) return SN_ERR_ARG;
     h->mode = (uint32_t)mode;
     return SN_OK;

@@ -68,6 +68,13 @@ SN_INLINE sn_ihdr *hdr_of(sn_instance *inst) { return (sn_ihdr *)(void *)inst; }
 SN_INLINE const sn_ihdr *chdr_of(const sn_instance *inst) {
     return (const sn_ihdr *)(const void *)inst;
 }
+/* The check every public call on an instance starts with: SN_ERR_NULL, or
+ * SN_ERR_INSTANCE when the memory does not hold an initialised instance. */
+SN_INLINE sn_status inst_status(const sn_instance *inst) {
+    if (!inst) return SN_ERR_NULL;
+    return chdr_of(inst)->magic == SN_INST_MAGIC ? SN_OK : SN_ERR_INSTANCE;
+}
+#define SN_CHECK_INST(inst) do { sn_status st_ = inst_status(inst); if (st_ != SN_OK) return st_; } while (0)
 
 /* Saturating counter increment (stats never wrap). */
 SN_INLINE uint32_t sn_count(uint32_t c, uint32_t add) {

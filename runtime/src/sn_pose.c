@@ -30,7 +30,7 @@ static int xform_ok(const sn_xform *x) {
 static sn_status pose_ok(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
     uint32_t j;
     if (!inst || !joints) return SN_ERR_NULL;
-    if (hdr_of(inst)->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
+    if (inst_status(inst) != SN_OK) return SN_ERR_INSTANCE;
     if (n_joints != hdr_of(inst)->v.nJ) return SN_ERR_ARG;
     for (j = 0; j < n_joints; j++)
         if (!xform_ok(&joints[j])) return SN_ERR_ARG;

@@ -157,9 +157,8 @@ int32_t sn_control_kind_of(const sn_blob *blob, uint32_t c) {
 
 sn_status sn_set_control(sn_instance *inst, uint32_t c, sn_real value) {
     sn_ihdr *h;
-    if (!inst) return SN_ERR_NULL;
+    SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (c >= h->v.nK || h->v.sec[SN_SEC_CONTROLS][(size_t)c * CTL_ELEM + 32] != SN_CTL_ABSTRACT)
         return SN_ERR_ARG;
 #if defined(SN_FLOAT)

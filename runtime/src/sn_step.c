@@ -12,9 +12,8 @@
 sn_status sn_step(sn_instance *inst) {
     sn_ihdr *h;
     uint32_t sat = 0;
-    if (!inst) return SN_ERR_NULL;
+    SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
     sn_solve(h, &sat);
