@@ -166,3 +166,14 @@ $(PHYS_EX)/limb_norig_float.blob: $(PHYS_EX)/limb_norig/limb.sinew $(BAKE)
 $(PHYS_EX)/limb_norig_double.blob: $(PHYS_EX)/limb_norig/limb.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour double --quiet
 TEST_DEPS += $(PHYS_EX)/limb_norig.blob $(PHYS_EX)/limb_norig_float.blob $(PHYS_EX)/limb_norig_double.blob
+
+# External forces and impulses (issue 14): distribution, wrench, response vs
+# the reference; white box (sn_forces_rhs), fixed and float.
+FORCE_RT_DEPS = tests/test_runtime_force.c $(REF_SRC) $(PHYS_HDRS)
+$(BUILD)/tests/test_runtime_force: $(FORCE_RT_DEPS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_force_float: $(FORCE_RT_DEPS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force_float

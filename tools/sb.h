@@ -69,6 +69,10 @@ typedef struct sb_joint {
     int bone_line;  /* line of its 'bone' statement, 0 if none */
 } sb_joint;
 typedef struct sb_limitrule { sb_region r; double dist; } sb_limitrule;
+/* 'shares NAME FINE C2 C4 C8 RIGID' (seed 004 ch. 4): an external force's split over levels */
+typedef struct sb_shares { char name[SB_NAME_MAX]; double s[5]; int line; } sb_shares;
+/* 'shares_region REGION NAME': free vertices in REGION use that profile */
+typedef struct sb_sharerule { sb_region r; int prof; } sb_sharerule;
 
 /* rig controls and rigs (seed 003 §3, §4.1-4.2; tools/DESCRIPTION.md "Rigs and controls") */
 enum { SB_CTL_ABSTRACT = 0, SB_CTL_ANGLE = 1, SB_CTL_TWIST = 2 };   /* TWIST bakes as an ANGLE about the bone axis */
@@ -124,6 +128,9 @@ typedef struct sb_desc {
     int rest_modelled;      /* 'rest_shape modelled' (1) or 'sag' (0, default) */
     sb_control *ctls; int nctl;      /* 'control' */
     sb_rigdef *rigs; int nrig;       /* 'rig', 'tau' */
+    int force_slots;                 /* 'forces N': external forces per step (default 8) */
+    sb_shares *shares; int nshares;  /* 'shares' */
+    sb_sharerule *srules; int nsr;   /* 'shares_region' */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -190,6 +197,15 @@ typedef struct sb_model {
     int nctl, nrig;
     struct sb_control *ctl; /* joints in sorted order, TWIST resolved to an axis */
     struct sb_rig *rig;
+    /* external forces (sb_force.c, sb_force_build): slots per step, share profiles
+     * (fine, coarse 1..3, rigid; each sums to 1), profile of each free vertex (NULL: all 0) */
+    int max_forces;
+    int nprof;
+    double (*prof)[5];
+    unsigned char *vprof;
+    /* segment meshes (sb_segment.c, sb_segment_build) */
+    int nsm;
+    struct sb_segmesh *sm;
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -247,6 +263,23 @@ void sb_rig_field(const sb_model *o, const sb_rig *r, const double p[3], double 
 /* tau_a(gamma): piecewise linear through the samples, clamped at the ends */
 double sb_rig_tau(const sb_rigdef *r, double gamma);
 const char *sb_rig_tpl_name(int tpl);
+
+/* ---- external forces (sb_force.c) ---- */
+/* share profiles from the description's 'force' lines, per free vertex */
+int sb_force_build(const sb_desc *d, sb_model *o);
+void sb_force_free(sb_model *o);
+
+/* ---- segment meshes (sb_segment.c) ---- */
+/* chains and sheets from the description, attached to the built model */
+int sb_segment_build(const sb_desc *d, const sb_mesh *m, sb_model *o);
+void sb_segment_free(sb_model *o);
+/* instance state bytes of o's segment meshes (SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes) */
+uint32_t sb_segment_state_bytes(const sb_model *o);
+/* SEGNODES and SEGATTACH counts of o's segment meshes */
+void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach);
+/* write the three segment sections at their offsets (w: blob bytes, rs: real size,
+ * flavour SB_*); 0 or -1 (sb_fail) */
+int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t *off, int flavour, int rs, int len_shift);
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

@@ -7,7 +7,8 @@
 
 static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
-                                             "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES"};
+                                             "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
+                                             "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
@@ -26,7 +27,8 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
-    if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
+    if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_force_build(&d, o) ||
+        sb_segment_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
         sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
@@ -61,6 +63,14 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
             printf("  rig       %-14s control %-12s %-7s s %-6g %4d entries, peak |Q_i| %.4g N (at eta 1), total |int f dV| %.4g N, frac %s\n",
                    r->def.name, o->ctl[r->def.control].name, sb_rig_tpl_name(r->def.tpl), r->def.s, r->n, r->qmax,
                    sqrt(r->total[0] * r->total[0] + r->total[1] * r->total[1] + r->total[2] * r->total[2]), fr);
+        }
+        printf("  forces    %d per step (sn_apply_force), %d share profile%s (fine, 2, 4, 8 cells, rigid)%s\n", o->max_forces, o->nprof,
+               o->nprof == 1 ? "" : "s", o->nprof ? ":" : "");
+        for (k = 0; k < o->nprof; k++) {
+            int nv = 0, i;
+            for (i = 0; i < o->nf; i++) nv += o->vprof && o->vprof[i] == k;
+            printf("            %d %-14s %.3g %.3g %.3g %.3g %.3g  (%d free vertices)\n", k, d.shares[k].name, o->prof[k][0], o->prof[k][1],
+                   o->prof[k][2], o->prof[k][3], o->prof[k][4], nv);
         }
         printf("  time      %.2f s\n", sb_now() - t0);
     }

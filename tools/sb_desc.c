@@ -137,7 +137,7 @@ static int region(ctx_t *c, const sb_desc *d, int first, int tail, sb_region *r)
     if (r->kind == SB_RG_BONE) {
         r->bone = find_joint(d, c->tok[first + 1]);
         if (r->bone < 0) return sb_fail("%s:%d: unknown joint '%s' (declare joints before using them)", c->path, c->line, c->tok[first + 1]);
-        if (d->joints[r->bone].parent < 0) return sb_fail("%s:%d: '%s' is the root: a bone is named by its child joint", c->path, c->line, c->tok[first + 1]);
+        if (!strcmp(d->joints[r->bone].parent_name, "-")) /* parents resolve after the last line */ return sb_fail("%s:%d: '%s' is the root: a bone is named by its child joint", c->path, c->line, c->tok[first + 1]);
     }
     return n;
 }
@@ -286,6 +286,37 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (r.dist < 0) return sb_fail("%s:%d: limit distance must be >= 0 (0 = no limit)", c->path, c->line);
         GROW(d->lrules, d->nlr);
         d->lrules[d->nlr++] = r;
+    } else if (!strcmp(kw, "forces")) {
+        double n_;
+        if (nargs(c, 1) || num(c, 1, &n_)) return -1;
+        if (!(n_ >= 0 && n_ <= 32 && n_ == floor(n_))) return sb_fail("%s:%d: forces: slots per step must be a whole number in 0..32", c->path, c->line);
+        d->force_slots = (int)n_;
+    } else if (!strcmp(kw, "shares")) {
+        sb_shares *p_;
+        double sum = 0;
+        if (nargs(c, 6)) return -1;
+        if (strlen(c->tok[1]) >= SB_NAME_MAX) return sb_fail("%s:%d: share profile names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
+        for (k = 0; k < d->nshares; k++)
+            if (!strcmp(d->shares[k].name, c->tok[1])) return sb_fail("%s:%d: share profile '%s' declared twice (first at line %d)", c->path, c->line, c->tok[1], d->shares[k].line);
+        if (d->nshares >= 255) return sb_fail("%s:%d: more than 255 share profiles", c->path, c->line);
+        GROW(d->shares, d->nshares);
+        p_ = &d->shares[d->nshares];
+        strcpy(p_->name, c->tok[1]);
+        p_->line = c->line;
+        for (k = 0; k < 5; k++) {
+            if (num(c, 2 + k, &p_->s[k])) return -1;
+            if (!(p_->s[k] >= 0 && p_->s[k] <= 1)) return sb_fail("%s:%d: share %g out of [0, 1] (shares: FINE COARSE2 COARSE4 COARSE8 RIGID)", c->path, c->line, p_->s[k]);
+            sum += p_->s[k];
+        }
+        if (fabs(sum - 1) > 1e-6) return sb_fail("%s:%d: shares of '%s' sum to %.9g: they must sum to 1 (the force is split, not scaled)", c->path, c->line, c->tok[1], sum);
+        d->nshares++;
+    } else if (!strcmp(kw, "shares_region")) {
+        sb_sharerule r;
+        if ((n = region(c, d, 1, 1, &r.r)) < 0) return -1;
+        for (r.prof = 0; r.prof < d->nshares && strcmp(d->shares[r.prof].name, c->tok[1 + n]); r.prof++) {}
+        if (r.prof == d->nshares) return sb_fail("%s:%d: unknown share profile '%s' (declare it with 'shares' first)", c->path, c->line, c->tok[1 + n]);
+        GROW(d->srules, d->nsr);
+        d->srules[d->nsr++] = r;
     } else if (!strcmp(kw, "control")) {
         sb_control *k_;
         if (c->nt < 2) return sb_fail("%s:%d: missing value: 'control NAME [DEFAULT]', 'control NAME angle JOINT AX AY AZ' or 'control NAME twist JOINT'", c->path, c->line);
@@ -406,6 +437,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->g[1] = -9.81;
     d->element = SB_ELEM_INCOMPATIBLE;
     d->bone_radius = -1;
+    d->force_slots = 8;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
     memset(&c, 0, sizeof c);
@@ -479,7 +511,7 @@ int sb_desc_load(const char *path, sb_desc *d)
 
 void sb_desc_free(sb_desc *d)
 {
-    free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins); free(d->lrules);
+    free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins); free(d->lrules); free(d->shares); free(d->srules);
     free(d->ctls); free(d->rigs);
     memset(d, 0, sizeof *d);
 }

@@ -52,7 +52,7 @@ extern "C" {
 #endif
 
 /// Version of this header and of the blob format it reads (major.minor).
-#define SN_VERSION_MAJOR 3
+#define SN_VERSION_MAJOR 4
 #define SN_VERSION_MINOR 0
 
 #if defined(SN_FLOAT)
@@ -98,7 +98,8 @@ typedef struct sn_xform { sn_quat rot; sn_vec3 pos; } sn_xform;
     X(SN_ERR_VALUE,     "a number stored in the blob is out of its allowed range") \
     X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size()") \
     X(SN_ERR_ARG,       "argument out of range") \
-    X(SN_ERR_INSTANCE,  "instance memory does not hold an initialised instance")
+    X(SN_ERR_INSTANCE,  "instance memory does not hold an initialised instance") \
+    X(SN_ERR_FULL,      "every slot the blob provides for this step is taken")
 
 /// Status code returned by every fallible call. Never mixed with data.
 typedef enum sn_status {
@@ -138,6 +139,8 @@ typedef struct sn_blob_info {
     uint32_t controls;          ///< control parameters (sn_find_control), abstract and pose-driven
     uint32_t rigs;              ///< rig force fields driven by the controls
     uint32_t rig_entries;       ///< (rig, free vertex) force entries: the rigs' per-step cost
+    uint32_t force_slots;       ///< external forces (sn_apply_force / sn_apply_impulse) accepted per step
+    uint32_t force_profiles;    ///< share profiles baked for them (0: every force acts on the fine lattice)
     sn_real  timestep;          ///< h in seconds (fixed: Q16.16)
 } sn_blob_info;
 
@@ -255,6 +258,9 @@ typedef struct sn_stats {
     sn_real  energy;       ///< elastic + kinetic energy after the last step, joules (Q16.16 / float); kinetic uses the lumped mass
     sn_real  energy_max;   ///< largest energy since init/reset
     uint32_t cg_clamps;    ///< CG step ratios (alpha, beta) clamped at 8 since init/reset (fixed; 0 in float): rounding-floor noise of a converged solve, not a fault
+    uint32_t force_drops;  ///< sn_apply_force / sn_apply_impulse calls refused since init/reset because the step's force slots were full
+    sn_real  seg_gap;      ///< largest segment-mesh constraint gap left after the last step's fixed sweeps, in segment lengths (Q16.16 / float)
+    sn_real  seg_gap_max;  ///< largest seg_gap since init/reset
 } sn_stats;
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.
@@ -294,6 +300,53 @@ sn_status sn_set_control(sn_instance *inst, uint32_t c, sn_real value);
 /// Current value of control c: an abstract control as set, a pose control as
 /// the last step measured it (0 before the first step). SN_ERR_ARG if c is out of range.
 sn_status sn_get_control(const sn_instance *inst, uint32_t c, sn_real *value);
+
+/* ---- external forces and impulses (seed 004 ch. 4 applied to the lattice) ----
+ * A force acts on a material point of the flesh during the next sn_step
+ * (then its slot empties). Its share profile (baked per region of the
+ * character, or chosen per call) splits it over levels: the fine lattice
+ * (a local dent), coarse levels of 2, 4 and 8 cells (the region around the
+ * point moves and turns as one piece: the force a rigid body of that region
+ * would feel, keeping the total force and moment), and a rigid level that
+ * the flesh does not feel, returned to the game per joint by
+ * sn_get_joint_wrench (stagger, lean). Every distribution keeps the applied
+ * force and moment (runtime/NUMERICS.md "External forces"). The step's cost
+ * grows by a fixed amount per applied force (a few passes over the free
+ * vertices for each coarse level the profile uses): the caller knows it
+ * before stepping; sn_blob_info.force_slots bounds it. */
+
+/// Where an external force acts.
+typedef enum sn_force_at {
+    SN_AT_SURFACE = 0, ///< surface vertex `vertex`, wherever the flesh carries it
+    SN_AT_POINT = 1    ///< world point `point`: the flesh under it now (the cell whose rest box holds the point, carried back to rest by the nearest lattice vertex's frame; clamped to the nearest cell when outside)
+} sn_force_at;
+
+/// An external force or impulse on the flesh.
+typedef struct sn_force {
+    uint32_t at;       ///< sn_force_at
+    uint32_t vertex;   ///< SN_AT_SURFACE: surface vertex index
+    sn_vec3  point;    ///< SN_AT_POINT: world point, mesh units
+    sn_vec3  force;    ///< world axes: newtons (sn_apply_force) or newton-seconds (sn_apply_impulse); fixed: Q16.16
+    int32_t  profile;  ///< share profile index (< force_profiles), or -1: the profile baked for the flesh at the point
+} sn_force;
+
+/// Apply a force during the next sn_step (one step long). SN_ERR_ARG for a
+/// bad vertex, kind or profile (float: non-finite or beyond 1e9);
+/// SN_ERR_FULL, counted in sn_stats.force_drops, when the step's
+/// force_slots are taken. Nothing changes on an error.
+sn_status sn_apply_force(sn_instance *inst, const sn_force *f);
+/// Apply an impulse (newton-seconds) in the next sn_step: the force J/h for one step.
+sn_status sn_apply_impulse(sn_instance *inst, const sn_force *f);
+/// The rigid level's share of the last step's forces (and the parts that fell
+/// on skeleton lattice vertices) on joint j: force (newtons) and torque about
+/// the joint's current position (newton x mesh units; multiply by metres per
+/// mesh unit for N m), summed over the step's forces, split between the two
+/// bones of the cell's frame by its weight. about (may be NULL) receives that
+/// position (world, mesh units). Fixed: the torque is the exact sum of
+/// (point - about) x force in Q32, rounded once to Q16.16. Zero after a step
+/// without forces. SN_ERR_ARG if j is out of range.
+sn_status sn_get_joint_wrench(const sn_instance *inst, uint32_t joint, sn_vec3 *force, sn_vec3 *torque,
+                              sn_vec3 *about);
 
 /* ---- small math helpers (integer-only in the fixed flavour, deterministic) ---- */
 

@@ -12,6 +12,23 @@
  */
 #include "sn_internal.h"
 
+/* floor(n / D) for 0 < D <= 2^62: restoring division over the 64 bits of n
+ * with no data-dependent branch (a library 64-bit divide is neither
+ * constant-time nor available everywhere); the remainder stays below D, so
+ * shifting it left never overflows. */
+uint64_t sn_udiv64(uint64_t n, uint64_t D) {
+    uint64_t q = 0, r = 0;
+    int i;
+    for (i = 63; i >= 0; i--) {
+        uint64_t ge;
+        r = (r << 1) | ((n >> i) & 1u);
+        ge = (uint64_t)(r >= D);
+        r -= D & (0 - ge);
+        q |= ge << i;
+    }
+    return q;
+}
+
 /* floor(sqrt(x)) for every uint64 x, exact. Bit-by-bit method, 32 fixed
  * iterations, shifts and subtractions only (same code in both flavours). */
 uint32_t sn_isqrt64(uint64_t x) {

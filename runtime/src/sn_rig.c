@@ -11,24 +11,6 @@
 #define CTL_ELEM SN_ELEM_CONTROLS(SN_REAL_BYTES)
 #define SMP_ELEM SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES)
 
-#if !defined(SN_FLOAT)
-/* floor(n / D) for n < D 2^32, 0 < D <= 2^31: restoring division over the 64
- * bits of n with no data-dependent branch (a library 64-bit divide is neither
- * constant-time nor available everywhere); the remainder stays below 2D. */
-static uint64_t udiv_ct(uint64_t n, uint64_t D) {
-    uint64_t q = 0, r = 0;
-    int i;
-    for (i = 63; i >= 0; i--) {
-        uint64_t ge;
-        r = (r << 1) | ((n >> i) & 1u);
-        ge = (uint64_t)(r >= D);
-        r -= D & (0 - ge);
-        q |= ge << i;
-    }
-    return q;
-}
-#endif
-
 /* tau(g) = eta_0 + sum_k (eta_k+1 - eta_k) clamp((g - g_k)/(g_k+1 - g_k), 0, 1).
  * Fixed: each term is round(d |de| / D) with its sign, d = clamp(g - g_k, 0, D),
  * D = g_k+1 - g_k <= 2^31 and |de| <= 2^31 (validated), so d |de| < 2^62:
@@ -54,7 +36,7 @@ static sn_q tau(const unsigned char *smp, uint32_t n, sn_real g) {
         int64_t de = (int64_t)sn_rd_i32(e + SMP_ELEM + SN_REAL_BYTES) - sn_rd_i32(e + SN_REAL_BYTES);
         uint64_t m = (uint64_t)(de < 0 ? -de : de), t;
         d = d < 0 ? 0 : (d > D ? D : d);
-        t = udiv_ct((uint64_t)d * m + ((uint64_t)D >> 1), (uint64_t)D);
+        t = sn_udiv64((uint64_t)d * m + ((uint64_t)D >> 1), (uint64_t)D);
         eta += de < 0 ? -(int64_t)t : (int64_t)t;
     }
     return (int32_t)(eta > one ? one : (eta < -one ? -one : eta));
