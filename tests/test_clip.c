@@ -304,7 +304,24 @@ int main(void) {
     bad(H "control breath 1 1\nrot breath 0 0 1 0 5\ncontrol breath 1 0\n", 5, "strictly increase");
     bad(H "control a_control_name_that_is_much_too_long 0 1\n", 3, "longer than 31 bytes");
     bad("sinew-clip 1\ncontrol breath 0 1\nduration 1\n", 2, "'duration' must come before");
-    bad(H "controls breath 0 1\n", 3, "unknown keyword (expected duration, loop, rot, move, control)");
+    bad(H "controls breath 0 1\n", 3, "unknown keyword (expected duration, loop, rot, move, control, impulse)");
+    /* impulse lines: impulse <time> <surface vertex> <jx> <jy> <jz> [profile] */
+    bad(H "impulse 0 3 0 1\n", 3, "usage: impulse");
+    bad(H "impulse 0 3 0 1 0 0 9\n", 3, "usage: impulse");
+    bad(H "impulse 0 -3 0 1 0\n", 3, "surface vertex must be a whole number");
+    bad(H "impulse 0 3.5 0 1 0\n", 3, "surface vertex must be a whole number");
+    bad(H "impulse 0 3 0 hard 0\n", 3, "impulse (newton-seconds) is not a number: 'hard'");
+    bad(H "impulse 0 3 0 1 0 255\n", 3, "profile must be a whole number in 0..254");
+    bad(H "impulse 0 3 0 1 0 -1\n", 3, "profile must be a whole number");
+    bad(H "impulse 3 3 0 1 0\n", 3, "after the clip duration");
+    bad(H "impulse 1 3 0 1 0\nimpulse 1 4 0 1 0\n", 4, "strictly increase");
+    {
+        static const char ok[] = H "impulse 0.5 3 0 10 0\nimpulse 1 7 1 2 3 2\nimpulse 1 9 0 0 1\n";
+        T_CHECK(sn_clip_parse(&clip, ok, sizeof ok - 1, err, sizeof err) == 0 && clip.n_channels == 2 &&
+                clip.chan[0].kind == SN_CLIP_IMPULSE && !strcmp(clip.chan[0].name, "-1") && clip.chan[0].count == 2 &&
+                !strcmp(clip.chan[1].name, "2") && clip.keys[clip.chan[1].first].v[3] == 7 &&
+                clip.keys[clip.chan[1].first].v[2] == 3 * 65536, "impulse channels per profile: %s", err);
+    }
     bad(H "control breath 0 1e3\n", 3, "control value is not a number: '1e3'");
     {
         static const char nul[] = "sinew-clip 1\nduration 1\nrot a\0 0 0 1 0 5\n";

@@ -179,6 +179,33 @@ int main(void) {
     T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0, "parse 2: %s", err);
     T_CHECK(sn_clip_bind(&clip, blob, err, sizeof err) == 1 && strstr(err, "'no_such_joint'") && strstr(err, na) && !clip.bound,
             "bind of an unknown joint: %s", err);
+
+    /* impulse events fire once per pass of their time, across the loop's wrap, at the runtime */
+    {
+        void *mem = malloc(sn_instance_size(blob) + 8);
+        sn_instance *inst;
+        sn_stats st;
+        uint32_t fired = 0, steps = (uint32_t)(3 * 2 * 65536 / sn_clip_timestep_q16(blob)) + 1;   /* three passes */
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 2\nloop yes\nimpulse 0.5 3 0 10 0\nimpulse 1.95 4 1 0 0 0\n"
+                                                  "impulse 2 5 0 0 -1 1\n");
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 0, "impulse clip: %s", err);
+        T_CHECK(sn_instance_init(mem, sn_instance_size(blob), blob, &inst) == SN_OK, "instance");
+        T_CHECK(sn_clip_impulses(&clip, blob, 0, inst) == 0, "no impulse at step 0");
+        for (k = 1; k <= steps; k++) {
+            fired += sn_clip_impulses(&clip, blob, k, inst);
+            sn_step(inst);
+        }
+        T_CHECK(fired == 9, "three impulses x three passes of a 2 s loop fired %u times (want 9)", fired);
+        sn_get_stats(inst, &st);
+        T_CHECK(st.force_drops == 0, "no slot overflow (%u)", st.force_drops);
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\nimpulse 0.5 3 0 10 0 200\n");
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 1 && strstr(err, "profile 200"),
+                "bind refuses a profile the blob lacks: %s", err);
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\nimpulse 0.5 %u 0 10 0\n", info.surface_vertices);
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 1 && strstr(err, "surface vertex"),
+                "bind refuses a surface vertex the blob lacks: %s", err);
+        free(mem);
+    }
     free(bytes);
     return T_END();
 }

@@ -284,7 +284,38 @@ static int parse_line(pstate *ps, const char *s, size_t n) {
         if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
         return add_key(ps, ci, &key, t.p[2], t.n[2]);
     }
-    return fail(ps, "unknown keyword (expected duration, loop, rot, move, control):", t.p[0], t.n[0]);
+    if (tok_is(&t, 0, "impulse")) { /* impulse <time> <surface vertex> <jx> <jy> <jz> [profile] */
+        int ci, k;
+        sn_clip_key key;
+        int32_t vq, pq = -65536;
+        char pname[12];
+        size_t pn = 0;
+        memset(&key, 0, sizeof key);
+        if (!ps->have_duration) return fail(ps, "'duration' must come before the first key", 0, 0);
+        if (nt != 6 && nt != 7) return fail(ps, "usage: impulse <time> <surface vertex> <jx> <jy> <jz> [profile]", 0, 0);
+        if (num(ps, &t, 1, "key time is not a number:", &key.t)) return 1;
+        if (num(ps, &t, 2, "surface vertex is not a number:", &vq)) return 1;
+        if (vq < 0 || (vq & 0xFFFF) != 0) return fail(ps, "surface vertex must be a whole number >= 0:", t.p[2], t.n[2]);
+        key.v[3] = vq >> 16;
+        for (k = 0; k < 3; k++)
+            if (num(ps, &t, 3 + k, "impulse (newton-seconds) is not a number:", &key.v[k])) return 1;
+        if (nt == 7) {
+            if (num(ps, &t, 6, "profile is not a number:", &pq)) return 1;
+            if (pq < 0 || (pq & 0xFFFF) != 0 || pq > (254 << 16)) return fail(ps, "profile must be a whole number in 0..254:", t.p[6], t.n[6]);
+        }
+        {   /* the channel is named by the profile ("-1": the flesh's own) */
+            int32_t pv = pq >> 16;
+            char tmp[12];
+            size_t nd = 0;
+            if (pv < 0) { pname[pn++] = '-'; pv = 1; }
+            do { tmp[nd++] = (char)('0' + pv % 10); pv /= 10; } while (pv);
+            while (nd) pname[pn++] = tmp[--nd];
+        }
+        ci = channel(c, SN_CLIP_IMPULSE, pname, pn);
+        if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
+        return add_key(ps, ci, &key, t.p[1], t.n[1]);
+    }
+    return fail(ps, "unknown keyword (expected duration, loop, rot, move, control, impulse):", t.p[0], t.n[0]);
 }
 
 int32_t sn_clip_control_at(const sn_clip *clip, uint32_t c, int32_t t) {

@@ -44,12 +44,14 @@
 /// A good size for the error buffer (and for sn_clip_warning_str).
 #define SN_CLIP_ERR_LEN 256
 
-/// Channel kinds: a joint's rotation, the root translation, a rig control.
-enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1, SN_CLIP_CONTROL = 2 };
+/// Channel kinds: a joint's rotation, the root translation, a rig control,
+/// impulses on the flesh (one channel per share profile, named by it).
+enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1, SN_CLIP_CONTROL = 2, SN_CLIP_IMPULSE = 3 };
 
 /// One key. Q16.16 throughout: t seconds; v = axis x,y,z + angle degrees
 /// (rotation), x,y,z mesh units (root translation, v[3] = 0), or the
-/// control's value in v[0] (control, v[1..3] = 0).
+/// control's value in v[0] (control, v[1..3] = 0), or an impulse's
+/// newton-seconds in v[0..2] and its surface vertex in v[3] (impulse).
 typedef struct sn_clip_key { int32_t t; int32_t v[4]; } sn_clip_key;
 
 /// One channel: keys[first .. first+count) with strictly increasing t.
@@ -142,6 +144,13 @@ int32_t sn_clip_control_at(const sn_clip *clip, uint32_t c, int32_t t);
 /// sn_clip_time(k), set with sn_set_control (fixed: the Q16.16 value as is;
 /// float: value / 65536). Returns the number of controls set.
 uint32_t sn_clip_controls(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst);
+
+/// Impulse events for step k: every impulse key whose time lies in the step's
+/// clip-time interval (sn_clip_time(k-1), sn_clip_time(k)] (across the wrap
+/// of a looping clip; none at k = 0), applied with sn_apply_impulse at its
+/// surface vertex and profile (-1: the blob's for the flesh there). Returns
+/// the number the runtime accepted (a full step's slots refuse the rest).
+uint32_t sn_clip_impulses(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst);
 
 /// Own decimal reader (exported for tests): optional sign, digits, optional
 /// '.' and digits; no exponent. Rounds to nearest Q16.16 (half away from

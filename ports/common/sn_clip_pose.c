@@ -33,6 +33,31 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
     }
     for (c = 0; c < clip->n_channels; c++) {
         sn_clip_channel *ch = &clip->chan[c];
+        if (ch->kind == SN_CLIP_IMPULSE) {   /* profile and surface vertices must exist */
+            uint32_t k;
+            int32_t prof = 0;
+            const char *q = ch->name;
+            sn_blob_get_info(blob, &info);
+            if (*q == '-') prof = -1;
+            else for (; *q; q++) prof = prof * 10 + (*q - '0');
+            if (prof >= 0 && (uint32_t)prof >= info.force_profiles) {
+                put(err, errlen, &len, "clip impulse profile ");
+                put(err, errlen, &len, ch->name);
+                put(err, errlen, &len, " is not in the blob (it has fewer share profiles: sinew-bake lists them)");
+                return 1;
+            }
+            for (k = ch->first; k < (uint32_t)ch->first + ch->count; k++)
+                if ((uint32_t)clip->keys[k].v[3] >= info.surface_vertices) {
+                    put(err, errlen, &len, "clip impulse on a surface vertex beyond the blob's");
+                    return 1;
+                }
+            if (info.force_slots == 0) {
+                put(err, errlen, &len, "the clip has impulses but the blob has no force slots (description: 'forces N')");
+                return 1;
+            }
+            ch->joint = prof;
+            continue;
+        }
         if (ch->kind == SN_CLIP_CONTROL) {   /* a control the blob lacks: ignored (joint -1) */
             ch->joint = sn_find_control(blob, ch->name);
             if (ch->joint >= 0 && sn_control_kind_of(blob, (uint32_t)ch->joint) != SN_CONTROL_ABSTRACT) {
@@ -165,6 +190,34 @@ uint32_t sn_clip_controls(const sn_clip *clip, const sn_blob *blob, uint32_t ste
         const sn_clip_channel *ch = &clip->chan[c];
         if (ch->kind != SN_CLIP_CONTROL || !ch->count || ch->joint < 0 || (uint32_t)ch->joint >= info.controls) continue;
         if (sn_set_control(inst, (uint32_t)ch->joint, from_q16(sn_clip_control_at(clip, c, t))) == SN_OK) n++;
+    }
+    return n;
+}
+
+/* ---- impulse events ---- */
+uint32_t sn_clip_impulses(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst) {
+    int32_t h = sn_clip_timestep_q16(blob), t1, t0;
+    uint32_t c, k, n = 0;
+    if (step == 0 || h <= 0) return 0;
+    t1 = sn_clip_time(clip, h, step);
+    t0 = sn_clip_time(clip, h, step - 1u);
+    for (c = 0; c < clip->n_channels; c++) {
+        const sn_clip_channel *ch = &clip->chan[c];
+        if (ch->kind != SN_CLIP_IMPULSE) continue;
+        for (k = ch->first; k < (uint32_t)ch->first + ch->count && k < SN_CLIP_MAX_KEYS; k++) {
+            const sn_clip_key *e = &clip->keys[k];
+            /* (t0, t1]; a looping clip that wrapped covers (t0, duration] and [0, t1] */
+            int in = t1 >= t0 ? (e->t > t0 && e->t <= t1) : (e->t > t0 || e->t <= t1);
+            if (in && t1 != t0) {
+                sn_force f;
+                memset(&f, 0, sizeof f);
+                f.at = SN_AT_SURFACE;
+                f.vertex = (uint32_t)e->v[3];
+                f.profile = ch->joint;
+                f.force.x = from_q16(e->v[0]); f.force.y = from_q16(e->v[1]); f.force.z = from_q16(e->v[2]);
+                if (sn_apply_impulse(inst, &f) == SN_OK) n++;
+            }
+        }
     }
     return n;
 }

@@ -66,6 +66,7 @@ void sn_det_pose(sn_det *d) {
     else builtin_pose(d);
     (void)sn_set_pose(d->inst, d->xf, d->n_joints);
     if (d->clip) (void)sn_clip_controls(d->clip, d->blob, d->k + 1u, d->inst); /* rig control tracks */
+    if (d->clip) (void)sn_clip_impulses(d->clip, d->blob, d->k + 1u, d->inst); /* hits on the flesh */
 }
 
 void sn_det_step(sn_det *d) {

@@ -634,6 +634,7 @@ static void controls_step(sn_instance *in, const sn_blob *blob, const sn_clip *c
                           const held_control *held, int n_held) {
     int i;
     if (clip) sn_clip_controls(clip, blob, k, in);
+    if (clip) sn_clip_impulses(clip, blob, k, in); /* hits on the flesh (clip impulse events) */
     for (i = 0; i < n_held; i++) sn_set_control(in, held[i].c, real_of_q16(held[i].q16));
 }
 
