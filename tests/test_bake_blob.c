@@ -35,7 +35,7 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
     T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
             u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS)),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], 0),
             "%s: instance bytes from SN_INSTANCE_BYTES", what);
     for (k = 0; k < SN_SEC_COUNT; k++) {
         uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);
@@ -74,14 +74,14 @@ static uint32_t spec_crc32(const unsigned char *p, size_t n)
 static void check_spec(const sb_blob *bl, int flavour, const char *what)
 {
     const unsigned char *b = bl->bytes;
-    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 21u;
+    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 26u;
     uint32_t total = u32(b + 16), nV = u32(b + 32), nF = u32(b + 36), nC = u32(b + 40), nJ = u32(b + 44), nS = u32(b + 48),
              nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
-    const uint32_t elem[21] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
-                               40 + 4 * R, 16, 2 * R, 2, 3 * R};
-    uint32_t want[21], inst;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 3 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 3.0", what);
+    const uint32_t elem[26] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
+                               40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R};
+    uint32_t want[26], inst, segB = 0;
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 4 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 4.0", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
@@ -97,11 +97,20 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
                 "%s: spec: frac_S %u <= 59, frac_M %u <= 59, frac_P %u <= 50, frac_E %d in -40..60", what, b[69], b[70], b[71], (signed char)b[76]);
     else
         T_CHECK(b[69] == 0 && b[70] == 0 && b[71] == 0 && b[76] == 0, "%s: spec: float flavours store fractions 0", what);
-    T_CHECK(b[77] == 0 && b[78] == 0 && b[79] == 0, "%s: spec: reserved1 zero", what);
-    {   /* physics scalars at 80 + i R: a1, b1 in [0, 16] (fixed Q24), h > 0 (Q16.16), reserved 10 and 11 zero */
+    T_CHECK((flavour == 0 ? (signed char)b[77] >= -40 && (signed char)b[77] <= 60 : b[77] == 0) && b[78] <= 32 && b[79] == 0,
+            "%s: spec: frac_F %d, max forces %u <= 32, reserved byte zero", what, (signed char)b[77], b[78]);
+    {   /* physics scalars at 80 + i R: a1, b1 in [0, 16] (fixed Q24), h > 0 (Q16.16), FORCE > 0, reserved 11 zero */
         double a1 = real_at(b, 80, 0, 24), b1 = real_at(b, 80, 1, 24), h = real_at(b, 80, 5, 16);
-        T_CHECK(a1 >= 0 && a1 <= 16 && b1 >= 0 && b1 <= 16 && h > 0 && real_at(b, 80, 10, 0) == 0 && real_at(b, 80, 11, 0) == 0,
-                "%s: spec: a1 %g, b1 %g in [0, 16], h %g > 0, reserved reals 0", what, a1, b1, h);
+        double fs = real_at(b, 80, 10, flavour == 0 ? (signed char)b[77] : 0), m0 = real_at(b, 80, 6, 16);
+        T_CHECK(a1 >= 0 && a1 <= 16 && b1 >= 0 && b1 <= 16 && h > 0 && fs > 0 && real_at(b, 80, 11, 0) == 0,
+                "%s: spec: a1 %g, b1 %g in [0, 16], h %g > 0, FORCE %g > 0, reserved real 0", what, a1, b1, h, fs);
+        /* FORCE = h^2 / (m0 U unit): with ENERGY = m0 (U unit)^2 / h^2, FORCE^2 ENERGY = h^2 / m0 */
+        {
+            double en = real_at(b, 80, 7, flavour == 0 ? (signed char)b[76] : 0), want_ = h * h / m0;
+            /* MASS_SCALE and TIMESTEP are m0 and h rounded to Q16.16: their rounding bounds the comparison */
+            if (m0 < 32767) T_CHECK(fabs(fs * fs * en / want_ - 1) < ldexp(1.0, -17) * (1 / m0 + 2 / h) + 1e-6,
+                                    "%s: spec: FORCE^2 ENERGY = h^2/m0 (%g vs %g)", what, fs * fs * en, want_);
+        }
     }
     /* counts of the rig sections: CONTROLS nK, RIGS nR; samples and entries are the RIGS' running sums */
     nK = u32(b + 176 + 16 * 16 + 8); nR = u32(b + 176 + 16 * 17 + 8);
@@ -111,8 +120,24 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         nsamp += r[2]; nent += u32(r + 12);
     }
     {
-        const uint32_t w[21] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent};
+        const uint32_t w[26] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
+                                u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0};
         memcpy(want, w, sizeof want);
+    }
+    want[22] = u32(b + 176 + 16 * 22 + 8) == 0 ? 0 : nF;   /* VSHARE: 0 or nF */
+    {   /* SEGMESH: nodes and attachments are the running sums; state bytes 64 per segment + 24 per node, every level */
+        uint32_t m, nodes = 0, att = 0;
+        for (m = 0; m < want[23]; m++) {
+            const unsigned char *r = b + u32(b + 176 + 16 * 23) + (16 + 9 * R) * m;
+            uint32_t side = u16(r + 4), lv = r[1], l, segs = 0, nn = 0;
+            T_CHECK(u32(r + 8) == nodes && u32(r + 12) == att, "%s: spec: segment mesh %u's first node/attachment are the running sums", what, m);
+            if (r[0] == 0) { segs = side - 1; nn = side; }
+            else for (l = 0; l < lv; l++) { uint32_t s_ = ((side - 1) >> l) + 1; segs += 2 * s_ * (s_ - 1) + (s_ == 2 ? 2 : 0); nn += s_ * s_; }
+            nodes += r[0] == 0 ? side : side * side;
+            att += u16(r + 6);
+            segB += 64 * segs + 24 * nn;
+        }
+        want[24] = nodes; want[25] = att;
     }
     want[13] = u32(b + 176 + 16 * 13 + 8) == 0 ? 0 : nF;   /* LIMIT: 0 or nF */
     for (k = 0, prev = 176 + 16 * NSEC; k < NSEC; k++) {
@@ -127,7 +152,7 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     }
     for (k = prev; k < total; k++) if (b[k]) break;
     T_CHECK(k == total, "%s: spec: trailing padding is zero", what);
-    inst = (512u + 76u * nJ + 84u * nV + 73u * nF + 12u * (nV - nF) + 36u * nC + 4u * nK + 7u) & ~7u;
+    inst = (768u + (76u + 48u) * nJ + 84u * nV + 73u * nF + 12u * (nV - nF) + 36u * nC + 4u * nK + 64u * b[78] + segB + 7u) & ~7u;
     T_CHECK(u32(b + 60) == inst, "%s: spec: instance bytes %u, README formula %u", what, u32(b + 60), inst);
 }
 

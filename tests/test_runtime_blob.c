@@ -107,7 +107,8 @@ static void test_header(void) {
     CASE(SN_ERR_ENDIAN, "wrong endian mark", tb_u32(b + SN_H_ENDIAN, 0x01020305u));
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
-    CASE(SN_ERR_VERSION, "major 4", tb_u16(b + SN_H_VER_MAJOR, 4));
+    CASE(SN_ERR_VERSION, "major 5", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
     CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0200));
     CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
@@ -126,8 +127,11 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "unknown flag bit 7", b[SN_H_FLAGS] |= 0x80);
     CASE(SN_OK, "REST_MODELLED clear", b[SN_H_FLAGS] = 0);
     CASE(SN_OK, "REST_MODELLED set", b[SN_H_FLAGS] = SN_FLAG_REST_MODELLED);
-    CASE(SN_ERR_HEADER, "reserved1 byte 0", b[SN_H_RESERVED1] = 1);
-    CASE(SN_ERR_HEADER, "reserved1 byte 2", b[SN_H_RESERVED1 + 2] = 0x80);
+    CASE(SN_ERR_HEADER, "reserved1 byte", b[SN_H_RESERVED1] = 1);
+    CASE(SN_ERR_HEADER, "reserved1 byte top bit", b[SN_H_RESERVED1] = 0x80);
+    CASE(SN_ERR_HEADER, "max forces > SN_MAX_FORCES", b[SN_H_MAX_FORCES] = SN_MAX_FORCES + 1);
+    CASE(SN_ERR_HEADER, "max forces changed: instance bytes no longer match", b[SN_H_MAX_FORCES] = TB_NFRC + 1);
+    CASE(SN_ERR_HEADER, "frac_F > 60", b[SN_H_FRAC_F] = 61);
 #if !defined(SN_VALIDATE_NO_CHECKSUM)
     CASE_RAW(SN_ERR_CHECKSUM, "flipped data bit", g_total, b[g_total - 3] ^= 0x10);
     CASE_RAW(SN_ERR_CHECKSUM, "flipped header count bit", g_total, b[SN_H_N_CELLS] ^= 0x01);
@@ -167,13 +171,13 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
     CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0) - 8));
     CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, 0)));
     CASE(SN_ERR_HEADER, "instance_bytes larger than the formula (a blob cannot ask for memory)",
          tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
     CASE(SN_ERR_HEADER, "instance_bytes without the control values",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, 0)));
 
     /* physics scalars */
 #define RL(i) (b + SN_H_REALS + 4 * (i))
@@ -202,14 +206,16 @@ static void test_header(void) {
     CASE(SN_ERR_VALUE, "DISP_BOUND 0", tb_real(RL(SN_R_DISP_BOUND), 0.0, 16));
     CASE(SN_ERR_VALUE, "DISP_BOUND < 0", tb_real(RL(SN_R_DISP_BOUND), -2.0, 16));
     CASE(SN_OK, "DISP_BOUND 1 LSB", put_at(RL(SN_R_DISP_BOUND), 1, 16));
-    CASE(SN_ERR_VALUE, "reserved real 10", tb_real(RL(SN_R_RESERVED10), 1.0, 16));
+    CASE(SN_ERR_VALUE, "FORCE 0", tb_u32(RL(SN_R_FORCE), 0));
+    CASE(SN_ERR_VALUE, "FORCE < 0", tb_real(RL(SN_R_FORCE), -1.0 / 1024, TB_FRAC_F));
     CASE(SN_ERR_VALUE, "reserved real 11", tb_u32(RL(SN_R_RESERVED11), 1));
 #if defined(SN_FLOAT)
     CASE(SN_ERR_VALUE, "a1 NaN", tb_u32(RL(SN_R_A1), 0x7FC00000u));
     CASE(SN_ERR_VALUE, "grav inf", tb_u32(RL(SN_R_GRAV_X), 0x7F800000u));
     CASE(SN_ERR_VALUE, "timestep inf", tb_u32(RL(SN_R_TIMESTEP), 0x7F800000u));
     CASE(SN_ERR_VALUE, "mass scale NaN", tb_u32(RL(SN_R_MASS_SCALE), 0xFFC00000u));
-    CASE(SN_ERR_VALUE, "reserved real -0.0", tb_u32(RL(SN_R_RESERVED10), 0x80000000u));
+    CASE(SN_ERR_VALUE, "reserved real -0.0", tb_u32(RL(SN_R_RESERVED11), 0x80000000u));
+    CASE(SN_ERR_VALUE, "FORCE NaN", tb_u32(RL(SN_R_FORCE), 0x7FC00000u));
     CASE(SN_ERR_VALUE, "ENERGY NaN", tb_u32(RL(SN_R_ENERGY), 0x7FC00000u));
     CASE(SN_ERR_VALUE, "ENERGY inf", tb_u32(RL(SN_R_ENERGY), 0x7F800000u));
     CASE(SN_ERR_VALUE, "CELL NaN", tb_u32(RL(SN_R_CELL), 0x7FC00000u));
@@ -434,7 +440,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)
@@ -580,11 +586,14 @@ static void test_steps(void) {
 static void test_instance_size_formula(void) {
     static const uint32_t nv[] = {2, 12, 233, 65535}, nf[] = {1, 8, 126, 65534}, nj[] = {1, 2, 15, 255};
     static const uint32_t nc[] = {1, 2, 106, 65535}, nk[] = {0, 1, 3, 256};
-    int a, b, c, d, e, bad = 0, n = 0;
-    for (a = 0; a < 4; a++) for (b = 0; b < 4; b++) for (c = 0; c < 4; c++) for (d = 0; d < 4; d++) for (e = 0; e < 4; e++) {
+    static const uint32_t nfr[] = {0, 1, 32}, sgb[] = {0, 88, 1234568};
+    int a, b, c, d, e, f, bad = 0, n = 0;
+    for (a = 0; a < 4; a++) for (b = 0; b < 4; b++) for (c = 0; c < 4; c++) for (d = 0; d < 4; d++) for (e = 0; e < 4; e++)
+    for (f = 0; f < 3; f++) {
         if (nf[b] >= nv[a]) continue;
         n++;
-        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e]) != sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e]);
+        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3]) !=
+               sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3]);
     }
     T_CHECK(n > 300 && bad == 0, "SN_INSTANCE_BYTES == the runtime layout's size for %d count sets (%d differ)", n, bad);
 }

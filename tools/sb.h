@@ -190,6 +190,15 @@ typedef struct sb_model {
     int nctl, nrig;
     struct sb_control *ctl; /* joints in sorted order, TWIST resolved to an axis */
     struct sb_rig *rig;
+    /* external forces (sb_force.c, sb_force_build): slots per step, share profiles
+     * (fine, coarse 1..3, rigid; each sums to 1), profile of each free vertex (NULL: all 0) */
+    int max_forces;
+    int nprof;
+    double (*prof)[5];
+    unsigned char *vprof;
+    /* segment meshes (sb_segment.c, sb_segment_build) */
+    int nsm;
+    struct sb_segmesh *sm;
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -247,6 +256,23 @@ void sb_rig_field(const sb_model *o, const sb_rig *r, const double p[3], double 
 /* tau_a(gamma): piecewise linear through the samples, clamped at the ends */
 double sb_rig_tau(const sb_rigdef *r, double gamma);
 const char *sb_rig_tpl_name(int tpl);
+
+/* ---- external forces (sb_force.c) ---- */
+/* share profiles from the description's 'force' lines, per free vertex */
+int sb_force_build(const sb_desc *d, sb_model *o);
+void sb_force_free(sb_model *o);
+
+/* ---- segment meshes (sb_segment.c) ---- */
+/* chains and sheets from the description, attached to the built model */
+int sb_segment_build(const sb_desc *d, const sb_mesh *m, sb_model *o);
+void sb_segment_free(sb_model *o);
+/* instance state bytes of o's segment meshes (SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes) */
+uint32_t sb_segment_state_bytes(const sb_model *o);
+/* SEGNODES and SEGATTACH counts of o's segment meshes */
+void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach);
+/* write the three segment sections at their offsets (w: blob bytes, rs: real size,
+ * flavour SB_*); 0 or -1 (sb_fail) */
+int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t *off, int flavour, int rs, int len_shift);
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

@@ -209,8 +209,8 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total;
     wr_t w;
 
-    int nlim = 0, efrac = 0;
-    double escale;
+    int nlim = 0, efrac = 0, ffrac = 0;
+    double escale, fscale;
     memset(b, 0, sizeof *b);
     for (i = 0; i < nF; i++) if (o->limit && o->limit[i] > 0) nlim = nF;
     for (i = 0; i < nV; i++) { e = sb_pattern_find(o, i, i); if (o->M[e] > m0) m0 = o->M[e]; }
@@ -287,6 +287,18 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         cnt[SN_SEC_RIG_FORCES] = nent;             esz[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(rs);
         if (o->nctl > (int)SN_MAX_CONTROLS || o->nrig > (int)SN_MAX_RIGS) { free(P); free(lump); return sb_fail("%d controls, %d rigs: at most %u and %u", o->nctl, o->nrig, SN_MAX_CONTROLS, SN_MAX_RIGS); }
     }
+    {   /* external forces: share profiles, per-vertex profiles */
+        if (o->nprof > (int)SN_MAX_PROFILES || o->max_forces < 0 || o->max_forces > (int)SN_MAX_FORCES) { free(P); free(lump); return sb_fail("%d force profiles, %d force slots: at most %u and %u", o->nprof, o->max_forces, SN_MAX_PROFILES, SN_MAX_FORCES); }
+        cnt[SN_SEC_SHARES] = (uint32_t)o->nprof;                 esz[SN_SEC_SHARES] = SN_ELEM_SHARES(rs);
+        cnt[SN_SEC_VSHARE] = o->vprof ? (uint32_t)nF : 0u;       esz[SN_SEC_VSHARE] = SN_ELEM_VSHARE;
+    }
+    {   /* segment meshes (sb_segment.c) */
+        uint32_t nodes = 0, natt = 0;
+        sb_segment_blob_counts(o, &nodes, &natt);
+        cnt[SN_SEC_SEGMESH] = (uint32_t)o->nsm;    esz[SN_SEC_SEGMESH] = SN_ELEM_SEGMESH(rs);
+        cnt[SN_SEC_SEGNODES] = nodes;              esz[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(rs);
+        cnt[SN_SEC_SEGATTACH] = natt;              esz[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(rs);
+    }
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -318,7 +330,9 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, SN_H_N_SURFACE, (uint32_t)o->ns);
     put_u32(&w, SN_H_N_TRIANGLES, (uint32_t)o->nt);
     put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
-    put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc, (uint32_t)o->nctl));
+    put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc, (uint32_t)o->nctl, (uint32_t)o->max_forces,
+                                                       sb_segment_state_bytes(o)));
+    put_u8(&w, SN_H_MAX_FORCES, (unsigned)o->max_forces);
     put_u8(&w, SN_H_FLAGS, o->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
     put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
     put_u16(&w, SN_H_CG_MAX, (unsigned)o->cg_max);
@@ -333,6 +347,14 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         put_u8(&w, SN_H_FRAC_E, (unsigned)(fe & 255));
         efrac = fe;
     }
+    {   /* FORCE = h^2 / (m0 U unit) rhs units per newton, in [2^29, 2^30) in fixed */
+        int ff = 0;
+        fscale = h * h / (m0 * U * o->unit);
+        if (flavour == SB_FIXED) { frexp(fscale, &ff); ff = 30 - ff; }
+        if (!(fscale > 0) || ff < -40 || ff > 60) { sb_blob_free(b); free(P); free(lump); return sb_fail("force scale %g per newton out of range", fscale); }
+        put_u8(&w, SN_H_FRAC_F, (unsigned)(ff & 255));
+        ffrac = ff;
+    }
     {
         size_t R0 = SN_H_REALS;
         double gs = h * h / (U * o->unit);   /* g^ = h^2 g / U, U in metres */
@@ -344,7 +366,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         put_real(&w, R0 + SN_R_ENERGY * (size_t)rs, escale, efrac);
         put_real(&w, R0 + SN_R_CELL * (size_t)rs, o->c / U, SN_Q_LEN);
         put_real(&w, R0 + SN_R_DISP_BOUND * (size_t)rs, SB_DISP_BOUND, 16);
-        put_real(&w, R0 + SN_R_RESERVED10 * (size_t)rs, 0.0, 0);
+        put_real(&w, R0 + SN_R_FORCE * (size_t)rs, fscale, ffrac);
         put_real(&w, R0 + SN_R_RESERVED11 * (size_t)rs, 0.0, 0);
     }
     for (k = 0; k < SN_SEC_COUNT; k++) {
@@ -415,6 +437,19 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         for (k = 0; k < 3; k++) put_u16(&w, off[SN_SEC_TRIS] + 6 * (size_t)i + 2 * (size_t)k, (unsigned)o->tri[3 * i + k]);
     free(P); free(lump);
     if (!w.err && write_rigs(o, &w, off, U * o->unit, m0, b) != 0) { sb_blob_free(b); return -1; }
+    for (i = 0; i < o->nprof; i++)   /* share profiles: Q30, the fine share takes the rounding so each sums to 2^30 */
+        for (k = 0; k < SN_LEVELS; k++) {
+            size_t at = off[SN_SEC_SHARES] + ((size_t)i * SN_LEVELS + (size_t)k) * (size_t)rs;
+            if (flavour == SB_FIXED) {
+                int32_t q = 0, rest = (int32_t)1 << 30;
+                int kk;
+                for (kk = 1; kk < SN_LEVELS; kk++) rest -= (int32_t)rnd(o->prof[i][kk] * 1073741824.0);
+                q = k == 0 ? rest : (int32_t)rnd(o->prof[i][k] * 1073741824.0);
+                put_u32(&w, at, (uint32_t)q);
+            } else put_real(&w, at, o->prof[i][k], 0);
+        }
+    if (o->vprof) for (i = 0; i < nF; i++) put_u8(&w, off[SN_SEC_VSHARE] + (size_t)i, o->vprof[i]);
+    if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s) != 0) { sb_blob_free(b); return -1; }
     if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
     if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }
     put_u32(&w, SN_H_CRC32, sb_crc32(b->bytes + 16, total - 16));

@@ -52,7 +52,7 @@ extern "C" {
 #endif
 
 /// Version of this header and of the blob format it reads (major.minor).
-#define SN_VERSION_MAJOR 3
+#define SN_VERSION_MAJOR 4
 #define SN_VERSION_MINOR 0
 
 #if defined(SN_FLOAT)
@@ -255,6 +255,9 @@ typedef struct sn_stats {
     sn_real  energy;       ///< elastic + kinetic energy after the last step, joules (Q16.16 / float); kinetic uses the lumped mass
     sn_real  energy_max;   ///< largest energy since init/reset
     uint32_t cg_clamps;    ///< CG step ratios (alpha, beta) clamped at 8 since init/reset (fixed; 0 in float): rounding-floor noise of a converged solve, not a fault
+    uint32_t force_drops;  ///< sn_apply_force / sn_apply_impulse calls refused since init/reset because the step's force slots were full
+    sn_real  seg_gap;      ///< largest segment-mesh constraint gap left after the last step's fixed sweeps, in segment lengths (Q16.16 / float)
+    sn_real  seg_gap_max;  ///< largest seg_gap since init/reset
 } sn_stats;
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.

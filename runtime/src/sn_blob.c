@@ -306,7 +306,7 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (total > size) return SN_ERR_TRUNCATED;
     if (sn_rd_u32(p + SN_H_HEADER_SIZE) != SN_HEADER_BYTES || p[SN_H_NSECTIONS] != SN_SEC_COUNT ||
         (p[SN_H_FLAGS] & ~SN_FLAG_REST_MODELLED) != 0 || p[SN_H_RESERVED1] != 0 ||
-        p[SN_H_RESERVED1 + 1] != 0 || p[SN_H_RESERVED1 + 2] != 0)
+        p[SN_H_MAX_FORCES] > SN_MAX_FORCES)
         return SN_ERR_HEADER;
 #if !defined(SN_VALIDATE_NO_CHECKSUM)
     if (sn_crc32(p + 16, total - 16) != sn_rd_u32(p + SN_H_CRC32)) return SN_ERR_CHECKSUM;
@@ -321,7 +321,8 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     /* shifts the step takes: frac_S - k + 3 and frac_M - k + 3 (k in 0..15),
      * frac_P + k - 3: all must stay <= 62 for sn_rshr64 */
     if (v.len_shift < -24 || v.len_shift > 24 || v.frac_S > 59 || v.frac_M > 59 || v.frac_P > 50 ||
-        v.frac_E < -40 || v.frac_E > 60 || (SN_FLAVOUR != SN_FLAVOUR_FIXED && v.frac_E != 0))
+        v.frac_E < -40 || v.frac_E > 60 || (SN_FLAVOUR != SN_FLAVOUR_FIXED && v.frac_E != 0) ||
+        v.frac_F < -40 || v.frac_F > 60 || (SN_FLAVOUR != SN_FLAVOUR_FIXED && v.frac_F != 0))
         return SN_ERR_HEADER;
     if (v.nC < 1 || v.nC > SN_MAX_VERTICES) return SN_ERR_HEADER;
 
@@ -337,7 +338,7 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             !sn_real_ok(r + SN_R_ENERGY * SN_REAL_BYTES, 0, INT32_MAX, 0) || !(v.energy > 0) ||
             !sn_real_ok(r + SN_R_CELL * SN_REAL_BYTES, 1, SN_ENTRY_LIM, SN_Q_LEN) || !(v.cell > 0) ||
             !sn_real_ok(r + SN_R_DISP_BOUND * SN_REAL_BYTES, 1, INT32_MAX, 16) || !(v.disp_bound > 0) ||
-            !sn_real_zero(r + SN_R_RESERVED10 * SN_REAL_BYTES) ||
+            !sn_real_ok(r + SN_R_FORCE * SN_REAL_BYTES, 0, INT32_MAX, 0) || !(v.force > 0) ||
             !sn_real_zero(r + SN_R_RESERVED11 * SN_REAL_BYTES))
             return SN_ERR_VALUE;
     }
@@ -375,9 +376,21 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         cnt[SN_SEC_RIG_SAMPLES] = v.nRS;
         cnt[SN_SEC_RIG_VERTS] = v.nRE;
         cnt[SN_SEC_RIG_FORCES] = v.nRE; /* one force per vertex entry */
+        /* forces and segments (format 4.0) */
+        v.nP = sn_rd_u32(t + SN_SEC_SHARES * SN_SECTION_ENTRY);
+        v.nM = sn_rd_u32(t + SN_SEC_SEGMESH * SN_SECTION_ENTRY);
+        v.nSN = sn_rd_u32(t + SN_SEC_SEGNODES * SN_SECTION_ENTRY);
+        v.nSA = sn_rd_u32(t + SN_SEC_SEGATTACH * SN_SECTION_ENTRY);
+        if (v.nP > SN_MAX_PROFILES || v.nM > SN_SEG_MAX_MESHES ||
+            v.nSN > SN_SEG_MAX_MESHES * SN_SEG_MAX_SIDE * SN_SEG_MAX_SIDE ||
+            v.nSA > SN_SEG_MAX_MESHES * SN_SEG_MAX_SIDE * SN_SEG_MAX_SIDE)
+            return SN_ERR_SECTION;
+        cnt[SN_SEC_SHARES] = v.nP;
+        cnt[SN_SEC_VSHARE] = 0; /* 0 or nF: taken from the table below */
+        cnt[SN_SEC_SEGMESH] = v.nM;
+        cnt[SN_SEC_SEGNODES] = v.nSN;
+        cnt[SN_SEC_SEGATTACH] = v.nSA;
     }
-    /* the instance size is the runtime's layout (one source: sn_instance.c) */
-    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK)) return SN_ERR_HEADER;
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
             SN_ELEM_JOINTS(SN_REAL_BYTES), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(SN_REAL_BYTES),
@@ -386,12 +399,14 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_CELLS, SN_ELEM_CFRAMES,
             SN_ELEM_CELLK(SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS,
             SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
-            SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES)};
+            SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
+            SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
+            SN_ELEM_SEGATTACH(SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
             uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
-            if (k == SN_SEC_LIMIT && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
+            if ((k == SN_SEC_LIMIT || k == SN_SEC_VSHARE) && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -402,12 +417,19 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             prev_end = off + sz;
         }
         v.nL = cnt[SN_SEC_LIMIT];
+        v.nVP = cnt[SN_SEC_VSHARE];
         if (!sn_zero_bytes(p + prev_end, total - prev_end)) return SN_ERR_SECTION;
     }
 
     sn_view_sections(&v);
     st = sn_check_contents(&v);
     if (st != SN_OK) return st;
+    st = sn_check_forces(&v);
+    if (st != SN_OK) return st;
+    st = sn_check_segments(&v, &v.segB);
+    if (st != SN_OK) return st;
+    /* the instance size is the runtime's layout (one source: sn_instance.c) */
+    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB)) return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }
@@ -433,6 +455,8 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->frac_M = p[SN_H_FRAC_M];
     v->frac_P = p[SN_H_FRAC_P];
     v->frac_E = p[SN_H_FRAC_E] < 128 ? (int)p[SN_H_FRAC_E] : (int)p[SN_H_FRAC_E] - 256;
+    v->frac_F = p[SN_H_FRAC_F] < 128 ? (int)p[SN_H_FRAC_F] : (int)p[SN_H_FRAC_F] - 256;
+    v->nFrc = p[SN_H_MAX_FORCES];
     v->a1 = SN_RD_REAL(r + SN_R_A1 * SN_REAL_BYTES);
     v->b1 = SN_RD_REAL(r + SN_R_B1 * SN_REAL_BYTES);
     v->grav[0] = SN_RD_REAL(r + SN_R_GRAV_X * SN_REAL_BYTES);
@@ -442,8 +466,10 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->energy = SN_RD_REAL(r + SN_R_ENERGY * SN_REAL_BYTES);
     v->cell = SN_RD_REAL(r + SN_R_CELL * SN_REAL_BYTES);
     v->disp_bound = SN_RD_REAL(r + SN_R_DISP_BOUND * SN_REAL_BYTES);
+    v->force = SN_RD_REAL(r + SN_R_FORCE * SN_REAL_BYTES);
     v->flags = p[SN_H_FLAGS];
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
+    v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
@@ -455,12 +481,24 @@ static void sn_view_sections(sn_view *v) {
     v->nR = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIGS * SN_SECTION_ENTRY + 8);
     v->nRS = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIG_SAMPLES * SN_SECTION_ENTRY + 8);
     v->nRE = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIG_VERTS * SN_SECTION_ENTRY + 8);
+    v->nP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SHARES * SN_SECTION_ENTRY + 8);
+    v->nVP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_VSHARE * SN_SECTION_ENTRY + 8);
+    v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
+    v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
+    v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob) {
+    uint32_t m;
     sn_view_header(v, sn_bytes(blob));
     sn_view_sections(v);
+    for (m = 0; m < v->nM; m++) { /* segment state bytes (validated records) */
+        const unsigned char *r = v->sec[SN_SEC_SEGMESH] + (size_t)m * SN_ELEM_SEGMESH(SN_REAL_BYTES);
+        uint32_t segs, nodes;
+        sn_seg_counts(r[0], sn_rd_u16(r + 4), r[1], &segs, &nodes);
+        v->segB += SN_SEG_SEG_BYTES * segs + SN_SEG_NODE_BYTES * nodes;
+    }
 }
 
 /* ---- accessors of a validated blob (NULL blob -> neutral answer) ---- */

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 3.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 4.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -9,11 +9,13 @@
 #ifndef SN_FORMAT_H
 #define SN_FORMAT_H
 
+#include <stdint.h>
+
 #define SN_MAGIC0 'S'
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 3
+#define SN_FORMAT_MAJOR 4
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -55,7 +57,9 @@
 #define SN_H_FRAC_P        71   /* u8  fractional bits of preconditioner entries (fixed) */
 #define SN_H_ONE_HI        72   /* u32 high word of 1.0 for float64, else 0 */
 #define SN_H_FRAC_E        76   /* i8  fractional bits of the ENERGY real (fixed flavour; 0 otherwise), -40..60 */
-#define SN_H_RESERVED1     77   /* u8[3] 0 */
+#define SN_H_FRAC_F        77   /* i8  fractional bits of the FORCE real (fixed flavour; 0 otherwise), -40..60 */
+#define SN_H_MAX_FORCES    78   /* u8  external force slots per step (sn_apply_force), 0..SN_MAX_FORCES */
+#define SN_H_RESERVED1     79   /* u8  0 */
 /* physics scalars: SN_H_NREALS reals, at SN_H_REALS + i*real_size */
 #define SN_H_REALS         80
 #define SN_R_A1             0   /* h*alpha (Rayleigh mass term), fixed Q24, >= 0 */
@@ -68,7 +72,7 @@
 #define SN_R_ENERGY         7   /* joules per internal energy unit, m0 (U unit)^2 / h^2, fixed Q frac_E, > 0 */
 #define SN_R_CELL           8   /* lattice cell edge in internal length units, fixed Q22, > 0 */
 #define SN_R_DISP_BOUND     9   /* health bound on the distance of a free vertex from its skinned position, cells, fixed Q16.16, > 0 */
-#define SN_R_RESERVED10    10   /* 0 */
+#define SN_R_FORCE         10   /* right-hand-side units per newton, h^2 / (m0 U unit), fixed Q frac_F, > 0 */
 #define SN_R_RESERVED11    11   /* 0 */
 #define SN_H_NREALS        12
 #define SN_H_SECTIONS     176   /* section table: SN_SEC_COUNT x {u32 offset, u32 size, u32 count, u32 elem_size} */
@@ -114,6 +118,24 @@ enum {
     SN_SEC_RIG_FORCES,   /* sum of n_entries x R[3]: the rig's generalized force Q^a_i at eta = 1 in the vertex's rest frame,
                             in the units of the right-hand side (h^2 Q / (m0 U), NUMERICS.md) (fixed: Q frac of the rig;
                             float: |.| <= SN_RIG_FLOAT_MAX) */
+    /* ---- external forces (seed 004 ch. 4 on the lattice), format 4.0; both may have count 0 ---- */
+    SN_SEC_SHARES,       /* nP x R[SN_LEVELS] share profile: the part of an applied force taken by the fine lattice, the coarse
+                            levels 1..SN_LEVELS-2 (regions of 2^k cells) and the rigid level (the joint wrench), fixed Q30,
+                            each >= 0, summing to exactly 2^30 (float: within 2^-20 of 1); nP <= SN_MAX_PROFILES.
+                            Count 0: every force goes to the fine lattice */
+    SN_SEC_VSHARE,       /* nF x u8 profile of free vertex i (< nP), or count 0 (profile 0, or all-fine without profiles) */
+    /* ---- segment meshes (seed 004 ch. 3-4), format 4.0; all three may have count 0 ---- */
+    SN_SEC_SEGMESH,      /* nM x {u8 kind (SN_SEG_*), u8 levels, u8 sweeps (1..SN_SEG_MAX_SWEEPS), u8 flags (SN_SEGF_*), u16 side,
+                            u16 n_attach, u32 first_node, u32 first_attach, R seg_len (Q22 internal, > 0),
+                            R gamma (translation factor, Q30, (0, 1]), R keep (velocity kept per step, Q30, [0, 1]),
+                            R inv_mass (m0 / segment mass, Q16.16, > 0), R centre (share of a node force applied at the
+                            segments' centres, seed 004 §3.2.2, Q30, [0, 1]), R share[4] (force share per level, finest
+                            first, Q30, sum 2^30)}; nM <= SN_SEG_MAX_MESHES.
+                            chain: side = nodes (2..SN_SEG_MAX_SIDE), levels 1; sheet: side = 2^n + 1 (3..SN_SEG_MAX_SHEET),
+                            levels 1..min(n+1, 4). first_node / first_attach are running sums from 0 */
+    SN_SEC_SEGNODES,     /* sum of nodes x R[3]: rest node positions, model space, Q22 (sheets row-major) */
+    SN_SEC_SEGATTACH,    /* sum of n_attach x {u16 node (< the mesh's nodes), u8 kind (SN_SEGATT_*), u8 0, u16 target, u16 0,
+                            R point[3] (JOINT: attachment point at rest, model space Q22; SURFACE: 0)} */
     SN_SEC_COUNT
 };
 
@@ -140,6 +162,45 @@ enum {
 #define SN_ELEM_RIG_SAMPLES(R) (2 * (R))
 #define SN_ELEM_RIG_VERTS   2
 #define SN_ELEM_RIG_FORCES(R) (3 * (R))
+#define SN_ELEM_SHARES(R)   (SN_LEVELS * (R))
+#define SN_ELEM_VSHARE      1
+#define SN_ELEM_SEGMESH(R)  (16 + 9 * (R))
+#define SN_ELEM_SEGNODES(R) (3 * (R))
+#define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
+
+/* external forces: levels fine, coarse 1..3 (2, 4, 8 cells), rigid */
+#define SN_LEVELS 5
+#define SN_MAX_PROFILES 255u
+#define SN_MAX_FORCES 32u
+#define SN_FORCE_SLOT_BYTES 64u   /* instance bytes per force slot */
+#define SN_WRENCH_BYTES 48u       /* instance bytes per joint: force and torque (fixed: int64 sums; float: 6 floats) */
+
+/* segment meshes */
+#define SN_SEG_CHAIN 0
+#define SN_SEG_SHEET 1
+#define SN_SEGF_NO_GRAVITY 1u      /* the mesh feels no gravity (the thesis' experiments) */
+#define SN_SEG_MAX_LEVELS 4u
+#define SN_SEGATT_SURFACE 0       /* target = surface vertex: follows the deformed surface */
+#define SN_SEGATT_JOINT 1         /* target = joint: point moves with the joint's transform */
+#define SN_SEG_MAX_MESHES 64u
+#define SN_SEG_MAX_SIDE 256u
+#define SN_SEG_MAX_SHEET 65u
+#define SN_SEG_MAX_SWEEPS 64u
+#define SN_SEG_SEG_BYTES 64u      /* instance bytes per segment (state of every level) */
+#define SN_SEG_NODE_BYTES 24u     /* instance bytes per node (every level) */
+/* Segments and nodes of a mesh over all its levels (sheet level l has side
+ * (side-1)/2^l + 1; a 2x2 coarsest level carries two braces, seed 004 fig. 4.4).
+ * Arguments must be validated (kind, side, levels). */
+static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, uint32_t *segs, uint32_t *nodes) {
+    unsigned l;
+    *segs = 0; *nodes = 0;
+    if (kind == SN_SEG_CHAIN) { *segs = side - 1u; *nodes = side; return; }
+    for (l = 0; l < levels; l++) {
+        uint32_t s = ((side - 1u) >> l) + 1u;
+        *segs += 2u * s * (s - 1u) + (s == 2u ? 2u : 0u);
+        *nodes += s * s;
+    }
+}
 
 /* control kinds (CONTROLS.kind) */
 #define SN_CTL_ABSTRACT 0   /* set by the game: sn_set_control */
@@ -173,8 +234,12 @@ enum {
  * writers (the host tool, the tests' blob writers). The runtime's layout
  * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
  * the header to equal it, and test_runtime_blob checks this macro against it. */
-#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK) \
-    (((uint32_t)512u + 76u * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
-      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + 7u) & ~7u)
+#define SN_INSTANCE_HDR_BYTES 768u /* the instance header before the arrays */
+/* nFrc: force slots (header MAX_FORCES); segB: segment state bytes, the sum
+ * over meshes of SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts). */
+#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB) \
+    ((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
+      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
+      SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

@@ -5,6 +5,8 @@
  *   sn_pose.c      pose input, forward kinematics, joint and frame transforms, skeleton
  *   sn_solve.c     right-hand side, per-cell stiffness, mat-vec, preconditioner, PCG
  *   sn_rig.c       controls, tau maps, rig forces (seed 003 §4)
+ *   sn_force.c     external forces and impulses, multilevel shares, joint wrench (seed 004 ch. 4)
+ *   sn_segment.c   segment meshes: chains and sheets (seed 004 ch. 3-4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
  *   sn_step.c      the step: the stages in order
@@ -15,7 +17,7 @@
 #include "sn_internal.h"
 
 #define SN_INST_MAGIC 0x534E4932u /* "SNI2" */
-#define SN_HDR_BYTES 512u
+#define SN_HDR_BYTES SN_INSTANCE_HDR_BYTES
 
 /* Instance header; arrays follow at fixed offsets computed from the blob. */
 typedef struct sn_ihdr {
@@ -30,7 +32,11 @@ typedef struct sn_ihdr {
 #endif
     /* byte offsets of the arrays from the instance start */
     uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds,
-        o_k, o_cR, o_ctl;
+        o_k, o_cR, o_ctl, o_wr, o_frc, o_seg;
+    uint32_t n_forces;      /* force slots filled since the last step (sn_force.c) */
+    uint32_t force_drops;   /* forces refused since init/reset: slots full */
+    sn_real seg_gap;        /* largest segment constraint gap after the last step's sweeps, fraction of a segment (public Q16.16 / float) */
+    sn_real seg_gap_max;    /* largest seg_gap since init/reset */
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -131,6 +137,11 @@ void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
 void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */
 void sn_controls_reset(sn_ihdr *h);                 /* abstract controls to their baked values */
+void sn_forces_rhs(sn_ihdr *h, sn_q *b, uint32_t *sat); /* 5: b += applied forces' fine and coarse shares (sn_force.c) */
+void sn_forces_clear(sn_ihdr *h);                   /* after the step: slots emptied */
+void sn_segments_reset(sn_ihdr *h);                 /* segment meshes at rest (sn_segment.c) */
+void sn_segments_step(sn_ihdr *h, uint32_t *sat);   /* 8b: segment meshes after the flesh (sn_segment.c) */
+uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into the FNV-1a hash */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 
 /* Twice the elastic + kinetic energy of the step's starting state in

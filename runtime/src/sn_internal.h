@@ -202,15 +202,25 @@ typedef struct sn_view {
     const unsigned char *sec[SN_SEC_COUNT];
     uint32_t nV, nF, nC, nJ, nS, nT, nnz, nL; /* nL: LIMIT entries, 0 or nF */
     uint32_t nK, nR, nRS, nRE; /* controls, rigs, rig samples, rig entries (section counts) */
+    uint32_t nP, nVP, nFrc;    /* share profiles, vertex profile entries (0 or nF), force slots */
+    uint32_t nM, nSN, nSA, segB; /* segment meshes, nodes, attachments; segment state bytes */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;
-    int len_shift, frac_S, frac_M, frac_P, frac_E;
+    int len_shift, frac_S, frac_M, frac_P, frac_E, frac_F;
     sn_q a1, b1, grav[3], timestep;
     sn_q energy, cell, disp_bound; /* health scalars (NUMERICS.md) */
+    sn_q force;                    /* right-hand-side units per newton (Q frac_F) */
 } sn_view;
 
 /* Instance bytes for these counts: the runtime's layout (sn_instance.c), the
  * one source of the size (SN_INSTANCE_BYTES in sn_format.h is tested equal). */
-uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK);
+uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
+                           uint32_t nFrc, uint32_t segB);
+
+/* Segment sections (sn_segment.c): contents valid, and *segB = the state
+ * bytes they need. Called by the validator once the table is checked. */
+sn_status sn_check_segments(const sn_view *v, uint32_t *segB);
+/* Force sections (sn_force.c): profiles and vertex profiles valid. */
+sn_status sn_check_forces(const sn_view *v);
 
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob);

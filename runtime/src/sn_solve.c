@@ -210,6 +210,7 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
         }
     }
     sn_rigs(h, b, sat); /* + R_i sum_a tau_a Q^a_i (seed 003 eq. 12) */
+    sn_forces_rhs(h, b, sat); /* + applied forces (seed 004 ch. 4 shares) */
 }
 
 

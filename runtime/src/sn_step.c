@@ -18,6 +18,8 @@ sn_status sn_step(sn_instance *inst) {
     sn_skeleton(h, &sat);
     sn_solve(h, &sat);
     sn_limits(h, &sat);
+    sn_segments_step(h, &sat);
+    sn_forces_clear(h);
     sn_health(h, sat);
     h->saturations = sn_count(h->saturations, sat);
     h->steps = sn_count(h->steps, 1);

@@ -41,6 +41,9 @@
 #define TB_NRS 6     /* rig samples */
 #define TB_NRE 7     /* rig entries */
 #define TB_RIG_FRAC 36 /* rig forces ~2e-2 internal units: 2^30.4 at Q36 */
+#define TB_NP 2      /* force share profiles */
+#define TB_NFRC 4    /* force slots */
+#define TB_FRAC_F 40 /* FORCE: 1/1024 rhs units per newton */
 
 static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
 static void tb_u32(unsigned char *p, uint32_t v) {
@@ -156,6 +159,11 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_RIG_SAMPLES] = TB_NRS; elem[SN_SEC_RIG_SAMPLES] = (uint32_t)SN_ELEM_RIG_SAMPLES(R);
     cnt[SN_SEC_RIG_VERTS] = TB_NRE;   elem[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
     cnt[SN_SEC_RIG_FORCES] = TB_NRE;  elem[SN_SEC_RIG_FORCES] = (uint32_t)SN_ELEM_RIG_FORCES(R);
+    cnt[SN_SEC_SHARES] = TB_NP;       elem[SN_SEC_SHARES] = (uint32_t)SN_ELEM_SHARES(R);
+    cnt[SN_SEC_VSHARE] = TB_NF;       elem[SN_SEC_VSHARE] = SN_ELEM_VSHARE;
+    cnt[SN_SEC_SEGMESH] = 0;          elem[SN_SEC_SEGMESH] = (uint32_t)SN_ELEM_SEGMESH(R);
+    cnt[SN_SEC_SEGNODES] = 0;         elem[SN_SEC_SEGNODES] = (uint32_t)SN_ELEM_SEGNODES(R);
+    cnt[SN_SEC_SEGATTACH] = 0;        elem[SN_SEC_SEGATTACH] = (uint32_t)SN_ELEM_SEGATTACH(R);
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -258,6 +266,13 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
             }
         }
     }
+    {   /* force shares: profile 0 all fine, profile 1 spread (1/2, 1/4, 1/8, 0, 1/8); vertices alternate */
+        static const double prof[TB_NP][SN_LEVELS] = {{1, 0, 0, 0, 0}, {0.5, 0.25, 0.125, 0, 0.125}};
+        for (i = 0; i < TB_NP; i++)
+            for (j = 0; j < SN_LEVELS; j++)
+                tb_real(b + secoff[SN_SEC_SHARES] + (SN_LEVELS * i + j) * R, prof[i][j], SN_Q_ROT);
+        for (i = 0; i < TB_NF; i++) b[secoff[SN_SEC_VSHARE] + i] = (unsigned char)(i & 1);
+    }
     /* header */
     b[0] = 'S'; b[1] = 'N'; b[2] = 'W'; b[3] = 'B';
     tb_u16(b + SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
@@ -277,7 +292,8 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0));
+    b[SN_H_MAX_FORCES] = TB_NFRC;
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);
     b[SN_H_LEN_SHIFT] = (unsigned char)(len_shift & 0xFF);
@@ -285,6 +301,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     b[SN_H_FRAC_M] = TB_FRAC_M;
 #if !defined(SN_FLOAT)
     b[SN_H_FRAC_E] = TB_FRAC_E;
+    b[SN_H_FRAC_F] = TB_FRAC_F;
 #endif
     tb_real(b + SN_H_REALS + SN_R_A1 * R, a1, SN_Q_COEF);
     tb_real(b + SN_H_REALS + SN_R_B1 * R, b1, SN_Q_COEF);
@@ -295,6 +312,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_real(b + SN_H_REALS + SN_R_ENERGY * R, m0 / (h * h), TB_FRAC_E);
     tb_real(b + SN_H_REALS + SN_R_CELL * R, cell, SN_Q_LEN);
     tb_real(b + SN_H_REALS + SN_R_DISP_BOUND * R, 2.0, 16);
+    tb_real(b + SN_H_REALS + SN_R_FORCE * R, 1.0 / 1024.0, TB_FRAC_F); /* 2^30 at Q40 */
     tb_fix_crc(b);
     return off;
 }
@@ -318,6 +336,6 @@ static inline void tb_drop_rigs(unsigned char *b, uint32_t at) {
         tb_u32(b + SN_H_SECTIONS + 16 * k + 4, 0);
         tb_u32(b + SN_H_SECTIONS + 16 * k + 8, 0);
     }
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, 0));
 }
 #endif

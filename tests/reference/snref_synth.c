@@ -262,6 +262,12 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_RIG_SAMPLES] = 0; el[SN_SEC_RIG_SAMPLES] = SN_ELEM_RIG_SAMPLES(R);
         cnt[SN_SEC_RIG_VERTS] = 0; el[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
         cnt[SN_SEC_RIG_FORCES] = 0; el[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(R);
+        /* format 4.0: no force profiles or segment meshes */
+        cnt[SN_SEC_SHARES] = 0; el[SN_SEC_SHARES] = SN_ELEM_SHARES(R);
+        cnt[SN_SEC_VSHARE] = 0; el[SN_SEC_VSHARE] = SN_ELEM_VSHARE;
+        cnt[SN_SEC_SEGMESH] = 0; el[SN_SEC_SEGMESH] = SN_ELEM_SEGMESH(R);
+        cnt[SN_SEC_SEGNODES] = 0; el[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(R);
+        cnt[SN_SEC_SEGATTACH] = 0; el[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(R);
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;
@@ -282,7 +288,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         w_u32(&w, SN_H_ONE_HI, bx->flavour == SN_FLAVOUR_FLOAT64 ? SN_ONE_FLOAT64_HI : 0u);
         w_u32(&w, SN_H_N_VERTICES, nV); w_u32(&w, SN_H_N_FREE, nF); w_u32(&w, SN_H_N_CELLS, nC);
         w_u32(&w, SN_H_N_JOINTS, nJ); w_u32(&w, SN_H_N_SURFACE, nV); w_u32(&w, SN_H_N_TRIANGLES, 0);
-        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC, 0));
+        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC, 0, 0, 0));
         w_u16(&w, SN_H_CG_DEFAULT, bx->cg_default); w_u16(&w, SN_H_CG_MAX, 256);
         w_u8(&w, SN_H_LEN_SHIFT, (unsigned)(len_shift & 255));
         {
@@ -295,6 +301,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
             w_real(&w, rp + SN_R_ENERGY * R, m0 * U * U / h2);          /* mesh unit = 1 m */
             w_real(&w, rp + SN_R_CELL * R, bx->dx / U);
             w_real(&w, rp + SN_R_DISP_BOUND * R, bx->disp_bound > 0 ? bx->disp_bound : 1.0);
+            w_real(&w, rp + SN_R_FORCE * R, h2 / (m0 * U));              /* mesh unit = 1 m */
         }
         for (k = 0; k < SN_SEC_COUNT; k++) {
             size_t e = SN_H_SECTIONS + k * SN_SECTION_ENTRY;
@@ -439,6 +446,11 @@ unsigned char *snsyn_with_rigs(const unsigned char *blob, size_t size, const sns
     cnt[SN_SEC_RIG_SAMPLES] = ns; el[SN_SEC_RIG_SAMPLES] = SN_ELEM_RIG_SAMPLES(R);
     cnt[SN_SEC_RIG_VERTS] = ne; el[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
     cnt[SN_SEC_RIG_FORCES] = ne; el[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(R);
+    for (k = SN_SEC_SHARES; k < SN_SEC_COUNT; k++) { /* kept empty (the synthetic bar has none) */
+        const unsigned char *e = blob + SN_H_SECTIONS + k * SN_SECTION_ENTRY;
+        if (rs_u32(e + 8) != 0) return NULL;
+        cnt[k] = 0; el[k] = rs_u32(e + 12);
+    }
     pos = end;
     for (k = SN_SEC_CONTROLS; k < SN_SEC_COUNT; k++) {
         pos = (pos + 7) & ~(size_t)7;
@@ -482,7 +494,7 @@ unsigned char *snsyn_with_rigs(const unsigned char *blob, size_t size, const sns
             for (k = 0; k < 3; k++) ws_real(o + off[SN_SEC_RIG_FORCES] + el[SN_SEC_RIG_FORCES] * ne + k * R, flavour, rig[a].force[3 * i + k], frac);
         }
     }
-    ib = SN_INSTANCE_BYTES(rs_u32(o + SN_H_N_VERTICES), rs_u32(o + SN_H_N_FREE), rs_u32(o + SN_H_N_JOINTS), rs_u32(o + SN_H_N_CELLS), nk);
+    ib = SN_INSTANCE_BYTES(rs_u32(o + SN_H_N_VERTICES), rs_u32(o + SN_H_N_FREE), rs_u32(o + SN_H_N_JOINTS), rs_u32(o + SN_H_N_CELLS), nk, 0, 0);
     ws_u32(o + SN_H_INSTANCE_BYTES, ib);   /* the validator wants exactly the runtime's formula */
     ws_u32(o + SN_H_TOTAL_SIZE, (uint32_t)pos);
     ws_u32(o + SN_H_CRC32, snref_crc32(o + 16, pos - 16));

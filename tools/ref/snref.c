@@ -291,19 +291,21 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         const unsigned expect_cnt[SN_SEC_COUNT] = { m->nJ, m->nJ, m->nV, m->nV, m->nF, m->nF, m->nF,
             m->nF + 1, m->nnz, m->nnz, m->nC, m->nC, m->nC, m->nF, m->nS, m->nT,
             SEC_CNT(SN_SEC_CONTROLS), SEC_CNT(SN_SEC_RIGS), SEC_CNT(SN_SEC_RIG_SAMPLES),
-            SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_RIG_VERTS) };
+            SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_SHARES), m->nF,
+            SEC_CNT(SN_SEC_SEGMESH), SEC_CNT(SN_SEC_SEGNODES), SEC_CNT(SN_SEC_SEGATTACH) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(R),
             SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS, SN_ELEM_CONTROLS(R), SN_ELEM_RIGS,
-            SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R) };
+            SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R), SN_ELEM_SHARES(R), SN_ELEM_VSHARE,
+            SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R) };
 #undef SEC_CNT
-        typedef char sec_count_check[SN_SEC_COUNT == 21 ? 1 : -1];   /* format 3.0: update the tables above */
+        typedef char sec_count_check[SN_SEC_COUNT == 26 ? 1 : -1];   /* format 4.0: update the tables above */
         (void)sizeof(sec_count_check);
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
             uint32_t off = rd_u32(e), sz = rd_u32(e + 4), cnt = rd_u32(e + 8), el = rd_u32(e + 12);
-            int cnt_ok = cnt == expect_cnt[i] || (i == SN_SEC_LIMIT && cnt == 0);
+            int cnt_ok = cnt == expect_cnt[i] || ((i == SN_SEC_LIMIT || i == SN_SEC_VSHARE) && cnt == 0);
             if (!cnt_ok || el != expect_el[i] || (uint64_t)cnt * el != sz || (uint64_t)off + sz > total)
                 FAIL("section %u: off %u size %u count %u elem %u", i, (unsigned)off, (unsigned)sz,
                      (unsigned)cnt, (unsigned)el);
