@@ -37,6 +37,12 @@ typedef struct sn_ihdr {
     uint32_t force_drops;   /* forces refused since init/reset: slots full */
     sn_real seg_gap;        /* largest segment constraint gap after the last step's sweeps, fraction of a segment (public Q16.16 / float) */
     sn_real seg_gap_max;    /* largest seg_gap since init/reset */
+    /* segment meshes (sn_segment.c) */
+    sn_real seg_origin[3];  /* the origin the segment state was last expressed against (public) */
+    uint32_t seg_placed;    /* 0 after init/reset: the first step places the meshes by their joint */
+    uint32_t floor_on;      /* sn_set_segment_floor: a floor plane is set (a setting: survives reset) */
+    sn_q floor_n[3];        /* its unit normal (Q30 / float) */
+    sn_real floor_off;      /* n.p >= floor_off, world public units */
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
