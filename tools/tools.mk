@@ -135,9 +135,13 @@ $(EX)/sheet_%/sheet.sinew: $(SHEET_GEN)
 	sh tools/examples/sheet/make_sheet.sh $* $(EX)/sheet_$*
 $(EX)/sheet_%.blob: $(EX)/sheet_%/sheet.sinew $(BAKE)
 	$(BAKE) $< -o $@ --quiet
+$(EX)/sheet_%_float.blob: $(EX)/sheet_%/sheet.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
 $(EX)/sheet.blob: tools/examples/sheet/sheet.sinew tools/examples/sheet/sheet.obj $(BAKE)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/sheet/sheet.sinew -o $@ --quiet
 .PRECIOUS: $(EX)/sheet_%/sheet.sinew
-SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS))
+SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS)) \
+              $(patsubst %,$(EX)/sheet_%_float.blob,$(SHEET_VARIANTS))
 all: $(SHEET_BLOBS)
+TEST_DEPS += $(SHEET_BLOBS)

@@ -189,19 +189,47 @@ void seg_from_nodes(const seg_lvl *L, uint32_t *sat) {
 
 /* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
 
+/* A rotation angle from a lever: f c/half, with c (Q22) limited to +-half
+ * and f a factor (fixed: f >> fs, |f >> fs| <= 3), the result limited to
+ * +-ROT_MAX. Both limits are designed limiters of the small-angle update
+ * (a turn of more than 0.25 rad per constraint or per step is not
+ * followed), not overflows: not counted in sat. Fixed: |c| r <= 2^(b+30)
+ * < 2^57, shift b - 1: the quotient c/half (Q30) <= 2^30; times |f| <= 2^31:
+ * < 2^62 (before the shift fs). */
+static sn_q lever(sn_q c, sn_q hl, sn_q r, int sh, sn_q f, int fs) {
+    sn_q ck = c > hl ? hl : (c < -hl ? -hl : c);
+#if defined(SN_FLOAT)
+    sn_q t = ck * r * f;
+    (void)sh; (void)fs;
+#else
+    int64_t t = sn_rshr64(sn_rshr64((int64_t)ck * r, sh) * f, fs);
+#endif
+    return (sn_q)(t > ROT_MAX ? ROT_MAX : (t < -ROT_MAX ? -ROT_MAX : t));
+}
+
+/* a Q60 product sum known to be within +-2^61 to Q30 (rounded), no clamp */
+static sn_q shr30(sn_acc a) {
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return (sn_q)sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+
 /* u + theta x u, renormalized; |theta_k| limited to ROT_MAX (a designed
  * limiter of the small-angle update, like the clamp of u x d to half in
  * seg_move: not an overflow, so not counted in sat) */
-static void rotate_u(sn_q u[3], const sn_q th[3], uint32_t *sat) {
+static void rotate_u(sn_q u[3], const sn_q th[3]) {
     sn_q t[3], x[3];
     unsigned k;
     for (k = 0; k < 3; k++) {
         t[k] = th[k] > ROT_MAX ? ROT_MAX : (th[k] < -ROT_MAX ? -ROT_MAX : th[k]);
     }
-    /* |t x u| <= 2^29 (each product <= 2^58): x within int32 */
-    x[0] = u[0] + sn_out(sn_mul(t[1], u[2]) - sn_mul(t[2], u[1]), SN_Q_ROT, sat);
-    x[1] = u[1] + sn_out(sn_mul(t[2], u[0]) - sn_mul(t[0], u[2]), SN_Q_ROT, sat);
-    x[2] = u[2] + sn_out(sn_mul(t[0], u[1]) - sn_mul(t[1], u[0]), SN_Q_ROT, sat);
+    /* each term of t x u <= 2^58, a component <= 2^59 -> 2^29 in Q30 (beyond
+     * the state clamp 2^28, so not through sn_out): u + t x u < 1.5 2^30 */
+    x[0] = u[0] + shr30(sn_mul(t[1], u[2]) - sn_mul(t[2], u[1]));
+    x[1] = u[1] + shr30(sn_mul(t[2], u[0]) - sn_mul(t[0], u[2]));
+    x[2] = u[2] + shr30(sn_mul(t[0], u[1]) - sn_mul(t[1], u[0]));
     seg_unit(x, u);
 }
 
@@ -223,13 +251,11 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
     c[1] = sn_out(sn_mul(S[5], d[0]) - sn_mul(S[3], d[2]), SN_Q_ROT, sat);
     c[2] = sn_out(sn_mul(S[3], d[1]) - sn_mul(S[4], d[0]), SN_Q_ROT, sat);
     for (k = 0; k < 3; k++) {
-        sn_q ck = c[k] > hl ? hl : (c[k] < -hl ? -hl : c[k]);
-        sn_q q = sn_mulq(ck, r, sh, sat);           /* c/half, Q30, |q| <= 2^30 */
-        th[k] = sn_mulq(q, rf, SN_Q_ROT, sat);
+        th[k] = lever(c[k], hl, r, sh, rf, SN_Q_ROT);
         if (s < 0) th[k] = -th[k];
         S[k] = sn_add(S[k], t[k], sat);
     }
-    rotate_u(S + 3, th, sat);
+    rotate_u(S + 3, th);
 }
 
 /* |d| in public Q16.16 segment lengths (or float) */
@@ -420,11 +446,8 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
             c[0] = sn_out(sn_mul(S[4], fe[2]) - sn_mul(S[5], fe[1]), SN_Q_ROT, sat);
             c[1] = sn_out(sn_mul(S[5], fe[0]) - sn_mul(S[3], fe[2]), SN_Q_ROT, sat);
             c[2] = sn_out(sn_mul(S[3], fe[1]) - sn_mul(S[4], fe[0]), SN_Q_ROT, sat);
-            for (k = 0; k < 3; k++) {
-                sn_q hl = br ? L->bhalf : L->half;
-                sn_q ck = c[k] > hl ? hl : (c[k] < -hl ? -hl : c[k]);
-                sn_q q = sn_mulq(ck, br ? L->rb : L->rh, br ? L->sb : L->sh, sat); /* Q30, <= 1 */
-                sn_q dw = sn_out(sn_mul(q, THREE), 0, sat); /* 3q, clamped to +-2^28 (0.25 rad/step) */
+            for (k = 0; k < 3; k++) { /* 3 (u x f)/half, limited to 0.25 rad/step */
+                sn_q dw = lever(c[k], br ? L->bhalf : L->half, br ? L->rb : L->rh, br ? L->sb : L->sh, THREE, 0);
                 S[9 + k] = sn_add(S[9 + k], sgn[j] > 0 ? dw : -dw, sat);
             }
         }
@@ -436,9 +459,20 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
             u0[k] = S[3 + k];
             S[k] = sn_add(S[k], S[6 + k], sat);
         }
-        rotate_u(S + 3, S + 9, sat);
+        rotate_u(S + 3, S + 9);
         for (k = 0; k < 3; k++) { S[6 + k] = G0[k]; S[9 + k] = u0[k]; }
     }
+}
+
+/* A Q60 product sum (|.| <= 2^61) to Q30 limited to +-ROT_MAX: the
+ * per-step rotation cap, a designed limiter (not counted in sat). */
+static sn_q rot_cap(sn_acc a) {
+#if defined(SN_FLOAT)
+    sn_q t = a;
+#else
+    int64_t t = sn_rshr64(a, SN_Q_ROT);
+#endif
+    return (sn_q)(t > ROT_MAX ? ROT_MAX : (t < -ROT_MAX ? -ROT_MAX : t));
 }
 
 /* Velocities from the displacements (seed 004 fig. 3.1 step 4):
@@ -450,9 +484,9 @@ static void velocities(const seg_lvl *L, uint32_t *sat) {
     for (i = 0; i < L->ns; i++) {
         sn_q *S = L->S + SEG_W * i, w[3];
         const sn_q *u0 = S + 9, *u = S + 3;
-        w[0] = sn_out(sn_mul(u0[1], u[2]) - sn_mul(u0[2], u[1]), SN_Q_ROT, sat);
-        w[1] = sn_out(sn_mul(u0[2], u[0]) - sn_mul(u0[0], u[2]), SN_Q_ROT, sat);
-        w[2] = sn_out(sn_mul(u0[0], u[1]) - sn_mul(u0[1], u[0]), SN_Q_ROT, sat);
+        w[0] = rot_cap(sn_mul(u0[1], u[2]) - sn_mul(u0[2], u[1]));
+        w[1] = rot_cap(sn_mul(u0[2], u[0]) - sn_mul(u0[0], u[2]));
+        w[2] = rot_cap(sn_mul(u0[0], u[1]) - sn_mul(u0[1], u[0]));
         for (k = 0; k < 3; k++) {
             S[6 + k] = sn_add(S[k], -S[6 + k], sat);
             S[9 + k] = w[k];
