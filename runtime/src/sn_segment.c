@@ -128,9 +128,22 @@ static int is_brace(const seg_lvl *L, uint32_t i) {
     return L->kind == SN_SEG_SHEET && L->side == 2u && i >= 4u;
 }
 
+/* half length of segment i with its reciprocal and shift: the level's on
+ * the finest level; on a coarser one the segment's own (words 12-14, set by
+ * seg_from_nodes from its restricted nodes) */
+static sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
+    const sn_q *S = L->S + SEG_W * i;
+    if (L->l == 0) { *r = L->rh; *sh = L->sh; return L->half; }
+    *r = S[13];
+    *sh = (int)S[14];
+    return S[12];
+}
+
 void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
     const sn_q *S = L->S + SEG_W * i;
-    sn_q hl = is_brace(L, i) ? L->bhalf : L->half;
+    sn_q r;
+    int sh;
+    sn_q hl = seg_half(L, i, &r, &sh);
     unsigned k;
     for (k = 0; k < 3; k++) {
         sn_q o = sn_mulq(S[3 + k], hl, SN_Q_ROT, sat);
@@ -172,7 +185,7 @@ void seg_node_means(const seg_lvl *L, uint32_t *sat) {
     }
 }
 
-void seg_from_nodes(const seg_lvl *L, uint32_t *sat) {
+void seg_from_nodes(const seg_lvl *L, int lens, uint32_t *sat) {
     uint32_t i, a, b;
     unsigned k;
     for (i = 0; i < L->ns; i++) {
@@ -184,6 +197,21 @@ void seg_from_nodes(const seg_lvl *L, uint32_t *sat) {
             d[k] = sn_add(pb, -pa, sat);
         }
         seg_unit(d, S + 3);
+        if (lens && L->l > 0) { /* a coarse segment's length: its restricted nodes' distance */
+            int sh;
+#if defined(SN_FLOAT)
+            float n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            S[12] = n2 > 1e-12f ? 0.5f * n2 * sn_frsqrt(n2) : (is_brace(L, i) ? L->bhalf : L->half);
+#else
+            /* |d_k| <= 2^29 (differences of clamped Q22 values): sum of squares < 2^60 */
+            uint64_t n2 = 0;
+            for (k = 0; k < 3; k++) n2 += (uint64_t)((int64_t)d[k] * d[k]);
+            S[12] = (sn_q)(sn_isqrt64(n2) >> 1); /* <= 2^29 */
+            S[12] = S[12] < 1 ? 1 : S[12];
+#endif
+            recip(S[12], &S[13], &sh);
+            S[14] = (sn_q)sh;
+        }
     }
 }
 
@@ -243,9 +271,9 @@ static void rotate_u(sn_q u[3], const sn_q th[3]) {
 static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
                      uint32_t *sat) {
     sn_q *S = L->S + SEG_W * i, c[3], th[3];
-    int br = is_brace(L, i);
-    sn_q hl = br ? L->bhalf : L->half, r = br ? L->rb : L->rh;
-    int sh = br ? L->sb : L->sh;
+    sn_q r;
+    int sh;
+    sn_q hl = seg_half(L, i, &r, &sh);
     unsigned k;
     c[0] = sn_out(sn_mul(S[4], d[2]) - sn_mul(S[5], d[1]), SN_Q_ROT, sat);
     c[1] = sn_out(sn_mul(S[5], d[0]) - sn_mul(S[3], d[2]), SN_Q_ROT, sat);
@@ -382,6 +410,21 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, uint32_t *sat) {
             for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
             if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
         }
+    if (is_brace(L, 4) && !measure) {
+        /* the braces keep the offset of their centres at the step's start
+         * (node words: the restricted nodes until seg_node_means): a flat
+         * cell stays flat, so the braced 2x2 level is rigid (fig. 4.4) and
+         * not a mechanism folding about a diagonal */
+        sn_q *B4 = L->S + SEG_W * 4, *B5 = L->S + SEG_W * 5, t;
+        const sn_q *N = L->N;
+        for (k = 0; k < 3; k++) {
+            sn_q d0 = sn_add(mean_k((sn_acc)N[NODE_W + k] + N[2 * NODE_W + k], 2, sat),
+                             -mean_k((sn_acc)N[k] + N[3 * NODE_W + k], 2, sat), sat);
+            t = sn_mulq(sn_add(sn_add(B5[k], -B4[k], sat), -d0, sat), C->gh, SN_Q_ROT, sat);
+            B4[k] = sn_add(B4[k], t, sat);
+            B5[k] = sn_add(B5[k], -t, sat);
+        }
+    }
     for (i = 0; i < M->n_attach; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
@@ -437,7 +480,9 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
         ne = seg_node_ends(L, n, seg, sgn);
         for (j = 0; j < ne; j++) {
             sn_q *S = L->S + SEG_W * seg[j], f[3], fe[3], c[3];
-            int br = is_brace(L, seg[j]);
+            sn_q rr;
+            int rs;
+            sn_q hl = seg_half(L, seg[j], &rr, &rs);
             for (k = 0; k < 3; k++) {
                 f[k] = sn_mulq(mean_k(J[k], ne, sat), inv_mass, 16, sat);
                 S[6 + k] = sn_add(S[6 + k], f[k], sat);
@@ -447,7 +492,7 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
             c[1] = sn_out(sn_mul(S[5], fe[0]) - sn_mul(S[3], fe[2]), SN_Q_ROT, sat);
             c[2] = sn_out(sn_mul(S[3], fe[1]) - sn_mul(S[4], fe[0]), SN_Q_ROT, sat);
             for (k = 0; k < 3; k++) { /* 3 (u x f)/half, limited to 0.25 rad/step */
-                sn_q dw = lever(c[k], br ? L->bhalf : L->half, br ? L->rb : L->rh, br ? L->sb : L->sh, THREE, 0);
+                sn_q dw = lever(c[k], hl, rr, rs, THREE, 0);
                 S[9 + k] = sn_add(S[9 + k], sgn[j] > 0 ? dw : -dw, sat);
             }
         }
@@ -638,7 +683,7 @@ void sn_segments_reset(sn_ihdr *h) {
         for (i = 0; i < L.nn; i++)
             for (k = 0; k < 3; k++) L.N[NODE_W * i + k] = rd_real(h->v.sec[SN_SEC_SEGNODES], 3 * (M.first_node + i) + k);
         for (i = 0; i < M.segs; i++) M.S[SEG_W * i + 3] = SN_ONE_ROT; /* any unit u before seg_from_nodes */
-        seg_from_nodes(&L, &sat);
+        seg_from_nodes(&L, 0, &sat);
         for (l = 1; l < M.levels; l++) {
             seg_lvl Lc;
             seg_level(&M, l, &Lc);
@@ -648,7 +693,7 @@ void sn_segments_reset(sn_ihdr *h) {
                 f = 2u * r * L.side + 2u * c;
                 for (k = 0; k < 3; k++) Lc.N[NODE_W * i + k] = L.N[NODE_W * f + k];
             }
-            seg_from_nodes(&Lc, &sat);
+            seg_from_nodes(&Lc, 1, &sat);
         }
     }
 }

@@ -5,7 +5,9 @@
  * (finest first, SEG_W words each), then every level's nodes (NODE_W words).
  *   segment: G[3] centre (Q22), u[3] unit direction start->end (Q30),
  *            v[3] velocity per step (Q22), w[3] angular velocity per step
- *            (Q30 rad), 4 words 0. Between the dynamics and the velocity
+ *            (Q30 rad); on coarse levels (l > 0) the segment's half
+ *            length (Q22), its reciprocal and shift (recip), then 0; on
+ *            the finest level 4 words 0. Between the dynamics and the velocity
  *            update v holds the centre and w the direction before the step.
  *   node:    p[3] position (Q22: mean of the endpoints meeting there),
  *            J[3] impulse accumulated for the next step (Q22 per step,
@@ -44,8 +46,9 @@ void seg_level(const seg_mesh *M, unsigned l, seg_lvl *L);
 void seg_nodes(const seg_lvl *L, uint32_t i, uint32_t *a, uint32_t *b);
 /* segment ends meeting at node n: segment index and sign (+1 end, -1 start) */
 unsigned seg_node_ends(const seg_lvl *L, uint32_t n, uint32_t seg[5], int sgn[5]);
-/* segments of a level rebuilt from its node positions: G = mean, u = unit(b - a) */
-void seg_from_nodes(const seg_lvl *L, uint32_t *sat);
+/* segments of a level rebuilt from its node positions: G = mean, u = unit(b - a);
+ * lens (coarse levels): also the segment's half length |b - a|/2 (words 12-14) */
+void seg_from_nodes(const seg_lvl *L, int lens, uint32_t *sat);
 /* node positions = mean of the endpoints meeting there */
 void seg_node_means(const seg_lvl *L, uint32_t *sat);
 /* endpoint of segment i (sign s) */

@@ -50,7 +50,7 @@ void seg_restrict(const seg_mesh *M, uint32_t *sat) {
             uint32_t f = 2u * (i / L.side) * F.side + 2u * (i % L.side);
             for (k = 0; k < 3; k++) L.N[NODE_W * i + k] = F.N[NODE_W * f + k];
         }
-        seg_from_nodes(&L, sat);
+        seg_from_nodes(&L, 1, sat);
     }
 }
 
@@ -136,5 +136,5 @@ void seg_prolong(const seg_mesh *M, unsigned l, uint32_t *sat) {
 #endif
             }
         }
-    seg_from_nodes(&F, sat);
+    seg_from_nodes(&F, 0, sat);
 }
