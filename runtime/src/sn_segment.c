@@ -394,18 +394,36 @@ static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
     return (int64_t)(r >> L->l) * L->side + (c >> L->l);
 }
 
-/* One sweep, or (measure) the gaps it would close: red nodes ((r+c) even),
- * black nodes, attachments, floor. At a node with k ends the pairs are
- * (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3, (e_k-1, e0): a ring. */
-static void sweep(seg_ctx *C, const seg_lvl *L, int measure, uint32_t *sat) {
+/* One sweep, or (measure) the gaps it would close. Order (NUMERICS.md):
+ * attachments first, so the pinned ends propagate through the same sweep;
+ * then the nodes: a chain from node 0 up on even sweeps (dir 0) and back
+ * down on odd ones (symmetric Gauss-Seidel: a chain held at either end
+ * has one sweep in each pass running away from its holder); a sheet red
+ * nodes ((r+c) even) then black ones, in the opposite colour order on odd
+ * sweeps; the brace crossing of a 2x2 level; the floor last. At a node with
+ * k ends the pairs are (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3,
+ * (e_k-1, e0): a ring. */
+static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const seg_mesh *M = C->M;
-    uint32_t n, seg[5], i;
+    uint32_t n, seg[5], i, q;
     int sgn[5];
     unsigned color, j, k;
+    for (i = 0; i < M->n_attach; i++) {
+        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        int64_t ln = level_node(M, L, sn_rd_u16(rec));
+        sn_q T[3];
+        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
+        attach_target(C->h, rec, T, sat);
+        k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
+        for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
+    }
     for (color = 0; color < 2; color++)
-        for (n = 0; n < L->nn; n++) {
-            uint32_t r = L->kind == SN_SEG_CHAIN ? 0 : n / L->side, c = L->kind == SN_SEG_CHAIN ? n : n % L->side;
-            if (((r + c) & 1u) != color) continue;
+        for (q = 0; q < L->nn; q++) {
+            uint32_t r, c;
+            n = (L->kind == SN_SEG_CHAIN && dir) ? L->nn - 1u - q : q;
+            r = L->kind == SN_SEG_CHAIN ? 0 : n / L->side;
+            c = L->kind == SN_SEG_CHAIN ? n : n % L->side;
+            if (L->kind == SN_SEG_CHAIN ? color != 0 : ((r + c) & 1u) != (color ^ dir)) continue;
             k = seg_node_ends(L, n, seg, sgn);
             for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
             if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
@@ -424,15 +442,6 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, uint32_t *sat) {
             B4[k] = sn_add(B4[k], t, sat);
             B5[k] = sn_add(B5[k], -t, sat);
         }
-    }
-    for (i = 0; i < M->n_attach; i++) {
-        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
-        int64_t ln = level_node(M, L, sn_rd_u16(rec));
-        sn_q T[3];
-        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
-        attach_target(C->h, rec, T, sat);
-        k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
-        for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
     }
     if (C->floor_on && !measure)
         for (i = 0; i < L->ns; i++)
@@ -652,13 +661,13 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
 #endif
             }
             dynamics(&C, &L, im, sat);
-            for (s = 0; s < M.sweeps; s++) sweep(&C, &L, 0, sat);
+            for (s = 0; s < M.sweeps; s++) sweep(&C, &L, 0, s & 1u, sat);
             seg_node_means(&L, sat);
             if (l > 0) seg_prolong(&M, l, sat); /* reads this level's start (v, w words) */
             velocities(&L, sat);
         }
         seg_level(&M, 0, &L);
-        sweep(&C, &L, 1, sat); /* measure the gaps left (no displacement) */
+        sweep(&C, &L, 1, 0, sat); /* measure the gaps left (no displacement) */
         gap = C.gap > gap ? C.gap : gap;
         clear_impulses(&M);
     }

@@ -81,12 +81,26 @@ void segref_init(segref *r, int kind, int side, const double *nodes, double len,
     }
 }
 
-static void sweep(segref *r, int measure) {
-    int color, n, j, k, i, seg[4], sg[4], ne;
+/* order (NUMERICS.md "Sweep"): attachments; chain nodes up (dir 0) or down
+ * (dir 1); sheet red then black (dir 0) or black then red (dir 1) */
+static void sweep(segref *r, int measure, int dir) {
+    int color, q, n, j, k, i, seg[4], sg[4], ne;
+    for (i = 0; i < r->n_att; i++) {
+        ne = ends_of(r, r->att_node[i], seg, sg);
+        for (j = 0; j < ne; j++) {
+            double P[3], d[3], t[3];
+            endp(r, seg[j], sg[j], P);
+            for (k = 0; k < 3; k++) { d[k] = r->att_T[i][k] - P[k]; t[k] = r->gamma * d[k]; }
+            if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
+            move(r, seg[j], sg[j], t, d, 1 - r->gamma);
+        }
+    }
     for (color = 0; color < 2; color++)
-        for (n = 0; n < r->nn; n++) {
-            int row = r->kind ? n / r->side : 0, c = r->kind ? n % r->side : n;
-            if (((row + c) & 1) != color) continue;
+        for (q = 0; q < r->nn; q++) {
+            int row, c;
+            n = (!r->kind && dir) ? r->nn - 1 - q : q;
+            row = r->kind ? n / r->side : 0; c = r->kind ? n % r->side : n;
+            if (r->kind ? ((row + c) & 1) != (color ^ dir) : color != 0) continue;
             ne = ends_of(r, n, seg, sg);
             for (j = 0; j < ne && (j + 1 < ne || ne >= 3); j++) {
                 int a = seg[j], sa = sg[j], b = seg[(j + 1) % ne], sb = sg[(j + 1) % ne];
@@ -101,16 +115,6 @@ static void sweep(segref *r, int measure) {
                 move(r, b, sb, nt, nd, 0.5 * (1 - r->gamma));
             }
         }
-    for (i = 0; i < r->n_att; i++) {
-        ne = ends_of(r, r->att_node[i], seg, sg);
-        for (j = 0; j < ne; j++) {
-            double P[3], d[3], t[3];
-            endp(r, seg[j], sg[j], P);
-            for (k = 0; k < 3; k++) { d[k] = r->att_T[i][k] - P[k]; t[k] = r->gamma * d[k]; }
-            if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
-            move(r, seg[j], sg[j], t, d, 1 - r->gamma);
-        }
-    }
     if (r->floor_on && !measure)
         for (i = 0; i < r->ns; i++)
             for (j = 0; j < 2; j++) {
@@ -148,7 +152,7 @@ void segref_step(segref *r) {
         for (k = 0; k < 3; k++) r->w[i][k] = clampd(r->w[i][k], 0.25);
         turn(r->u[i], r->w[i]);
     }
-    for (j = 0; j < r->sweeps; j++) sweep(r, 0);
+    for (j = 0; j < r->sweeps; j++) sweep(r, 0, j & 1);
     for (i = 0; i < r->ns; i++) {
         double w[3];
         cross(u0[i], r->u[i], w);
@@ -165,5 +169,5 @@ void segref_step(segref *r) {
         for (k = 0; k < 3; k++) { r->N[n][k] = s[k]; r->J[n][k] = 0; }
     }
     r->gap = 0;
-    sweep(r, 1);
+    sweep(r, 1, 0);
 }
