@@ -676,6 +676,45 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
     h->seg_gap_max = gap > h->seg_gap_max ? gap : h->seg_gap_max;
 }
 
+/* M a (Q30 rotation times a value of any Q) without the state clamp: |M a|
+ * <= 1.74 |a|_max (rows of a rotation, rounded), each product <= 2^61 */
+static void turn_raw(const sn_q M[9], const sn_q a[3], sn_q out[3]) {
+    unsigned k;
+    for (k = 0; k < 3; k++) out[k] = shr30(sn_mul(M[3 * k], a[0]) + sn_mul(M[3 * k + 1], a[1]) + sn_mul(M[3 * k + 2], a[2]));
+}
+
+void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const sn_q T1[3], uint32_t *sat) {
+    uint32_t m, i;
+    unsigned k;
+    if (h->v.nM == 0) return;
+    for (k = 0; k < 3; k++) h->seg_origin[k] = h->origin[k];
+    if (!h->seg_placed) return; /* the first step places the meshes by their joint */
+    for (m = 0; m < h->v.nM; m++) {
+        seg_mesh Ms;
+        seg_mesh_get(h, m, &Ms);
+        for (i = 0; i < Ms.segs; i++) {
+            sn_q *S = Ms.S + SEG_W * i, a[3], b[3];
+            for (k = 0; k < 3; k++) a[k] = sn_add(S[k], -T0[k], sat);
+            sn_rot(M, a, b, sat); /* Q22 positions: within the state range */
+            for (k = 0; k < 3; k++) S[k] = sn_add(b[k], T1[k], sat);
+            turn_raw(M, S + 3, a); /* Q30 unit: <= 1.74 2^30 */
+            seg_unit(a, S + 3);
+            memcpy(a, S + 6, sizeof a);
+            sn_rot(M, a, S + 6, sat);
+            turn_raw(M, S + 9, a); /* w: each |w_k| <= 2^28, limited again */
+            for (k = 0; k < 3; k++) S[9 + k] = a[k] > ROT_MAX ? ROT_MAX : (a[k] < -ROT_MAX ? -ROT_MAX : a[k]);
+        }
+        for (i = 0; i < Ms.nodes; i++) {
+            sn_q *N = Ms.N + NODE_W * i, a[3];
+            for (k = 0; k < 3; k++) a[k] = sn_add(N[k], -T0[k], sat);
+            sn_rot(M, a, N, sat);
+            for (k = 0; k < 3; k++) N[k] = sn_add(N[k], T1[k], sat);
+            memcpy(a, N + 3, sizeof a);
+            sn_rot(M, a, N + 3, sat);
+        }
+    }
+}
+
 /* Rest state: level 0 from the rest nodes, coarser levels restricted; all
  * velocities and impulses zero. */
 void sn_segments_reset(sn_ihdr *h) {
