@@ -46,6 +46,15 @@ $(BUILD)/tests/test_runtime_$(1)_float: tests/test_runtime_$(1).c $(SN_TEST_HDRS
 endef
 $(foreach t,$(SN_TESTS),$(eval $(call SN_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(SN_TESTS),$(BUILD)/tests/test_runtime_$(t) $(BUILD)/tests/test_runtime_$(t)_float)
+# segment meshes: with the double reference tests/reference/segref.c
+SN_SEG_TEST_DEPS = tests/test_runtime_segment.c tests/reference/segref.c tests/reference/segref.h $(SN_TEST_HDRS)
+$(BUILD)/tests/test_runtime_segment: $(SN_SEG_TEST_DEPS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ tests/test_runtime_segment.c tests/reference/segref.c $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_segment_float: $(SN_SEG_TEST_DEPS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ tests/test_runtime_segment.c tests/reference/segref.c $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_segment $(BUILD)/tests/test_runtime_segment_float
 
 # ---- constant cost: the probe tests/scripts/test_cost.sh runs under callgrind ----
 $(BUILD)/tests/cost_probe: tests/cost_probe.c $(SN_HDRS) $(SN_LIB_FIXED)

@@ -30,7 +30,7 @@ soak: $(BUILD)/tests/test_reference $(BUILD)/examples/limb_double.blob
 # Physics tests against the runtime: each built fixed and float (suffix _float).
 PHYS_CFLAGS = $(HOST_CFLAGS) $(SN_INC) -Itests -Itests/reference $(REF_INC)
 PHYS_HDRS   = $(REF_HDR) tests/reference/phys_util.h tests/reference/phys_pose.h $(SN_HDRS)
-PHYS_TESTS  = cantilever runtime vibration rigid limb longrun teleport soak
+PHYS_TESTS  = cantilever runtime vibration rigid limb longrun teleport soak segment
 
 define PHYS_TEST_RULE
 $(BUILD)/tests/test_physics_$(1): tests/test_physics_$(1).c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)

@@ -21,6 +21,20 @@ static double real_at(const unsigned char *b, uint32_t off, uint32_t n, int q)
 }
 static uint32_t sec_off(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k); }
 static uint32_t sec_cnt(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k + 8); }
+/* segment state bytes of a blob (format 4.0): every SEGMESH record's segments
+ * and nodes over its levels (sn_seg_counts), 0 without segment meshes */
+static uint32_t seg_state_bytes(const unsigned char *b)
+{
+    uint32_t off = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH), n = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 8);
+    uint32_t es = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 12), m, tot = 0;
+    for (m = 0; m < n; m++) {
+        const unsigned char *r = b + off + m * es;
+        uint32_t segs, nodes;
+        sn_seg_counts(r[0], (unsigned)r[4] | (unsigned)r[5] << 8, r[1], &segs, &nodes);
+        tot += SN_SEG_SEG_BYTES * segs + SN_SEG_NODE_BYTES * nodes;
+    }
+    return tot;
+}
 
 static void check_structure(const sb_blob *bl, int flavour, const char *what)
 {
@@ -35,7 +49,7 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
     T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
             u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], 0),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], seg_state_bytes(b)),
             "%s: instance bytes from SN_INSTANCE_BYTES", what);
     for (k = 0; k < SN_SEC_COUNT; k++) {
         uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);

@@ -257,6 +257,20 @@ static void test_bump_peak(void)
 /* ---- blob reader (sn_format.h offsets; independent of sb_blob.c) ---- */
 static uint32_t u32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
 static unsigned u16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
+/* segment state bytes of a blob (format 4.0): every SEGMESH record's segments
+ * and nodes over its levels (sn_seg_counts), 0 without segment meshes */
+static uint32_t seg_state_bytes(const unsigned char *b)
+{
+    uint32_t off = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH), n = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 8);
+    uint32_t es = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 12), m, tot = 0;
+    for (m = 0; m < n; m++) {
+        const unsigned char *r = b + off + m * es;
+        uint32_t segs, nodes;
+        sn_seg_counts(r[0], (unsigned)r[4] | (unsigned)r[5] << 8, r[1], &segs, &nodes);
+        tot += SN_SEG_SEG_BYTES * segs + SN_SEG_NODE_BYTES * nodes;
+    }
+    return tot;
+}
 static double real(const unsigned char *p, int flavour, int frac)
 {
     if (flavour == SN_FLAVOUR_FIXED) return ldexp((double)(int32_t)u32(p), -frac);
@@ -289,7 +303,7 @@ static void check_blob(const char *desc, int flavour, int print)
     T_CHECK(es[SN_SEC_CONTROLS] == 40u + 4u * (uint32_t)rs && es[SN_SEC_RIGS] == 16 && es[SN_SEC_RIG_SAMPLES] == 2u * (uint32_t)rs &&
                 es[SN_SEC_RIG_VERTS] == 2 && es[SN_SEC_RIG_FORCES] == 3u * (uint32_t)rs, "%s: element sizes", desc);
     T_CHECK(u32(B + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(B + SN_H_N_VERTICES), u32(B + SN_H_N_FREE), u32(B + SN_H_N_JOINTS),
-                                                              u32(B + SN_H_N_CELLS), cnt[SN_SEC_CONTROLS], B[SN_H_MAX_FORCES], 0), "%s: instance bytes count the controls", desc);
+                                                              u32(B + SN_H_N_CELLS), cnt[SN_SEC_CONTROLS], B[SN_H_MAX_FORCES], seg_state_bytes(B)), "%s: instance bytes count the controls", desc);
     for (k = SN_SEC_CONTROLS; k <= SN_SEC_RIG_FORCES; k++) T_CHECK(off[k] % 8 == 0 && off[k] + cnt[k] * es[k] <= b.size, "%s: section %d placed", desc, k);
     for (a = 0; a < (int)cnt[SN_SEC_CONTROLS]; a++) {
         const unsigned char *c = B + off[SN_SEC_CONTROLS] + (size_t)a * es[SN_SEC_CONTROLS];

@@ -171,13 +171,13 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
     CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB) - 8));
     CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, 0)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, TB_SEGB)));
     CASE(SN_ERR_HEADER, "instance_bytes larger than the formula (a blob cannot ask for memory)",
          tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
     CASE(SN_ERR_HEADER, "instance_bytes without the control values",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, 0)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, TB_SEGB)));
 
     /* physics scalars */
 #define RL(i) (b + SN_H_REALS + 4 * (i))
@@ -440,7 +440,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)

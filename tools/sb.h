@@ -102,6 +102,34 @@ typedef struct sb_rigdef {
     int line;
 } sb_rigdef;
 
+/* segment meshes (seed 004 ch. 3-4; tools/DESCRIPTION.md "Segment meshes"):
+ * 'chain' / 'sheet' declare a mesh, 'attach' pins nodes of it */
+enum { SB_SEGATT_SURFACE = 0, SB_SEGATT_JOINT = 1 };   /* = SN_SEGATT_* */
+typedef struct sb_segatt {
+    int node;           /* node index (sheets row-major: row * side + column) */
+    int kind;           /* SB_SEGATT_* */
+    int joint;          /* JOINT: description order index; SURFACE: -1 */
+    double within;      /* SURFACE: largest node-to-vertex distance, mesh units (< 0: default, half a segment) */
+    int line;
+} sb_segatt;
+typedef struct sb_segdef {
+    char name[SB_NAME_MAX];
+    int kind;           /* 0 chain, 1 sheet (= SN_SEG_CHAIN / SN_SEG_SHEET) */
+    int side;           /* chain: nodes; sheet: nodes per row and per column (2^n + 1) */
+    double p0[3];       /* chain: first node; sheet: node (0,0), mesh units */
+    double u[3], v[3];  /* chain: last node - first node (u); sheet: row edge (0,0)->(0,side-1) and column edge (0,0)->(side-1,0) */
+    int levels;         /* sheet: 1..min(n+1, 4); chain 1 */
+    double share[4];    /* force share per level, finest first, sum 1 */
+    double mass;        /* kg, the whole mesh (finest level) */
+    int sweeps;         /* constraint sweeps per level per step */
+    double gamma;       /* translation factor (seed 004 §3.2.2), (0, 1] */
+    double damping;     /* 1/s: velocity kept per step = exp(-damping h) */
+    double centre;      /* share of a node force applied at the segments' centres (seed 004 §3.1) */
+    int gravity;        /* 1 on, 0 off */
+    sb_segatt *att; int natt;
+    int line;
+} sb_segdef;
+
 typedef struct sb_desc {
     char path[1024];
     char mesh_path[1024];   /* resolved relative to the description's directory */
@@ -131,6 +159,7 @@ typedef struct sb_desc {
     int force_slots;                 /* 'forces N': external forces per step (default 8) */
     sb_shares *shares; int nshares;  /* 'shares' */
     sb_sharerule *srules; int nsr;   /* 'shares_region' */
+    sb_segdef *segs; int nseg;       /* 'chain', 'sheet', 'attach' */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -270,6 +299,24 @@ int sb_force_build(const sb_desc *d, sb_model *o);
 void sb_force_free(sb_model *o);
 
 /* ---- segment meshes (sb_segment.c) ---- */
+/* A built mesh: rest nodes evenly spaced (every segment seg_len long), moved
+ * rigidly by 'shift', the mean offset of its surface-attached nodes to their
+ * nearest vertices (one attachment: exactly onto it). */
+typedef struct sb_segmesh {
+    sb_segdef def;          /* the description's mesh (att owned by the description) */
+    char path[1024];        /* the description, for file:line messages */
+    int nodes;              /* finest level: chain side, sheet side^2 */
+    int segs;               /* finest level segments */
+    uint32_t segs_all, nodes_all;   /* over every level (sn_seg_counts) */
+    double *x;              /* nodes x 3 rest positions, mesh units */
+    double seg_len;         /* mesh units */
+    double seg_mass;        /* kg per finest segment: mass / segs */
+    double keep;            /* velocity kept per step, exp(-damping h) */
+    double shift[3];        /* rigid move applied to the declared nodes, mesh units */
+    int natt;               /* attachments, node strictly increasing */
+    int *att_node, *att_kind, *att_target;   /* target: surface vertex or sorted joint index */
+    double *att_dist;       /* SURFACE: node-to-vertex distance after the shift; JOINT: 0 */
+} sb_segmesh;
 /* chains and sheets from the description, attached to the built model */
 int sb_segment_build(const sb_desc *d, const sb_mesh *m, sb_model *o);
 void sb_segment_free(sb_model *o);
@@ -277,9 +324,9 @@ void sb_segment_free(sb_model *o);
 uint32_t sb_segment_state_bytes(const sb_model *o);
 /* SEGNODES and SEGATTACH counts of o's segment meshes */
 void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach);
-/* write the three segment sections at their offsets (w: blob bytes, rs: real size,
- * flavour SB_*); 0 or -1 (sb_fail) */
-int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t *off, int flavour, int rs, int len_shift);
+/* write the three segment sections at their offsets (blob bytes, rs: real size,
+ * flavour SB_*, internal unit 2^len_shift mesh units, mass unit m0 kg); 0 or -1 (sb_fail) */
+int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t *off, int flavour, int rs, int len_shift, double m0);
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

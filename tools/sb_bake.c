@@ -72,6 +72,22 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
             printf("            %d %-14s %.3g %.3g %.3g %.3g %.3g  (%d free vertices)\n", k, d.shares[k].name, o->prof[k][0], o->prof[k][1],
                    o->prof[k][2], o->prof[k][3], o->prof[k][4], nv);
         }
+        for (k = 0; k < o->nsm; k++) {   /* segment meshes (seed 004 ch. 3-4) */
+            const sb_segmesh *g = &o->sm[k];
+            int a, ns = 0, nj = 0;
+            for (a = 0; a < g->natt; a++) { ns += g->att_kind[a] == SB_SEGATT_SURFACE; nj += g->att_kind[a] == SB_SEGATT_JOINT; }
+            printf("  segment   %-14s %-5s %4d nodes, %4d segments (%u nodes, %u segments over %d level(s)), segment %.4g mesh units, "
+                   "%d attachment(s) (%d surface, %d joint), gravity %s, state %u bytes\n",
+                   g->def.name, g->def.kind ? "sheet" : "chain", g->nodes, g->segs, (unsigned)g->nodes_all, (unsigned)g->segs_all, g->def.levels,
+                   g->seg_len, g->natt, ns, nj, g->def.gravity ? "on" : "off",
+                   (unsigned)(SN_SEG_SEG_BYTES * g->segs_all + SN_SEG_NODE_BYTES * g->nodes_all));
+            if (ns) {
+                double gap = 0;
+                for (a = 0; a < g->natt; a++) gap = g->att_dist[a] > gap ? g->att_dist[a] : gap;
+                printf("            moved by (%.4g, %.4g, %.4g) mesh units onto its surface attachments (mean offset); largest node-to-vertex gap %.4g\n",
+                       g->shift[0], g->shift[1], g->shift[2], gap);
+            }
+        }
         printf("  time      %.2f s\n", sb_now() - t0);
     }
     sb_mesh_free(&m);

@@ -449,7 +449,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             } else put_real(&w, at, o->prof[i][k], 0);
         }
     if (o->vprof) for (i = 0; i < nF; i++) put_u8(&w, off[SN_SEC_VSHARE] + (size_t)i, o->vprof[i]);
-    if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s) != 0) { sb_blob_free(b); return -1; }
+    if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s, m0) != 0) { sb_blob_free(b); return -1; }
     if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
     if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }
     put_u32(&w, SN_H_CRC32, sb_crc32(b->bytes + 16, total - 16));

@@ -125,3 +125,23 @@ $(EX)/diag_float.blob: $(DIAG_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/diag/diag.sinew -o $@ --flavour float --quiet
 all: $(EX)/diag.blob $(EX)/diag_float.blob
+
+# ---- the sheet experiments of seed 004 ch. 3-4 (tools/examples/sheet): a free
+# 9x9 segment sheet; variants by make_sheet.sh (shares fine/equal/coarse,
+# gravity off; floor_*: gravity on, tilted) into $(EX)/sheet_VARIANT/ ----
+SHEET_VARIANTS = fine equal coarse floor_fine floor_equal floor_coarse
+SHEET_GEN = tools/examples/sheet/make_sheet.sh tools/examples/sheet/sheet.sinew tools/examples/sheet/sheet.obj
+$(EX)/sheet_%/sheet.sinew: $(SHEET_GEN)
+	sh tools/examples/sheet/make_sheet.sh $* $(EX)/sheet_$*
+$(EX)/sheet_%.blob: $(EX)/sheet_%/sheet.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(EX)/sheet_%_float.blob: $(EX)/sheet_%/sheet.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+$(EX)/sheet.blob: tools/examples/sheet/sheet.sinew tools/examples/sheet/sheet.obj $(BAKE)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/sheet/sheet.sinew -o $@ --quiet
+.PRECIOUS: $(EX)/sheet_%/sheet.sinew
+SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS)) \
+              $(patsubst %,$(EX)/sheet_%_float.blob,$(SHEET_VARIANTS))
+all: $(SHEET_BLOBS)
+TEST_DEPS += $(SHEET_BLOBS)

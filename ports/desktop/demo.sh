@@ -53,6 +53,32 @@ run "trot float sheet (72 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/trot.clip" --f
 run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_turn.clip" --frames 130 \
     --compare "$OUT/demo.png" --size 400x300 $FRONT
 
+# Segment meshes (seed 004 ch. 3-4). The cow's tail (a chain hanging from the
+# tail root) swinging over the trot, seen from behind; its saddle blanket (a
+# 5x5 sheet held along its front and back edges) from above.
+REAR="--view -55,8 --frame-box -2.6,-3.6,-2.2,2.4,2.4,2.2"
+run "cow tail over the trot (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 \
+    --sheet "$OUT/cow_tail.png" --title "tail: 8 segments (seed 004 ch. 3)" $REAR
+run "cow blanket over the trot (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 \
+    --sheet "$OUT/cow_blanket.png" --title "blanket: 5x5 sheet, 2 levels" --view 35,40 --frame-box 0.6,-0.6,-2,5,2.6,2
+# The thesis' sheet experiments on a free 9x9 sheet without gravity
+# (tools/examples/sheet, variants by make_sheet.sh): one upward impulse at a
+# corner (fig. 3.11, 4.9-4.11) and at the centre (fig. 3.12) with all the
+# force on the finest level, shared equally by the four levels, or all on the
+# coarsest; then the tilted sheet dropped on a floor with gravity (fig.
+# 4.13-4.15), beside the box. One second per impulse run (60 steps), 0.6 s per
+# drop (36 steps), 12 panels each.
+EXS=$BUILD/examples
+SHEETVIEW="--view 30,20 --frame-box -6,-1,-6,6,7,6"
+for v in fine equal coarse; do
+    run "sheet corner $v (60 steps)" "$PLAY" "$EXS/sheet_$v.blob" --frames 60 --seg-impulse 0:0:0,0.08,0 \
+        --sheet "$OUT/sheet_corner_$v.png" --title "corner impulse, shares $v" $SHEETVIEW
+    run "sheet centre $v (60 steps)" "$PLAY" "$EXS/sheet_$v.blob" --frames 60 --seg-impulse 0:40:0,0.08,0 \
+        --sheet "$OUT/sheet_centre_$v.png" --title "centre impulse, shares $v" $SHEETVIEW
+    run "sheet floor $v (36 steps)" "$PLAY" "$EXS/sheet_floor_$v.blob" --frames 36 --seg-floor -0.5 \
+        --sheet "$OUT/sheet_floor_$v.png" --title "dropped on the floor, shares $v" --view 15,12 --frame-box -6,-0.5,2,6,6.5,12
+done
+
 # The beast (tools/examples/beast, 32k surface vertices): baked here if
 # missing or stale; walk and violent-motion sheets, and the head turned 90
 # degrees about the neck axis: rest | unwarped | warped.

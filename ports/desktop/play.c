@@ -23,10 +23,12 @@
 #define PROG "sinew-play-float"
 static float F(sn_real v) { return v; }
 static double D(sn_real v) { return v; }
+static sn_real R(double v) { return (sn_real)v; }
 #else
 #define PROG "sinew-play"
 static float F(sn_real v) { return (float)v / 65536.0f; }
 static double D(sn_real v) { return (double)v / 65536.0; }
+static sn_real R(double v) { return (sn_real)floor(v * 65536.0 + 0.5); }
 #endif
 
 static void usage(FILE *f) {
@@ -52,6 +54,10 @@ static void usage(FILE *f) {
         "  --rig-off-blob B   the same character baked without its rigs (same lattice and surface), for\n"
         "                     the rigs-off panel of --compare-rigs (pose-driven rigs cannot be switched off)\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
+        "  --seg-impulse M:N:X,Y,Z[@K]  impulse (newton-seconds, world axes) at node N of segment mesh M\n"
+        "                     during step K (default 1); repeatable (at most 16)\n"
+        "  --seg-floor Y      floor under the segment meshes at height Y (world mesh units, normal +y)\n"
+        "  --segments off     do not draw the segment meshes (drawn over the surface by default)\n"
         "  --heat D           colour the flesh by its distance from rigid skinning (red at D mesh units)\n"
         "  --size WxH         size of --png (default 640x480), of the sheet's cells (320x240), of --plot (800x500)\n"
         "  --view AZ,EL       camera azimuth, elevation in degrees (default 30,15)\n"
@@ -146,6 +152,13 @@ typedef struct {
     float *dev, *col;           /* per lattice vertex (3), per surface vertex (3) */
     const sn_xform *pose;       /* pose of the state being drawn */
     const float *ref;           /* --compare-rigs --heat: colour by the distance from this surface */
+    /* segment meshes (seed 004 ch. 3-4): nodes of every mesh, drawn over the surface */
+    uint32_t n_sm, n_snodes;
+    sn_segment_info *sm;
+    sn_vec3 *snode;
+    float *spos;                /* n_snodes x 3, mesh m's nodes from sm_first[m] */
+    uint32_t *sm_first;
+    int segments;               /* draw them */
 } scene;
 
 static int cmp_edge(const void *a, const void *b) {
@@ -184,7 +197,14 @@ static int lattice_edges(scene *s, const unsigned char *bytes) {
 }
 
 static void fetch(scene *s, const sn_instance *inst) {
-    uint32_t i;
+    uint32_t i, m;
+    for (m = 0; m < s->n_sm; m++) {
+        uint32_t f = s->sm_first[m];
+        if (sn_get_segment_nodes(inst, m, s->snode + f, 0, s->sm[m].nodes) != SN_OK) continue;
+        for (i = f; i < f + s->sm[m].nodes; i++) {
+            s->spos[3 * i] = F(s->snode[i].x); s->spos[3 * i + 1] = F(s->snode[i].y); s->spos[3 * i + 2] = F(s->snode[i].z);
+        }
+    }
     sn_get_surface(inst, s->surf, 0, s->info.surface_vertices);
     for (i = 0; i < s->info.surface_vertices; i++) {
         s->pos[3 * i] = F(s->surf[i].x); s->pos[3 * i + 1] = F(s->surf[i].y); s->pos[3 * i + 2] = F(s->surf[i].z);
@@ -198,6 +218,42 @@ static void fetch(scene *s, const sn_instance *inst) {
 }
 
 static const float cow_colour[3] = {0.78f, 0.60f, 0.44f};
+
+/* Segment a-b as a thick line: 3x3 copies offset across the view by about a
+ * pixel of the (supersampled) picture; faint where the flesh hides it. */
+static void thick_line(rs_image *im, const rs_camera *cam, const float *a, const float *b, const uint8_t c[3]) {
+    int i, j, k;
+    float d = 0.9f / (cam->scale > 0 ? cam->scale : 1.0f), pa[3], pb[3];
+    for (i = -1; i <= 1; i++)
+        for (j = -1; j <= 1; j++) {
+            for (k = 0; k < 3; k++) {
+                float o = d * ((float)i * cam->right[k] + (float)j * cam->up[k]);
+                pa[k] = a[k] + o; pb[k] = b[k] + o;
+            }
+            rs_draw_line(im, cam, pa, pb, c, 0.35f);
+        }
+}
+
+/* Every segment mesh: chains along their nodes, sheets along rows and columns
+ * (the finest level, seed 004 fig. 3.7), with a dot per node. */
+static void draw_segments(const scene *s, rs_image *im, const rs_camera *cam) {
+    static const uint8_t chain_c[3] = {120, 40, 20}, sheet_c[3] = {30, 60, 160}, node_c[3] = {20, 20, 20};
+    uint32_t m, i;
+    float r = (float)im->w / 700.0f;
+    for (m = 0; m < s->n_sm; m++) {
+        const float *p = s->spos + 3 * (size_t)s->sm_first[m];
+        uint32_t n = s->sm[m].side;
+        if (s->sm[m].kind == SN_SEGMENT_CHAIN) {
+            for (i = 0; i + 1 < n; i++) thick_line(im, cam, p + 3 * i, p + 3 * (i + 1), chain_c);
+        } else {
+            for (i = 0; i < n * n; i++) {
+                if (i % n + 1 < n) thick_line(im, cam, p + 3 * i, p + 3 * (i + 1), sheet_c);
+                if (i / n + 1 < n) thick_line(im, cam, p + 3 * i, p + 3 * (i + n), sheet_c);
+            }
+        }
+        for (i = 0; i < s->sm[m].nodes; i++) rs_draw_dot(im, cam, p + 3 * i, r, node_c);
+    }
+}
 
 static const unsigned char *section(const unsigned char *bytes, int sec, uint32_t *count) {
     const unsigned char *ent = bytes + SN_H_SECTIONS + (size_t)sec * SN_SECTION_ENTRY;
@@ -359,6 +415,7 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
             rs_draw_line(&big, &cam, s->lpos + 3 * s->edges[2 * e], s->lpos + 3 * s->edges[2 * e + 1], lc, 0.3f);
         for (v = s->info.free_vertices; v < s->info.vertices; v++) rs_draw_dot(&big, &cam, s->lpos + 3 * v, r, sc);
     }
+    if (s->segments) draw_segments(s, &big, &cam);
     rs_downsample2(&big, out);
     rs_image_free(&big);
     if (label) rs_draw_text(out, 8, 8, out->w >= 480 ? 2 : 1, label, ink);
@@ -376,6 +433,10 @@ typedef struct {
     int unwarped, hash, lattice, quiet, w, h, have_size;
     float az, el, box[6], heat;
     int have_box;
+    /* segment meshes: --seg-impulse, --seg-floor, --segments */
+    int n_imp, have_floor, no_segments;
+    struct { unsigned mesh, node; long step; double j[3]; } imp[16];
+    double floor_y;
 } options;
 
 #define MAX_FRAMES 10000000L
@@ -421,7 +482,8 @@ static int frame_list(const char *v, long n, unsigned char *sel, char *err, size
 static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
-                                         "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", NULL};
+                                         "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob",
+                                         "--seg-impulse", "--seg-floor", "--segments", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -463,6 +525,27 @@ static int parse_args(int argc, char **argv, options *o) {
             }
             if (o->n_held >= MAX_HELD) { fprintf(stderr, PROG ": --control: at most %d\n", MAX_HELD); return 2; }
             o->held[o->n_held++] = v;
+        }
+        else if (!strcmp(a, "--seg-impulse")) {
+            unsigned m, n;
+            double x, y, z;
+            long k = 1;
+            int used = 0, used2 = 0;
+            if (sscanf(v, "%u:%u:%lf,%lf,%lf%n", &m, &n, &x, &y, &z, &used) != 5 || !isfinite(x) || !isfinite(y) || !isfinite(z) ||
+                (v[used] && (sscanf(v + used, "@%ld%n", &k, &used2) != 1 || v[used + used2] || k < 1 || k > MAX_FRAMES))) {
+                fprintf(stderr, PROG ": --seg-impulse: want MESH:NODE:X,Y,Z[@STEP] (newton-seconds, step >= 1), got '%s'\n", v); return 2;
+            }
+            if (o->n_imp >= 16) { fprintf(stderr, PROG ": --seg-impulse: at most 16\n"); return 2; }
+            o->imp[o->n_imp].mesh = m; o->imp[o->n_imp].node = n; o->imp[o->n_imp].step = k;
+            o->imp[o->n_imp].j[0] = x; o->imp[o->n_imp].j[1] = y; o->imp[o->n_imp].j[2] = z;
+            o->n_imp++;
+        } else if (!strcmp(a, "--seg-floor")) {
+            o->floor_y = strtod(v, &end);
+            if (!*v || *end || !isfinite(o->floor_y) || fabs(o->floor_y) > 16384) { fprintf(stderr, PROG ": --seg-floor: want a height in mesh units, got '%s'\n", v); return 2; }
+            o->have_floor = 1;
+        } else if (!strcmp(a, "--segments")) {
+            if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --segments: want on or off, got '%s'\n", v); return 2; }
+            o->no_segments = !strcmp(v, "off");
         }
         else if (!strcmp(a, "--title")) o->title = v;
         else if (!strcmp(a, "--frames") || !strcmp(a, "--iterations") || !strcmp(a, "--health")) {
@@ -834,6 +917,32 @@ int main(int argc, char **argv) {
     if ((o.stats_csv || o.plot) && !(fst = malloc(((size_t)n_frames + 1) * sizeof *fst))) { die("out of memory"); goto done; }
     if ((o.stats_csv || o.plot) && n_ctl && !(fctl = malloc(((size_t)n_frames + 1) * n_ctl * sizeof *fctl))) { die("out of memory"); goto done; }
     for (t = 0; t < s.info.triangles; t++) sn_get_triangle(s.blob, t, s.tri + 3 * t);
+    /* segment meshes: node buffers, the floor, impulses checked against the blob */
+    s.segments = !o.no_segments;
+    s.n_sm = sn_segment_mesh_count(s.blob);
+    s.sm = malloc((s.n_sm + 1) * sizeof *s.sm);
+    s.sm_first = malloc((s.n_sm + 1) * sizeof *s.sm_first);
+    if (!s.sm || !s.sm_first) { die("out of memory"); goto done; }
+    for (i = 0; i < s.n_sm; i++) {
+        sn_segment_mesh_info(s.blob, i, &s.sm[i]);
+        s.sm_first[i] = s.n_snodes;
+        s.n_snodes += s.sm[i].nodes;
+    }
+    s.snode = malloc((s.n_snodes + 1) * sizeof *s.snode);
+    s.spos = calloc((size_t)s.n_snodes * 3 + 3, sizeof(float));
+    if (!s.snode || !s.spos) { die("out of memory"); goto done; }
+    for (i = 0; i < (uint32_t)o.n_imp; i++)
+        if (o.imp[i].mesh >= s.n_sm || o.imp[i].node >= s.sm[o.imp[i].mesh].nodes) {
+            fprintf(stderr, PROG ": --seg-impulse: %s has %u segment mesh(es): no node %u of mesh %u\n", o.blob_path, s.n_sm,
+                    o.imp[i].node, o.imp[i].mesh);
+            goto done;
+        }
+    if (o.have_floor) {
+        sn_vec3 up;
+        up.x = 0; up.y = R(1.0); up.z = 0;
+        if (sn_set_segment_floor(inst, up, R(o.floor_y)) != SN_OK) { die("--seg-floor: refused"); goto done; }
+        if (inst2) sn_set_segment_floor(inst2, up, R(o.floor_y));
+    }
     pictures = o.png || o.sheet || o.compare || o.compare_rigs;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
@@ -865,6 +974,11 @@ int main(int argc, char **argv) {
             for (k = 0; k < 3; k++) {
                 if (s.pos[3 * i + (uint32_t)k] < s.lo[k]) s.lo[k] = s.pos[3 * i + (uint32_t)k];
                 if (s.pos[3 * i + (uint32_t)k] > s.hi[k]) s.hi[k] = s.pos[3 * i + (uint32_t)k];
+            }
+        for (i = 0; s.segments && i < s.n_snodes; i++)   /* and the segment meshes at rest */
+            for (k = 0; k < 3; k++) {
+                if (s.spos[3 * i + (uint32_t)k] < s.lo[k]) s.lo[k] = s.spos[3 * i + (uint32_t)k];
+                if (s.spos[3 * i + (uint32_t)k] > s.hi[k]) s.hi[k] = s.spos[3 * i + (uint32_t)k];
             }
         if (have_clip && !o.have_box) {
             int32_t hq = sn_clip_timestep_q16(s.blob);
@@ -922,6 +1036,13 @@ int main(int argc, char **argv) {
         s.pose = xf;
         sn_set_pose(inst, xf, s.info.joints);
         if (!o.rigs_off) controls_step(inst, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held);
+        for (i = 0; i < (uint32_t)o.n_imp; i++)
+            if (o.imp[i].step == k) {
+                sn_vec3 j;
+                j.x = R(o.imp[i].j[0]); j.y = R(o.imp[i].j[1]); j.z = R(o.imp[i].j[2]);
+                if (sn_apply_segment_impulse(inst, o.imp[i].mesh, o.imp[i].node, j) != SN_OK) { die("--seg-impulse: refused"); goto done; }
+                if (inst2) sn_apply_segment_impulse(inst2, o.imp[i].mesh, o.imp[i].node, j);
+            }
         c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
         t0 = now_us(CLOCK_MONOTONIC);
         sn_step(inst);
@@ -1100,6 +1221,7 @@ done:
     rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp);
     free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
+    free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
     free(fctl); free(bytes2); free(refpos);
     return rc;

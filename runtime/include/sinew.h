@@ -359,6 +359,68 @@ sn_quat sn_quat_slerp(sn_quat a, sn_quat b, sn_real t);
 /// Rotate vector v (mesh units) by unit quaternion q.
 sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v);
 
+/* ---- segment meshes (seed 004 ch. 3-4: Palazzi's displacement constraints) ----
+ * Chains (hair, straps, tails) and square sheets (cloth, flags) of rigid
+ * segments joined at their ends by displacement constraints: each step the
+ * segments move freely under gravity and impulses, then a fixed number of
+ * sweeps (baked per mesh) translates and turns them to close the gaps at the
+ * nodes. Nodes may be pinned to a surface vertex of the flesh or to a joint.
+ * Sheets may spread every force over coarser levels (seed 004 ch. 4): the
+ * more goes to the coarse levels, the stiffer the sheet reacts as a whole.
+ * The meshes step inside sn_step, after the flesh; their cost is fixed by the
+ * blob (runtime/NUMERICS.md "Segment meshes"). */
+
+/// Kinds of segment mesh.
+typedef enum sn_segment_kind {
+    SN_SEGMENT_CHAIN = 0, ///< nodes 0..side-1 in a row, side-1 segments
+    SN_SEGMENT_SHEET = 1  ///< side x side nodes (side = 2^n + 1), row-major, segments along rows and columns
+} sn_segment_kind;
+
+/// Description of one segment mesh of a blob (finest level).
+typedef struct sn_segment_info {
+    uint32_t kind;        ///< sn_segment_kind
+    uint32_t side;        ///< chain: nodes; sheet: nodes per row
+    uint32_t nodes;       ///< nodes (chain: side; sheet: side * side)
+    uint32_t segments;    ///< segments (chain: side - 1; sheet: 2 side (side - 1))
+    uint32_t levels;      ///< multilevel levels (1: single level; chains always 1)
+    uint32_t attachments; ///< nodes pinned to the flesh surface or a joint
+} sn_segment_info;
+
+/// Number of segment meshes in a validated blob (0 if blob is NULL).
+uint32_t sn_segment_mesh_count(const sn_blob *blob);
+/// Describe mesh `mesh`. SN_ERR_NULL for NULL pointers, SN_ERR_ARG if mesh is out of range.
+sn_status sn_segment_mesh_info(const sn_blob *blob, uint32_t mesh, sn_segment_info *out);
+/// Node positions first .. first+count-1 of mesh `mesh` after the last step
+/// (the mean of the segment ends meeting at each node), in world mesh units like
+/// sn_get_lattice. Before the first step: the rest positions (model space).
+/// SN_ERR_ARG, writing nothing, if mesh or the range is out of range.
+sn_status sn_get_segment_nodes(const sn_instance *inst, uint32_t mesh, sn_vec3 *out, uint32_t first,
+                               uint32_t count);
+/// Per segment first .. first+count-1 of mesh `mesh`: the rigid transform
+/// taking the segment's rest placement (model space at rest, in mesh units)
+/// to its current world placement, p_world = rot * p_rest + pos, so an
+/// artist's mesh can be skinned to the segments as bones. rot is the shortest
+/// turn of the segment's direction (the roll about a segment is not
+/// simulated). SN_ERR_ARG, writing nothing, if mesh or the range is out of range.
+sn_status sn_get_segment_xforms(const sn_instance *inst, uint32_t mesh, sn_xform *out, uint32_t first,
+                                uint32_t count);
+/// Apply an impulse (newton-seconds, world axes) at node `node` of mesh
+/// `mesh` during the next sn_step, shared evenly by the segments meeting at
+/// the node (the baked `centre` share at their centres, the rest at their
+/// ends, turning them). Impulses add up per node until the step (no slots to
+/// run out of; a sum beyond the state range is clamped and counted in
+/// sn_stats.saturations). SN_ERR_ARG, and nothing changes, if mesh or node
+/// is out of range or (float) a component is not finite.
+sn_status sn_apply_segment_impulse(sn_instance *inst, uint32_t mesh, uint32_t node,
+                                   sn_vec3 impulse_newton_seconds);
+/// Set the floor every segment end of every mesh stays above: the world
+/// half-space normal . p >= offset (normal: any length, mesh units; offset:
+/// mesh units). Enforced inside the sweeps as a one-sided displacement
+/// constraint (a penetrating end is pushed out along the normal, no bounce,
+/// no friction). A zero normal removes the floor. A setting: kept by
+/// sn_reset. SN_ERR_ARG, and nothing changes, if (float) a value is not finite.
+sn_status sn_set_segment_floor(sn_instance *inst, sn_vec3 normal, sn_real offset);
+
 #ifdef __cplusplus
 }
 #endif

@@ -37,6 +37,12 @@ typedef struct sn_ihdr {
     uint32_t force_drops;   /* forces refused since init/reset: slots full */
     sn_real seg_gap;        /* largest segment constraint gap after the last step's sweeps, fraction of a segment (public Q16.16 / float) */
     sn_real seg_gap_max;    /* largest seg_gap since init/reset */
+    /* segment meshes (sn_segment.c) */
+    sn_real seg_origin[3];  /* the origin the segment state was last expressed against (public) */
+    uint32_t seg_placed;    /* 0 after init/reset: the first step places the meshes by their joint */
+    uint32_t floor_on;      /* sn_set_segment_floor: a floor plane is set (a setting: survives reset) */
+    sn_q floor_n[3];        /* its unit normal (Q30 / float) */
+    sn_real floor_off;      /* n.p >= floor_off, world public units */
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -141,6 +147,10 @@ void sn_forces_rhs(sn_ihdr *h, sn_q *b, uint32_t *sat); /* 5: b += applied force
 void sn_forces_clear(sn_ihdr *h);                   /* after the step: slots emptied */
 void sn_segments_reset(sn_ihdr *h);                 /* segment meshes at rest (sn_segment.c) */
 void sn_segments_step(sn_ihdr *h, uint32_t *sat);   /* 8b: segment meshes after the flesh (sn_segment.c) */
+/* sn_teleport: every segment mesh moved rigidly with the root, x' = M (x - T0) + T1
+ * (M the root's turn, Q30; T0, T1 the root's internal position before and after),
+ * directions, velocities and pending impulses turned by M; expressed against h->origin */
+void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const sn_q T1[3], uint32_t *sat);
 uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into the FNV-1a hash */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 

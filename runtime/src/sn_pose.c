@@ -248,7 +248,7 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     sn_ihdr *h;
     const sn_view *v;
     sn_q *pq, *R, *c, *pos, *vel, *x, *jR;
-    sn_q d0[4], q0old[4], Rroot[9];
+    sn_q d0[4], q0old[4], Rroot[9], T0old[3];
     sn_real target[3];
     uint32_t i, j, k, sat = 0;
     sn_status st = pose_ok(inst, joints, n_joints);
@@ -261,6 +261,7 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     pos = ARR(h, o_pos, sn_q); vel = ARR(h, o_vel, sn_q); x = ARR(h, o_x, sn_q);
     memcpy(q0old, pq, sizeof q0old);
     memcpy(Rroot, jR, sizeof Rroot); /* the root's rotation of the state's frames */
+    memcpy(T0old, ARR(h, o_jT, sn_q), sizeof T0old); /* the root's internal position (segment meshes) */
     /* New quaternions. The root keeps the sign nearest its old one; every
      * other joint the sign nearest its old quaternion carried by the root's
      * turn D = q0' conj(q0), so the winding between bones is kept. */
@@ -309,6 +310,15 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
         joint_frames(h, &sat); /* T_j for the new origin, R', c', cell frames */
         for (i = 0; i < v->nV; i++)
             for (k = 0; k < 3; k++) pos[3 * i + k] = sn_add(pos[3 * i + k], c[3 * i + k], &sat);
+    }
+    {   /* segment meshes: rigidly with the root (the root's turn, exactly I if unturned) */
+        sn_q Mr[9];
+        uint32_t diff = 0;
+        for (k = 0; k < 9; k++) diff |= jR[k] != Rroot[k];
+        mul_abt(jR, Rroot, Mr);
+        if (!diff)
+            for (k = 0; k < 9; k++) Mr[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+        sn_segments_teleport(h, Mr, T0old, ARR(h, o_jT, sn_q), &sat);
     }
     h->saturations = sn_count(h->saturations, sat);
     return SN_OK;

@@ -1,16 +1,765 @@
 /* sn_segment.c -- segment meshes: chains and sheets of rigid segments joined
- * by displacement constraints (seed 004 ch. 3), with multilevel force
- * distribution on sheets (seed 004 ch. 4). Placeholder: no meshes yet. */
-#include "sn_instance.h"
+ * by displacement constraints (seed 004 ch. 3, Gascuel and Gascuel's method
+ * as Palazzi applies it to surfaces), with the multilevel force distribution
+ * of seed 004 ch. 4 on sheets (transfers in sn_segment_level.c). Model,
+ * units and bounds: runtime/NUMERICS.md "Segment meshes (seed 004 ch. 3-4)".
+ *
+ * Step of one mesh (seed 004 fig. 3.1, fig. 4.3): restriction of positions
+ * and impulses to the coarser levels; then from the coarsest level to the
+ * finest: dynamics (damping, gravity and impulses by the level's share,
+ * Euler-Cromer, seed 004 appendix A), a FIXED number of constraint sweeps
+ * (no error-driven exit, unlike seed 004 fig. 3.8), velocities from the
+ * displacements, prolongation to the next finer level.
+ *
+ * Cost per step, with S_l, N_l, E_l the segments, nodes and node-endpoint
+ * pairs of level l (chain: E = N - 2; sheet interior node: 4 pairs in a
+ * ring), A the attachments, F = 1 if a floor is set:
+ *   sum_l [ c1 S_l + c2 N_l + sweeps (c3 E_l + c4 A + F c5 2 S_l) ] + c6 N_0 levels
+ * with constants c_i independent of the data: every loop runs over counts
+ * fixed by the blob and the settings; no loop exits on a value.
+ */
+#include "sn_segment.h"
 
-sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
-    *segB = 0;
-    if (v->nM != 0 || v->nSN != 0 || v->nSA != 0) return SN_ERR_SECTION;
-    return SN_OK;
+#if defined(SN_FLOAT)
+#define THREE 3.0f
+#else
+#define THREE 3
+#endif
+/* largest rotation per constraint or per step, per component: 0.25 rad
+ * (the small-angle update u + theta x u stays within 3% of a true rotation) */
+#if defined(SN_FLOAT)
+#define ROT_MAX 0.25f
+#else
+#define ROT_MAX ((int32_t)1 << 28)
+#endif
+
+/* ---------------- mesh records and topology ---------------- */
+
+void seg_mesh_get(const sn_ihdr *h, uint32_t m, seg_mesh *M) {
+    const unsigned char *r = h->v.sec[SN_SEC_SEGMESH];
+    sn_q *base = (sn_q *)(void *)((unsigned char *)(uintptr_t)h + h->o_seg);
+    uint32_t i, k;
+    for (i = 0; i <= m; i++, r += SEG_REC) {
+        M->kind = r[0]; M->levels = r[1]; M->sweeps = r[2]; M->flags = r[3];
+        M->side = sn_rd_u16(r + 4); M->n_attach = sn_rd_u16(r + 6);
+        M->first_node = sn_rd_u32(r + 8); M->first_attach = sn_rd_u32(r + 12);
+        sn_seg_counts(M->kind, M->side, M->levels, &M->segs, &M->nodes);
+        M->S = base;
+        M->N = base + SEG_W * M->segs;
+        base = M->N + NODE_W * M->nodes;
+        if (i == m) {
+            M->len = rd_real(r + 16, 0); M->gamma = rd_real(r + 16, 1); M->keep = rd_real(r + 16, 2);
+            M->inv_mass = rd_real(r + 16, 3); M->centre = rd_real(r + 16, 4);
+            for (k = 0; k < SN_SEG_MAX_LEVELS; k++) M->share[k] = rd_real(r + 16, 5 + k);
+        }
+    }
 }
 
-void sn_segments_reset(sn_ihdr *h) { (void)h; }
+/* reciprocal of a half length x: fixed r = 2^(29+b)/x in (2^29, 2^30] with
+ * b = bits of x, so y/x (Q30) = y r >> (b - 1); float 1/x */
+static void recip(sn_q x, sn_q *r, int *s) {
+#if defined(SN_FLOAT)
+    *r = 1.0f / x;
+    *s = 0;
+#else
+    int b = bitlen64((uint64_t)x);
+    *r = (sn_q)(((int64_t)1 << (29 + b)) / x);
+    *s = b - 1;
+#endif
+}
 
-void sn_segments_step(sn_ihdr *h, uint32_t *sat) { (void)h; (void)sat; }
+void seg_level(const seg_mesh *M, unsigned l, seg_lvl *L) {
+    unsigned k;
+    uint32_t so = 0, no = 0;
+    L->kind = M->kind;
+    L->l = l;
+    for (k = 0; k <= l; k++) {
+        uint32_t s = M->kind == SN_SEG_CHAIN ? M->side : ((M->side - 1u) >> k) + 1u;
+        uint32_t ns = M->kind == SN_SEG_CHAIN ? s - 1u : 2u * s * (s - 1u) + (s == 2u ? 2u : 0u);
+        uint32_t nn = M->kind == SN_SEG_CHAIN ? s : s * s;
+        if (k == l) { L->side = s; L->ns = ns; L->nn = nn; }
+        else { so += ns; no += nn; }
+    }
+    L->S = M->S + SEG_W * so;
+    L->N = M->N + NODE_W * no;
+#if defined(SN_FLOAT)
+    L->half = M->len * (float)(1u << l) * 0.5f;
+    L->bhalf = L->half * 1.41421356237f;
+#else
+    /* (side-1) len <= 2^27 (validated) and 2^l <= side-1: no overflow */
+    L->half = (sn_q)(((int64_t)M->len << l) >> 1);
+    L->half = L->half < 1 ? 1 : L->half;
+    L->bhalf = (sn_q)sn_isqrt64(2u * (uint64_t)L->half * (uint64_t)L->half);
+#endif
+    recip(L->half, &L->rh, &L->sh);
+    recip(L->bhalf, &L->rb, &L->sb);
+}
 
-uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh) { (void)h; return hsh; }
+/* sheet of side s: horizontal (r,c)-(r,c+1) first, r(s-1)+c; vertical
+ * (r,c)-(r+1,c) next, s(s-1)+rs+c; at s = 2 the braces (0,0)-(1,1), (0,1)-(1,0) */
+void seg_nodes(const seg_lvl *L, uint32_t i, uint32_t *a, uint32_t *b) {
+    uint32_t s = L->side, nh = s * (s - 1u);
+    if (L->kind == SN_SEG_CHAIN) { *a = i; *b = i + 1u; return; }
+    if (i < nh) { *a = (i / (s - 1u)) * s + i % (s - 1u); *b = *a + 1u; }
+    else if (i < 2u * nh) { *a = i - nh; *b = *a + s; }
+    else if (i == 2u * nh) { *a = 0; *b = 3; }
+    else { *a = 1; *b = 2; }
+}
+
+/* in ring order: left (end), up (end), right (start), down (start), brace */
+unsigned seg_node_ends(const seg_lvl *L, uint32_t n, uint32_t seg[5], int sgn[5]) {
+    unsigned k = 0;
+    uint32_t s = L->side, r, c, nh;
+    if (L->kind == SN_SEG_CHAIN) {
+        if (n > 0) { seg[k] = n - 1u; sgn[k++] = 1; }
+        if (n + 1u < s) { seg[k] = n; sgn[k++] = -1; }
+        return k;
+    }
+    r = n / s; c = n % s; nh = s * (s - 1u);
+    if (c > 0) { seg[k] = r * (s - 1u) + c - 1u; sgn[k++] = 1; }
+    if (r > 0) { seg[k] = nh + n - s; sgn[k++] = 1; }
+    if (c + 1u < s) { seg[k] = r * (s - 1u) + c; sgn[k++] = -1; }
+    if (r + 1u < s) { seg[k] = nh + n; sgn[k++] = -1; }
+    if (s == 2u) { seg[k] = 2u * nh + (n == 0 || n == 3 ? 0u : 1u); sgn[k++] = (n == 0 || n == 1) ? -1 : 1; }
+    return k;
+}
+
+static int is_brace(const seg_lvl *L, uint32_t i) {
+    return L->kind == SN_SEG_SHEET && L->side == 2u && i >= 4u;
+}
+
+/* half length of segment i with its reciprocal and shift: the level's on
+ * the finest level; on a coarser one the segment's own (words 12-14, set by
+ * seg_from_nodes from its restricted nodes) */
+static sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
+    const sn_q *S = L->S + SEG_W * i;
+    if (L->l == 0) { *r = L->rh; *sh = L->sh; return L->half; }
+    *r = S[13];
+    *sh = (int)S[14];
+    return S[12];
+}
+
+void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
+    const sn_q *S = L->S + SEG_W * i;
+    sn_q r;
+    int sh;
+    sn_q hl = seg_half(L, i, &r, &sh);
+    unsigned k;
+    for (k = 0; k < 3; k++) {
+        sn_q o = sn_mulq(S[3 + k], hl, SN_Q_ROT, sat);
+        P[k] = sn_add(S[k], s > 0 ? o : -o, sat);
+    }
+}
+
+void seg_unit(const sn_q x[3], sn_q u[3]) {
+    sn_q q[4];
+    q[0] = x[0]; q[1] = x[1]; q[2] = x[2]; q[3] = 0;
+    sn_qnormalize(q);
+    if (q[3] != 0) return; /* zero vector: keep u */
+    u[0] = q[0]; u[1] = q[1]; u[2] = q[2];
+}
+
+/* mean of k <= 5 values: fixed sum x round(2^30/k) >> 30 (sums of five Q22 values < 2^31.4) */
+static sn_q mean_k(sn_acc sum, unsigned k, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    return sn_out(sum / (float)k, 0, sat);
+#else
+    static const int32_t inv[6] = {0, 1 << 30, 1 << 29, 357913941, 1 << 28, 214748365};
+    return sn_out(sum * inv[k], SN_Q_ROT, sat);
+#endif
+}
+
+void seg_node_means(const seg_lvl *L, uint32_t *sat) {
+    uint32_t n, seg[5];
+    int sgn[5];
+    unsigned j, k, c;
+    for (n = 0; n < L->nn; n++) {
+        sn_acc sum[3] = {0, 0, 0};
+        k = seg_node_ends(L, n, seg, sgn);
+        for (j = 0; j < k; j++) {
+            sn_q P[3];
+            seg_end(L, seg[j], sgn[j], P, sat);
+            for (c = 0; c < 3; c++) sum[c] += P[c];
+        }
+        for (c = 0; c < 3; c++) L->N[NODE_W * n + c] = mean_k(sum[c], k, sat);
+    }
+}
+
+void seg_from_nodes(const seg_lvl *L, int lens, uint32_t *sat) {
+    uint32_t i, a, b;
+    unsigned k;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *S = L->S + SEG_W * i, d[3];
+        seg_nodes(L, i, &a, &b);
+        for (k = 0; k < 3; k++) {
+            sn_q pa = L->N[NODE_W * a + k], pb = L->N[NODE_W * b + k];
+            S[k] = mean_k((sn_acc)pa + pb, 2, sat);
+            d[k] = sn_add(pb, -pa, sat);
+        }
+        seg_unit(d, S + 3);
+        if (lens && L->l > 0) { /* a coarse segment's length: its restricted nodes' distance */
+            int sh;
+#if defined(SN_FLOAT)
+            float n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            S[12] = n2 > 1e-12f ? 0.5f * n2 * sn_frsqrt(n2) : (is_brace(L, i) ? L->bhalf : L->half);
+#else
+            /* |d_k| <= 2^29 (differences of clamped Q22 values): sum of squares < 2^60 */
+            uint64_t n2 = 0;
+            for (k = 0; k < 3; k++) n2 += (uint64_t)((int64_t)d[k] * d[k]);
+            S[12] = (sn_q)(sn_isqrt64(n2) >> 1); /* <= 2^29 */
+            S[12] = S[12] < 1 ? 1 : S[12];
+#endif
+            recip(S[12], &S[13], &sh);
+            S[14] = (sn_q)sh;
+        }
+    }
+}
+
+/* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
+
+/* A rotation angle from a lever: f c/half, with c (Q22) limited to +-half
+ * and f a factor (fixed: f >> fs, |f >> fs| <= 3), the result limited to
+ * +-ROT_MAX. Both limits are designed limiters of the small-angle update
+ * (a turn of more than 0.25 rad per constraint or per step is not
+ * followed), not overflows: not counted in sat. Fixed: |c| r <= 2^(b+30)
+ * < 2^57, shift b - 1: the quotient c/half (Q30) <= 2^30; times |f| <= 2^31:
+ * < 2^62 (before the shift fs). */
+static sn_q lever(sn_q c, sn_q hl, sn_q r, int sh, sn_q f, int fs) {
+    sn_q ck = c > hl ? hl : (c < -hl ? -hl : c);
+#if defined(SN_FLOAT)
+    sn_q t = ck * r * f;
+    (void)sh; (void)fs;
+#else
+    int64_t t = sn_rshr64(sn_rshr64((int64_t)ck * r, sh) * f, fs);
+#endif
+    return (sn_q)(t > ROT_MAX ? ROT_MAX : (t < -ROT_MAX ? -ROT_MAX : t));
+}
+
+/* a Q60 product sum known to be within +-2^61 to Q30 (rounded), no clamp */
+static sn_q shr30(sn_acc a) {
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return (sn_q)sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+
+/* u + theta x u, renormalized; |theta_k| limited to ROT_MAX (a designed
+ * limiter of the small-angle update, like the clamp of u x d to half in
+ * seg_move: not an overflow, so not counted in sat) */
+static void rotate_u(sn_q u[3], const sn_q th[3]) {
+    sn_q t[3], x[3];
+    unsigned k;
+    for (k = 0; k < 3; k++) {
+        t[k] = th[k] > ROT_MAX ? ROT_MAX : (th[k] < -ROT_MAX ? -ROT_MAX : th[k]);
+    }
+    /* each term of t x u <= 2^58, a component <= 2^59 -> 2^29 in Q30 (beyond
+     * the state clamp 2^28, so not through sn_out): u + t x u < 1.5 2^30 */
+    x[0] = u[0] + shr30(sn_mul(t[1], u[2]) - sn_mul(t[2], u[1]));
+    x[1] = u[1] + shr30(sn_mul(t[2], u[0]) - sn_mul(t[0], u[2]));
+    x[2] = u[2] + shr30(sn_mul(t[0], u[1]) - sn_mul(t[1], u[0]));
+    seg_unit(x, u);
+}
+
+/* Move segment i so its endpoint (sign s) closes part of the gap d: the
+ * centre by t, and a rotation closing the share rf of the gap's part
+ * perpendicular to the segment, seed 004 eq. 3.8 with Palazzi's user factor:
+ *   dTheta = rf (r x d) / |r|^2,  r = s half u,  so  dTheta = s rf (u x d) / half.
+ * Fixed: c = u x d (Q22) clamped to +-half (a rotation of more than one
+ * radian is not a small-angle correction), c/half in Q30 via the level's
+ * reciprocal, times rf (Q30). */
+static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
+                     uint32_t *sat) {
+    sn_q *S = L->S + SEG_W * i, c[3], th[3];
+    sn_q r;
+    int sh;
+    sn_q hl = seg_half(L, i, &r, &sh);
+    unsigned k;
+    c[0] = sn_out(sn_mul(S[4], d[2]) - sn_mul(S[5], d[1]), SN_Q_ROT, sat);
+    c[1] = sn_out(sn_mul(S[5], d[0]) - sn_mul(S[3], d[2]), SN_Q_ROT, sat);
+    c[2] = sn_out(sn_mul(S[3], d[1]) - sn_mul(S[4], d[0]), SN_Q_ROT, sat);
+    for (k = 0; k < 3; k++) {
+        th[k] = lever(c[k], hl, r, sh, rf, SN_Q_ROT);
+        if (s < 0) th[k] = -th[k];
+        S[k] = sn_add(S[k], t[k], sat);
+    }
+    rotate_u(S + 3, th);
+}
+
+/* |d| in public Q16.16 segment lengths (or float) */
+static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
+#if defined(SN_FLOAT)
+    float n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    return n2 > 0.0f ? n2 * sn_frsqrt(n2) / (2.0f * L->half) : 0.0f;
+#else
+    uint64_t n2 = 0;
+    int64_t g;
+    unsigned k;
+    for (k = 0; k < 3; k++) n2 += (uint64_t)((int64_t)d[k] * d[k]); /* |d| <= 2^29: < 2^60 */
+    g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
+    return g > INT32_MAX ? INT32_MAX : (sn_real)g;
+#endif
+}
+
+typedef struct seg_ctx {
+    sn_ihdr *h;
+    const seg_mesh *M;
+    sn_q gh, rf1, rf2;  /* gamma/2, 1-gamma, (1-gamma)/2 */
+    sn_q fn[3], foff;   /* floor in the internal frame */
+    int floor_on;
+    sn_real gap;
+} seg_ctx;
+
+/* pair constraint between two endpoints of equal masses: d = P2 - P1,
+ * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
+ * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
+ * perpendicular part */
+static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                 uint32_t *sat) {
+    sn_q P1[3], P2[3], d[3], nd[3], t[3], nt[3];
+    unsigned k;
+    seg_end(L, a, sa, P1, sat);
+    seg_end(L, b, sb, P2, sat);
+    for (k = 0; k < 3; k++) {
+        d[k] = sn_add(P2[k], -P1[k], sat);
+        nd[k] = -d[k];
+        t[k] = sn_mulq(d[k], C->gh, SN_Q_ROT, sat);
+        nt[k] = -t[k];
+    }
+    if (measure) {
+        sn_real g = gap_of(d, L);
+        C->gap = g > C->gap ? g : C->gap;
+        return;
+    }
+    seg_move(L, a, sa, t, d, C->rf2, sat);
+    seg_move(L, b, sb, nt, nd, C->rf2, sat);
+}
+
+/* an endpoint against a point of infinite mass: the segment takes gamma d
+ * and rotates to close (1-gamma) of the perpendicular part */
+static void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
+    sn_q P[3], d[3], t[3];
+    unsigned k;
+    seg_end(L, a, sa, P, sat);
+    for (k = 0; k < 3; k++) {
+        d[k] = sn_add(T[k], -P[k], sat);
+        t[k] = sn_mulq(d[k], C->M->gamma, SN_Q_ROT, sat);
+    }
+    if (measure) {
+        sn_real g = gap_of(d, L);
+        C->gap = g > C->gap ? g : C->gap;
+        return;
+    }
+    seg_move(L, a, sa, t, d, C->rf1, sat);
+}
+
+/* attachment target in the internal frame */
+static void attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3], uint32_t *sat) {
+    uint32_t tgt = sn_rd_u16(rec + 4), k;
+    if (rec[2] == SN_SEGATT_JOINT) {
+        const sn_q *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+        sn_q p0[3];
+        for (k = 0; k < 3; k++) p0[k] = rd_real(rec + 8, k);
+        sn_rot(jR + 9 * tgt, p0, T, sat);
+        for (k = 0; k < 3; k++) T[k] = sn_add(T[k], jT[3 * tgt + k], sat);
+    } else { /* surface vertex: trilinear in its cell, as sn_get_surface */
+        const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)tgt * SN_ELEM_EMBED;
+        const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+        const sn_q *pos = CARR(h, o_pos, sn_q);
+        sn_acc acc[3] = {0, 0, 0};
+        uint32_t a, t[3];
+        for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
+        for (a = 0; a < 8; a++) {
+            uint32_t vtx = sn_rd_u16(cell + 2 * a);
+            uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
+            uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
+            uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
+#if defined(SN_FLOAT)
+            float w = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f);
+#else
+            int64_t w = (int64_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15); /* Q30, weights sum to 2^30 */
+#endif
+            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
+        }
+        for (k = 0; k < 3; k++) T[k] = sn_out(acc[k], SN_Q_ROT, sat);
+    }
+}
+
+/* fine node n of the mesh at level l, or -1 if it is not a node there */
+static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
+    uint32_t r, c, m;
+    if (L->l == 0) return n;
+    r = n / M->side; c = n % M->side; m = (1u << L->l) - 1u;
+    if ((r & m) || (c & m)) return -1;
+    return (int64_t)(r >> L->l) * L->side + (c >> L->l);
+}
+
+/* One sweep, or (measure) the gaps it would close. Order (NUMERICS.md):
+ * attachments first, so the pinned ends propagate through the same sweep;
+ * then the nodes: a chain from node 0 up on even sweeps (dir 0) and back
+ * down on odd ones (symmetric Gauss-Seidel: a chain held at either end
+ * has one sweep in each pass running away from its holder); a sheet red
+ * nodes ((r+c) even) then black ones, in the opposite colour order on odd
+ * sweeps; the brace crossing of a 2x2 level; the floor last. At a node with
+ * k ends the pairs are (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3,
+ * (e_k-1, e0): a ring. */
+static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
+    const seg_mesh *M = C->M;
+    uint32_t n, seg[5], i, q;
+    int sgn[5];
+    unsigned color, j, k;
+    for (i = 0; i < M->n_attach; i++) {
+        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        int64_t ln = level_node(M, L, sn_rd_u16(rec));
+        sn_q T[3];
+        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
+        attach_target(C->h, rec, T, sat);
+        k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
+        for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
+    }
+    for (color = 0; color < 2; color++)
+        for (q = 0; q < L->nn; q++) {
+            uint32_t r, c;
+            n = (L->kind == SN_SEG_CHAIN && dir) ? L->nn - 1u - q : q;
+            r = L->kind == SN_SEG_CHAIN ? 0 : n / L->side;
+            c = L->kind == SN_SEG_CHAIN ? n : n % L->side;
+            if (L->kind == SN_SEG_CHAIN ? color != 0 : ((r + c) & 1u) != (color ^ dir)) continue;
+            k = seg_node_ends(L, n, seg, sgn);
+            for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+            if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+        }
+    if (is_brace(L, 4) && !measure) {
+        /* the braces keep the offset of their centres at the step's start
+         * (node words: the restricted nodes until seg_node_means): a flat
+         * cell stays flat, so the braced 2x2 level is rigid (fig. 4.4) and
+         * not a mechanism folding about a diagonal */
+        sn_q *B4 = L->S + SEG_W * 4, *B5 = L->S + SEG_W * 5, t;
+        const sn_q *N = L->N;
+        for (k = 0; k < 3; k++) {
+            sn_q d0 = sn_add(mean_k((sn_acc)N[NODE_W + k] + N[2 * NODE_W + k], 2, sat),
+                             -mean_k((sn_acc)N[k] + N[3 * NODE_W + k], 2, sat), sat);
+            t = sn_mulq(sn_add(sn_add(B5[k], -B4[k], sat), -d0, sat), C->gh, SN_Q_ROT, sat);
+            B4[k] = sn_add(B4[k], t, sat);
+            B5[k] = sn_add(B5[k], -t, sat);
+        }
+    }
+    if (C->floor_on && !measure)
+        for (i = 0; i < L->ns; i++)
+            for (j = 0; j < 2; j++) {
+                int s = j ? 1 : -1;
+                sn_q P[3], d[3], t[3], pen;
+                seg_end(L, i, s, P, sat);
+                pen = sn_add(C->foff, -sn_out(sn_mul(C->fn[0], P[0]) + sn_mul(C->fn[1], P[1]) +
+                                                  sn_mul(C->fn[2], P[2]), SN_Q_ROT, sat), sat);
+                pen = pen > 0 ? pen : 0; /* one-sided: only a penetration is pushed out */
+                for (k = 0; k < 3; k++) {
+                    d[k] = sn_mulq(C->fn[k], pen, SN_Q_ROT, sat);
+                    t[k] = sn_mulq(d[k], M->gamma, SN_Q_ROT, sat);
+                }
+                seg_move(L, i, s, t, d, C->rf1, sat);
+            }
+}
+
+/* ---------------- dynamics and velocities ---------------- */
+
+/* Level l's dynamics: save G, u (into v, w's words after the velocities are
+ * read), damping, gravity and the node impulses (J at the centres' share
+ * `centre`, the rest at the endpoints with torque), Euler-Cromer. */
+static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat) {
+    const seg_mesh *M = C->M;
+    sn_q g[3];
+    uint32_t i, n, seg[5];
+    int sgn[5];
+    unsigned j, k, ne;
+    for (k = 0; k < 3; k++)
+        g[k] = (M->flags & SN_SEGF_NO_GRAVITY) ? 0 : sn_mulq(C->h->v.grav[k], M->share[L->l], SN_Q_ROT, sat);
+    for (i = 0; i < L->ns; i++) { /* damping and gravity: v = keep v + g; w = keep w */
+        sn_q *S = L->S + SEG_W * i;
+        for (k = 0; k < 3; k++) {
+            S[6 + k] = sn_add(sn_mulq(S[6 + k], M->keep, SN_Q_ROT, sat), g[k], sat);
+            S[9 + k] = sn_mulq(S[9 + k], M->keep, SN_Q_ROT, sat);
+        }
+    }
+    /* impulses: node J split evenly over its k ends; dv = J/k inv_mass
+     * (an end force translates too); dw = s 6 inv_mass (u x J_end)/L
+     * = s 3 (u x f)/half with f = (1 - centre) J/k inv_mass, the thin rod's
+     * J = m L^2/12 about the perpendicular axes (seed 004 §3.2.2, app. A) */
+    for (n = 0; n < L->nn; n++) {
+        const sn_q *J = L->N + NODE_W * n + 3;
+        ne = seg_node_ends(L, n, seg, sgn);
+        for (j = 0; j < ne; j++) {
+            sn_q *S = L->S + SEG_W * seg[j], f[3], fe[3], c[3];
+            sn_q rr;
+            int rs;
+            sn_q hl = seg_half(L, seg[j], &rr, &rs);
+            for (k = 0; k < 3; k++) {
+                f[k] = sn_mulq(mean_k(J[k], ne, sat), inv_mass, 16, sat);
+                S[6 + k] = sn_add(S[6 + k], f[k], sat);
+                fe[k] = sn_add(f[k], -sn_mulq(f[k], M->centre, SN_Q_ROT, sat), sat);
+            }
+            c[0] = sn_out(sn_mul(S[4], fe[2]) - sn_mul(S[5], fe[1]), SN_Q_ROT, sat);
+            c[1] = sn_out(sn_mul(S[5], fe[0]) - sn_mul(S[3], fe[2]), SN_Q_ROT, sat);
+            c[2] = sn_out(sn_mul(S[3], fe[1]) - sn_mul(S[4], fe[0]), SN_Q_ROT, sat);
+            for (k = 0; k < 3; k++) { /* 3 (u x f)/half, limited to 0.25 rad/step */
+                sn_q dw = lever(c[k], hl, rr, rs, THREE, 0);
+                S[9 + k] = sn_add(S[9 + k], sgn[j] > 0 ? dw : -dw, sat);
+            }
+        }
+    }
+    for (i = 0; i < L->ns; i++) { /* Euler-Cromer: G += v; u turned by w; save the start */
+        sn_q *S = L->S + SEG_W * i, G0[3], u0[3];
+        for (k = 0; k < 3; k++) {
+            G0[k] = S[k];
+            u0[k] = S[3 + k];
+            S[k] = sn_add(S[k], S[6 + k], sat);
+        }
+        rotate_u(S + 3, S + 9);
+        for (k = 0; k < 3; k++) { S[6 + k] = G0[k]; S[9 + k] = u0[k]; }
+    }
+}
+
+/* A Q60 product sum (|.| <= 2^61) to Q30 limited to +-ROT_MAX: the
+ * per-step rotation cap, a designed limiter (not counted in sat). */
+static sn_q rot_cap(sn_acc a) {
+#if defined(SN_FLOAT)
+    sn_q t = a;
+#else
+    int64_t t = sn_rshr64(a, SN_Q_ROT);
+#endif
+    return (sn_q)(t > ROT_MAX ? ROT_MAX : (t < -ROT_MAX ? -ROT_MAX : t));
+}
+
+/* Velocities from the displacements (seed 004 fig. 3.1 step 4):
+ * v = G - G_start (exact: the sum of v changes only by external terms),
+ * w = u_start x u (small angle), clamped to 0.25 rad per step. */
+static void velocities(const seg_lvl *L, uint32_t *sat) {
+    uint32_t i;
+    unsigned k;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *S = L->S + SEG_W * i, w[3];
+        const sn_q *u0 = S + 9, *u = S + 3;
+        w[0] = rot_cap(sn_mul(u0[1], u[2]) - sn_mul(u0[2], u[1]));
+        w[1] = rot_cap(sn_mul(u0[2], u[0]) - sn_mul(u0[0], u[2]));
+        w[2] = rot_cap(sn_mul(u0[0], u[1]) - sn_mul(u0[1], u[0]));
+        for (k = 0; k < 3; k++) {
+            S[6 + k] = sn_add(S[k], -S[6 + k], sat);
+            S[9 + k] = w[k];
+        }
+    }
+}
+
+static void ctx_init(seg_ctx *C, sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
+    unsigned k;
+    C->h = h;
+    C->M = M;
+#if defined(SN_FLOAT)
+    C->gh = 0.5f * M->gamma;
+    C->rf1 = 1.0f - M->gamma;
+    C->rf2 = 0.5f * C->rf1;
+#else
+    C->gh = M->gamma >> 1; /* gamma/2 rounded down: the pair's translation is t = d gamma/2 */
+    C->rf1 = ((int32_t)1 << 30) - M->gamma;
+    C->rf2 = C->rf1 >> 1;
+#endif
+    (void)sat;
+    C->floor_on = (int)h->floor_on;
+    C->gap = 0;
+    C->foff = 0;
+    for (k = 0; k < 3; k++) C->fn[k] = h->floor_n[k];
+    if (h->floor_on) { /* n.(origin + p) >= off  <=>  n.p >= off - n.origin */
+#if defined(SN_FLOAT)
+        float no = C->fn[0] * h->origin[0] + C->fn[1] * h->origin[1] + C->fn[2] * h->origin[2];
+        C->foff = pub_to_int(h, h->floor_off - no);
+#else
+        int64_t no = sn_rshr64((int64_t)C->fn[0] * h->origin[0] + (int64_t)C->fn[1] * h->origin[1] +
+                                   (int64_t)C->fn[2] * h->origin[2], SN_Q_ROT); /* |.| < 2^32.6 */
+        C->foff = pub_to_int_sat(h, (int64_t)h->floor_off - no, sat);
+#endif
+    }
+}
+
+/* The mesh's node-impulse accumulators of every level to zero. */
+static void clear_impulses(const seg_mesh *M) {
+    uint32_t n;
+    for (n = 0; n < M->nodes; n++) M->N[NODE_W * n + 3] = M->N[NODE_W * n + 4] = M->N[NODE_W * n + 5] = 0;
+}
+
+/* First step after init/reset: the rest mesh (model space) placed by the
+ * transform of the joint of its first JOINT attachment (else the root),
+ * as the skeleton's rest positions are (p = R_j x + T_j). */
+static void place(sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
+    const sn_q *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+    uint32_t j = 0, i;
+    unsigned k;
+    for (i = M->n_attach; i-- > 0;) {
+        const unsigned char *rec = h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        if (rec[2] == SN_SEGATT_JOINT) j = sn_rd_u16(rec + 4);
+    }
+    for (i = 0; i < M->segs; i++) {
+        sn_q *S = M->S + SEG_W * i, x[3], y[3];
+        memcpy(x, S, sizeof x);
+        sn_rot(jR + 9 * j, x, S, sat);
+        for (k = 0; k < 3; k++) S[k] = sn_add(S[k], jT[3 * j + k], sat);
+        for (k = 0; k < 3; k++) x[k] = S[3 + k] / 4; /* Q28 (sn_rot clamps at 2^28), then unit again */
+        sn_rot(jR + 9 * j, x, y, sat);
+        seg_unit(y, S + 3);
+    }
+    for (i = 0; i < M->nodes; i++) {
+        sn_q *N = M->N + NODE_W * i, x[3];
+        memcpy(x, N, sizeof x);
+        sn_rot(jR + 9 * j, x, N, sat);
+        for (k = 0; k < 3; k++) N[k] = sn_add(N[k], jT[3 * j + k], sat);
+    }
+}
+
+void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
+    uint32_t m, i, s;
+    sn_q shift[3] = {0, 0, 0};
+    sn_real gap = 0;
+    unsigned k;
+    if (h->v.nM == 0) return;
+    /* the origin moved with the root since the last step: positions are kept
+     * in the world by shifting them, as sn_frames shifts the flesh */
+    for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+        shift[k] = h->seg_placed ? pub_to_int(h, h->origin[k] - h->seg_origin[k]) : 0;
+#else
+        shift[k] = h->seg_placed ? pub_to_int_sat(h, (int64_t)h->origin[k] - h->seg_origin[k], sat) : 0;
+#endif
+        h->seg_origin[k] = h->origin[k];
+    }
+    for (m = 0; m < h->v.nM; m++) {
+        seg_mesh M;
+        seg_ctx C;
+        seg_lvl L;
+        unsigned l;
+        seg_mesh_get(h, m, &M);
+        if (!h->seg_placed) place(h, &M, sat);
+        for (i = 0; i < M.segs; i++)
+            for (k = 0; k < 3; k++) M.S[SEG_W * i + k] = sn_add(M.S[SEG_W * i + k], -shift[k], sat);
+        for (i = 0; i < M.nodes; i++)
+            for (k = 0; k < 3; k++) M.N[NODE_W * i + k] = sn_add(M.N[NODE_W * i + k], -shift[k], sat);
+        ctx_init(&C, h, &M, sat);
+        if (M.levels > 1) seg_restrict(&M, sat); /* positions and impulse shares of the coarse levels */
+        else {
+            seg_level(&M, 0, &L);
+            for (i = 0; i < L.nn; i++) /* one level: share[0] is 1 (validated) */
+                for (k = 0; k < 3; k++)
+                    L.N[NODE_W * i + 3 + k] = sn_mulq(L.N[NODE_W * i + 3 + k], M.share[0], SN_Q_ROT, sat);
+        }
+        for (l = M.levels; l-- > 0;) {
+            sn_q im;
+            seg_level(&M, l, &L);
+            {   /* equal total mass on every level (seed 004 §4.2.1): m_l = m_0 S_0 / S_l */
+                seg_lvl L0;
+                seg_level(&M, 0, &L0);
+#if defined(SN_FLOAT)
+                im = M.inv_mass * (float)L.ns / (float)L0.ns;
+#else
+                im = (sn_q)(((int64_t)M.inv_mass * L.ns) / L0.ns); /* S_l <= S_0: <= inv_mass */
+                im = im < 1 ? 1 : im;
+#endif
+            }
+            dynamics(&C, &L, im, sat);
+            for (s = 0; s < M.sweeps; s++) sweep(&C, &L, 0, s & 1u, sat);
+            seg_node_means(&L, sat);
+            if (l > 0) seg_prolong(&M, l, sat); /* reads this level's start (v, w words) */
+            velocities(&L, sat);
+        }
+        seg_level(&M, 0, &L);
+        sweep(&C, &L, 1, 0, sat); /* measure the gaps left (no displacement) */
+        gap = C.gap > gap ? C.gap : gap;
+        clear_impulses(&M);
+    }
+    h->seg_placed = 1;
+    h->seg_gap = gap;
+    h->seg_gap_max = gap > h->seg_gap_max ? gap : h->seg_gap_max;
+}
+
+/* M a (Q30 rotation times a value of any Q) without the state clamp: |M a|
+ * <= 1.74 |a|_max (rows of a rotation, rounded), each product <= 2^61 */
+static void turn_raw(const sn_q M[9], const sn_q a[3], sn_q out[3]) {
+    unsigned k;
+    for (k = 0; k < 3; k++) out[k] = shr30(sn_mul(M[3 * k], a[0]) + sn_mul(M[3 * k + 1], a[1]) + sn_mul(M[3 * k + 2], a[2]));
+}
+
+void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const sn_q T1[3], uint32_t *sat) {
+    uint32_t m, i;
+    unsigned k;
+    if (h->v.nM == 0) return;
+    for (k = 0; k < 3; k++) h->seg_origin[k] = h->origin[k];
+    if (!h->seg_placed) return; /* the first step places the meshes by their joint */
+    for (m = 0; m < h->v.nM; m++) {
+        seg_mesh Ms;
+        seg_mesh_get(h, m, &Ms);
+        for (i = 0; i < Ms.segs; i++) {
+            sn_q *S = Ms.S + SEG_W * i, a[3], b[3];
+            for (k = 0; k < 3; k++) a[k] = sn_add(S[k], -T0[k], sat);
+            sn_rot(M, a, b, sat); /* Q22 positions: within the state range */
+            for (k = 0; k < 3; k++) S[k] = sn_add(b[k], T1[k], sat);
+            turn_raw(M, S + 3, a); /* Q30 unit: <= 1.74 2^30 */
+            seg_unit(a, S + 3);
+            memcpy(a, S + 6, sizeof a);
+            sn_rot(M, a, S + 6, sat);
+            turn_raw(M, S + 9, a); /* w: each |w_k| <= 2^28, limited again */
+            for (k = 0; k < 3; k++) S[9 + k] = a[k] > ROT_MAX ? ROT_MAX : (a[k] < -ROT_MAX ? -ROT_MAX : a[k]);
+        }
+        for (i = 0; i < Ms.nodes; i++) {
+            sn_q *N = Ms.N + NODE_W * i, a[3];
+            for (k = 0; k < 3; k++) a[k] = sn_add(N[k], -T0[k], sat);
+            sn_rot(M, a, N, sat);
+            for (k = 0; k < 3; k++) N[k] = sn_add(N[k], T1[k], sat);
+            memcpy(a, N + 3, sizeof a);
+            sn_rot(M, a, N + 3, sat);
+        }
+    }
+}
+
+/* Rest state: level 0 from the rest nodes, coarser levels restricted; all
+ * velocities and impulses zero. */
+void sn_segments_reset(sn_ihdr *h) {
+    uint32_t m, i, sat = 0;
+    unsigned k, l;
+    h->seg_placed = 0;
+    for (k = 0; k < 3; k++) h->seg_origin[k] = h->origin[k];
+    for (m = 0; m < h->v.nM; m++) {
+        seg_mesh M;
+        seg_lvl L;
+        seg_mesh_get(h, m, &M);
+        memset(M.S, 0, (size_t)SN_SEG_SEG_BYTES * M.segs + (size_t)SN_SEG_NODE_BYTES * M.nodes);
+        seg_level(&M, 0, &L);
+        for (i = 0; i < L.nn; i++)
+            for (k = 0; k < 3; k++) L.N[NODE_W * i + k] = rd_real(h->v.sec[SN_SEC_SEGNODES], 3 * (M.first_node + i) + k);
+        for (i = 0; i < M.segs; i++) M.S[SEG_W * i + 3] = SN_ONE_ROT; /* any unit u before seg_from_nodes */
+        seg_from_nodes(&L, 0, &sat);
+        for (l = 1; l < M.levels; l++) {
+            seg_lvl Lc;
+            seg_level(&M, l, &Lc);
+            for (i = 0; i < Lc.nn; i++) { /* coarse node (r,c) = finer node (2r, 2c), eq. 4.1-4.2 */
+                uint32_t r = i / Lc.side, c = i % Lc.side, f;
+                seg_level(&M, l - 1, &L);
+                f = 2u * r * L.side + 2u * c;
+                for (k = 0; k < 3; k++) Lc.N[NODE_W * i + k] = L.N[NODE_W * f + k];
+            }
+            seg_from_nodes(&Lc, 1, &sat);
+        }
+    }
+}
+
+/* ---- determinism hash: every word of the segment state, little-endian ---- */
+uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh) {
+    const unsigned char *p = (const unsigned char *)h + h->o_seg;
+    uint32_t i;
+    for (i = 0; i < h->v.segB / 4u; i++) {
+        sn_q x;
+        uint32_t u;
+        int b;
+        memcpy(&x, p + 4u * i, 4);
+        memcpy(&u, &x, 4);
+        for (b = 0; b < 4; b++) {
+            hsh ^= (u >> (8 * b)) & 0xFFu;
+            hsh *= 0x100000001B3ull;
+        }
+    }
+    return hsh;
+}

@@ -15,7 +15,11 @@
  * control "bend" (the tip's angle about z); rig 0 on puff, samples
  * (-1,-1) (0,0) (1,1), pushing free vertices 1, 3, 5 along +y; rig 1 on
  * bend, samples (0 deg, 0) (90 deg, 1), pulling 0, 4, 7 along -x; rig 2 on
- * puff, one sample (eta 0.5 everywhere), on vertex 2 along +z. Flavour
+ * puff, one sample (eta 0.5 everywhere), on vertex 2 along +z. Segment
+ * meshes (format 4.0): a chain of 5 nodes 0.1 apart hanging along -y from
+ * the tip end (x = 1), node 0 pinned to the tip joint; a 3x3 sheet (2 levels,
+ * shares 1/2 1/2, no gravity) in the plane y = -0.25 from surface vertex 0
+ * (0.25, -0.25, 0.25), its node 0, pinned there. Flavour
  * follows SN_FLOAT of the including file (fixed: Q formats of NUMERICS.md;
  * float: true values).
  */
@@ -44,6 +48,12 @@
 #define TB_NP 2      /* force share profiles */
 #define TB_NFRC 4    /* force slots */
 #define TB_FRAC_F 40 /* FORCE: 1/1024 rhs units per newton */
+#define TB_NM 2      /* segment meshes (format 4.0): a chain and a small sheet */
+#define TB_NSN 14    /* segment nodes: 5 + 3x3 */
+#define TB_NSA 2     /* segment attachments */
+#define TB_SEG_LEN 0.1
+/* segment state bytes: chain 4 segs 5 nodes; sheet side 3 levels 2: 12 + 6 segs, 9 + 4 nodes */
+#define TB_SEGB (SN_SEG_SEG_BYTES * (4u + 18u) + SN_SEG_NODE_BYTES * (5u + 13u))
 
 static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
 static void tb_u32(unsigned char *p, uint32_t v) {
@@ -161,9 +171,9 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_RIG_FORCES] = TB_NRE;  elem[SN_SEC_RIG_FORCES] = (uint32_t)SN_ELEM_RIG_FORCES(R);
     cnt[SN_SEC_SHARES] = TB_NP;       elem[SN_SEC_SHARES] = (uint32_t)SN_ELEM_SHARES(R);
     cnt[SN_SEC_VSHARE] = TB_NF;       elem[SN_SEC_VSHARE] = SN_ELEM_VSHARE;
-    cnt[SN_SEC_SEGMESH] = 0;          elem[SN_SEC_SEGMESH] = (uint32_t)SN_ELEM_SEGMESH(R);
-    cnt[SN_SEC_SEGNODES] = 0;         elem[SN_SEC_SEGNODES] = (uint32_t)SN_ELEM_SEGNODES(R);
-    cnt[SN_SEC_SEGATTACH] = 0;        elem[SN_SEC_SEGATTACH] = (uint32_t)SN_ELEM_SEGATTACH(R);
+    cnt[SN_SEC_SEGMESH] = TB_NM;      elem[SN_SEC_SEGMESH] = (uint32_t)SN_ELEM_SEGMESH(R);
+    cnt[SN_SEC_SEGNODES] = TB_NSN;    elem[SN_SEC_SEGNODES] = (uint32_t)SN_ELEM_SEGNODES(R);
+    cnt[SN_SEC_SEGATTACH] = TB_NSA;   elem[SN_SEC_SEGATTACH] = (uint32_t)SN_ELEM_SEGATTACH(R);
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -273,6 +283,42 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
                 tb_real(b + secoff[SN_SEC_SHARES] + (SN_LEVELS * i + j) * R, prof[i][j], SN_Q_ROT);
         for (i = 0; i < TB_NF; i++) b[secoff[SN_SEC_VSHARE] + i] = (unsigned char)(i & 1);
     }
+    {   /* segment meshes: {kind, levels, sweeps, flags, side, n_attach, first_node, first_attach,
+         * len, gamma, keep, inv_mass, centre, share[4]} */
+        static const double sh[2][4] = {{1, 0, 0, 0}, {0.5, 0.5, 0, 0}};
+        static const unsigned hd[2][6] = {{SN_SEG_CHAIN, 1, 8, 0, 5, 1}, {SN_SEG_SHEET, 2, 4, SN_SEGF_NO_GRAVITY, 3, 1}};
+        unsigned char *ms = b + secoff[SN_SEC_SEGMESH], *nd = b + secoff[SN_SEC_SEGNODES];
+        unsigned char *at = b + secoff[SN_SEC_SEGATTACH];
+        for (i = 0; i < TB_NM; i++) {
+            unsigned char *r = ms + elem[SN_SEC_SEGMESH] * (uint32_t)i;
+            r[0] = (unsigned char)hd[i][0]; r[1] = (unsigned char)hd[i][1];
+            r[2] = (unsigned char)hd[i][2]; r[3] = (unsigned char)hd[i][3];
+            tb_u16(r + 4, hd[i][4]);
+            tb_u16(r + 6, hd[i][5]);
+            tb_u32(r + 8, i ? 5u : 0u);
+            tb_u32(r + 12, (uint32_t)i);
+            tb_real(r + 16, TB_SEG_LEN, SN_Q_LEN);
+            tb_real(r + 16 + R, 0.5, SN_Q_ROT);
+            tb_real(r + 16 + 2 * R, 0.99, SN_Q_ROT);
+            tb_real(r + 16 + 3 * R, 4.0, 16);
+            tb_real(r + 16 + 4 * R, 0.5, SN_Q_ROT);
+            for (j = 0; j < 4; j++) tb_real(r + 16 + (5 + j) * R, sh[i][j], SN_Q_ROT);
+        }
+        for (i = 0; i < 5; i++) { /* chain along -y from (1, 0, 0) */
+            tb_real(nd + 3 * R * i, 2 * cell, SN_Q_LEN);
+            tb_real(nd + 3 * R * i + R, -TB_SEG_LEN * i, SN_Q_LEN);
+        }
+        for (i = 0; i < 9; i++) { /* sheet: (0.25 + 0.1 c, -0.25, 0.25 + 0.1 r), node 0 on surface vertex 0 */
+            tb_real(nd + 3 * R * (5 + i), 0.5 * cell + TB_SEG_LEN * (i % 3), SN_Q_LEN);
+            tb_real(nd + 3 * R * (5 + i) + R, -0.5 * cell, SN_Q_LEN);
+            tb_real(nd + 3 * R * (5 + i) + 2 * R, 0.5 * cell + TB_SEG_LEN * (i / 3), SN_Q_LEN);
+        }
+        /* chain node 0 -> joint 1 at its rest point; sheet node 0 -> surface vertex 0 */
+        at[2] = SN_SEGATT_JOINT;
+        tb_u16(at + 4, 1);
+        tb_real(at + 8, 2 * cell, SN_Q_LEN);
+        at[elem[SN_SEC_SEGATTACH] + 2] = SN_SEGATT_SURFACE;
+    }
     /* header */
     b[0] = 'S'; b[1] = 'N'; b[2] = 'W'; b[3] = 'B';
     tb_u16(b + SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
@@ -292,7 +338,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, 0));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB));
     b[SN_H_MAX_FORCES] = TB_NFRC;
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);

@@ -113,12 +113,30 @@ base | sed 's/^mesh box.obj/mesh bad.obj/' > "$T/m.sinew"
 { base; echo "region box -1e300 0 0 1 1 1 flesh"; } > "$T/n8.sinew"; expect region-far "n8.sinew:8: '-1e300' is beyond 1e\+09 mesh units" "$T/n8.sinew"
 { base; echo "control x"; echo "rig r x bump 0.1  2 0 0 0.5  tau 0 0 20000 1"; } > "$T/n9.sinew"; expect tau-far "n9.sinew:9: tau gamma 20000 out of range \(\|gamma\| <= 16384\)" "$T/n9.sinew"
 { base; echo "control x"; echo "rig r x bump 0.1  2 0 0 1e300"; } > "$T/n10.sinew"; expect rig-radius-huge "n10.sinew:9: '1e300' is beyond 1e\+09 mesh units" "$T/n10.sinew"
+# segment meshes (seed 004 ch. 3-4; DESCRIPTION.md "Segment meshes")
+{ base; echo "chain t nodes 1 from 5 0 0 to 7 0 0"; } > "$T/s1.sinew"; expect chain-one-node "s1.sinew:8: '1' must be an integer in 2..256" "$T/s1.sinew"
+{ base; echo "sheet s side 6 corner 0 1 -1 u 2 0 0 v 0 0 2"; } > "$T/s2.sinew"; expect sheet-side "s2.sinew:8: sheet side 6 is not 2\^n \+ 1" "$T/s2.sinew"
+{ base; echo "sheet s side 3 corner 0 1 -1 u 2 0 0 v 0 0 2 levels 3"; } > "$T/s3.sinew"; expect sheet-levels "s3.sinew:8: sheet 's': 3 levels, at most 2 for side 3" "$T/s3.sinew"
+{ base; echo "sheet s side 9 corner 0 1 -1 u 2 0 0 v 0 0 2 shares 0.5 0.4"; } > "$T/s4.sinew"; expect sheet-shares "s4.sinew:8: sheet 's': shares sum to 0.9, want 1" "$T/s4.sinew"
+{ base; echo "sheet s side 5 corner 0 1 -1 u 2 0 0 v 0 0 3"; } > "$T/s5.sinew"; expect sheet-not-square "s5.sinew:8: sheet 's': edges u and v have lengths 2 and 3" "$T/s5.sinew"
+{ base; echo "attach cape first surface"; } > "$T/s6.sinew"; expect attach-unknown "s6.sinew:8: unknown segment mesh 'cape'" "$T/s6.sinew"
+{ base; echo "chain t nodes 3 from 2 0 0 to 2 0 -3"; echo "attach t first surface"; } > "$T/s7.sinew"; expect attach-far "s7.sinew:9: chain 't' node 0 at \(2, 0, 0\) is 1 from the nearest surface vertex [0-9]+ at \(2, -1, 0\), more than 0.75 \(half a segment\)" "$T/s7.sinew"
+{ base; echo "chain t nodes 3 from 5 0 0 to 7 0 0 gamma 0"; } > "$T/s8.sinew"; expect chain-gamma "s8.sinew:8: gamma \(translation factor\) must be in \(0, 1\]" "$T/s8.sinew"
+{ base; echo "chain t nodes 2 from 5 0 0 to 5 0 1000"; } > "$T/s9.sinew"; expect chain-far "s9.sinew:8: chain 't' node 1 lies 1000 mesh units from the root joint" "$T/s9.sinew"
+{ base; echo "chain t nodes 2 from 5 0 0 to 7 0 0 mass 1e6"; } > "$T/s10.sinew"; expect chain-mass "s10.sinew:8: chain 't': segment mass 1e\+06 kg is out of range" "$T/s10.sinew"
+{ base; echo "chain t nodes 3 from 5 0 0 to 7 0 0"; echo "attach t first joint zz"; } > "$T/s11.sinew"; expect attach-joint "s11.sinew:9: unknown joint 'zz'" "$T/s11.sinew"
+{ base; echo "sheet s side 3 corner 0 1 -1 u 2 0 0 v 0 0 2"; echo "attach s corners surface"; echo "attach s node 0 joint a"; } > "$T/s12.sinew"; expect attach-twice "s12.sinew:10: sheet 's': node 0 is already attached \(line 9\)" "$T/s12.sinew"
+{ base; echo "chain t nodes 3 from 5 0 0 to 7 0 0 wobble 1"; } > "$T/s13.sinew"; expect chain-option "s13.sinew:8: unknown chain option 'wobble'" "$T/s13.sinew"
 { cat "$T/box.obj"; echo "v 0 -1.5e9 0"; } > "$T/bad.obj";                  expect obj-minus-1.5e9 "bad.obj:172: vertex coordinate '-1.5e9' is out of range" "$T/m.sinew"
 # a mesh wider than 32768 mesh units can never bake (a blob holds positions within 16384 of the root)
 awk '$1 == "v" && $2 > 0 { $2 = 40000 } { print }' "$T/box.obj" > "$T/bad.obj"; expect obj-extent "bad.obj:[0-9]+: vertex at x = 40000 is 40001 mesh units from the vertex at line [0-9]+ \(x = -1\): a mesh may span at most 32768" "$T/m.sinew"
 { cat "$T/box.obj"; echo "bogus 1 2 3"; } > "$T/bad.obj";                   expect obj-statement "bad.obj:[0-9]+: malformed OBJ: unsupported statement 'bogus'" "$T/m.sinew"
 grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | sed 1d >> "$T/bad.obj"; expect mesh-open "bad.obj: mesh is not closed" "$T/m.sinew"
 grep -v '^f' "$T/box.obj" > "$T/bad.obj"; grep '^f' "$T/box.obj" | awk '{ print $1, $2, $4, $3 }' >> "$T/bad.obj"; expect mesh-inside-out "bad.obj: mesh encloses a non-positive volume" "$T/m.sinew"
+
+# a valid chain and sheet bake
+{ base; echo "chain t nodes 5 from 5 0 0 to 7 0 0"; echo "attach t first surface"; echo "sheet s side 5 corner 0 1 -1 u 2 0 0 v 0 0 2 shares 0.5 0.25 0.25"; echo "attach s row 0 surface within 0.5"; echo "attach s node 24 joint c"; } > "$T/s0.sinew"
+expect_ok segments "$T/s0.sinew"
 
 # --- command line ---
 "$BAKE" --help > "$T/help" 2>&1 && grep -q "usage: sinew-bake" "$T/help" && { echo "ok   --help"; pass=$((pass + 1)); } || { echo "FAIL --help"; fail=$((fail + 1)); }

@@ -41,6 +41,20 @@ expect 2 '--frames needs a value' "$PLAY" "$BLOB" --frames
 expect 2 "bad number 'x'" "$PLAY" "$BLOB" --frames x
 expect nz 'this blob allows 1\.\.' "$PLAY" "$BLOB" --iterations 100000
 
+# segment meshes (seed 004 ch. 3-4): the cow's tail chain is mesh 0 (9 nodes)
+expect 2 '--seg-impulse: want MESH:NODE:X,Y,Z' "$PLAY" "$BLOB" --seg-impulse 0:8
+expect 2 '--seg-impulse: want MESH:NODE:X,Y,Z' "$PLAY" "$BLOB" --seg-impulse 0:8:0,1,0@0
+expect 2 '--seg-floor: want a height' "$PLAY" "$BLOB" --seg-floor nan
+expect 2 '--segments: want on or off' "$PLAY" "$BLOB" --segments maybe
+expect 1 'no node 9 of mesh 0' "$PLAY" "$BLOB" --frames 1 --seg-impulse 0:9:0,1,0
+expect 1 'no node 0 of mesh 64' "$PLAY" "$BLOB" --frames 1 --seg-impulse 64:0:0,1,0
+h0=$("$PLAY" "$BLOB" --frames 10 --hash --quiet 2>/dev/null | grep '^hash:')
+h1=$("$PLAY" "$BLOB" --frames 10 --hash --quiet --seg-impulse 0:8:0.5,0,0@3 2>/dev/null | grep '^hash:')
+h2=$("$PLAY" "$BLOB" --frames 10 --hash --quiet --seg-impulse 0:8:0.5,0,0@3 --segments off 2>/dev/null | grep '^hash:')
+[ -n "$h0" ] && [ "$h0" != "$h1" ] && [ "$h1" = "$h2" ] && ok || bad "--seg-impulse moves the tail (hash $h0 -> $h1), drawing off changes nothing ($h2)"
+expect 0 'wrote|step:' "$PLAY" "$BLOB" --frames 4 --seg-floor -3.6 --png "$TMP/seg.png"
+[ -s "$TMP/seg.png" ] && ok || bad "--seg-floor run wrote no picture"
+
 # blobs: missing, empty, truncated, corrupt, wrong flavour
 expect 1 "cannot read $TMP/none.blob" "$PLAY" "$TMP/none.blob"
 expect 1 "cannot read $TMP: not a regular file" "$PLAY" "$TMP"
