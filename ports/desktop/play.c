@@ -48,6 +48,8 @@ static void usage(FILE *f) {
         "  --png FILE         picture of the last frame\n"
         "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid of 320x240 (or --size) cells\n"
         "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n"
+        "  --compare-hits FILE  rest | no hit | hit at the last frame: a second instance steps the clip without its\n"
+        "                     impulse lines; with --heat D the hit panel is coloured by its distance from it\n"
         "  --compare-rigs FILE  rest | rigs off | rigs on at the last frame; rigs off = a second instance with\n"
         "                     every abstract control at 0, of --rig-off-blob if given; with --heat D the rigs-on\n"
         "                     panel is coloured by its distance from the rigs-off one (red at D mesh units)\n"
@@ -426,7 +428,7 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
 #define MAX_HELD 64
 typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *obj_frames, *png, *sheet, *compare, *title, *stats_csv, *plot;
-    const char *compare_rigs, *rig_off_blob;
+    const char *compare_rigs, *rig_off_blob, *compare_hits;
     const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
     int n_held, rigs_off;
     long frames, iterations, health;
@@ -482,7 +484,7 @@ static int frame_list(const char *v, long n, unsigned char *sel, char *err, size
 static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
-                                         "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob",
+                                         "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
                                          "--seg-impulse", "--seg-floor", "--segments", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
@@ -509,6 +511,7 @@ static int parse_args(int argc, char **argv, options *o) {
         else if (!strcmp(a, "--sheet")) o->sheet = v;
         else if (!strcmp(a, "--compare")) o->compare = v;
         else if (!strcmp(a, "--compare-rigs")) o->compare_rigs = v;
+        else if (!strcmp(a, "--compare-hits")) o->compare_hits = v;
         else if (!strcmp(a, "--rig-off-blob")) o->rig_off_blob = v;
         else if (!strcmp(a, "--rigs")) {
             if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --rigs: want on or off, got '%s'\n", v); return 2; }
@@ -591,6 +594,8 @@ static int parse_args(int argc, char **argv, options *o) {
     if (o->rigs_off && o->n_held) { fprintf(stderr, PROG ": --rigs off holds every control at 0: it cannot go with --control\n"); return 2; }
     if (o->rig_off_blob && !o->compare_rigs) { fprintf(stderr, PROG ": --rig-off-blob needs --compare-rigs\n"); return 2; }
     if (o->compare && o->compare_rigs) { fprintf(stderr, PROG ": --compare and --compare-rigs: one at a time\n"); return 2; }
+    if (o->compare_hits && (o->compare || o->compare_rigs)) { fprintf(stderr, PROG ": --compare-hits and --compare/--compare-rigs: one at a time\n"); return 2; }
+    if (o->compare_hits && !o->clip_path) { fprintf(stderr, PROG ": --compare-hits needs a --clip with impulse lines\n"); return 2; }
     if (o->compare_rigs && o->rigs_off) { fprintf(stderr, PROG ": --compare-rigs shows rigs off next to rigs on: not with --rigs off\n"); return 2; }
     if (o->sheet && o->have_size && (o->w > 2048 || o->h > 2048)) {
         fprintf(stderr, PROG ": --size: sheet cells are at most 2048x2048 (the sheet is 4x3 cells)\n"); return 2;
@@ -714,10 +719,10 @@ static void controls_zero(sn_instance *in, const sn_blob *blob, uint32_t nc) {
 
 /* Controls for step k: the clip's tracks, then the held values over them. */
 static void controls_step(sn_instance *in, const sn_blob *blob, const sn_clip *clip, uint32_t k,
-                          const held_control *held, int n_held) {
+                          const held_control *held, int n_held, int hits) {
     int i;
     if (clip) sn_clip_controls(clip, blob, k, in);
-    if (clip) sn_clip_impulses(clip, blob, k, in); /* hits on the flesh (clip impulse events) */
+    if (clip && hits) sn_clip_impulses(clip, blob, k, in); /* hits on the flesh (clip impulse events) */
     for (i = 0; i < n_held; i++) sn_set_control(in, held[i].c, real_of_q16(held[i].q16));
 }
 
@@ -849,6 +854,7 @@ int main(int argc, char **argv) {
     if (o.sheet && probe_writable(o.sheet, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare && probe_writable(o.compare, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare_rigs && probe_writable(o.compare_rigs, err, sizeof err)) { die("%s", err); goto done; }
+    if (o.compare_hits && probe_writable(o.compare_hits, err, sizeof err)) { die("%s", err); goto done; }
     if (o.obj_dir) {
         snprintf(path, sizeof path, "%s/frame_0000.obj", o.obj_dir);
         if (probe_writable(path, err, sizeof err)) { die("%s", err); goto done; }
@@ -871,6 +877,12 @@ int main(int argc, char **argv) {
         if (o.rigs_off) controls_zero(inst2, s.blob, n_ctl);
     }
     if (o.rigs_off) controls_zero(inst, s.blob, n_ctl);
+    if (o.compare_hits) {   /* the no-hit instance, stepped in lockstep: the clip without its impulses */
+        mem2 = malloc(need);
+        if (!mem2 || sn_instance_init(mem2, need, s.blob, &inst2) != SN_OK) { die("cannot create the no-hit instance"); goto done; }
+        if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
+        if (o.unwarped) sn_set_mode(inst2, SN_MODE_UNWARPED);
+    }
     if (o.compare_rigs) {   /* the rigs-off instance, stepped in lockstep: abstract controls 0 */
         const sn_blob *b2 = s.blob;
         size_t need2 = need;
@@ -943,7 +955,7 @@ int main(int argc, char **argv) {
         if (sn_set_segment_floor(inst, up, R(o.floor_y)) != SN_OK) { die("--seg-floor: refused"); goto done; }
         if (inst2) sn_set_segment_floor(inst2, up, R(o.floor_y));
     }
-    pictures = o.png || o.sheet || o.compare || o.compare_rigs;
+    pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
@@ -1035,7 +1047,7 @@ int main(int argc, char **argv) {
         else memcpy(xf, rest_xf, s.info.joints * sizeof *xf);
         s.pose = xf;
         sn_set_pose(inst, xf, s.info.joints);
-        if (!o.rigs_off) controls_step(inst, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held);
+        if (!o.rigs_off) controls_step(inst, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held, 1);
         for (i = 0; i < (uint32_t)o.n_imp; i++)
             if (o.imp[i].step == k) {
                 sn_vec3 j;
@@ -1051,7 +1063,8 @@ int main(int argc, char **argv) {
         times[k - 1] = t1 - t0;
         cpu[k - 1] = c1 - c0;
         if (inst2) {
-            if (o.compare && !o.rigs_off) controls_step(inst2, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held);
+            if ((o.compare && !o.rigs_off) || o.compare_hits)
+                controls_step(inst2, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held, !o.compare_hits);
             sn_set_pose(inst2, xf, s.info.joints);
             sn_step(inst2);
         }
@@ -1168,7 +1181,8 @@ int main(int argc, char **argv) {
         if (png_write(o.compare, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
         if (!o.quiet) printf("wrote %s\n", o.compare);
     }
-    if (o.compare_rigs) {
+    if (o.compare_rigs || o.compare_hits) {
+        const char *out_path = o.compare_hits ? o.compare_hits : o.compare_rigs;
         rs_image pane;
         void *mem0 = malloc(need);
         sn_instance *rest = NULL;
@@ -1197,14 +1211,14 @@ int main(int argc, char **argv) {
         render(&s, rest, &pane, "rest", NULL);
         rs_blit(&cmp, 0, 0, &pane);
         s.pose = xf;
-        render(&s, inst2, &pane, o.rig_off_blob ? "rigs off (baked without)" : "rigs off (controls 0)", lab);
+        render(&s, inst2, &pane, o.compare_hits ? "no hit" : o.rig_off_blob ? "rigs off (baked without)" : "rigs off (controls 0)", lab);
         rs_blit(&cmp, pw, 0, &pane);
         if (heat > 0) {   /* colour the rigs-on flesh by how far the rigs moved it */
             memcpy(refpos, s.pos, (size_t)s.info.surface_vertices * 3 * sizeof(float));
             s.ref = refpos;
             s.heat = heat;
         }
-        render(&s, inst, &pane, "rigs on", lab_on);
+        render(&s, inst, &pane, o.compare_hits ? "hit" : "rigs on", o.compare_hits ? NULL : lab_on);
         rs_blit(&cmp, 2 * pw, 0, &pane);
         s.ref = NULL;
         s.heat = heat;
@@ -1212,8 +1226,8 @@ int main(int argc, char **argv) {
         rs_fill(&cmp, 2 * pw - 1, 0, 2, ph, line);
         rs_image_free(&pane);
         free(mem0);
-        if (png_write(o.compare_rigs, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
-        if (!o.quiet) printf("wrote %s\n", o.compare_rigs);
+        if (png_write(out_path, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
+        if (!o.quiet) printf("wrote %s\n", out_path);
     }
     if (o.hash) printf("hash: %016llx\n", (unsigned long long)sn_state_hash(inst));
     rc = 0;

@@ -590,11 +590,13 @@ static sn_status apply(sn_instance *inst, const sn_force *f, int impulse) {
     {
         const sn_real F[3] = {f->force.x, f->force.y, f->force.z};
 #if defined(SN_FLOAT)
-        float scale = impulse ? v->force / v->timestep : v->force;
-        for (c = 0; c < 3; c++) {
-            s->m[c] = F[c] * scale;
-            s->fn[c] = impulse ? F[c] / v->timestep : F[c];
+        float scale = impulse ? v->force / v->timestep : v->force, m[3], fn[3];
+        for (c = 0; c < 3; c++) { /* a valid blob's tiny h can make J/h overflow: refused, nothing stored */
+            m[c] = F[c] * scale;
+            fn[c] = impulse ? F[c] / v->timestep : F[c];
+            if (!(m[c] >= -1.0e30f && m[c] <= 1.0e30f && fn[c] >= -1.0e30f && fn[c] <= 1.0e30f)) return SN_ERR_ARG;
         }
+        for (c = 0; c < 3; c++) { s->m[c] = m[c]; s->fn[c] = fn[c]; }
         s->q = 0;
 #else
         /* value = F FORCE in Q(16 + frac_F) (< 2^62); an impulse is the force

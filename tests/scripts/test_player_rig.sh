@@ -153,5 +153,18 @@ else
 fi
 expect 1 "is not .* without its rigs" "$PLAY" "$COW" --frames 1 --compare-rigs "$TMP/x.png" --rig-off-blob "$LIMB"
 
+# clip impulses and --compare-hits (issue 14): the hit changes the state, the no-hit panel's instance does not
+expect 0 "wrote $TMP/hit.png" "$PLAY" "$COW" --clip tools/examples/cow/hit_global.clip --frames 9 --compare-hits "$TMP/hit.png" --heat 0.1 --size 320x240
+[ -s "$TMP/hit.png" ] && ok || bad "--compare-hits wrote nothing"
+expect 2 "needs a --clip" "$PLAY" "$COW" --frames 2 --compare-hits "$TMP/x.png"
+expect 2 "one at a time" "$PLAY" "$COW" --clip tools/examples/cow/hit_local.clip --compare "$TMP/a.png" --compare-hits "$TMP/b.png"
+printf 'sinew-clip 1\nduration 1\nimpulse 0.05 1000 0 0 25\n' > "$TMP/hit_only.clip"
+printf 'sinew-clip 1\nduration 1\n' > "$TMP/nohit.clip"
+a=$(hash "$PLAY" "$COW" --clip "$TMP/hit_only.clip" --frames 10)
+b=$(hash "$PLAY" "$COW" --clip "$TMP/nohit.clip" --frames 10)
+[ -n "$a" ] && [ "$a" != "$b" ] && ok || bad "a clip impulse changes the state ($a, $b)"
+printf 'sinew-clip 1\nduration 1\nimpulse 0.05 1000 0 0 25 9\n' > "$TMP/badprof.clip"
+expect 1 "profile 9 is not in the blob" "$PLAY" "$COW" --clip "$TMP/badprof.clip" --frames 2
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
