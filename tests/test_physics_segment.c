@@ -3,7 +3,8 @@
  *
  *  - zero saturations: the cow (tail chain and 5x5 two-level blanket held
  *    along its spine, settling from flat in the first steps) over the trot;
- *    the free 9x9 sheet with a corner and a centre impulse and the tilted sheet dropped on a floor, each with shares fine, equal, coarse
+ *    the free 9x9 sheet with a corner and a centre impulse and the tilted
+ *    sheet dropped on a floor, each with shares fine, equal, coarse
  *    (the demo runs of ports/desktop/demo.sh);
  *  - the gap left after the examples' sweeps (sn_stats seg_gap): the cow's
  *    asserted (< 1% of a segment through the trot, < 2% since init), the
