@@ -90,6 +90,13 @@ SN_INLINE sn_acc sn_mul(sn_q a, sn_q b) {
 #endif
 }
 
+/* a*b - c*d, exact. Written as a sum with c negated (|c| < 2^31): clang 14
+ * for 32-bit MIPS selects a fused multiply-subtract (msub) for the plain
+ * difference of two widened int32 products and swaps its operands,
+ * returning c*d - a*b (found by tests/scripts/test_determinism.sh; gcc and
+ * every other target are right). Use it for every such difference. */
+#define sn_mul_sub(a, b, c, d) (sn_mul((a), (b)) + sn_mul(-(c), (d)))
+
 /* Round-to-nearest right shift of an int64 (ties toward +infinity).
  * Right-shifting a negative value is implementation-defined in C99; every
  * supported compiler shifts arithmetically, and the check below refuses to

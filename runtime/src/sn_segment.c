@@ -131,7 +131,7 @@ static int is_brace(const seg_lvl *L, uint32_t i) {
 /* half length of segment i with its reciprocal and shift: the level's on
  * the finest level; on a coarser one the segment's own (words 12-14, set by
  * seg_from_nodes from its restricted nodes) */
-static sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
+SN_INLINE sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
     const sn_q *S = L->S + SEG_W * i;
     if (L->l == 0) { *r = L->rh; *sh = L->sh; return L->half; }
     *r = S[13];
@@ -139,17 +139,26 @@ static sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
     return S[12];
 }
 
-void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
+/* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,
+ * one clamp of the sum (fixed); float the same expression */
+SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
     const sn_q *S = L->S + SEG_W * i;
     sn_q r;
     int sh;
     sn_q hl = seg_half(L, i, &r, &sh);
     unsigned k;
     for (k = 0; k < 3; k++) {
-        sn_q o = sn_mulq(S[3 + k], hl, SN_Q_ROT, sat);
-        P[k] = sn_add(S[k], s > 0 ? o : -o, sat);
+#if defined(SN_FLOAT)
+        sn_q o = S[3 + k] * hl;
+        P[k] = sn_out(s > 0 ? S[k] + o : S[k] - o, 0, sat);
+#else
+        int64_t o = sn_rshr64((int64_t)S[3 + k] * hl, SN_Q_ROT);
+        P[k] = sn_out(s > 0 ? S[k] + o : S[k] - o, 0, sat);
+#endif
     }
 }
+
+void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) { end_of(L, i, s, P, sat); }
 
 void seg_unit(const sn_q x[3], sn_q u[3]) {
     sn_q q[4];
@@ -236,7 +245,7 @@ static sn_q lever(sn_q c, sn_q hl, sn_q r, int sh, sn_q f, int fs) {
 }
 
 /* a Q60 product sum known to be within +-2^61 to Q30 (rounded), no clamp */
-static sn_q shr30(sn_acc a) {
+SN_INLINE sn_q shr30(sn_acc a) {
 #if defined(SN_FLOAT)
     return a;
 #else
@@ -244,46 +253,121 @@ static sn_q shr30(sn_acc a) {
 #endif
 }
 
-/* u + theta x u, renormalized; |theta_k| limited to ROT_MAX (a designed
- * limiter of the small-angle update, like the clamp of u x d to half in
- * seg_move: not an overflow, so not counted in sat) */
-static void rotate_u(sn_q u[3], const sn_q th[3]) {
-    sn_q t[3], x[3];
-    unsigned k;
-    for (k = 0; k < 3; k++) {
-        t[k] = th[k] > ROT_MAX ? ROT_MAX : (th[k] < -ROT_MAX ? -ROT_MAX : th[k]);
+/* every segment's u of a level to unit length (exact: isqrt, one division) */
+static void renormalize(const seg_lvl *L) {
+    uint32_t i;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *u = L->S + SEG_W * i + 3, x[3];
+        x[0] = u[0]; x[1] = u[1]; x[2] = u[2];
+        seg_unit(x, u);
     }
+}
+
+/* One multiply-only Newton step towards unit length: u = x (3 - |x|^2)/2
+ * (no square root, no division). For |x| = n the result has length
+ * n (3 - n^2)/2 <= 1 (equality at n = 1): an error e = n^2 - 1 becomes
+ * -3e^2/4 + e^3/4. A turn of u (|u| in [0.987, 1]) by e perpendicular to u
+ * with |e_k| <= 0.25 gives n^2 <= 1.1875, so the result stays in
+ * [0.987, 1] (NUMERICS.md "Fixed point, bounds"); the small turns of the
+ * later sweeps restore the length to the LSB, and the sweeps' end
+ * renormalizes exactly (renormalize, once per segment and step). */
+SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
+#if defined(SN_FLOAT)
+    float f = 1.5f - 0.5f * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    u[0] = x[0] * f; u[1] = x[1] * f; u[2] = x[2] * f;
+#else
+    /* |x_k| < 1.5 2^30: the sum of squares <= 1.19 2^60 (Q60); f in Q30
+     * within [0.9, 1.01] 2^30; x_k f < 2^61 */
+    int64_t n2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    int64_t f = sn_rshr64(((int64_t)3 << 60) - n2, SN_Q_ROT + 1);
+    unsigned k;
+    for (k = 0; k < 3; k++) u[k] = (sn_q)sn_rshr64(x[k] * f, SN_Q_ROT);
+#endif
+}
+
+/* u + theta x u (the dynamics' turn by w, |theta_k| <= ROT_MAX, limited by
+ * the caller), brought back towards unit length by newton_unit. */
+SN_INLINE void rotate_u(sn_q u[3], const sn_q t[3]) {
+    sn_acc x[3];
     /* each term of t x u <= 2^58, a component <= 2^59 -> 2^29 in Q30 (beyond
      * the state clamp 2^28, so not through sn_out): u + t x u < 1.5 2^30 */
-    x[0] = u[0] + shr30(sn_mul(t[1], u[2]) - sn_mul(t[2], u[1]));
-    x[1] = u[1] + shr30(sn_mul(t[2], u[0]) - sn_mul(t[0], u[2]));
-    x[2] = u[2] + shr30(sn_mul(t[0], u[1]) - sn_mul(t[1], u[0]));
-    seg_unit(x, u);
+    x[0] = u[0] + shr30(sn_mul_sub(t[1], u[2], t[2], u[1]));
+    x[1] = u[1] + shr30(sn_mul_sub(t[2], u[0], t[0], u[2]));
+    x[2] = u[2] + shr30(sn_mul_sub(t[0], u[1], t[1], u[0]));
+    newton_unit(x, u);
 }
 
 /* Move segment i so its endpoint (sign s) closes part of the gap d: the
  * centre by t, and a rotation closing the share rf of the gap's part
  * perpendicular to the segment, seed 004 eq. 3.8 with Palazzi's user factor:
- *   dTheta = rf (r x d) / |r|^2,  r = s half u,  so  dTheta = s rf (u x d) / half.
- * Fixed: c = u x d (Q22) clamped to +-half (a rotation of more than one
- * radian is not a small-angle correction), c/half in Q30 via the level's
- * reciprocal, times rf (Q30). */
+ *   dTheta = rf (r x d) / |r|^2,  r = s half u,  so  dTheta = s rf (u x d) / half,
+ * applied as u + dTheta x u = u + e, e = s rf d_perp / half (for a unit u,
+ * (u x d) x u = d - (d.u) u = d_perp): no cross products. Each component
+ * of the turn e is limited to ROT_MAX (0.25 rad; a designed limiter of the
+ * small-angle update, not counted in sat) and e's part along u removed
+ * again (the limiter may tilt it), so |u + e|^2 <= |u|^2 + 3/16; then one
+ * Newton step towards unit length (newton_unit).
+ * Fixed: kf = s rf r / 2^30 (|kf| <= 2^30) with r the half length's
+ * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: |d_k|
+ * <= 2^29 (differences of clamped Q22 values), d.u <= 2^59.8 in Q52 -> Q22
+ * <= 2^29.8; |d_perp_k| <= 2^31 (int64); d_perp kf <= 2^61; e.u <= 3 2^58. */
+SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+SN_INLINE sn_acc rsh(sn_acc a, int s) {
+#if defined(SN_FLOAT)
+    (void)s;
+    return a;
+#else
+    return sn_rshr64(a, s);
+#endif
+}
+SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
+
+/* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30
+ * with the shift of r in *sh, see seg_move) */
+SN_INLINE sn_acc seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
+    sn_q r;
+    sn_acc kf;
+    (void)seg_half(L, i, &r, sh);
+    kf = r30((sn_acc)rf * r);
+    return s > 0 ? kf : -kf;
+}
+
+/* the move on one segment's words S, all in registers (see above) */
+SN_INLINE void move_seg(sn_q *S, sn_acc d0, sn_acc d1, sn_acc d2, sn_acc t0, sn_acc t1, sn_acc t2, sn_acc kf,
+                        int sh, uint32_t *sat) {
+    sn_acc u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
+    du = r30(d0 * u0 + d1 * u1 + d2 * u2);
+    e0 = lim(rsh((d0 - r30(du * u0)) * kf, sh), ROT_MAX);
+    e1 = lim(rsh((d1 - r30(du * u1)) * kf, sh), ROT_MAX);
+    e2 = lim(rsh((d2 - r30(du * u2)) * kf, sh), ROT_MAX);
+    eu = r30(e0 * u0 + e1 * u1 + e2 * u2);
+    x0 = u0 + e0 - r30(eu * u0);
+    x1 = u1 + e1 - r30(eu * u1);
+    x2 = u2 + e2 - r30(eu * u2);
+#if defined(SN_FLOAT)
+    f = 1.5f - 0.5f * (x0 * x0 + x1 * x1 + x2 * x2);
+#else
+    f = sn_rshr64(((int64_t)3 << 60) - (x0 * x0 + x1 * x1 + x2 * x2), SN_Q_ROT + 1);
+#endif
+    S[3] = (sn_q)r30(x0 * f);
+    S[4] = (sn_q)r30(x1 * f);
+    S[5] = (sn_q)r30(x2 * f);
+    S[0] = sn_add(S[0], (sn_q)t0, sat);
+    S[1] = sn_add(S[1], (sn_q)t1, sat);
+    S[2] = sn_add(S[2], (sn_q)t2, sat);
+}
+
 static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
                      uint32_t *sat) {
-    sn_q *S = L->S + SEG_W * i, c[3], th[3];
-    sn_q r;
     int sh;
-    sn_q hl = seg_half(L, i, &r, &sh);
-    unsigned k;
-    c[0] = sn_out(sn_mul(S[4], d[2]) - sn_mul(S[5], d[1]), SN_Q_ROT, sat);
-    c[1] = sn_out(sn_mul(S[5], d[0]) - sn_mul(S[3], d[2]), SN_Q_ROT, sat);
-    c[2] = sn_out(sn_mul(S[3], d[1]) - sn_mul(S[4], d[0]), SN_Q_ROT, sat);
-    for (k = 0; k < 3; k++) {
-        th[k] = lever(c[k], hl, r, sh, rf, SN_Q_ROT);
-        if (s < 0) th[k] = -th[k];
-        S[k] = sn_add(S[k], t[k], sat);
-    }
-    rotate_u(S + 3, th);
+    sn_acc kf = seg_kf(L, i, s, rf, &sh);
+    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
 }
 
 /* |d| in public Q16.16 segment lengths (or float) */
@@ -316,23 +400,30 @@ typedef struct seg_ctx {
  * perpendicular part */
 static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
                  uint32_t *sat) {
-    sn_q P1[3], P2[3], d[3], nd[3], t[3], nt[3];
+    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3], r;
+    sn_acc ha, hb, ka, kb, t[3];
+    uint32_t ls = 0; /* local count: no aliasing with the state words */
+    int sha, shb;
     unsigned k;
-    seg_end(L, a, sa, P1, sat);
-    seg_end(L, b, sb, P2, sat);
+    ha = seg_half(L, a, &r, &sha);
+    hb = seg_half(L, b, &r, &shb);
+    ha = sa > 0 ? ha : -ha;
+    hb = sb > 0 ? hb : -hb;
+    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped */
     for (k = 0; k < 3; k++) {
-        d[k] = sn_add(P2[k], -P1[k], sat);
-        nd[k] = -d[k];
-        t[k] = sn_mulq(d[k], C->gh, SN_Q_ROT, sat);
-        nt[k] = -t[k];
+        d[k] = sn_out((B[k] + r30(B[3 + k] * hb)) - (A[k] + r30(A[3 + k] * ha)), 0, &ls);
+        t[k] = r30((sn_acc)d[k] * C->gh); /* gamma d / 2: |.| <= 2^27 */
     }
     if (measure) {
         sn_real g = gap_of(d, L);
         C->gap = g > C->gap ? g : C->gap;
-        return;
+    } else {
+        ka = seg_kf(L, a, sa, C->rf2, &sha);
+        kb = seg_kf(L, b, sb, C->rf2, &shb);
+        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
+        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
     }
-    seg_move(L, a, sa, t, d, C->rf2, sat);
-    seg_move(L, b, sb, nt, nd, C->rf2, sat);
+    *sat += ls;
 }
 
 /* an endpoint against a point of infinite mass: the segment takes gamma d
@@ -497,9 +588,9 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
                 S[6 + k] = sn_add(S[6 + k], f[k], sat);
                 fe[k] = sn_add(f[k], -sn_mulq(f[k], M->centre, SN_Q_ROT, sat), sat);
             }
-            c[0] = sn_out(sn_mul(S[4], fe[2]) - sn_mul(S[5], fe[1]), SN_Q_ROT, sat);
-            c[1] = sn_out(sn_mul(S[5], fe[0]) - sn_mul(S[3], fe[2]), SN_Q_ROT, sat);
-            c[2] = sn_out(sn_mul(S[3], fe[1]) - sn_mul(S[4], fe[0]), SN_Q_ROT, sat);
+            c[0] = sn_out(sn_mul_sub(S[4], fe[2], S[5], fe[1]), SN_Q_ROT, sat);
+            c[1] = sn_out(sn_mul_sub(S[5], fe[0], S[3], fe[2]), SN_Q_ROT, sat);
+            c[2] = sn_out(sn_mul_sub(S[3], fe[1], S[4], fe[0]), SN_Q_ROT, sat);
             for (k = 0; k < 3; k++) { /* 3 (u x f)/half, limited to 0.25 rad/step */
                 sn_q dw = lever(c[k], hl, rr, rs, THREE, 0);
                 S[9 + k] = sn_add(S[9 + k], sgn[j] > 0 ? dw : -dw, sat);
@@ -507,13 +598,15 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
         }
     }
     for (i = 0; i < L->ns; i++) { /* Euler-Cromer: G += v; u turned by w; save the start */
-        sn_q *S = L->S + SEG_W * i, G0[3], u0[3];
+        sn_q *S = L->S + SEG_W * i, G0[3], u0[3], w[3];
         for (k = 0; k < 3; k++) {
             G0[k] = S[k];
             u0[k] = S[3 + k];
             S[k] = sn_add(S[k], S[6 + k], sat);
+            /* |w_k| <= 0.25 rad (fixed: already, the state clamp is 2^28) */
+            w[k] = S[9 + k] > ROT_MAX ? ROT_MAX : (S[9 + k] < -ROT_MAX ? -ROT_MAX : S[9 + k]);
         }
-        rotate_u(S + 3, S + 9);
+        rotate_u(S + 3, w);
         for (k = 0; k < 3; k++) { S[6 + k] = G0[k]; S[9 + k] = u0[k]; }
     }
 }
@@ -538,9 +631,9 @@ static void velocities(const seg_lvl *L, uint32_t *sat) {
     for (i = 0; i < L->ns; i++) {
         sn_q *S = L->S + SEG_W * i, w[3];
         const sn_q *u0 = S + 9, *u = S + 3;
-        w[0] = rot_cap(sn_mul(u0[1], u[2]) - sn_mul(u0[2], u[1]));
-        w[1] = rot_cap(sn_mul(u0[2], u[0]) - sn_mul(u0[0], u[2]));
-        w[2] = rot_cap(sn_mul(u0[0], u[1]) - sn_mul(u0[1], u[0]));
+        w[0] = rot_cap(sn_mul_sub(u0[1], u[2], u0[2], u[1]));
+        w[1] = rot_cap(sn_mul_sub(u0[2], u[0], u0[0], u[2]));
+        w[2] = rot_cap(sn_mul_sub(u0[0], u[1], u0[1], u[0]));
         for (k = 0; k < 3; k++) {
             S[6 + k] = sn_add(S[k], -S[6 + k], sat);
             S[9 + k] = w[k];
@@ -662,6 +755,7 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
             }
             dynamics(&C, &L, im, sat);
             for (s = 0; s < M.sweeps; s++) sweep(&C, &L, 0, s & 1u, sat);
+            renormalize(&L); /* the Newton steps of the moves leave |u| within 2% of 1 */
             seg_node_means(&L, sat);
             if (l > 0) seg_prolong(&M, l, sat); /* reads this level's start (v, w words) */
             velocities(&L, sat);

@@ -234,9 +234,9 @@ sn_status sn_get_segment_xforms(const sn_instance *inst, uint32_t mesh, sn_xform
         q[2] = u0[0] * S[4] - u0[1] * S[3];
         q[3] = 1.0f + u0[0] * S[3] + u0[1] * S[4] + u0[2] * S[5];
 #else
-        q[0] = sn_out(sn_mul(u0[1], S[5]) - sn_mul(u0[2], S[4]), SN_Q_ROT + 1, &dummy);
-        q[1] = sn_out(sn_mul(u0[2], S[3]) - sn_mul(u0[0], S[5]), SN_Q_ROT + 1, &dummy);
-        q[2] = sn_out(sn_mul(u0[0], S[4]) - sn_mul(u0[1], S[3]), SN_Q_ROT + 1, &dummy);
+        q[0] = sn_out(sn_mul_sub(u0[1], S[5], u0[2], S[4]), SN_Q_ROT + 1, &dummy);
+        q[1] = sn_out(sn_mul_sub(u0[2], S[3], u0[0], S[5]), SN_Q_ROT + 1, &dummy);
+        q[2] = sn_out(sn_mul_sub(u0[0], S[4], u0[1], S[3]), SN_Q_ROT + 1, &dummy);
         {
             int64_t w = ((int64_t)1 << 60) + sn_mul(u0[0], S[3]) + sn_mul(u0[1], S[4]) + sn_mul(u0[2], S[5]);
             q[3] = (sn_q)sn_rshr64(w < 0 ? 0 : w, SN_Q_ROT + 1);

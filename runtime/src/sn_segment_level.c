@@ -69,9 +69,9 @@ static void turn(const sn_q a[3], const sn_q b[3], sn_q R[9], uint32_t *sat) {
     /* (a x b)/2: each component <= 2^61 in Q60 -> 2^29 in Q30, beyond the
      * state clamp (a turn of more than 30 degrees would count): no sn_out */
     (void)sat;
-    q[0] = (sn_q)sn_rshr64(sn_mul(a[1], b[2]) - sn_mul(a[2], b[1]), SN_Q_ROT + 1);
-    q[1] = (sn_q)sn_rshr64(sn_mul(a[2], b[0]) - sn_mul(a[0], b[2]), SN_Q_ROT + 1);
-    q[2] = (sn_q)sn_rshr64(sn_mul(a[0], b[1]) - sn_mul(a[1], b[0]), SN_Q_ROT + 1);
+    q[0] = (sn_q)sn_rshr64(sn_mul_sub(a[1], b[2], a[2], b[1]), SN_Q_ROT + 1);
+    q[1] = (sn_q)sn_rshr64(sn_mul_sub(a[2], b[0], a[0], b[2]), SN_Q_ROT + 1);
+    q[2] = (sn_q)sn_rshr64(sn_mul_sub(a[0], b[1], a[1], b[0]), SN_Q_ROT + 1);
     w = sn_rshr64(w < 0 ? 0 : w, SN_Q_ROT + 1); /* (1 + a.b)/2 in [0, 2^30] */
     q[3] = (sn_q)w;
 #endif

@@ -34,28 +34,36 @@ static void cross(const double a[3], const double b[3], double o[3]) {
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 static double clampd(double x, double m) { return x > m ? m : (x < -m ? -m : x); }
-static void turn(double u[3], const double th[3]) { /* u + th x u, |th_k| <= 0.25, renormalized */
-    double t[3], c[3];
+/* u + th x u, |th_k| <= 0.25, then one Newton step towards unit length
+ * x (3 - |x|^2)/2 (the runtime's multiply-only step; exact unit after the sweeps) */
+static void turn(double u[3], const double th[3]) {
+    double t[3], c[3], f;
     int k;
     for (k = 0; k < 3; k++) t[k] = clampd(th[k], 0.25);
     cross(t, u, c);
     for (k = 0; k < 3; k++) u[k] += c[k];
-    unit(u);
+    f = 1.5 - 0.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (k = 0; k < 3; k++) u[k] *= f;
 }
 static void endp(const segref *r, int i, int s, double P[3]) {
     int k;
     for (k = 0; k < 3; k++) P[k] = r->G[i][k] + s * 0.5 * r->len * r->u[i][k];
 }
-/* move segment i: centre by t, rotation closing rf of the perpendicular gap at end s */
+/* move segment i: centre by t, turn u + e closing rf of the perpendicular gap
+ * at end s: e = s rf d_perp / h (= dTheta x u), components limited to 0.25,
+ * e's part along u removed, one Newton step (the runtime's move) */
 static void move(segref *r, int i, int s, const double t[3], const double d[3], double rf) {
-    double c[3], th[3], h = 0.5 * r->len;
+    double e[3], h = 0.5 * r->len, du, eu, f, *u = r->u[i];
     int k;
-    cross(r->u[i], d, c);
+    du = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
     for (k = 0; k < 3; k++) {
-        th[k] = s * rf * clampd(c[k], h) / h;
+        e[k] = clampd(s * rf * (d[k] - du * u[k]) / h, 0.25);
         r->G[i][k] += t[k];
     }
-    turn(r->u[i], th);
+    eu = e[0] * u[0] + e[1] * u[1] + e[2] * u[2];
+    for (k = 0; k < 3; k++) u[k] += e[k] - eu * u[k];
+    f = 1.5 - 0.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (k = 0; k < 3; k++) u[k] *= f;
 }
 static double norm(const double d[3]) { return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]); }
 
@@ -153,6 +161,7 @@ void segref_step(segref *r) {
         turn(r->u[i], r->w[i]);
     }
     for (j = 0; j < r->sweeps; j++) sweep(r, 0, j & 1);
+    for (i = 0; i < r->ns; i++) unit(r->u[i]);
     for (i = 0; i < r->ns; i++) {
         double w[3];
         cross(u0[i], r->u[i], w);

@@ -10,6 +10,7 @@
 #      is inlined or turned into a loop) is acyclic; no indirect calls
 #   5. sinew.h is valid C++: g++ -fsyntax-only, and a C++ TU using it links
 #      against the C library
+#   6. no sn_mul(a, b) - sn_mul(c, d): sn_mul_sub (a clang MIPS32 miscompile)
 # Prints a worst-case stack figure per public entry point (gcc -O2).
 # clang missing: "SKIPPED: install clang" (a failure when $CI is set).
 BUILD=${BUILD:-build}
@@ -112,6 +113,13 @@ if [ "$cg_ok" = 1 ]; then
             for (f in dyn) print "  note: dynamic stack in " f
         }' "$tmp/su.all"
 fi
+
+# ---- 6. no plain difference of two widened products (sn_mul(a, b) - sn_mul(c, d)):
+# clang 14 for 32-bit MIPS fuses it into an msub with swapped operands (wrong
+# sign); sn_mul_sub (sn_internal.h) writes it as a sum ----
+if grep -n "sn_mul([^()]*) *- *sn_mul(" runtime/src/*.c runtime/src/*.h > "$tmp/msub.log"; then
+    bad "sn_mul(a, b) - sn_mul(c, d) in the runtime: use sn_mul_sub (clang MIPS msub bug)"; cat "$tmp/msub.log"
+else ok; fi
 
 # ---- 5. sinew.h as C++ ----
 if command -v g++ > /dev/null 2>&1; then
