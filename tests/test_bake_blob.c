@@ -2,6 +2,7 @@
  * table against sn_format.h, checksum, fixed/float/double agreement, Q ranges. */
 #include "sb.h"
 #include "sn_format.h"
+#include "blob_seg.h"
 #include "sn_test.h"
 #include <math.h>
 #include <stdio.h>
@@ -21,20 +22,6 @@ static double real_at(const unsigned char *b, uint32_t off, uint32_t n, int q)
 }
 static uint32_t sec_off(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k); }
 static uint32_t sec_cnt(const unsigned char *b, int k) { return u32(b + SN_H_SECTIONS + 16 * k + 8); }
-/* segment state bytes of a blob (format 4.0): every SEGMESH record's segments
- * and nodes over its levels (sn_seg_counts), 0 without segment meshes */
-static uint32_t seg_state_bytes(const unsigned char *b)
-{
-    uint32_t off = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH), n = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 8);
-    uint32_t es = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 12), m, tot = 0;
-    for (m = 0; m < n; m++) {
-        const unsigned char *r = b + off + m * es;
-        uint32_t segs, nodes;
-        sn_seg_counts(r[0], (unsigned)r[4] | (unsigned)r[5] << 8, r[1], &segs, &nodes);
-        tot += SN_SEG_SEG_BYTES * segs + SN_SEG_NODE_BYTES * nodes;
-    }
-    return tot;
-}
 
 static void check_structure(const sb_blob *bl, int flavour, const char *what)
 {

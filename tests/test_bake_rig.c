@@ -8,6 +8,7 @@
  * float32 and float64 cow, the limb's pose control, and description errors. */
 #include "sb.h"
 #include "sn_format.h"
+#include "blob_seg.h"
 #include "sn_test.h"
 #include <math.h>
 #include <stdio.h>
@@ -257,20 +258,6 @@ static void test_bump_peak(void)
 /* ---- blob reader (sn_format.h offsets; independent of sb_blob.c) ---- */
 static uint32_t u32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
 static unsigned u16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
-/* segment state bytes of a blob (format 4.0): every SEGMESH record's segments
- * and nodes over its levels (sn_seg_counts), 0 without segment meshes */
-static uint32_t seg_state_bytes(const unsigned char *b)
-{
-    uint32_t off = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH), n = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 8);
-    uint32_t es = u32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 12), m, tot = 0;
-    for (m = 0; m < n; m++) {
-        const unsigned char *r = b + off + m * es;
-        uint32_t segs, nodes;
-        sn_seg_counts(r[0], (unsigned)r[4] | (unsigned)r[5] << 8, r[1], &segs, &nodes);
-        tot += SN_SEG_SEG_BYTES * segs + SN_SEG_NODE_BYTES * nodes;
-    }
-    return tot;
-}
 static double real(const unsigned char *p, int flavour, int frac)
 {
     if (flavour == SN_FLAVOUR_FIXED) return ldexp((double)(int32_t)u32(p), -frac);

@@ -4,7 +4,8 @@
 
 /* ---- outputs ---- */
 
-static void to_public(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
+/* Public (world, mesh units) position of an internal point p: origin + p. */
+void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
 #if defined(SN_FLOAT)
     out->x = h->origin[0] + int_to_pub(h, p[0]);
     out->y = h->origin[1] + int_to_pub(h, p[1]);
@@ -16,6 +17,41 @@ static void to_public(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
 #endif
 }
 
+/* Trilinear weights phi_a (Q30 / float, summing to one) of a cell's 8
+ * corners at coordinates t (Q15), corner a at bits (x, y, z). */
+void sn_trilinear(const uint32_t t[3], sn_q phi[8]) {
+    uint32_t a;
+    for (a = 0; a < 8; a++) {
+        uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
+        uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
+        uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
+#if defined(SN_FLOAT)
+        phi[a] = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f); /* 2^45 */
+#else
+        /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
+        phi[a] = (int32_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15);
+#endif
+    }
+}
+
+/* Current position (internal) of surface vertex s: trilinear in its cell
+ * (seed 000 §3.1). A convex combination: the output conversion never clamps. */
+void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
+    const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
+    const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+    const sn_q *pos = CARR(h, o_pos, sn_q);
+    uint32_t t[3], a, k, dummy = 0;
+    sn_q phi[8];
+    sn_acc acc[3] = {0, 0, 0};
+    for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
+    sn_trilinear(t, phi);
+    for (a = 0; a < 8; a++) {
+        uint32_t vtx = sn_rd_u16(cell + 2 * a);
+        for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], pos[3 * vtx + k]);
+    }
+    for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
+}
+
 sn_status sn_get_lattice(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count) {
     const sn_ihdr *h;
     const sn_q *pos;
@@ -25,49 +61,21 @@ sn_status sn_get_lattice(const sn_instance *inst, sn_vec3 *out, uint32_t first, 
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (first > h->v.nV || count > h->v.nV - first) return SN_ERR_ARG;
     pos = CARR(h, o_pos, sn_q);
-    for (i = 0; i < count; i++) to_public(h, pos + 3 * (first + i), out + i);
+    for (i = 0; i < count; i++) sn_pub_point(h, pos + 3 * (first + i), out + i);
     return SN_OK;
 }
 
 sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count) {
     const sn_ihdr *h;
-    const sn_q *pos;
-    const unsigned char *emb, *cells;
-    uint32_t s, k, a;
+    uint32_t s;
     if (!inst || !out) return SN_ERR_NULL;
     h = chdr_of(inst);
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (first > h->v.nS || count > h->v.nS - first) return SN_ERR_ARG;
-    pos = CARR(h, o_pos, sn_q);
-    emb = h->v.sec[SN_SEC_EMBED];
-    cells = h->v.sec[SN_SEC_CELLS];
     for (s = 0; s < count; s++) {
-        const unsigned char *e = emb + (size_t)(first + s) * SN_ELEM_EMBED;
-        const unsigned char *cell = cells + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3];
         sn_q p[3];
-        sn_acc acc[3] = {0, 0, 0};
-        for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
-        /* trilinear basis phi_a at (t) over the 8 corners, corner a at bits (x, y, z) */
-        for (a = 0; a < 8; a++) {
-            uint32_t vtx = sn_rd_u16(cell + 2 * a);
-            uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
-            uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
-            uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
-#if defined(SN_FLOAT)
-            float w = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f); /* 2^45 */
-            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
-#else
-            /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
-            int64_t w = (int64_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15);
-            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
-#endif
-        }
-        {
-            uint32_t dummy = 0;
-            for (k = 0; k < 3; k++) p[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
-        }
-        to_public(h, p, out + s);
+        sn_surface_point(h, first + s, p);
+        sn_pub_point(h, p, out + s);
     }
     return SN_OK;
 }

@@ -96,20 +96,10 @@ sn_status sn_check_forces(const sn_view *v) {
 
 /* ---- small helpers ---- */
 
-/* Trilinear weights phi_a (Q30 / float) of the 8 corners at t (Q15), corner
- * a at bits (x, y, z): the embedding's (sn_get_surface) arithmetic. */
+/* Trilinear weights of the slot's coordinates (the embedding's arithmetic). */
 static void corner_weights(const uint16_t t[3], sn_q phi[8]) {
-    uint32_t a;
-    for (a = 0; a < 8; a++) {
-        uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
-        uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
-        uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
-#if defined(SN_FLOAT)
-        phi[a] = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f); /* 2^45 */
-#else
-        phi[a] = (int32_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15);
-#endif
-    }
+    const uint32_t tt[3] = {t[0], t[1], t[2]};
+    sn_trilinear(tt, phi);
 }
 
 /* Point of the cell at the weights: sum_a phi_a x_a (Q22 in, Q22 out). */

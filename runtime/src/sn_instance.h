@@ -154,6 +154,11 @@ void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const s
 uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into the FNV-1a hash */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 
+/* ---- shared by the outputs, forces and segment meshes (sn_embed.c) ---- */
+void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out);  /* origin + p, public units */
+void sn_trilinear(const uint32_t t[3], sn_q phi[8]);                  /* corner weights at t (Q15), Q30 */
+void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]);    /* surface vertex s, internal */
+
 /* Twice the elastic + kinetic energy of the step's starting state in
  * internal units (fixed: Q32, summed with saturation at 2^62), set by
  * sn_solve; converted to joules by sn_health. */

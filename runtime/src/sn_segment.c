@@ -454,25 +454,7 @@ static void attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3],
         sn_rot(jR + 9 * tgt, p0, T, sat);
         for (k = 0; k < 3; k++) T[k] = sn_add(T[k], jT[3 * tgt + k], sat);
     } else { /* surface vertex: trilinear in its cell, as sn_get_surface */
-        const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)tgt * SN_ELEM_EMBED;
-        const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        const sn_q *pos = CARR(h, o_pos, sn_q);
-        sn_acc acc[3] = {0, 0, 0};
-        uint32_t a, t[3];
-        for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
-        for (a = 0; a < 8; a++) {
-            uint32_t vtx = sn_rd_u16(cell + 2 * a);
-            uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
-            uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
-            uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
-#if defined(SN_FLOAT)
-            float w = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f);
-#else
-            int64_t w = (int64_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15); /* Q30, weights sum to 2^30 */
-#endif
-            for (k = 0; k < 3; k++) acc[k] += w * pos[3 * vtx + k];
-        }
-        for (k = 0; k < 3; k++) T[k] = sn_out(acc[k], SN_Q_ROT, sat);
+        sn_surface_point(h, tgt, T);
     }
 }
 

@@ -154,18 +154,6 @@ sn_status sn_segment_mesh_info(const sn_blob *blob, uint32_t mesh, sn_segment_in
     return SN_OK;
 }
 
-static void to_pub(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
-#if defined(SN_FLOAT)
-    out->x = h->origin[0] + int_to_pub(h, p[0]);
-    out->y = h->origin[1] + int_to_pub(h, p[1]);
-    out->z = h->origin[2] + int_to_pub(h, p[2]);
-#else
-    out->x = clamp32((int64_t)h->origin[0] + int_to_pub64(h, p[0]));
-    out->y = clamp32((int64_t)h->origin[1] + int_to_pub64(h, p[1]));
-    out->z = clamp32((int64_t)h->origin[2] + int_to_pub64(h, p[2]));
-#endif
-}
-
 /* mesh m's level 0, or an error for bad arguments */
 static sn_status level0(const sn_instance *inst, uint32_t mesh, const void *out, uint32_t first, uint32_t count,
                         int nodes, seg_mesh *M, seg_lvl *L) {
@@ -189,7 +177,7 @@ sn_status sn_get_segment_nodes(const sn_instance *inst, uint32_t mesh, sn_vec3 *
     uint32_t i;
     sn_status st = level0(inst, mesh, out, first, count, 1, &M, &L);
     if (st != SN_OK) return st;
-    for (i = 0; i < count; i++) to_pub(chdr_of(inst), L.N + NODE_W * (first + i), out + i);
+    for (i = 0; i < count; i++) sn_pub_point(chdr_of(inst), L.N + NODE_W * (first + i), out + i);
     return SN_OK;
 }
 
@@ -244,7 +232,7 @@ sn_status sn_get_segment_xforms(const sn_instance *inst, uint32_t mesh, sn_xform
 #endif
         sn_qnormalize(q);
         sn_qtomat(q, Rm);
-        to_pub(h, S, &g);
+        sn_pub_point(h, S, &g);
         {   /* pos = G_world - R G0_world */
             sn_q rr[3];
             sn_rot(Rm, G0, rr, &dummy);
