@@ -95,26 +95,40 @@ static char *make_json(const char *buffer, int matrices, int ibm)
              "{\n"
              "\"asset\":{\"version\":\"2.0\",\"generator\":\"test_bake_gltf \\u00e9\\ud83d\\ude00\"},\n"
              "\"scene\":0,\n"
-             "\"scenes\":[{\"nodes\":[0,1,4]}],\n"
+             "\"scenes\":[{\"nodes\":[0,1,4,5]}],\n"
              "\"nodes\":[{\"name\":\"body\",\"mesh\":0,\"skin\":0,\"translation\":[0.5,0,0]},\n"
              "  {\"name\":\"armature\",%s,\"children\":[2]},\n"
              "  {\"name\":\"bone0\",%s,\"children\":[3]},\n"
              "  {\"name\":\"bone1\",%s},\n"
-             "  {\"name\":\"body2\",\"mesh\":1,\"skin\":0,\"translation\":[0,0,5]}],\n"
+             "  {\"name\":\"body2\",\"mesh\":1,\"skin\":0,\"translation\":[0,0,5]},\n"
+             "  {\"name\":\"body3\",\"mesh\":2,\"skin\":0}],\n"
              "\"skins\":[{\"joints\":[2,3]%s}],\n"
              "\"meshes\":[{\"name\":\"strip\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2},\"indices\":3,\"mode\":4}]},\n"
-             "  {\"name\":\"strip2\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2},\"indices\":3}]}],\n"
+             "  {\"name\":\"strip2\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2},\"indices\":3}]},\n"
+             "  {\"name\":\"types\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":5,\"WEIGHTS_0\":6},\"indices\":7},\n"
+             "    {\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":9},\"indices\":8},\n"
+             "    {\"attributes\":{\"POSITION\":0,\"JOINTS_0\":5,\"WEIGHTS_0\":6}}]}],\n"
              "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},\n"
              "  {\"bufferView\":1,\"componentType\":5121,\"count\":6,\"type\":\"VEC4\"},\n"
              "  {\"bufferView\":2,\"componentType\":5126,\"count\":6,\"type\":\"VEC4\"},\n"
              "  {\"bufferView\":3,\"componentType\":5123,\"count\":12,\"type\":\"SCALAR\"},\n"
-             "  {\"bufferView\":4,\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"}],\n"
+             "  {\"bufferView\":4,\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"},\n"
+             "  {\"bufferView\":5,\"componentType\":5123,\"count\":6,\"type\":\"VEC4\"},\n"
+             "  {\"bufferView\":6,\"componentType\":5121,\"normalized\":true,\"count\":6,\"type\":\"VEC4\"},\n"
+             "  {\"bufferView\":7,\"componentType\":5125,\"count\":12,\"type\":\"SCALAR\"},\n"
+             "  {\"bufferView\":8,\"componentType\":5121,\"count\":12,\"type\":\"SCALAR\"},\n"
+             "  {\"bufferView\":9,\"componentType\":5123,\"normalized\":true,\"count\":6,\"type\":\"VEC4\"}],\n"
              "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":96,\"byteStride\":16},\n"
              "  {\"buffer\":0,\"byteOffset\":96,\"byteLength\":24},\n"
              "  {\"buffer\":0,\"byteOffset\":120,\"byteLength\":96},\n"
              "  {\"buffer\":0,\"byteOffset\":216,\"byteLength\":24},\n"
-             "  {\"buffer\":0,\"byteOffset\":240,\"byteLength\":128}],\n"
-             "\"buffers\":[%s]\n"
+             "  {\"buffer\":0,\"byteOffset\":240,\"byteLength\":128},\n"
+             "  {\"buffer\":1,\"byteLength\":48},\n"
+             "  {\"buffer\":1,\"byteOffset\":48,\"byteLength\":24},\n"
+             "  {\"buffer\":1,\"byteOffset\":72,\"byteLength\":48},\n"
+             "  {\"buffer\":1,\"byteOffset\":120,\"byteLength\":12},\n"
+             "  {\"buffer\":1,\"byteOffset\":132,\"byteLength\":48}],\n"
+             "\"buffers\":[%s,{\"uri\":\"types.bin\",\"byteLength\":180}]\n"
              "}\n",
              arm, b0, b1, ibm ? ",\"inverseBindMatrices\":4" : "", buffer);
     return j;
@@ -133,6 +147,55 @@ static char *b64(const unsigned char *b, size_t n)
     }
     *p = 0;
     return o;
+}
+
+/* buffer 1 (types.bin): JOINTS_0 as unsigned short 0..48, WEIGHTS_0 as
+ * normalized unsigned byte 48..72, indices as unsigned int 72..120 and as
+ * unsigned byte 120..132, WEIGHTS_0 as normalized unsigned short 132..180 */
+static const unsigned char WB[6][4] = {{255, 0, 0, 0}, {200, 55, 0, 0}, {128, 127, 0, 0}, {1, 2, 0, 0}, {0, 255, 0, 0}, {0, 0, 0, 9}};
+static const unsigned short WS[6][4] = {{65535, 0, 0, 0}, {1, 65534, 0, 0}, {300, 300, 0, 0}, {0, 7, 0, 0}, {0, 65535, 0, 0}, {65535, 0, 0, 0}};
+static unsigned char tbin[180];
+
+static void make_types_bin(void)
+{
+    int v, k;
+    for (v = 0; v < 6; v++)
+        for (k = 0; k < 4; k++) {
+            tbin[8 * v + 2 * k] = JNT[v][k], tbin[8 * v + 2 * k + 1] = 0;
+            tbin[48 + 4 * v + k] = WB[v][k];
+            tbin[132 + 8 * v + 2 * k] = (unsigned char)WS[v][k], tbin[133 + 8 * v + 2 * k] = (unsigned char)(WS[v][k] >> 8);
+        }
+    tbin[8 * 5 + 2 * 3] = 1;   /* vertex 5: joint 1 in slot 3 (weight 9/255 there) */
+    for (k = 0; k < 12; k++) {
+        put32(tbin + 72 + 4 * k, IDX[k]);
+        tbin[120 + k] = (unsigned char)IDX[11 - k];
+    }
+}
+
+/* mesh "types": primitive 0 (ushort joints, ubyte weights, uint indices),
+ * 1 (ubyte joints, ushort weights, ubyte indices reversed), 2 (no indices) */
+static void check_types(const sb_gltf *g)
+{
+    int v, k, p, bad = 0;
+    T_CHECK(g->nv == 18 && g->nt == 10 && g->nj == 2, "types: nv %d nt %d nj %d", g->nv, g->nt, g->nj);
+    if (g->nv != 18 || g->nt != 10) return;
+    for (p = 0; p < 3; p++)
+        for (v = 0; v < 6; v++) {
+            int o = 6 * p + v;
+            double w[4], sum = 0;
+            for (k = 0; k < 4; k++) w[k] = p == 1 ? WS[v][k] / 65535.0 : WB[v][k] / 255.0, sum += w[k];
+            for (k = 0; k < 3; k++) bad += g->pos[3 * o + k] != (double)P[v][k];
+            bad += g->src_prim[o] != p || g->src_vert[o] != v;
+            for (k = 0; k < 4; k++) {
+                int jw = p != 1 && v == 5 && k == 3 ? 1 : JNT[v][k];
+                bad += fabs(g->weight[4 * o + k] - w[k] / sum) > 1e-15;
+                bad += g->joint[4 * o + k] != (w[k] > 0 ? jw : 0);
+            }
+        }
+    T_CHECK(bad == 0, "types: %d vertex values differ", bad);
+    for (k = 0, bad = 0; k < 12; k++) bad += g->tri[k] != IDX[k] || g->tri[12 + k] != 6 + IDX[11 - k];
+    for (k = 0; k < 6; k++) bad += g->tri[24 + k] != 12 + k;
+    T_CHECK(bad == 0, "types: triangle indices differ");
 }
 
 /* a GLB of json + bin into buf; returns its length */
@@ -286,12 +349,17 @@ int main(void)
     test_json();
     make_bin();
     write_bytes(at("strip.bin"), bin, BIN_LEN);
+    make_types_bin();
+    write_bytes(at("types.bin"), tbin, sizeof tbin);
 
     /* valid: external .bin, TRS hierarchy, with and without IBMs, matrices */
     json = make_json("{\"uri\":\"strip.bin\",\"byteLength\":368}", 0, 1);
     write_bytes(at("trs.gltf"), json, strlen(json));
     load_ok("trs + ibm, external bin", at("trs.gltf"), NULL, T0, 1);
     load_ok("named mesh strip2", at("trs.gltf"), "strip2", T4, 1);
+    if (sb_gltf_load(&g, at("trs.gltf"), "types") == 0) check_types(&g);
+    else T_CHECK(0, "types: %s", sb_error());
+    sb_gltf_free(&g);
     json = make_json("{\"uri\":\"strip.bin\",\"byteLength\":368}", 0, 0);
     write_bytes(at("noibm.gltf"), json, strlen(json));
     load_ok("trs, no ibm", at("noibm.gltf"), NULL, T0, 0);
@@ -318,7 +386,7 @@ int main(void)
     j2 = subst(json, "base64,", "base64,A");
     bad_json("base64 length", j2, "buffers[0].uri: base64 data of");
     free(j2);
-    j2 = subst(json, "\"byteLength\":368}]", "\"byteLength\":372}]");
+    j2 = subst(json, "\"byteLength\":368}", "\"byteLength\":372}");
     bad_json("data URI shorter than byteLength", j2, "buffers[0].uri: 368 bytes, but byteLength says 372");
     free(j2);
 
@@ -385,7 +453,7 @@ int main(void)
             {"matrix and TRS", "\"translation\":[0,0.5,0]", "\"translation\":[0,0.5,0],\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]",
              "nodes[2]: both matrix and translation"},
             {"bad scene", "\"scene\":0", "\"scene\":3", "scene:"},
-            {"scene node not root", "\"nodes\":[0,1,4]", "\"nodes\":[0,2,4]", "scenes[0].nodes[1]"},
+            {"scene node not root", "\"nodes\":[0,1,4,5]", "\"nodes\":[0,2,4,5]", "scenes[0].nodes[1]"},
             {"asset version", "\"version\":\"2.0\"", "\"version\":\"1.0\"", "asset.version: \"1.0\""},
             {"required extension", "\"scene\":0,", "\"scene\":0,\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],",
              "extensionsRequired[0]: \"KHR_draco_mesh_compression\""},
@@ -428,6 +496,34 @@ int main(void)
         make_bin();
         write_bytes(at("strip.bin"), bin, BIN_LEN);
         load_ok("restored bin", at("trs.gltf"), NULL, T0, 1);
+    }
+    {   /* every byte of the GLB replaced by a few values: refused cleanly or
+         * loaded with every index in range (run under ASan+UBSan too) */
+        static const unsigned char vals[] = {0x00, 0xff, '9', '[', '"', '-'};
+        size_t i, loads = 0, ok = 0, bad = 0;
+        unsigned k;
+        json = make_json("{\"byteLength\":368}", 0, 1);
+        n = make_glb(glb, json);
+        for (i = 0; i < n; i++)
+            for (k = 0; k < sizeof vals; k++) {
+                int rc, t;
+                if (glb[i] == vals[k]) continue;
+                memcpy(tmpb, glb, n);
+                tmpb[i] = vals[k];
+                write_bytes(at("mut.glb"), tmpb, n);
+                rc = sb_gltf_load(&g, at("mut.glb"), NULL);
+                loads++;
+                if (rc == 0) {
+                    ok++;
+                    for (t = 0; t < 3 * g.nt; t++) bad += g.tri[t] < 0 || g.tri[t] >= g.nv;
+                    for (t = 0; t < 4 * g.nv; t++) bad += g.joint[t] < 0 || g.joint[t] >= g.nj;
+                    for (t = 0; t < g.nj; t++) bad += g.joints[t].parent < -1 || g.joints[t].parent >= g.nj;
+                } else
+                    bad += g.nv != 0 || g.pos != NULL || g.joints != NULL;
+                sb_gltf_free(&g);
+            }
+        T_CHECK(bad == 0, "mutated GLBs: %lu bad results", (unsigned long)bad);
+        T_FIGURE("%lu mutated GLBs: %lu loaded, %lu refused", (unsigned long)loads, (unsigned long)ok, (unsigned long)(loads - ok));
     }
     free(data), free(uri);
     return T_END();
