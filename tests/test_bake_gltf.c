@@ -369,6 +369,10 @@ int main(void)
     json = make_json("{\"uri\":\"strip.bin\",\"byteLength\":368}", 1, 0);
     write_bytes(at("mat0.gltf"), json, strlen(json));
     load_ok("matrices, no ibm", at("mat0.gltf"), NULL, T0, 0);
+    write_bytes(at("strip copy.bin"), bin, BIN_LEN);
+    json = make_json("{\"uri\":\"strip%20copy.bin\",\"byteLength\":368}", 0, 1);
+    write_bytes(at("pct.gltf"), json, strlen(json));
+    load_ok("%-escaped uri", at("pct.gltf"), NULL, T0, 1);
     T_CHECK(sb_gltf_load(&g, at("trs.gltf"), "nope") == -1 && strstr(sb_error(), "no skinned mesh named \"nope\""),
             "unknown mesh name: %s", sb_error());
     sb_gltf_free(&g);
@@ -433,6 +437,7 @@ int main(void)
             {"unknown componentType", "\"componentType\":5123", "\"componentType\":5124",
              "accessors[3].componentType: 5124 is not a glTF component type"},
             {"missing buffer file", "strip.bin", "missing.bin", "buffers[0].uri: cannot read"},
+            {"bad %-escape", "strip.bin", "strip%2.bin", "buffers[0].uri: bad %-escape"},
             {"absolute buffer path", "strip.bin", "/etc/passwd", "buffers[0].uri: \"/etc/passwd\" is not a relative file name"},
             {"JSON syntax error", "\"scenes\":[", "\"scenes\" [", "JSON line 4"},
             {"cycle in children", "{\"name\":\"bone1\",", "{\"name\":\"bone1\",\"children\":[1],", "a cycle"},
@@ -496,6 +501,30 @@ int main(void)
         make_bin();
         write_bytes(at("strip.bin"), bin, BIN_LEN);
         load_ok("restored bin", at("trs.gltf"), NULL, T0, 1);
+    }
+    {   /* a 50,000-node chain: read in linear time (the parent walk is not
+         * redone per node), world positions summed exactly */
+        enum { N = 50000 };
+        size_t cap = (size_t)N * 48 + 4096, len;
+        char *big = malloc(cap);
+        int k;
+        len = (size_t)sprintf(big, "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[");
+        for (k = 0; k < N - 1; k++) len += (size_t)sprintf(big + len, "{\"translation\":[0,0,1],\"children\":[%d]},", k + 1);
+        len += (size_t)sprintf(big + len, "{\"translation\":[0,0,1],\"mesh\":0,\"skin\":0}],\"skins\":[{\"joints\":[%d,%d]}],", N - 2, N - 1);
+        len += (size_t)sprintf(big + len, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":1,\"WEIGHTS_0\":2}}]}],"
+                                   "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},"
+                                   "{\"bufferView\":1,\"componentType\":5121,\"count\":6,\"type\":\"VEC4\"},"
+                                   "{\"bufferView\":2,\"componentType\":5126,\"count\":6,\"type\":\"VEC4\"}],"
+                                   "\"bufferViews\":[{\"buffer\":0,\"byteLength\":96,\"byteStride\":16},"
+                                   "{\"buffer\":0,\"byteOffset\":96,\"byteLength\":24},{\"buffer\":0,\"byteOffset\":120,\"byteLength\":96}],"
+                                   "\"buffers\":[{\"uri\":\"strip.bin\",\"byteLength\":368}]}");
+        write_bytes(at("chain.gltf"), big, len);
+        k = sb_gltf_load(&g, at("chain.gltf"), NULL);
+        T_CHECK(k == 0 && g.nv == 6 && g.nt == 2 && g.nj == 2 && g.joints[1].parent == 0 && g.joints[0].parent == -1 &&
+                    g.joints[0].node_pos[2] == N - 1 && g.joints[1].node_pos[2] == N && g.pos[2 * 3 + 2] == N,
+                "chain: rc %d %s", k, k ? sb_error() : "");
+        sb_gltf_free(&g);
+        free(big);
     }
     {   /* every byte of the GLB replaced by a few values: refused cleanly or
          * loaded with every index in range (run under ASan+UBSan too) */

@@ -111,7 +111,7 @@ static int read_node(scene *s, int i)
 
 static int read_nodes(scene *s)
 {
-    int i;
+    int i, *chain;
     s->nn = s->d.count[GA_NODES];
     s->parent = sb_alloc((size_t)s->nn * sizeof *s->parent);
     s->local = sb_alloc((size_t)s->nn * 16 * sizeof *s->local);
@@ -122,24 +122,24 @@ static int read_nodes(scene *s)
     for (i = 0; i < s->nn; i++) s->parent[i] = -1;
     for (i = 0; i < s->nn; i++)
         if (read_node(s, i)) return -1;
-    /* one parent each, so a cycle is a parent chain longer than the node count */
+    /* world matrices, parents first: walk up to a finished node (done 2)
+     * marking the walk (done 1); meeting a marked node is a cycle. Linear. */
+    chain = sb_alloc((size_t)s->nn * sizeof *chain + 1);
     for (i = 0; i < s->nn; i++) {
-        int j = i, steps = 0;
-        while (j >= 0 && steps <= s->nn) j = s->parent[j], steps++;
-        if (j >= 0) return sb_fail("nodes[%d].children: a cycle through node %d", s->parent[i], i);
-    }
-    for (i = 0; i < s->nn; i++) {   /* world matrices, parents first */
-        int j = i, chain = 0;
-        while (j >= 0 && !s->done[j]) j = s->parent[j], chain++;
-        while (chain > 0) {   /* the topmost node not yet done, then down */
-            int k = i, up = chain - 1;
-            while (up-- > 0) k = s->parent[k];
+        int j = i, len = 0;
+        while (j >= 0 && !s->done[j]) s->done[j] = 1, chain[len++] = j, j = s->parent[j];
+        if (j >= 0 && s->done[j] == 1) {
+            free(chain);
+            return sb_fail("nodes[%d].children: a cycle through node %d", s->parent[j], j);
+        }
+        while (len > 0) {
+            int k = chain[--len];
             if (s->parent[k] >= 0) mat_mul(s->world + 16 * s->parent[k], s->local + 16 * k, s->world + 16 * k);
             else memcpy(s->world + 16 * k, s->local + 16 * k, 16 * sizeof(double));
-            s->done[k] = 1;
-            chain--;
+            s->done[k] = 2;
         }
     }
+    free(chain);
     return 0;
 }
 
@@ -162,11 +162,8 @@ static int pick_node(scene *s, const char *want)
             free(stack), free(seen);
             return sb_fail("scenes[%d].nodes: an array expected", sc);
         }
-        /* pushed in reverse so the walk meets them in order */
-        for (k = nodes < 0 ? 0 : s->d.j.node[nodes].count - 1; nodes >= 0 && k >= 0; k--) {
-            double x;
-            c = sbj_at(&s->d.j, nodes, k);
-            x = s->d.j.node[c].num;
+        for (c = nodes < 0 ? -1 : s->d.j.node[nodes].child; c >= 0; c = s->d.j.node[c].next, k++) {
+            double x = s->d.j.node[c].num;
             if (s->d.j.node[c].kind != SBJ_NUM || x != floor(x) || x < 0 || x >= s->nn || s->parent[(int)x] >= 0 ||
                 seen[(int)x]) {
                 free(stack), free(seen);
@@ -174,6 +171,10 @@ static int pick_node(scene *s, const char *want)
             }
             seen[(int)x] = 1;
             stack[top++] = (int)x;
+        }
+        for (c = top - 1, k = 0; k < c; k++, c--) {   /* reversed: the walk meets them in order */
+            int t = stack[k];
+            stack[k] = stack[c], stack[c] = t;
         }
     } else
         for (i = s->nn - 1; i >= 0; i--)
@@ -187,9 +188,11 @@ static int pick_node(scene *s, const char *want)
             else if (match) named = n;
         }
         ch = sbj_get(&s->d.j, gl_elem(&s->d, GA_NODES, n), "children");
-        for (k = ch < 0 ? -1 : s->d.j.node[ch].count - 1; k >= 0; k--) {
-            c = sbj_at(&s->d.j, ch, k);
-            stack[top++] = (int)s->d.j.node[c].num;
+        k = top;   /* pushed in order, then reversed: the walk meets them in order */
+        for (c = ch < 0 ? -1 : s->d.j.node[ch].child; c >= 0; c = s->d.j.node[c].next) stack[top++] = (int)s->d.j.node[c].num;
+        for (c = top - 1; k < c; k++, c--) {
+            int t = stack[k];
+            stack[k] = stack[c], stack[c] = t;
         }
     }
     free(stack), free(seen);
@@ -290,6 +293,15 @@ static int prim_acc(scene *s, int prim, const char *key, int in_attr, const char
     return 1;
 }
 
+/* realloc keeping the old block on failure (sb_gltf_free still frees it) */
+static int grow(void **p, size_t n)
+{
+    void *q = realloc(*p, n ? n : 1);
+    if (!q) return -1;
+    *p = q;
+    return 0;
+}
+
 static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
 {
     static const int t_pos[] = {5126, 0}, t_joint[] = {5121, 5123, 0}, t_weight[] = {5126, 5121, 5123, 0},
@@ -317,13 +329,15 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
     ni = c ? I.count : nv;
     if (ni % 3) { sb_fail("%s: %lld indices, not a multiple of 3", path, ni); goto out; }
     if ((long long)g->nv + nv > (1LL << 28) || (long long)g->nt + ni / 3 > (1LL << 28)) { sb_fail("%s: too many vertices", path); goto out; }
-    g->pos = realloc(g->pos, (size_t)(g->nv + nv) * 3 * sizeof *g->pos);
-    g->joint = realloc(g->joint, (size_t)(g->nv + nv) * 4 * sizeof *g->joint);
-    g->weight = realloc(g->weight, (size_t)(g->nv + nv) * 4 * sizeof *g->weight);
-    g->src_prim = realloc(g->src_prim, (size_t)(g->nv + nv) * sizeof *g->src_prim);
-    g->src_vert = realloc(g->src_vert, (size_t)(g->nv + nv) * sizeof *g->src_vert);
-    g->tri = realloc(g->tri, (size_t)(g->nt + ni / 3) * 3 * sizeof *g->tri);
-    if (!g->pos || !g->joint || !g->weight || !g->src_prim || !g->src_vert || !g->tri) { sb_fail("%s: out of memory", path); goto out; }
+    if (grow((void **)&g->pos, (size_t)(g->nv + nv) * 3 * sizeof *g->pos) ||
+        grow((void **)&g->joint, (size_t)(g->nv + nv) * 4 * sizeof *g->joint) ||
+        grow((void **)&g->weight, (size_t)(g->nv + nv) * 4 * sizeof *g->weight) ||
+        grow((void **)&g->src_prim, (size_t)(g->nv + nv) * sizeof *g->src_prim) ||
+        grow((void **)&g->src_vert, (size_t)(g->nv + nv) * sizeof *g->src_vert) ||
+        grow((void **)&g->tri, (size_t)(g->nt + ni / 3) * 3 * sizeof *g->tri)) {
+        sb_fail("%s: out of memory", path);
+        goto out;
+    }
     for (v = 0; v < nv; v++) {
         double sum = 0, *w = g->weight + 4 * (nv0 + v);
         int *j = g->joint + 4 * (nv0 + v);

@@ -4,6 +4,7 @@
  * arithmetic on values already bounded (so the sums cannot wrap). */
 #include "sb_gltf_int.h"
 #include "sb.h"
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,7 +42,7 @@ int gl_read_file(const char *path, unsigned char **data, size_t *len)
 
 int gl_elem(const gl_doc *d, int which, int i)
 {
-    return sbj_at(&d->j, d->arr[which], i);
+    return i >= 0 && i < d->count[which] ? d->elem[which][i] : -1;
 }
 
 int gl_int(const gl_doc *d, int obj, const char *key, const char *path,
@@ -152,6 +153,24 @@ static int b64_decode(const char *s, size_t n, const char *path, unsigned char *
     return 0;
 }
 
+/* a relative URI's %XX escapes (exporters write "a%20b.bin"); -1 if malformed */
+static int pct_decode(char *o, const char *u)
+{
+    for (; *u; u++, o++) {
+        char hx[3];
+        if (*u != '%') {
+            *o = *u;
+            continue;
+        }
+        if (!isxdigit((unsigned char)u[1]) || !isxdigit((unsigned char)u[2])) return -1;
+        hx[0] = u[1], hx[1] = u[2], hx[2] = 0;
+        if (!(*o = (char)strtol(hx, NULL, 16))) return -1;
+        u += 2;
+    }
+    *o = 0;
+    return 0;
+}
+
 static int load_buffer(gl_doc *d, int i)
 {
     char path[64], file[2048];
@@ -165,7 +184,7 @@ static int load_buffer(gl_doc *d, int i)
     u = sbj_get(&d->j, b, "uri");
     if (u < 0) {
         if (i != 0 || !d->bin) return sb_fail("%s: no uri, and not the GLB's BIN chunk", path);
-        if ((size_t)blen > d->bin_len)
+        if ((unsigned long long)blen > (unsigned long long)d->bin_len)
             return sb_fail("%s.byteLength: %lld, but the GLB BIN chunk has %lu bytes", path, blen, (unsigned long)d->bin_len);
         d->buf[i] = (unsigned char *)d->bin;
         d->buf_len[i] = (size_t)blen;
@@ -182,13 +201,13 @@ static int load_buffer(gl_doc *d, int i)
         if (uri[0] == '/' || strstr(uri, "://") || strlen(d->dir) + strlen(uri) + 1 > sizeof file)
             return sb_fail("%s: \"%s\" is not a relative file name", path, uri);
         strcpy(file, d->dir);
-        strcat(file, uri);
+        if (pct_decode(file + strlen(file), uri)) return sb_fail("%s: bad %%-escape in \"%s\"", path, uri);
         if (gl_read_file(file, &data, &dlen)) return sb_fail("%s: cannot read \"%s\"", path, file);
     }
     d->buf[i] = data;
     d->buf_owned[i] = 1;
     d->buf_len[i] = (size_t)blen;
-    if (dlen < (size_t)blen)
+    if ((unsigned long long)dlen < (unsigned long long)blen)
         return sb_fail("%s: %lu bytes, but byteLength says %lld", path, (unsigned long)dlen, blen);
     return 0;
 }
@@ -235,8 +254,11 @@ int gl_open(gl_doc *d, const char *path)
         if (a < 0) continue;
         if (d->j.node[a].kind != SBJ_ARR) return sb_fail("%s: an array expected", top_names[w]);
         d->count[w] = d->j.node[a].count;
-        for (c = d->j.node[a].child; c >= 0; c = d->j.node[c].next, i++)
+        d->elem[w] = sb_alloc((size_t)d->count[w] * sizeof *d->elem[w]);
+        for (c = d->j.node[a].child; c >= 0; c = d->j.node[c].next, i++) {
             if (d->j.node[c].kind != SBJ_OBJ) return sb_fail("%s[%d]: an object expected", top_names[w], i);
+            d->elem[w][i] = c;
+        }
     }
     d->nbuf = d->count[GA_BUFFERS];
     d->buf = sb_alloc((size_t)d->nbuf * sizeof *d->buf);
@@ -255,6 +277,7 @@ void gl_close(gl_doc *d)
     free(d->buf);
     free(d->buf_len);
     free(d->buf_owned);
+    for (i = 0; i < 7; i++) free(d->elem[i]);
     free(d->file);
     sbj_free(&d->j);
     memset(d, 0, sizeof *d);

@@ -19,6 +19,7 @@ typedef struct {
     size_t *buf_len;          /* declared byteLength (the bytes hold at least this) */
     int *buf_owned;
     int arr[7], count[7];     /* top-level arrays (node index, length), by GA_* */
+    int *elem[7];             /* their elements' JSON nodes (sbj_at walks a list) */
 } gl_doc;
 
 enum { GA_BUFFERS, GA_VIEWS, GA_ACCESSORS, GA_NODES, GA_MESHES, GA_SKINS, GA_SCENES };
