@@ -464,6 +464,10 @@ int main(void)
              "extensionsRequired[0]: \"KHR_draco_mesh_compression\""},
             {"count not integer", "\"count\":12", "\"count\":12.5", "accessors[3].count: an integer expected"},
             {"huge count", "\"count\":12", "\"count\":1e300", "is out of range [1, 268435456]"},
+            {"position overflow", "\"translation\":[0.5,0,0]", "\"translation\":[0.5,1e308,0],\"scale\":[1,1e308,1]",
+             "meshes[0].primitives[0].attributes.POSITION: vertex 2 is not finite after nodes[0]'s world transform"},
+            {"joint position overflow", "\"translation\":[0,1,0]", "\"translation\":[0,1e308,0]",
+             "skins[0].joints[1]: the bind position of nodes[3] is not finite"},
             {"JOINTS_1", "\"JOINTS_0\":1,", "\"JOINTS_0\":1,\"JOINTS_1\":1,", "attributes.JOINTS_1"},
         };
         int k;

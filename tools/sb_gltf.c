@@ -209,6 +209,17 @@ static char *dup_str(const char *s)
     return d;
 }
 
+/* huge TRS values or IBMs can overflow: refuse rather than pass infinities on */
+static int joints_finite(const sb_gltf *g, const char *path)
+{
+    int k, c;
+    for (k = 0; k < g->nj; k++)
+        for (c = 0; c < 3; c++)
+            if (!isfinite(g->joints[k].pos[c]) || !isfinite(g->joints[k].node_pos[c]))
+                return sb_fail("%s.joints[%d]: the bind position of nodes[%d] is not finite", path, k, g->joints[k].node);
+    return 0;
+}
+
 static int read_skin(scene *s, sb_gltf *g)
 {
     char path[48];
@@ -249,7 +260,7 @@ static int read_skin(scene *s, sb_gltf *g)
     }
     free(of_node);
     if (gl_int(&s->d, sk, "inverseBindMatrices", path, -1, 0, s->d.count[GA_ACCESSORS] - 1, &ibm_acc)) return -1;
-    if (ibm_acc < 0) return 0;
+    if (ibm_acc < 0) return joints_finite(g, path);
     if (gl_accessor(&s->d, (int)ibm_acc, &ibm)) return -1;
     if (ibm.ncomp != 16 || ibm.count < g->nj) {
         free(ibm.v);
@@ -265,7 +276,7 @@ static int read_skin(scene *s, sb_gltf *g)
         mat_point(mw, o, g->joints[k].pos);
     }
     free(ibm.v);
-    return 0;
+    return joints_finite(g, path);
 }
 
 /* read an attribute/indices accessor, checking its shape; path names the use */
@@ -342,12 +353,19 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
         double sum = 0, *w = g->weight + 4 * (nv0 + v);
         int *j = g->joint + 4 * (nv0 + v);
         mat_point(mw, P.v + 3 * v, g->pos + 3 * (nv0 + v));
+        if (!isfinite(g->pos[3 * (nv0 + v)]) || !isfinite(g->pos[3 * (nv0 + v) + 1]) || !isfinite(g->pos[3 * (nv0 + v) + 2])) {
+            sb_fail("%s.attributes.POSITION: vertex %lld is not finite after nodes[%d]'s world transform", path, v, g->node);
+            goto out;
+        }
         g->src_prim[nv0 + v] = pi;
         g->src_vert[nv0 + v] = (int)v;
         for (k = 0; k < 4; k++) {
             w[k] = W.v[4 * v + k];
             j[k] = (int)J.v[4 * v + k];
-            if (!(w[k] >= 0)) { sb_fail("%s.attributes.WEIGHTS_0: vertex %lld has a negative weight", path, v); goto out; }
+            if (!(w[k] >= 0) || !isfinite(w[k])) {
+                sb_fail("%s.attributes.WEIGHTS_0: vertex %lld has a negative or non-finite weight", path, v);
+                goto out;
+            }
             if (w[k] > 0 && j[k] >= g->nj) {
                 sb_fail("%s.attributes.JOINTS_0: vertex %lld uses joint %d, skins[%d] has %d", path, v, j[k], g->skin, g->nj);
                 goto out;

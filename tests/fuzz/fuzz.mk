@@ -8,6 +8,7 @@
 #   $(FUZZ_DIR)/fuzz_clip         clip parser + sampler (ports/common; tests/fuzz/lf_clip.c)
 #   $(FUZZ_DIR)/fuzz_desc         description reader (tools/sb_desc.c; tests/fuzz/lf_desc.c)
 #   $(FUZZ_DIR)/fuzz_obj          OBJ reader + inside test (tools/sb_mesh.c; tests/fuzz/lf_obj.c)
+#   $(FUZZ_DIR)/fuzz_gltf         glTF 2.0 reader (tools/sb_gltf*.c, sb_json.c; tests/fuzz/lf_gltf.c)
 #
 # Seeds: tests/fuzz/corpus/<harness>/ (in the tree: clips, descriptions, OBJs)
 # plus $(FUZZ_DIR)/seeds/<harness>/ generated at build time (blobs of the
@@ -27,7 +28,7 @@ FUZZ_HAVE := $(shell command -v $(FUZZ_CC) 2>/dev/null)
 LF_CFLAGS  = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined \
              -fno-sanitize-recover=all -Itests/fuzz
 LF_RT      = $(SN_INC) -Iruntime/src $(SN_SRCS)
-LF_NAMES   = fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj
+LF_NAMES   = fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj fuzz_gltf
 LF_BINS    = $(addprefix $(FUZZ_DIR)/,$(LF_NAMES))
 LF_SEEDS   = $(addprefix $(FUZZ_DIR)/seeds/,$(addsuffix /.stamp,$(LF_NAMES)))
 
@@ -47,6 +48,10 @@ $(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h tools/sb_desc
 $(FUZZ_DIR)/fuzz_obj: tests/fuzz/lf_obj.c tests/fuzz/lf_common.h tools/sb_mesh.c tools/sb_util.c tools/sb.h
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_mesh.c tools/sb_util.c -lm
+LF_GLTF_SRC = tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_json.c tools/sb_util.c
+$(FUZZ_DIR)/fuzz_gltf: tests/fuzz/lf_gltf.c tests/fuzz/lf_common.h $(LF_GLTF_SRC) tools/sb.h $(GLTF_HDR)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< $(LF_GLTF_SRC) -lm
 
 # ---- generated seeds ----
 $(FUZZ_DIR)/lf_seed_blob_fixed: tests/fuzz/lf_seed_blob.c tests/fuzz/sn_tblob.h $(SN_HDRS) $(SN_LIB_FIXED)
@@ -78,6 +83,10 @@ $(FUZZ_DIR)/seeds/fuzz_desc/.stamp: $(wildcard tools/examples/*/*.sinew)
 $(FUZZ_DIR)/seeds/fuzz_obj/.stamp: tools/examples/limb/limb.obj tools/examples/diag/diag.obj
 	@rm -rf $(@D) && mkdir -p $(@D)
 	cp tools/examples/limb/limb.obj tools/examples/diag/diag.obj $(@D)/
+	@touch $@
+# the glTF seeds are all in tests/fuzz/corpus/fuzz_gltf/ (written by test_bake_gltf)
+$(FUZZ_DIR)/seeds/fuzz_gltf/.stamp:
+	@rm -rf $(@D) && mkdir -p $(@D)
 	@touch $@
 
 .PHONY: fuzz fuzz-bins fuzz-seeds

@@ -6,7 +6,7 @@
 # $BUILD/fuzz/artifacts/<harness>-crash-* (replay: $BUILD/fuzz/<harness> FILE).
 # Prints executions and exec/s per harness as "figure:" lines.
 #
-#   sh tests/scripts/test_fuzz.sh [harness ...]    (default: all five)
+#   sh tests/scripts/test_fuzz.sh [harness ...]    (default: all six)
 #   env FUZZ_SECONDS=N   seconds per harness
 #   env FUZZ_KEEP=1      keep new inputs in $BUILD/fuzz/work/<harness>/ across
 #                        runs (make fuzz); otherwise a fresh temp dir each run
@@ -14,7 +14,7 @@
 BUILD=${BUILD:-build}
 FD=$BUILD/fuzz
 SECS=${FUZZ_SECONDS:-6}
-NAMES=${*:-fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj}
+NAMES=${*:-fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj fuzz_gltf}
 pass=0; fail=0
 
 if ! command -v "${FUZZ_CC:-clang}" > /dev/null 2>&1; then
