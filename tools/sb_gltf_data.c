@@ -316,7 +316,7 @@ int gl_accessor(const gl_doc *d, int a, gl_acc *out)
     static const int ncomps[] = {1, 2, 3, 4, 16};
     char path[64], vpath[64];
     int acc = gl_elem(d, GA_ACCESSORS, a), vn, t, csize, elem, nt = -1, norm = 0, nb;
-    long long ctype, count, off, view, voff = 0, vlen = 0, stride, buf = 0, k;
+    long long ctype = 0, count = 0, off = 0, view = 0, voff = 0, vlen = 0, stride = 0, buf = 0, k; /* set before use; -O3 cannot tell */
     const char *type;
     memset(out, 0, sizeof *out);
     snprintf(path, sizeof path, "accessors[%d]", a);
