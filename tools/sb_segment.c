@@ -71,7 +71,7 @@ static int build_one(const sb_desc *d, const sb_mesh *m, const sb_model *o, cons
         int v;
         if (att[i].kind != SB_SEGATT_SURFACE) continue;
         v = nearest_vertex(m, p, &dist);
-        if (v < 0) { free(att); return sb_fail("%s:%d: %s '%s': no surface vertex to attach to", d->path, att[i].line, what, g->name); }
+        if (v < 0) { sb_fail("%s:%d: %s '%s': no surface vertex to attach to", d->path, att[i].line, what, g->name); free(att); return -1; }
         if (dist > within) {
             sb_fail("%s:%d: %s '%s' node %d at (%g, %g, %g) is %g from the nearest surface vertex %d at (%g, %g, %g), more than %g%s: "
                     "move the %s onto the surface or give 'within D'", d->path, att[i].line, what, g->name, att[i].node,
@@ -96,7 +96,7 @@ static int build_one(const sb_desc *d, const sb_mesh *m, const sb_model *o, cons
         } else {
             double dist, within = att[i].within >= 0 ? att[i].within : 0.5 * s->seg_len;
             int v = nearest_vertex(m, p, &dist);
-            if (v > 65535) { free(att); return sb_fail("%s:%d: %s '%s': surface vertex %d beyond 65535", d->path, att[i].line, what, g->name, v); }
+            if (v > 65535) { sb_fail("%s:%d: %s '%s': surface vertex %d beyond 65535", d->path, att[i].line, what, g->name, v); free(att); return -1; }
             if (dist > within) {
                 sb_fail("%s:%d: %s '%s' node %d is %g from the nearest surface vertex %d after the %s moved by (%g, %g, %g) (the mean offset of "
                         "its surface attachments), more than %g%s: attach fewer nodes, reshape the %s or give 'within D'",

@@ -100,7 +100,7 @@ void seg_prolong(const seg_mesh *M, unsigned l, uint32_t *sat) {
             const sn_q *Sc;
             int odd = (int)((r | c) & 1u);
 #if !defined(SN_FLOAT)
-            int cs;
+            int cs = 1; /* set in the first loop; some optimisation levels cannot tell */
 #endif
             if (!odd) {
                 if (pass == 1)
