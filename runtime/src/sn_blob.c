@@ -50,7 +50,7 @@ static uint32_t sn_crc32(const unsigned char *p, uint32_t n) {
 /* ---- one real in range (fixed: stored integer in [lo, hi]; float: finite
  * and in [lo, hi] / 2^q) ---- */
 #if defined(SN_FLOAT)
-static int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
+int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
     uint32_t u = sn_rd_u32(p);
     float v, s = 1.0f / (float)((int32_t)1 << q);
     if (((u >> 23) & 0xFFu) == 0xFFu) return 0; /* inf or NaN */
@@ -58,7 +58,7 @@ static int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
     return v >= (float)lo * s && v <= (float)hi * s;
 }
 #else
-static int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
+int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
     int32_t v = sn_rd_i32(p);
     (void)q;
     return v >= lo && v <= hi;

@@ -73,19 +73,16 @@ sn_status sn_check_forces(const sn_view *v) {
         const unsigned char *p = v->sec[SN_SEC_SHARES] + (size_t)i * SHARE_ELEM;
 #if defined(SN_FLOAT)
         float sum = 0.0f;
-        for (k = 0; k < SN_LEVELS; k++) {
-            float x = sn_rd_f32(p + 4 * k);
-            if (!(x >= 0.0f && x <= 1.0f)) return SN_ERR_VALUE; /* NaN fails too */
-            sum += x;
-        }
-        if (!(sum >= 1.0f - 1.0f / 1048576 && sum <= 1.0f + 1.0f / 1048576)) return SN_ERR_VALUE;
 #else
         int64_t sum = 0;
+#endif
         for (k = 0; k < SN_LEVELS; k++) {
-            int32_t x = sn_rd_i32(p + 4 * k);
-            if (x < 0 || x > (int32_t)1 << 30) return SN_ERR_VALUE;
-            sum += x;
+            if (!sn_real_ok(p + 4 * k, 0, (int32_t)1 << 30, 30)) return SN_ERR_VALUE; /* [0, 1], finite */
+            sum += rd_real(p, k);
         }
+#if defined(SN_FLOAT)
+        if (!(sum >= 1.0f - 1.0f / 1048576 && sum <= 1.0f + 1.0f / 1048576)) return SN_ERR_VALUE;
+#else
         if (sum != (int64_t)1 << 30) return SN_ERR_VALUE;
 #endif
     }

@@ -225,6 +225,10 @@ typedef struct sn_view {
 uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
                            uint32_t nFrc, uint32_t segB);
 
+/* One stored real in range (validator helper, sn_blob.c): fixed, the stored
+ * integer in [lo, hi]; float, finite and in [lo, hi] / 2^q (q <= 30). */
+int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q);
+
 /* Segment sections (sn_segment.c): contents valid, and *segB = the state
  * bytes they need. Called by the validator once the table is checked. */
 sn_status sn_check_segments(const sn_view *v, uint32_t *segB);

@@ -3,21 +3,6 @@
  * meshes") and the public calls (sinew.h, end). */
 #include "sn_segment.h"
 
-/* a real within [lo, hi] (fixed raw; float: the same values / 2^q, finite) */
-static int rok(const unsigned char *p, int32_t lo, int32_t hi, int q) {
-#if defined(SN_FLOAT)
-    uint32_t u = sn_rd_u32(p);
-    float x, s = 1.0f / (float)((int64_t)1 << q);
-    if (((u >> 23) & 0xFFu) == 0xFFu) return 0; /* inf or NaN */
-    x = sn_rd_f32(p);
-    return x >= (float)lo * s && x <= (float)hi * s;
-#else
-    int32_t x = sn_rd_i32(p);
-    (void)q;
-    return x >= lo && x <= hi;
-#endif
-}
-
 /* |x_a - x_b| within len/1024 + 2 LSB of len (fixed; float: len/1024 + 2^-20 len):
  * a writer rounding exact positions to the nearest LSB errs by <= sqrt(3) LSB */
 static int spacing_ok(const unsigned char *nodes, uint32_t a, uint32_t b, const unsigned char *lenp) {
@@ -68,15 +53,15 @@ sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
         /* seg_len: >= 2^-14 internal units (reciprocals keep 8+ bits), a
          * stretched mesh (side-1) len <= 2^27 (32 units): every node and
          * coarse length stays within the Q22 state range 2^28 */
-        if (!rok(R, 256, (int32_t)(((uint32_t)1 << 27) / (side - 1u)), SN_Q_LEN) ||
-            !rok(R + 4, 1, (int32_t)1 << 30, 30) ||        /* gamma (0, 1] */
-            !rok(R + 8, 0, (int32_t)1 << 30, 30) ||        /* keep [0, 1] */
-            !rok(R + 12, 1, INT32_MAX, 16) ||              /* inv_mass (0, 32768) */
-            !rok(R + 16, 0, (int32_t)1 << 30, 30))         /* centre [0, 1] */
+        if (!sn_real_ok(R, 256, (int32_t)(((uint32_t)1 << 27) / (side - 1u)), SN_Q_LEN) ||
+            !sn_real_ok(R + 4, 1, (int32_t)1 << 30, 30) ||        /* gamma (0, 1] */
+            !sn_real_ok(R + 8, 0, (int32_t)1 << 30, 30) ||        /* keep [0, 1] */
+            !sn_real_ok(R + 12, 1, INT32_MAX, 16) ||              /* inv_mass (0, 32768) */
+            !sn_real_ok(R + 16, 0, (int32_t)1 << 30, 30))         /* centre [0, 1] */
             return SN_ERR_VALUE;
         for (k = 0; k < SN_SEG_MAX_LEVELS; k++) {
             const unsigned char *p = R + 20 + 4 * k;
-            if (!rok(p, 0, (int32_t)1 << 30, 30)) return SN_ERR_VALUE;
+            if (!sn_real_ok(p, 0, (int32_t)1 << 30, 30)) return SN_ERR_VALUE;
             if (k >= levels && sn_rd_u32(p) != 0) return SN_ERR_VALUE;
 #if defined(SN_FLOAT)
             ssum += (int64_t)(sn_rd_f32(p) * 1073741824.0f); /* within 2^-20: 1024 Q30 LSB */
@@ -90,7 +75,7 @@ sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
         if (ssum != (int64_t)1 << 30) return SN_ERR_VALUE;
 #endif
         for (i = 0; i < 3u * nodes; i++)
-            if (!rok(nd + 4u * (3u * nsum + i), -((int32_t)1 << 27), (int32_t)1 << 27, SN_Q_LEN)) return SN_ERR_VALUE;
+            if (!sn_real_ok(nd + 4u * (3u * nsum + i), -((int32_t)1 << 27), (int32_t)1 << 27, SN_Q_LEN)) return SN_ERR_VALUE;
         for (i = 0; i < nodes; i++) { /* rest neighbours seg_len apart */
             uint32_t a = nsum + i;
             if (kind == SN_SEG_CHAIN) {
@@ -112,7 +97,7 @@ sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
             } else if (ak == SN_SEGATT_JOINT) {
                 if (tgt >= v->nJ) return SN_ERR_INDEX;
                 for (k = 0; k < 3; k++)
-                    if (!rok(at + 8 + 4 * k, -((int32_t)1 << 27), (int32_t)1 << 27, SN_Q_LEN)) return SN_ERR_VALUE;
+                    if (!sn_real_ok(at + 8 + 4 * k, -((int32_t)1 << 27), (int32_t)1 << 27, SN_Q_LEN)) return SN_ERR_VALUE;
             } else {
                 return SN_ERR_VALUE;
             }
