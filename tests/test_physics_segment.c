@@ -80,12 +80,6 @@ static void sheet_run(const char *variant, int node, double jy, int floor_on, do
     pu_rt_close(&a);
 }
 
-static void qmat(sn_quat q, double R[9]) {
-    double x = pu_q(q.x), y = pu_q(q.y), z = pu_q(q.z), w = pu_q(q.w);
-    R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - z * w); R[2] = 2 * (x * z + y * w);
-    R[3] = 2 * (x * y + z * w); R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - x * w);
-    R[6] = 2 * (x * z - y * w); R[7] = 2 * (y * z + x * w); R[8] = 1 - 2 * (x * x + y * y);
-}
 /* every segment node of every mesh, world, doubles; returns the count */
 static unsigned seg_nodes_all(const pu_rt *r, double *out) {
     uint32_t m, nm = sn_segment_mesh_count(r->blob), i, n = 0;
@@ -100,17 +94,6 @@ static unsigned seg_nodes_all(const pu_rt *r, double *out) {
     }
     return n;
 }
-static double moved_err(const double *a, const double *b, unsigned n, const double R[9], const double t[3]) {
-    double e = 0;
-    unsigned i, k;
-    for (i = 0; i < n; i++)
-        for (k = 0; k < 3; k++) {
-            double g = R[3 * k] * a[3 * i] + R[3 * k + 1] * a[3 * i + 1] + R[3 * k + 2] * a[3 * i + 2] + t[k];
-            double d = fabs(g - b[3 * i + k]);
-            e = d > e ? d : e;
-        }
-    return e;
-}
 
 static void teleport(double turn_deg) {
     enum { K0 = 120, K1 = 60 };
@@ -124,7 +107,7 @@ static void teleport(double turn_deg) {
     pu_example(path, sizeof path, "cow" PU_BLOB_SUFFIX);
     if (pu_rt_open(&a, path) || pu_rt_open(&b, path)) { T_CHECK(0, "open %s", path); return; }
     h = SN_FLAVOUR ? (double)a.info.timestep : ldexp((double)a.info.timestep, -16);
-    qmat(qg, R);
+    pu_qmat(qg, R);
     for (k = 0; k < K0; k++) {
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
@@ -134,7 +117,7 @@ static void teleport(double turn_deg) {
     pu_move_pose(x, a.info.joints, qg, tg, xm);
     T_CHECK(sn_teleport(b.inst, xm, b.info.joints) == SN_OK, "teleport accepted");
     seg_nodes_all(&b, nb);
-    e_jump = moved_err(na, nb, n, R, tg);
+    e_jump = pu_moved_err(na, nb, n, R, tg);
     for (k = K0; k < K0 + K1; k++) {
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
@@ -143,7 +126,7 @@ static void teleport(double turn_deg) {
     }
     seg_nodes_all(&a, na);
     seg_nodes_all(&b, nb);
-    e_run = moved_err(na, nb, n, R, tg);
+    e_run = pu_moved_err(na, nb, n, R, tg);
     sn_get_stats(b.inst, &st);
     T_FIGURE("[%s] teleport %.0f units, turn %.0f deg, mid-trot: %u segment nodes vs G(untouched) across the jump %.3g, "
              "after %d steps %.3g units; saturations %u", fl(), 30000.0, turn_deg, n, e_jump, K1, e_run, st.saturations);

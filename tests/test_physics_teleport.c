@@ -22,24 +22,6 @@
 #define K1 60      /* steps after it */
 #define JUMP 30000.0
 
-static void qmat(sn_quat q, double R[9]) {
-    double x = pu_q(q.x), y = pu_q(q.y), z = pu_q(q.z), w = pu_q(q.w);
-    R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - z * w); R[2] = 2 * (x * z + y * w);
-    R[3] = 2 * (x * y + z * w); R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - x * w);
-    R[6] = 2 * (x * z - y * w); R[7] = 2 * (y * z + x * w); R[8] = 1 - 2 * (x * x + y * y);
-}
-/* largest |G a - b| over n points */
-static double moved_err(const double *a, const double *b, unsigned n, const double R[9], const double t[3]) {
-    double e = 0;
-    unsigned i, k;
-    for (i = 0; i < n; i++)
-        for (k = 0; k < 3; k++) {
-            double g = R[3 * k] * a[3 * i] + R[3 * k + 1] * a[3 * i + 1] + R[3 * k + 2] * a[3 * i + 2] + t[k];
-            double d = fabs(g - b[3 * i + k]);
-            e = d > e ? d : e;
-        }
-    return e;
-}
 
 static void run(const char *path, double turn_deg) {
     pu_rt a, b;
@@ -57,7 +39,7 @@ static void run(const char *path, double turn_deg) {
 #endif
     sa = malloc(sizeof *sa * 3 * nS);
     sb = malloc(sizeof *sb * 3 * nS);
-    qmat(qg, R);
+    pu_qmat(qg, R);
     for (k = 0; k < K0; k++) { /* both instances trot the same */
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
@@ -69,7 +51,7 @@ static void run(const char *path, double turn_deg) {
     pu_move_pose(x, a.info.joints, qg, tg, xm);
     T_CHECK(sn_teleport(b.inst, xm, b.info.joints) == SN_OK, "teleport accepted");
     pu_rt_surface(&b, sb);
-    e_jump = moved_err(sa, sb, nS, R, tg);
+    e_jump = pu_moved_err(sa, sb, nS, R, tg);
     for (k = K0; k < K0 + K1; k++) {
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints); sn_step(a.inst);
@@ -78,7 +60,7 @@ static void run(const char *path, double turn_deg) {
     }
     pu_rt_surface(&a, sa);
     pu_rt_surface(&b, sb);
-    e_run = moved_err(sa, sb, nS, R, tg);
+    e_run = pu_moved_err(sa, sb, nS, R, tg);
     sn_get_stats(b.inst, &st);
     T_FIGURE("[%s] teleport %.0f units, turn %.0f deg, mid-trot: surface vs skeleton across the jump %.3g units, "
              "after %d more steps %.3g units; saturations %u", fl, JUMP * 1.118, turn_deg, e_jump, K1, e_run, st.saturations);

@@ -38,6 +38,27 @@ static inline void pu_move_pose(const sn_xform *in, unsigned n, sn_quat qg, cons
     }
 }
 
+/* The rotation matrix (row-major, doubles) of a runtime quaternion. */
+static inline void pu_qmat(sn_quat q, double R[9]) {
+    double x = pu_q(q.x), y = pu_q(q.y), z = pu_q(q.z), w = pu_q(q.w);
+    R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - z * w); R[2] = 2 * (x * z + y * w);
+    R[3] = 2 * (x * y + z * w); R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - x * w);
+    R[6] = 2 * (x * z - y * w); R[7] = 2 * (y * z + x * w); R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* Largest |G a - b| over n points (G: x -> R x + t), per component. */
+static inline double pu_moved_err(const double *a, const double *b, unsigned n, const double R[9], const double t[3]) {
+    double e = 0;
+    unsigned i, k;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) {
+            double g = R[3 * k] * a[3 * i] + R[3 * k + 1] * a[3 * i + 1] + R[3 * k + 2] * a[3 * i + 2] + t[k];
+            double d = fabs(g - b[3 * i + k]);
+            e = d > e ? d : e;
+        }
+    return e;
+}
+
 static inline sn_quat pu_qident(void) {
     sn_quat q;
     memset(&q, 0, sizeof q);
