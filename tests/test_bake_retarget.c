@@ -266,6 +266,28 @@ int main(void)
     }
     sb_rt_free(&rt);
 
+    /* ---- the same with L-BFGS-B (tools/sb_lbfgsb.c) as the inner optimizer ---- */
+    {
+        double worst = 0, gn = 0;
+        opt.optimizer = SB_RT_OPT_LBFGSB;
+        opt.cg_tol = 1e-12;
+        opt.cg_max = 50000;
+        T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) == 0, "init: %s", sb_error());
+        T_CHECK(sb_rt_solve(&rt) == 0, "solve (L-BFGS-B): %s", sb_error());
+        T_CHECK(sb_rt_jacobians(&rt) == 0, "jacobians: %s", sb_error());
+        for (k = 0; k < 9; k++) gn += G[k] * G[k];
+        gn = sqrt(gn);
+        for (i = 0; i < rt.nv; i++) {
+            double e = 0;
+            for (k = 0; k < 9; k++) e += (rt.J[9 * i + k] - G[k]) * (rt.J[9 * i + k] - G[k]);
+            worst = fmax(worst, sqrt(e) / gn);
+        }
+        T_FIGURE("affine copy by L-BFGS-B: %d iterations, %.2f s, cost %.3e; largest |J_i - G| / |G| = %.3e", rt.cg_iters, rt.secs, rt.cost, worst);
+        T_CHECK(worst <= 1e-6, "L-BFGS-B: J_i = G within 1e-6 (got %.3g)", worst);
+        sb_rt_free(&rt);
+        sb_rt_defaults(&opt);
+    }
+
     /* ---- closest points on the same pair (no correspondence used) ---- */
     {
         double worst = 0, gn = 0;

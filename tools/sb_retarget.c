@@ -1,6 +1,7 @@
 /* sb_retarget.c -- rig retargeting, seed 003 §4.4 (eq. 15-16). See sb_retarget.h
  * for the cost terms, the Jacobian estimate and the transfer chain. */
 #include "sb_retarget.h"
+#include "sb_lbfgsb.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -47,6 +48,7 @@ void sb_rt_defaults(sb_rt_opts *o)
     o->round_tol = 1e-4;
     o->cg_max = 20000;
     o->cg_tol = 1e-10;
+    o->optimizer = SB_RT_OPT_CG;
     o->verbose = 0;
 }
 
@@ -516,6 +518,30 @@ static int cg_round(sb_retarget *rt, int *iters)
     return 0;
 }
 
+static double lb_fn(void *ctx, const double *x, double *grad) { return sb_rt_cost((const sb_retarget *)ctx, x, grad, NULL); }
+
+/* one round by L-BFGS-B (no bounds), stopping at the same relative gradient as CG */
+static int lbfgsb_round(sb_retarget *rt, int *iters)
+{
+    sb_opt_opts o;
+    sb_opt_result r;
+    double *g = sb_alloc(sizeof(double) * 3 * (size_t)rt->nv), g0 = 0;
+    int i;
+    sb_rt_cost(rt, rt->h, g, NULL);
+    for (i = 0; i < 3 * rt->nv; i++) g0 = fmax(g0, fabs(g[i]));
+    free(g);
+    sb_opt_defaults(&o);
+    o.m = 10;
+    o.max_iter = rt->opt.cg_max;
+    o.pgtol = rt->opt.cg_tol * g0;
+    o.ftol = 0;
+    o.label = "retarget lbfgsb";
+    memset(&r, 0, sizeof r);
+    sb_lbfgsb(3 * rt->nv, rt->h, NULL, NULL, lb_fn, rt, &o, &r, NULL);
+    *iters = r.iterations;
+    return r.status < 0 ? -1 : 0;
+}
+
 static void residual_stats(sb_retarget *rt)
 {
     int i;
@@ -555,14 +581,15 @@ int sb_rt_solve(sb_retarget *rt)
             printf("retarget: start    cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e\n", c, parts[0], parts[1], parts[2],
                    norm(g, 3 * rt->nv));
         }
-        cg_round(rt, &it);
+        if (rt->opt.optimizer == SB_RT_OPT_LBFGSB) { if (lbfgsb_round(rt, &it)) { free(g); return sb_fail("retarget: L-BFGS-B refused the problem (non-finite cost?)"); } }
+        else cg_round(rt, &it);
         rt->cg_iters += it;
         c = sb_rt_cost(rt, rt->h, g, parts);
         if (!isfinite(c)) { free(g); return sb_fail("retarget: the cost is not finite after round %d", round + 1); }
         rt->gnorm = norm(g, 3 * rt->nv);
         if (rt->opt.verbose)
-            printf("retarget: round %2d cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e, %d CG iterations, %.2f s\n",
-                   round + 1, c, parts[0], parts[1], parts[2], rt->gnorm, it, sb_now() - t0);
+            printf("retarget: round %2d cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e, %d %s iterations, %.2f s\n",
+                   round + 1, c, parts[0], parts[1], parts[2], rt->gnorm, it, rt->opt.optimizer == SB_RT_OPT_LBFGSB ? "L-BFGS-B" : "CG", sb_now() - t0);
         rt->rounds = round + 1;
         if (prev >= 0 && prev - c <= rt->opt.round_tol * prev) break;
         prev = c;

@@ -34,7 +34,10 @@
  *
  * With the closest points held fixed C is quadratic in h; each round solves
  * it by preconditioned conjugate gradients on the analytic gradient (the
- * Hessian-vector product is the gradient with the targets set to zero).
+ * Hessian-vector product is the gradient with the targets set to zero); the
+ * L-BFGS-B of tools/sb_lbfgsb.c on the same cost and gradient is an option
+ * (slower on this ill-conditioned quadratic: the distortion term is a
+ * biharmonic-like operator).
  *
  * The Jacobian J_i (eq. 16) minimizes sum_j |J_i e_ij - ebar_ij|^2 over the
  * lattice vertices j sharing a cell with i (e_ij = x_j - x_i in A,
@@ -65,8 +68,10 @@ typedef struct sb_rt_opts {
     double round_tol;       /* stop when the cost falls by less than this fraction in a round */
     int cg_max;             /* CG iterations per round */
     double cg_tol;          /* CG stops at |grad| <= cg_tol |grad at the round's start| */
+    int optimizer;          /* SB_RT_OPT_CG (default) or SB_RT_OPT_LBFGSB (tools/sb_lbfgsb.c, unbounded, same stopping rule) */
     int verbose;            /* progress lines on stdout */
 } sb_rt_opts;
+enum { SB_RT_OPT_CG = 0, SB_RT_OPT_LBFGSB = 1 };
 void sb_rt_defaults(sb_rt_opts *o);
 
 /* one quadratic term f |sum_k w_k h_{v_k} - t|^2 */
