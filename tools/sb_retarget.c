@@ -796,12 +796,20 @@ static int resample(const sb_retarget *rt, const double *qbar, double *qB, sb_rt
     double *d = sb_alloc(sizeof(double) * (size_t)n), *Ad = sb_alloc(sizeof(double) * (size_t)n), *dg = sb_alloc(sizeof(double) * (size_t)B->nf);
     double *z = sb_alloc(sizeof(double) * (size_t)n), rz = 0, bn;
     unsigned char *has = sb_alloc((size_t)B->nv);
-    /* samples */
-    for (i = 0; i < A->nv; i++) add_sample(B, S, &ns, rt->h + 3 * i, qbar + 3 * i);
+    sb_inside in;
+    /* samples: inside A's mesh only (the lattice vertices and cell centres
+     * outside it carry the 'air' displacement, not flesh) */
+    sb_inside_init(&in, rt->mA);
+    for (i = 0; i < A->nv; i++) if (sb_inside_test(&in, A->x + 3 * i)) add_sample(B, S, &ns, rt->h + 3 * i, qbar + 3 * i);
     for (k = 0; k < A->nc + A->ns; k++) {
         double t[3] = { 0.5, 0.5, 0.5 }, N[8], y[3] = { 0, 0, 0 }, v[3] = { 0, 0, 0 };
         int ci = k < A->nc ? k : A->emb_cell[k - A->nc], c;
         if (k >= A->nc) memcpy(t, A->emb_t + 3 * (k - A->nc), sizeof t);
+        if (k < A->nc) {
+            double xc[3];
+            sb_cell_point(A, ci, t, xc);
+            if (!sb_inside_test(&in, xc)) continue;
+        }
         sb_shape(t, N, NULL);
         for (c = 0; c < 8; c++) {
             int v0 = A->cells[8 * ci + c];
@@ -809,6 +817,7 @@ static int resample(const sb_retarget *rt, const double *qbar, double *qB, sb_rt
         }
         add_sample(B, S, &ns, y, v);
     }
+    sb_inside_free(&in);
     if (!ns) {
         free(S); free(st); free(stw); free(b); free(x); free(r); free(d); free(Ad); free(dg); free(z); free(has);
         return sb_fail("retarget: empty overlap: no point of A's mapped lattice or surface lies in B's lattice (the map does not cover B)");

@@ -138,8 +138,8 @@ int sb_rt_rig_force(const sb_model *o, const char *names, double *Q, int *contro
 /* rig transfer (seed 003 §4.4): Q_A (nf_A x 3, N) -> q_A (eq. 10 on A) ->
  * qbar_i = J_i q_A,i at the mapped vertex h(x_i) -> B's lattice field q_B
  * (free vertices; skeleton vertices 0) fitted by least squares to the
- * transferred field sampled at A's mapped lattice vertices, cell centres and
- * surface vertices, with a small second-difference smoothing (B's lattice is
+ * transferred field sampled at A's mapped lattice vertices and cell centres
+ * inside A's mesh and at A's mapped surface vertices, with a small second-difference smoothing (B's lattice is
  * its own grid, not h(K) as in the paper) -> Q_B = S_FF q_B (nf_B x 3, N).
  * An empty overlap (no sample inside B's lattice) is an error. qA, qB (nv x 3, mesh units of
  * A and B) out if non-NULL. Needs sb_rt_jacobians. 0 or -1. */

@@ -148,3 +148,12 @@ SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS)
               $(patsubst %,$(EX)/sheet_%_float.blob,$(SHEET_VARIANTS))
 all: $(SHEET_BLOBS)
 TEST_DEPS += $(SHEET_BLOBS)
+
+# ---- sinew-retarget (seed 003 §4.4; tools/sb_retarget_cli.c): rigs carried between characters ----
+RETARGET = $(BUILD)/sinew-retarget
+$(BUILD)/tools/static/sb_retarget_cli.o: tools/sb_retarget_cli.c $(STATIC_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
+$(RETARGET): $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(TOOLS_LIB) $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
+	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o $(TOOLS_LIB) -lm
+all: $(RETARGET)
