@@ -157,3 +157,4 @@ $(BUILD)/tools/static/sb_retarget_cli.o: tools/sb_retarget_cli.c $(STATIC_HDR)
 $(RETARGET): $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(TOOLS_LIB) $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
 	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o $(TOOLS_LIB) -lm
 all: $(RETARGET)
+TEST_DEPS += $(RETARGET)
