@@ -1,6 +1,6 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h tools/sb_lbfgsb.h runtime/src/sn_format.h
@@ -41,6 +41,15 @@ $(BUILD)/tools/sinew_bake.o: tools/sb_static.h
 
 $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_bake.o $(STATIC_OBJ) $(TOOLS_LIB) -lm
+
+# sinew-rig (issue 11): rig fitting on the double-precision reference model,
+# tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
+FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
+$(FIT_OBJ): tools/sb_fit.h
+$(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -Itests -o $@ $< $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+TEST_BINS += $(BUILD)/tests/test_rigfit
 
 # ---- baked examples ----
 EX = $(BUILD)/examples
