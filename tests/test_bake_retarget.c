@@ -244,8 +244,8 @@ int main(void)
         {
             FILE *f1, *f2;
             int same = 1, c1, c2;
-            T_CHECK(sb_rt_write_rig(path_in("r1.rig"), &cb.o, "bump", "c", QB, "# test\n") == 0, "write rig: %s", sb_error());
-            T_CHECK(sb_rt_write_rig(path_in("r2.rig"), &cb.o, "bump", "c", QB, "# test\n") == 0, "write rig: %s", sb_error());
+            T_CHECK(sb_rt_write_rig(path_in("r1.rig"), &cb.o, &cb.m, QB, "test") == 0, "write rig: %s", sb_error());
+            T_CHECK(sb_rt_write_rig(path_in("r2.rig"), &cb.o, &cb.m, QB, "test") == 0, "write rig: %s", sb_error());
             f1 = fopen(path_in("r1.rig"), "rb"); f2 = fopen(path_in("r2.rig"), "rb");
             if (f1 && f2) {
                 do { c1 = fgetc(f1); c2 = fgetc(f2); if (c1 != c2) same = 0; } while (c1 != EOF && c2 != EOF);
@@ -253,8 +253,30 @@ int main(void)
             if (f1) fclose(f1);
             if (f2) fclose(f2);
             T_CHECK(same, "the rig file is the same bytes twice");
+            {   /* B's description including the file (rig_file): the baked rig gives the same shape */
+                sb_rt_char cr;
+                double *Qr = calloc(3 * (size_t)cb.o.nf, sizeof(double)), *qr = calloc(3 * (size_t)cb.o.nv, sizeof(double));
+                double *sr = malloc(sizeof(double) * 3 * (size_t)cb.o.ns), e = 0;
+                write_desc(path_in("br.sinew"), "b.obj", 1, 1, "control c\nrig_file bump r1.rig c\n");
+                T_CHECK(sb_rt_char_load(path_in("br.sinew"), &cr) == 0, "B with rig_file: %s", sb_error());
+                if (cr.loaded) {
+                    T_CHECK(cr.o.nrig == 1 && cr.o.nf == cb.o.nf, "one rig baked, same lattice");
+                    if (cr.o.nrig == 1 && cr.o.nf == cb.o.nf) {
+                        for (k = 0; k < cr.o.rig[0].n; k++)
+                            for (a = 0; a < 3; a++) Qr[3 * cr.o.rig[0].vert[k] + a] = cr.o.rig[0].Q[3 * k + a];
+                        sb_rt_static(&cr.o, Qr, qr);
+                        sb_rt_surface(&cr.o, qr, sr);
+                        for (k = 0; k < cb.o.ns; k++)
+                            for (a = 0; a < 3; a++) e = fmax(e, fabs(sr[3 * k + a] - sB1[3 * k + a]));
+                        T_FIGURE("rig_file round trip: baked rig moves B's surface within %.2e of the transferred shape (%.2e of its largest displacement)", e, e / dmax);
+                        T_CHECK(e <= 1e-6 * dmax, "rig_file round trip within 1e-6 of the displacement (%.3g)", e / dmax);
+                    }
+                    sb_rt_char_free(&cr);
+                }
+                free(Qr); free(qr); free(sr);
+            }
             memset(QB, 0, sizeof(double) * 3 * (size_t)cb.o.nf);
-            T_CHECK(sb_rt_write_rig(path_in("r0.rig"), &cb.o, "bump", "c", QB, NULL) != 0, "a zero rig is refused");
+            T_CHECK(sb_rt_write_rig(path_in("r0.rig"), &cb.o, &cb.m, QB, NULL) != 0, "a zero rig is refused");
             T_CHECK(access(path_in("r0.rig"), F_OK) != 0, "nothing written for a zero rig");
             printf("  message: %s\n", sb_error());
         }

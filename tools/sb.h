@@ -84,7 +84,7 @@ typedef struct sb_control {
     double value0;      /* ABSTRACT: value after init/reset (public units) */
     int line;
 } sb_control;
-enum { SB_TPL_BUMP = 0, SB_TPL_RING = 1, SB_TPL_MUSCLE = 2, SB_TPL_UNIFORM = 3 };
+enum { SB_TPL_BUMP = 0, SB_TPL_RING = 1, SB_TPL_MUSCLE = 2, SB_TPL_UNIFORM = 3, SB_TPL_FILE = 4 };   /* FILE: 'rig_file' (a fitted force field) */
 #define SB_TAU_MAX 16
 typedef struct sb_rigdef {
     char name[SB_NAME_MAX];
@@ -100,6 +100,7 @@ typedef struct sb_rigdef {
     double tau_g[SB_TAU_MAX], tau_e[SB_TAU_MAX];
     int tau_line;       /* line of the tau samples (0: default) */
     int line;
+    char file[1024];    /* SB_TPL_FILE: the rig file, resolved relative to the description's directory */
 } sb_rigdef;
 
 /* segment meshes (seed 004 ch. 3-4; tools/DESCRIPTION.md "Segment meshes"):
@@ -292,6 +293,28 @@ void sb_rig_field(const sb_model *o, const sb_rig *r, const double p[3], double 
 /* tau_a(gamma): piecewise linear through the samples, clamped at the ends */
 double sb_rig_tau(const sb_rigdef *r, double gamma);
 const char *sb_rig_tpl_name(int tpl);
+
+/* ---- rig files (sb_rigfile.c; tools/DESCRIPTION.md "Rig files") ----
+ * A fitted generalized force field (seed 003 eq. 13) keyed by lattice rest positions. */
+typedef struct sb_rigfile {
+    int mesh_nv;            /* identity of the character: mesh vertex count and sb_mesh_crc */
+    uint32_t mesh_crc;
+    double cell, origin[3]; /* lattice the keys lie on (mesh units) */
+    int n;
+    double *x;              /* n x 3 rest positions, mesh units */
+    double *Q;              /* n x 3 forces at eta = 1, newtons, rest model axes */
+} sb_rigfile;
+/* CRC-32 of the mesh's vertex coordinates as little-endian IEEE doubles */
+uint32_t sb_mesh_crc(const sb_mesh *m);
+int sb_rigfile_read(const char *path, sb_rigfile *rf);
+void sb_rigfile_free(sb_rigfile *rf);
+/* write Q (o->nf x 3: per free vertex, newtons, rest model axes; zero rows left out) for
+ * model o baked from mesh m; comment lines (may hold newlines) go after the first line */
+int sb_rigfile_write(const char *path, const sb_model *o, const sb_mesh *m, const double *Q, const char *comment);
+/* the file's forces on o's free vertices: vert (o->nf ints) and Q (o->nf x 3) get the nout
+ * non-zero entries, increasing vertex order; ndrop: entries on no free vertex (skeleton or
+ * outside the lattice). Errors: another mesh, another cell, keys off the grid, nothing left. */
+int sb_rigfile_apply(const sb_rigfile *rf, const char *path, const sb_model *o, const sb_mesh *m, int *vert, double *Q, int *nout, int *ndrop);
 
 /* ---- external forces (sb_force.c) ---- */
 /* share profiles from the description's 'force' lines, per free vertex */

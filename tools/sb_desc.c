@@ -598,6 +598,38 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (tau_at >= 0 && tau_samples(c, tau_at + 1, &r)) return -1;
         GROW(d->rigs, d->nrig);
         d->rigs[d->nrig++] = r;
+    } else if (!strcmp(kw, "rig_file")) {   /* a fitted force field (sinew-rig; "Rig files") */
+        sb_rigdef r;
+        int nt_all = c->nt, tau_at = -1;
+        const char *slash;
+        size_t dl;
+        memset(&r, 0, sizeof r);
+        for (k = 1; k < c->nt; k++) if (!strcmp(c->tok[k], "tau")) { tau_at = k; break; }
+        if (tau_at >= 0) c->nt = tau_at;
+        if (c->nt != 4) {
+            int bad = c->nt;
+            c->nt = nt_all;
+            return sb_fail("%s:%d: %s: 'rig_file NAME FILE CONTROL [tau G1 E1 ...]'", c->path, c->line, bad < 4 ? "missing value" : "too many values");
+        }
+        c->nt = nt_all;
+        if (strlen(c->tok[1]) >= SB_NAME_MAX) return sb_fail("%s:%d: rig names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
+        if (find_rig(d, c->tok[1]) >= 0) return sb_fail("%s:%d: rig '%s' declared twice", c->path, c->line, c->tok[1]);
+        if (d->nrig >= 4096) return sb_fail("%s:%d: more than 4096 rigs", c->path, c->line);
+        strcpy(r.name, c->tok[1]);
+        r.line = c->line;
+        r.tpl = SB_TPL_FILE;
+        r.s = 1;
+        slash = strrchr(d->path, '/');
+        dl = slash ? (size_t)(slash - d->path + 1) : 0;
+        if (c->tok[2][0] == '/') dl = 0;
+        if (dl + strlen(c->tok[2]) + 1 > sizeof r.file) return sb_fail("%s:%d: rig file path too long", c->path, c->line);
+        memcpy(r.file, d->path, dl);
+        strcpy(r.file + dl, c->tok[2]);
+        r.control = find_ctl(d, c->tok[3]);
+        if (r.control < 0) return sb_fail("%s:%d: unknown control '%s' (declare controls before the rigs that use them)", c->path, c->line, c->tok[3]);
+        if (tau_at >= 0 && tau_samples(c, tau_at + 1, &r)) return -1;
+        GROW(d->rigs, d->nrig);
+        d->rigs[d->nrig++] = r;
     } else if (!strcmp(kw, "tau")) {
         int ri;
         if (c->nt < 2) return sb_fail("%s:%d: missing value: 'tau RIG GAMMA1 ETA1 [GAMMA2 ETA2 ...]'", c->path, c->line);

@@ -931,30 +931,14 @@ int sb_rt_transfer(const sb_retarget *rt, const double *QA, double *QB, double *
 
 /* ---------------- output ---------------- */
 
-int sb_rt_write_rig(const char *path, const sb_model *B, const char *name, const char *control, const double *Q, const char *comment)
+int sb_rt_write_rig(const char *path, const sb_model *B, const sb_mesh *mB, const double *Q, const char *comment)
 {
-    size_t cap = 4096 + (comment ? strlen(comment) : 0) + (size_t)B->nf * 160, n = 0;
-    char *buf = sb_alloc(cap);
     double qmax = 0;
-    int i, nent = 0, rc;
-    for (i = 0; i < B->nf; i++) qmax = fmax(qmax, sqrt(dot3(Q + 3 * i, Q + 3 * i)));
-    if (!(qmax > 0) || !isfinite(qmax)) { free(buf); return sb_fail("retarget: the rig force is zero or not finite: nothing written"); }
-    if (comment) n += (size_t)snprintf(buf + n, cap - n, "%s", comment);
-    n += (size_t)snprintf(buf + n, cap - n,
-                          "# generalized force per free lattice vertex of the character (newtons, rest model axes, at eta = 1),\n"
-                          "# vertex named by its rest position (mesh units); entries below 1e-9 of the largest dropped\n"
-                          "field_rig %s %s\n"
-                          "lattice cell %.17g origin %.17g %.17g %.17g free %d\n",
-                          name, control, B->c, B->gorg[0], B->gorg[1], B->gorg[2], B->nf);
-    for (i = 0; i < B->nf; i++) {
-        const double *q = Q + 3 * i;
-        if (sqrt(dot3(q, q)) < 1e-9 * qmax) continue;
-        n += (size_t)snprintf(buf + n, cap - n, "f %.17g %.17g %.17g  %.17g %.17g %.17g\n", B->x[3 * i], B->x[3 * i + 1], B->x[3 * i + 2],
-                              q[0], q[1], q[2]);
-        nent++;
+    int i;
+    for (i = 0; i < 3 * B->nf; i++) {
+        if (!isfinite(Q[i])) return sb_fail("retarget: the rig force is not finite: nothing written");
+        qmax = fmax(qmax, fabs(Q[i]));
     }
-    n += (size_t)snprintf(buf + n, cap - n, "end %d\n", nent);
-    rc = sb_write_file(path, (const unsigned char *)buf, n);
-    free(buf);
-    return rc;
+    if (!(qmax > 0)) return sb_fail("retarget: the rig force is zero: nothing written");
+    return sb_rigfile_write(path, B, mB, Q, comment);
 }

@@ -150,9 +150,11 @@ typedef struct sb_rt_transfer_stats {
 } sb_rt_transfer_stats;
 int sb_rt_transfer(const sb_retarget *rt, const double *QA, double *QB, double *qA, double *qB, sb_rt_transfer_stats *st);
 
-/* Write a generalized-force rig of B as a text file (tools/DESCRIPTION.md
- * "Field rigs"): one function so the format can follow the rig fitter's.
- * Deterministic (%.17g). 0 or -1 (sb_error; nothing written). */
-int sb_rt_write_rig(const char *path, const sb_model *B, const char *name, const char *control, const double *Q, const char *comment);
+/* Write a generalized-force rig of B (Q: nf_B x 3, newtons, at eta = 1) as a
+ * rig file (tools/sb_rigfile.c, DESCRIPTION.md "Rig files": keyed by lattice
+ * rest positions, with B's mesh identity), which B's description includes
+ * with 'rig_file NAME FILE CONTROL'. comment: lines written as '# ...'.
+ * Refuses a zero or non-finite force. 0 or -1 (sb_error; nothing written). */
+int sb_rt_write_rig(const char *path, const sb_model *B, const sb_mesh *mB, const double *Q, const char *comment);
 
 #endif /* SB_RETARGET_H */

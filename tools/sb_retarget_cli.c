@@ -27,10 +27,11 @@ static void usage(FILE *f, const char *prog)
             "by minimizing w_skel C_skel + w_surf C_surf + C_distort (eq. 15; joints matched by name, every\n"
             "joint of A must exist in B), estimates the map's Jacobian J_i at every lattice vertex (eq. 16),\n"
             "and transfers the rigs' generalized force: Q_A -> q_A (static equilibrium at rest, eq. 10) ->\n"
-            "J_i q_A,i -> B's lattice -> Q_B = K_B q_B. Writes Q_B as a field rig (tools/DESCRIPTION.md).\n"
+            "J_i q_A,i -> B's lattice -> Q_B = K_B q_B. Writes Q_B as a rig file (tools/DESCRIPTION.md \"Rig\n"
+            "files\") that B's description includes with 'rig_file NAME FILE CONTROL'.\n"
             "  --rig LIST        rigs of A, comma-separated, summed at eta = 1 (e.g. smile_l,smile_r)\n"
             "  -o OUT.rig        the rig of B (written to OUT.rig.tmp, then renamed)\n"
-            "  --name NAME       name of the rig in the file (default: the first rig's name)\n"
+            "  --name NAME       the rig's name in the printed rig_file line (default: the first rig's name)\n"
             "  --control NAME    control of B driving it (default: the first rig's control in A)\n"
             "  --w-skel W        weight of C_skel (default 100)\n"
             "  --w-surf W        weight of C_surf (default 100)\n"
@@ -246,11 +247,13 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
     {
         char head[4096];
         snprintf(head, sizeof head,
-                 "# retargeted rig (seed 003 §4.4): rigs %s of %s carried to %s\n# w_skel %g, w_surf %g, %s correspondence\n"
-                 "# map residuals (B mesh units): skeleton rms %.6g max %.6g, surface rms %.6g max %.6g; distortion %.6g\n",
-                 rigs, pa, pb, opt.w_skel, opt.w_surf, rt.corr == SB_RT_CORR_VERTEX ? "vertex" : "closest-point", rt.skel_rms, rt.skel_max,
-                 rt.surf_rms, rt.surf_max, rt.c_dist);
-        if (sb_rt_write_rig(out, &B.o, name, control, QB, head)) { fprintf(stderr, "%s: error: %s\n", prog, sb_error()); goto done; }
+                 "retargeted (sinew-retarget, seed 003 §4.4): rigs %s of %s carried to %s\n"
+                 "include in B's description: rig_file %s FILE %s\n"
+                 "w_skel %g, w_surf %g, %s correspondence, %d rounds\n"
+                 "map residuals (B mesh units): skeleton rms %.6g max %.6g, surface rms %.6g max %.6g; distortion %.6g",
+                 rigs, pa, pb, name, control, opt.w_skel, opt.w_surf, rt.corr == SB_RT_CORR_VERTEX ? "vertex" : "closest-point", rt.rounds,
+                 rt.skel_rms, rt.skel_max, rt.surf_rms, rt.surf_max, rt.c_dist);
+        if (sb_rt_write_rig(out, &B.o, &B.m, QB, head)) { fprintf(stderr, "%s: error: %s\n", prog, sb_error()); goto done; }
     }
     if (mapobj) {
         FILE *f = fopen(mapobj, "w");
@@ -313,6 +316,7 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
         free(a0); free(a1); free(b0); free(b1);
         if (!ok) { remove(out); if (mapobj) remove(mapobj); fprintf(stderr, "%s: the picture failed: nothing kept\n", prog); goto done; }
     }
+    if (!quiet) printf("retarget: include it in %s with: rig_file %s %s %s\n", pb, name, out, control);
     if (!quiet) printf("retarget: wrote %s%s%s%s%s (%.2f s in all)\n", out, png ? " and " : "", png ? png : "", mapobj ? " and " : "", mapobj ? mapobj : "",
                        sb_now() - t0);
     rc = 0;

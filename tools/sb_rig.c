@@ -33,8 +33,8 @@
 
 const char *sb_rig_tpl_name(int tpl)
 {
-    static const char *n[4] = {"bump", "ring", "muscle", "uniform"};
-    return tpl >= 0 && tpl < 4 ? n[tpl] : "?";
+    static const char *n[5] = {"bump", "ring", "muscle", "uniform", "file"};
+    return tpl >= 0 && tpl < 5 ? n[tpl] : "?";
 }
 
 double sb_rig_tau(const sb_rigdef *r, double g)
@@ -249,6 +249,7 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
         double centre[3];
         int mat = 0, r;
         rg->def = d->rigs[a];
+        if (rg->def.tpl == SB_TPL_FILE) continue;   /* a fitted field: read below */
         rig_geometry(o, rg, centre);
         for (r = 0; r < d->nmr; r++) if (sb_region_has(o, &d->mrules[r].r, centre)) mat = d->mrules[r].mat;
         rg->E_ref = d->mats[mat].E;
@@ -265,6 +266,29 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
         sb_rig *rg = &o->rig[a];
         double *Qv = sb_alloc(sizeof(double) * 3 * (size_t)o->nv), qmax = 0, qall = 0, hb = o->c / (2 * n), lmin = rig_feature(rg);
         int ne = 0, rr;
+        if (rg->def.tpl == SB_TPL_FILE) {   /* 'rig_file': a fitted force field (sb_rigfile.c) */
+            sb_rigfile rf;
+            int drop = 0;
+            free(Qv);
+            rg->vert = sb_alloc(sizeof(int) * (size_t)(o->nf ? o->nf : 1));
+            rg->Q = sb_alloc(sizeof(double) * 3 * (size_t)(o->nf ? o->nf : 1));
+            if (sb_rigfile_read(rg->def.file, &rf) || sb_rigfile_apply(&rf, rg->def.file, o, m, rg->vert, rg->Q, &rg->n, &drop)) {
+                char msg[2048];
+                snprintf(msg, sizeof msg, "%s", sb_error());
+                sb_rigfile_free(&rf); free(need); free(F.slot); free(F.frac);
+                return sb_fail("%s:%d: rig '%s': %s", d->path, rg->def.line, rg->def.name, msg);
+            }
+            if (drop)
+                fprintf(stderr, "sinew-bake: warning: %s:%d: rig '%s': %d of the %d forces of '%s' fall on no free lattice vertex "
+                        "(skeleton or outside this lattice) and are dropped\n", d->path, rg->def.line, rg->def.name, drop, rf.n, rg->def.file);
+            for (i = 0; i < rg->n; i++) {
+                rg->qmax = fmax(rg->qmax, sqrt(dot3(rg->Q + 3 * i, rg->Q + 3 * i)));
+                for (k = 0; k < 3; k++) rg->total[k] += rg->Q[3 * i + k];
+            }
+            rg->E_ref = 0; rg->L_ref = 0; rg->amp = 0; rg->refine = 0;
+            sb_rigfile_free(&rf);
+            continue;
+        }
         /* refinement: each quadrature box (edge hb = c/2n, inside fraction frac_q) split
          * into rr^3 mini-boxes with 2x2x2 Gauss points each so that the mini-box edge is
          * <= lmin/8: a rig can be much smaller than a cell (the cow's nostrils) */

@@ -213,6 +213,62 @@ static int joint_pose(const snref_model *m, const char *s, double *local) {
     return 0;
 }
 
+
+static int sb_static_pose_(snref_state *s, const snref_model *m, const char *spec, double *local, double root[3], char *what, size_t whatn) {
+    unsigned j, c;
+    for (j = 0; j < m->nJ; j++) local[4 * j + 3] = 1;
+    if (!strcmp(spec, "rest")) snprintf(what, whatn, "rest");
+    else {
+        const char *at = strrchr(spec, '@');
+        size_t n = strlen(spec);
+        int is_clip = (at && at - spec >= 5 && !strncmp(at - 5, ".clip", 5)) || (n >= 5 && !strcmp(spec + n - 5, ".clip"));
+        if (is_clip) {
+            char path[1024];
+            double t = 0;
+            size_t pl = at && !(n >= 5 && !strcmp(spec + n - 5, ".clip")) ? (size_t)(at - spec) : n;
+            if (pl >= sizeof path) { fprintf(stderr, PROG ": --static: clip path too long\n"); return 2; }
+            memcpy(path, spec, pl); path[pl] = 0;
+            if (pl < n && parse_num(spec + pl + 1, n - pl - 1, &t)) {
+                fprintf(stderr, PROG ": --static: '%s': the time after @ is not a number of seconds\n", spec + pl + 1);
+                return 2;
+            }
+            {
+                double *cval = calloc(m->nK + 1, sizeof *cval);
+                unsigned char *cset = calloc(m->nK + 1, 1);
+                int bad = !cval || !cset || clip_pose(m, path, t, local, root, what, whatn, cval, cset);
+                for (c = 0; !bad && c < m->nK; c++) /* the clip's tracks; --controls below overrides them */
+                    if (cset[c]) snref_set_control(s, c, cval[c]);
+                free(cval);
+                free(cset);
+                if (bad) return 2;
+            }
+        } else {
+            if (joint_pose(m, spec, local)) return 2;
+            snprintf(what, whatn, "%s", spec);
+        }
+    }
+    return 0;
+}
+
+/* POSE (as --static takes it) -> per-joint transforms (nJ) and local rotations
+ * (nJ x 4, x y z w; may be NULL); a clip's control tracks set s's abstract
+ * controls. 0, or 2 with a message (sb_static.h). */
+int sb_static_pose(snref_state *s, const char *spec, snref_xform *pose, double *local_out, char *what, size_t whatn) {
+    const snref_model *m = s->m;
+    double *local = calloc(4 * (size_t)m->nJ + 4, sizeof *local), root[3] = { 0, 0, 0 };
+    int rc;
+    if (!local) { fprintf(stderr, PROG ": out of memory\n"); return 2; }
+    rc = sb_static_pose_(s, m, spec, local, root, what, whatn);
+    if (!rc) {
+        pose_from_local(m, local, root, pose);
+        if (local_out) memcpy(local_out, local, 4 * (size_t)m->nJ * sizeof *local);
+    }
+    free(local);
+    return rc;
+}
+
+void sb_pose_from_local(const snref_model *m, const double *local, const double root[3], snref_xform *out) { pose_from_local(m, local, root, out); }
+
 /* ---------------- controls ---------------- */
 
 static void list_controls(const snref_model *m) {
@@ -389,7 +445,7 @@ int sb_static_run(const char *desc, const sb_static_opts *opt) {
     snref_model m;
     snref_state s;
     snref_xform *pose = NULL;
-    double *local = NULL, root[3] = { 0, 0, 0 }, off[3], *s_on = NULL, *s_off = NULL, *skin = NULL, t0;
+    double *local = NULL, off[3], *s_on = NULL, *s_off = NULL, *skin = NULL, t0;
     char err[300], posewhat[1200], objpath[1024], pngpath[1100], ctlline[2048], *head = NULL;
     unsigned j, c;
     int rc = 1, q = opt->quiet;
@@ -422,37 +478,7 @@ int sb_static_run(const char *desc, const sb_static_opts *opt) {
     if (!local || !pose) { fprintf(stderr, PROG ": out of memory\n"); goto done; }
     for (j = 0; j < m.nJ; j++) local[4 * j + 3] = 1;
     rc = 2;
-    if (!strcmp(opt->pose, "rest")) snprintf(posewhat, sizeof posewhat, "rest");
-    else {
-        const char *at = strrchr(opt->pose, '@');
-        size_t n = strlen(opt->pose);
-        int is_clip = (at && at - opt->pose >= 5 && !strncmp(at - 5, ".clip", 5)) || (n >= 5 && !strcmp(opt->pose + n - 5, ".clip"));
-        if (is_clip) {
-            char path[1024];
-            double t = 0;
-            size_t pl = at && !(n >= 5 && !strcmp(opt->pose + n - 5, ".clip")) ? (size_t)(at - opt->pose) : n;
-            if (pl >= sizeof path) { fprintf(stderr, PROG ": --static: clip path too long\n"); goto done; }
-            memcpy(path, opt->pose, pl); path[pl] = 0;
-            if (pl < n && parse_num(opt->pose + pl + 1, n - pl - 1, &t)) {
-                fprintf(stderr, PROG ": --static: '%s': the time after @ is not a number of seconds\n", opt->pose + pl + 1);
-                goto done;
-            }
-            {
-                double *cval = calloc(m.nK + 1, sizeof *cval);
-                unsigned char *cset = calloc(m.nK + 1, 1);
-                int bad = !cval || !cset || clip_pose(&m, path, t, local, root, posewhat, sizeof posewhat, cval, cset);
-                for (c = 0; !bad && c < m.nK; c++) /* the clip's tracks; --controls below overrides them */
-                    if (cset[c]) snref_set_control(&s, c, cval[c]);
-                free(cval);
-                free(cset);
-                if (bad) goto done;
-            }
-        } else {
-            if (joint_pose(&m, opt->pose, local)) goto done;
-            snprintf(posewhat, sizeof posewhat, "%s", opt->pose);
-        }
-    }
-    pose_from_local(&m, local, root, pose);
+    if (sb_static_pose(&s, opt->pose, pose, local, posewhat, sizeof posewhat)) goto done;
     if (opt->controls && set_controls(&s, opt->controls)) goto done;
     snref_set_pose(&s, pose);
     /* the control values in effect */

@@ -19,4 +19,14 @@ typedef struct sb_static_opts {
  * controls). Nothing is written unless everything before the writing succeeded. */
 int sb_static_run(const char *desc, const sb_static_opts *opt);
 
+/* Shared with sinew-rig (tools/sb_fit.c); need snref.h. POSE as --static takes
+ * it -> per-joint transforms pose (nJ) and the local rotations (nJ x 4, x y z w,
+ * may be NULL); a clip's control tracks set s's abstract controls. 0, or 2
+ * with a message on stderr. */
+#ifdef SNREF_H
+int sb_static_pose(snref_state *s, const char *spec, snref_xform *pose, double *local, char *what, size_t whatn);
+/* local rotations (nJ x 4) and a root offset (mesh units) -> per-joint transforms, as sn_pose_from_local */
+void sb_pose_from_local(const snref_model *m, const double *local, const double root[3], snref_xform *out);
+#endif
+
 #endif

@@ -1,6 +1,6 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_retarget.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_retarget.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h tools/sb_lbfgsb.h tools/sb_retarget.h runtime/src/sn_format.h
@@ -41,6 +41,15 @@ $(BUILD)/tools/sinew_bake.o: tools/sb_static.h
 
 $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_bake.o $(STATIC_OBJ) $(TOOLS_LIB) -lm
+
+# sinew-rig (issue 11): rig fitting on the double-precision reference model,
+# tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
+FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
+$(FIT_OBJ): tools/sb_fit.h
+$(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -Itests -o $@ $< $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+TEST_BINS += $(BUILD)/tests/test_rigfit
 
 # ---- baked examples ----
 EX = $(BUILD)/examples
@@ -157,4 +166,10 @@ $(BUILD)/tools/static/sb_retarget_cli.o: tools/sb_retarget_cli.c $(STATIC_HDR)
 $(RETARGET): $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(TOOLS_LIB) $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
 	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o $(TOOLS_LIB) -lm
 all: $(RETARGET)
+# Spot (tools/examples/spot): the retargeting target, with the cow's smile as a rig file
+SPOT_DEPS = tools/examples/spot/spot.sinew tools/examples/spot/spot.obj tools/examples/spot/spot_smile.rig $(BAKE)
+$(EX)/spot.blob: $(SPOT_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/spot/spot.sinew -o $@ --quiet
+all: $(EX)/spot.blob
 TEST_DEPS += $(RETARGET)

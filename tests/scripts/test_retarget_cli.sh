@@ -23,13 +23,18 @@ SPOT=tools/examples/spot/spot.sinew
 grep -q "^retarget: round  1 cost" "$T/a.out" && ok "progress lines (round, cost, |grad|)" || bad "progress lines"
 grep -q "^retarget: residuals" "$T/a.out" && grep -q "^retarget: transfer:" "$T/a.out" && ok "summary (residuals, transfer)" || bad "summary"
 grep "^retarget: \(map\|residuals\|transfer\)" "$T/a.out" | sed 's/^/  figure: /'
-grep -q "^field_rig smile smile$" "$T/a.rig" && grep -q "^end [0-9]*$" "$T/a.rig" && ok "rig file header and end" || bad "rig file"
+grep -q "^sinew-rig 1$" "$T/a.rig" && grep -q "^end$" "$T/a.rig" && grep -q "rig_file smile FILE smile" "$T/a.rig" && ok "rig file (sinew-rig 1) with its rig_file line" || bad "rig file"
 "$RT" "$COW" "$SPOT" --rig smile_l,smile_r --name smile --w-surf 1000 -o "$T/b.rig" --png "$T/b.png" --quiet > "$T/b.out" 2>&1
 [ ! -s "$T/b.out" ] && ok "--quiet prints nothing" || bad "--quiet printed: $(head -c 200 "$T/b.out")"
 cmp -s "$T/a.rig" "$T/b.rig" && cmp -s "$T/a.png" "$T/b.png" && ok "two runs write the same bytes (rig and picture)" || bad "two runs differ"
+cmp -s "$T/a.rig" tools/examples/spot/spot_smile.rig && ok "tools/examples/spot/spot_smile.rig is this run's output" ||
+    bad "tools/examples/spot/spot_smile.rig differs from a fresh run (regenerate: tools/examples/spot/SOURCE.md)"
+"$BUILD/sinew-bake" "$SPOT" --static rest --controls smile=1 -o "$T/st.obj" > "$T/st.out" 2>&1 &&
+    grep -q "rigs move the surface by up to 0.031" "$T/st.out" && ok "spot bakes with the rig file; --static moves it 0.031 as transferred" ||
+    { bad "spot --static with the retargeted rig"; cat "$T/st.out"; }
 
 # B without the tail tip: A's joint tail_tip is missing
-mkdir -p "$T/s"; cp tools/examples/spot/spot.obj "$T/s/"
+mkdir -p "$T/s"; cp tools/examples/spot/spot.obj tools/examples/spot/spot_smile.rig "$T/s/"
 grep -v "^joint tail_tip" "$SPOT" > "$T/s/spot.sinew"
 "$RT" "$COW" "$T/s/spot.sinew" --rig smile_l -o "$T/m.rig" > "$T/m.out" 2>&1; rc=$?
 [ $rc -ne 0 ] && grep -q "tail_tip" "$T/m.out" && [ ! -e "$T/m.rig" ] && ok "a joint missing in B is named, exit $rc, nothing written" || { bad "missing joint"; cat "$T/m.out"; }

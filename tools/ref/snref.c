@@ -1373,5 +1373,13 @@ void snref_solve_load(snref_state *s, const double *load, double *x) {
     band_free(B);
 }
 
+struct snref_band *snref_factor(snref_state *s) { return band_build(s, 0, 0.0, (size_t)60000000); }
+void snref_factor_solve(const struct snref_band *B, const double *load, double *x) {
+    memset(x, 0, 3 * (size_t)B->nF * sizeof *x);
+    band_solve(B, load, x);
+}
+void snref_factor_free(struct snref_band *B) { band_free(B); }
+void snref_hess_mul(const snref_state *s, const double *x, double *y) { hess_mul(s, x, y); }
+
 /* y = M^_FF x (free rows, free columns). */
 void snref_mass_mul(const snref_state *s, const double *x, double *y) { mass_mul(s, x, y, 0); }

@@ -168,6 +168,14 @@ double snref_static(snref_state *s, unsigned dense_max);
  * rows, internal units). Used for eigen-frequencies. */
 void snref_solve_load(snref_state *s, const double *load, double *x);
 void snref_mass_mul(const snref_state *s, const double *x, double *y);
+/* The same solve for many loads at fixed frames (rig fitting, tools/sb_fit.c):
+ * H factored once (banded LU, reverse Cuthill-McKee); NULL if the band is
+ * too large (then use snref_solve_load). snref_hess_mul: y = H x (free rows
+ * and columns), the matrix the factor inverts. */
+struct snref_band *snref_factor(snref_state *s);
+void snref_factor_solve(const struct snref_band *B, const double *load, double *x);
+void snref_factor_free(struct snref_band *B);
+void snref_hess_mul(const snref_state *s, const double *x, double *y);
 
 /* Net force residual f + m^g^ [- m^ R g^] + f_rig (internal units) at the current positions, free rows. */
 void snref_residual(const snref_state *s, double *out);
