@@ -341,6 +341,21 @@ int main(void)
         free(Q);
     }
     printf("  message: %s\n", sb_error());
+    opt.skip = "wrist";
+    T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cm.o, &cm.m, &opt) == 0, "the missing joint skipped: %s", sb_error());
+    if (rt.h) { T_CHECK(rt.njm == 2, "two joints matched (%d)", rt.njm); sb_rt_free(&rt); }
+    opt.skip = NULL;
+    opt.joint_map = "wrist=elbow,elbow=shoulder";   /* a map onto other names (here a wrong one, but legal) */
+    T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) == 0, "joint map: %s", sb_error());
+    if (rt.h) {
+        T_CHECK(rt.njm == 3 && !strcmp(cb.o.joints[rt.jB[2]].name, "elbow") && !strcmp(cb.o.joints[rt.jB[1]].name, "shoulder"),
+                "wrist -> elbow, elbow -> shoulder");
+        sb_rt_free(&rt);
+    }
+    opt.joint_map = "wrist=hand";
+    T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) != 0 && strstr(sb_error(), "hand"), "a map to a joint B lacks is named: %s", sb_error());
+    printf("  message: %s\n", sb_error());
+    opt.joint_map = NULL;
     opt.w_skel = NAN;
     T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) != 0, "a non-finite weight is refused");
     printf("  message: %s\n", sb_error());

@@ -50,6 +50,8 @@ void sb_rt_defaults(sb_rt_opts *o)
     o->cg_tol = 1e-10;
     o->optimizer = SB_RT_OPT_CG;
     o->verbose = 0;
+    o->joint_map = NULL;
+    o->skip = NULL;
 }
 
 /* ---------------- small helpers ---------------- */
@@ -126,6 +128,65 @@ static int find_joint(const sb_model *o, const char *name)
     return -1;
 }
 
+/* is name an item of the comma list? (for "a=b" items, the part before '=') */
+static const char *list_find(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    const char *p = list;
+    while (p && *p) {
+        const char *e = strchr(p, ','), *eq;
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        eq = memchr(p, '=', l);
+        if ((size_t)((eq ? eq : p + l) - p) == n && !strncmp(p, name, n)) return p;
+        p = e ? e + 1 : NULL;
+    }
+    return NULL;
+}
+
+/* B's joint matched to A's joint j: -1 skipped, -2 missing */
+static int match_joint(const sb_model *A, const sb_model *B, const sb_rt_opts *opt, int j)
+{
+    const char *nm = A->joints[j].name, *it;
+    char buf[SB_NAME_MAX];
+    int jb;
+    if (opt->skip && list_find(opt->skip, nm)) return -1;
+    if (opt->joint_map && (it = list_find(opt->joint_map, nm)) != NULL) {
+        const char *eq = strchr(it, '='), *e = strchr(it, ',');
+        size_t l;
+        if (!eq || (e && eq > e)) return -2;
+        l = e ? (size_t)(e - eq - 1) : strlen(eq + 1);
+        if (l >= sizeof buf) return -2;
+        memcpy(buf, eq + 1, l); buf[l] = 0;
+        nm = buf;
+    }
+    jb = find_joint(B, nm);
+    return jb < 0 ? -2 : jb;
+}
+
+/* every item of a joint list names a joint of A (the part before '=') and, for a map, of B (after) */
+static int check_list(const sb_model *A, const sb_model *B, const char *list, const char *what)
+{
+    const char *p = list;
+    while (p && *p) {
+        const char *e = strchr(p, ','), *eq;
+        size_t l = e ? (size_t)(e - p) : strlen(p), la;
+        char a[SB_NAME_MAX + 1], b[SB_NAME_MAX + 1];
+        eq = memchr(p, '=', l);
+        la = eq ? (size_t)(eq - p) : l;
+        if (la == 0 || la > SB_NAME_MAX) return sb_fail("retarget: %s: bad item '%.*s'", what, (int)l, p);
+        memcpy(a, p, la); a[la] = 0;
+        if (find_joint(A, a) < 0) return sb_fail("retarget: %s: A has no joint '%s'", what, a);
+        if (B && eq) {
+            size_t lb = l - la - 1;
+            if (lb == 0 || lb > SB_NAME_MAX) return sb_fail("retarget: %s: bad item '%.*s'", what, (int)l, p);
+            memcpy(b, eq + 1, lb); b[lb] = 0;
+            if (find_joint(B, b) < 0) return sb_fail("retarget: %s: B has no joint '%s'", what, b);
+        } else if (B) return sb_fail("retarget: %s: '%.*s' is not A_JOINT=B_JOINT", what, (int)l, p);
+        p = e ? e + 1 : NULL;
+    }
+    return 0;
+}
+
 /* affine least squares G p + g ~ pbar over the skeleton sample points, with a
  * small pull towards the isotropic scale s (so collinear skeletons still give
  * a unique map): rows of G independent, 4x4 normal equations per row */
@@ -192,8 +253,10 @@ int sb_rt_init(sb_retarget *rt, const sb_model *A, const sb_mesh *mA, const sb_m
     miss[0] = 0;
     rt->jA = sb_alloc(sizeof(int) * (size_t)A->nj);
     rt->jB = sb_alloc(sizeof(int) * (size_t)A->nj);
+    if (check_list(A, B, opt->joint_map, "joint map") || check_list(A, NULL, opt->skip, "skipped joints")) { sb_rt_free(rt); return -1; }
     for (j = 0; j < A->nj; j++) {
-        int jb = find_joint(B, A->joints[j].name);
+        int jb = match_joint(A, B, opt, j);
+        if (jb == -1) continue;
         if (jb < 0) {
             size_t l = strlen(miss);
             if (l + SB_NAME_MAX + 4 < sizeof miss) snprintf(miss + l, sizeof miss - l, "%s%s", nmiss ? ", " : "", A->joints[j].name);
@@ -202,7 +265,11 @@ int sb_rt_init(sb_retarget *rt, const sb_model *A, const sb_mesh *mA, const sb_m
         }
         rt->jA[rt->njm] = j; rt->jB[rt->njm] = jb; rt->njm++;
     }
-    if (nmiss) { sb_rt_free(rt); return sb_fail("retarget: %d joint(s) of A have no joint of the same name in B: %s", nmiss, miss); }
+    if (nmiss) {
+        sb_rt_free(rt);
+        return sb_fail("retarget: %d joint(s) of A have no joint of the same name in B: %s (match them to other names or skip them)", nmiss, miss);
+    }
+    if (rt->njm < 1) { sb_rt_free(rt); return sb_fail("retarget: no joint of A is matched to B"); }
     rt->LA = bbox_diag(mA);
     rt->L = bbox_diag(mB);
     if (!(rt->L > 0 && rt->LA > 0)) { sb_rt_free(rt); return sb_fail("retarget: a character's surface has an empty bounding box"); }
@@ -226,7 +293,7 @@ int sb_rt_init(sb_retarget *rt, const sb_model *A, const sb_mesh *mA, const sb_m
     for (k = 0; k < rt->njm; k++) {
         int pa = A->joints[rt->jA[k]].parent, pb;
         if (pa < 0) continue;
-        pb = find_joint(B, A->joints[pa].name);
+        pb = match_joint(A, B, opt, pa);
         if (pb < 0) continue;
         for (i = 1; i <= nb; i++) {
             double u = (double)i / (nb + 1);

@@ -70,6 +70,8 @@ typedef struct sb_rt_opts {
     double cg_tol;          /* CG stops at |grad| <= cg_tol |grad at the round's start| */
     int optimizer;          /* SB_RT_OPT_CG (default) or SB_RT_OPT_LBFGSB (tools/sb_lbfgsb.c, unbounded, same stopping rule) */
     int verbose;            /* progress lines on stdout */
+    const char *joint_map;  /* "A_JOINT=B_JOINT,..." : joints of A matched to a B joint of another name (NULL: none) */
+    const char *skip;       /* "A_JOINT,..." : joints of A left out of C_skel (NULL: none) */
 } sb_rt_opts;
 enum { SB_RT_OPT_CG = 0, SB_RT_OPT_LBFGSB = 1 };
 void sb_rt_defaults(sb_rt_opts *o);
@@ -108,8 +110,9 @@ typedef struct sb_retarget {
     double *J;              /* nv x 9 row-major (sb_rt_jacobians) */
 } sb_retarget;
 
-/* Set up A -> B: match joints by name (every joint of A must exist in B, else
- * an error naming the missing ones), sample the skeleton, build the
+/* Set up A -> B: match joints by name (every joint of A not in opt->skip must
+ * exist in B under its own name or the name opt->joint_map gives it, else an
+ * error naming the missing ones), sample the skeleton, build the
  * distortion stencils, initial h = the affine least-squares fit of A's
  * skeleton samples to B's. 0 or -1 (sb_error). */
 int sb_rt_init(sb_retarget *rt, const sb_model *A, const sb_mesh *mA, const sb_model *B, const sb_mesh *mB, const sb_rt_opts *opt);

@@ -25,7 +25,8 @@ static void usage(FILE *f, const char *prog)
             "usage: %s A.sinew B.sinew --rig NAME[,NAME...] -o OUT.rig [options]\n"
             "Carries rigs of character A to character B (seed 003 §4.4): maps A's control lattice onto B\n"
             "by minimizing w_skel C_skel + w_surf C_surf + C_distort (eq. 15; joints matched by name, every\n"
-            "joint of A must exist in B), estimates the map's Jacobian J_i at every lattice vertex (eq. 16),\n"
+            "joint of A must exist in B unless --joints/--skip say otherwise), estimates the map's Jacobian\n"
+            "J_i at every lattice vertex (eq. 16),\n"
             "and transfers the rigs' generalized force: Q_A -> q_A (static equilibrium at rest, eq. 10) ->\n"
             "J_i q_A,i -> B's lattice -> Q_B = K_B q_B. Writes Q_B as a rig file (tools/DESCRIPTION.md \"Rig\n"
             "files\") that B's description includes with 'rig_file NAME FILE CONTROL'.\n"
@@ -33,6 +34,8 @@ static void usage(FILE *f, const char *prog)
             "  -o OUT.rig        the rig of B (written to OUT.rig.tmp, then renamed)\n"
             "  --name NAME       the rig's name in the printed rig_file line (default: the first rig's name)\n"
             "  --control NAME    control of B driving it (default: the first rig's control in A)\n"
+            "  --joints LIST     A_JOINT=B_JOINT,... : joints of A matched to B joints of other names\n"
+            "  --skip LIST       A_JOINT,... : joints of A left out of the skeleton match\n"
             "  --w-skel W        weight of C_skel (default 100)\n"
             "  --w-surf W        weight of C_surf (default 100)\n"
             "  --corr MODE       auto | vertex | closest: surface correspondence (auto: vertex when A and B\n"
@@ -166,6 +169,8 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
         else if (!strcmp(a, "--name")) name = v;
         else if (!strcmp(a, "--control")) control = v;
         else if (!strcmp(a, "--png")) png = v;
+        else if (!strcmp(a, "--joints")) opt.joint_map = v;
+        else if (!strcmp(a, "--skip")) opt.skip = v;
         else if (!strcmp(a, "--map-obj")) mapobj = v;
         else if (!strcmp(a, "--w-skel")) bad = parse_pos(v, &opt.w_skel);
         else if (!strcmp(a, "--w-surf")) bad = parse_pos(v, &opt.w_surf);
