@@ -409,41 +409,116 @@ done:
     return dot3(q, q);
 }
 
-/* closest point of a triangle soup (positions P, nt triangles T) to p: triangle index, weights */
-typedef struct tri_index { int nt; const int *tri; const double *P; double *box; } tri_index;
+/* closest point of a triangle soup (positions P, nt triangles): a uniform grid
+ * of buckets over the triangles' bounding boxes, searched in shells of cells
+ * around the query until the best distance is below the shell's reach */
+typedef struct tri_index {
+    int nt;
+    const int *tri;
+    const double *P;
+    double *box;            /* nt x 6 bounding boxes */
+    double lo[3], h;        /* grid corner and cell edge */
+    int n[3];               /* cells per axis */
+    int *start, *items;     /* CSR: triangles of each cell */
+} tri_index;
+
+static int gclamp(int v, int n) { return v < 0 ? 0 : v >= n ? n - 1 : v; }
 
 static void tri_index_make(tri_index *x, const double *P, const int *tri, int nt)
 {
-    int t, k, a;
+    double hi[3], ext = 0, vol = 1;
+    int t, k, a, ncell, *cnt;
+    memset(x, 0, sizeof *x);
     x->nt = nt; x->tri = tri; x->P = P;
     x->box = sb_alloc(sizeof(double) * 6 * (size_t)nt);
+    for (a = 0; a < 3; a++) { x->lo[a] = 1e300; hi[a] = -1e300; }
     for (t = 0; t < nt; t++)
         for (a = 0; a < 3; a++) {
-            double lo = 1e300, hi = -1e300;
-            for (k = 0; k < 3; k++) { double v = P[3 * tri[3 * t + k] + a]; if (v < lo) lo = v; if (v > hi) hi = v; }
-            x->box[6 * t + a] = lo; x->box[6 * t + 3 + a] = hi;
+            double lo = 1e300, hh = -1e300;
+            for (k = 0; k < 3; k++) { double v = P[3 * tri[3 * t + k] + a]; if (v < lo) lo = v; if (v > hh) hh = v; }
+            x->box[6 * t + a] = lo; x->box[6 * t + 3 + a] = hh;
+            if (lo < x->lo[a]) x->lo[a] = lo;
+            if (hh > hi[a]) hi[a] = hh;
         }
+    for (a = 0; a < 3; a++) { ext = fmax(ext, hi[a] - x->lo[a]); vol *= fmax(hi[a] - x->lo[a], 1e-300); }
+    /* about one triangle per cell, at most 64 cells per axis */
+    x->h = fmax(cbrt(vol / (nt > 0 ? nt : 1)), ext / 64);
+    if (!(x->h > 0)) x->h = 1;
+    for (a = 0; a < 3; a++) x->n[a] = gclamp((int)((hi[a] - x->lo[a]) / x->h) + 1, 65);
+    ncell = x->n[0] * x->n[1] * x->n[2];
+    x->start = sb_alloc(sizeof(int) * (size_t)(ncell + 1));
+    cnt = sb_alloc(sizeof(int) * (size_t)(ncell + 1));
+    for (k = 0; k < 2; k++) {   /* count, then fill */
+        for (t = 0; t < nt; t++) {
+            int c0[3], c1[3], i, j, l;
+            for (a = 0; a < 3; a++) {
+                c0[a] = gclamp((int)floor((x->box[6 * t + a] - x->lo[a]) / x->h), x->n[a]);
+                c1[a] = gclamp((int)floor((x->box[6 * t + 3 + a] - x->lo[a]) / x->h), x->n[a]);
+            }
+            for (l = c0[2]; l <= c1[2]; l++)
+                for (j = c0[1]; j <= c1[1]; j++)
+                    for (i = c0[0]; i <= c1[0]; i++) {
+                        int c = i + x->n[0] * (j + x->n[1] * l);
+                        if (k == 0) x->start[c + 1]++;
+                        else x->items[x->start[c] + cnt[c]++] = t;
+                    }
+        }
+        if (k == 0) {
+            for (t = 0; t < ncell; t++) x->start[t + 1] += x->start[t];
+            x->items = sb_alloc(sizeof(int) * (size_t)(x->start[ncell] + 1));
+        }
+    }
+    free(cnt);
+}
+
+static void tri_index_free(tri_index *x)
+{
+    free(x->box); free(x->start); free(x->items);
+    memset(x, 0, sizeof *x);
+}
+
+static void tri_test(const tri_index *x, int t, const double p[3], double *best, int *bt, double bw[3])
+{
+    const double *bx = x->box + 6 * t;
+    double d = 0, e, w[3], dd;
+    int a;
+    for (a = 0; a < 3; a++) {
+        e = p[a] < bx[a] ? bx[a] - p[a] : p[a] > bx[3 + a] ? p[a] - bx[3 + a] : 0;
+        d += e * e;
+    }
+    if (d > *best) return;
+    dd = closest_tri(p, x->P + 3 * x->tri[3 * t], x->P + 3 * x->tri[3 * t + 1], x->P + 3 * x->tri[3 * t + 2], w);
+    /* ties: the lower triangle index, so the answer does not depend on the visiting order */
+    if (dd < *best || (dd == *best && t < *bt)) { *best = dd; *bt = t; memcpy(bw, w, 3 * sizeof(double)); }
 }
 
 static int tri_closest(const tri_index *x, const double p[3], double bw[3])
 {
-    double best = 1e300, rb = 1e300;
-    int t, bt = -1;
-    for (t = 0; t < x->nt; t++) {
-        const double *bx = x->box + 6 * t;
-        double d = 0, e;
-        int a;
-        for (a = 0; a < 3; a++) {
-            e = p[a] < bx[a] ? bx[a] - p[a] : p[a] > bx[3 + a] ? p[a] - bx[3 + a] : 0;
-            d += e * e;
-        }
-        if (d >= best) continue;
-        {
-            double w[3], dd = closest_tri(p, x->P + 3 * x->tri[3 * t], x->P + 3 * x->tri[3 * t + 1], x->P + 3 * x->tri[3 * t + 2], w);
-            if (dd < best) { best = dd; bt = t; memcpy(bw, w, sizeof w); }
-        }
+    double best = 1e300;
+    int bt = -1, c[3], a, r, rmax = 0;
+    for (a = 0; a < 3; a++) {
+        c[a] = gclamp((int)floor((p[a] - x->lo[a]) / x->h), x->n[a]);
+        rmax = c[a] > rmax ? c[a] : rmax;
+        rmax = x->n[a] - 1 - c[a] > rmax ? x->n[a] - 1 - c[a] : rmax;
     }
-    (void)rb;
+    for (r = 0; r <= rmax; r++) {
+        int i, j, l;
+        for (l = c[2] - r; l <= c[2] + r; l++) {
+            if (l < 0 || l >= x->n[2]) continue;
+            for (j = c[1] - r; j <= c[1] + r; j++) {
+                if (j < 0 || j >= x->n[1]) continue;
+                for (i = c[0] - r; i <= c[0] + r; i++) {
+                    int cc, q;
+                    if (i < 0 || i >= x->n[0]) continue;
+                    if (abs(i - c[0]) != r && abs(j - c[1]) != r && abs(l - c[2]) != r) continue;   /* the shell only */
+                    cc = i + x->n[0] * (j + x->n[1] * l);
+                    for (q = x->start[cc]; q < x->start[cc + 1]; q++) tri_test(x, x->items[q], p, &best, &bt, bw);
+                }
+            }
+        }
+        /* every triangle not yet seen lies in cells at least r cells away: farther than r h */
+        if (bt >= 0 && best < (r * x->h) * (r * x->h)) break;
+    }
     return bt;
 }
 
@@ -509,7 +584,7 @@ int sb_rt_update_surface(sb_retarget *rt)
             tm->f = 0.5 * rt->opt.w_surf / (mB->nv * L2);
         }
         rt->nsa = mA->nv;
-        free(hs); free(tb.box); free(ta.box);
+        free(hs); tri_index_free(&tb); tri_index_free(&ta);
     }
     return 0;
 }
