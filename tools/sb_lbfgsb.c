@@ -379,9 +379,9 @@ int sb_lbfgsb(int n, double *x, const double *lo, const double *hi,
             memcpy(g, gn, sizeof(double) * N);
             f = fn_;
             pg = pgnorm(n, x, g, lo, hi);
-            if (o->verbose) fprintf(stderr, "%s: iter %5d  f %.12g  |pg|inf %.3e\n", lab, iter, f, pg);
             if (pg <= o->pgtol) status = SB_OPT_PGTOL;
             else if ((fold - f) <= o->ftol * fmax(fmax(fabs(fold), fabs(f)), 1.0)) status = SB_OPT_FTOL;
+            if (o->verbose > 0 && iter % o->verbose == 0) fprintf(stderr, "%s: iter %5d  f %.12g  |pg|inf %.3e\n", lab, iter, f, pg);
         }
     }
     res->iterations = iter;

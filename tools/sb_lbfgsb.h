@@ -32,7 +32,8 @@ typedef struct sb_opt_opts {
     int max_iter;       /* iterations (default 2000) */
     double pgtol;       /* stop when |P(x - g) - x|_inf <= pgtol (default 1e-6) */
     double ftol;        /* stop when (f_k - f_k+1) / max(|f_k|, |f_k+1|, 1) <= ftol (default 1e-13) */
-    int verbose;        /* progress lines to stderr: iteration, f, |proj grad|_inf */
+    int verbose;        /* progress lines to stderr: iteration, f, |proj grad|_inf; N > 0: at the start,
+                         * every N-th iteration and a closing line (0: silent) */
     const char *label;  /* prefix of the progress lines (NULL: "lbfgsb") */
 } sb_opt_opts;
 typedef struct sb_opt_result {

@@ -406,8 +406,16 @@ static int write_png(const char *path, const snref_model *m, const double *a, co
 /* ---------------- the command ---------------- */
 
 static int solve(snref_state *s, const char *what, int quiet) {
-    double t0 = sb_now(), res;
+    double t0 = sb_now(), res, *lat = malloc(3 * (size_t)s->m->nV * sizeof *lat);
+    unsigned i;
     if (!quiet) { printf("static: solving %s (%u unknowns)...", what, 3 * s->m->nF); fflush(stdout); }
+    /* start from the skinned shape: the relative residual is measured against the
+     * start's, so a start already at equilibrium (rigs on = rigs off when every rig
+     * is at tau 0) could not converge by that measure */
+    if (!lat) { fprintf(stderr, PROG ": out of memory\n"); return 1; }
+    snref_get_skinned(s, lat);
+    for (i = 0; i < 3 * s->m->nF; i++) s->p[i] = lat[i] / s->m->unit;
+    free(lat);
     res = snref_static(s, 0);
     if (!quiet) printf(" %.2f s, relative residual %.1e\n", sb_now() - t0, res);
     if (!(res <= 1e-6)) {

@@ -44,12 +44,17 @@ $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 
 # sinew-rig (issue 11): rig fitting on the double-precision reference model,
 # tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
+RIGTOOL = $(BUILD)/sinew-rig
 FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
-$(FIT_OBJ): tools/sb_fit.h
+$(FIT_OBJ) $(BUILD)/tools/static/sinew_rig.o: tools/sb_fit.h
+$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
+	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+all: $(RIGTOOL)
 $(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -Itests -o $@ $< $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
 TEST_BINS += $(BUILD)/tests/test_rigfit
+TEST_DEPS += $(RIGTOOL)
 
 # ---- baked examples ----
 EX = $(BUILD)/examples

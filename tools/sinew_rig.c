@@ -1,0 +1,686 @@
+/* sinew_rig.c -- sinew-rig: rig fitting on the command line (seed 003
+ * §4.2-4.3, issue 11; tools/DESCRIPTION.md "Rig fitting (sinew-rig)").
+ *
+ *   fit-surface  a surface rig from a target mesh (pose from feature points or given)
+ *   fit-pose     the pose of a target mesh from feature points
+ *   fit-points   template rig strengths from dragged surface points
+ *   export       a description rig's baked forces as a rig file
+ *
+ * Every output is written only after everything before it succeeded, and
+ * depends only on the inputs (no times or paths of temporaries in files). */
+#include "sb.h"
+#include "sb_fit.h"
+#include "sb_static.h"
+#include "raster.h"
+#include "png.h"
+#include "sn_format.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PROG "sinew-rig"
+#define PI 3.14159265358979323846
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: sinew-rig COMMAND DESCRIPTION [options]\n"
+        "Rig fitting (seed 003 4.2-4.3) at the static equilibrium of eq. 10, double precision, L-BFGS-B.\n"
+        "Commands:\n"
+        "  fit-surface DESC --target T.obj[@GAMMA] [--target ...] --control NAME -o OUT.rig\n"
+        "              [--pose POSE | --features V1,V2,... [--joints J1,J2,...]] [--controls N=V,...]\n"
+        "              [--omega W] [--rigs-off] [--name RIG] [--png PIC.png] [--view AZ,EL] [--max-iter N]\n"
+        "      a surface rig: the generalized force whose equilibrium matches the target mesh (same\n"
+        "      vertices as the description's mesh), stored as a rig file (DESCRIPTION.md 'Rig files')\n"
+        "      for 'rig_file RIG OUT.rig CONTROL tau ...' (the line is printed). GAMMA: the control's\n"
+        "      value the target shows (default 1 for an abstract control, the fitted pose's angle for a\n"
+        "      pose control); several targets at several GAMMA become tau samples. The pose: --pose, or\n"
+        "      fitted to the feature vertices (0-based indices of the mesh) over --joints (default every\n"
+        "      non-root joint); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
+        "      rigs off during the fit (default on at the controls' values); --png: rest | unrigged | rigged\n"
+        "      | target\n"
+        "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [-o POSE.txt]\n"
+        "      the pose (local joint rotations, as --static/--pose take them) whose skinned surface puts\n"
+        "      the feature vertices nearest their target positions\n"
+        "  fit-points DESC --points FILE --rigs R1,R2,... [--pose POSE] [--controls N=V,...] [--lambda L]\n"
+        "              [--bounds LO,HI] [-o OUT.sinew]\n"
+        "      strengths of template rigs so that surface points reach dragged positions; FILE lines\n"
+        "      'VERTEX X Y Z' (0-based mesh vertex, target in the mesh's coordinates); writes the rig\n"
+        "      lines with the fitted strengths (to replace the description's)\n"
+        "  export DESC RIG -o OUT.rig\n"
+        "      a rig of the description (template or file) as a rig file\n"
+        "Common options: --quiet (no progress or summary), --progress N (a progress line every N\n"
+        "iterations, default 10), --help.\n"
+        "Progress lines (stderr): LABEL: iter N  f COST  |pg|inf PROJECTED-GRADIENT. Exit status: 0, 1 (a\n"
+        "bake or solve failed), 2 (bad command line or input); nothing is written on failure.\n");
+}
+
+/* ---------------- small parsers ---------------- */
+
+static int parse_ints(const char *s, int *out, int max, const char *what)
+{
+    int n = 0;
+    while (*s) {
+        char *e;
+        long v = strtol(s, &e, 10);
+        if (e == s || v < 0 || v > 2000000000L || (*e && *e != ',')) { fprintf(stderr, PROG ": %s: '%s' is not a list of vertex indices\n", what, s); return -1; }
+        if (n >= max) { fprintf(stderr, PROG ": %s: more than %d entries\n", what, max); return -1; }
+        out[n++] = (int)v;
+        s = *e ? e + 1 : e;
+    }
+    return n;
+}
+
+/* OBJ vertex positions: count must equal want; non-finite refused */
+static double *read_obj_vertices(const char *path, int want)
+{
+    FILE *f = fopen(path, "r");
+    char line[4096];
+    int n = 0, ln = 0, cap = want > 0 ? want : 1;
+    double *v;
+    if (!f) { fprintf(stderr, PROG ": cannot open target '%s'\n", path); return NULL; }
+    v = malloc(3 * (size_t)cap * sizeof *v);
+    if (!v) { fclose(f); fprintf(stderr, PROG ": out of memory\n"); return NULL; }
+    while (fgets(line, sizeof line, f)) {
+        double x[3];
+        char *p = line, *e;
+        int k;
+        ln++;
+        while (*p == ' ' || *p == '\t') p++;
+        if (p[0] != 'v' || (p[1] != ' ' && p[1] != '\t')) continue;
+        p += 2;
+        for (k = 0; k < 3; k++) {
+            x[k] = strtod(p, &e);
+            if (e == p) { fprintf(stderr, PROG ": %s:%d: a vertex needs three numbers\n", path, ln); fclose(f); free(v); return NULL; }
+            if (!isfinite(x[k])) { fprintf(stderr, PROG ": %s:%d: non-finite vertex coordinate\n", path, ln); fclose(f); free(v); return NULL; }
+            p = e;
+        }
+        if (n < cap) memcpy(v + 3 * n, x, sizeof x);
+        n++;
+    }
+    fclose(f);
+    if (n != want) {
+        fprintf(stderr, PROG ": target '%s' has %d vertices, the character's mesh has %d (a target must have the same vertices, same order)\n", path, n, want);
+        free(v);
+        return NULL;
+    }
+    return v;
+}
+
+static int find_joint(const snref_model *m, const char *name)
+{
+    unsigned j;
+    for (j = 0; j < m->nJ; j++) if (!strcmp(m->jname[j], name)) return (int)j;
+    return -1;
+}
+
+static int parse_joints(const snref_model *m, const char *s, int *out, int max)
+{
+    int n = 0;
+    char buf[256];
+    while (s && *s) {
+        const char *e = strchr(s, ',');
+        size_t l = e ? (size_t)(e - s) : strlen(s);
+        int j;
+        if (l >= sizeof buf) l = sizeof buf - 1;
+        memcpy(buf, s, l); buf[l] = 0;
+        if ((j = find_joint(m, buf)) < 0) {
+            unsigned k;
+            fprintf(stderr, PROG ": --joints: unknown joint '%s'; joints:", buf);
+            for (k = 0; k < m->nJ; k++) fprintf(stderr, " %s", m->jname[k]);
+            fprintf(stderr, "\n");
+            return -1;
+        }
+        if (n >= max) { fprintf(stderr, PROG ": --joints: at most %d\n", max); return -1; }
+        out[n++] = j;
+        s = e ? e + 1 : s + l;
+    }
+    return n;
+}
+
+static int set_controls(snref_state *s, const char *list)
+{
+    const char *p = list;
+    while (p && *p) {
+        const char *end = strchr(p, ','), *eq;
+        char name[64], *e;
+        double v;
+        int c;
+        if (!end) end = p + strlen(p);
+        eq = memchr(p, '=', (size_t)(end - p));
+        if (!eq || eq == p || (size_t)(eq - p) >= sizeof name) { fprintf(stderr, PROG ": --controls: '%.*s': want NAME=VALUE\n", (int)(end - p), p); return -1; }
+        memcpy(name, p, (size_t)(eq - p)); name[eq - p] = 0;
+        if ((c = snref_find_control(s->m, name)) < 0 || s->m->kkind[c] != SN_CTL_ABSTRACT) {
+            fprintf(stderr, PROG ": --controls: '%s' is not an abstract control of the description\n", name);
+            return -1;
+        }
+        v = strtod(eq + 1, &e);
+        if (e != end || !isfinite(v) || fabs(v) >= 32768) { fprintf(stderr, PROG ": --controls: %s: not a number in (-32768, 32768)\n", name); return -1; }
+        snref_set_control(s, (unsigned)c, v);
+        p = *end ? end + 1 : end;
+    }
+    return 0;
+}
+
+/* local rotations -> "J:ax,ay,az,deg+..." (non-identity joints; "rest" if none) */
+static void pose_string(const snref_model *m, const double *local, char *out, size_t n)
+{
+    size_t l = 0;
+    unsigned j;
+    out[0] = 0;
+    for (j = 0; j < m->nJ; j++) {
+        double r[3], th;
+        sb_quat_rotvec(local + 4 * j, r);
+        th = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if (th < 1e-12) continue;
+        l += (size_t)snprintf(out + l, l < n ? n - l : 0, "%s%s:%.9g,%.9g,%.9g,%.9g", l ? "+" : "", m->jname[j], r[0] / th, r[1] / th, r[2] / th, th * 180 / PI);
+    }
+    if (!l) snprintf(out, n, "rest");
+}
+
+/* ---------------- picture ---------------- */
+
+static const uint8_t ink[3] = {25, 28, 38};
+
+/* one panel: surf coloured red by |surf - ref| / scale (ref NULL: flesh) */
+static int panel(rs_image *out, const snref_model *m, const double *surf, const double *ref, double scale, const float lo[3], const float hi[3],
+                 double az, double el, const char *l1, const char *l2)
+{
+    rs_image big;
+    rs_camera cam;
+    float *pos = malloc(3 * (size_t)m->nS * sizeof *pos), *col = malloc(3 * (size_t)m->nS * sizeof *col);
+    uint32_t *tri = malloc(3 * (size_t)m->nT * sizeof *tri + 4);
+    unsigned i, k;
+    if (!pos || !col || !tri || rs_image_alloc(&big, 2 * out->w, 2 * out->h)) { free(pos); free(col); free(tri); return -1; }
+    for (i = 0; i < 3 * m->nS; i++) pos[i] = (float)surf[i];
+    for (i = 0; i < 3 * m->nT; i++) tri[i] = m->tris[i];
+    for (i = 0; i < m->nS; i++) {
+        float h = 0;
+        if (ref && scale > 0) {
+            double d = 0;
+            for (k = 0; k < 3; k++) d += (surf[3 * i + k] - ref[3 * i + k]) * (surf[3 * i + k] - ref[3 * i + k]);
+            h = (float)(sqrt(d) / scale);
+            if (h > 1) h = 1;
+        }
+        col[3 * i] = 0.78f + h * (0.95f - 0.78f);
+        col[3 * i + 1] = 0.60f + h * (0.12f - 0.60f);
+        col[3 * i + 2] = 0.44f + h * (0.05f - 0.44f);
+    }
+    rs_camera_frame(&cam, lo, hi, big.w, big.h, (float)az, (float)el);
+    cam.ground_y = lo[1];
+    rs_clear(&big, &cam);
+    rs_draw_mesh_colors(&big, &cam, pos, (int)m->nS, tri, (int)m->nT, col);
+    rs_downsample2(&big, out);
+    rs_image_free(&big);
+    if (l1) rs_draw_text(out, 8, 8, 2, l1, ink);
+    if (l2) rs_draw_text(out, 8, 28, 1, l2, ink);
+    free(pos); free(col); free(tri);
+    return 0;
+}
+
+static int picture(const char *path, const snref_model *m, int np, const double *const *surf, const double *const *ref, const double *scale,
+                   const char *const *l1, const char *const *l2, double az, double el)
+{
+    enum { PW = 480, PH = 400 };
+    rs_image img, pane;
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    unsigned i, k;
+    int p, rc = 0;
+    char err[300];
+    const uint8_t line[3] = {90, 90, 90};
+    for (p = 0; p < np; p++)
+        for (i = 0; i < m->nS; i++)
+            for (k = 0; k < 3; k++) {
+                float x = (float)surf[p][3 * i + k];
+                if (x < lo[k]) lo[k] = x;
+                if (x > hi[k]) hi[k] = x;
+            }
+    if (rs_image_alloc(&img, np * PW, PH)) return -1;
+    if (rs_image_alloc(&pane, PW, PH)) { rs_image_free(&img); return -1; }
+    for (p = 0; p < np && !rc; p++) {
+        rc = panel(&pane, m, surf[p], ref[p], scale[p], lo, hi, az, el, l1[p], l2[p]);
+        if (!rc) { rs_blit(&img, p * PW, 0, &pane); if (p) rs_fill(&img, p * PW - 1, 0, 2, PH, line); }
+    }
+    if (!rc) { rc = png_write(path, img.rgb, img.w, img.h, err, sizeof err); if (rc) fprintf(stderr, PROG ": %s\n", err); }
+    rs_image_free(&pane); rs_image_free(&img);
+    return rc;
+}
+
+/* ---------------- figures ---------------- */
+
+/* residual of a against target, as fractions of target's displacement from base: rms and max */
+static unsigned worst_at;
+static void residual(const double *a, const double *target, const double *base, unsigned n, double *rms, double *mx, double *dmax)
+{
+    double r2 = 0, d2 = 0, rm = 0, dm = 0;
+    unsigned i, k;
+    worst_at = 0;
+    for (i = 0; i < n; i++) {
+        double r = 0, d = 0;
+        for (k = 0; k < 3; k++) {
+            r += (a[3 * i + k] - target[3 * i + k]) * (a[3 * i + k] - target[3 * i + k]);
+            d += (target[3 * i + k] - base[3 * i + k]) * (target[3 * i + k] - base[3 * i + k]);
+        }
+        r2 += r; d2 += d; dm = fmax(dm, sqrt(d));
+        if (sqrt(r) > rm) { rm = sqrt(r); worst_at = i; }
+    }
+    *rms = d2 > 0 ? sqrt(r2 / d2) : 0;
+    *mx = dm > 0 ? rm / dm : 0;
+    if (dmax) *dmax = dm;
+}
+
+/* ---------------- options ---------------- */
+
+typedef struct {
+    const char *cmd, *desc, *out, *pose, *features, *joints, *controls, *control, *points, *rigs, *png, *name, *bounds, *export_rig;
+    const char *target[SB_TAU_MAX];
+    int ntarget, quiet, rigs_off, max_iter, progress;
+    double omega, lambda, az, el;
+} opts_t;
+
+static int parse(int argc, char **argv, opts_t *o)
+{
+    int i;
+    memset(o, 0, sizeof *o);
+    o->omega = 1e-5; o->lambda = 1e-3; o->az = 30; o->el = 15; o->max_iter = 3000; o->progress = 10;
+    if (argc < 2) { usage(stderr); return 2; }
+    for (i = 1; i < argc; i++) if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { usage(stdout); return 1; }
+    o->cmd = argv[1];
+    if (strcmp(o->cmd, "fit-surface") && strcmp(o->cmd, "fit-pose") && strcmp(o->cmd, "fit-points") && strcmp(o->cmd, "export")) {
+        fprintf(stderr, PROG ": unknown command '%s' (fit-surface, fit-pose, fit-points, export; --help)\n", o->cmd);
+        return 2;
+    }
+    for (i = 2; i < argc; i++) {
+        const char *a = argv[i];
+        int more = i + 1 < argc;
+#define ARG(name, field) if (!strcmp(a, name)) { if (!more) { fprintf(stderr, PROG ": %s needs a value\n", name); return 2; } field = argv[++i]; continue; }
+        ARG("-o", o->out) ARG("--pose", o->pose) ARG("--features", o->features) ARG("--joints", o->joints) ARG("--controls", o->controls)
+        ARG("--control", o->control) ARG("--points", o->points) ARG("--rigs", o->rigs) ARG("--png", o->png) ARG("--name", o->name)
+        ARG("--bounds", o->bounds)
+#undef ARG
+        if (!strcmp(a, "--target")) {
+            if (!more) { fprintf(stderr, PROG ": --target needs a value\n"); return 2; }
+            if (o->ntarget >= SB_TAU_MAX - 1) { fprintf(stderr, PROG ": at most %d targets\n", SB_TAU_MAX - 1); return 2; }
+            o->target[o->ntarget++] = argv[++i];
+            continue;
+        }
+        if (!strcmp(a, "--omega") || !strcmp(a, "--lambda") || !strcmp(a, "--max-iter") || !strcmp(a, "--progress")) {
+            char *e;
+            double v;
+            if (!more) { fprintf(stderr, PROG ": %s needs a value\n", a); return 2; }
+            v = strtod(argv[++i], &e);
+            if (*e || e == argv[i] || !isfinite(v) || v < 0) { fprintf(stderr, PROG ": %s: '%s' is not a non-negative number\n", a, argv[i]); return 2; }
+            if (!strcmp(a, "--omega")) o->omega = v;
+            else if (!strcmp(a, "--lambda")) o->lambda = v;
+            else if (!strcmp(a, "--max-iter")) o->max_iter = (int)fmin(v, 1e8);
+            else o->progress = (int)fmin(v, 1e8);
+            continue;
+        }
+        if (!strcmp(a, "--view")) {
+            if (!more || sscanf(argv[++i], "%lf,%lf", &o->az, &o->el) != 2) { fprintf(stderr, PROG ": --view AZ,EL\n"); return 2; }
+            continue;
+        }
+        if (!strcmp(a, "--quiet")) { o->quiet = 1; continue; }
+        if (!strcmp(a, "--rigs-off")) { o->rigs_off = 1; continue; }
+        if (a[0] == '-') { fprintf(stderr, PROG ": unknown option '%s' (--help)\n", a); return 2; }
+        if (!o->desc) o->desc = a;
+        else if (!strcmp(o->cmd, "export") && !o->export_rig) o->export_rig = a;
+        else { fprintf(stderr, PROG ": unexpected argument '%s'\n", a); return 2; }
+    }
+    if (!o->desc) { fprintf(stderr, PROG ": %s: missing DESCRIPTION\n", o->cmd); return 2; }
+    return 0;
+}
+
+static FILE *check_readable(const char *path, const char *what)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) fprintf(stderr, PROG ": cannot open %s '%s'\n", what, path);
+    return f;
+}
+
+/* ---------------- commands ---------------- */
+
+static int cmd_export(const opts_t *o)
+{
+    sb_fit F;
+    int a, i, k, rc = 1;
+    double *Q;
+    char note[1200];
+    if (!o->export_rig || !o->out) { fprintf(stderr, PROG ": export DESC RIG -o OUT.rig\n"); return 2; }
+    if (sb_fit_open(&F, o->desc, 1)) return 1;
+    for (a = 0; a < F.o.nrig && strcmp(F.o.rig[a].def.name, o->export_rig); a++) {}
+    if (a == F.o.nrig) { fprintf(stderr, PROG ": the description has no rig '%s'\n", o->export_rig); sb_fit_close(&F); return 2; }
+    Q = calloc(3 * (size_t)F.o.nf + 3, sizeof *Q);
+    for (i = 0; i < F.o.rig[a].n; i++) for (k = 0; k < 3; k++) Q[3 * F.o.rig[a].vert[i] + k] = F.o.rig[a].Q[3 * i + k];
+    snprintf(note, sizeof note, "exported by sinew-rig from rig '%s' of %s (template %s, strength %g): forces at eta = 1", o->export_rig, o->desc,
+             sb_rig_tpl_name(F.o.rig[a].def.tpl), F.o.rig[a].def.s);
+    if (sb_rigfile_write(o->out, &F.o, &F.mesh, Q, note)) fprintf(stderr, PROG ": %s\n", sb_error());
+    else { rc = 0; if (!o->quiet) printf("sinew-rig: wrote %s (%d forces of rig '%s')\n", o->out, F.o.rig[a].n, o->export_rig); }
+    free(Q);
+    sb_fit_close(&F);
+    return rc;
+}
+
+/* the pose for fit-surface / fit-pose: --pose, or fitted to --features on the (first) target */
+static int get_pose(sb_fit *F, const opts_t *o, const double *target, double *local, snref_xform *pose, char *what, size_t whatn, double *secs, int *iters)
+{
+    const snref_model *m = &F->m;
+    unsigned j;
+    *secs = 0; *iters = 0;
+    for (j = 0; j < 4 * m->nJ; j++) local[j] = (j % 4 == 3);
+    if (o->pose && sb_static_pose(&F->s, o->pose, pose, local, what, whatn)) return 2;
+    if (o->features) {
+        int feat[4096], nf, joints[64], nj = 0, k;
+        double *tg, t0 = sb_now(), root[3] = {0, 0, 0};
+        sb_opt_opts oo;
+        sb_opt_result rr;
+        if ((nf = parse_ints(o->features, feat, 4096, "--features")) < 0) return 2;
+        for (k = 0; k < nf; k++)
+            if (feat[k] >= (int)m->nS) { fprintf(stderr, PROG ": --features: vertex %d out of range (the mesh has %u)\n", feat[k], m->nS); return 2; }
+        if (o->joints) { if ((nj = parse_joints(m, o->joints, joints, 64)) < 0) return 2; }
+        else for (j = 0; j < m->nJ && nj < 64; j++) if (m->jparent[j] >= 0) joints[nj++] = (int)j;
+        if (nj == 0) { fprintf(stderr, PROG ": no joints to fit\n"); return 2; }
+        if (3 * nj > 3 * nf) fprintf(stderr, PROG ": warning: %d feature points for %d joint rotations (%d unknowns): the pose is underdetermined\n", nf, nj, 3 * nj);
+        tg = malloc(3 * (size_t)nf * sizeof *tg);
+        for (k = 0; k < nf; k++) memcpy(tg + 3 * k, target + 3 * feat[k], 3 * sizeof *tg);
+        sb_opt_defaults(&oo);
+        oo.pgtol = 1e-10; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-pose";
+        if (sb_fit_pose(F, feat, nf, tg, joints, nj, local, &oo, &rr)) { free(tg); return 1; }
+        free(tg);
+        sb_pose_from_local(m, local, root, pose);
+        pose_string(m, local, what, whatn);
+        *secs = sb_now() - t0; *iters = rr.iterations;
+        if (!o->quiet) printf("fit-pose: %d feature points, %d joints: rms feature distance %.4g mesh units (%.3g cells), %d iterations, %.2f s\n",
+                              nf, nj, sqrt(rr.f) * m->cell * m->unit, sqrt(rr.f), rr.iterations, *secs);
+    } else if (!o->pose) {
+        double root[3] = {0, 0, 0};
+        sb_pose_from_local(m, local, root, pose);
+        snprintf(what, whatn, "rest");
+    }
+    return 0;
+}
+
+static int cmd_fit_pose(const opts_t *o)
+{
+    sb_fit F;
+    double *target, *local, secs;
+    snref_xform *pose;
+    char what[4096];
+    int rc, it;
+    if (o->ntarget != 1 || !o->features) { fprintf(stderr, PROG ": fit-pose DESC --target T.obj --features V1,V2,... [--joints ...]\n"); return 2; }
+    {   FILE *f = check_readable(o->target[0], "target"); if (!f) return 2; fclose(f); }
+    if (sb_fit_open(&F, o->desc, 1)) return 1;
+    if (!(target = read_obj_vertices(o->target[0], F.mesh.nv))) { sb_fit_close(&F); return 2; }
+    local = malloc(4 * (size_t)F.m.nJ * sizeof *local);
+    pose = malloc(F.m.nJ * sizeof *pose);
+    rc = get_pose(&F, o, target, local, pose, what, sizeof what, &secs, &it);
+    if (!rc) {
+        printf("pose %s\n", what);
+        if (o->out) {
+            char buf[4200];
+            int n = snprintf(buf, sizeof buf, "%s\n", what);
+            if (sb_write_file(o->out, (const unsigned char *)buf, (size_t)n)) { fprintf(stderr, PROG ": %s\n", sb_error()); rc = 1; }
+        }
+    }
+    free(target); free(local); free(pose);
+    sb_fit_close(&F);
+    return rc;
+}
+
+static int cmp_gamma(const void *a, const void *b)
+{
+    double x = ((const double *)a)[0], y = ((const double *)b)[0];
+    return (x > y) - (x < y);
+}
+
+static int cmd_fit_surface(const opts_t *o)
+{
+    sb_fit F;
+    const snref_model *m;
+    double *tg[SB_TAU_MAX], gam[SB_TAU_MAX], *local = NULL, *eta = NULL, *fit = NULL, *base = NULL, *rest = NULL, secs_pose, t0, rms, mx, dmax;
+    double samples[2 * SB_TAU_MAX];
+    snref_xform *pose = NULL;
+    char what[4096], tau[512], *comment = NULL;
+    int i, k, rc = 2, ctl, primary = 0, it_pose, ns = 0, have_g[SB_TAU_MAX];
+    sb_opt_opts oo;
+    sb_opt_result rr;
+    size_t cl;
+    memset(tg, 0, sizeof tg);
+    if (!o->ntarget || !o->control || !o->out) { fprintf(stderr, PROG ": fit-surface DESC --target T.obj --control NAME -o OUT.rig (--help)\n"); return 2; }
+    if (o->pose && o->features && 0) return 2;
+    for (i = 0; i < o->ntarget; i++) {   /* TARGET[@GAMMA] */
+        const char *at = strrchr(o->target[i], '@');
+        have_g[i] = 0; gam[i] = 0;
+        if (at && !strchr(at, '/')) {
+            char *e;
+            gam[i] = strtod(at + 1, &e);
+            if (*e || e == at + 1 || !isfinite(gam[i]) || fabs(gam[i]) > 16384) { fprintf(stderr, PROG ": --target %s: the value after @ is not a control value\n", o->target[i]); return 2; }
+            have_g[i] = 1;
+        }
+    }
+    if (sb_fit_open(&F, o->desc, 1)) return 1;
+    m = &F.m;
+    rc = 2;
+    if ((ctl = snref_find_control(m, o->control)) < 0) {
+        unsigned c;
+        fprintf(stderr, PROG ": --control: the description has no control '%s' (declare it: 'control %s' or 'control %s angle JOINT AX AY AZ'); controls:",
+                o->control, o->control, o->control);
+        for (c = 0; c < m->nK; c++) fprintf(stderr, " %s", m->kname[c]);
+        fprintf(stderr, "\n");
+        goto done;
+    }
+    for (i = 0; i < o->ntarget; i++) {
+        char path[1024];
+        const char *at = strrchr(o->target[i], '@');
+        size_t l = have_g[i] ? (size_t)(at - o->target[i]) : strlen(o->target[i]);
+        snprintf(path, sizeof path, "%.*s", (int)l, o->target[i]);
+        if (!(tg[i] = read_obj_vertices(path, F.mesh.nv))) goto done;
+    }
+    if ((unsigned)F.mesh.nv != m->nS) { fprintf(stderr, PROG ": the baked surface has %u vertices, the mesh %d\n", m->nS, F.mesh.nv); rc = 1; goto done; }
+    if (o->controls && set_controls(&F.s, o->controls)) goto done;
+    /* the primary target: the largest |gamma| (the first if none given) */
+    for (i = 1; i < o->ntarget; i++) if (have_g[i] && (!have_g[primary] || fabs(gam[i]) > fabs(gam[primary]))) primary = i;
+    local = malloc(4 * (size_t)m->nJ * sizeof *local);
+    pose = malloc(m->nJ * sizeof *pose);
+    eta = calloc(3 * (size_t)F.o.nf + 3, sizeof *eta);
+    fit = malloc(3 * (size_t)m->nS * sizeof *fit);
+    base = malloc(3 * (size_t)m->nS * sizeof *base);
+    rest = malloc(3 * (size_t)m->nS * sizeof *rest);
+    if ((rc = get_pose(&F, o, tg[primary], local, pose, what, sizeof what, &secs_pose, &it_pose))) goto done;
+    rc = 1;
+    {   /* the rest shape for the picture */
+        snref_xform *id = malloc(m->nJ * sizeof *id);
+        double root[3] = {0, 0, 0}, *l0 = malloc(4 * (size_t)m->nJ * sizeof *l0);
+        unsigned j;
+        for (j = 0; j < 4 * m->nJ; j++) l0[j] = (j % 4 == 3);
+        sb_pose_from_local(m, l0, root, id);
+        if (sb_fit_set_pose(&F, id, o->rigs_off ? 0 : 1)) { free(id); free(l0); goto done; }
+        memcpy(rest, F.surf0, 3 * (size_t)m->nS * sizeof *rest);
+        free(id); free(l0);
+    }
+    if (sb_fit_set_pose(&F, pose, o->rigs_off ? 0 : 1)) goto done;
+    memcpy(base, F.surf0, 3 * (size_t)m->nS * sizeof *base);
+    if (!have_g[primary]) gam[primary] = m->kkind[ctl] == SN_CTL_ABSTRACT ? 1.0 : snref_get_control(&F.s, (unsigned)ctl);
+    if (!(fabs(gam[primary]) > 1e-9)) {
+        fprintf(stderr, PROG ": the target's control value is 0 (the rig Q(gamma) = tau(gamma) eta would be off there): give TARGET@GAMMA%s\n",
+                m->kkind[ctl] == SN_CTL_ABSTRACT ? "" : " or pose the joint");
+        rc = 2;
+        goto done;
+    }
+    if (!o->quiet) printf("fit-surface: %s: pose %s; control %s = %g at the target; %u free lattice vertices (%u unknowns), omega %g\n",
+                          o->desc, what, o->control, gam[primary], m->nF, 3 * m->nF, o->omega);
+    sb_opt_defaults(&oo);
+    oo.pgtol = 1e-10; oo.ftol = 1e-15; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-surface";
+    t0 = sb_now();
+    if (sb_fit_surface(&F, tg[primary], o->omega, &oo, &rr, eta, fit)) goto done;
+    residual(fit, tg[primary], base, m->nS, &rms, &mx, &dmax);
+    if (!o->quiet) printf("fit-surface: %d iterations (%s), %.2f s: residual rms %.3g%%, max %.3g%% of the target's displacement (largest %.4g mesh units); "
+                          "worst at mesh vertex %u (%.4g, %.4g, %.4g)\n",
+                          rr.iterations, rr.status == 0 ? "converged" : rr.status == 1 ? "converged (ftol)" : rr.status == 2 ? "max-iter" : "line search failed",
+                          sb_now() - t0, 100 * rms, 100 * mx, dmax, worst_at, tg[primary][3 * worst_at], tg[primary][3 * worst_at + 1], tg[primary][3 * worst_at + 2]);
+    /* tau samples: (0, 0), the primary at 1, the others by least squares on the rig's shape */
+    samples[ns * 2] = gam[primary]; samples[ns * 2 + 1] = 1; ns++;
+    for (i = 0; i < o->ntarget; i++) {
+        double num = 0, den = 0;
+        unsigned s;
+        if (i == primary) continue;
+        if (!have_g[i]) { fprintf(stderr, PROG ": with several targets each needs its control value: TARGET@GAMMA\n"); rc = 2; goto done; }
+        for (s = 0; s < 3 * m->nS; s++) { double u = fit[s] - base[s]; num += u * (tg[i][s] - base[s]); den += u * u; }
+        samples[ns * 2] = gam[i]; samples[ns * 2 + 1] = den > 0 ? num / den : 0; ns++;
+        if (!o->quiet) printf("fit-surface: target %s at %s = %g: tau %.6g (least squares on the fitted shape)\n", o->target[i], o->control, gam[i], samples[ns * 2 - 1]);
+    }
+    {   int has0 = 0; for (i = 0; i < ns; i++) has0 |= samples[2 * i] == 0; if (!has0) { samples[2 * ns] = 0; samples[2 * ns + 1] = 0; ns++; } }
+    qsort(samples, (size_t)ns, 2 * sizeof(double), cmp_gamma);
+    for (i = 1; i < ns; i++) if (samples[2 * i] == samples[2 * i - 2]) { fprintf(stderr, PROG ": two targets at %s = %g\n", o->control, samples[2 * i]); rc = 2; goto done; }
+    for (i = 0, k = 0; i < ns; i++) k += snprintf(tau + k, sizeof tau - (size_t)k, "%s%.9g %.9g", i ? "  " : "", samples[2 * i], samples[2 * i + 1]);
+    /* outputs: picture first (so a failed picture leaves no rig file), then the rig file */
+    if (o->png) {
+        const double *S[4], *R[4];
+        double sc[4];
+        const char *l1[4] = {"rest", "unrigged", "rigged (fit)", "target"}, *l2[4];
+        char s2[160], s3[160], s4[160];
+        S[0] = rest; S[1] = base; S[2] = fit; S[3] = tg[primary];
+        R[0] = NULL; R[1] = tg[primary]; R[2] = tg[primary]; R[3] = base;
+        sc[0] = 0; sc[1] = sc[2] = sc[3] = dmax;
+        snprintf(s2, sizeof s2, "red: distance to the target (%.3g = full red)", dmax);
+        snprintf(s3, sizeof s3, "residual rms %.2g%%, max %.2g%%", 100 * rms, 100 * mx);
+        snprintf(s4, sizeof s4, "red: displacement from unrigged");
+        l2[0] = NULL; l2[1] = s2; l2[2] = s3; l2[3] = s4;
+        if (picture(o->png, m, 4, S, R, sc, l1, l2, o->az, o->el)) goto done;
+    }
+    cl = strlen(o->desc) + strlen(what) + 2048;
+    comment = malloc(cl);
+    {
+        size_t n = 0;
+        n += (size_t)snprintf(comment + n, cl - n, "surface rig fitted by sinew-rig fit-surface (seed 003 eq. 13-14) from %s\n", o->desc);
+        for (i = 0; i < o->ntarget && n < cl; i++) n += (size_t)snprintf(comment + n, cl - n, "target %s\n", o->target[i]);
+        n += (size_t)snprintf(comment + n, cl - n, "pose %s\ncontrol %s, omega %g%s\n", what, o->control, o->omega, o->rigs_off ? ", description rigs off" : "");
+        n += (size_t)snprintf(comment + n, cl - n, "residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations\n", 100 * rms, 100 * mx, rr.iterations);
+        snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, o->out, o->control, tau);
+    }
+    if (sb_rigfile_write(o->out, &F.o, &F.mesh, eta, comment)) { fprintf(stderr, PROG ": %s\n", sb_error()); if (o->png) remove(o->png); goto done; }
+    rc = 0;
+    if (!o->quiet) {
+        printf("fit-surface: wrote %s%s%s\n", o->out, o->png ? " and " : "", o->png ? o->png : "");
+        printf("rig_file %s %s %s tau %s\n", o->name ? o->name : o->control, o->out, o->control, tau);
+    }
+done:
+    for (i = 0; i < o->ntarget; i++) free(tg[i]);
+    free(local); free(pose); free(eta); free(fit); free(base); free(rest); free(comment);
+    sb_fit_close(&F);
+    return rc;
+}
+
+static int cmd_fit_points(const opts_t *o)
+{
+    sb_fit F;
+    const snref_model *m;
+    int rigs[64], nr = 0, vert[1024], np = 0, rc = 2, a;
+    double tgt[3 * 1024], eta[64], lo[64], hi[64], blo = -1e6, bhi = 1e6, t0;
+    snref_xform *pose = NULL;
+    char what[4096];
+    sb_opt_opts oo;
+    sb_opt_result rr;
+    if (!o->points || !o->rigs) { fprintf(stderr, PROG ": fit-points DESC --points FILE --rigs R1,... (--help)\n"); return 2; }
+    if (o->bounds && (sscanf(o->bounds, "%lf,%lf", &blo, &bhi) != 2 || !(blo <= bhi))) { fprintf(stderr, PROG ": --bounds LO,HI with LO <= HI\n"); return 2; }
+    {   /* points file */
+        FILE *f = check_readable(o->points, "points file");
+        char line[512];
+        int ln = 0;
+        if (!f) return 2;
+        while (fgets(line, sizeof line, f)) {
+            char *h = strchr(line, '#');
+            int v, nn;
+            double x[3];
+            ln++;
+            if (h) *h = 0;
+            if (sscanf(line, " %d %lf %lf %lf %n", &v, &x[0], &x[1], &x[2], &nn) != 4) {
+                if (strspn(line, " \t\r\n") == strlen(line)) continue;
+                fprintf(stderr, PROG ": %s:%d: want 'VERTEX X Y Z'\n", o->points, ln); fclose(f); return 2;
+            }
+            if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2])) { fprintf(stderr, PROG ": %s:%d: non-finite coordinate\n", o->points, ln); fclose(f); return 2; }
+            if (np >= 1024) { fprintf(stderr, PROG ": %s: more than 1024 points\n", o->points); fclose(f); return 2; }
+            vert[np] = v; memcpy(tgt + 3 * np, x, sizeof x); np++;
+        }
+        fclose(f);
+        if (!np) { fprintf(stderr, PROG ": %s: no points\n", o->points); return 2; }
+    }
+    if (sb_fit_open(&F, o->desc, 1)) return 1;
+    m = &F.m;
+    for (a = 0; a < np; a++) if (vert[a] < 0 || vert[a] >= (int)m->nS) { fprintf(stderr, PROG ": %s: vertex %d out of range (the mesh has %u)\n", o->points, vert[a], m->nS); goto done; }
+    {
+        const char *s = o->rigs;
+        while (*s) {
+            const char *e = strchr(s, ',');
+            size_t l = e ? (size_t)(e - s) : strlen(s);
+            for (a = 0; a < F.o.nrig && !(strlen(F.o.rig[a].def.name) == l && !strncmp(F.o.rig[a].def.name, s, l)); a++) {}
+            if (a == F.o.nrig) { fprintf(stderr, PROG ": --rigs: the description has no rig '%.*s'\n", (int)l, s); goto done; }
+            if (F.o.rig[a].def.tpl == SB_TPL_FILE) { fprintf(stderr, PROG ": --rigs: '%.*s' is a file rig (its strength is not a template parameter)\n", (int)l, s); goto done; }
+            if (nr >= 64) { fprintf(stderr, PROG ": --rigs: at most 64\n"); goto done; }
+            rigs[nr] = a; eta[nr] = F.o.rig[a].def.s; lo[nr] = blo; hi[nr] = bhi; nr++;
+            s = e ? e + 1 : s + l;
+        }
+    }
+    pose = malloc(m->nJ * sizeof *pose);
+    if (o->controls && set_controls(&F.s, o->controls)) goto done;
+    if (sb_static_pose(&F.s, o->pose ? o->pose : "rest", pose, NULL, what, sizeof what)) goto done;
+    if (o->controls && set_controls(&F.s, o->controls)) goto done;   /* over a clip's tracks */
+    rc = 1;
+    if (sb_fit_set_pose(&F, pose, 1.0)) goto done;
+    for (a = 0; a < nr; a++) {
+        unsigned r = (unsigned)rigs[a];
+        if (snref_tau(m, r, snref_get_control(&F.s, m->rctl[r])) == 0)
+            fprintf(stderr, PROG ": warning: rig '%s' is off at its control's value (tau = 0): its strength cannot move the points\n", F.o.rig[r].def.name);
+    }
+    sb_opt_defaults(&oo);
+    oo.pgtol = 1e-12; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-points";
+    t0 = sb_now();
+    {
+        double c0 = sb_fit_points_cost(&F, rigs, nr, vert, tgt, np, o->lambda, eta, NULL);
+        if (sb_fit_points(&F, rigs, nr, vert, tgt, np, o->lambda, lo, hi, eta, &oo, &rr)) goto done;
+        if (!o->quiet) printf("fit-points: %d points, %d rigs, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d solves, %.3f s\n",
+                              np, nr, what, c0, rr.f, rr.iterations, 2 * rr.evaluations, sb_now() - t0);
+    }
+    {   /* the description's rig lines with the fitted strengths */
+        FILE *f = fopen(o->desc, "r");
+        char line[4096], *buf = malloc(64 * 4096 + 256);
+        int ln = 0;
+        size_t n = 0;
+        n += (size_t)sprintf(buf + n, "# sinew-rig fit-points: %d points of %s at pose %s, lambda %g\n", np, o->points, what, o->lambda);
+        while (f && fgets(line, sizeof line, f)) {
+            ln++;
+            for (a = 0; a < nr; a++)
+                if (F.o.rig[rigs[a]].def.line == ln) {   /* replace the 5th token (the strength) */
+                    char *p = line;
+                    int t;
+                    for (t = 0; t < 4; t++) { p += strspn(p, " \t"); p += strcspn(p, " \t"); }
+                    p += strspn(p, " \t");
+                    n += (size_t)sprintf(buf + n, "%.*s%.9g%s", (int)(p - line), line, eta[a], p + strcspn(p, " \t\r\n"));
+                    if (!o->quiet) printf("rig %-14s strength %.9g -> %.9g\n", F.o.rig[rigs[a]].def.name, F.o.rig[rigs[a]].def.s, eta[a]);
+                }
+        }
+        if (f) fclose(f);
+        if (o->out && sb_write_file(o->out, (const unsigned char *)buf, n)) { fprintf(stderr, PROG ": %s\n", sb_error()); free(buf); goto done; }
+        if (o->out && !o->quiet) printf("fit-points: wrote %s\n", o->out);
+        free(buf);
+    }
+    rc = 0;
+done:
+    free(pose);
+    sb_fit_close(&F);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    opts_t o;
+    int rc = parse(argc, argv, &o);
+    if (rc) return rc == 1 ? 0 : rc;
+    {   FILE *f = check_readable(o.desc, "description"); if (!f) return 2; fclose(f); }
+    if (!strcmp(o.cmd, "export")) return cmd_export(&o);
+    if (!strcmp(o.cmd, "fit-pose")) return cmd_fit_pose(&o);
+    if (!strcmp(o.cmd, "fit-points")) return cmd_fit_points(&o);
+    return cmd_fit_surface(&o);
+}
