@@ -720,7 +720,7 @@ int sb_rt_solve(sb_retarget *rt)
         if (round > 0 && sb_rt_update_surface(rt)) { free(g); return -1; }
         if (rt->opt.verbose && round == 0) {
             c = sb_rt_cost(rt, rt->h, g, parts);
-            printf("retarget: start    cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e\n", c, parts[0], parts[1], parts[2],
+            fprintf(stderr, "retarget: start    cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e\n", c, parts[0], parts[1], parts[2],
                    norm(g, 3 * rt->nv));
         }
         if (rt->opt.optimizer == SB_RT_OPT_LBFGSB) { if (lbfgsb_round(rt, &it)) { free(g); return sb_fail("retarget: L-BFGS-B refused the problem (non-finite cost?)"); } }
@@ -730,7 +730,7 @@ int sb_rt_solve(sb_retarget *rt)
         if (!isfinite(c)) { free(g); return sb_fail("retarget: the cost is not finite after round %d", round + 1); }
         rt->gnorm = norm(g, 3 * rt->nv);
         if (rt->opt.verbose)
-            printf("retarget: round %2d cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e, %d %s iterations, %.2f s\n",
+            fprintf(stderr, "retarget: round %2d cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e, %d %s iterations, %.2f s\n",
                    round + 1, c, parts[0], parts[1], parts[2], rt->gnorm, it, rt->opt.optimizer == SB_RT_OPT_LBFGSB ? "L-BFGS-B" : "CG", sb_now() - t0);
         rt->rounds = round + 1;
         if (prev >= 0 && prev - c <= rt->opt.round_tol * prev) break;

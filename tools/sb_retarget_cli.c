@@ -1,9 +1,7 @@
-/* sb_retarget_cli.c -- the 'retarget' command (seed 003 §4.4): kept in its
- * own file so it can become a sub-command of the rig tool (sinew-rig
- * retarget ...) by calling sb_retarget_cli from its dispatcher; until then
- * tools/sinew_retarget.c is its main.
+/* sb_retarget_cli.c -- 'sinew-rig retarget' (seed 003 §4.4), in its own file:
+ * tools/sinew_rig.c's main hands it argv from the sub-command's name on.
  *
- *   retarget A.sinew B.sinew --rig NAME[,NAME...] -o OUT.rig [options]
+ *   sinew-rig retarget A.sinew B.sinew --rig NAME[,NAME...] -o OUT.rig [options]
  *
  * Loads both characters, maps A's lattice onto B (eq. 15), estimates J_i
  * (eq. 16), transfers the named rigs of A (summed at eta = 1) to B and writes
@@ -50,6 +48,9 @@ static void usage(FILE *f, const char *prog)
             "                    bounds); --frame-b for B's\n"
             "  --map-obj OUT.obj A's surface under the map h (to compare with B's in a viewer)\n"
             "  --quiet           no progress lines or summary\n"
+            "Progress (stderr): one line per closest-point round: cost, its three terms, gradient norm,\n"
+            "inner iterations. Summary (stdout): residuals, det J_i range, transfer figures. Exit status 0,\n"
+            "1 (a bake, the map or the transfer failed), 2 (bad command line); nothing written on failure.\n"
             "  --help            this text\n",
             prog);
 }
@@ -252,7 +253,7 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
     {
         char head[4096];
         snprintf(head, sizeof head,
-                 "retargeted (sinew-retarget, seed 003 §4.4): rigs %s of %s carried to %s\n"
+                 "retargeted (sinew-rig retarget, seed 003 §4.4): rigs %s of %s carried to %s\n"
                  "include in B's description: rig_file %s FILE %s\n"
                  "w_skel %g, w_surf %g, %s correspondence, %d rounds\n"
                  "map residuals (B mesh units): skeleton rms %.6g max %.6g, surface rms %.6g max %.6g; distortion %.6g",

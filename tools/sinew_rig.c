@@ -51,6 +51,10 @@ static void usage(FILE *f)
         "      lines with the fitted strengths (to replace the description's)\n"
         "  export DESC RIG -o OUT.rig\n"
         "      a rig of the description (template or file) as a rig file\n"
+        "  retarget A.sinew B.sinew --rig R1,R2,... -o OUT.rig [options]\n"
+        "      rigs of character A carried to character B (seed 003 4.4): a map of A's lattice onto B,\n"
+        "      its Jacobians, the rig moved as a displacement; written as a rig file of B\n"
+        "      (sinew-rig retarget --help)\n"
         "Common options: --quiet (no progress or summary), --progress N (a progress line every N\n"
         "iterations, default 10), --help.\n"
         "Progress lines (stderr): LABEL: iter N  f COST  |pg|inf PROJECTED-GRADIENT. Exit status: 0, 1 (a\n"
@@ -289,7 +293,7 @@ static int parse(int argc, char **argv, opts_t *o)
     for (i = 1; i < argc; i++) if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { usage(stdout); return 1; }
     o->cmd = argv[1];
     if (strcmp(o->cmd, "fit-surface") && strcmp(o->cmd, "fit-pose") && strcmp(o->cmd, "fit-points") && strcmp(o->cmd, "export")) {
-        fprintf(stderr, PROG ": unknown command '%s' (fit-surface, fit-pose, fit-points, export; --help)\n", o->cmd);
+        fprintf(stderr, PROG ": unknown command '%s' (fit-surface, fit-pose, fit-points, export, retarget; --help)\n", o->cmd);
         return 2;
     }
     for (i = 2; i < argc; i++) {
@@ -673,10 +677,14 @@ done:
     return rc;
 }
 
+int sb_retarget_cli(int argc, char **argv, const char *prog);   /* tools/sb_retarget_cli.c */
+
 int main(int argc, char **argv)
 {
     opts_t o;
-    int rc = parse(argc, argv, &o);
+    int rc;
+    if (argc >= 2 && !strcmp(argv[1], "retarget")) return sb_retarget_cli(argc - 1, argv + 1, PROG " retarget");
+    rc = parse(argc, argv, &o);
     if (rc) return rc == 1 ? 0 : rc;
     {   FILE *f = check_readable(o.desc, "description"); if (!f) return 2; fclose(f); }
     if (!strcmp(o.cmd, "export")) return cmd_export(&o);

@@ -47,8 +47,8 @@ $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 RIGTOOL = $(BUILD)/sinew-rig
 FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
 $(FIT_OBJ) $(BUILD)/tools/static/sinew_rig.o: tools/sb_fit.h
-$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
-	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
+	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
 all: $(RIGTOOL)
 $(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
 	@mkdir -p $(dir $@)
@@ -163,18 +163,10 @@ SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS)
 all: $(SHEET_BLOBS)
 TEST_DEPS += $(SHEET_BLOBS)
 
-# ---- sinew-retarget (seed 003 §4.4; tools/sb_retarget_cli.c): rigs carried between characters ----
-RETARGET = $(BUILD)/sinew-retarget
-$(BUILD)/tools/static/sb_retarget_cli.o: tools/sb_retarget_cli.c $(STATIC_HDR)
-	@mkdir -p $(dir $@)
-	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
-$(RETARGET): $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(TOOLS_LIB) $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
-	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_retarget.o $(BUILD)/tools/static/sb_retarget_cli.o $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o $(TOOLS_LIB) -lm
-all: $(RETARGET)
+# sinew-rig retarget (seed 003 §4.4): tools/sb_retarget_cli.c, the sub-command's own file, linked into $(RIGTOOL) above
 # Spot (tools/examples/spot): the retargeting target, with the cow's smile as a rig file
 SPOT_DEPS = tools/examples/spot/spot.sinew tools/examples/spot/spot.obj tools/examples/spot/spot_smile.rig $(BAKE)
 $(EX)/spot.blob: $(SPOT_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/spot/spot.sinew -o $@ --quiet
 all: $(EX)/spot.blob
-TEST_DEPS += $(RETARGET)

@@ -1,30 +1,30 @@
 #!/bin/sh
-# sinew-retarget command line (seed 003 §4.4, tools/sb_retarget_cli.c): --help,
+# sinew-rig retarget command line (seed 003 §4.4, tools/sb_retarget_cli.c): --help,
 # usage errors, progress lines and summary, the cow's smile on Spot written
 # twice as the same bytes (rig file and picture), and refusals (a joint of A
 # missing in B, an unknown rig, a bad option value) that exit non-zero and
 # write nothing.
 BUILD=${BUILD:-build}
-RT=$BUILD/sinew-retarget
+RIG=$BUILD/sinew-rig
 pass=0; fail=0
 ok() { echo "ok   $1"; pass=$((pass + 1)); }
 bad() { echo "FAIL $1"; fail=$((fail + 1)); }
-[ -x "$RT" ] || { echo "FAIL: $RT not built"; echo "0 passed, 1 failed"; exit 1; }
+[ -x "$RIG" ] || { echo "FAIL: $RIG not built"; echo "0 passed, 1 failed"; exit 1; }
 T=$(mktemp -d "${TMPDIR:-/tmp}/sinew_retarget_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT
 COW=tools/examples/cow/cow.sinew
 SPOT=tools/examples/spot/spot.sinew
 
-"$RT" --help > "$T/help" 2>&1 && grep -q "usage: sinew-retarget" "$T/help" && ok "--help" || bad "--help"
-"$RT" "$COW" > /dev/null 2>&1; [ $? -eq 2 ] && ok "missing arguments: exit 2" || bad "missing arguments"
-"$RT" "$COW" "$SPOT" --rig smile_l -o "$T/x.rig" --w-surf -3 > /dev/null 2>&1; [ $? -eq 2 ] && [ ! -e "$T/x.rig" ] && ok "bad --w-surf: exit 2, nothing written" || bad "bad --w-surf"
+"$RIG" retarget --help > "$T/help" 2>&1 && grep -q "usage: sinew-rig retarget" "$T/help" && ok "--help" || bad "--help"
+"$RIG" retarget "$COW" > /dev/null 2>&1; [ $? -eq 2 ] && ok "missing arguments: exit 2" || bad "missing arguments"
+"$RIG" retarget "$COW" "$SPOT" --rig smile_l -o "$T/x.rig" --w-surf -3 > /dev/null 2>&1; [ $? -eq 2 ] && [ ! -e "$T/x.rig" ] && ok "bad --w-surf: exit 2, nothing written" || bad "bad --w-surf"
 
-"$RT" "$COW" "$SPOT" --rig smile_l,smile_r --name smile --w-surf 1000 -o "$T/a.rig" --png "$T/a.png" > "$T/a.out" 2>&1 && ok "cow smile -> spot" || { bad "cow smile -> spot"; cat "$T/a.out"; }
+"$RIG" retarget "$COW" "$SPOT" --rig smile_l,smile_r --name smile --w-surf 1000 -o "$T/a.rig" --png "$T/a.png" > "$T/a.out" 2>&1 && ok "cow smile -> spot" || { bad "cow smile -> spot"; cat "$T/a.out"; }
 grep -q "^retarget: round  1 cost" "$T/a.out" && ok "progress lines (round, cost, |grad|)" || bad "progress lines"
 grep -q "^retarget: residuals" "$T/a.out" && grep -q "^retarget: transfer:" "$T/a.out" && ok "summary (residuals, transfer)" || bad "summary"
 grep "^retarget: \(map\|residuals\|transfer\)" "$T/a.out" | sed 's/^/  figure: /'
 grep -q "^sinew-rig 1$" "$T/a.rig" && grep -q "^end$" "$T/a.rig" && grep -q "rig_file smile FILE smile" "$T/a.rig" && ok "rig file (sinew-rig 1) with its rig_file line" || bad "rig file"
-"$RT" "$COW" "$SPOT" --rig smile_l,smile_r --name smile --w-surf 1000 -o "$T/b.rig" --png "$T/b.png" --quiet > "$T/b.out" 2>&1
+"$RIG" retarget "$COW" "$SPOT" --rig smile_l,smile_r --name smile --w-surf 1000 -o "$T/b.rig" --png "$T/b.png" --quiet > "$T/b.out" 2>&1
 [ ! -s "$T/b.out" ] && ok "--quiet prints nothing" || bad "--quiet printed: $(head -c 200 "$T/b.out")"
 cmp -s "$T/a.rig" "$T/b.rig" && cmp -s "$T/a.png" "$T/b.png" && ok "two runs write the same bytes (rig and picture)" || bad "two runs differ"
 cmp -s "$T/a.rig" tools/examples/spot/spot_smile.rig && ok "tools/examples/spot/spot_smile.rig is this run's output" ||
@@ -36,10 +36,10 @@ cmp -s "$T/a.rig" tools/examples/spot/spot_smile.rig && ok "tools/examples/spot/
 # B without the tail tip: A's joint tail_tip is missing
 mkdir -p "$T/s"; cp tools/examples/spot/spot.obj tools/examples/spot/spot_smile.rig "$T/s/"
 grep -v "^joint tail_tip" "$SPOT" > "$T/s/spot.sinew"
-"$RT" "$COW" "$T/s/spot.sinew" --rig smile_l -o "$T/m.rig" > "$T/m.out" 2>&1; rc=$?
+"$RIG" retarget "$COW" "$T/s/spot.sinew" --rig smile_l -o "$T/m.rig" > "$T/m.out" 2>&1; rc=$?
 [ $rc -ne 0 ] && grep -q "tail_tip" "$T/m.out" && [ ! -e "$T/m.rig" ] && ok "a joint missing in B is named, exit $rc, nothing written" || { bad "missing joint"; cat "$T/m.out"; }
 grep "error" "$T/m.out" | sed 's/^/  message: /'
-"$RT" "$COW" "$SPOT" --rig grin -o "$T/g.rig" > "$T/g.out" 2>&1; rc=$?
+"$RIG" retarget "$COW" "$SPOT" --rig grin -o "$T/g.rig" > "$T/g.out" 2>&1; rc=$?
 [ $rc -ne 0 ] && grep -q "grin" "$T/g.out" && [ ! -e "$T/g.rig" ] && ok "an unknown rig is named, nothing written" || { bad "unknown rig"; cat "$T/g.out"; }
 
 echo "$pass passed, $fail failed"
