@@ -80,8 +80,9 @@ static double bbox_diag(const sb_mesh *m)
     return sqrt(dot3(d, d));
 }
 
-/* the kept cell of A holding p and its reference coordinates; -1 if none */
-static int locate(const sb_model *o, const double p[3], double t[3])
+/* the kept cell of o holding p and its reference coordinates; -1 if none.
+ * cmap: kept cell of every grid cell (-1 none), or NULL (a search) */
+static int locate(const sb_model *o, const int *cmap, const double p[3], double t[3])
 {
     int gi[3], k, ci;
     for (k = 0; k < 3; k++) {
@@ -92,6 +93,7 @@ static int locate(const sb_model *o, const double p[3], double t[3])
     }
     {
         int g = gi[0] + (o->gn[0] - 1) * (gi[1] + (o->gn[1] - 1) * gi[2]);
+        if (cmap) return cmap[g];
         for (ci = 0; ci < o->nc; ci++) if (o->cell_grid[ci] == g) return ci;
     }
     return -1;
@@ -312,7 +314,7 @@ int sb_rt_init(sb_retarget *rt, const sb_model *A, const sb_mesh *mA, const sb_m
     }
     for (i = 0; i < nsamp; i++) {
         double t[3];
-        int ci = locate(A, sp + 3 * i, t);
+        int ci = locate(A, NULL, sp + 3 * i, t);
         sb_rt_term *tm;
         if (ci < 0) continue;   /* a bone sample outside the lattice (cannot happen for joints) */
         tm = &rt->term[rt->nsk++];
@@ -719,6 +721,7 @@ int sb_rt_solve(sb_retarget *rt)
         double c;
         if (round > 0 && sb_rt_update_surface(rt)) { free(g); return -1; }
         if (rt->opt.verbose && round == 0) {
+            fflush(stdout);   /* progress goes to stderr: keep the order of the lines */
             c = sb_rt_cost(rt, rt->h, g, parts);
             fprintf(stderr, "retarget: start    cost %.6e (skel %.3e, surf %.3e, distort %.3e), |grad| %.3e\n", c, parts[0], parts[1], parts[2],
                    norm(g, 3 * rt->nv));
@@ -891,10 +894,10 @@ int sb_rt_rig_force(const sb_model *o, const char *names, double *Q, int *contro
 /* a sample of the transferred field: B cell, reference coordinates, value */
 typedef struct rs_sample { int cell; double t[3]; double v[3]; } rs_sample;
 
-static void add_sample(const sb_model *B, rs_sample *S, int *ns, const double y[3], const double v[3])
+static void add_sample(const sb_model *B, const int *cmap, rs_sample *S, int *ns, const double y[3], const double v[3])
 {
     double t[3];
-    int ci = locate(B, y, t);
+    int ci = locate(B, cmap, y, t);
     if (ci < 0) return;
     S[*ns].cell = ci;
     memcpy(S[*ns].t, t, sizeof t);
@@ -938,11 +941,15 @@ static int resample(const sb_retarget *rt, const double *qbar, double *qB, sb_rt
     double *d = sb_alloc(sizeof(double) * (size_t)n), *Ad = sb_alloc(sizeof(double) * (size_t)n), *dg = sb_alloc(sizeof(double) * (size_t)B->nf);
     double *z = sb_alloc(sizeof(double) * (size_t)n), rz = 0, bn;
     unsigned char *has = sb_alloc((size_t)B->nv);
+    size_t ngc = (size_t)(B->gn[0] - 1) * (size_t)(B->gn[1] - 1) * (size_t)(B->gn[2] - 1);
+    int *cmap = sb_alloc(sizeof(int) * ngc);
     sb_inside in;
+    for (i = 0; i < (int)ngc; i++) cmap[i] = -1;
+    for (i = 0; i < B->nc; i++) cmap[B->cell_grid[i]] = i;
     /* samples: inside A's mesh only (the lattice vertices and cell centres
      * outside it carry the 'air' displacement, not flesh) */
     sb_inside_init(&in, rt->mA);
-    for (i = 0; i < A->nv; i++) if (sb_inside_test(&in, A->x + 3 * i)) add_sample(B, S, &ns, rt->h + 3 * i, qbar + 3 * i);
+    for (i = 0; i < A->nv; i++) if (sb_inside_test(&in, A->x + 3 * i)) add_sample(B, cmap, S, &ns, rt->h + 3 * i, qbar + 3 * i);
     for (k = 0; k < A->nc + A->ns; k++) {
         double t[3] = { 0.5, 0.5, 0.5 }, N[8], y[3] = { 0, 0, 0 }, v[3] = { 0, 0, 0 };
         int ci = k < A->nc ? k : A->emb_cell[k - A->nc], c;
@@ -957,9 +964,10 @@ static int resample(const sb_retarget *rt, const double *qbar, double *qB, sb_rt
             int v0 = A->cells[8 * ci + c];
             for (a = 0; a < 3; a++) { y[a] += N[c] * rt->h[3 * v0 + a]; v[a] += N[c] * qbar[3 * v0 + a]; }
         }
-        add_sample(B, S, &ns, y, v);
+        add_sample(B, cmap, S, &ns, y, v);
     }
     sb_inside_free(&in);
+    free(cmap);
     if (!ns) {
         free(S); free(st); free(stw); free(b); free(x); free(r); free(d); free(Ad); free(dg); free(z); free(has);
         return sb_fail("retarget: empty overlap: no point of A's mapped lattice or surface lies in B's lattice (the map does not cover B)");
