@@ -13,8 +13,10 @@
  *    J_i of an affine map is exact;
  *  - the transferred rig (Q_A -> q_A -> J q_A -> Q_B, then B's static
  *    equilibrium under Q_B) moves B's surface as G moves A's rigged
- *    displacement: rms error <= 1% of the largest displacement (measured
- *    0.12%), largest <= 2% (measured 1.0%);
+ *    displacement: error at every surface vertex <= 1% of the largest
+ *    displacement (measured 0.26%, rms 0.02%); a second rig under the arm
+ *    within 1% at every vertex (0.15%); A onto itself
+ *    J_i = I and the rig back within 1% (0.12%);
  *  - bad inputs are refused with a message and nothing is written;
  *  - the rig file is the same bytes when written twice.
  * Files go to a temporary directory under /tmp. */
@@ -131,6 +133,34 @@ static double grad_check(const sb_retarget *rt, const double *x0, int ncheck, un
     return worst;
 }
 
+/* rig `name` of A through rt onto B: surface error against G times A's
+ * displacement (max, rms) and the largest mapped displacement */
+static void transfer_error(const sb_retarget *rt, const sb_model *A, const sb_model *B, const char *name, double *emax, double *erms, double *dmax)
+{
+    double *QA = calloc(3 * (size_t)A->nf, sizeof(double)), *QB = calloc(3 * (size_t)B->nf, sizeof(double));
+    double *qA = calloc(3 * (size_t)A->nv, sizeof(double)), *qB = calloc(3 * (size_t)B->nv, sizeof(double));
+    double *a0 = malloc(sizeof(double) * 3 * (size_t)A->ns), *a1 = malloc(sizeof(double) * 3 * (size_t)A->ns);
+    double *b0 = malloc(sizeof(double) * 3 * (size_t)B->ns), *b1 = malloc(sizeof(double) * 3 * (size_t)B->ns), e2 = 0;
+    int k, a;
+    *emax = *dmax = 0;
+    T_CHECK(sb_rt_rig_force(A, name, QA, NULL) == 0 && sb_rt_transfer(rt, QA, QB, qA, NULL, NULL) == 0, "transfer %s: %s", name, sb_error());
+    sb_rt_static(B, QB, qB);
+    sb_rt_surface(A, NULL, a0); sb_rt_surface(A, qA, a1);
+    sb_rt_surface(B, NULL, b0); sb_rt_surface(B, qB, b1);
+    for (k = 0; k < A->ns; k++) {
+        double dA[3], dG[3], z[3] = { 0, 0, 0 }, gz[3], e = 0, d = 0;
+        for (a = 0; a < 3; a++) dA[a] = a1[3 * k + a] - a0[3 * k + a];
+        affine(dA, dG); affine(z, gz);
+        for (a = 0; a < 3; a++) {
+            double r = (b1[3 * k + a] - b0[3 * k + a]) - (dG[a] - gz[a]);
+            e += r * r; d += (dG[a] - gz[a]) * (dG[a] - gz[a]);
+        }
+        *emax = fmax(*emax, sqrt(e)); *dmax = fmax(*dmax, sqrt(d)); e2 += e;
+    }
+    *erms = sqrt(e2 / A->ns);
+    free(QA); free(QB); free(qA); free(qB); free(a0); free(a1); free(b0); free(b1);
+}
+
 int main(void)
 {
     sb_rt_char ca, cb, cm;
@@ -139,7 +169,8 @@ int main(void)
     unsigned seed = (unsigned)T_SEED();
     int i, k, a, ctl = -1;
     char cmd[600];
-    const char *rig = "control c\nrig bump c bump 0.6   5.0 0.9 0.2   0.9   0 1 0.3\n";
+    const char *rig = "control c\nrig bump c bump 0.6   5.0 0.9 0.2   0.9   0 1 0.3\n"
+                      "rig under c bump 0.8   2.5 -0.6 -0.5   1.2   0.2 -1 -0.4\n";
 
     snprintf(dir, sizeof dir, "/tmp/sn_test_retarget_%ld", (long)getpid());
     snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
@@ -233,12 +264,16 @@ int main(void)
         T_FIGURE("transfer: largest mapped displacement %.4g mesh units; transferred - mapped: max %.3e (%.3f%%), rms %.3e (%.3f%%)", dmax, emax,
                  100 * emax / dmax, sqrt(e2 / ca.o.ns), 100 * sqrt(e2 / ca.o.ns) / dmax);
         T_CHECK(dmax > 0.05, "the rig moves the surface (%.3g mesh units)", dmax);
-        /* the issue's 1%: as the rms over the surface vertices (measured 0.12%); the
-         * largest single-vertex error is 1.0% (B's own axis-aligned lattice cannot
-         * hold the sheared trilinear field exactly, and B's bones capture
-         * other lattice vertices than G maps A's onto): asserted at 2% */
+        /* the 1%, at every surface vertex (measured 0.26%; rms 0.02%) */
+        T_CHECK(emax <= 0.01 * dmax, "transferred shape = mapped shape within 1%% at every vertex (max error %.3g%%)", 100 * emax / dmax);
         T_CHECK(sqrt(e2 / ca.o.ns) <= 0.01 * dmax, "transferred shape = mapped shape within 1%% rms (%.3g%%)", 100 * sqrt(e2 / ca.o.ns) / dmax);
-        T_CHECK(emax <= 0.02 * dmax, "transferred shape = mapped shape within 2%% at every vertex (max error %.3g%%)", 100 * emax / dmax);
+        {   /* a second rig, under the arm across the bone's side: max 0.15%, rms 0.02% */
+            double em2, er2, dm2;
+            transfer_error(&rt, &ca.o, &cb.o, "under", &em2, &er2, &dm2);
+            T_FIGURE("transfer of rig 'under': largest mapped displacement %.4g; max error %.3e (%.3f%%), rms %.3e (%.3f%%)", dm2, em2, 100 * em2 / dm2,
+                     er2, 100 * er2 / dm2);
+            T_CHECK(em2 <= 0.01 * dm2, "rig 'under': within 1%% at every vertex (%.3g%%)", 100 * em2 / dm2);
+        }
 
         /* rig file: deterministic, refused when zero */
         {
@@ -287,6 +322,29 @@ int main(void)
         free(QA); free(QB); free(qA); free(qB); free(sA0); free(sA1); free(sB0); free(sB1);
     }
     sb_rt_free(&rt);
+
+    /* ---- A onto itself: J_i = I, the rig comes back ---- */
+    {
+        double *QA = calloc(3 * (size_t)ca.o.nf, sizeof(double)), *QB = calloc(3 * (size_t)ca.o.nf, sizeof(double));
+        double *qA = calloc(3 * (size_t)ca.o.nv, sizeof(double)), *qB = calloc(3 * (size_t)ca.o.nv, sizeof(double));
+        double *s0 = malloc(sizeof(double) * 3 * (size_t)ca.o.ns), *s1 = malloc(sizeof(double) * 3 * (size_t)ca.o.ns);
+        double *s2 = malloc(sizeof(double) * 3 * (size_t)ca.o.ns), jerr = 0, e = 0, dm = 0;
+        T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &ca.o, &ca.m, &opt) == 0, "init A -> A: %s", sb_error());
+        T_CHECK(sb_rt_solve(&rt) == 0 && sb_rt_jacobians(&rt) == 0, "solve A -> A: %s", sb_error());
+        for (i = 0; i < rt.nv; i++)
+            for (k = 0; k < 9; k++) jerr = fmax(jerr, fabs(rt.J[9 * i + k] - (k % 4 == 0)));
+        T_CHECK(jerr <= 1e-9, "A -> A: J_i = I within 1e-9 (%.3g)", jerr);
+        sb_rt_rig_force(&ca.o, "bump", QA, NULL);
+        T_CHECK(sb_rt_transfer(&rt, QA, QB, qA, NULL, NULL) == 0, "transfer A -> A: %s", sb_error());
+        sb_rt_static(&ca.o, QB, qB);
+        sb_rt_surface(&ca.o, NULL, s0); sb_rt_surface(&ca.o, qA, s1); sb_rt_surface(&ca.o, qB, s2);
+        for (k = 0; k < 3 * ca.o.ns; k++) { e = fmax(e, fabs(s2[k] - s1[k])); dm = fmax(dm, fabs(s1[k] - s0[k])); }
+        T_FIGURE("A onto itself: largest |J_i - I| %.2e; the rig's surface displacement comes back within %.2e (%.3f%% of its largest component)", jerr, e,
+                 100 * e / dm);
+        T_CHECK(e <= 0.01 * dm, "A -> A: the rig comes back within 1%% (%.3g%%)", 100 * e / dm);
+        sb_rt_free(&rt);
+        free(QA); free(QB); free(qA); free(qB); free(s0); free(s1); free(s2);
+    }
 
     /* ---- the same with L-BFGS-B (tools/sb_lbfgsb.c) as the inner optimizer ---- */
     {

@@ -141,13 +141,18 @@ int sb_rt_rig_force(const sb_model *o, const char *names, double *Q, int *contro
 /* rig transfer (seed 003 §4.4): Q_A (nf_A x 3, N) -> q_A (eq. 10 on A) ->
  * qbar_i = J_i q_A,i at the mapped vertex h(x_i) -> B's lattice field q_B
  * (free vertices; skeleton vertices 0) fitted by least squares to the
- * transferred field sampled at A's mapped lattice vertices and cell centres
- * inside A's mesh and at A's mapped surface vertices, with a small second-difference smoothing (B's lattice is
- * its own grid, not h(K) as in the paper) -> Q_B = S_FF q_B (nf_B x 3, N).
- * An empty overlap (no sample inside B's lattice) is an error. qA, qB (nv x 3, mesh units of
- * A and B) out if non-NULL. Needs sb_rt_jacobians. 0 or -1. */
+ * transferred field at B's surface vertices (weight 1; the field at the
+ * vertex's preimage in A's mapped lattice, or at the closest point of A's
+ * mapped surface for a vertex outside it) and at A's mapped lattice vertices
+ * and 2x2x2 points per cell inside A's mesh (weight 0.01), with a 1e-6
+ * second-difference smoothing (B's lattice is its own grid, not h(K) as in
+ * the paper) -> Q_B = S_FF q_B (nf_B x 3, N).
+ * An empty overlap (no surface vertex of B in A's mapped lattice) is an error.
+ * qA, qB (nv x 3, mesh units of A and B) out if non-NULL. Needs
+ * sb_rt_jacobians. 0 or -1. */
 typedef struct sb_rt_transfer_stats {
     int inside, outside;    /* B free vertices with / without a sample in one of their cells */
+    int surf_inside, surf_outside;  /* B surface vertices inside A's mapped lattice / valued from the closest mapped surface point */
     double qA_max, qB_max;  /* largest |q| (mesh units of A / B) */
     double static_res;      /* relative residual of the static solve on A */
 } sb_rt_transfer_stats;

@@ -245,9 +245,21 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
         double res;
         if (sb_rt_transfer(&rt, QA, QB, qA, qB, &st)) { fprintf(stderr, "%s: error: %s\n", prog, sb_error()); goto done; }
         res = sb_rt_static(&B.o, QB, qB);
+        {   /* the rigs' surface displacement on A and B (static equilibria at rest) */
+            double *s0 = malloc(sizeof(double) * 3 * (size_t)(A.o.ns > B.o.ns ? A.o.ns : B.o.ns));
+            double *s1 = malloc(sizeof(double) * 3 * (size_t)(A.o.ns > B.o.ns ? A.o.ns : B.o.ns)), da, db;
+            if (!s0 || !s1) { free(s0); free(s1); fprintf(stderr, "%s: out of memory\n", prog); goto done; }
+            sb_rt_surface(&A.o, NULL, s0); sb_rt_surface(&A.o, qA, s1); da = maxdisp(s0, s1, A.o.ns);
+            sb_rt_surface(&B.o, NULL, s0); sb_rt_surface(&B.o, qB, s1); db = maxdisp(s0, s1, B.o.ns);
+            if (!quiet)
+                printf("retarget: the rig moves the surface by up to %.4g mesh units on A (%.3g%% of its size), %.4g on B (%.3g%%)\n", da,
+                       100 * da / rt.LA, db, 100 * db / rt.L);
+            free(s0); free(s1);
+        }
         if (!quiet)
-            printf("retarget: transfer: |q_A| max %.4g (A units), |q_B| max %.4g (B units); %d of B's %d free vertices sampled, %d smoothed; "
-                   "static residuals A %.1e, B %.1e\n", st.qA_max, st.qB_max, st.inside, B.o.nf, st.outside, st.static_res, res);
+            printf("retarget: transfer: |q_A| max %.4g (A units), |q_B| max %.4g (B units); B's surface vertices: %d in A's mapped lattice, %d "
+                   "outside (closest mapped surface point); %d of B's %d free vertices sampled, %d smoothed; static residuals A %.1e, B %.1e\n",
+                   st.qA_max, st.qB_max, st.surf_inside, st.surf_outside, st.inside, B.o.nf, st.outside, st.static_res, res);
     }
     /* outputs */
     {
