@@ -558,7 +558,10 @@ static int cmd_fit_surface(const opts_t *o)
         for (i = 0; i < o->ntarget && n < cl; i++) n += (size_t)snprintf(comment + n, cl - n, "target %s\n", o->target[i]);
         n += (size_t)snprintf(comment + n, cl - n, "pose %s\ncontrol %s, omega %g%s\n", what, o->control, o->omega, o->rigs_off ? ", description rigs off" : "");
         n += (size_t)snprintf(comment + n, cl - n, "residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations\n", 100 * rms, 100 * mx, rr.iterations);
-        snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, o->out, o->control, tau);
+        {   /* the file's own name (not its directory): the bytes depend on the inputs only */
+            const char *b = strrchr(o->out, '/');
+            snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, b ? b + 1 : o->out, o->control, tau);
+        }
     }
     if (sb_rigfile_write(o->out, &F.o, &F.mesh, eta, comment)) { fprintf(stderr, PROG ": %s\n", sb_error()); if (o->png) remove(o->png); goto done; }
     rc = 0;
