@@ -181,6 +181,66 @@ int main(void)
     }
     sb_fit_close(&F);
 
+    /* ---------------- point drag with the template's geometry (limb biceps) ---------------- */
+    {
+        char desc[4096], full[8192], cwd[1024], *p, *q;
+        FILE *f = fopen(LIMB, "r");
+        size_t n = f ? fread(desc, 1, sizeof desc - 1, f) : 0;
+        sb_fit G;
+        if (f) fclose(f);
+        desc[n] = 0;
+        snprintf(cwd, sizeof cwd, "%s", getenv("PWD") ? getenv("PWD") : ".");
+        q = strstr(desc, "\nmesh ") + 1;
+        *q = 0;
+        p = strchr(q + 5, '\n');
+        snprintf(full, sizeof full, "%smesh %s/tools/examples/limb/limb.obj%s", desc, cwd, p);
+        /* the target: the biceps moved 0.4 along the arm, thicker, weaker */
+        p = strstr(full, "rig biceps elbow_bend muscle 2.5   2.0 0.3 0   5.5 0.3 0   1.5 0.2");
+        T_CHECK(p != NULL, "the limb's biceps line");
+        if (p) memcpy(p, "rig biceps elbow_bend muscle 2.0   2.4 0.3 0   5.9 0.3 0   1.8 0.2", 66);
+        write_text("/tmp/test_rigfit_limb_geo.sinew", full);
+        if (sb_fit_open(&G, "/tmp/test_rigfit_limb_geo.sinew", 1) == 0 && sb_fit_open(&F, LIMB, 1) == 0) {
+            const snref_model *m = &F.m;
+            snref_xform *pose = malloc(m->nJ * sizeof *pose);
+            int rigs[1] = {0}, vert[40], np = 0, k, c, npar = sb_fit_template_npar(&F, 0);
+            double pts[120], par[8], par_true[8], g[8], lo[8], hi[8], worst = 0, t0;
+            sb_static_pose(&G.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what);
+            sb_fit_set_pose(&G, pose, 1.0);
+            sb_static_pose(&F.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what);
+            T_CHECK(sb_fit_set_pose(&F, pose, 1.0) == 0, "limb solve");
+            for (k = 0; k < (int)m->nS && np < 40; k += 8) vert[np++] = k;
+            for (k = 0; k < np; k++) for (c = 0; c < 3; c++) pts[3 * k + c] = G.surf0[3 * vert[k] + c];
+            sb_fit_template_get(&G, 0, par_true);
+            sb_fit_template_get(&F, 0, par);
+            T_CHECK(npar == 8, "muscle: strength, two ends, radius (%d)", npar);
+            for (k = 0; k < npar; k++) par[k] = 0.5 * (par[k] + par_true[k]);   /* half way: a gradient away from 0 */
+            sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, par, g);
+            for (k = 0; k < npar; k++) {
+                double pp[8], pm[8], h = 1e-5 * (k ? 1.5 : 2.5), fd, rel;
+                memcpy(pp, par, sizeof pp); memcpy(pm, par, sizeof pm);
+                pp[k] += h; pm[k] -= h;
+                fd = (sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, pp, NULL) - sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, pm, NULL)) / (2 * h);
+                rel = fabs(g[k] - fd) / fmax(fabs(fd), 1e-12);
+                if (fabs(fd) > 1e-9) worst = fmax(worst, rel);
+                printf("    d C / d par[%d]: adjoint %.9g, central difference %.9g, relative error %.2e\n", k, g[k], fd, rel);
+            }
+            printf("  template geometry (limb biceps, 8 parameters): adjoint vs central differences, worst relative error %.2e\n", worst);
+            T_CHECK(worst <= 1e-5, "adjoint gradient with the template's geometry: relative error %.3g (want <= 1e-5)", worst);
+            sb_fit_template_get(&F, 0, par);
+            sb_fit_template_bounds(&F, 0, lo, hi);
+            oo.pgtol = 1e-9; oo.max_iter = 200; oo.ftol = 1e-13;
+            t0 = sb_now();
+            sb_fit_template(&F, rigs, 1, vert, pts, np, 0, lo, hi, par, &oo, &rr);
+            printf("  template geometry fit: cost %.3g (mean squared point distance / cell^2), %d iterations, %d evaluations, %.2f s;"
+                   " s %.4g (2.0), a.x %.4g (2.4), b.x %.4g (5.9), R %.4g (1.8)\n",
+                   rr.f, rr.iterations, rr.evaluations, sb_now() - t0, par[0], par[1], par[4], par[7]);
+            T_CHECK(rr.f < 1e-6, "40 dragged points reached: rms distance %.3g cells (want < 1e-3)", sqrt(rr.f));
+            free(pose);
+            sb_fit_close(&F);
+            sb_fit_close(&G);
+        } else T_CHECK(0, "open the limbs");
+    }
+
     /* ---------------- the rig file refused by another character ---------------- */
     {
         sb_desc d;

@@ -17,6 +17,7 @@ typedef struct sb_fit {
     sb_model o;             /* the bake (float64) */
     sb_blob b;
     sb_mesh mesh;           /* the description's mesh (identity of rig files) */
+    sb_desc d;              /* the description (template rigs re-integrated by sb_fit_template) */
     snref_model m;          /* the reference model of the blob */
     snref_state s;
     double off[3];          /* description coordinates = snref positions (mesh units) + off */
@@ -73,6 +74,28 @@ int sb_fit_points(sb_fit *F, const int *rigs, int nr, const int *vert, const dou
 /* the point-drag cost and gradient at eta (for checks against finite differences) */
 double sb_fit_points_cost(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
                           const double *eta, double *grad);
+
+/* Point-drag with the templates' geometry (§4.2: "one integration over the
+ * character for each element of eta"): per rig a, its parameters
+ *   bump: s, centre (3), radius; ring: s, centre (3), radius, width;
+ *   muscle: s, end a (3), end b (3), radius; uniform: s
+ * (directions, axes and SHORTEN stay), packed rig after rig. The rig's force
+ * is re-integrated by the bake's own quadrature (sb_rig_build) at every
+ * evaluation, dQ/dp by central differences of that integration (step 1e-4 of
+ * the template's size; Q is linear in s). Same C_points; C_params =
+ * lambda sum_k ((par_k - par0_k) / scale_k)^2, scale = |s| for strengths, the
+ * template's size for geometry. npar: parameters of rig a. */
+int sb_fit_template_npar(const sb_fit *F, int rig);
+void sb_fit_template_get(const sb_fit *F, int rig, double *par);
+/* bounds that make sense: strength within +-1e6, centres within 2 sizes of the
+ * description's, sizes within [1/4, 4] of it */
+void sb_fit_template_bounds(const sb_fit *F, int rig, double *lo, double *hi);
+double sb_fit_template_cost(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                            const double *par, double *grad);
+int sb_fit_template(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                    const double *lo, const double *hi, double *par, const sb_opt_opts *oo, sb_opt_result *res);
+/* rig a's template parameters par written into a rigdef copy */
+void sb_fit_template_apply(const sb_fit *F, int rig, const double *par, sb_rigdef *out);
 
 /* rotation vector <-> quaternion (x y z w) */
 void sb_rotvec_quat(const double r[3], double q[4]);

@@ -44,11 +44,12 @@ static void usage(FILE *f)
         "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [-o POSE.txt]\n"
         "      the pose (local joint rotations, as --static/--pose take them) whose skinned surface puts\n"
         "      the feature vertices nearest their target positions\n"
-        "  fit-points DESC --points FILE --rigs R1,R2,... [--pose POSE] [--controls N=V,...] [--lambda L]\n"
-        "              [--bounds LO,HI] [-o OUT.sinew]\n"
-        "      strengths of template rigs so that surface points reach dragged positions; FILE lines\n"
-        "      'VERTEX X Y Z' (0-based mesh vertex, target in the mesh's coordinates); writes the rig\n"
-        "      lines with the fitted strengths (to replace the description's)\n"
+        "  fit-points DESC --points FILE --rigs R1,R2,... [--geometry] [--pose POSE] [--controls N=V,...]\n"
+        "              [--lambda L] [--bounds LO,HI] [-o OUT.sinew]\n"
+        "      template rigs' strengths (--geometry: also centres/ends and sizes, re-integrated at every\n"
+        "      evaluation) so that surface points reach dragged positions; FILE lines 'VERTEX X Y Z'\n"
+        "      (0-based mesh vertex, target in the mesh's coordinates); --bounds: the strengths' range;\n"
+        "      writes the rig lines with the fitted parameters (to replace the description's)\n"
         "  export DESC RIG -o OUT.rig\n"
         "      a rig of the description (template or file) as a rig file\n"
         "Common options: --quiet (no progress or summary), --progress N (a progress line every N\n"
@@ -276,7 +277,7 @@ static void residual(const double *a, const double *target, const double *base, 
 typedef struct {
     const char *cmd, *desc, *out, *pose, *features, *joints, *controls, *control, *points, *rigs, *png, *name, *bounds, *export_rig;
     const char *target[SB_TAU_MAX];
-    int ntarget, quiet, rigs_off, max_iter, progress;
+    int ntarget, quiet, rigs_off, max_iter, progress, geometry;
     double omega, lambda, az, el;
 } opts_t;
 
@@ -324,6 +325,7 @@ static int parse(int argc, char **argv, opts_t *o)
         }
         if (!strcmp(a, "--quiet")) { o->quiet = 1; continue; }
         if (!strcmp(a, "--rigs-off")) { o->rigs_off = 1; continue; }
+        if (!strcmp(a, "--geometry")) { o->geometry = 1; continue; }
         if (a[0] == '-') { fprintf(stderr, PROG ": unknown option '%s' (--help)\n", a); return 2; }
         if (!o->desc) o->desc = a;
         else if (!strcmp(o->cmd, "export") && !o->export_rig) o->export_rig = a;
@@ -582,6 +584,7 @@ static int cmd_fit_points(const opts_t *o)
     const snref_model *m;
     int rigs[64], nr = 0, vert[1024], np = 0, rc = 2, a;
     double tgt[3 * 1024], eta[64], lo[64], hi[64], blo = -1e6, bhi = 1e6, t0;
+    static sb_rigdef fitted[64];
     snref_xform *pose = NULL;
     char what[4096];
     sb_opt_opts oo;
@@ -641,10 +644,30 @@ static int cmd_fit_points(const opts_t *o)
     oo.pgtol = 1e-12; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-points";
     t0 = sb_now();
     {
-        double c0 = sb_fit_points_cost(&F, rigs, nr, vert, tgt, np, o->lambda, eta, NULL);
-        if (sb_fit_points(&F, rigs, nr, vert, tgt, np, o->lambda, lo, hi, eta, &oo, &rr)) goto done;
-        if (!o->quiet) printf("fit-points: %d points, %d rigs, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d solves, %.3f s\n",
-                              np, nr, what, c0, rr.f, rr.iterations, 2 * rr.evaluations, sb_now() - t0);
+        double c0, par[64 * 8], plo[64 * 8], phi[64 * 8];
+        int npar = 0;
+        if (o->geometry) {
+            for (a = 0; a < nr; a++) {
+                int na = sb_fit_template_npar(&F, rigs[a]);
+                sb_fit_template_get(&F, rigs[a], par + npar);
+                sb_fit_template_bounds(&F, rigs[a], plo + npar, phi + npar);
+                plo[npar] = blo; phi[npar] = bhi;
+                npar += na;
+            }
+            c0 = sb_fit_template_cost(&F, rigs, nr, vert, tgt, np, o->lambda, par, NULL);
+            if (sb_fit_template(&F, rigs, nr, vert, tgt, np, o->lambda, plo, phi, par, &oo, &rr)) goto done;
+            for (a = 0, npar = 0; a < nr; a++) {   /* back into the strengths and rigdefs */
+                eta[a] = par[npar];
+                sb_fit_template_apply(&F, rigs[a], par + npar, &fitted[a]);
+                npar += sb_fit_template_npar(&F, rigs[a]);
+            }
+        } else {
+            c0 = sb_fit_points_cost(&F, rigs, nr, vert, tgt, np, o->lambda, eta, NULL);
+            if (sb_fit_points(&F, rigs, nr, vert, tgt, np, o->lambda, lo, hi, eta, &oo, &rr)) goto done;
+            for (a = 0; a < nr; a++) { fitted[a] = F.d.rigs[rigs[a]]; fitted[a].s = eta[a]; }
+        }
+        if (!o->quiet) printf("fit-points: %d points, %d rigs%s, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d evaluations, %.3f s\n",
+                              np, nr, o->geometry ? " (strengths and geometry)" : " (strengths)", what, c0, rr.f, rr.iterations, rr.evaluations, sb_now() - t0);
     }
     {   /* the description's rig lines with the fitted strengths */
         FILE *f = fopen(o->desc, "r");
@@ -655,12 +678,31 @@ static int cmd_fit_points(const opts_t *o)
         while (f && fgets(line, sizeof line, f)) {
             ln++;
             for (a = 0; a < nr; a++)
-                if (F.o.rig[rigs[a]].def.line == ln) {   /* replace the 5th token (the strength) */
+                if (F.o.rig[rigs[a]].def.line == ln) {   /* tokens 5.. (strength, parameters) replaced by the fit */
+                    const sb_rigdef *r = &fitted[a];
                     char *p = line;
-                    int t;
+                    int t, idx[8], ng = 0, g;
+                    if (o->geometry) {
+                        if (r->tpl == SB_TPL_BUMP) { idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 3; ng = 4; }
+                        else if (r->tpl == SB_TPL_RING) { idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 6; idx[4] = 7; ng = 5; }
+                        else if (r->tpl == SB_TPL_MUSCLE) { for (g = 0; g < 7; g++) idx[g] = g; ng = 7; }
+                    }
                     for (t = 0; t < 4; t++) { p += strspn(p, " \t"); p += strcspn(p, " \t"); }
-                    p += strspn(p, " \t");
-                    n += (size_t)sprintf(buf + n, "%.*s%.9g%s", (int)(p - line), line, eta[a], p + strcspn(p, " \t\r\n"));
+                    n += (size_t)sprintf(buf + n, "%.*s", (int)(p - line), line);
+                    for (t = 4; *p && *p != '\n' && *p != '\r'; t++) {   /* token t (0-based) */
+                        size_t sp = strspn(p, " \t"), len;
+                        int j = -1;
+                        n += (size_t)sprintf(buf + n, "%.*s", (int)sp, p);
+                        p += sp;
+                        len = strcspn(p, " \t\r\n");
+                        if (!len) break;
+                        for (g = 0; g < ng; g++) if (5 + idx[g] == t) j = idx[g];
+                        if (t == 4) n += (size_t)sprintf(buf + n, "%.9g", r->s);
+                        else if (j >= 0) n += (size_t)sprintf(buf + n, "%.9g", r->p[j]);
+                        else n += (size_t)sprintf(buf + n, "%.*s", (int)len, p);
+                        p += len;
+                    }
+                    n += (size_t)sprintf(buf + n, "%s", p);
                     if (!o->quiet) printf("rig %-14s strength %.9g -> %.9g\n", F.o.rig[rigs[a]].def.name, F.o.rig[rigs[a]].def.s, eta[a]);
                 }
         }
