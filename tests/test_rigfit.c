@@ -39,6 +39,17 @@ static void disp_stats(const double *a, const double *target, const double *base
     *max_frac = rmax / dmax;
 }
 
+/* scratch files in $BUILD/tests (default build/tests), as the other tool tests */
+static const char *tpath(const char *name)
+{
+    static char buf[4][1100];
+    static int k;
+    const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/tests/%s", b, name);
+    return buf[k];
+}
+
 static int write_text(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -142,7 +153,7 @@ int main(void)
                    100 * rmsf, 100 * maxf, rr.iterations, sb_now() - t0);
             T_CHECK(maxf <= 0.01, "target recovered within 1%% of its displacement (max %.3g%%)", 100 * maxf);
             /* through a rig file and a re-bake: the same shape */
-            T_CHECK(sb_rigfile_write("/tmp/test_rigfit_biceps.rig", &F.o, &F.mesh, eta, "test_rigfit: limb biceps refit") == 0, "write rig file: %s", sb_error());
+            T_CHECK(sb_rigfile_write(tpath("test_rigfit_biceps.rig"), &F.o, &F.mesh, eta, "test_rigfit: limb biceps refit") == 0, "write rig file: %s", sb_error());
             {
                 char desc[4096], *p;
                 FILE *f = fopen(LIMB, "r");
@@ -156,7 +167,7 @@ int main(void)
                     char *eol = strchr(p, '\n');
                     char tail[2048];
                     snprintf(tail, sizeof tail, "%s", eol ? eol : "");
-                    sprintf(p, "rig_file biceps /tmp/test_rigfit_biceps.rig elbow_bend tau 0 0 90 1%s", tail);
+                    sprintf(p, "rig_file biceps test_rigfit_biceps.rig elbow_bend tau 0 0 90 1%s", tail);
                 }
                 {   /* absolute mesh path */
                     char full[8192], cwd[1024];
@@ -164,9 +175,9 @@ int main(void)
                     if (!getenv("PWD")) snprintf(cwd, sizeof cwd, "."); else snprintf(cwd, sizeof cwd, "%s", getenv("PWD"));
                     *q = 0;
                     snprintf(full, sizeof full, "%smesh %s/tools/examples/limb/limb.obj%s", desc, cwd, strchr(q + 5, '\n'));
-                    write_text("/tmp/test_rigfit_limb.sinew", full);
+                    write_text(tpath("test_rigfit_limb.sinew"), full);
                 }
-                if (sb_fit_open(&G, "/tmp/test_rigfit_limb.sinew", 1) == 0) {
+                if (sb_fit_open(&G, tpath("test_rigfit_limb.sinew"), 1) == 0) {
                     T_CHECK(sb_static_pose(&G.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what) == 0, "pose");
                     T_CHECK(sb_fit_set_pose(&G, pose, 1.0) == 0, "rig_file on");
                     disp_stats(G.surf0, target, base, m->nS, &rmsf, &maxf);
@@ -198,8 +209,8 @@ int main(void)
         p = strstr(full, "rig biceps elbow_bend muscle 2.5   2.0 0.3 0   5.5 0.3 0   1.5 0.2");
         T_CHECK(p != NULL, "the limb's biceps line");
         if (p) memcpy(p, "rig biceps elbow_bend muscle 2.0   2.4 0.3 0   5.9 0.3 0   1.8 0.2", 66);
-        write_text("/tmp/test_rigfit_limb_geo.sinew", full);
-        if (sb_fit_open(&G, "/tmp/test_rigfit_limb_geo.sinew", 1) == 0 && sb_fit_open(&F, LIMB, 1) == 0) {
+        write_text(tpath("test_rigfit_limb_geo.sinew"), full);
+        if (sb_fit_open(&G, tpath("test_rigfit_limb_geo.sinew"), 1) == 0 && sb_fit_open(&F, LIMB, 1) == 0) {
             const snref_model *m = &F.m;
             snref_xform *pose = malloc(m->nJ * sizeof *pose);
             int rigs[1] = {0}, vert[40], np = 0, k, c, npar = sb_fit_template_npar(&F, 0);
@@ -251,13 +262,13 @@ int main(void)
         double Q[12];
         memset(&o, 0, sizeof o);
         T_CHECK(sb_desc_load(COW, &d) == 0 && sb_mesh_load_obj(d.mesh_path, &mm) == 0, "cow");
-        T_CHECK(sb_rigfile_read("/tmp/test_rigfit_biceps.rig", &rf) == 0, "read back");
+        T_CHECK(sb_rigfile_read(tpath("test_rigfit_biceps.rig"), &rf) == 0, "read back");
         T_CHECK(sb_rigfile_apply(&rf, "biceps.rig", &o, &mm, vert, Q, &n, &drop) == -1 && strstr(sb_error(), "fitted to another character"),
                 "wrong character refused: %s", sb_error());
         printf("  wrong character: %s\n", sb_error());
         sb_rigfile_free(&rf);
-        write_text("/tmp/test_rigfit_bad.rig", "sinew-rig 1\nmesh 322 0\ncell 1\norigin 0 0 0\nforces 1\nf 0 0 0 nan 0 0\nend\n");
-        T_CHECK(sb_rigfile_read("/tmp/test_rigfit_bad.rig", &rf) == -1 && strstr(sb_error(), "finite"), "non-finite force refused: %s", sb_error());
+        write_text(tpath("test_rigfit_bad.rig"), "sinew-rig 1\nmesh 322 0\ncell 1\norigin 0 0 0\nforces 1\nf 0 0 0 nan 0 0\nend\n");
+        T_CHECK(sb_rigfile_read(tpath("test_rigfit_bad.rig"), &rf) == -1 && strstr(sb_error(), "finite"), "non-finite force refused: %s", sb_error());
         sb_mesh_free(&mm); sb_desc_free(&d);
     }
 
