@@ -151,6 +151,13 @@ static double pose_cost(pose_ctx *P, const double *x)
     sb_pose_from_local(m, P->local, root, P->pose);
     snref_set_pose(&F->s, P->pose);
     snref_get_skinned(&F->s, P->lat);
+    if (F->pose_static) {   /* the static equilibrium from the skinned start, in mesh units */
+        unsigned i;
+        F->s.rig_scale = F->pose_rig_scale;
+        for (i = 0; i < 3 * m->nF; i++) F->s.p[i] = P->lat[i] / m->unit;
+        if (!(snref_static(&F->s, 0) <= 1e-6)) return NAN;
+        for (i = 0; i < 3 * m->nF; i++) P->lat[i] = F->s.p[i] * m->unit;
+    }
     for (a = 0; a < P->nfeat; a++) {
         unsigned cell[8];
         double w[8], p[3] = {0, 0, 0};
@@ -168,7 +175,7 @@ static double pose_fn(void *ctx, const double *x, double *g)
     int i, n = 3 * P->nj;
     memcpy(xx, x, (size_t)n * sizeof *xx);
     for (i = 0; i < n; i++) {   /* central differences */
-        double h = 1e-7, fp, fm;
+        double h = P->F->pose_static ? 1e-5 : 1e-7, fp, fm;
         xx[i] = x[i] + h; fp = pose_cost(P, xx);
         xx[i] = x[i] - h; fm = pose_cost(P, xx);
         xx[i] = x[i];

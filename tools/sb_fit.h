@@ -26,6 +26,11 @@ typedef struct sb_fit {
     double *p0;             /* nV x 3: static equilibrium at the current pose (internal units) */
     double *surf0;          /* nS x 3: its surface, description coordinates */
     int quiet;
+    /* sb_fit_pose: the shape the feature points are read on: 0 the rigidly framed
+     * ("skinned") lattice (default), 1 the static equilibrium at the pose with the
+     * rigs times pose_rig_scale (one solve per evaluation, sag included) */
+    int pose_static;
+    double pose_rig_scale;
 } sb_fit;
 
 /* bake desc (float64), load the reference model, read the mesh. 0, or -1 with a message on stderr */
@@ -42,9 +47,10 @@ void sb_fit_skinned_surface(sb_fit *F, const snref_xform *pose, double *surf);
 /* Pose fit (§4.3, C_features): local rotations of the joints listed (rotation
  * vectors, bounds [-pi, pi] per component) minimizing
  *   C_features = (1/N) sum_k |p_k(alpha) - pbar_k|^2 / c^2
- * (p_k: surface vertex feat[k] of the skinned shape at the pose, pbar_k its
- * target, c the cell edge). local (nJ x 4, x y z w) in: the start and the
- * joints not fitted; out: the fit. Gradient by central differences (1e-7 rad). */
+ * (p_k: surface vertex feat[k] of the skinned shape at the pose, or of the
+ * static equilibrium if F->pose_static; pbar_k its target, c the cell edge).
+ * local (nJ x 4, x y z w) in: the start and the joints not fitted; out: the
+ * fit. Gradient by central differences (1e-7 rad skinned, 1e-5 static). */
 int sb_fit_pose(sb_fit *F, const int *feat, int nfeat, const double *target, const int *joints, int nj, double *local,
                 const sb_opt_opts *oo, sb_opt_result *res);
 

@@ -38,12 +38,14 @@ static void usage(FILE *f)
         "      value the target shows (default 1 for an abstract control, the fitted pose's angle for a\n"
         "      pose control); several targets at several GAMMA become tau samples. The pose: --pose, or\n"
         "      fitted to the feature vertices (0-based indices of the mesh) over --joints (default every\n"
-        "      non-root joint); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
+        "      non-root joint) on the static equilibrium (--pose-skinned: on the rigidly skinned shape,\n"
+        "      faster, ignores sag); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
         "      rigs off during the fit (default on at the controls' values); --png: rest | unrigged | rigged\n"
         "      | target\n"
-        "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [-o POSE.txt]\n"
-        "      the pose (local joint rotations, as --static/--pose take them) whose skinned surface puts\n"
-        "      the feature vertices nearest their target positions\n"
+        "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [--pose-skinned]\n"
+        "              [--controls N=V,...] [--rigs-off] [-o POSE.txt]\n"
+        "      the pose (local joint rotations, as --static/--pose take them) whose static shape (or\n"
+        "      skinned shape) puts the feature vertices nearest their target positions\n"
         "  fit-points DESC --points FILE --rigs R1,R2,... [--geometry] [--pose POSE] [--controls N=V,...]\n"
         "              [--lambda L] [--bounds LO,HI] [-o OUT.sinew]\n"
         "      template rigs' strengths (--geometry: also centres/ends and sizes, re-integrated at every\n"
@@ -277,7 +279,7 @@ static void residual(const double *a, const double *target, const double *base, 
 typedef struct {
     const char *cmd, *desc, *out, *pose, *features, *joints, *controls, *control, *points, *rigs, *png, *name, *bounds, *export_rig;
     const char *target[SB_TAU_MAX];
-    int ntarget, quiet, rigs_off, max_iter, progress, geometry;
+    int ntarget, quiet, rigs_off, max_iter, progress, geometry, pose_skinned;
     double omega, lambda, az, el;
 } opts_t;
 
@@ -326,6 +328,7 @@ static int parse(int argc, char **argv, opts_t *o)
         if (!strcmp(a, "--quiet")) { o->quiet = 1; continue; }
         if (!strcmp(a, "--rigs-off")) { o->rigs_off = 1; continue; }
         if (!strcmp(a, "--geometry")) { o->geometry = 1; continue; }
+        if (!strcmp(a, "--pose-skinned")) { o->pose_skinned = 1; continue; }
         if (a[0] == '-') { fprintf(stderr, PROG ": unknown option '%s' (--help)\n", a); return 2; }
         if (!o->desc) o->desc = a;
         else if (!strcmp(o->cmd, "export") && !o->export_rig) o->export_rig = a;
@@ -389,6 +392,8 @@ static int get_pose(sb_fit *F, const opts_t *o, const double *target, double *lo
         for (k = 0; k < nf; k++) memcpy(tg + 3 * k, target + 3 * feat[k], 3 * sizeof *tg);
         sb_opt_defaults(&oo);
         oo.pgtol = 1e-10; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-pose";
+        F->pose_static = !o->pose_skinned;
+        F->pose_rig_scale = o->rigs_off ? 0 : 1;
         if (sb_fit_pose(F, feat, nf, tg, joints, nj, local, &oo, &rr)) { free(tg); return 1; }
         free(tg);
         sb_pose_from_local(m, local, root, pose);
@@ -415,6 +420,7 @@ static int cmd_fit_pose(const opts_t *o)
     {   FILE *f = check_readable(o->target[0], "target"); if (!f) return 2; fclose(f); }
     if (sb_fit_open(&F, o->desc, 1)) return 1;
     if (!(target = read_obj_vertices(o->target[0], F.mesh.nv))) { sb_fit_close(&F); return 2; }
+    if (o->controls && set_controls(&F.s, o->controls)) { free(target); sb_fit_close(&F); return 2; }
     local = malloc(4 * (size_t)F.m.nJ * sizeof *local);
     pose = malloc(F.m.nJ * sizeof *pose);
     rc = get_pose(&F, o, target, local, pose, what, sizeof what, &secs, &it);

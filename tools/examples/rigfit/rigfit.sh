@@ -111,6 +111,10 @@ tau=$(sed -n 's/^rig_file [^ ]* [^ ]* [^ ]* tau //p' "$OUT/limb_fit.txt")
 "$BAKE" "$OUT/limb_fit.sinew" -o "$OUT/limb_norig.blob" --quiet
 "$BAKE" "$OUT/limb_rigged.sinew" --static "$(cat "$OUT/limb_pose.txt")" -o "$OUT/limb_rigged_static.obj" --quiet
 note "    baked rig_file, static at the fitted pose vs target: $(residual "$OUT/limb_rigged_static.obj" "$OUT/limb_target.obj" "$OUT/limb_bent.obj")"
+"$RIG" fit-surface "$OUT/limb_fit.sinew" --target "$OUT/limb_target.obj" --pose elbow:0,0,1,90 \
+    --control elbow_bend -o "$OUT/limb_biceps_truepose.rig" --progress 1000 > "$OUT/limb_fit_truepose.txt"
+note "bent limb surface rig at the true pose (elbow:0,0,1,90, no pose fit):"
+fitline "$OUT/limb_fit_truepose.txt" >> "$FIG"
 "$BAKE" "$OUT/limb_rigged.sinew" --static elbow:0,0,1,45 -o "$OUT/limb_rigged_45.obj" --png "$OUT/limb_rigged_45.png" --quiet
 if [ -x "$PLAY" ]; then
     "$PLAY" "$OUT/limb_rigged.blob" --clip tools/examples/limb/flex.clip --frames 150 --quiet \
