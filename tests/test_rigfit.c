@@ -39,6 +39,17 @@ static void disp_stats(const double *a, const double *target, const double *base
     *max_frac = rmax / dmax;
 }
 
+/* scratch files in $BUILD/tests (default build/tests), as the other tool tests */
+static const char *tpath(const char *name)
+{
+    static char buf[4][1100];
+    static int k;
+    const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/tests/%s", b, name);
+    return buf[k];
+}
+
 static int write_text(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -124,6 +135,23 @@ int main(void)
             printf("  pose fit (limb, 10 feature points, 2 joints): worst joint error %.2e degrees (joint %d), %d iterations, %.3f s\n",
                    worstdeg, jw, rr.iterations, sb_now() - t0);
             T_CHECK(worstdeg <= 0.5, "known pose recovered within 0.5 degrees per joint (worst %.3g)", worstdeg);
+            /* the same on the static equilibrium (sag included): the target is the static shape at the pose */
+            {
+                double root[3] = {0, 0, 0}, tg[30];
+                sb_pose_from_local(m, local_true, root, pose);
+                T_CHECK(sb_fit_set_pose(&F, pose, 0.0) == 0, "static target");
+                for (k = 0; k < 10; k++) for (i = 0; i < 3; i++) tg[3 * k + i] = F.surf0[3 * feat[k] + i];
+                for (k = 0; k < 12; k++) local[k] = (k % 4 == 3);
+                F.pose_static = 1; F.pose_rig_scale = 0;
+                t0 = sb_now();
+                sb_fit_pose(&F, feat, 10, tg, joints, 2, local, &oo, &rr);
+                F.pose_static = 0;
+                worstdeg = 0;
+                for (k = 0; k < 2; k++) { double a = qangle(local + 4 * k, local_true + 4 * k); if (a > worstdeg) { worstdeg = a; jw = k; } }
+                printf("  pose fit on the static shape (limb, 10 feature points, 2 joints): worst joint error %.2e degrees, %d iterations, %.3f s\n",
+                       worstdeg, rr.iterations, sb_now() - t0);
+                T_CHECK(worstdeg <= 0.5, "known pose recovered from the static shape within 0.5 degrees per joint (worst %.3g)", worstdeg);
+            }
         }
 
         /* surface rig: the target is the biceps' shape at 90 degrees; fit with the rigs off */
@@ -142,7 +170,7 @@ int main(void)
                    100 * rmsf, 100 * maxf, rr.iterations, sb_now() - t0);
             T_CHECK(maxf <= 0.01, "target recovered within 1%% of its displacement (max %.3g%%)", 100 * maxf);
             /* through a rig file and a re-bake: the same shape */
-            T_CHECK(sb_rigfile_write("/tmp/test_rigfit_biceps.rig", &F.o, &F.mesh, eta, "test_rigfit: limb biceps refit") == 0, "write rig file: %s", sb_error());
+            T_CHECK(sb_rigfile_write(tpath("test_rigfit_biceps.rig"), &F.o, &F.mesh, eta, "test_rigfit: limb biceps refit") == 0, "write rig file: %s", sb_error());
             {
                 char desc[4096], *p;
                 FILE *f = fopen(LIMB, "r");
@@ -156,7 +184,7 @@ int main(void)
                     char *eol = strchr(p, '\n');
                     char tail[2048];
                     snprintf(tail, sizeof tail, "%s", eol ? eol : "");
-                    sprintf(p, "rig_file biceps /tmp/test_rigfit_biceps.rig elbow_bend tau 0 0 90 1%s", tail);
+                    sprintf(p, "rig_file biceps test_rigfit_biceps.rig elbow_bend tau 0 0 90 1%s", tail);
                 }
                 {   /* absolute mesh path */
                     char full[8192], cwd[1024];
@@ -164,9 +192,9 @@ int main(void)
                     if (!getenv("PWD")) snprintf(cwd, sizeof cwd, "."); else snprintf(cwd, sizeof cwd, "%s", getenv("PWD"));
                     *q = 0;
                     snprintf(full, sizeof full, "%smesh %s/tools/examples/limb/limb.obj%s", desc, cwd, strchr(q + 5, '\n'));
-                    write_text("/tmp/test_rigfit_limb.sinew", full);
+                    write_text(tpath("test_rigfit_limb.sinew"), full);
                 }
-                if (sb_fit_open(&G, "/tmp/test_rigfit_limb.sinew", 1) == 0) {
+                if (sb_fit_open(&G, tpath("test_rigfit_limb.sinew"), 1) == 0) {
                     T_CHECK(sb_static_pose(&G.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what) == 0, "pose");
                     T_CHECK(sb_fit_set_pose(&G, pose, 1.0) == 0, "rig_file on");
                     disp_stats(G.surf0, target, base, m->nS, &rmsf, &maxf);
@@ -181,6 +209,66 @@ int main(void)
     }
     sb_fit_close(&F);
 
+    /* ---------------- point drag with the template's geometry (limb biceps) ---------------- */
+    {
+        char desc[4096], full[8192], cwd[1024], *p, *q;
+        FILE *f = fopen(LIMB, "r");
+        size_t n = f ? fread(desc, 1, sizeof desc - 1, f) : 0;
+        sb_fit G;
+        if (f) fclose(f);
+        desc[n] = 0;
+        snprintf(cwd, sizeof cwd, "%s", getenv("PWD") ? getenv("PWD") : ".");
+        q = strstr(desc, "\nmesh ") + 1;
+        *q = 0;
+        p = strchr(q + 5, '\n');
+        snprintf(full, sizeof full, "%smesh %s/tools/examples/limb/limb.obj%s", desc, cwd, p);
+        /* the target: the biceps moved 0.4 along the arm, thicker, weaker */
+        p = strstr(full, "rig biceps elbow_bend muscle 2.5   2.0 0.3 0   5.5 0.3 0   1.5 0.2");
+        T_CHECK(p != NULL, "the limb's biceps line");
+        if (p) memcpy(p, "rig biceps elbow_bend muscle 2.0   2.4 0.3 0   5.9 0.3 0   1.8 0.2", 66);
+        write_text(tpath("test_rigfit_limb_geo.sinew"), full);
+        if (sb_fit_open(&G, tpath("test_rigfit_limb_geo.sinew"), 1) == 0 && sb_fit_open(&F, LIMB, 1) == 0) {
+            const snref_model *m = &F.m;
+            snref_xform *pose = malloc(m->nJ * sizeof *pose);
+            int rigs[1] = {0}, vert[40], np = 0, k, c, npar = sb_fit_template_npar(&F, 0);
+            double pts[120], par[8], par_true[8], g[8], lo[8], hi[8], worst = 0, t0;
+            sb_static_pose(&G.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what);
+            sb_fit_set_pose(&G, pose, 1.0);
+            sb_static_pose(&F.s, "elbow:0,0,1,90", pose, NULL, what, sizeof what);
+            T_CHECK(sb_fit_set_pose(&F, pose, 1.0) == 0, "limb solve");
+            for (k = 0; k < (int)m->nS && np < 40; k += 8) vert[np++] = k;
+            for (k = 0; k < np; k++) for (c = 0; c < 3; c++) pts[3 * k + c] = G.surf0[3 * vert[k] + c];
+            sb_fit_template_get(&G, 0, par_true);
+            sb_fit_template_get(&F, 0, par);
+            T_CHECK(npar == 8, "muscle: strength, two ends, radius (%d)", npar);
+            for (k = 0; k < npar; k++) par[k] = 0.5 * (par[k] + par_true[k]);   /* half way: a gradient away from 0 */
+            sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, par, g);
+            for (k = 0; k < npar; k++) {
+                double pp[8], pm[8], h = 1e-5 * (k ? 1.5 : 2.5), fd, rel;
+                memcpy(pp, par, sizeof pp); memcpy(pm, par, sizeof pm);
+                pp[k] += h; pm[k] -= h;
+                fd = (sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, pp, NULL) - sb_fit_template_cost(&F, rigs, 1, vert, pts, np, 1e-3, pm, NULL)) / (2 * h);
+                rel = fabs(g[k] - fd) / fmax(fabs(fd), 1e-12);
+                if (fabs(fd) > 1e-9) worst = fmax(worst, rel);
+                printf("    d C / d par[%d]: adjoint %.9g, central difference %.9g, relative error %.2e\n", k, g[k], fd, rel);
+            }
+            printf("  template geometry (limb biceps, 8 parameters): adjoint vs central differences, worst relative error %.2e\n", worst);
+            T_CHECK(worst <= 1e-5, "adjoint gradient with the template's geometry: relative error %.3g (want <= 1e-5)", worst);
+            sb_fit_template_get(&F, 0, par);
+            sb_fit_template_bounds(&F, 0, lo, hi);
+            oo.pgtol = 1e-9; oo.max_iter = 200; oo.ftol = 1e-13;
+            t0 = sb_now();
+            sb_fit_template(&F, rigs, 1, vert, pts, np, 0, lo, hi, par, &oo, &rr);
+            printf("  template geometry fit: cost %.3g (mean squared point distance / cell^2), %d iterations, %d evaluations, %.2f s;"
+                   " s %.4g (2.0), a.x %.4g (2.4), b.x %.4g (5.9), R %.4g (1.8)\n",
+                   rr.f, rr.iterations, rr.evaluations, sb_now() - t0, par[0], par[1], par[4], par[7]);
+            T_CHECK(rr.f < 1e-6, "40 dragged points reached: rms distance %.3g cells (want < 1e-3)", sqrt(rr.f));
+            free(pose);
+            sb_fit_close(&F);
+            sb_fit_close(&G);
+        } else T_CHECK(0, "open the limbs");
+    }
+
     /* ---------------- the rig file refused by another character ---------------- */
     {
         sb_desc d;
@@ -191,13 +279,13 @@ int main(void)
         double Q[12];
         memset(&o, 0, sizeof o);
         T_CHECK(sb_desc_load(COW, &d) == 0 && sb_mesh_load_obj(d.mesh_path, &mm) == 0, "cow");
-        T_CHECK(sb_rigfile_read("/tmp/test_rigfit_biceps.rig", &rf) == 0, "read back");
+        T_CHECK(sb_rigfile_read(tpath("test_rigfit_biceps.rig"), &rf) == 0, "read back");
         T_CHECK(sb_rigfile_apply(&rf, "biceps.rig", &o, &mm, vert, Q, &n, &drop) == -1 && strstr(sb_error(), "fitted to another character"),
                 "wrong character refused: %s", sb_error());
         printf("  wrong character: %s\n", sb_error());
         sb_rigfile_free(&rf);
-        write_text("/tmp/test_rigfit_bad.rig", "sinew-rig 1\nmesh 322 0\ncell 1\norigin 0 0 0\nforces 1\nf 0 0 0 nan 0 0\nend\n");
-        T_CHECK(sb_rigfile_read("/tmp/test_rigfit_bad.rig", &rf) == -1 && strstr(sb_error(), "finite"), "non-finite force refused: %s", sb_error());
+        write_text(tpath("test_rigfit_bad.rig"), "sinew-rig 1\nmesh 322 0\ncell 1\norigin 0 0 0\nforces 1\nf 0 0 0 nan 0 0\nend\n");
+        T_CHECK(sb_rigfile_read(tpath("test_rigfit_bad.rig"), &rf) == -1 && strstr(sb_error(), "finite"), "non-finite force refused: %s", sb_error());
         sb_mesh_free(&mm); sb_desc_free(&d);
     }
 
@@ -222,6 +310,23 @@ int main(void)
         }
         printf("  point drag (cow smile_l, smile_r): adjoint vs central differences, worst relative error %.2e\n", worst);
         T_CHECK(worst <= 1e-5, "adjoint gradient (2 rigs): relative error %.3g (want <= 1e-5)", worst);
+        {   /* the smile (smile = 1) refitted as a surface rig with the smile off: within 1% */
+            double *target = malloc(3 * (size_t)m->nS * sizeof *target), *base = malloc(3 * (size_t)m->nS * sizeof *base);
+            double *fit = malloc(3 * (size_t)m->nS * sizeof *fit), *etaf = malloc(3 * (size_t)F.o.nf * sizeof *etaf), rmsf, maxf, t0;
+            memcpy(target, F.surf0, 3 * (size_t)m->nS * sizeof *target);
+            snref_set_control(&F.s, (unsigned)snref_find_control(m, "smile"), 0.0);
+            T_CHECK(sb_fit_set_pose(&F, pose, 1.0) == 0, "cow smile off");
+            memcpy(base, F.surf0, 3 * (size_t)m->nS * sizeof *base);
+            sb_opt_defaults(&oo);
+            oo.pgtol = 1e-10; oo.ftol = 1e-15; oo.max_iter = 3000;
+            t0 = sb_now();
+            sb_fit_surface(&F, target, 1e-5, &oo, &rr, etaf, fit);
+            disp_stats(fit, target, base, m->nS, &rmsf, &maxf);
+            printf("  surface rig (cow smile target, omega 1e-5): residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations, %.3f s\n",
+                   100 * rmsf, 100 * maxf, rr.iterations, sb_now() - t0);
+            T_CHECK(maxf <= 0.01, "cow smile recovered within 1%% of its displacement (max %.3g%%)", 100 * maxf);
+            free(target); free(base); free(fit); free(etaf);
+        }
         free(pose);
         sb_fit_close(&F);
     } else T_CHECK(0, "open cow");

@@ -38,7 +38,6 @@ void sb_quat_rotvec(const double q0[4], double r[3])
 int sb_fit_open(sb_fit *F, const char *desc, int quiet)
 {
     char err[300];
-    sb_desc d;
     unsigned c;
     memset(F, 0, sizeof *F);
     snprintf(F->desc, sizeof F->desc, "%s", desc);
@@ -46,13 +45,10 @@ int sb_fit_open(sb_fit *F, const char *desc, int quiet)
     if (sb_bake_file(desc, SB_DOUBLE, 1, &F->o, &F->b)) { fprintf(stderr, "sinew-rig: error: %s\n", sb_error()); return -1; }
     if (snref_load(&F->m, F->b.bytes, F->b.size, err, sizeof err)) { fprintf(stderr, "sinew-rig: reading the baked blob: %s\n", err); return -1; }
     if (snref_init(&F->s, &F->m)) { fprintf(stderr, "sinew-rig: out of memory\n"); return -1; }
-    memset(&d, 0, sizeof d);
-    if (sb_desc_load(desc, &d) || sb_mesh_load_obj(d.mesh_path, &F->mesh)) {
+    if (sb_desc_load(desc, &F->d) || sb_mesh_load_obj(F->d.mesh_path, &F->mesh)) {
         fprintf(stderr, "sinew-rig: error: %s\n", sb_error());
-        sb_desc_free(&d);
         return -1;
     }
-    sb_desc_free(&d);
     for (c = 0; c < 3; c++) F->off[c] = F->o.x[c] - F->m.rest[c] * F->m.unit;
     F->nscale = F->o.h * F->o.h / (F->b.m0 * F->m.unit * F->o.unit);
     F->p0 = calloc(3 * (size_t)F->m.nV, sizeof *F->p0);
@@ -71,6 +67,7 @@ void sb_fit_close(sb_fit *F)
     sb_rig_free(&F->o);
     sb_model_free(&F->o);
     sb_mesh_free(&F->mesh);
+    sb_desc_free(&F->d);
     memset(F, 0, sizeof *F);
 }
 
@@ -154,6 +151,13 @@ static double pose_cost(pose_ctx *P, const double *x)
     sb_pose_from_local(m, P->local, root, P->pose);
     snref_set_pose(&F->s, P->pose);
     snref_get_skinned(&F->s, P->lat);
+    if (F->pose_static) {   /* the static equilibrium from the skinned start, in mesh units */
+        unsigned i;
+        F->s.rig_scale = F->pose_rig_scale;
+        for (i = 0; i < 3 * m->nF; i++) F->s.p[i] = P->lat[i] / m->unit;
+        if (!(snref_static(&F->s, 0) <= 1e-6)) return NAN;
+        for (i = 0; i < 3 * m->nF; i++) P->lat[i] = F->s.p[i] * m->unit;
+    }
     for (a = 0; a < P->nfeat; a++) {
         unsigned cell[8];
         double w[8], p[3] = {0, 0, 0};
@@ -171,7 +175,7 @@ static double pose_fn(void *ctx, const double *x, double *g)
     int i, n = 3 * P->nj;
     memcpy(xx, x, (size_t)n * sizeof *xx);
     for (i = 0; i < n; i++) {   /* central differences */
-        double h = 1e-7, fp, fm;
+        double h = P->F->pose_static ? 1e-5 : 1e-7, fp, fm;
         xx[i] = x[i] + h; fp = pose_cost(P, xx);
         xx[i] = x[i] - h; fm = pose_cost(P, xx);
         xx[i] = x[i];
@@ -373,5 +377,221 @@ int sb_fit_points(sb_fit *F, const int *rigs, int nr, const int *vert, const dou
     int st = -1;
     if (!pts_setup(F, &P, rigs, nr, vert, target, np, lambda)) st = sb_lbfgsb(nr, eta, lo, hi, pts_fn, &P, oo, res, NULL);
     pts_free(&P);
+    return st < 0 ? -1 : 0;
+}
+
+/* ---------------- point-drag with the templates' geometry ---------------- */
+
+/* indices into sb_rigdef.p of the geometric parameters, and the size */
+static int geo_idx(int tpl, int *idx)
+{
+    switch (tpl) {
+    case SB_TPL_BUMP: idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 3; return 4;
+    case SB_TPL_RING: idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 6; idx[4] = 7; return 5;
+    case SB_TPL_MUSCLE: { int k; for (k = 0; k < 7; k++) idx[k] = k; return 7; }
+    default: return 0;
+    }
+}
+static double geo_size(const sb_rigdef *r)
+{
+    switch (r->tpl) {
+    case SB_TPL_BUMP: return r->p[3];
+    case SB_TPL_RING: return r->p[7];
+    case SB_TPL_MUSCLE: return r->p[6];
+    default: return 1;
+    }
+}
+
+int sb_fit_template_npar(const sb_fit *F, int rig)
+{
+    int idx[8];
+    return 1 + geo_idx(F->d.rigs[rig].tpl, idx);
+}
+
+void sb_fit_template_get(const sb_fit *F, int rig, double *par)
+{
+    const sb_rigdef *r = &F->d.rigs[rig];
+    int idx[8], n = geo_idx(r->tpl, idx), k;
+    par[0] = r->s;
+    for (k = 0; k < n; k++) par[1 + k] = r->p[idx[k]];
+}
+
+void sb_fit_template_apply(const sb_fit *F, int rig, const double *par, sb_rigdef *out)
+{
+    int idx[8], n, k;
+    *out = F->d.rigs[rig];
+    n = geo_idx(out->tpl, idx);
+    out->s = par[0];
+    for (k = 0; k < n; k++) out->p[idx[k]] = par[1 + k];
+}
+
+void sb_fit_template_bounds(const sb_fit *F, int rig, double *lo, double *hi)
+{
+    const sb_rigdef *r = &F->d.rigs[rig];
+    int idx[8], n = geo_idx(r->tpl, idx), k;
+    double L = geo_size(r);
+    lo[0] = -1e6; hi[0] = 1e6;
+    for (k = 0; k < n; k++) {
+        double v = r->p[idx[k]];
+        int is_size = (r->tpl == SB_TPL_BUMP && idx[k] == 3) || (r->tpl == SB_TPL_RING && idx[k] >= 6) || (r->tpl == SB_TPL_MUSCLE && idx[k] == 6);
+        if (is_size) { lo[1 + k] = 0.25 * v; hi[1 + k] = 4 * v; }
+        else { lo[1 + k] = v - 2 * L; hi[1 + k] = v + 2 * L; }
+    }
+}
+
+/* rig `rig` integrated with parameters par: its force on the free vertices
+ * (nF x 3, newtons, rest axes) by the bake's quadrature. -1 if it reaches no free vertex. */
+static int integrate_rig(sb_fit *F, int rig, const double *par, double *Q)
+{
+    sb_desc d1 = F->d;
+    sb_rigdef rd;
+    struct sb_rig *save_rig = F->o.rig;
+    struct sb_control *save_ctl = F->o.ctl;
+    int save_nrig = F->o.nrig, save_nctl = F->o.nctl, rc, i, k;
+    sb_fit_template_apply(F, rig, par, &rd);
+    d1.rigs = &rd; d1.nrig = 1;
+    F->o.rig = NULL; F->o.ctl = NULL; F->o.nrig = F->o.nctl = 0;
+    rc = sb_rig_build(&d1, &F->mesh, &F->o);
+    memset(Q, 0, 3 * (size_t)F->o.nf * sizeof *Q);
+    if (!rc) for (i = 0; i < F->o.rig[0].n; i++) for (k = 0; k < 3; k++) Q[3 * F->o.rig[0].vert[i] + k] = F->o.rig[0].Q[3 * i + k];
+    sb_rig_free(&F->o);
+    F->o.rig = save_rig; F->o.ctl = save_ctl; F->o.nrig = save_nrig; F->o.nctl = save_nctl;
+    return rc;
+}
+
+typedef struct {
+    sb_fit *F;
+    const int *rigs, *vert;
+    int nr, np, npar;
+    const double *target;
+    double lambda, inv;
+    double *par0, *scale, *tau;   /* npar, npar, nr */
+    double *Q0;                   /* nr x nF*3: world load (rhs units) at the description's parameters */
+    double *Q, *Qp, *Qm, *load, *x, *adj, *dl;
+} tpl_ctx;
+
+/* world right-hand-side load of rest-frame newtons Qn (nF x 3) times t */
+static void to_load(const sb_fit *F, const double *Qn, double t, double *out)
+{
+    unsigned i, k;
+    for (i = 0; i < F->m.nF; i++) {
+        const double *R = F->s.R + 9 * i, *q = Qn + 3 * i;
+        for (k = 0; k < 3; k++) out[3 * i + k] = t * F->nscale * (R[3 * k] * q[0] + R[3 * k + 1] * q[1] + R[3 * k + 2] * q[2]);
+    }
+}
+
+static double tpl_fn(void *ctx, const double *par, double *grad)
+{
+    tpl_ctx *P = ctx;
+    sb_fit *F = P->F;
+    const snref_model *m = &F->m;
+    size_t n = 3 * (size_t)m->nF, i;
+    int a, k, c, off = 0;
+    double C = 0;
+    memset(P->load, 0, n * sizeof *P->load);
+    for (a = 0; a < P->nr; a++) {
+        int na = sb_fit_template_npar(F, P->rigs[a]);
+        if (integrate_rig(F, P->rigs[a], par + off, P->Q)) return NAN;
+        to_load(F, P->Q, P->tau[a], P->dl);
+        for (i = 0; i < n; i++) P->load[i] += P->dl[i] - P->Q0[(size_t)a * n + i];
+        off += na;
+    }
+    snref_factor_solve(F->B, P->load, P->x);
+    memset(P->adj, 0, n * sizeof *P->adj);
+    for (k = 0; k < P->np; k++) {
+        unsigned cell[8];
+        double w[8], p[3] = {0, 0, 0}, e[3];
+        embed(m, (unsigned)P->vert[k], cell, w);
+        for (a = 0; a < 8; a++)
+            for (c = 0; c < 3; c++) p[c] += w[a] * (F->p0[3 * cell[a] + c] + (cell[a] < m->nF ? P->x[3 * cell[a] + c] : 0));
+        for (c = 0; c < 3; c++) { e[c] = p[c] * m->unit + F->off[c] - P->target[3 * k + c]; C += P->inv * e[c] * e[c]; }
+        for (a = 0; a < 8; a++)
+            if (cell[a] < m->nF) for (c = 0; c < 3; c++) P->adj[3 * cell[a] + c] += 2 * P->inv * e[c] * w[a] * m->unit;
+    }
+    for (k = 0; k < P->npar; k++) { double u = (par[k] - P->par0[k]) / P->scale[k]; C += P->lambda * u * u; }
+    if (grad) {
+        snref_factor_solve(F->B, P->adj, P->x);   /* adjoint (A symmetric) */
+        off = 0;
+        for (a = 0; a < P->nr; a++) {
+            int na = sb_fit_template_npar(F, P->rigs[a]), j;
+            double *pp = malloc((size_t)na * sizeof *pp);
+            memcpy(pp, par + off, (size_t)na * sizeof *pp);
+            for (j = 0; j < na; j++) {
+                double s = 0;
+                if (j == 0) {   /* strength: Q linear in s */
+                    integrate_rig(F, P->rigs[a], pp, P->Q);
+                    to_load(F, P->Q, P->tau[a] / pp[0], P->dl);
+                } else {        /* geometry: central difference of the integration */
+                    double h = 1e-4 * P->scale[off + j], v = pp[j];
+                    pp[j] = v + h; if (integrate_rig(F, P->rigs[a], pp, P->Qp)) memset(P->Qp, 0, n * sizeof *P->Qp);
+                    pp[j] = v - h; if (integrate_rig(F, P->rigs[a], pp, P->Qm)) memset(P->Qm, 0, n * sizeof *P->Qm);
+                    pp[j] = v;
+                    for (i = 0; i < n; i++) P->Q[i] = (P->Qp[i] - P->Qm[i]) / (2 * h);
+                    to_load(F, P->Q, P->tau[a], P->dl);
+                }
+                for (i = 0; i < n; i++) s += P->x[i] * P->dl[i];
+                grad[off + j] = s + 2 * P->lambda * (par[off + j] - P->par0[off + j]) / (P->scale[off + j] * P->scale[off + j]);
+            }
+            free(pp);
+            off += na;
+        }
+    }
+    return C;
+}
+
+static int tpl_setup(sb_fit *F, tpl_ctx *P, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda)
+{
+    const snref_model *m = &F->m;
+    size_t n = 3 * (size_t)m->nF;
+    int a, off = 0, k;
+    double cm = m->cell * m->unit;
+    memset(P, 0, sizeof *P);
+    P->F = F; P->rigs = rigs; P->nr = nr; P->vert = vert; P->np = np; P->target = target; P->lambda = lambda;
+    P->inv = 1.0 / (np * cm * cm);
+    for (a = 0; a < nr; a++) P->npar += sb_fit_template_npar(F, rigs[a]);
+    P->par0 = malloc((size_t)P->npar * sizeof *P->par0); P->scale = malloc((size_t)P->npar * sizeof *P->scale);
+    P->tau = malloc((size_t)nr * sizeof *P->tau);
+    P->Q0 = calloc(n * (size_t)nr + 1, sizeof *P->Q0);
+    P->Q = malloc(n * sizeof *P->Q); P->Qp = malloc(n * sizeof *P->Qp); P->Qm = malloc(n * sizeof *P->Qm);
+    P->load = malloc(n * sizeof *P->load); P->x = malloc(n * sizeof *P->x); P->adj = malloc(n * sizeof *P->adj); P->dl = malloc(n * sizeof *P->dl);
+    if (!P->par0 || !P->scale || !P->tau || !P->Q0 || !P->Q || !P->Qp || !P->Qm || !P->load || !P->x || !P->adj || !P->dl) return -1;
+    for (a = 0; a < nr; a++) {
+        unsigned r = (unsigned)rigs[a];
+        int na = sb_fit_template_npar(F, rigs[a]);
+        double L = geo_size(&F->d.rigs[r]);
+        P->tau[a] = sb_rig_tau(&F->d.rigs[r], snref_get_control(&F->s, m->rctl[r]));   /* the description's tau (unnormalized) */
+        sb_fit_template_get(F, rigs[a], P->par0 + off);
+        P->scale[off] = fabs(P->par0[off]) > 0 ? fabs(P->par0[off]) : 1;
+        for (k = 1; k < na; k++) P->scale[off + k] = L;
+        if (integrate_rig(F, rigs[a], P->par0 + off, P->Q)) return -1;
+        to_load(F, P->Q, P->tau[a], P->Q0 + (size_t)a * n);
+        off += na;
+    }
+    return 0;
+}
+
+static void tpl_free(tpl_ctx *P)
+{
+    free(P->par0); free(P->scale); free(P->tau); free(P->Q0); free(P->Q); free(P->Qp); free(P->Qm);
+    free(P->load); free(P->x); free(P->adj); free(P->dl);
+}
+
+double sb_fit_template_cost(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                            const double *par, double *grad)
+{
+    tpl_ctx P;
+    double C = NAN;
+    if (!tpl_setup(F, &P, rigs, nr, vert, target, np, lambda)) C = tpl_fn(&P, par, grad);
+    tpl_free(&P);
+    return C;
+}
+
+int sb_fit_template(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                    const double *lo, const double *hi, double *par, const sb_opt_opts *oo, sb_opt_result *res)
+{
+    tpl_ctx P;
+    int st = -1;
+    if (!tpl_setup(F, &P, rigs, nr, vert, target, np, lambda)) st = sb_lbfgsb(P.npar, par, lo, hi, tpl_fn, &P, oo, res, NULL);
+    tpl_free(&P);
     return st < 0 ? -1 : 0;
 }

@@ -17,6 +17,7 @@ typedef struct sb_fit {
     sb_model o;             /* the bake (float64) */
     sb_blob b;
     sb_mesh mesh;           /* the description's mesh (identity of rig files) */
+    sb_desc d;              /* the description (template rigs re-integrated by sb_fit_template) */
     snref_model m;          /* the reference model of the blob */
     snref_state s;
     double off[3];          /* description coordinates = snref positions (mesh units) + off */
@@ -25,6 +26,11 @@ typedef struct sb_fit {
     double *p0;             /* nV x 3: static equilibrium at the current pose (internal units) */
     double *surf0;          /* nS x 3: its surface, description coordinates */
     int quiet;
+    /* sb_fit_pose: the shape the feature points are read on: 0 the rigidly framed
+     * ("skinned") lattice (default), 1 the static equilibrium at the pose with the
+     * rigs times pose_rig_scale (one solve per evaluation, sag included) */
+    int pose_static;
+    double pose_rig_scale;
 } sb_fit;
 
 /* bake desc (float64), load the reference model, read the mesh. 0, or -1 with a message on stderr */
@@ -41,9 +47,10 @@ void sb_fit_skinned_surface(sb_fit *F, const snref_xform *pose, double *surf);
 /* Pose fit (§4.3, C_features): local rotations of the joints listed (rotation
  * vectors, bounds [-pi, pi] per component) minimizing
  *   C_features = (1/N) sum_k |p_k(alpha) - pbar_k|^2 / c^2
- * (p_k: surface vertex feat[k] of the skinned shape at the pose, pbar_k its
- * target, c the cell edge). local (nJ x 4, x y z w) in: the start and the
- * joints not fitted; out: the fit. Gradient by central differences (1e-7 rad). */
+ * (p_k: surface vertex feat[k] of the skinned shape at the pose, or of the
+ * static equilibrium if F->pose_static; pbar_k its target, c the cell edge).
+ * local (nJ x 4, x y z w) in: the start and the joints not fitted; out: the
+ * fit. Gradient by central differences (1e-7 rad skinned, 1e-5 static). */
 int sb_fit_pose(sb_fit *F, const int *feat, int nfeat, const double *target, const int *joints, int nj, double *local,
                 const sb_opt_opts *oo, sb_opt_result *res);
 
@@ -73,6 +80,28 @@ int sb_fit_points(sb_fit *F, const int *rigs, int nr, const int *vert, const dou
 /* the point-drag cost and gradient at eta (for checks against finite differences) */
 double sb_fit_points_cost(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
                           const double *eta, double *grad);
+
+/* Point-drag with the templates' geometry (§4.2: "one integration over the
+ * character for each element of eta"): per rig a, its parameters
+ *   bump: s, centre (3), radius; ring: s, centre (3), radius, width;
+ *   muscle: s, end a (3), end b (3), radius; uniform: s
+ * (directions, axes and SHORTEN stay), packed rig after rig. The rig's force
+ * is re-integrated by the bake's own quadrature (sb_rig_build) at every
+ * evaluation, dQ/dp by central differences of that integration (step 1e-4 of
+ * the template's size; Q is linear in s). Same C_points; C_params =
+ * lambda sum_k ((par_k - par0_k) / scale_k)^2, scale = |s| for strengths, the
+ * template's size for geometry. npar: parameters of rig a. */
+int sb_fit_template_npar(const sb_fit *F, int rig);
+void sb_fit_template_get(const sb_fit *F, int rig, double *par);
+/* bounds that make sense: strength within +-1e6, centres within 2 sizes of the
+ * description's, sizes within [1/4, 4] of it */
+void sb_fit_template_bounds(const sb_fit *F, int rig, double *lo, double *hi);
+double sb_fit_template_cost(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                            const double *par, double *grad);
+int sb_fit_template(sb_fit *F, const int *rigs, int nr, const int *vert, const double *target, int np, double lambda,
+                    const double *lo, const double *hi, double *par, const sb_opt_opts *oo, sb_opt_result *res);
+/* rig a's template parameters par written into a rigdef copy */
+void sb_fit_template_apply(const sb_fit *F, int rig, const double *par, sb_rigdef *out);
 
 /* rotation vector <-> quaternion (x y z w) */
 void sb_rotvec_quat(const double r[3], double q[4]);

@@ -38,17 +38,20 @@ static void usage(FILE *f)
         "      value the target shows (default 1 for an abstract control, the fitted pose's angle for a\n"
         "      pose control); several targets at several GAMMA become tau samples. The pose: --pose, or\n"
         "      fitted to the feature vertices (0-based indices of the mesh) over --joints (default every\n"
-        "      non-root joint); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
+        "      non-root joint) on the static equilibrium (--pose-skinned: on the rigidly skinned shape,\n"
+        "      faster, ignores sag); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
         "      rigs off during the fit (default on at the controls' values); --png: rest | unrigged | rigged\n"
         "      | target\n"
-        "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [-o POSE.txt]\n"
-        "      the pose (local joint rotations, as --static/--pose take them) whose skinned surface puts\n"
-        "      the feature vertices nearest their target positions\n"
-        "  fit-points DESC --points FILE --rigs R1,R2,... [--pose POSE] [--controls N=V,...] [--lambda L]\n"
-        "              [--bounds LO,HI] [-o OUT.sinew]\n"
-        "      strengths of template rigs so that surface points reach dragged positions; FILE lines\n"
-        "      'VERTEX X Y Z' (0-based mesh vertex, target in the mesh's coordinates); writes the rig\n"
-        "      lines with the fitted strengths (to replace the description's)\n"
+        "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [--pose-skinned]\n"
+        "              [--controls N=V,...] [--rigs-off] [-o POSE.txt]\n"
+        "      the pose (local joint rotations, as --static/--pose take them) whose static shape (or\n"
+        "      skinned shape) puts the feature vertices nearest their target positions\n"
+        "  fit-points DESC --points FILE --rigs R1,R2,... [--geometry] [--pose POSE] [--controls N=V,...]\n"
+        "              [--lambda L] [--bounds LO,HI] [-o OUT.sinew]\n"
+        "      template rigs' strengths (--geometry: also centres/ends and sizes, re-integrated at every\n"
+        "      evaluation) so that surface points reach dragged positions; FILE lines 'VERTEX X Y Z'\n"
+        "      (0-based mesh vertex, target in the mesh's coordinates); --bounds: the strengths' range;\n"
+        "      writes the rig lines with the fitted parameters (to replace the description's)\n"
         "  export DESC RIG -o OUT.rig\n"
         "      a rig of the description (template or file) as a rig file\n"
         "  retarget A.sinew B.sinew --rig R1,R2,... -o OUT.rig [options]\n"
@@ -280,7 +283,7 @@ static void residual(const double *a, const double *target, const double *base, 
 typedef struct {
     const char *cmd, *desc, *out, *pose, *features, *joints, *controls, *control, *points, *rigs, *png, *name, *bounds, *export_rig;
     const char *target[SB_TAU_MAX];
-    int ntarget, quiet, rigs_off, max_iter, progress;
+    int ntarget, quiet, rigs_off, max_iter, progress, geometry, pose_skinned;
     double omega, lambda, az, el;
 } opts_t;
 
@@ -328,6 +331,8 @@ static int parse(int argc, char **argv, opts_t *o)
         }
         if (!strcmp(a, "--quiet")) { o->quiet = 1; continue; }
         if (!strcmp(a, "--rigs-off")) { o->rigs_off = 1; continue; }
+        if (!strcmp(a, "--geometry")) { o->geometry = 1; continue; }
+        if (!strcmp(a, "--pose-skinned")) { o->pose_skinned = 1; continue; }
         if (a[0] == '-') { fprintf(stderr, PROG ": unknown option '%s' (--help)\n", a); return 2; }
         if (!o->desc) o->desc = a;
         else if (!strcmp(o->cmd, "export") && !o->export_rig) o->export_rig = a;
@@ -391,6 +396,8 @@ static int get_pose(sb_fit *F, const opts_t *o, const double *target, double *lo
         for (k = 0; k < nf; k++) memcpy(tg + 3 * k, target + 3 * feat[k], 3 * sizeof *tg);
         sb_opt_defaults(&oo);
         oo.pgtol = 1e-10; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-pose";
+        F->pose_static = !o->pose_skinned;
+        F->pose_rig_scale = o->rigs_off ? 0 : 1;
         if (sb_fit_pose(F, feat, nf, tg, joints, nj, local, &oo, &rr)) { free(tg); return 1; }
         free(tg);
         sb_pose_from_local(m, local, root, pose);
@@ -417,6 +424,7 @@ static int cmd_fit_pose(const opts_t *o)
     {   FILE *f = check_readable(o->target[0], "target"); if (!f) return 2; fclose(f); }
     if (sb_fit_open(&F, o->desc, 1)) return 1;
     if (!(target = read_obj_vertices(o->target[0], F.mesh.nv))) { sb_fit_close(&F); return 2; }
+    if (o->controls && set_controls(&F.s, o->controls)) { free(target); sb_fit_close(&F); return 2; }
     local = malloc(4 * (size_t)F.m.nJ * sizeof *local);
     pose = malloc(F.m.nJ * sizeof *pose);
     rc = get_pose(&F, o, target, local, pose, what, sizeof what, &secs, &it);
@@ -562,7 +570,10 @@ static int cmd_fit_surface(const opts_t *o)
         for (i = 0; i < o->ntarget && n < cl; i++) n += (size_t)snprintf(comment + n, cl - n, "target %s\n", o->target[i]);
         n += (size_t)snprintf(comment + n, cl - n, "pose %s\ncontrol %s, omega %g%s\n", what, o->control, o->omega, o->rigs_off ? ", description rigs off" : "");
         n += (size_t)snprintf(comment + n, cl - n, "residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations\n", 100 * rms, 100 * mx, rr.iterations);
-        snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, o->out, o->control, tau);
+        {   /* the file's own name (not its directory): the bytes depend on the inputs only */
+            const char *b = strrchr(o->out, '/');
+            snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, b ? b + 1 : o->out, o->control, tau);
+        }
     }
     if (sb_rigfile_write(o->out, &F.o, &F.mesh, eta, comment)) { fprintf(stderr, PROG ": %s\n", sb_error()); if (o->png) remove(o->png); goto done; }
     rc = 0;
@@ -583,6 +594,7 @@ static int cmd_fit_points(const opts_t *o)
     const snref_model *m;
     int rigs[64], nr = 0, vert[1024], np = 0, rc = 2, a;
     double tgt[3 * 1024], eta[64], lo[64], hi[64], blo = -1e6, bhi = 1e6, t0;
+    static sb_rigdef fitted[64];
     snref_xform *pose = NULL;
     char what[4096];
     sb_opt_opts oo;
@@ -642,10 +654,30 @@ static int cmd_fit_points(const opts_t *o)
     oo.pgtol = 1e-12; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-points";
     t0 = sb_now();
     {
-        double c0 = sb_fit_points_cost(&F, rigs, nr, vert, tgt, np, o->lambda, eta, NULL);
-        if (sb_fit_points(&F, rigs, nr, vert, tgt, np, o->lambda, lo, hi, eta, &oo, &rr)) goto done;
-        if (!o->quiet) printf("fit-points: %d points, %d rigs, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d solves, %.3f s\n",
-                              np, nr, what, c0, rr.f, rr.iterations, 2 * rr.evaluations, sb_now() - t0);
+        double c0, par[64 * 8], plo[64 * 8], phi[64 * 8];
+        int npar = 0;
+        if (o->geometry) {
+            for (a = 0; a < nr; a++) {
+                int na = sb_fit_template_npar(&F, rigs[a]);
+                sb_fit_template_get(&F, rigs[a], par + npar);
+                sb_fit_template_bounds(&F, rigs[a], plo + npar, phi + npar);
+                plo[npar] = blo; phi[npar] = bhi;
+                npar += na;
+            }
+            c0 = sb_fit_template_cost(&F, rigs, nr, vert, tgt, np, o->lambda, par, NULL);
+            if (sb_fit_template(&F, rigs, nr, vert, tgt, np, o->lambda, plo, phi, par, &oo, &rr)) goto done;
+            for (a = 0, npar = 0; a < nr; a++) {   /* back into the strengths and rigdefs */
+                eta[a] = par[npar];
+                sb_fit_template_apply(&F, rigs[a], par + npar, &fitted[a]);
+                npar += sb_fit_template_npar(&F, rigs[a]);
+            }
+        } else {
+            c0 = sb_fit_points_cost(&F, rigs, nr, vert, tgt, np, o->lambda, eta, NULL);
+            if (sb_fit_points(&F, rigs, nr, vert, tgt, np, o->lambda, lo, hi, eta, &oo, &rr)) goto done;
+            for (a = 0; a < nr; a++) { fitted[a] = F.d.rigs[rigs[a]]; fitted[a].s = eta[a]; }
+        }
+        if (!o->quiet) printf("fit-points: %d points, %d rigs%s, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d evaluations, %.3f s\n",
+                              np, nr, o->geometry ? " (strengths and geometry)" : " (strengths)", what, c0, rr.f, rr.iterations, rr.evaluations, sb_now() - t0);
     }
     {   /* the description's rig lines with the fitted strengths */
         FILE *f = fopen(o->desc, "r");
@@ -656,12 +688,31 @@ static int cmd_fit_points(const opts_t *o)
         while (f && fgets(line, sizeof line, f)) {
             ln++;
             for (a = 0; a < nr; a++)
-                if (F.o.rig[rigs[a]].def.line == ln) {   /* replace the 5th token (the strength) */
+                if (F.o.rig[rigs[a]].def.line == ln) {   /* tokens 5.. (strength, parameters) replaced by the fit */
+                    const sb_rigdef *r = &fitted[a];
                     char *p = line;
-                    int t;
+                    int t, idx[8], ng = 0, g;
+                    if (o->geometry) {
+                        if (r->tpl == SB_TPL_BUMP) { idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 3; ng = 4; }
+                        else if (r->tpl == SB_TPL_RING) { idx[0] = 0; idx[1] = 1; idx[2] = 2; idx[3] = 6; idx[4] = 7; ng = 5; }
+                        else if (r->tpl == SB_TPL_MUSCLE) { for (g = 0; g < 7; g++) idx[g] = g; ng = 7; }
+                    }
                     for (t = 0; t < 4; t++) { p += strspn(p, " \t"); p += strcspn(p, " \t"); }
-                    p += strspn(p, " \t");
-                    n += (size_t)sprintf(buf + n, "%.*s%.9g%s", (int)(p - line), line, eta[a], p + strcspn(p, " \t\r\n"));
+                    n += (size_t)sprintf(buf + n, "%.*s", (int)(p - line), line);
+                    for (t = 4; *p && *p != '\n' && *p != '\r'; t++) {   /* token t (0-based) */
+                        size_t sp = strspn(p, " \t"), len;
+                        int j = -1;
+                        n += (size_t)sprintf(buf + n, "%.*s", (int)sp, p);
+                        p += sp;
+                        len = strcspn(p, " \t\r\n");
+                        if (!len) break;
+                        for (g = 0; g < ng; g++) if (5 + idx[g] == t) j = idx[g];
+                        if (t == 4) n += (size_t)sprintf(buf + n, "%.9g", r->s);
+                        else if (j >= 0) n += (size_t)sprintf(buf + n, "%.9g", r->p[j]);
+                        else n += (size_t)sprintf(buf + n, "%.*s", (int)len, p);
+                        p += len;
+                    }
+                    n += (size_t)sprintf(buf + n, "%s", p);
                     if (!o->quiet) printf("rig %-14s strength %.9g -> %.9g\n", F.o.rig[rigs[a]].def.name, F.o.rig[rigs[a]].def.s, eta[a]);
                 }
         }

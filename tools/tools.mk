@@ -45,6 +45,7 @@ $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 # sinew-rig (issue 11): rig fitting on the double-precision reference model,
 # tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
 RIGTOOL = $(BUILD)/sinew-rig
+RIG_SRC = tools/sb_fit.c tools/sinew_rig.c tools/sb_retarget_cli.c   # + TOOLS_LIB_SRC and STATIC_SRC (the CMake build reads this list)
 FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
 $(FIT_OBJ) $(BUILD)/tools/static/sinew_rig.o: tools/sb_fit.h
 $(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)

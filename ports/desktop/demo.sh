@@ -153,6 +153,14 @@ run "beast flex and breathe (150 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/fle
     --compare-rigs "$OUT/beast_rigs.png" --rig-off-blob "$BUILD/examples/norig/beast.blob" --heat 3 --view 10,10 --size 600x450
 rm -f "$OUT/run.out"
 
+# Rig fitting (issue 11, seed 003 fig. 5-6): sinew-rig fits surface rigs to
+# target shapes; pictures and figures in $OUT/rigfit/ (figures.txt).
+if [ -x "$BUILD/sinew-rig" ]; then
+    echo "== rig fitting: tools/examples/rigfit/rigfit.sh"
+    BUILD=$BUILD sh tools/examples/rigfit/rigfit.sh "$OUT/rigfit" > "$OUT/rigfit.log" 2>&1 || { cat "$OUT/rigfit.log"; exit 1; }
+    cat "$OUT/rigfit/figures.txt"
+fi
+
 # Retargeting (seed 003 §4.4): the cow's two-bump smile carried to Spot
 # (tools/examples/spot): A rest | A rigged | B rest | B rigged (static
 # equilibria at rest) | the cow's surface under the map, framed on the heads.
@@ -170,4 +178,4 @@ printf '  %-38s %9s %9s %9s %9s\n' "run" "median" "p99" "CPU med" "CPU p99"
 cat "$log"
 echo
 echo "Pictures in $OUT/:"
-for f in "$OUT"/*.png; do echo "  $f"; done
+for f in "$OUT"/*.png "$OUT"/rigfit/*.png; do [ -e "$f" ] && echo "  $f"; done

@@ -111,6 +111,10 @@ tau=$(sed -n 's/^rig_file [^ ]* [^ ]* [^ ]* tau //p' "$OUT/limb_fit.txt")
 "$BAKE" "$OUT/limb_fit.sinew" -o "$OUT/limb_norig.blob" --quiet
 "$BAKE" "$OUT/limb_rigged.sinew" --static "$(cat "$OUT/limb_pose.txt")" -o "$OUT/limb_rigged_static.obj" --quiet
 note "    baked rig_file, static at the fitted pose vs target: $(residual "$OUT/limb_rigged_static.obj" "$OUT/limb_target.obj" "$OUT/limb_bent.obj")"
+"$RIG" fit-surface "$OUT/limb_fit.sinew" --target "$OUT/limb_target.obj" --pose elbow:0,0,1,90 \
+    --control elbow_bend -o "$OUT/limb_biceps_truepose.rig" --progress 1000 > "$OUT/limb_fit_truepose.txt"
+note "bent limb surface rig at the true pose (elbow:0,0,1,90, no pose fit):"
+fitline "$OUT/limb_fit_truepose.txt" >> "$FIG"
 "$BAKE" "$OUT/limb_rigged.sinew" --static elbow:0,0,1,45 -o "$OUT/limb_rigged_45.obj" --png "$OUT/limb_rigged_45.png" --quiet
 if [ -x "$PLAY" ]; then
     "$PLAY" "$OUT/limb_rigged.blob" --clip tools/examples/limb/flex.clip --frames 150 --quiet \
@@ -133,5 +137,27 @@ printf '\ncontrol inhale\n' >> "$OUT/beast_refit.sinew"
     --png "$OUT/beast_breath_refit.png" --view 20,10 --progress 500 > "$OUT/beast_breath_refit.txt"
 note "beast breathing (breath=1 of the ring template) refitted as a surface rig:"
 fitline "$OUT/beast_breath_refit.txt" >> "$FIG"
+# the humanoid: its left arm's pose (shoulder 20 deg about z, elbow 60 deg about its bend axis)
+# from 10 feature vertices on the arm, on the static shape and on the skinned one
+BPOSE="shoulder_l:0,0,1,20+elbow_l:-0.35,-0.93,-0.07,60"
+BFEAT=10281,11930,13385,14064,15810,17653,19787,21145,22988,24055
+"$BAKE" "$OUT/beast_refit.sinew" --static "$BPOSE" -o "$OUT/beast_pose_target.obj" --png "$OUT/beast_pose_target.png" --quiet
+note "beast left arm pose from 10 feature points (true: $BPOSE):"
+for mode in static skinned; do
+    flag=; [ $mode = skinned ] && flag=--pose-skinned
+    "$RIG" fit-pose "$OUT/beast_refit.sinew" --target "$OUT/beast_pose_target.obj" --features $BFEAT --joints shoulder_l,elbow_l $flag \
+        -o "$OUT/beast_pose_$mode.txt" --progress 1000 > "$OUT/beast_pose_$mode.out"
+    note "    on the $mode shape: $(sed -n 's/^fit-pose: //p' "$OUT/beast_pose_$mode.out")"
+    note "        $(grep '^pose ' "$OUT/beast_pose_$mode.out")"
+done
+# the humanoid's biceps (elbow-driven template, tau 0 0 90 1) at that pose refitted as a surface rig on a new pose control
+{ cat "$OUT/beast_refit.sinew"; echo "control flex_l angle elbow_l -0.35 -0.93 -0.07"; } > "$OUT/beast_flex.sinew"
+"$BAKE" "$OUT/beast_flex.sinew" --static "$BPOSE" -o "$OUT/beast_flex_target.obj" --quiet
+"$RIG" fit-surface "$OUT/beast_flex.sinew" --target "$OUT/beast_flex_target.obj" --pose "$BPOSE" \
+    --rigs-off --control flex_l -o "$OUT/beast_flex.rig" --png "$OUT/beast_flex_fit.png" --view 10,10 --progress 1000 > "$OUT/beast_flex_fit.txt"
+note "beast biceps (template, 2/3 on at 60 deg) refitted at the pose as a surface rig on a new pose control flex_l (the description's rigs off):"
+fitline "$OUT/beast_flex_fit.txt" >> "$FIG"
+note "    $(grep '^rig_file' "$OUT/beast_flex_fit.txt")"
+
 echo
 echo "rigfit: figures in $FIG; pictures in $OUT"
