@@ -167,7 +167,9 @@ fi
 echo "== retarget the cow's smile onto spot"
 "$BUILD/sinew-rig" retarget tools/examples/cow/cow.sinew tools/examples/spot/spot.sinew --rig smile_l,smile_r --name smile \
     --w-surf 1000 -o "$OUT/spot_smile.rig" --png "$OUT/retarget_spot_smile.png" --view-a 50,10 --view-b 140,10 \
-    --frame-a 3.3,-0.8,-1.5,6.2,2.8,1.5 --frame-b -0.5,-0.2,-0.75,0.5,1.0,0.0 2>&1 | grep -v "^retarget: round "
+    --frame-a 3.3,-0.8,-1.5,6.2,2.8,1.5 --frame-b -0.5,-0.2,-0.75,0.5,1.0,0.0 > "$OUT/retarget.log" 2>&1 ||
+    { cat "$OUT/retarget.log"; exit 1; }
+grep -v "^retarget: round " "$OUT/retarget.log"
 
 echo
 echo "Time of one sn_step in microseconds on this machine (CPU = thread CPU time,"
