@@ -226,7 +226,6 @@ static int read_skin(scene *s, sb_gltf *g)
     int sk = gl_elem(&s->d, GA_SKINS, g->skin), ja = sbj_get(&s->d.j, sk, "joints"), c, k = 0, *of_node;
     long long ibm_acc;
     gl_acc ibm;
-    double *mw = s->world + 16 * g->node;
     snprintf(path, sizeof path, "skins[%d]", g->skin);
     if (ja < 0 || s->d.j.node[ja].kind != SBJ_ARR || s->d.j.node[ja].count < 1)
         return sb_fail("%s.joints: a non-empty array expected", path);
@@ -272,8 +271,9 @@ static int read_skin(scene *s, sb_gltf *g)
             free(ibm.v);
             return sb_fail("%s.inverseBindMatrices: matrix %d is not an invertible affine matrix", path, k);
         }
-        mat_point(inv, o, o);
-        mat_point(mw, o, g->joints[k].pos);
+        /* glTF 2.0 (3.7.3.3 Skins): the skinned mesh node's own transform is
+         * ignored; inverse(IBM) takes the joint's origin into the space of POSITION */
+        mat_point(inv, o, g->joints[k].pos);
     }
     free(ibm.v);
     return joints_finite(g, path);
@@ -321,7 +321,6 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
     long long mode, nv, ni, v, k;
     gl_acc P, J, W, I;
     int nv0 = g->nv, nt0 = g->nt, rc = -1, c;
-    double *mw = s->world + 16 * g->node;
     snprintf(path, sizeof path, "meshes[%d].primitives[%d]", m, pi);
     memset(&J, 0, sizeof J), memset(&W, 0, sizeof W), memset(&I, 0, sizeof I);
     if (gl_int(&s->d, prim, "mode", path, 4, 0, 6, &mode)) return -1;
@@ -352,9 +351,10 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
     for (v = 0; v < nv; v++) {
         double sum = 0, *w = g->weight + 4 * (nv0 + v);
         int *j = g->joint + 4 * (nv0 + v);
-        mat_point(mw, P.v + 3 * v, g->pos + 3 * (nv0 + v));
+        /* POSITION as stored: a skinned mesh ignores its node's transform (glTF 2.0, 3.7.3.3) */
+        memcpy(g->pos + 3 * (nv0 + v), P.v + 3 * v, 3 * sizeof(double));
         if (!isfinite(g->pos[3 * (nv0 + v)]) || !isfinite(g->pos[3 * (nv0 + v) + 1]) || !isfinite(g->pos[3 * (nv0 + v) + 2])) {
-            sb_fail("%s.attributes.POSITION: vertex %lld is not finite after nodes[%d]'s world transform", path, v, g->node);
+            sb_fail("%s.attributes.POSITION: vertex %lld is not finite", path, v);
             goto out;
         }
         g->src_prim[nv0 + v] = pi;

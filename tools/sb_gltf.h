@@ -8,8 +8,9 @@ typedef struct {
     char *name;         /* the joint node's name ("" if it has none) */
     int node;           /* glTF node index */
     int parent;         /* index in joints[] of the nearest ancestor in the skin, -1 at a root */
-    double pos[3];      /* bind-pose position, mesh-node world frame: world(mesh node) * inverse(IBM)
-                           origin; the node hierarchy's position when the skin has no IBMs */
+    double pos[3];      /* bind-pose position in the frame of POSITION: inverse(IBM) origin (the
+                           skinned mesh node's own transform is ignored, glTF 2.0 3.7.3.3); the
+                           node hierarchy's world position when the skin has no IBMs */
     double node_pos[3]; /* world position from the node hierarchy (TRS or matrix) */
 } sb_gltf_joint;
 
@@ -17,7 +18,7 @@ typedef struct {
     char *mesh_name;    /* meshes[mesh].name ("" if none) */
     int mesh, node, skin;  /* glTF indices of the chosen mesh, the node using it, its skin */
     int nv;             /* vertices, all primitives concatenated in glTF order */
-    double *pos;        /* 3*nv: POSITION after the mesh node's world transform */
+    double *pos;        /* 3*nv: POSITION as stored (bind space; the mesh node's transform is ignored) */
     int *joint;         /* 4*nv: indices into joints[] (0 where the weight is 0) */
     double *weight;     /* 4*nv: WEIGHTS_0, each vertex summing to 1 */
     int *src_prim, *src_vert;  /* per vertex: primitive and vertex index in the glTF file */
