@@ -14,7 +14,7 @@ typedef struct {
     double node_pos[3]; /* world position from the node hierarchy (TRS or matrix) */
 } sb_gltf_joint;
 
-typedef struct {
+typedef struct sb_gltf {
     char *mesh_name;    /* meshes[mesh].name ("" if none) */
     int mesh, node, skin;  /* glTF indices of the chosen mesh, the node using it, its skin */
     int nv;             /* vertices, all primitives concatenated in glTF order */

@@ -691,6 +691,7 @@ void sb_model_free(sb_model *o)
     free(o->nbptr); free(o->nb); free(o->M); free(o->S); free(o->T); free(o->emb_cell); free(o->emb_t); free(o->tri);
     free(o->Se); free(o->cfb1); free(o->cfb2); free(o->cfw); free(o->limit); free(o->vseg);
     free(o->seg_r); free(o->seg_flesh); free(o->seg_auto); free(o->seg_nv); free(o->seg_ncap);
+    sb_srcmap_free(&o->src);
     memset(o, 0, sizeof *o);
 }
 
