@@ -188,6 +188,7 @@ typedef struct sb_srcmap {
     int nsrc_tri;           /* glTF triangles (before the weld dropped *dropped of them) */
     int *src_tri;           /* 3 x nsrc_tri, glTF vertex indices (concatenated order) */
     int dropped;
+    double root[3];         /* the root joint's rest position in the glTF frame: the runtime's model-space origin */
 } sb_srcmap;
 /* the 'gltf FILE [MESH]' line: load the file, declare its skin's joints */
 int sb_desc_gltf(sb_desc *d, const char *file, const char *mesh, int line);

@@ -31,6 +31,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         return -1;
     }
     o->src = src;   /* sb_build cleared the model: the glTF vertex order goes in afterwards */
+    if (o->src.nsrc) memcpy(o->src.root, o->joints[0].pos, sizeof o->src.root);
     vol = sb_mesh_volume(&m) * d.unit * d.unit * d.unit;
     if (!quiet) {
         double fmin_ = 1, fsum = 0;

@@ -10,16 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* a glTF node name as a description token: whitespace and '#' become '_' */
-static void joint_name(const char *in, int k, char *out)
-{
-    size_t i;
-    if (!in[0]) { snprintf(out, SB_NAME_MAX, "joint%d", k); return; }
-    for (i = 0; in[i] && i < SB_NAME_MAX - 1; i++)
-        out[i] = (in[i] == ' ' || in[i] == '\t' || in[i] == '\r' || in[i] == '\n' || in[i] == '#') ? '_' : in[i];
-    out[i] = '\0';
-}
-
 int sb_desc_gltf(sb_desc *d, const char *file, const char *mesh, int line)
 {
     const char *slash = strrchr(d->path, '/');
@@ -48,7 +38,7 @@ int sb_desc_gltf(sb_desc *d, const char *file, const char *mesh, int line)
         if (strlen(g->joints[k].name) >= SB_NAME_MAX)
             return sb_fail("%s:%d: %s: skins[%d].joints[%d]: node name \"%s\" is longer than %d characters", d->path, line,
                            d->mesh_path, g->skin, k, g->joints[k].name, SB_NAME_MAX - 1);
-        joint_name(g->joints[k].name, k, j->name);
+        sb_gltf_token(g->joints[k].name, k, j->name, SB_NAME_MAX);
         if (!strcmp(j->name, "-")) strcpy(j->name, "_");
         for (i = 0; i < k; i++)
             if (!strcmp(d->joints[i].name, j->name))
@@ -119,6 +109,7 @@ int sb_srcmap_write(const char *path, const sb_srcmap *s)
     fprintf(f, "source %s\n", s->path);
     fprintf(f, "mesh %s\n", s->mesh[0] ? s->mesh : "-");
     fprintf(f, "counts %d %d %d %d %d\n", s->nsrc, s->nsurf, s->nprim, s->nsrc_tri, s->dropped);
+    fprintf(f, "root %.17g %.17g %.17g\n", s->root[0], s->root[1], s->root[2]);
     for (k = 0; k < s->nsrc; k++) fprintf(f, "v %d %d %d\n", s->prim[k], s->vert[k], s->to_surf[k]);
     for (k = 0; k < s->nsrc_tri; k++) fprintf(f, "t %d %d %d\n", s->src_tri[3 * k], s->src_tri[3 * k + 1], s->src_tri[3 * k + 2]);
     ok = !ferror(f);

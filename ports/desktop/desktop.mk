@@ -6,9 +6,14 @@
 # ports/common (clip parser) is shared with the bare-metal port.
 DESK_INC  = $(if $(SN_INC),$(SN_INC),-Iruntime/include) -Iruntime/src -Iports/common -Iports/desktop
 DESK_HDRS = runtime/include/sinew.h runtime/src/sn_format.h ports/common/sn_clip.h \
-            ports/desktop/raster.h ports/desktop/png.h ports/desktop/plot.h
+            ports/desktop/raster.h ports/desktop/png.h ports/desktop/plot.h ports/desktop/play_gltf.h \
+            tools/sb.h tools/sb_gltf.h tools/sb_gltf_int.h tools/sb_json.h
 PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c ports/desktop/plot.c \
-            ports/common/sn_clip.c ports/common/sn_clip_pose.c
+            ports/common/sn_clip.c ports/common/sn_clip_pose.c \
+            ports/desktop/play_gltf.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_gltf_anim.c tools/sb_util.c
+# the player reads glTF with the host tool's reader (issue 17: --gltf-anim, --out-gltf); a glTF
+# animation keyed at every step needs more clip keys than the bare-metal default
+PLAY_CFLAGS = -Itools -DSN_CLIP_MAX_KEYS=32768 -DSN_CLIP_MAX_CHANNELS=256
 DEMO_DIR  = $(BUILD)/demo
 COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip tools/examples/cow/breathe.clip \
             tools/examples/cow/smile.clip tools/examples/cow/belly.clip
@@ -42,11 +47,11 @@ all: $(BUILD)/sinew-play $(BUILD)/sinew-play-float
 
 $(BUILD)/sinew-play: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FIXED) -o $@ -lm
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLAY_CFLAGS) $(PLAY_SRCS) $(SN_LIB_FIXED) -o $@ -lm
 
 $(BUILD)/sinew-play-float: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FLOAT) -o $@ -lm
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) $(PLAY_CFLAGS) $(PLAY_SRCS) $(SN_LIB_FLOAT) -o $@ -lm
 
 # Clip sampling through the runtime against a double reference.
 $(BUILD)/tests/test_clip_pose: tests/test_clip_pose.c ports/common/sn_clip.c ports/common/sn_clip_pose.c \
