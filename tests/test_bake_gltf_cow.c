@@ -38,6 +38,42 @@ static void put32(unsigned char *p, unsigned u)
     p[0] = (unsigned char)u, p[1] = (unsigned char)(u >> 8), p[2] = (unsigned char)(u >> 16), p[3] = (unsigned char)(u >> 24);
 }
 
+/* ---- animations (issue 17 item 3): keyed so that the clip clock's steps
+ * (HQ = the cow's timestep in Q16.16, 1092) land on whole degrees and
+ * 1/64 mesh units, values a clip holds exactly, so the hand-written clip
+ * (hand.clip, one key per step computed here from the same definition) and
+ * the glTF animation resampled by sinew-play --gltf-anim must give the same
+ * state hash (tests/scripts/gltf_play.sh). ---- */
+#define HQ 1092
+static float anim[4096];
+static int nanim;
+static char acc_json[8192], anim_json[4096];
+static int nacc_extra;
+/* append count elements as an accessor of the given type; returns its index (9 + k) */
+static int anim_acc(const float *v, int count, int ncomp, const char *type, int with_minmax)
+{
+    size_t o = strlen(acc_json);
+    int k;
+    snprintf(acc_json + o, sizeof acc_json - o, ",\n{\"bufferView\":6,\"byteOffset\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"%s\"",
+             4 * nanim, count, type);
+    if (with_minmax) {
+        o = strlen(acc_json);
+        snprintf(acc_json + o, sizeof acc_json - o, ",\"min\":[%.9g],\"max\":[%.9g]", (double)v[0], (double)v[count - 1]);
+    }
+    strcat(acc_json, "}");
+    for (k = 0; k < count * ncomp; k++) anim[nanim++] = v[k];
+    return 9 + nacc_extra++;
+}
+static void quat_axis(float *q, int axis, double deg)
+{
+    double h = deg * 3.14159265358979323846 / 360.0;
+    q[0] = q[1] = q[2] = 0, q[axis] = (float)sin(h), q[3] = (float)cos(h);
+}
+/* the test animation's values at step k (definitions shared with hand.clip) */
+static double neck_deg(int k) { return k <= 30 ? k : k <= 60 ? 30 - 2 * (k - 30) : -30; }   /* LINEAR 0 -> 30 -> -30 about z */
+static double hip_deg(int k) { return k < 20 ? 10 : k < 40 ? -15 : 5; }                      /* STEP 10, -15, 5 about x */
+static double move_x(int k) { return (k < 40 ? k : 40) / 64.0; }                              /* LINEAR 0 -> 0.625 in x */
+
 /* cow.gltf + cow.bin, cow_f.obj, cow_gltf.sinew, cow_obj.sinew in tmp; 0 ok */
 static int write_cow(void)
 {
@@ -92,6 +128,59 @@ static int write_cow(void)
     free(bin);
     /* nodes: 0 the mesh node (moved, rotated, scaled: ignored), 1 an armature root at the origin,
      * 2.. the joints, each translated from its parent (float differences of float positions) */
+    {   /* animations: "test" (LINEAR rotation, STEP rotation, LINEAR root translation, an ignored scale)
+         * and "spline" (CUBICSPLINE rotation and translation) */
+        float t3[3] = {0, 30 * HQ / 65536.0f, 60 * HQ / 65536.0f}, ts[3] = {0, 20 * HQ / 65536.0f, 40 * HQ / 65536.0f};
+        float t2[2] = {0, 40 * HQ / 65536.0f}, q[12], tr[6], sc[9] = {1, 1, 1, 1.5f, 1, 1, 1, 1, 1}, cq[24], ct[18];
+        int hips = -1, neck = -1, hip_l = -1, chest = -1, a[16], k;
+        for (j = 0; j < d.nj; j++) {
+            if (!strcmp(d.joints[j].name, "hips")) hips = j;
+            if (!strcmp(d.joints[j].name, "neck")) neck = j;
+            if (!strcmp(d.joints[j].name, "hip_l")) hip_l = j;
+            if (!strcmp(d.joints[j].name, "chest")) chest = j;
+        }
+        acc_json[0] = 0, nanim = 0, nacc_extra = 0;
+        a[0] = anim_acc(t3, 3, 1, "SCALAR", 1);
+        quat_axis(q, 2, 0), quat_axis(q + 4, 2, 30), quat_axis(q + 8, 2, -30);
+        a[1] = anim_acc(q, 3, 4, "VEC4", 0);
+        a[2] = anim_acc(ts, 3, 1, "SCALAR", 1);
+        quat_axis(q, 0, 10), quat_axis(q + 4, 0, -15), quat_axis(q + 8, 0, 5);
+        a[3] = anim_acc(q, 3, 4, "VEC4", 0);
+        a[4] = anim_acc(t2, 2, 1, "SCALAR", 1);
+        for (c = 0; c < 3; c++) tr[c] = (float)d.joints[hips].pos[c], tr[3 + c] = (float)((double)(float)d.joints[hips].pos[c] + (c == 0 ? 0.625 : 0));
+        a[5] = anim_acc(tr, 2, 3, "VEC3", 0);
+        a[6] = anim_acc(sc, 3, 3, "VEC3", 0);
+        /* spline: keys at 0 and 30 steps; (in-tangent, value, out-tangent) per key */
+        memset(cq, 0, sizeof cq);
+        quat_axis(cq + 4, 2, 0), quat_axis(cq + 16, 2, 30);
+        cq[8 + 2] = 0.5f, cq[12 + 0] = 0.25f;   /* out-tangent of key 0 (z), in-tangent of key 1 (x) */
+        a[7] = anim_acc(t3, 2, 1, "SCALAR", 1);
+        a[8] = anim_acc(cq, 6, 4, "VEC4", 0);
+        memset(ct, 0, sizeof ct);
+        for (c = 0; c < 3; c++) ct[3 + c] = (float)d.joints[hips].pos[c], ct[12 + c] = (float)d.joints[hips].pos[c];
+        ct[12 + 1] += 0.5f, ct[6 + 1] = 2.0f;   /* rise 0.5 with out-tangent 2 per second */
+        a[9] = anim_acc(ct, 6, 3, "VEC3", 0);
+        f = fopen(at("anim.bin"), "wb");
+        fwrite(anim, 4, (size_t)nanim, f);
+        fclose(f);
+        k = sprintf(anim_json, ",\n\"animations\":[{\"name\":\"test\",\"channels\":["
+                               "{\"sampler\":0,\"target\":{\"node\":%d,\"path\":\"rotation\"}},{\"sampler\":1,\"target\":{\"node\":%d,\"path\":\"rotation\"}},"
+                               "{\"sampler\":2,\"target\":{\"node\":%d,\"path\":\"translation\"}},{\"sampler\":3,\"target\":{\"node\":%d,\"path\":\"scale\"}}],"
+                               "\"samplers\":[{\"input\":%d,\"output\":%d},{\"input\":%d,\"output\":%d,\"interpolation\":\"STEP\"},"
+                               "{\"input\":%d,\"output\":%d,\"interpolation\":\"LINEAR\"},{\"input\":%d,\"output\":%d}]},\n",
+                    2 + neck, 2 + hip_l, 2 + hips, 2 + chest, a[0], a[1], a[2], a[3], a[4], a[5], a[2], a[6]);
+        sprintf(anim_json + k, " {\"name\":\"spline\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":%d,\"path\":\"rotation\"}},"
+                               "{\"sampler\":1,\"target\":{\"node\":%d,\"path\":\"translation\"}}],"
+                               "\"samplers\":[{\"input\":%d,\"output\":%d,\"interpolation\":\"CUBICSPLINE\"},{\"input\":%d,\"output\":%d,\"interpolation\":\"CUBICSPLINE\"}]}]",
+                2 + neck, 2 + hips, a[7], a[8], a[7], a[9]);
+        /* the hand-written equivalent of "test": one key per step, from the same definitions */
+        f = fopen(at("hand.clip"), "w");
+        fprintf(f, "sinew-clip 1\n# hand-written twin of cow.gltf's animation \"test\" (test_bake_gltf_cow.c)\nduration %.9f\nloop yes\n", 60 * HQ / 65536.0);
+        for (k = 0; k <= 60; k++) fprintf(f, "rot neck %.9f 0 0 1 %g\n", k * HQ / 65536.0, neck_deg(k));
+        for (k = 0; k <= 60; k++) fprintf(f, "rot hip_l %.9f 1 0 0 %g\n", k * HQ / 65536.0, hip_deg(k));
+        for (k = 0; k <= 60; k++) fprintf(f, "move %.9f %.9f 0 0\n", k * HQ / 65536.0, move_x(k));
+        fclose(f);
+    }
     f = fopen(at("cow.gltf"), "w");
     fprintf(f, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"test_bake_gltf_cow\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],\n\"nodes\":[\n");
     fprintf(f, " {\"name\":\"cow\",\"mesh\":0,\"skin\":0,\"translation\":[7,-3,2],\"rotation\":[0,0.6,0,0.8],\"scale\":[2,2,2]},\n");
@@ -132,7 +221,7 @@ static int write_cow(void)
                     (unsigned long)(16 * nv * (size_t)i), (unsigned long)nv);
         fprintf(f, "{\"bufferView\":3,\"componentType\":5126,\"count\":%d,\"type\":\"MAT4\"},\n", d.nj);
         fprintf(f, "{\"bufferView\":4,\"componentType\":5125,\"count\":%lu,\"type\":\"SCALAR\"},\n", (unsigned long)(3 * nt0));
-        fprintf(f, "{\"bufferView\":5,\"componentType\":5125,\"count\":%lu,\"type\":\"SCALAR\"}],\n", (unsigned long)(3 * nt1));
+        fprintf(f, "{\"bufferView\":5,\"componentType\":5125,\"count\":%lu,\"type\":\"SCALAR\"}%s],\n", (unsigned long)(3 * nt1), acc_json);
     }
     fprintf(f, "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu},{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu},"
                "{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu},{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu},"
@@ -140,7 +229,10 @@ static int write_cow(void)
             (unsigned long)off_pos, (unsigned long)(24 * nv), (unsigned long)off_jw, (unsigned long)(8 * nv),
             (unsigned long)(off_jw + 8 * nv), (unsigned long)(32 * nv), (unsigned long)off_ibm, (unsigned long)(64 * (size_t)d.nj),
             (unsigned long)off_i0, (unsigned long)(12 * nt0), (unsigned long)off_i1, (unsigned long)(12 * nt1));
-    fprintf(f, "\"buffers\":[{\"uri\":\"cow.bin\",\"byteLength\":%lu}]}\n", (unsigned long)len);
+    fseek(f, -3, SEEK_CUR);   /* reopen the bufferViews list: the animation data's view */
+    fprintf(f, ",{\"buffer\":1,\"byteLength\":%d}],\n", 4 * nanim);
+    fprintf(f, "\"buffers\":[{\"uri\":\"cow.bin\",\"byteLength\":%lu},{\"uri\":\"anim.bin\",\"byteLength\":%d}]%s}\n", (unsigned long)len,
+            4 * nanim, anim_json);
     fclose(f);
     /* the same geometry as OBJ + joints, float-rounded, and the two descriptions */
     f = fopen(at("cow_f.obj"), "w");
@@ -242,12 +334,28 @@ static void refusals(void)
     }
 }
 
-int main(void)
+/* --read FILE: our reader on a file (tests/scripts/test_gltf.sh re-reads
+ * sinew-play --out-gltf results): "read: NV NT NJ lo.. hi.." of POSITION */
+static int read_mode(const char *path)
+{
+    sb_gltf g;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    int v, c;
+    if (sb_gltf_load(&g, path, NULL)) { printf("read: error: %s\n", sb_error()); return 1; }
+    for (v = 0; v < g.nv; v++)
+        for (c = 0; c < 3; c++) lo[c] = fmin(lo[c], g.pos[3 * v + c]), hi[c] = fmax(hi[c], g.pos[3 * v + c]);
+    printf("read: %d %d %d %.9g %.9g %.9g %.9g %.9g %.9g\n", g.nv, g.nt, g.nj, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    sb_gltf_free(&g);
+    return 0;
+}
+
+int main(int argc, char **argv)
 {
     const char *base = getenv("BUILD") ? getenv("BUILD") : "build";
     char cmd[700];
     double tg, to, tg2, to2;
     (void)t_seed;
+    if (argc == 3 && !strcmp(argv[1], "--read")) return read_mode(argv[2]);
     snprintf(tmp, sizeof tmp, "%s/test_bake_gltf_cow.d", base);
     snprintf(cmd, sizeof cmd, "mkdir -p '%s'", tmp);
     if (system(cmd)) { printf("cannot create %s\n", tmp); return 1; }

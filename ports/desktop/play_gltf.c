@@ -39,11 +39,12 @@ char *pg_anim_clip(const char *spec, int32_t hq, int loop, int quiet, char *err,
         sb_gltf_free(&g);
         return NULL;
     }
-    if (!quiet) {
+    {   /* warnings also under --quiet (the player's rule) */
         int k, n = 0;
         for (k = 0; k < a.nj; k++) n += a.animated[k];
-        fprintf(stderr, "sinew-play: %s: animation %d \"%s\": %.3f s, %d channel(s) on %d of %d skin joints\n", file, a.index,
-                a.name, a.end, a.n_channels, n, a.nj);
+        if (!quiet)
+            fprintf(stderr, "sinew-play: %s: animation %d \"%s\": %.3f s, %d channel(s) on %d of %d skin joints\n", file, a.index,
+                    a.name, a.end, a.n_channels, n, a.nj);
         if (a.n_scale) fprintf(stderr, "sinew-play: warning: %s: %d scale channel(s) ignored (Sinew bones do not scale)\n", file, a.n_scale);
         if (a.n_other) fprintf(stderr, "sinew-play: warning: %s: %d channel(s) on morph weights or extensions ignored\n", file, a.n_other);
         if (a.bone_gap > 1e-4)

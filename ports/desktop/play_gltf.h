@@ -9,8 +9,8 @@
 
 /* FILE[:NAME] -> clip text (ports/common/CLIP.md), malloc'd, keyed at every
  * step of the clip clock (hq: the blob's timestep, Q16.16 s); NULL and err on
- * failure. Notes (ignored scale channels, bone translations) go to stderr
- * unless quiet. */
+ * failure. Warnings (ignored scale channels, bone translations) go to
+ * stderr; the summary line only unless quiet. */
 char *pg_anim_clip(const char *spec, int32_t hq, int loop, int quiet, char *err, size_t errlen);
 
 typedef struct pg_out {
