@@ -261,18 +261,16 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
     for (k = 0; k < g->nj; k++) jn[g->joints[k].node] = k;
     for (k = 0; k < g->nj; k++)
         for (i = g->joints[k].node; i >= 0 && !sel[i]; i = s.parent[i]) sel[i] = 1;
-    {   /* order: by depth (a node after its parent) */
-        int n = 0, d, maxd = 0, *dep = sb_alloc(((size_t)s.nn + 1) * sizeof *dep);
-        for (k = 0; k < s.nn; k++)
-            if (sel[k]) {
-                for (d = 0, i = s.parent[k]; i >= 0; i = s.parent[i]) d++;
-                dep[k] = d, maxd = d > maxd ? d : maxd;
-            }
-        for (d = 0; d <= maxd; d++)
-            for (k = 0; k < s.nn; k++)
-                if (sel[k] && dep[k] == d) ord[n++] = k;
+    {   /* order: parents first, linear in the nodes (walk up to a placed node, place the walk reversed) */
+        int n = 0, len, *walk = sb_alloc(((size_t)s.nn + 1) * sizeof *walk);
+        char *placed = sb_alloc((size_t)s.nn + 1);
+        for (k = 0; k < s.nn; k++) {
+            if (!sel[k] || placed[k]) continue;
+            for (len = 0, i = k; i >= 0 && !placed[i]; i = s.parent[i]) walk[len++] = i;
+            while (len > 0) placed[walk[--len]] = 1, ord[n++] = walk[len];
+        }
         ord[n] = -1;
-        free(dep);
+        free(walk), free(placed);
     }
     for (k = 0; k < nch; k++) if (jn[ch[k].node] >= 0) a->animated[jn[ch[k].node]] = 1;
     trs = sb_alloc((size_t)s.nn * 10 * sizeof *trs);

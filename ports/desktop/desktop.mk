@@ -74,3 +74,29 @@ endif
 demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
       $(BUILD)/examples/limb.blob $(BUILD)/examples/beast.blob $(COW_CLIPS) $(SHEET_BLOBS)
 	@BUILD=$(BUILD) sh ports/desktop/demo.sh
+
+# ---- glTF with Blender (issue 17 item 5; tools/blender/) ----
+# make gltf-roundtrip: the Blender-exported cow baked, its walk played with
+# --out-gltf, and the result imported by Blender's own glTF importer
+# (tools/blender/import_check.py); skipped, with the reason, without Blender.
+# make gltf-assets: regenerate tools/examples/{cow,beast}_gltf/*.glb and the
+# bone heads with Blender (tools/blender/make_gltf.py); only for maintainers.
+BLENDER ?= blender
+BLENDER_RUN = $(BLENDER) -b --factory-startup --python-exit-code 1 -P
+.PHONY: gltf-roundtrip gltf-assets
+gltf-roundtrip: $(BUILD)/sinew-play $(BAKE)
+	@if ! command -v $(BLENDER) > /dev/null 2>&1; then \
+	    echo "gltf-roundtrip: SKIPPED: '$(BLENDER)' not found (apt-get install blender, or BLENDER=/path/to/blender)"; \
+	else \
+	    mkdir -p $(BUILD)/gltf && \
+	    $(BAKE) tools/examples/cow_gltf/cow_gltf.sinew -o $(BUILD)/gltf/cow_gltf.blob --quiet && \
+	    $(BUILD)/sinew-play $(BUILD)/gltf/cow_gltf.blob --gltf-anim tools/examples/cow_gltf/cow.glb:walk --quiet \
+	        --out-gltf $(BUILD)/gltf/cow_walk.glb && \
+	    $(BLENDER_RUN) tools/blender/import_check.py -- $(BUILD)/gltf/cow_walk.glb > $(BUILD)/gltf/import.log 2>&1 && \
+	    grep '^import_check:' $(BUILD)/gltf/import.log || { echo "gltf-roundtrip: FAILED (log: $(BUILD)/gltf/import.log)"; exit 1; }; \
+	fi
+gltf-assets:
+	$(BLENDER_RUN) tools/blender/make_gltf.py -- --obj tools/examples/cow/cow.obj --desc tools/examples/cow/cow.sinew \
+	    --walk cow --out tools/examples/cow_gltf/cow.glb --heads tools/examples/cow_gltf/cow_heads.txt
+	$(BLENDER_RUN) tools/blender/make_gltf.py -- --obj tools/examples/beast/beast.obj --desc tools/examples/beast/beast.sinew \
+	    --walk biped --normals 0 --out tools/examples/beast_gltf/beast.glb --heads tools/examples/beast_gltf/beast_heads.txt

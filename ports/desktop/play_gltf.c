@@ -34,7 +34,7 @@ char *pg_anim_clip(const char *spec, int32_t hq, int loop, int quiet, char *err,
     colon = strrchr(file, ':');
     if (colon && (strstr(colon, ".gltf") == NULL && strstr(colon, ".glb") == NULL)) *colon = '\0', name = colon + 1;
     if (sb_gltf_load(&g, file, NULL)) { snprintf(err, errlen, "%s", sb_error()); return NULL; }
-    if (sb_gltf_anim_load(&a, file, &g, name, hq / 65536.0, 1000000)) {
+    if (sb_gltf_anim_load(&a, file, &g, name, hq / 65536.0, 20000)) {   /* 20000 steps: 5.5 min at 60 Hz */
         snprintf(err, errlen, "%s", sb_error());
         sb_gltf_free(&g);
         return NULL;
