@@ -8,7 +8,9 @@
  * ignores it). It writes the same geometry rounded to float32 as an OBJ +
  * 'joint' description, bakes both and wants equal blobs (so matrices equal
  * far within 1e-9 relative), the glTF vertex order map, and 'region bone'
- * with the glTF's joint names. */
+ * with the glTF's joint names. It adds two animations to the file and checks
+ * the sampler (tools/sb_gltf_anim.c) against their definitions (LINEAR, STEP,
+ * CUBICSPLINE) and its refusals; tests/scripts/test_gltf.sh plays them. */
 #include "sb.h"
 #include "sb_gltf.h"
 #include "sn_test.h"
@@ -334,6 +336,109 @@ static void refusals(void)
     }
 }
 
+/* the animation sampler (tools/sb_gltf_anim.c) on cow.gltf's "test" and
+ * "spline", against the definitions they were written from */
+static double qang_about(const double *q, int axis)   /* signed angle (degrees) of q about a coordinate axis */
+{
+    return 2 * atan2(q[axis], q[3]) * 180 / 3.14159265358979323846;
+}
+
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    long n;
+    char *s;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END), n = ftell(f), fseek(f, 0, SEEK_SET);
+    s = calloc((size_t)n + 1, 1);
+    if (fread(s, 1, (size_t)n, f) != (size_t)n) n = 0;
+    fclose(f);
+    return s;
+}
+
+static void anim_checks(void)
+{
+    sb_gltf g;
+    sb_gltf_anim a;
+    int k, neck = -1, hip_l = -1, hips = -1, bad = 0, rc;
+    double h = HQ / 65536.0;
+    if (sb_gltf_load(&g, at("cow.gltf"), NULL)) { T_CHECK(0, "cow.gltf: %s", sb_error()); return; }
+    for (k = 0; k < g.nj; k++) {
+        if (!strcmp(g.joints[k].name, "neck")) neck = k;
+        if (!strcmp(g.joints[k].name, "hip_l")) hip_l = k;
+        if (!strcmp(g.joints[k].name, "hips")) hips = k;
+    }
+    rc = sb_gltf_anim_load(&a, at("cow.gltf"), &g, "test", h, 1000);
+    T_CHECK(rc == 0, "test: %s", rc ? sb_error() : "");
+    if (rc == 0) {
+        double worst_r = 0, worst_t = 0;
+        T_CHECK(a.nframes == 61 && a.n_channels == 4 && a.n_scale == 1 && a.animated[neck] && a.animated[hip_l] && a.animated[hips],
+                "test: %d frames, %d channels, %d scale", a.nframes, a.n_channels, a.n_scale);
+        for (k = 0; k < a.nframes && a.nframes == 61; k++) {
+            const double *qn = a.rot + ((size_t)k * a.nj + neck) * 4, *qh = a.rot + ((size_t)k * a.nj + hip_l) * 4;
+            worst_r = fmax(worst_r, fabs(qang_about(qn, 2) - neck_deg(k)));
+            worst_r = fmax(worst_r, fabs(qang_about(qh, 0) - hip_deg(k)));
+            bad += fabs(qn[0]) + fabs(qn[1]) > 1e-12 || fabs(qh[1]) + fabs(qh[2]) > 1e-12;
+            worst_t = fmax(worst_t, fabs(a.move[3 * k] - move_x(k)) + fabs(a.move[3 * k + 1]) + fabs(a.move[3 * k + 2]));
+        }
+        /* float32 keys: ~4e-6 degrees, ~2e-7 units; a clip resolves 1.5e-5 */
+        T_CHECK(bad == 0 && worst_r < 5e-6 && worst_t < 5e-7, "test: rotation off by %.3g degrees, translation by %.3g, %d off-axis",
+                worst_r, worst_t, bad);
+        T_FIGURE("sampled 'test' (LINEAR, STEP rotations, LINEAR translation) vs its definition: %.2g degrees, %.2g units", worst_r, worst_t);
+        sb_gltf_anim_free(&a);
+    }
+    rc = sb_gltf_anim_load(&a, at("cow.gltf"), &g, "spline", h, 1000);
+    T_CHECK(rc == 0, "spline: %s", rc ? sb_error() : "");
+    if (rc == 0) {   /* frame 15: halfway between the keys (0 and 30 steps): Hermite by hand */
+        double dt = (double)(30 * HQ / 65536.0f), u = 15 * h / dt, u2 = u * u, u3 = u2 * u;
+        double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2, q[4], n, d = 0, ty;
+        float v1z = (float)sin(15 * 3.14159265358979323846 / 180), v1w = (float)cos(15 * 3.14159265358979323846 / 180);
+        const double *got = a.rot + ((size_t)15 * a.nj + neck) * 4;
+        q[0] = h11 * dt * 0.25, q[1] = 0, q[2] = h10 * dt * 0.5 + h01 * v1z, q[3] = h00 + h01 * v1w;
+        n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (k = 0; k < 4; k++) d = fmax(d, fabs(q[k] / n - got[k]));
+        ty = h10 * dt * 2.0 + h01 * 0.5;   /* the root's rise above its bind position */
+        T_CHECK(d < 1e-12 && fabs(a.move[3 * 15 + 1] - ty) < 1e-6, "spline at frame 15: quaternion off by %.3g, rise %.9g want %.9g", d,
+                a.move[3 * 15 + 1], ty);
+        sb_gltf_anim_free(&a);
+    }
+    {   /* refusals, each naming its JSON path */
+        static const char *const cases[][4] = {
+            {"unknown name", NULL, NULL, "animations: none named \"nosuch\""},
+            {"bad interpolation", "\"interpolation\":\"STEP\"", "\"interpolation\":\"SMOOTH\"", "animations[0].samplers[1].interpolation: \"SMOOTH\""},
+            {"cubic count", "\"interpolation\":\"STEP\"", "\"interpolation\":\"CUBICSPLINE\"", "animations[0].samplers[1].output: accessors[12] must be VEC4 with 9"},
+            {"rotation from vec3", "\"path\":\"scale\"", "\"path\":\"rotation\"", "animations[0].samplers[3].output"},
+            {"no animations", "\"animations\":[", "\"unused\":[", "animations: the file has none"},
+            {"bad target node", "\"node\":4,\"path\":\"rotation\"}},{\"sampler\":1", "\"node\":999,\"path\":\"rotation\"}},{\"sampler\":1",
+             "animations[0].channels[0].target.node"},
+        };
+        char *text = slurp(at("cow.gltf"));
+        size_t c;
+        for (c = 0; text && c < sizeof cases / sizeof cases[0]; c++) {
+            char *t2 = text, *hit;
+            FILE *f;
+            if (cases[c][1]) {
+                hit = strstr(text, cases[c][1]);
+                if (!hit) { T_CHECK(0, "%s: '%s' not in cow.gltf", cases[c][0], cases[c][1]); continue; }
+                t2 = malloc(strlen(text) + strlen(cases[c][2]) + 1);
+                memcpy(t2, text, (size_t)(hit - text));
+                strcpy(t2 + (hit - text), cases[c][2]);
+                strcat(t2, hit + strlen(cases[c][1]));
+            }
+            f = fopen(at("bad_anim.gltf"), "w");
+            fputs(t2, f);
+            fclose(f);
+            rc = sb_gltf_anim_load(&a, at("bad_anim.gltf"), &g, cases[c][1] ? NULL : "nosuch", h, 1000);
+            T_CHECK(rc == -1 && strstr(sb_error(), cases[c][3]) && a.rot == NULL, "%s: rc %d \"%s\", want \"%s\"", cases[c][0], rc,
+                    rc ? sb_error() : "", cases[c][3]);
+            sb_gltf_anim_free(&a);
+            if (t2 != text) free(t2);
+        }
+        free(text);
+    }
+    sb_gltf_free(&g);
+}
+
 /* --read FILE: our reader on a file (tests/scripts/test_gltf.sh re-reads
  * sinew-play --out-gltf results): "read: NV NT NJ lo.. hi.." of POSITION */
 static int read_mode(const char *path)
@@ -381,5 +486,6 @@ int main(int argc, char **argv)
     compare("double", SB_DOUBLE, &tg2, &to2);
     T_FIGURE("bake time (fixed): from glTF %.2f s, from OBJ + joints %.2f s; (double) %.2f s vs %.2f s", tg, to, tg2, to2);
     refusals();
+    anim_checks();
     return T_END();
 }

@@ -119,6 +119,16 @@ BEAST_BLOBS = $(EX)/beast.blob $(EX)/beast_float.blob $(EX)/beast_double.blob
 TEST_DEPS += $(BEAST_BLOBS)
 all: $(BEAST_BLOBS)
 
+# ---- glTF examples (tools/examples/*_gltf, issue 17): Blender exports, 'gltf' descriptions;
+# each bake also writes BLOB.gltfmap (the glTF vertex order) ----
+$(EX)/cow_gltf.blob: tools/examples/cow_gltf/cow_gltf.sinew tools/examples/cow_gltf/cow.glb $(BAKE)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/cow_gltf/cow_gltf.sinew -o $@ --quiet
+$(EX)/beast_gltf.blob: tools/examples/beast_gltf/beast_gltf.sinew tools/examples/beast_gltf/beast.glb $(BAKE)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/beast_gltf/beast_gltf.sinew -o $@ --quiet
+all: $(EX)/cow_gltf.blob $(EX)/beast_gltf.blob
+
 # ---- diag (tools/examples/diag): synthetic character, bones at 30/45/60 degrees ----
 DIAG_DEPS = tools/examples/diag/diag.sinew tools/examples/diag/diag.obj $(BAKE)
 $(EX)/diag.blob: $(DIAG_DEPS)
