@@ -321,6 +321,8 @@ static void refusals(void)
         {"gltf missing.gltf\n", "missing.gltf"},
         {"gltf cow.gltf\nunit 0.2\ncell 1.2\nmaterial flesh 5e4 0.3 1000\nregion bone elbow flesh\n", "unknown joint 'elbow'"},
         {"gltf cow.gltf\nunit 0.2\ncell 1.2\nmaterial flesh 5e4 0.3 1000\nregion bone hips flesh\n", "'hips' is the root"},
+        {"frames skin\ngltf cow.gltf\n", "'frames skin' takes the frames from a glTF's skin weights: put it after a 'gltf' line"},
+        {"gltf cow.gltf\nframes artist\n", "'frames' takes 'skin' or 'auto'"},
     };
     size_t k;
     for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {

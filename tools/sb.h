@@ -144,6 +144,8 @@ typedef struct sb_desc {
     int mesh_line;
     struct sb_gltf *gltf;   /* 'gltf FILE [MESH]': the loaded file (joints and surface come from it), else NULL */
     char gltf_mesh[256];    /* its MESH argument ("" for the first skinned mesh) */
+    int skin_frames;        /* 'frames skin': lattice frames from the glTF's skin weights (sb_lattice.c) */
+    int skin_frames_line;
     double unit;            /* metres per mesh unit */
     double cell;            /* lattice cell edge, mesh units */
     double origin[3]; int has_origin;

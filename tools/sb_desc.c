@@ -386,6 +386,14 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
     } else if (!strcmp(kw, "min_fill")) {
         if (nargs(c, 1) || num(c, 1, &d->min_fill)) return -1;
         if (d->min_fill < 0 || d->min_fill >= 1) return sb_fail("%s:%d: min_fill must be in [0, 1)", c->path, c->line);
+    } else if (!strcmp(kw, "frames")) {   /* 'frames skin' | 'frames auto' */
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "skin")) {
+            if (!d->gltf) return sb_fail("%s:%d: 'frames skin' takes the frames from a glTF's skin weights: put it after a 'gltf' line", c->path, c->line);
+            d->skin_frames = 1;
+        } else if (!strcmp(c->tok[1], "auto")) d->skin_frames = 0;
+        else return sb_fail("%s:%d: 'frames' takes 'skin' or 'auto' (got '%s')", c->path, c->line, c->tok[1]);
+        d->skin_frames_line = c->line;
     } else if (!strcmp(kw, "blend")) {
         if (nargs(c, 1) || len_num(c, 1, &d->blend)) return -1;
         if (d->blend <= 0) return sb_fail("%s:%d: blend width must be positive", c->path, c->line);

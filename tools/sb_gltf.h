@@ -56,6 +56,7 @@ typedef struct sb_gltf_anim {
     double h, end;          /* step and the animation's last key time, seconds */
     double *rot;            /* nframes x nj x 4 quaternions (x, y, z, w), w >= 0 */
     double *move;           /* nframes x 3: root offset, POSITION units */
+    double *skin;           /* nframes x nj x 16: skinning matrices world(joint) x IBM, column-major */
     int *animated;          /* per joint: a rotation or translation channel targets its node */
     int n_channels, n_scale, n_other;   /* channels read; scale channels ignored; weights etc. ignored */
     double bone_gap;        /* largest distance between a joint animated by translation and where its rigid bone puts it */

@@ -120,7 +120,7 @@ static void mat_point(const double *m, const double *p, double *o)
 
 void sb_gltf_anim_free(sb_gltf_anim *a)
 {
-    free(a->rot), free(a->move), free(a->animated);
+    free(a->rot), free(a->move), free(a->animated), free(a->skin);
     memset(a, 0, sizeof *a);
 }
 
@@ -252,6 +252,7 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
     if (a->nframes > max_frames) { sb_fail("animations[%d]: %g s at %g s per step is %d frames, at most %d", ai, a->end, h, a->nframes, max_frames); goto out; }
     a->rot = sb_alloc((size_t)a->nframes * (size_t)g->nj * 4 * sizeof *a->rot);
     a->move = sb_alloc((size_t)a->nframes * 3 * sizeof *a->move);
+    a->skin = sb_alloc((size_t)a->nframes * (size_t)g->nj * 16 * sizeof *a->skin);
     a->animated = sb_alloc((size_t)g->nj * sizeof *a->animated);
     /* nodes that matter: the joints and their ancestors, parents first */
     sel = sb_alloc((size_t)s.nn + 1);
@@ -279,6 +280,7 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
     inv_bind = sb_alloc((size_t)g->nj * 16 * sizeof *inv_bind);
     for (k = 0; k < g->nj; k++)
         if (gl_mat_inv_affine(g->joints[k].bind, inv_bind + 16 * k)) { sb_fail("skin joint %d: bind matrix not invertible", k); goto out; }
+    if (g->nj > 256) { sb_fail("skin: %d joints, at most 256", g->nj); goto out; }
     for (f = 0; f < a->nframes; f++) {
         double t = f * h, qw[256 * 4];
         int o;
@@ -295,6 +297,7 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
             double M[16], *q = a->rot + ((size_t)f * g->nj + k) * 4;
             int p = g->joints[k].parent;
             gl_mat_mul(wld + 16 * g->joints[k].node, inv_bind + 16 * k, M);
+            memcpy(a->skin + ((size_t)f * g->nj + k) * 16, M, sizeof M);
             mat_quat(M, qw + 4 * k);
             if (p < 0) {
                 double pp[3];
@@ -319,7 +322,6 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
                 if (gap > a->bone_gap) a->bone_gap = gap;
             }
         }
-        if (g->nj > 256) { sb_fail("skin: %d joints, at most 256", g->nj); goto out; }
     }
     rc = 0;
 out:

@@ -6,7 +6,7 @@ TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h runtime/src/sn_format.h
 # the glTF reader (issue 17): its own headers
 GLTF_HDR = tools/sb_json.h tools/sb_gltf.h tools/sb_gltf_int.h
-$(BUILD)/tools/sb_json.o $(BUILD)/tools/sb_gltf_data.o $(BUILD)/tools/sb_gltf.o $(BUILD)/tools/sb_gltf_bake.o $(BUILD)/tools/sb_gltf_anim.o $(BUILD)/tools/sb_desc.o $(BUILD)/tests/test_bake_gltf: $(GLTF_HDR)
+$(BUILD)/tools/sb_json.o $(BUILD)/tools/sb_gltf_data.o $(BUILD)/tools/sb_gltf.o $(BUILD)/tools/sb_gltf_bake.o $(BUILD)/tools/sb_gltf_anim.o $(BUILD)/tools/sb_desc.o $(BUILD)/tools/sb_lattice.o $(BUILD)/tests/test_bake_gltf: $(GLTF_HDR)
 
 $(BUILD)/tools/%.o: tools/%.c $(TOOLS_HDR)
 	@mkdir -p $(dir $@)
