@@ -59,6 +59,7 @@ typedef struct sb_gltf_anim {
     double *skin;           /* nframes x nj x 16: skinning matrices world(joint) x IBM, column-major */
     int *animated;          /* per joint: a rotation or translation channel targets its node */
     int n_channels, n_scale, n_other;   /* channels read; scale channels ignored; weights etc. ignored */
+    int n_scale_active;     /* scale channels with a value other than 1 (the rest only key 1s) */
     double bone_gap;        /* largest distance between a joint animated by translation and where its rigid bone puts it */
 } sb_gltf_anim;
 /* name NULL: the first animation; else by name or decimal index. h > 0, at

@@ -161,7 +161,19 @@ static int read_chans(gl_scene *s, int ai, chan **out, int *nout, sb_gltf_anim *
         if (gl_int(&s->d, tg, "node", path, -1, 0, s->nn - 1, &node)) { free_chans(ch, n); return -1; }
         a->n_channels++;
         if (node < 0) { a->n_other++; continue; }   /* an extension's target */
-        if (!strcmp(p, "scale")) { a->n_scale++; continue; }
+        if (!strcmp(p, "scale")) {   /* ignored; counted as scaling when a value leaves 1 (exporters key constant 1s) */
+            long long so_ = -1, oa_ = -1;
+            gl_acc sc_;
+            int sc_o = sbj_at(&s->d.j, sa, (int)smp);
+            a->n_scale++;
+            if (sc_o >= 0 && s->d.j.node[sc_o].kind == SBJ_OBJ && !gl_int(&s->d, sc_o, "output", path, -1, 0, s->d.count[GA_ACCESSORS] - 1, &oa_) &&
+                oa_ >= 0 && !gl_accessor(&s->d, (int)oa_, &sc_)) {
+                for (so_ = 0; so_ < sc_.count * sc_.ncomp; so_++)
+                    if (!(fabs(sc_.v[so_] - 1) <= 1e-5)) { a->n_scale_active++; break; }
+                free(sc_.v);
+            } else a->n_scale_active++;
+            continue;
+        }
         if (strcmp(p, "rotation") && strcmp(p, "translation")) { a->n_other++; continue; }   /* weights */
         if (s->is_matrix[node]) { free_chans(ch, n); return sb_fail("%s.node: nodes[%lld] has a matrix: it cannot be animated", path, node); }
         C->node = (int)node;
@@ -396,8 +408,8 @@ char *sb_gltf_anim_clip(const sb_gltf_anim *a, const sb_gltf *g, int32_t hq, int
     if (dur >= 32767) { sb_fail("animation of %g s: a clip lasts less than 32767 s", dur); return NULL; }
     b.cap = 4096;
     b.p = sb_alloc(b.cap);
-    put(&b, "sinew-clip 1\n# %s: animation %d \"%s\", %d channel(s) (%d scale and %d other ignored), sampled every %.9f s\n",
-        source ? source : "glTF", a->index, a->name, a->n_channels, a->n_scale, a->n_other, hq / 65536.0);
+    put(&b, "sinew-clip 1\n# %s: animation %d \"%s\", %d channel(s) (%d scale, %d of them scaling, and %d other ignored), sampled every %.9f s\n",
+        source ? source : "glTF", a->index, a->name, a->n_channels, a->n_scale, a->n_scale_active, a->n_other, hq / 65536.0);
     put(&b, "duration %.9f\nloop %s\n", dur, loop ? "yes" : "no");
     (void)f;
     for (k = 0; k < a->nj; k++) {

@@ -45,7 +45,10 @@ char *pg_anim_clip(const char *spec, int32_t hq, int loop, int quiet, char *err,
         if (!quiet)
             fprintf(stderr, "sinew-play: %s: animation %d \"%s\": %.3f s, %d channel(s) on %d of %d skin joints\n", file, a.index,
                     a.name, a.end, a.n_channels, n, a.nj);
-        if (a.n_scale) fprintf(stderr, "sinew-play: warning: %s: %d scale channel(s) ignored (Sinew bones do not scale)\n", file, a.n_scale);
+        if (a.n_scale_active)
+            fprintf(stderr, "sinew-play: warning: %s: %d scale channel(s) that scale ignored (Sinew bones do not scale)\n", file, a.n_scale_active);
+        else if (a.n_scale && !quiet)
+            fprintf(stderr, "sinew-play: %s: %d scale channel(s) keying only 1 ignored\n", file, a.n_scale);
         if (a.n_other) fprintf(stderr, "sinew-play: warning: %s: %d channel(s) on morph weights or extensions ignored\n", file, a.n_other);
         if (a.bone_gap > 1e-4)
             fprintf(stderr, "sinew-play: warning: %s: joints below the root translated by up to %.4g units: ignored "

@@ -43,7 +43,7 @@ h3=$("$PLAY" "$D/cow.blob" --gltf-anim "$D/cow.gltf:0" --hash --quiet 2>/dev/nul
 [ -n "$h1" ] && [ "$h1" = "$h2" ] && ok || bad "--gltf-anim hash '$h1' != hand.clip hash '$h2'"
 [ "$h1" = "$h3" ] && ok || bad "by index: hash '$h3' != by name '$h1'"
 echo "  figure: cow, 60 steps: --gltf-anim cow.gltf:test and --clip hand.clip both hash $h1"
-grep -q '1 scale channel(s) ignored' "$TMP/anim.err" && ok || bad "no warning for the scale channel: $(cat "$TMP/anim.err")"
+grep -q '1 scale channel(s) that scale ignored' "$TMP/anim.err" && ok || bad "no warning for the scale channel: $(cat "$TMP/anim.err")"
 "$PLAY" "$D/cow.blob" --gltf-anim "$D/cow.gltf:spline" --clip-out "$TMP/spline.clip" --quiet > /dev/null 2>&1 && \
     grep -q '^rot neck' "$TMP/spline.clip" && grep -q '^move' "$TMP/spline.clip" && ok || bad "CUBICSPLINE animation"
 out=$("$PLAY" "$D/cow.blob" --gltf-anim "$D/cow.gltf:walk" --quiet 2>&1) && bad "unknown animation accepted" || \
