@@ -196,8 +196,9 @@ static int read_chans(gl_scene *s, int ai, chan **out, int *nout, sb_gltf_anim *
         }
         for (i = 0; i < in.count; i++)
             if (!isfinite(in.v[i]) || in.v[i] < 0 || (i > 0 && !(in.v[i] > in.v[i - 1]))) {
+                double ti = in.v[i];   /* read before the free (the fuzzer's use after free) */
                 free(in.v), free_chans(ch, n);
-                return sb_fail("%s.input: accessors[%lld] time %d (%g) is negative, not finite or not after the one before", path, ia, i, in.v[i]);
+                return sb_fail("%s.input: accessors[%lld] time %d (%g) is negative, not finite or not after the one before", path, ia, i, ti);
             }
         if (in.v[in.count - 1] > 3600) {
             double last = in.v[in.count - 1];
