@@ -260,9 +260,11 @@ int sb_gltf_anim_load(sb_gltf_anim *a, const char *path, const sb_gltf *g, const
     for (k = 0; k < g->nj; k++)
         if (g->joints[k].node < 0 || g->joints[k].node >= s.nn) { sb_fail("the skin does not belong to this file"); goto out; }
     a->nj = g->nj, a->h = h;
-    a->nframes = (int)ceil(a->end / h - 1e-9) + 1;
-    if (a->nframes < 1) a->nframes = 1;
-    if (a->nframes > max_frames) { sb_fail("animations[%d]: %g s at %g s per step is %d frames, at most %d", ai, a->end, h, a->nframes, max_frames); goto out; }
+    {   /* frames as a double first: a tiny h must not overflow the int */
+        double nf = ceil(a->end / h - 1e-9) + 1;
+        if (!(nf <= max_frames)) { sb_fail("animations[%d]: %g s at %g s per step is %.0f frames, at most %d", ai, a->end, h, nf, max_frames); goto out; }
+        a->nframes = nf < 1 ? 1 : (int)nf;
+    }
     a->rot = sb_alloc((size_t)a->nframes * (size_t)g->nj * 4 * sizeof *a->rot);
     a->move = sb_alloc((size_t)a->nframes * 3 * sizeof *a->move);
     a->skin = sb_alloc((size_t)a->nframes * (size_t)g->nj * 16 * sizeof *a->skin);
