@@ -84,7 +84,10 @@ $(FUZZ_DIR)/seeds/fuzz_obj/.stamp: tools/examples/limb/limb.obj tools/examples/d
 	@rm -rf $(@D) && mkdir -p $(@D)
 	cp tools/examples/limb/limb.obj tools/examples/diag/diag.obj $(@D)/
 	@touch $@
-# the glTF seeds are all in tests/fuzz/corpus/fuzz_gltf/ (written by test_bake_gltf)
+# the glTF seeds are all in tests/fuzz/corpus/fuzz_gltf/: strip.glb and strip_datauri.gltf (written by
+# test_bake_gltf), strip_anim.gltf (the data-URI strip with two animations: LINEAR, STEP, CUBICSPLINE,
+# translation and scale channels; issue 17 item 3) and regress_anim_time_uaf.gltf (a use after free
+# fuzz_gltf found in sb_gltf_anim.c, fixed)
 $(FUZZ_DIR)/seeds/fuzz_gltf/.stamp:
 	@rm -rf $(@D) && mkdir -p $(@D)
 	@touch $@
