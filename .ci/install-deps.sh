@@ -14,9 +14,11 @@ set -euo pipefail
 # clang + libclang-rt-14-dev (libFuzzer, ASan/UBSan runtimes) + llvm
 # (llvm-symbolizer: readable sanitizer reports): tests/fuzz/fuzz.mk's libFuzzer
 # harnesses, which must run under CI (tests/scripts/test_fuzz.sh).
+# python3: tests/scripts/gltf_check.py, the independent GLB and APNG decoder.
 PKGS=(
     make gcc g++ binutils clang valgrind libclang-rt-14-dev llvm
     cmake pkg-config
+    python3
     gcc-arm-none-eabi binutils-arm-none-eabi libnewlib-arm-none-eabi
     qemu-system-arm qemu-user
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross

@@ -72,7 +72,9 @@ static void make_bin(void)
     }
     for (k = 0; k < 12; k++) bin[216 + 2 * k] = (unsigned char)IDX[k], bin[217 + 2 * k] = (unsigned char)(IDX[k] >> 8);
     /* IBM j: translation by -(JW[j] + IBM_SHIFT - MESH_T), so that
-     * world(mesh node) * inverse(IBM) * origin = JW[j] + IBM_SHIFT */
+     * inverse(IBM) * origin = JW[j] + IBM_SHIFT - MESH_T: the mesh node's
+     * translation MESH_T is ignored (glTF 2.0, 3.7.3.3: a skinned mesh is
+     * placed by its joints only), so it does not come back */
     for (j = 0; j < 2; j++) {
         unsigned char *m = bin + 240 + 64 * j;
         for (k = 0; k < 16; k++) putf(m + 4 * k, k % 5 == 0 ? 1.0f : 0.0f);
@@ -238,11 +240,12 @@ static void check_strip(const char *what, const sb_gltf *g, const double *T, int
 {
     int v, k, j, bad = 0;
     double tol = 1e-12;   /* the quaternion's sqrt(1/2) rounding, not the data */
+    (void)T;   /* the mesh node's translation: ignored by a skinned mesh (glTF 2.0, 3.7.3.3) */
     T_CHECK(g->nv == 6 && g->nt == 4 && g->nj == 2, "%s: nv %d nt %d nj %d", what, g->nv, g->nt, g->nj);
     if (g->nv != 6 || g->nt != 4 || g->nj != 2) return;
     for (v = 0; v < 6; v++) {
         double sum = WGT[v][0] + WGT[v][1] + WGT[v][2] + WGT[v][3];
-        for (k = 0; k < 3; k++) bad += g->pos[3 * v + k] != (double)P[v][k] + T[k];
+        for (k = 0; k < 3; k++) bad += g->pos[3 * v + k] != (double)P[v][k];   /* the mesh node's T ignored */
         bad += g->src_prim[v] != 0 || g->src_vert[v] != v;
         for (k = 0; k < 4; k++) {
             bad += fabs(g->weight[4 * v + k] - WGT[v][k] / sum) > 1e-15;
@@ -258,7 +261,7 @@ static void check_strip(const char *what, const sb_gltf *g, const double *T, int
     T_CHECK(g->joints[0].node == 2 && g->joints[1].node == 3 && g->skin == 0, "%s: joint nodes", what);
     for (j = 0; j < 2; j++)
         for (k = 0; k < 3; k++) {
-            double want = ibm ? JW[j][k] + IBM_SHIFT[k] - MESH_T[k] + T[k] : JW[j][k];
+            double want = ibm ? JW[j][k] + IBM_SHIFT[k] - MESH_T[k] : JW[j][k];
             T_NEAR(g->joints[j].node_pos[k], JW[j][k], tol, "hierarchy");
             T_NEAR(g->joints[j].pos[k], want, tol, ibm ? "IBM (exact binary fractions in float)" : "hierarchy");
         }
@@ -464,8 +467,6 @@ int main(void)
              "extensionsRequired[0]: \"KHR_draco_mesh_compression\""},
             {"count not integer", "\"count\":12", "\"count\":12.5", "accessors[3].count: an integer expected"},
             {"huge count", "\"count\":12", "\"count\":1e300", "is out of range [1, 268435456]"},
-            {"position overflow", "\"translation\":[0.5,0,0]", "\"translation\":[0.5,1e308,0],\"scale\":[1,1e308,1]",
-             "meshes[0].primitives[0].attributes.POSITION: vertex 2 is not finite after nodes[0]'s world transform"},
             {"joint position overflow", "\"translation\":[0,1,0]", "\"translation\":[0,1e308,0]",
              "skins[0].joints[1]: the bind position of nodes[3] is not finite"},
             {"JOINTS_1", "\"JOINTS_0\":1,", "\"JOINTS_0\":1,\"JOINTS_1\":1,", "attributes.JOINTS_1"},
@@ -505,6 +506,19 @@ int main(void)
         make_bin();
         write_bytes(at("strip.bin"), bin, BIN_LEN);
         load_ok("restored bin", at("trs.gltf"), NULL, T0, 1);
+        putf(bin + 16 * 2 + 4, (float)HUGE_VAL);   /* vertex 2: y = +inf */
+        write_bytes(at("strip.bin"), bin, BIN_LEN);
+        load_bad("infinite position", at("trs.gltf"), "meshes[0].primitives[0].attributes.POSITION: vertex 2 is not finite");
+        make_bin();
+        write_bytes(at("strip.bin"), bin, BIN_LEN);
+    }
+    {   /* the skinned mesh node's transform is ignored (glTF 2.0, 3.7.3.3),
+         * even one that would overflow every position */
+        char *j2 = subst(make_json("{\"uri\":\"strip.bin\",\"byteLength\":368}", 0, 1), "\"translation\":[0.5,0,0]",
+                         "\"translation\":[0.5,1e308,0],\"scale\":[1,1e308,1]");
+        write_bytes(at("huge_node.gltf"), j2, strlen(j2));
+        load_ok("mesh node transform ignored", at("huge_node.gltf"), NULL, T0, 1);
+        free(j2);
     }
     {   /* a 50,000-node chain: read in linear time (the parent walk is not
          * redone per node), world positions summed exactly */
@@ -525,7 +539,7 @@ int main(void)
         write_bytes(at("chain.gltf"), big, len);
         k = sb_gltf_load(&g, at("chain.gltf"), NULL);
         T_CHECK(k == 0 && g.nv == 6 && g.nt == 2 && g.nj == 2 && g.joints[1].parent == 0 && g.joints[0].parent == -1 &&
-                    g.joints[0].node_pos[2] == N - 1 && g.joints[1].node_pos[2] == N && g.pos[2 * 3 + 2] == N,
+                    g.joints[0].node_pos[2] == N - 1 && g.joints[1].node_pos[2] == N && g.pos[2 * 3 + 2] == 0 /* mesh node transform ignored */,
                 "chain: rc %d %s", k, k ? sb_error() : "");
         sb_gltf_free(&g);
         free(big);

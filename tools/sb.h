@@ -26,6 +26,13 @@ typedef struct sb_mesh {
 } sb_mesh;
 int sb_mesh_load_obj(const char *path, sb_mesh *m);  /* parse, triangulate (no duplicate edges), check closed */
 void sb_mesh_free(sb_mesh *m);
+/* A surface from separate points and triangles (a glTF primitive's vertices):
+ * points at exactly the same position are welded into one vertex (first
+ * occurrence order), to_surf[i] (nsrc ints, caller's) gets point i's vertex;
+ * triangles collapsed by the weld are dropped (counted in *dropped); then the
+ * OBJ loader's checks (closed, consistently oriented, extent, volume). */
+int sb_mesh_from_points(const char *path, int nsrc, const double *pos, int nsrc_tri, const int *src_tri, sb_mesh *m,
+                        int *to_surf, int *dropped);
 double sb_mesh_volume(const sb_mesh *m);             /* divergence theorem, mesh units^3 */
 
 /* Inside test: rays along +x; triangles binned by their (y,z) bounding box. */
@@ -131,10 +138,15 @@ typedef struct sb_segdef {
     int line;
 } sb_segdef;
 
+struct sb_gltf;
 typedef struct sb_desc {
     char path[1024];
-    char mesh_path[1024];   /* resolved relative to the description's directory */
+    char mesh_path[1024];   /* resolved relative to the description's directory ('mesh' or 'gltf') */
     int mesh_line;
+    struct sb_gltf *gltf;   /* 'gltf FILE [MESH]': the loaded file (joints and surface come from it), else NULL */
+    char gltf_mesh[256];    /* its MESH argument ("" for the first skinned mesh) */
+    int skin_frames;        /* 'frames skin': lattice frames from the glTF's skin weights (sb_lattice.c) */
+    int skin_frames_line;
     double unit;            /* metres per mesh unit */
     double cell;            /* lattice cell edge, mesh units */
     double origin[3]; int has_origin;
@@ -166,6 +178,29 @@ typedef struct sb_desc {
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
 int sb_desc_load(const char *path, sb_desc *d);
 void sb_desc_free(sb_desc *d);
+
+/* ---- glTF input (sb_gltf_bake.c; tools/DESCRIPTION.md 'gltf') ---- */
+/* The glTF vertex order of a surface baked from 'gltf': surface vertex of
+ * every glTF vertex (primitives concatenated), so an output can drive the
+ * original mesh. Empty (nsrc 0) for an OBJ. */
+typedef struct sb_srcmap {
+    char path[1024];        /* the glTF file */
+    char mesh[256];         /* its mesh's name */
+    int nsrc, nsurf, nprim; /* glTF vertices, surface vertices, primitives */
+    int *to_surf, *prim, *vert;   /* per glTF vertex: surface vertex, primitive, index in the primitive */
+    int nsrc_tri;           /* glTF triangles (before the weld dropped *dropped of them) */
+    int *src_tri;           /* 3 x nsrc_tri, glTF vertex indices (concatenated order) */
+    int dropped;
+    double root[3];         /* the root joint's rest position in the glTF frame: the runtime's model-space origin */
+} sb_srcmap;
+/* the 'gltf FILE [MESH]' line: load the file, declare its skin's joints */
+int sb_desc_gltf(sb_desc *d, const char *file, const char *mesh, int line);
+/* the description's surface: its OBJ, or its glTF's welded skinned mesh (map
+ * filled, may be NULL) */
+int sb_desc_mesh(const sb_desc *d, sb_mesh *m, sb_srcmap *map);
+void sb_srcmap_free(sb_srcmap *s);
+/* text sidecar (format in tools/DESCRIPTION.md, 'gltf'); 0 or -1 (sb_fail) */
+int sb_srcmap_write(const char *path, const sb_srcmap *s);
 
 /* ---- lattice + integration (sb_lattice.c, sb_integrate.c) ---- */
 typedef struct sb_model {
@@ -236,6 +271,7 @@ typedef struct sb_model {
     /* segment meshes (sb_segment.c, sb_segment_build) */
     int nsm;
     struct sb_segmesh *sm;
+    sb_srcmap src;          /* 'gltf': the surface's glTF vertex order (sb_bake_file); nsrc 0 otherwise */
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);

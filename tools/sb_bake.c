@@ -14,30 +14,33 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
 {
     sb_desc d;
     sb_mesh m;
+    sb_srcmap src;
     double t0 = sb_now(), vol;
     int k;
     memset(o, 0, sizeof *o);
     memset(b, 0, sizeof *b);
     memset(&m, 0, sizeof m);
     if (sb_desc_load(desc_path, &d)) { sb_desc_free(&d); return -1; }
-    if (sb_mesh_load_obj(d.mesh_path, &m)) {
-        char msg[2048];
-        snprintf(msg, sizeof msg, "%s", sb_error());
-        sb_fail("%s (mesh named at %s:%d)", msg, d.path, d.mesh_line);
+    if (sb_desc_mesh(&d, &m, &src)) {   /* the OBJ, or the glTF's welded skinned mesh */
         sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
     if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_force_build(&d, o) ||
         sb_segment_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
-        sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d);
+        sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d); sb_srcmap_free(&src);
         return -1;
     }
+    o->src = src;   /* sb_build cleared the model: the glTF vertex order goes in afterwards */
+    if (o->src.nsrc) memcpy(o->src.root, o->joints[0].pos, sizeof o->src.root);
     vol = sb_mesh_volume(&m) * d.unit * d.unit * d.unit;
     if (!quiet) {
         double fmin_ = 1, fsum = 0;
         for (k = 0; k < o->nc; k++) { fsum += o->cell_fill[k]; if (o->cell_fill[k] < fmin_) fmin_ = o->cell_fill[k]; }
         printf("sinew-bake: %s (%s)\n", desc_path, flavour == 0 ? "fixed" : flavour == 1 ? "float" : "double");
         printf("  mesh      %d vertices, %d triangles, volume %.6g m^3\n", m.nv, m.nt, vol);
+        if (src.nsrc)
+            printf("  glTF      %s: mesh \"%s\", %d vertices in %d primitive(s) welded by position into %d (%d triangle(s) collapsed)\n",
+                   src.path, src.mesh, src.nsrc, src.nprim, src.nsurf, src.dropped);
         printf("  skeleton  %d joints, %d bones; model-space origin = root joint '%s' at (%g, %g, %g) mesh units\n",
                o->nj, o->nseg, o->joints[0].name, o->joints[0].pos[0], o->joints[0].pos[1], o->joints[0].pos[2]);
         printf("  lattice   %d vertices (%d free, %d skeleton), %d cells (mean fill %.2f, min %.3f), cell %g mesh units\n",

@@ -1,5 +1,6 @@
 /* sb_desc.c -- the text character description (format: tools/DESCRIPTION.md). */
 #include "sb.h"
+#include "sb_gltf.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -345,10 +346,18 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
 {
     const char *kw = c->tok[0];
     int k, n;
-    if (!strcmp(kw, "mesh")) {
+    if (!strcmp(kw, "gltf")) {   /* surface and skeleton from a glTF skin (sb_gltf_bake.c) */
+        if (c->nt < 2 || c->nt > 3)
+            return sb_fail("%s:%d: 'gltf' takes a file and an optional mesh name: 'gltf FILE [MESH]'", c->path, c->line);
+        if (seen[0]) return sb_fail("%s:%d: a second 'mesh' or 'gltf' line (the first at line %d)", c->path, c->line, d->mesh_line);
+        if (d->nj) return sb_fail("%s:%d: 'gltf' declares the joints from the file's skin: no 'joint' lines before it (line %d)", c->path, c->line, d->joints[0].line);
+        if (sb_desc_gltf(d, c->tok[1], c->nt == 3 ? c->tok[2] : NULL, c->line)) return -1;
+        seen[0] = 1;
+    } else if (!strcmp(kw, "mesh")) {
         const char *slash;
         size_t dl;
         if (nargs(c, 1)) return -1;
+        if (d->gltf) return sb_fail("%s:%d: 'mesh' after 'gltf' (line %d): the surface comes from the glTF", c->path, c->line, d->mesh_line);
         slash = strrchr(d->path, '/');
         dl = slash ? (size_t)(slash - d->path + 1) : 0;
         if (c->tok[1][0] == '/') dl = 0;
@@ -377,11 +386,20 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
     } else if (!strcmp(kw, "min_fill")) {
         if (nargs(c, 1) || num(c, 1, &d->min_fill)) return -1;
         if (d->min_fill < 0 || d->min_fill >= 1) return sb_fail("%s:%d: min_fill must be in [0, 1)", c->path, c->line);
+    } else if (!strcmp(kw, "frames")) {   /* 'frames skin' | 'frames auto' */
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "skin")) {
+            if (!d->gltf) return sb_fail("%s:%d: 'frames skin' takes the frames from a glTF's skin weights: put it after a 'gltf' line", c->path, c->line);
+            d->skin_frames = 1;
+        } else if (!strcmp(c->tok[1], "auto")) d->skin_frames = 0;
+        else return sb_fail("%s:%d: 'frames' takes 'skin' or 'auto' (got '%s')", c->path, c->line, c->tok[1]);
+        d->skin_frames_line = c->line;
     } else if (!strcmp(kw, "blend")) {
         if (nargs(c, 1) || len_num(c, 1, &d->blend)) return -1;
         if (d->blend <= 0) return sb_fail("%s:%d: blend width must be positive", c->path, c->line);
     } else if (!strcmp(kw, "joint")) {
         sb_joint *j;
+        if (d->gltf) return sb_fail("%s:%d: the joints come from the glTF skin ('gltf' at line %d): no 'joint' lines", c->path, c->line, d->mesh_line);
         if (nargs(c, 5)) return -1;
         if (strlen(c->tok[1]) >= SB_NAME_MAX || strlen(c->tok[2]) >= SB_NAME_MAX)
             return sb_fail("%s:%d: joint names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
@@ -689,7 +707,7 @@ int sb_desc_load(const char *path, sb_desc *d)
         if (parse_line(&c, d, seen)) { fclose(f); return -1; }
     }
     fclose(f);
-    if (!seen[0]) return sb_fail("%s: missing 'mesh PATH'", path);
+    if (!seen[0]) return sb_fail("%s: missing 'mesh PATH' (or 'gltf FILE [MESH]')", path);
     if (!seen[1]) return sb_fail("%s: missing 'unit METRES_PER_MESH_UNIT'", path);
     if (!seen[2]) return sb_fail("%s: missing 'cell SIZE'", path);
     if (d->nj == 0) return sb_fail("%s: no joints", path);
@@ -745,6 +763,7 @@ int sb_desc_load(const char *path, sb_desc *d)
 void sb_desc_free(sb_desc *d)
 {
     int i;
+    if (d->gltf) { sb_gltf_free(d->gltf); free(d->gltf); }
     free(d->joints); free(d->mats); free(d->mrules); free(d->frules); free(d->pins); free(d->lrules); free(d->shares); free(d->srules);
     free(d->ctls); free(d->rigs);
     for (i = 0; i < d->nseg; i++) free(d->segs[i].att);

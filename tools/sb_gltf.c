@@ -9,16 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct {
-    gl_doc d;
-    int nn;
-    int *parent;     /* per node, -1 for a root */
-    double *local, *world;   /* 16 per node */
-    char *done;
-    int *mesh, *skin;
-} scene;
+typedef gl_scene scene;
 
-static void mat_mul(const double *a, const double *b, double *o)
+void gl_mat_mul(const double *a, const double *b, double *o)
 {
     double t[16];
     int r, c, k;
@@ -40,7 +33,7 @@ static void mat_point(const double *m, const double *p, double *o)
 }
 
 /* inverse of an affine matrix (last row 0 0 0 1); -1 if not affine or singular */
-static int mat_inv_affine(const double *m, double *o)
+int gl_mat_inv_affine(const double *m, double *o)
 {
     double a[9], det, inv[9];
     int r, c;
@@ -66,6 +59,17 @@ static int mat_inv_affine(const double *m, double *o)
     return 0;
 }
 
+/* T * R * S, column-major; q a unit quaternion (x, y, z, w) */
+void gl_mat_trs(const double *t, const double *q, const double *sc, double *m)
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    m[0] = (1 - 2 * (y * y + z * z)) * sc[0], m[1] = 2 * (x * y + z * w) * sc[0], m[2] = 2 * (x * z - y * w) * sc[0];
+    m[4] = 2 * (x * y - z * w) * sc[1], m[5] = (1 - 2 * (x * x + z * z)) * sc[1], m[6] = 2 * (y * z + x * w) * sc[1];
+    m[8] = 2 * (x * z + y * w) * sc[2], m[9] = 2 * (y * z - x * w) * sc[2], m[10] = (1 - 2 * (x * x + y * y)) * sc[2];
+    m[3] = m[7] = m[11] = 0;
+    m[12] = t[0], m[13] = t[1], m[14] = t[2], m[15] = 1;
+}
+
 /* one node: local matrix, mesh, skin; children get their parent set */
 static int read_node(scene *s, int i)
 {
@@ -78,17 +82,14 @@ static int read_node(scene *s, int i)
         (has_r = gl_nums(&s->d, n, "rotation", path, 4, q)) < 0 || (has_s = gl_nums(&s->d, n, "scale", path, 3, sc)) < 0)
         return -1;
     if (has_m && (has_t || has_r || has_s)) return sb_fail("%s: both matrix and translation/rotation/scale", path);
+    s->is_matrix[i] = (char)has_m;
     if (!has_m) {
-        double x, y, z, w;
         len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
         if (!(len > 1e-6)) return sb_fail("%s.rotation: not a unit quaternion", path);
-        x = q[0] / len, y = q[1] / len, z = q[2] / len, w = q[3] / len;
-        m[0] = (1 - 2 * (y * y + z * z)) * sc[0], m[1] = 2 * (x * y + z * w) * sc[0], m[2] = 2 * (x * z - y * w) * sc[0];
-        m[4] = 2 * (x * y - z * w) * sc[1], m[5] = (1 - 2 * (x * x + z * z)) * sc[1], m[6] = 2 * (y * z + x * w) * sc[1];
-        m[8] = 2 * (x * z + y * w) * sc[2], m[9] = 2 * (y * z - x * w) * sc[2], m[10] = (1 - 2 * (x * x + y * y)) * sc[2];
-        m[3] = m[7] = m[11] = 0;
-        m[12] = t[0], m[13] = t[1], m[14] = t[2], m[15] = 1;
+        q[0] /= len, q[1] /= len, q[2] /= len, q[3] /= len;
+        gl_mat_trs(t, q, sc, m);
     }
+    memcpy(s->trs + 10 * i, t, sizeof t), memcpy(s->trs + 10 * i + 3, q, sizeof q), memcpy(s->trs + 10 * i + 7, sc, sizeof sc);
     if (gl_int(&s->d, n, "mesh", path, -1, 0, s->d.count[GA_MESHES] - 1, &v)) return -1;
     s->mesh[i] = (int)v;
     if (gl_int(&s->d, n, "skin", path, -1, 0, s->d.count[GA_SKINS] - 1, &v)) return -1;
@@ -119,6 +120,8 @@ static int read_nodes(scene *s)
     s->done = sb_alloc((size_t)s->nn);
     s->mesh = sb_alloc((size_t)s->nn * sizeof *s->mesh);
     s->skin = sb_alloc((size_t)s->nn * sizeof *s->skin);
+    s->trs = sb_alloc((size_t)s->nn * 10 * sizeof *s->trs);
+    s->is_matrix = sb_alloc((size_t)s->nn + 1);
     for (i = 0; i < s->nn; i++) s->parent[i] = -1;
     for (i = 0; i < s->nn; i++)
         if (read_node(s, i)) return -1;
@@ -134,7 +137,7 @@ static int read_nodes(scene *s)
         }
         while (len > 0) {
             int k = chain[--len];
-            if (s->parent[k] >= 0) mat_mul(s->world + 16 * s->parent[k], s->local + 16 * k, s->world + 16 * k);
+            if (s->parent[k] >= 0) gl_mat_mul(s->world + 16 * s->parent[k], s->local + 16 * k, s->world + 16 * k);
             else memcpy(s->world + 16 * k, s->local + 16 * k, 16 * sizeof(double));
             s->done[k] = 2;
         }
@@ -226,7 +229,6 @@ static int read_skin(scene *s, sb_gltf *g)
     int sk = gl_elem(&s->d, GA_SKINS, g->skin), ja = sbj_get(&s->d.j, sk, "joints"), c, k = 0, *of_node;
     long long ibm_acc;
     gl_acc ibm;
-    double *mw = s->world + 16 * g->node;
     snprintf(path, sizeof path, "skins[%d]", g->skin);
     if (ja < 0 || s->d.j.node[ja].kind != SBJ_ARR || s->d.j.node[ja].count < 1)
         return sb_fail("%s.joints: a non-empty array expected", path);
@@ -252,6 +254,7 @@ static int read_skin(scene *s, sb_gltf *g)
         J->node_pos[1] = s->world[16 * J->node + 13];
         J->node_pos[2] = s->world[16 * J->node + 14];
         memcpy(J->pos, J->node_pos, sizeof J->pos);
+        memcpy(J->bind, s->world + 16 * J->node, sizeof J->bind);
     }
     for (k = 0; k < g->nj; k++) {
         int p = s->parent[g->joints[k].node];
@@ -268,12 +271,14 @@ static int read_skin(scene *s, sb_gltf *g)
     }
     for (k = 0; k < g->nj; k++) {
         double inv[16], o[3] = {0, 0, 0};
-        if (mat_inv_affine(ibm.v + 16 * k, inv)) {
+        if (gl_mat_inv_affine(ibm.v + 16 * k, inv)) {
             free(ibm.v);
             return sb_fail("%s.inverseBindMatrices: matrix %d is not an invertible affine matrix", path, k);
         }
-        mat_point(inv, o, o);
-        mat_point(mw, o, g->joints[k].pos);
+        /* glTF 2.0 (3.7.3.3 Skins): the skinned mesh node's own transform is
+         * ignored; inverse(IBM) takes the joint's origin into the space of POSITION */
+        mat_point(inv, o, g->joints[k].pos);
+        memcpy(g->joints[k].bind, inv, sizeof inv);
     }
     free(ibm.v);
     return joints_finite(g, path);
@@ -321,7 +326,6 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
     long long mode, nv, ni, v, k;
     gl_acc P, J, W, I;
     int nv0 = g->nv, nt0 = g->nt, rc = -1, c;
-    double *mw = s->world + 16 * g->node;
     snprintf(path, sizeof path, "meshes[%d].primitives[%d]", m, pi);
     memset(&J, 0, sizeof J), memset(&W, 0, sizeof W), memset(&I, 0, sizeof I);
     if (gl_int(&s->d, prim, "mode", path, 4, 0, 6, &mode)) return -1;
@@ -352,9 +356,10 @@ static int read_prim(scene *s, sb_gltf *g, int m, int pi, int prim)
     for (v = 0; v < nv; v++) {
         double sum = 0, *w = g->weight + 4 * (nv0 + v);
         int *j = g->joint + 4 * (nv0 + v);
-        mat_point(mw, P.v + 3 * v, g->pos + 3 * (nv0 + v));
+        /* POSITION as stored: a skinned mesh ignores its node's transform (glTF 2.0, 3.7.3.3) */
+        memcpy(g->pos + 3 * (nv0 + v), P.v + 3 * v, 3 * sizeof(double));
         if (!isfinite(g->pos[3 * (nv0 + v)]) || !isfinite(g->pos[3 * (nv0 + v) + 1]) || !isfinite(g->pos[3 * (nv0 + v) + 2])) {
-            sb_fail("%s.attributes.POSITION: vertex %lld is not finite after nodes[%d]'s world transform", path, v, g->node);
+            sb_fail("%s.attributes.POSITION: vertex %lld is not finite", path, v);
             goto out;
         }
         g->src_prim[nv0 + v] = pi;
@@ -402,6 +407,30 @@ static int read_mesh(scene *s, sb_gltf *g)
     return 0;
 }
 
+void sb_gltf_token(const char *in, int k, char *out, int out_len)
+{
+    int i;
+    if (!in[0]) { snprintf(out, (size_t)out_len, "joint%d", k); return; }
+    for (i = 0; in[i] && i < out_len - 1; i++)
+        out[i] = (in[i] == ' ' || in[i] == '\t' || in[i] == '\r' || in[i] == '\n' || in[i] == '#') ? '_' : in[i];
+    out[i] = '\0';
+}
+
+int gl_scene_open(gl_scene *s, const char *path)
+{
+    memset(s, 0, sizeof *s);
+    return gl_open(&s->d, path) || read_nodes(s) ? -1 : 0;
+}
+
+int gl_scene_pick(gl_scene *s, const char *mesh_name) { return pick_node(s, mesh_name); }
+
+void gl_scene_close(gl_scene *s)
+{
+    free(s->parent), free(s->local), free(s->world), free(s->done), free(s->mesh), free(s->skin), free(s->trs), free(s->is_matrix);
+    gl_close(&s->d);
+    memset(s, 0, sizeof *s);
+}
+
 void sb_gltf_free(sb_gltf *g)
 {
     int k;
@@ -416,8 +445,7 @@ int sb_gltf_load(sb_gltf *g, const char *path, const char *mesh_name)
     scene s;
     int rc = -1, n;
     memset(g, 0, sizeof *g);
-    memset(&s, 0, sizeof s);
-    if (gl_open(&s.d, path) || read_nodes(&s) || (n = pick_node(&s, mesh_name)) < 0) goto out;
+    if (gl_scene_open(&s, path) || (n = pick_node(&s, mesh_name)) < 0) goto out;
     g->node = n;
     g->mesh = s.mesh[n];
     g->skin = s.skin[n];
@@ -430,7 +458,6 @@ out:
         sb_fail("%s: %s", path, msg);
         sb_gltf_free(g);
     }
-    free(s.parent), free(s.local), free(s.world), free(s.done), free(s.mesh), free(s.skin);
-    gl_close(&s.d);
+    gl_scene_close(&s);
     return rc;
 }

@@ -13,7 +13,7 @@
 #define MAX_FILE ((size_t)1 << 30)
 #define MAX_LEN (1LL << 40)      /* any byte length or offset in the JSON */
 
-static const char *const top_names[7] = {"buffers", "bufferViews", "accessors", "nodes", "meshes", "skins", "scenes"};
+static const char *const top_names[GA_COUNT] = {"buffers", "bufferViews", "accessors", "nodes", "meshes", "skins", "scenes", "animations"};
 
 int gl_read_file(const char *path, unsigned char **data, size_t *len)
 {
@@ -248,7 +248,7 @@ int gl_open(gl_doc *d, const char *path)
             return sb_fail("extensionsRequired[0]: \"%s\" is not supported", e ? e : "?");
         }
     }
-    for (w = 0; w < 7; w++) {
+    for (w = 0; w < GA_COUNT; w++) {
         int a = sbj_get(&d->j, 0, top_names[w]), c, i = 0;
         d->arr[w] = a;
         if (a < 0) continue;
@@ -277,7 +277,7 @@ void gl_close(gl_doc *d)
     free(d->buf);
     free(d->buf_len);
     free(d->buf_owned);
-    for (i = 0; i < 7; i++) free(d->elem[i]);
+    for (i = 0; i < GA_COUNT; i++) free(d->elem[i]);
     free(d->file);
     sbj_free(&d->j);
     memset(d, 0, sizeof *d);

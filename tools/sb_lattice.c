@@ -6,6 +6,7 @@
  * within its radius; the nearest segment wins); frames (seed 003 §3.3) at
  * vertices and cell centres; surface embedding; model checks. */
 #include "sb.h"
+#include "sb_gltf.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -204,6 +205,44 @@ static void frame_at(const sb_desc *d, const sb_model *o, const double p[3], dou
             b1 = o->desc_to_sorted[d->frules[a].j1]; b2 = o->desc_to_sorted[d->frules[a].j2]; w = d->frules[a].w;
         }
     *fb1 = b1; *fb2 = b2; *fw = w;
+}
+
+static int frame_ruled(const sb_desc *d, const sb_model *o, const double p[3])
+{
+    int a;
+    for (a = 0; a < d->nfr; a++) if (sb_region_has(o, &d->frules[a].r, p)) return 1;
+    return 0;
+}
+
+/* 'frames skin' (issue 17): the frame at p from the artist's skin weights of
+ * the glTF vertices within one cell of p (weighted (1 - r/c)^2), or of the
+ * nearest glTF vertex when none is that close: bone1/bone2 = the two joints
+ * with the largest summed weight, w = a2 / (a1 + a2). glTF joint k is
+ * description joint k (sb_desc_gltf). 'frame' rules still override. */
+static void skin_frame(const sb_desc *d, const sb_model *o, const double p[3], double *acc, int *fb1, int *fb2, double *fw)
+{
+    const sb_gltf *g = d->gltf;
+    double R = o->c, best = HUGE_VAL, a1 = 0, a2 = 0;
+    int v, k, j, nearest = 0, any = 0, b1 = 0, b2 = 0;
+    for (j = 0; j < g->nj; j++) acc[j] = 0;
+    for (v = 0; v < g->nv; v++) {
+        const double *q = g->pos + 3 * v;
+        double dd = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]), r, f;
+        if (dd < best) best = dd, nearest = v;
+        if (dd >= R * R) continue;
+        r = sqrt(dd) / R, f = (1 - r) * (1 - r);
+        for (k = 0; k < 4; k++) acc[g->joint[4 * v + k]] += f * g->weight[4 * v + k];
+        any = 1;
+    }
+    if (!any)
+        for (k = 0; k < 4; k++) acc[g->joint[4 * nearest + k]] += g->weight[4 * nearest + k];
+    for (j = 0; j < g->nj; j++) {
+        if (acc[j] > a1) { a2 = a1; b2 = b1; a1 = acc[j]; b1 = j; }
+        else if (acc[j] > a2) { a2 = acc[j]; b2 = j; }
+    }
+    *fb1 = o->desc_to_sorted[b1];
+    *fb2 = a2 > 0 ? o->desc_to_sorted[b2] : *fb1;
+    *fw = a2 > 0 ? a2 / (a1 + a2) : 0;
 }
 
 /* Flesh thickness of bone a: distance from the segment to the mesh surface, the
@@ -630,11 +669,13 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     for (i = 0; i < o->nv; i++) {
         if (i >= o->nf) { o->fb1[i] = o->fb2[i] = o->gjoint[o->v_grid[i]]; o->fw[i] = 0; continue; }
         frame_at(d, o, o->x + 3 * i, B, jd, &o->fb1[i], &o->fb2[i], &o->fw[i]);
+        if (d->skin_frames && !frame_ruled(d, o, o->x + 3 * i)) skin_frame(d, o, o->x + 3 * i, jd, &o->fb1[i], &o->fb2[i], &o->fw[i]);
     }
     for (a = 0; a < o->nc; a++) {
         double p[3];
         for (k = 0; k < 3; k++) p[k] = o->x[3 * o->cells[8 * a] + k] + 0.5 * c;
         frame_at(d, o, p, B, jd, &o->cfb1[a], &o->cfb2[a], &o->cfw[a]);
+        if (d->skin_frames && !frame_ruled(d, o, p)) skin_frame(d, o, p, jd, &o->cfb1[a], &o->cfb2[a], &o->cfw[a]);
     }
 
     /* 11. limits at rest positions, later rules override */
@@ -691,6 +732,7 @@ void sb_model_free(sb_model *o)
     free(o->nbptr); free(o->nb); free(o->M); free(o->S); free(o->T); free(o->emb_cell); free(o->emb_t); free(o->tri);
     free(o->Se); free(o->cfb1); free(o->cfb2); free(o->cfw); free(o->limit); free(o->vseg);
     free(o->seg_r); free(o->seg_flesh); free(o->seg_auto); free(o->seg_nv); free(o->seg_ncap);
+    sb_srcmap_free(&o->src);
     memset(o, 0, sizeof *o);
 }
 

@@ -76,6 +76,32 @@ static int fan_start(const eset_t *es, const int *p, int n)
     return -1;
 }
 
+/* closed, consistently oriented 2-manifold: every edge in exactly two faces, once each way */
+static int closed_check(const char *path, const sb_mesh *m)
+{
+    int i, k;
+    {
+        edge_t *e = sb_alloc(sizeof(edge_t) * 3 * (size_t)m->nt);
+        int ne = 3 * m->nt;
+        for (i = 0; i < m->nt; i++)
+            for (k = 0; k < 3; k++) { e[3 * i + k].a = m->tri[3 * i + k]; e[3 * i + k].b = m->tri[3 * i + (k + 1) % 3]; e[3 * i + k].face = i; }
+        qsort(e, (size_t)ne, sizeof *e, edge_cmp);
+        for (i = 0; i < ne;) {
+            int j = i;
+            while (j < ne && edge_cmp(&(edge_t){e[i].a, e[i].b, 0}, &(edge_t){e[j].a, e[j].b, 0}) == 0) j++;
+            if (j - i != 2 || e[i].a != e[i + 1].b) {
+                int a = e[i].a + 1, b = e[i].b + 1, n = j - i;
+                free(e);
+                if (n != 2) return sb_fail("%s: mesh is not closed: edge between vertices %d and %d is used by %d face(s), want 2", path, a, b, n);
+                return sb_fail("%s: mesh is not consistently oriented at the edge between vertices %d and %d", path, a, b);
+            }
+            i = j;
+        }
+        free(e);
+    }
+    return 0;
+}
+
 int sb_mesh_load_obj(const char *path, sb_mesh *m)
 {
     FILE *f = fopen(path, "r");
@@ -177,26 +203,7 @@ int sb_mesh_load_obj(const char *path, sb_mesh *m)
     fclose(f);
     if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
     if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices; a blob holds at most 65535 surface vertices", path, m->nv);
-    /* closed, consistently oriented 2-manifold: every edge in exactly two faces, once each way */
-    {
-        edge_t *e = sb_alloc(sizeof(edge_t) * 3 * (size_t)m->nt);
-        int ne = 3 * m->nt;
-        for (i = 0; i < m->nt; i++)
-            for (k = 0; k < 3; k++) { e[3 * i + k].a = m->tri[3 * i + k]; e[3 * i + k].b = m->tri[3 * i + (k + 1) % 3]; e[3 * i + k].face = i; }
-        qsort(e, (size_t)ne, sizeof *e, edge_cmp);
-        for (i = 0; i < ne;) {
-            int j = i;
-            while (j < ne && edge_cmp(&(edge_t){e[i].a, e[i].b, 0}, &(edge_t){e[j].a, e[j].b, 0}) == 0) j++;
-            if (j - i != 2 || e[i].a != e[i + 1].b) {
-                int a = e[i].a + 1, b = e[i].b + 1, n = j - i;
-                free(e);
-                if (n != 2) return sb_fail("%s: mesh is not closed: edge between vertices %d and %d is used by %d face(s), want 2", path, a, b, n);
-                return sb_fail("%s: mesh is not consistently oriented at the edge between vertices %d and %d", path, a, b);
-            }
-            i = j;
-        }
-        free(e);
-    }
+    if (closed_check(path, m)) return -1;
     for (k = 0; k < 3; k++) { m->lo[k] = HUGE_VAL; m->hi[k] = -HUGE_VAL; }
     for (i = 0; i < m->nv; i++)
         for (k = 0; k < 3; k++) {
@@ -379,4 +386,70 @@ double sb_mesh_closest(const sb_mesh *m, const double p[3], double out[3])
         if (d2 < best) { best = d2; memcpy(out, q, sizeof q); }
     }
     return sqrt(best);
+}
+
+/* ---- the surface of a glTF skinned mesh (sb_gltf.h): welded by position ---- */
+typedef struct { uint64_t *k; size_t cap; } pset_t;
+static uint64_t pos_hash(const double *p)
+{
+    uint64_t h = 1469598103934665603ULL, u;
+    int k;
+    for (k = 0; k < 3; k++) {
+        double x = p[k] == 0 ? 0 : p[k];   /* -0 welds with +0 */
+        memcpy(&u, &x, sizeof u);
+        h = (h ^ u) * 1099511628211ULL;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+int sb_mesh_from_points(const char *path, int nsrc, const double *pos, int nsrc_tri, const int *src_tri, sb_mesh *m,
+                        int *to_surf, int *dropped)
+{
+    size_t cap = 16, slot;
+    int *first, i, k;
+    memset(m, 0, sizeof *m);
+    *dropped = 0;
+    while (cap < 2 * (size_t)nsrc + 16) cap *= 2;
+    first = sb_alloc(cap * sizeof *first);   /* hash slot -> surface vertex + 1 */
+    m->v = sb_alloc(3 * sizeof(double) * (size_t)(nsrc > 0 ? nsrc : 1));
+    m->tri = sb_alloc(3 * sizeof(int) * (size_t)(nsrc_tri > 0 ? nsrc_tri : 1));
+    for (i = 0; i < nsrc; i++) {
+        const double *p = pos + 3 * i;
+        for (k = 0; k < 3; k++)
+            if (!isfinite(p[k]) || fabs(p[k]) > SB_MESH_COORD_MAX)
+                { free(first); return sb_fail("%s: vertex %d: coordinate %g is out of range (|coordinate| <= %g mesh units)", path, i, p[k], SB_MESH_COORD_MAX); }
+        for (slot = pos_hash(p) & (cap - 1); first[slot]; slot = (slot + 1) & (cap - 1)) {
+            const double *q = m->v + 3 * (first[slot] - 1);
+            if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2]) break;
+        }
+        if (!first[slot]) {
+            memcpy(m->v + 3 * m->nv, p, 3 * sizeof(double));
+            first[slot] = ++m->nv;
+        }
+        to_surf[i] = first[slot] - 1;
+    }
+    free(first);
+    for (i = 0; i < nsrc_tri; i++) {
+        int a = to_surf[src_tri[3 * i]], b = to_surf[src_tri[3 * i + 1]], c = to_surf[src_tri[3 * i + 2]];
+        if (a == b || b == c || a == c) { (*dropped)++; continue; }   /* collapsed by the weld */
+        m->tri[3 * m->nt] = a, m->tri[3 * m->nt + 1] = b, m->tri[3 * m->nt + 2] = c;
+        m->nt++;
+    }
+    if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
+    if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices after welding; a blob holds at most 65535 surface vertices", path, m->nv);
+    if (closed_check(path, m)) return -1;
+    for (k = 0; k < 3; k++) { m->lo[k] = HUGE_VAL; m->hi[k] = -HUGE_VAL; }
+    for (i = 0; i < m->nv; i++)
+        for (k = 0; k < 3; k++) {
+            if (m->v[3 * i + k] < m->lo[k]) m->lo[k] = m->v[3 * i + k];
+            if (m->v[3 * i + k] > m->hi[k]) m->hi[k] = m->v[3 * i + k];
+        }
+    for (k = 0; k < 3; k++)
+        if (m->hi[k] - m->lo[k] > SB_MESH_EXTENT_MAX)
+            return sb_fail("%s: the mesh spans %g mesh units along %c; at most %g (scale the mesh down and the description's 'unit' up)",
+                           path, m->hi[k] - m->lo[k], "xyz"[k], SB_MESH_EXTENT_MAX);
+    if (sb_mesh_volume(m) <= 0.0)
+        return sb_fail("%s: mesh encloses a non-positive volume: faces must be counter-clockwise seen from outside", path);
+    return 0;
 }

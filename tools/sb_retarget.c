@@ -14,10 +14,7 @@ int sb_rt_char_load(const char *desc_path, sb_rt_char *c)
 {
     memset(c, 0, sizeof *c);
     if (sb_desc_load(desc_path, &c->d)) { sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
-    if (sb_mesh_load_obj(c->d.mesh_path, &c->m)) {
-        char msg[2048];
-        snprintf(msg, sizeof msg, "%s", sb_error());
-        sb_fail("%s (mesh named at %s:%d)", msg, c->d.path, c->d.mesh_line);
+    if (sb_desc_mesh(&c->d, &c->m, NULL)) {   /* the OBJ, or the glTF's welded skinned mesh */
         sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c);
         return -1;
     }

@@ -14,7 +14,8 @@ static void usage(FILE *f)
             "       (-o may be left out when --c-array or --check is given)\n"
             "Bakes a character (OBJ mesh + text description, see tools/DESCRIPTION.md) into a\n"
             "Sinew blob (runtime/BLOB.md).\n"
-            "  -o OUT.blob       binary blob (written to OUT.blob.tmp, then renamed)\n"
+            "  -o OUT.blob       binary blob (written to OUT.blob.tmp, then renamed); from a 'gltf' description\n"
+            "                    also OUT.blob.gltfmap, the glTF vertex order of the surface (DESCRIPTION.md)\n"
             "  --c-array OUT.c   also write the blob as an 8-aligned C99 array\n"
             "  --name SYMBOL     C symbol of the array (default sinew_blob); SYMBOL_size holds the size\n"
             "  --flavour F       fixed (default, int32 Q formats), float (float32), double (float64, host/tests)\n"
@@ -59,7 +60,7 @@ static int run_check(const char *desc, const sb_model *o, double secs)
     sb_mesh m;
     sb_check r;
     memset(&m, 0, sizeof m);
-    if (sb_desc_load(desc, &d) || sb_mesh_load_obj(d.mesh_path, &m)) {
+    if (sb_desc_load(desc, &d) || sb_desc_mesh(&d, &m, NULL)) {
         fprintf(stderr, "sinew-bake: error: --check: %s\n", sb_error());
         sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
@@ -79,6 +80,7 @@ static int run_check(const char *desc, const sb_model *o, double secs)
 int main(int argc, char **argv)
 {
     const char *desc = NULL, *out = NULL, *carray = NULL, *name = "sinew_blob";
+    char mapname[1100] = "";
     int flavour = SB_FIXED, quiet = 0, check = 0, i;
     sb_static_opts st = { NULL, NULL, NULL, NULL, 30, 15, 0 };
     double t0;
@@ -131,9 +133,12 @@ int main(int argc, char **argv)
     t0 = sb_now() - t0;
     if (!quiet) bone_summary(&o);
     if (check && run_check(desc, &o, t0)) { sb_blob_free(&b); sb_rig_free(&o); sb_model_free(&o); return 1; }
-    if ((out && sb_write_file(out, b.bytes, b.size)) || (carray && sb_write_c_array(carray, name, b.bytes, b.size))) {
+    if (out && o.src.nsrc) snprintf(mapname, sizeof mapname, "%s.gltfmap", out);
+    if ((out && sb_write_file(out, b.bytes, b.size)) || (carray && sb_write_c_array(carray, name, b.bytes, b.size)) ||
+        (mapname[0] && sb_srcmap_write(mapname, &o.src))) {
         fprintf(stderr, "sinew-bake: error: %s\n", sb_error());
         if (out) remove(out);   /* all or nothing */
+        if (mapname[0]) remove(mapname);
         sb_blob_free(&b); sb_rig_free(&o); sb_model_free(&o);
         return 1;
     }

@@ -6,9 +6,14 @@
 # ports/common (clip parser) is shared with the bare-metal port.
 DESK_INC  = $(if $(SN_INC),$(SN_INC),-Iruntime/include) -Iruntime/src -Iports/common -Iports/desktop
 DESK_HDRS = runtime/include/sinew.h runtime/src/sn_format.h ports/common/sn_clip.h \
-            ports/desktop/raster.h ports/desktop/png.h ports/desktop/plot.h
+            ports/desktop/raster.h ports/desktop/png.h ports/desktop/plot.h ports/desktop/play_gltf.h \
+            tools/sb.h tools/sb_gltf.h tools/sb_gltf_int.h tools/sb_json.h
 PLAY_SRCS = ports/desktop/play.c ports/desktop/raster.c ports/desktop/png.c ports/desktop/plot.c \
-            ports/common/sn_clip.c ports/common/sn_clip_pose.c
+            ports/common/sn_clip.c ports/common/sn_clip_pose.c \
+            ports/desktop/play_gltf.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_gltf_anim.c tools/sb_util.c
+# the player reads glTF with the host tool's reader (issue 17: --gltf-anim, --out-gltf); a glTF
+# animation keyed at every step needs more clip keys than the bare-metal default
+PLAY_CFLAGS = -Itools -DSN_CLIP_MAX_KEYS=32768 -DSN_CLIP_MAX_CHANNELS=256
 DEMO_DIR  = $(BUILD)/demo
 COW_CLIPS = tools/examples/cow/head_turn.clip tools/examples/cow/trot.clip tools/examples/cow/breathe.clip \
             tools/examples/cow/smile.clip tools/examples/cow/belly.clip
@@ -42,11 +47,11 @@ all: $(BUILD)/sinew-play $(BUILD)/sinew-play-float
 
 $(BUILD)/sinew-play: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FIXED) -o $@ -lm
+	$(CC) $(HOST_CFLAGS) $(DESK_INC) $(PLAY_CFLAGS) $(PLAY_SRCS) $(SN_LIB_FIXED) -o $@ -lm
 
 $(BUILD)/sinew-play-float: $(PLAY_SRCS) $(DESK_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) $(PLAY_SRCS) $(SN_LIB_FLOAT) -o $@ -lm
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(DESK_INC) $(PLAY_CFLAGS) $(PLAY_SRCS) $(SN_LIB_FLOAT) -o $@ -lm
 
 # Clip sampling through the runtime against a double reference.
 $(BUILD)/tests/test_clip_pose: tests/test_clip_pose.c ports/common/sn_clip.c ports/common/sn_clip_pose.c \
@@ -69,3 +74,29 @@ endif
 demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
       $(BUILD)/examples/limb.blob $(BUILD)/examples/beast.blob $(COW_CLIPS) $(SHEET_BLOBS) $(BUILD)/sinew-rig $(BUILD)/sinew-bake
 	@BUILD=$(BUILD) sh ports/desktop/demo.sh
+
+# ---- glTF with Blender (issue 17 item 5; tools/blender/) ----
+# make gltf-roundtrip: the Blender-exported cow baked, its walk played with
+# --out-gltf, and the result imported by Blender's own glTF importer
+# (tools/blender/import_check.py); skipped, with the reason, without Blender.
+# make gltf-assets: regenerate tools/examples/{cow,beast}_gltf/*.glb and the
+# bone heads with Blender (tools/blender/make_gltf.py); only for maintainers.
+BLENDER ?= blender
+BLENDER_RUN = $(BLENDER) -b --factory-startup --python-exit-code 1 -P
+.PHONY: gltf-roundtrip gltf-assets
+gltf-roundtrip: $(BUILD)/sinew-play $(BAKE)
+	@if ! command -v $(BLENDER) > /dev/null 2>&1; then \
+	    echo "gltf-roundtrip: SKIPPED: '$(BLENDER)' not found (apt-get install blender, or BLENDER=/path/to/blender)"; \
+	else \
+	    mkdir -p $(BUILD)/gltf && \
+	    $(BAKE) tools/examples/cow_gltf/cow_gltf.sinew -o $(BUILD)/gltf/cow_gltf.blob --quiet && \
+	    $(BUILD)/sinew-play $(BUILD)/gltf/cow_gltf.blob --gltf-anim tools/examples/cow_gltf/cow.glb:walk --quiet \
+	        --out-gltf $(BUILD)/gltf/cow_walk.glb && \
+	    $(BLENDER_RUN) tools/blender/import_check.py -- $(BUILD)/gltf/cow_walk.glb > $(BUILD)/gltf/import.log 2>&1 && \
+	    grep '^import_check:' $(BUILD)/gltf/import.log || { echo "gltf-roundtrip: FAILED (log: $(BUILD)/gltf/import.log)"; exit 1; }; \
+	fi
+gltf-assets:
+	$(BLENDER_RUN) tools/blender/make_gltf.py -- --obj tools/examples/cow/cow.obj --desc tools/examples/cow/cow.sinew \
+	    --walk cow --out tools/examples/cow_gltf/cow.glb --heads tools/examples/cow_gltf/cow_heads.txt
+	$(BLENDER_RUN) tools/blender/make_gltf.py -- --obj tools/examples/beast/beast.obj --desc tools/examples/beast/beast.sinew \
+	    --walk biped --normals 0 --out tools/examples/beast_gltf/beast.glb --heads tools/examples/beast_gltf/beast_heads.txt

@@ -6,6 +6,7 @@
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_clip.h"
+#include "play_gltf.h"
 #include "raster.h"
 #include "png.h"
 #include "plot.h"
@@ -35,7 +36,17 @@ static void usage(FILE *f) {
     fprintf(f,
         "usage: " PROG " BLOB [options]\n"
         "Plays a clip on a baked Sinew character and reports the step time.\n"
-        "  --clip CLIP        keyframed skeleton clip (ports/common/CLIP.md); default: rest pose\n"
+        "  --clip CLIP        keyframed skeleton clip (ports/common/CLIP.md); default: rest pose\n");
+    fprintf(f,
+        "  --gltf-anim FILE[:NAME]  play a glTF 2.0 animation (by name or index; default the first) of the skin\n"
+        "                     the blob was baked from: resampled at every step into a clip (CLIP.md \"glTF in and out\")\n"
+        "  --gltf-loop yes|no with --gltf-anim: loop (default yes) or hold the end\n"
+        "  --clip-out FILE    with --gltf-anim: also write the clip it became\n"
+        "  --out-gltf FILE.glb  the simulated surface over the run as glTF: one morph target per recorded frame\n"
+        "                     (every step, at most 120; a longer run records every Nth) driven by a weights\n"
+        "                     animation; the original glTF's vertex order when BLOB.gltfmap is beside the blob\n"
+        "  --apng FILE.png    animated PNG of the run (every step, at most 120 frames; --size, default 320x240)\n");
+    fprintf(f,
         "  --control NAME=V   hold abstract rig control NAME at V for the whole run, over the clip's track\n"
         "                     (repeatable; V a decimal as in clips, |V| < 32768)\n"
         "  --rigs on|off      off: every abstract control held at 0, the clip's control tracks ignored\n"
@@ -429,6 +440,8 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
 typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *obj_frames, *png, *sheet, *compare, *title, *stats_csv, *plot;
     const char *compare_rigs, *rig_off_blob, *compare_hits;
+    const char *gltf_anim, *clip_out, *out_gltf, *apng;   /* issue 17: glTF in and out */
+    int gltf_noloop;
     const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
     int n_held, rigs_off;
     long frames, iterations, health;
@@ -485,7 +498,8 @@ static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
-                                         "--seg-impulse", "--seg-floor", "--segments", NULL};
+                                         "--seg-impulse", "--seg-floor", "--segments",
+                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -499,6 +513,14 @@ static int parse_args(int argc, char **argv, options *o) {
             }
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); exit(0); }
         else if (!strcmp(a, "--clip")) o->clip_path = v;
+        else if (!strcmp(a, "--gltf-anim")) o->gltf_anim = v;
+        else if (!strcmp(a, "--clip-out")) o->clip_out = v;
+        else if (!strcmp(a, "--out-gltf")) o->out_gltf = v;
+        else if (!strcmp(a, "--apng")) o->apng = v;
+        else if (!strcmp(a, "--gltf-loop")) {
+            if (strcmp(v, "yes") && strcmp(v, "no")) { fprintf(stderr, PROG ": --gltf-loop: want yes or no, got '%s'\n", v); return 2; }
+            o->gltf_noloop = !strcmp(v, "no");
+        }
         else if (!strcmp(a, "--obj-dir")) o->obj_dir = v;
         else if (!strcmp(a, "--obj-frames")) {
             char e[256];
@@ -587,6 +609,8 @@ static int parse_args(int argc, char **argv, options *o) {
         else { fprintf(stderr, PROG ": more than one blob given ('%s')\n", a); return 2; }
     }
     if (!o->blob_path) { usage(stderr); return 2; }
+    if (o->gltf_anim && o->clip_path) { fprintf(stderr, PROG ": --gltf-anim and --clip: one at a time\n"); return 2; }
+    if (o->clip_out && !o->gltf_anim) { fprintf(stderr, PROG ": --clip-out needs --gltf-anim\n"); return 2; }
     if (o->plot && o->have_size && (o->w < 240 || o->h < 180)) {
         fprintf(stderr, PROG ": --size: the plot needs at least 240x180\n"); return 2;
     }
@@ -735,6 +759,11 @@ int main(int argc, char **argv) {
     sn_status st;
     sn_instance *inst = NULL, *inst2 = NULL;
     static sn_clip clip;
+    char *gltf_clip = NULL;          /* --gltf-anim: the clip text */
+    pg_out gout;                     /* --out-gltf */
+    png_anim apng;                   /* --apng */
+    rs_image aframe;
+    long out_stride = 1, apng_stride = 1;
     int have_clip = 0, rc = 1;
     sn_quat *local = NULL;
     sn_xform *xf = NULL, *rest_xf = NULL;
@@ -758,6 +787,7 @@ int main(int argc, char **argv) {
     srand((unsigned)getpid());   /* distinct temp-file names for concurrent players */
     memset(&s, 0, sizeof s);
     memset(&sheet, 0, sizeof sheet); memset(&panel, 0, sizeof panel); memset(&cmp, 0, sizeof cmp);
+    memset(&gout, 0, sizeof gout); memset(&apng, 0, sizeof apng); memset(&aframe, 0, sizeof aframe);
 
     /* blob */
     if (!(bytes = read_file(o.blob_path, &nbytes, err, sizeof err))) return die("%s", err);
@@ -771,10 +801,18 @@ int main(int argc, char **argv) {
     sn_blob_get_info(s.blob, &s.info);
     h_s = (double)F(s.info.timestep);
 
-    /* clip */
+    /* clip (or a glTF animation turned into one) */
+    if (o.gltf_anim) {
+        int32_t hq0 = sn_clip_timestep_q16(s.blob);
+        if (hq0 < 1) { die("%s: its timestep cannot step a clip", o.blob_path); goto done; }
+        if (!(gltf_clip = pg_anim_clip(o.gltf_anim, hq0, !o.gltf_noloop, o.quiet, err, sizeof err))) { die("--gltf-anim: %s", err); goto done; }
+        if (o.clip_out && write_file_atomic(o.clip_out, gltf_clip, strlen(gltf_clip), err, sizeof err)) { die("%s", err); goto done; }
+        o.clip_path = o.gltf_anim;
+    }
     if (o.clip_path) {
         size_t cn;
-        char *text = read_file(o.clip_path, &cn, err, sizeof err);
+        char *text = gltf_clip ? gltf_clip : read_file(o.clip_path, &cn, err, sizeof err);
+        if (gltf_clip) cn = strlen(gltf_clip), gltf_clip = NULL;
         if (!text) { die("%s", err); goto done; }
         if (sn_clip_parse(&clip, text, cn, err, sizeof err)) { free(text); die("%s: %s", o.clip_path, err); goto done; }
         free(text);
@@ -955,7 +993,7 @@ int main(int argc, char **argv) {
         if (sn_set_segment_floor(inst, up, R(o.floor_y)) != SN_OK) { die("--seg-floor: refused"); goto done; }
         if (inst2) sn_set_segment_floor(inst2, up, R(o.floor_y));
     }
-    pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits;
+    pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits || o.apng;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
@@ -1033,6 +1071,27 @@ int main(int argc, char **argv) {
             }
     }
 
+    /* --out-gltf: the state before the first step, then every out_stride-th step;
+       --apng: every apng_stride-th step (at most 120 frames each) */
+    if (o.out_gltf) {
+        out_stride = n_frames > 120 ? (n_frames + 119) / 120 : 1;
+        if (n_frames < 1) { die("--out-gltf needs at least one step"); goto done; }
+        if (pg_out_begin(&gout, o.out_gltf, o.blob_path, s.info.surface_vertices, s.tri, s.info.triangles,
+                         (uint32_t)(n_frames / out_stride), (double)out_stride * h_s, err, sizeof err)) { die("%s", err); goto done; }
+        fetch(&s, inst);
+        pg_out_frame(&gout, s.pos);
+    }
+    if (o.apng) {
+        int pw = o.have_size ? o.w : 320, ph = o.have_size ? o.h : 240;
+        double dl;
+        apng_stride = n_frames > 120 ? (n_frames + 119) / 120 : 1;
+        dl = (double)apng_stride * h_s * 6000.0 + 0.5;
+        if (n_frames < 1) { die("--apng needs at least one step"); goto done; }
+        if (rs_image_alloc(&aframe, pw, ph)) { die("out of memory"); goto done; }
+        if (png_anim_begin(&apng, o.apng, pw, ph, (uint32_t)(n_frames / apng_stride), dl < 65535 ? (uint16_t)dl : 65535,
+                           dl < 65535 ? 6000 : 1000, err, sizeof err)) { die("%s", err); goto done; }
+    }
+
     /* frame 0 (the state before the first step) only when asked for */
     if (obj_sel && obj_sel[0]) {
         snprintf(path, sizeof path, "%s/frame_%04d.obj", o.obj_dir, 0);
@@ -1091,6 +1150,16 @@ int main(int argc, char **argv) {
             fetch(&s, inst);
             if (write_obj(&s, path, err, sizeof err)) { die("%s", err); goto done; }
         }
+        if (o.out_gltf && k % out_stride == 0 && k / out_stride <= (long)gout.frames) {
+            fetch(&s, inst);
+            pg_out_frame(&gout, s.pos);
+        }
+        if (o.apng && k % apng_stride == 0 && (uint32_t)(k / apng_stride) <= apng.frames) {
+            char lab[64];
+            snprintf(lab, sizeof lab, "t = %.2f s", (double)k * h_s);
+            if (render(&s, inst, &aframe, lab, o.title)) { die("out of memory"); goto done; }
+            if (png_anim_frame(&apng, aframe.rgb, err, sizeof err)) { die("%s", err); goto done; }
+        }
         if (o.sheet) {
             int p;
             for (p = 0; p < SHEET_COLS * SHEET_ROWS; p++)
@@ -1124,6 +1193,22 @@ int main(int argc, char **argv) {
         if (stats.bound_steps)
             fprintf(stderr, PROG ": warning: a baked bound was exceeded in %u of %ld steps\n", stats.bound_steps, n_frames);
     } else printf("step: no steps run\n");
+    if (o.out_gltf) {
+        size_t nb = 0;
+        int mapped = gout.have_map;
+        uint32_t nfr = gout.frames;
+        if (pg_out_end(&gout, &nb, err, sizeof err)) { die("%s", err); goto done; }
+        if (!o.quiet) printf("wrote %s (%u morph-target frames every %ld step(s), %s vertex order, %zu bytes)\n", o.out_gltf, nfr,
+                             out_stride, mapped ? "the original glTF's" : "the runtime surface's", nb);
+    }
+    if (o.apng) {
+        size_t nb;
+        uint32_t nfr = apng.frames;
+        if (png_anim_end(&apng, err, sizeof err)) { die("%s", err); goto done; }
+        nb = apng.bytes;
+        if (!o.quiet) printf("wrote %s (%u frames of %dx%d, %u/%u s each, %zu bytes)\n", o.apng, nfr, aframe.w, aframe.h,
+                             apng.delay_num, apng.delay_den, nb);
+    }
     if (o.stats_csv) {
         if (write_stats_csv(o.stats_csv, fst, n_frames, h_s, s.blob, n_ctl, fctl, err, sizeof err)) { die("%s", err); goto done; }
         if (!o.quiet) printf("wrote %s\n", o.stats_csv);
@@ -1232,7 +1317,8 @@ int main(int argc, char **argv) {
     if (o.hash) printf("hash: %016llx\n", (unsigned long long)sn_state_hash(inst));
     rc = 0;
 done:
-    rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp);
+    rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp); rs_image_free(&aframe);
+    pg_out_free(&gout); png_anim_abort(&apng); free(gltf_clip);
     free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
     free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);

@@ -150,11 +150,12 @@ static size_t chunk(uint8_t *p, const char *type, const uint8_t *data, size_t n)
     return n + 12;
 }
 
-int png_encode(const uint8_t *rgb, int w, int h, int compress, uint8_t **out, size_t *out_len) {
-    size_t stride, raw_n, cap, zn, o = 0;
-    uint8_t *raw, *z, *png, ihdr[13];
+/* the zlib stream of w x h RGB pixels (filtered rows), malloc'd in *z */
+static int png_zimage(const uint8_t *rgb, int w, int h, int compress, uint8_t **zout, size_t *zlen) {
+    size_t stride, raw_n, cap, zn;
+    uint8_t *raw, *z;
     int y;
-    *out = NULL; *out_len = 0;
+    *zout = NULL; *zlen = 0;
     if (w <= 0 || h <= 0 || w > 16384 || h > 16384) return -1;
     stride = (size_t)w * 3;
     raw_n = (size_t)h * (stride + 1);
@@ -190,18 +191,121 @@ int png_encode(const uint8_t *rgb, int w, int h, int compress, uint8_t **out, si
     be32(z + 2 + zn, png_adler32(1, raw, raw_n));
     zn += 6;
     free(raw);
+    *zout = z; *zlen = zn;
+    return 0;
+}
+
+static void png_ihdr(uint8_t *ihdr, int w, int h) {
+    be32(ihdr, (uint32_t)w); be32(ihdr + 4, (uint32_t)h);
+    ihdr[8] = 8; ihdr[9] = 2; ihdr[10] = 0; ihdr[11] = 0; ihdr[12] = 0;   /* 8-bit RGB */
+}
+
+int png_encode(const uint8_t *rgb, int w, int h, int compress, uint8_t **out, size_t *out_len) {
+    size_t zn, o = 0;
+    uint8_t *z, *png, ihdr[13];
+    *out = NULL; *out_len = 0;
+    if (png_zimage(rgb, w, h, compress, &z, &zn)) return -1;
     png = malloc(zn + 8 + 25 + 12 + 12);
     if (!png) { free(z); return -1; }
     memcpy(png, "\x89PNG\r\n\x1a\n", 8);
     o = 8;
-    be32(ihdr, (uint32_t)w); be32(ihdr + 4, (uint32_t)h);
-    ihdr[8] = 8; ihdr[9] = 2; ihdr[10] = 0; ihdr[11] = 0; ihdr[12] = 0;   /* 8-bit RGB */
+    png_ihdr(ihdr, w, h);
     o += chunk(png + o, "IHDR", ihdr, 13);
     o += chunk(png + o, "IDAT", z, zn);
     o += chunk(png + o, "IEND", NULL, 0);
     free(z);
     *out = png; *out_len = o;
     return 0;
+}
+
+/* ---- APNG (animated PNG: acTL, then per frame fcTL + IDAT / fdAT) ---- */
+static int anim_chunk(png_anim *a, const char *type, const uint8_t *data, size_t n) {
+    uint8_t *c = malloc(n + 12);
+    size_t m;
+    int ok;
+    if (!c) return -1;
+    m = chunk(c, type, data, n);
+    ok = fwrite(c, 1, m, a->f) == m;
+    free(c);
+    a->bytes += m;
+    return ok ? 0 : -1;
+}
+
+int png_anim_begin(png_anim *a, const char *path, int w, int h, uint32_t frames, uint16_t delay_num, uint16_t delay_den,
+                   char *err, size_t errlen) {
+    uint8_t ihdr[13], actl[8];
+    memset(a, 0, sizeof *a);
+    if (w <= 0 || h <= 0 || w > 16384 || h > 16384 || frames < 1 || !delay_den) {
+        snprintf(err, errlen, "%s: bad animation size %dx%d, %u frames or delay %u/%u", path, w, h, (unsigned)frames, delay_num, delay_den);
+        return -1;
+    }
+    if (strlen(path) + 16 > sizeof a->tmp) { snprintf(err, errlen, "%s: path too long", path); return -1; }
+    snprintf(a->path, sizeof a->path, "%s", path);
+    snprintf(a->tmp, sizeof a->tmp, "%s.tmp%ld", path, (long)(rand() & 0xFFFF));
+    if (!(a->f = fopen(a->tmp, "wb"))) { snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno)); return -1; }
+    a->w = w, a->h = h, a->frames = frames, a->delay_num = delay_num, a->delay_den = delay_den;
+    fwrite("\x89PNG\r\n\x1a\n", 1, 8, a->f);
+    a->bytes = 8;
+    png_ihdr(ihdr, w, h);
+    be32(actl, frames);
+    be32(actl + 4, 0);   /* plays forever */
+    if (anim_chunk(a, "IHDR", ihdr, 13) || anim_chunk(a, "acTL", actl, 8)) {
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+        fclose(a->f); remove(a->tmp); a->f = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+int png_anim_frame(png_anim *a, const uint8_t *rgb, char *err, size_t errlen) {
+    uint8_t fctl[26], *z, *d;
+    size_t zn;
+    int r;
+    if (!a->f || a->done >= a->frames) { snprintf(err, errlen, "%s: more frames than announced (%u)", a->path, (unsigned)a->frames); return -1; }
+    be32(fctl, a->seq++);
+    be32(fctl + 4, (uint32_t)a->w); be32(fctl + 8, (uint32_t)a->h);
+    be32(fctl + 12, 0); be32(fctl + 16, 0);   /* x, y offsets */
+    fctl[20] = (uint8_t)(a->delay_num >> 8); fctl[21] = (uint8_t)a->delay_num;
+    fctl[22] = (uint8_t)(a->delay_den >> 8); fctl[23] = (uint8_t)a->delay_den;
+    fctl[24] = 0;   /* dispose: none */
+    fctl[25] = 0;   /* blend: source */
+    if (png_zimage(rgb, a->w, a->h, 1, &z, &zn)) { snprintf(err, errlen, "%s: out of memory", a->path); return -1; }
+    if (a->done == 0) r = anim_chunk(a, "fcTL", fctl, 26) || anim_chunk(a, "IDAT", z, zn);   /* the default image is frame 0 */
+    else {
+        d = malloc(zn + 4);
+        if (!d) { free(z); snprintf(err, errlen, "%s: out of memory", a->path); return -1; }
+        be32(d, a->seq++);
+        memcpy(d + 4, z, zn);
+        r = anim_chunk(a, "fcTL", fctl, 26) || anim_chunk(a, "fdAT", d, zn + 4);
+        free(d);
+    }
+    free(z);
+    a->done++;
+    if (r) { snprintf(err, errlen, "cannot write %s: %s", a->path, strerror(errno)); return -1; }
+    return 0;
+}
+
+int png_anim_end(png_anim *a, char *err, size_t errlen) {
+    int ok;
+    if (!a->f) return -1;
+    if (a->done != a->frames) {
+        snprintf(err, errlen, "%s: %u of %u frames written", a->path, (unsigned)a->done, (unsigned)a->frames);
+        fclose(a->f); remove(a->tmp); a->f = NULL;
+        return -1;
+    }
+    ok = anim_chunk(a, "IEND", NULL, 0) == 0;
+    ok = (fclose(a->f) == 0) && ok;
+    a->f = NULL;
+    if (!ok || rename(a->tmp, a->path) != 0) {
+        snprintf(err, errlen, "cannot write %s: %s", a->path, strerror(errno));
+        remove(a->tmp);
+        return -1;
+    }
+    return 0;
+}
+
+void png_anim_abort(png_anim *a) {
+    if (a->f) { fclose(a->f); remove(a->tmp); a->f = NULL; }
 }
 
 int write_file_atomic(const char *path, const void *data, size_t n, char *err, size_t errlen) {

@@ -25,4 +25,24 @@ int write_file_atomic(const char *path, const void *data, size_t n, char *err, s
 /// png_encode (compressed) + write_file_atomic.
 int png_write(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t errlen);
 
+/// Animated PNG (APNG 1.0: acTL, per frame fcTL + IDAT (frame 0, also the
+/// still image) or fdAT, sequence numbers from 0), 8-bit RGB, full-size
+/// frames, dispose none, blend source, played forever, streamed to a temp
+/// file renamed at png_anim_end. Each frame's delay is num/den seconds.
+#include <stdio.h>
+typedef struct png_anim {
+    FILE *f;
+    char path[4096], tmp[4096];
+    int w, h;
+    uint32_t frames, done, seq;
+    uint16_t delay_num, delay_den;
+    size_t bytes;   /* written so far */
+} png_anim;
+int png_anim_begin(png_anim *a, const char *path, int w, int h, uint32_t frames, uint16_t delay_num, uint16_t delay_den,
+                   char *err, size_t errlen);
+int png_anim_frame(png_anim *a, const uint8_t *rgb, char *err, size_t errlen);
+/// Checks that every announced frame was written; 0, or -1 (nothing left behind).
+int png_anim_end(png_anim *a, char *err, size_t errlen);
+void png_anim_abort(png_anim *a);
+
 #endif

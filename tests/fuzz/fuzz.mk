@@ -8,7 +8,7 @@
 #   $(FUZZ_DIR)/fuzz_clip         clip parser + sampler (ports/common; tests/fuzz/lf_clip.c)
 #   $(FUZZ_DIR)/fuzz_desc         description reader (tools/sb_desc.c; tests/fuzz/lf_desc.c)
 #   $(FUZZ_DIR)/fuzz_obj          OBJ reader + inside test (tools/sb_mesh.c; tests/fuzz/lf_obj.c)
-#   $(FUZZ_DIR)/fuzz_gltf         glTF 2.0 reader (tools/sb_gltf*.c, sb_json.c; tests/fuzz/lf_gltf.c)
+#   $(FUZZ_DIR)/fuzz_gltf         glTF 2.0 reader and animations (tools/sb_gltf*.c, sb_json.c; tests/fuzz/lf_gltf.c)
 #
 # Seeds: tests/fuzz/corpus/<harness>/ (in the tree: clips, descriptions, OBJs)
 # plus $(FUZZ_DIR)/seeds/<harness>/ generated at build time (blobs of the
@@ -48,7 +48,7 @@ $(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h tools/sb_desc
 $(FUZZ_DIR)/fuzz_obj: tests/fuzz/lf_obj.c tests/fuzz/lf_common.h tools/sb_mesh.c tools/sb_util.c tools/sb.h
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_mesh.c tools/sb_util.c -lm
-LF_GLTF_SRC = tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_json.c tools/sb_util.c
+LF_GLTF_SRC = tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_gltf_anim.c tools/sb_json.c tools/sb_util.c
 $(FUZZ_DIR)/fuzz_gltf: tests/fuzz/lf_gltf.c tests/fuzz/lf_common.h $(LF_GLTF_SRC) tools/sb.h $(GLTF_HDR)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< $(LF_GLTF_SRC) -lm
@@ -84,7 +84,10 @@ $(FUZZ_DIR)/seeds/fuzz_obj/.stamp: tools/examples/limb/limb.obj tools/examples/d
 	@rm -rf $(@D) && mkdir -p $(@D)
 	cp tools/examples/limb/limb.obj tools/examples/diag/diag.obj $(@D)/
 	@touch $@
-# the glTF seeds are all in tests/fuzz/corpus/fuzz_gltf/ (written by test_bake_gltf)
+# the glTF seeds are all in tests/fuzz/corpus/fuzz_gltf/: strip.glb and strip_datauri.gltf (written by
+# test_bake_gltf), strip_anim.gltf (the data-URI strip with two animations: LINEAR, STEP, CUBICSPLINE,
+# translation and scale channels; issue 17 item 3) and regress_anim_time_uaf.gltf (a use after free
+# fuzz_gltf found in sb_gltf_anim.c, fixed)
 $(FUZZ_DIR)/seeds/fuzz_gltf/.stamp:
 	@rm -rf $(@D) && mkdir -p $(@D)
 	@touch $@

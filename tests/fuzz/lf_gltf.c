@@ -39,6 +39,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         LF_REQUIRE(g.joints[i].parent >= -1 && g.joints[i].parent < g.nj, "parent %d", g.joints[i].parent);
         for (k = 0; k < 3; k++) LF_REQUIRE(isfinite(g.joints[i].pos[k]) && isfinite(g.joints[i].node_pos[k]), "joint position");
     }
+    {
+        sb_gltf_anim a;
+        if (sb_gltf_anim_load(&a, path, &g, NULL, 1.0 / 60, 120) != 0) {   /* 2 s: longer ones are refused, cheaply */
+            LF_REQUIRE(sb_error() && sb_error()[0], "sb_gltf_anim_load failed without a message");
+            LF_REQUIRE(a.rot == NULL && a.nframes == 0, "a failed animation load left data");
+        } else {
+            char *clip;
+            LF_REQUIRE(a.nframes >= 1 && a.nj == g.nj, "frames %d joints %d", a.nframes, a.nj);
+            for (i = 0; i < a.nframes * a.nj; i++) {
+                const double *q = a.rot + 4 * i;
+                double n = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+                LF_REQUIRE(fabs(n - 1) < 1e-9 && q[3] >= 0, "quaternion %g %g %g %g", q[0], q[1], q[2], q[3]);
+            }
+            for (i = 0; i < 3 * a.nframes; i++) LF_REQUIRE(isfinite(a.move[i]), "root offset %g", a.move[i]);
+            clip = sb_gltf_anim_clip(&a, &g, 1092, 1, "fuzz");
+            LF_REQUIRE(clip || (sb_error() && sb_error()[0]), "sb_gltf_anim_clip failed without a message");
+            free(clip);
+            sb_gltf_anim_free(&a);
+        }
+    }
     sb_gltf_free(&g);
     return 0;
 }
