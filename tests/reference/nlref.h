@@ -1,0 +1,105 @@
+/* nlref.h -- nonlinear (Green strain, St. Venant-Kirchhoff) reference of the
+ * Sinew model, in double, for tests (issue 13 items 5-6).
+ *
+ * Same lattice, cells, skeleton, materials, mass, gravity as the baked blob:
+ * nlref_open bakes the description with the host tool's library (sb_build,
+ * no rigs), writes the double-flavour blob in memory and loads it with
+ * tools/ref/snref.c, so the linear models (warped, global linear = unwarped)
+ * and the nonlinear one share one snref_model and one set of units (internal
+ * lengths, NUMERICS.md: S^ = h^2 S / m0).
+ *
+ * Element: the tool's (sb_integrate.c) trilinear hex plus the 9 Wilson
+ * incompatible (bubble) modes P_k = 4 t_k (1 - t_k), here kept as per-cell
+ * internal unknowns alpha_e (3 bubbles x 3 components) of the nonlinear
+ * deformation map phi(X) = sum_a N_a p_a + sum_k P_k alpha_k; the tool
+ * condenses the same modes out of its linear element, so the Hessian of this
+ * energy at rest, with alpha condensed, IS the baked S^_e (tested to 1e-9).
+ * Cells the tool left trilinear (bubble block not positive definite) have no
+ * bubbles here either.
+ *
+ * Energy density (seed 000 eq. 10-12): E = 1/2 (F^T F - I),
+ * W = mu E:E + lambda/2 (tr E)^2, Lame parameters of the material at each
+ * quadrature point. Quadrature: the tool's 27-node moment-fitted rule per
+ * cell and material (weights = moments of the inside-weighted sub-box Gauss
+ * points against the Lagrange basis through the 3-point Gauss-Legendre
+ * nodes). It is exact for integrands of degree <= 2 per axis (so at rest it
+ * gives the tool's matrices exactly), and for wholly inside cells, where it is
+ * the 3x3x3 Gauss rule, exact up to degree 5 (W is of degree <= 4 per axis):
+ * the nonlinear energy of a partially filled cell is the rule's approximation.
+ *
+ * Static: minimise Pi(p_F, alpha) = sum_e psi_e - load . p_F (skeleton fixed at
+ * the pose, load = the blob's gravity as snref applies it) by Newton's method
+ * with alpha condensed per cell, dense Cholesky (shifted when the Hessian is
+ * not positive definite), Armijo backtracking on Pi. Dynamic: the runtime's
+ * backward Euler step (Rayleigh alpha on M, beta on the tangent frozen at the
+ * step's start) solved fully nonlinearly, by the same Newton on the
+ * incremental potential. Deterministic (no threads, fixed order). */
+#ifndef NLREF_H
+#define NLREF_H
+#include "sb.h"
+#include "snref.h"
+
+typedef struct nlref {
+    sb_desc d;
+    sb_mesh mesh;
+    sb_model o;
+    sb_blob b;
+    snref_model m;
+    int have_d, have_mesh, have_o, have_b, have_m;
+    double L;            /* metres per internal unit */
+    double hc;           /* cell edge, internal units */
+    unsigned nC, nF, nV;
+    unsigned *efirst;    /* nC+1: material entries of cell e */
+    double *elam, *emu;  /* per entry: Lame parameters in internal units (x h^2 L / m0) */
+    double *emw;         /* per entry: 27 moment weights, internal units^3 */
+    unsigned char *inc;  /* per cell: 1 = bubbles (incompatible modes) */
+    unsigned n_trilinear;/* cells without bubbles */
+    double *alpha;       /* nC*9 bubble amplitudes of the last solve (internal units) */
+    double *lin_dmp;     /* scratch */
+} nlref;
+
+typedef struct nlref_stats {
+    unsigned iters;       /* Newton iterations */
+    unsigned shifts;      /* iterations that needed a shifted (regularised) Hessian */
+    double res0, res;     /* |grad Pi| (free p and alpha) at the start and at the end */
+    double relres;        /* res / scale, scale = |load| + |elastic force at the start| */
+} nlref_stats;
+
+/* Bake desc (host tool library, no rigs, double flavour) and prepare. 0 or -1 (message in err). */
+int nlref_open(nlref *n, const char *desc_path, char *err, size_t errn);
+void nlref_close(nlref *n);
+
+/* Cell e: energy psi_e of corner positions P (24, internal units) and bubbles A
+ * (9; ignored for a trilinear cell); gradient g (33: 24 corner dofs then 9
+ * bubble dofs) and Hessian H (33x33 row-major) when non-NULL. */
+double nlref_cell(const nlref *n, unsigned e, const double P[24], const double A[9], double *g, double *H);
+/* Cell e's Hessian at rest with the bubbles condensed (24x24), internal units:
+ * must equal the blob's S^_e. Returns 0, or -1 if the bubble block is not
+ * positive definite (then the trilinear block). */
+int nlref_rest_condensed(const nlref *n, unsigned e, double K[576]);
+
+/* Elastic energy and force (free rows, 3 nF) at lattice positions p (3 nV,
+ * internal units), bubbles equilibrated (inner Newton per cell) when
+ * relax_bubbles, else taken as alpha (NULL: zero). */
+double nlref_force(nlref *n, const double *p, const double *alpha, double *f);
+
+/* Static solve: s is an snref state at the pose (skeleton positions and the
+ * load come from it, gscale and rig_scale as set; s->p is the initial guess,
+ * e.g. after snref_static). On return s->p holds the nonlinear equilibrium,
+ * n->alpha its bubbles. tol: on relres. */
+int nlref_static(nlref *n, snref_state *s, double tol, unsigned max_iter, nlref_stats *st);
+
+/* One dynamic step of the state s (its pose set for the end of the step with
+ * snref_set_pose, as before snref_step): backward Euler with the nonlinear
+ * elastic force, solved by Newton to tol. Updates s->p, s->v. */
+int nlref_step(nlref *n, snref_state *s, double tol, nlref_stats *st);
+
+/* Twist (seed 000 eq. 25-26), test-side (the tool's term is retired): the
+ * 8x8 scalar matrix T_ab = kappa * integral over cell e (rest) of the points
+ * within radius r (mesh units) of segment a0-a1 (mesh units, model space) of
+ * N_a N_b, by nsub^3 sub-boxes with 2x2x2 Gauss points and a 0/1 inside test
+ * per point (internal units^3 volume). */
+void nlref_twist_cell(const nlref *n, unsigned e, const double a0[3], const double a1[3], double r, double kappa,
+                      int nsub, double T[64]);
+
+#endif
