@@ -312,6 +312,128 @@ static void cow_table(nlref *n) {
     free(rest);
 }
 
+/* ---- 4. twist ---- */
+static double twist_angle(const nlref *n, const double *surf, const double *rest, double x0, double x1) {
+    double ss = 0, sc = 0;
+    unsigned i;
+    for (i = 0; i < n->m.nS; i++) {
+        const double *a = rest + 3 * i, *b = surf + 3 * i;
+        if (a[0] < x0 || a[0] > x1) continue;
+        ss += a[1] * b[2] - a[2] * b[1];   /* (a x b).x on the y-z components */
+        sc += a[1] * b[1] + a[2] * b[2];
+    }
+    return atan2(ss, sc) * 180 / 3.14159265358979323846;
+}
+
+/* Error bound of the 0/1 quadrature of N_a N_b (unit kappa and cell volume) for
+ * the cylinder of check_twist: sub-boxes the boundary does not cut are
+ * integrated exactly (2x2x2 Gauss, degree 2 per axis); a cut one errs by at
+ * most its volume times the largest N_a N_b on it (per axis: f^2 at an end, or
+ * t(1-t) at the point of the interval nearest 1/2). Cut: |distance of the
+ * centre to the axis - r| <= half the box's y-z diagonal. */
+static double axis_max(int same, int bit, double lo, double hi) {
+    if (same) { double f0 = bit ? lo : 1 - lo, f1 = bit ? hi : 1 - hi; return fmax(f0 * f0, f1 * f1); }
+    { double t = lo > 0.5 ? lo : hi < 0.5 ? hi : 0.5; return t * (1 - t); }
+}
+static double cut_bound(int nn, int a, int b, double c) {
+    double hb = 1.0 / nn, sx = 0, syz = 0;
+    int i, y, z;
+    (void)c;
+    for (i = 0; i < nn; i++) sx += axis_max((a & 1) == (b & 1), a & 1, i * hb, (i + 1) * hb);
+    for (y = 0; y < nn; y++)
+        for (z = 0; z < nn; z++) {
+            double dy = (y + 0.5) * hb - 0.3, dz = (z + 0.5) * hb - 0.6;
+            if (fabs(sqrt(dy * dy + dz * dz) - 0.45) > hb * 0.70710678118654752) continue;
+            syz += axis_max((a >> 1 & 1) == (b >> 1 & 1), a >> 1 & 1, y * hb, (y + 1) * hb) * axis_max((a >> 2 & 1) == (b >> 2 & 1), a >> 2 & 1, z * hb, (z + 1) * hb);
+        }
+    return sx * syz * hb * hb * hb;
+}
+
+static void check_twist(nlref *n) {
+    double T[64], Tr[64], a0[3], a1[3], kap = 2.5, worst = 0, c = n->o.c, hs = n->hc * n->hc * n->hc;
+    const double *x0 = n->o.x + 3 * n->o.cells[0];
+    unsigned a, b, k;
+    static const int ns[3] = {8, 16, 32};
+    /* a cell wholly within the radius: kappa h^3 prod_k (1/3 same end, 1/6 other end) */
+    for (k = 0; k < 3; k++) { a0[k] = x0[k] + 0.5 * c; a1[k] = a0[k] + (k == 0 ? 1.0 : 0.0); }
+    nlref_twist_cell(n, 0, 1, a0, a1, 0, 10 * c, kap, 2, T);
+    for (a = 0; a < 8; a++)
+        for (b = 0; b < 8; b++) {
+            double want = kap * hs;
+            for (k = 0; k < 3; k++) want *= ((a >> k & 1) == (b >> k & 1)) ? 1.0 / 3 : 1.0 / 6;
+            worst = fmax(worst, fabs(T[8 * a + b] - want) / want);
+        }
+    T_FIGURE("twist: cell wholly within r: kappa int N_a N_b against kappa h^3 (1/3 or 1/6 per axis): worst relative error %.3g", worst);
+    T_CHECK(worst <= 1e-12, "twist integral of a full cell = the analytic trilinear integral to 1e-12 (%.3g)", worst);
+    /* a partly covered cell: bone along x at (y, z) = (0.3, 0.6) cell, r = 0.45 cell */
+    a0[0] = x0[0] - c; a1[0] = x0[0] + 2 * c;
+    a0[1] = a1[1] = x0[1] + 0.3 * c; a0[2] = a1[2] = x0[2] + 0.6 * c;
+    nlref_twist_cell(n, 0, 1, a0, a1, 0, 0.45 * c, kap, 128, Tr);
+    for (k = 0; k < 3; k++) {
+        /* error bound: sub-boxes not cut by the cylinder are integrated exactly (2x2x2 Gauss, degree 2 per axis); a
+         * cut one errs by at most its volume x kappa (N_a N_b <= 1). Cut: |distance of its centre to the axis - r| <= half its y-z diagonal. */
+        int nn = ns[k], j;
+        double err = 0, bound = 0, Tmax = 0, eb = 0;
+        nlref_twist_cell(n, 0, 1, a0, a1, 0, 0.45 * c, kap, nn, T);
+        for (j = 0; j < 64; j++) {
+            double bj = cut_bound(nn, j / 8, j % 8, c) + cut_bound(128, j / 8, j % 8, c), ej = fabs(T[j] - Tr[j]);
+            err = fmax(err, ej); Tmax = fmax(Tmax, Tr[j]);
+            if (ej / bj > eb) { eb = ej / bj; bound = bj; }
+        }
+        err = 0;
+        for (j = 0; j < 64; j++) err = fmax(err, fabs(T[j] - Tr[j]));
+        bound *= kap * hs;
+        T_CHECK(eb <= kap * hs, "twist, partly covered cell, %d^3 sub-boxes: every entry within its quadrature error bound (worst at %.3g of it)", nn, eb / (kap * hs));
+        T_FIGURE("twist: partly covered cell (bone along x at (0.3, 0.6) cell, r 0.45 cell): %2d^3 sub-boxes vs 128^3: max |T - T_128| %.3g = %.3g of max T; "
+                 "the worst entry used %.2f of its bound", nn, err, err / Tmax, eb / (kap * hs));
+    }
+}
+
+static void twisted_limb(nlref *n) {
+    snref_xform pose[16];
+    snref_state s;
+    double x[3] = {1, 0, 0}, *rest = malloc(3 * n->m.nS * sizeof *rest), *surf = malloc(3 * n->m.nS * sizeof *surf), ang[4], warped;
+    double Eh = 0, deg = 60;
+    static const double ck[4] = {0, 0.1, 1, 10};
+    int el = find_joint(&n->m, "elbow");
+    unsigned i;
+    if (el < 0) { free(rest); free(surf); return; }
+    for (i = 0; i < (unsigned)n->d.nm; i++) Eh = fmax(Eh, n->d.mats[i].E);
+    Eh *= n->o.h * n->o.h * n->L / n->b.m0;   /* Young's modulus, internal units */
+    snref_init(&s, &n->m);
+    snref_get_surface(&s, rest);
+    s.gscale = 0; s.rig_scale = 0;
+    one_joint_pose(&n->m, el, x, deg, pose);
+    snref_set_pose(&s, pose);
+    snref_static(&s, 100000);
+    snref_get_surface(&s, surf);
+    warped = twist_angle(n, surf, rest, 5.0, 8.5);
+    printf("  twisted limb: elbow joint turned %.0f deg about the forearm (x), no gravity; flesh twist = least-squares angle of the forearm surface (x in [5, 8.5]) about x\n", deg);
+    printf("    warped (shipped): %.2f deg\n", warped);
+    for (i = 0; i < 4; i++) {
+        nlref_stats st;
+        double kh = ck[i] * Eh / (n->hc * n->hc), r = 2.0 * n->o.c, sl[4];
+        unsigned k;
+        T_CHECK(nlref_set_twist(n, kh, r, 4) == 0, "twist entries");
+        snref_set_pose(&s, pose);
+        snref_static(&s, 100000);
+        memset(n->alpha, 0, sizeof(double) * 9 * n->nC);
+        nlref_static(n, &s, NL_TOL, 100, &st);
+        T_CHECK(st.relres <= NL_TOL, "twisted limb, kappa %g E/h^2: Newton converged (%.3g, %u iterations)", ck[i], st.relres, st.iters);
+        snref_get_surface(&s, surf);
+        ang[i] = twist_angle(n, surf, rest, 5.0, 8.5);
+        for (k = 0; k < 4; k++) sl[k] = twist_angle(n, surf, rest, 4.5 + k, 5.5 + k);
+        printf("    nonlinear, kappa = %-4g E/h^2 (r = 2 cells, %u cell-bone pairs): %.2f deg; by slice x = 5, 6, 7, 8: %.2f %.2f %.2f %.2f\n",
+               ck[i], n->ntw, ang[i], sl[0], sl[1], sl[2], sl[3]);
+    }
+    nlref_set_twist(n, 0, 0, 0);
+    T_CHECK(fabs(deg - ang[0]) > fabs(deg - ang[1]) && fabs(deg - ang[1]) > fabs(deg - ang[2]) && fabs(deg - ang[2]) > fabs(deg - ang[3]),
+            "larger kappa: the flesh follows the bone's twist more closely, monotone: |%.0f - twist| %.3f > %.3f > %.3f > %.3f deg",
+            deg, fabs(deg - ang[0]), fabs(deg - ang[1]), fabs(deg - ang[2]), fabs(deg - ang[3]));
+    snref_release(&s);
+    free(rest); free(surf);
+}
+
 int main(int argc, char **argv) {
     nlref n;
     char err[512];
@@ -324,6 +446,8 @@ int main(int argc, char **argv) {
     check_dynamic(&n, "limb", 0.02, figures ? 120 : 30);
     header();
     limb_table(&n);
+    check_twist(&n);
+    twisted_limb(&n);
     nlref_close(&n);
     if (nlref_open(&n, COW, err, sizeof err)) { T_CHECK(0, "cow: %s", err); return T_END(); }
     check_reference(&n, "cow");

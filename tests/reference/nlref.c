@@ -160,7 +160,7 @@ void nlref_close(nlref *n) {
     if (n->have_o) sb_model_free(&n->o);
     if (n->have_mesh) sb_mesh_free(&n->mesh);
     if (n->have_d) sb_desc_free(&n->d);
-    free(n->efirst); free(n->elam); free(n->emu); free(n->emw); free(n->inc); free(n->alpha); free(n->lin_dmp);
+    free(n->efirst); free(n->elam); free(n->emu); free(n->emw); free(n->inc); free(n->alpha); free(n->lin_dmp); free(n->tw_cell); free(n->tw_joint); free(n->tw_T);
     memset(n, 0, sizeof *n);
 }
 
@@ -436,6 +436,63 @@ static double dyn_terms(const prob_t *pr, const double *p, double *grad /* 3nF o
     return Phi;
 }
 
+/* twist penalty (nlref_set_twist): 1/2 sum_entries sum_ab T_ab d_a.d_b,
+ * d_a = p_a - (R_j x_a + t_j) of the entry's bone j at the pose of n->tw_s.
+ * Adds to the energy (returned), to gp (free rows) and K (F3 x F3) if non-NULL. */
+static double twist_terms(const nlref *n, const double *p, double *gp, double *K) {
+    unsigned t, a, b, i, F3 = 3 * n->nF;
+    double E = 0;
+    if (!n->ntw || !n->tw_s) return 0;
+    for (t = 0; t < n->ntw; t++) {
+        const unsigned *cv = n->m.cells + 8 * n->tw_cell[t];
+        const double *T = n->tw_T + 64 * (size_t)t;
+        double R[9], d[24];
+        int j = n->tw_joint[t];
+        snref_quat_to_mat(n->tw_s->jq + 4 * j, R);
+        for (a = 0; a < 8; a++) {
+            const double *x = n->m.rest + 3 * cv[a];
+            for (i = 0; i < 3; i++) d[3 * a + i] = p[3 * cv[a] + i] - (R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2] + n->tw_s->jt[3 * j + i]);
+        }
+        for (a = 0; a < 8; a++)
+            for (b = 0; b < 8; b++) {
+                double dd = d[3 * a] * d[3 * b] + d[3 * a + 1] * d[3 * b + 1] + d[3 * a + 2] * d[3 * b + 2];
+                E += 0.5 * T[8 * a + b] * dd;
+                if (cv[a] >= n->nF) continue;
+                if (gp) for (i = 0; i < 3; i++) gp[3 * cv[a] + i] += T[8 * a + b] * d[3 * b + i];
+                if (K && cv[b] < n->nF) for (i = 0; i < 3; i++) K[(size_t)(3 * cv[a] + i) * F3 + 3 * cv[b] + i] += T[8 * a + b];
+            }
+    }
+    return E;
+}
+
+int nlref_set_twist(nlref *n, double kappa, double r, int nsub) {
+    unsigned e, sg, cap = n->nC * (unsigned)(n->o.nseg > 0 ? n->o.nseg : 1);
+    free(n->tw_cell); free(n->tw_joint); free(n->tw_T);
+    n->tw_cell = NULL; n->tw_joint = NULL; n->tw_T = NULL; n->ntw = 0;
+    if (!(kappa > 0)) return 0;
+    n->tw_cell = malloc(sizeof(unsigned) * cap); n->tw_joint = malloc(sizeof(int) * cap); n->tw_T = malloc(sizeof(double) * 64 * cap);
+    double *A0 = malloc(sizeof(double) * 3 * (size_t)(n->o.nseg + 1)), *A1 = malloc(sizeof(double) * 3 * (size_t)(n->o.nseg + 1));
+    for (sg = 0; sg < (unsigned)n->o.nseg; sg++) {
+        int ch = n->o.seg_child[sg], par = n->o.joints[ch].parent;
+        if (par < 0 || n->m.jparent[ch] != par) { free(A0); free(A1); return -1; }   /* blob joints = the tool's sorted joints */
+        memcpy(A0 + 3 * sg, n->o.joints[par].pos, sizeof(double) * 3);
+        memcpy(A1 + 3 * sg, n->o.joints[ch].pos, sizeof(double) * 3);
+    }
+    for (sg = 0; sg < (unsigned)n->o.nseg; sg++) {
+        int ch = n->o.seg_child[sg], par = n->o.joints[ch].parent;
+        for (e = 0; e < n->nC; e++) {
+            double *T = n->tw_T + 64 * (size_t)n->ntw, mx = 0;
+            int k;
+            nlref_twist_cell(n, e, n->o.nseg, A0, A1, (int)sg, r, kappa, nsub, T);
+            for (k = 0; k < 64; k++) mx = fmax(mx, T[k]);
+            if (mx == 0) continue;
+            n->tw_cell[n->ntw] = e; n->tw_joint[n->ntw] = par; n->ntw++;
+        }
+    }
+    free(A0); free(A1);
+    return 0;
+}
+
 static double pi_value(const prob_t *pr, const double *p, const double *alpha) {
     const nlref *n = pr->n;
     unsigned e, i;
@@ -443,6 +500,7 @@ static double pi_value(const prob_t *pr, const double *p, const double *alpha) {
     for (e = 0; e < n->nC; e++) { double P[24]; cell_pos(n, e, p, P); v += nlref_cell(n, e, P, alpha + 9 * e, NULL, NULL); }
     for (i = 0; i < 3 * n->nF; i++) v -= pr->load[i] * p[i];
     if (pr->dyn) v += dyn_terms(pr, p, NULL);
+    v += twist_terms(n, p, NULL, NULL);
     return v;
 }
 
@@ -453,6 +511,7 @@ static double grad_norm(const prob_t *pr, const double *p, const double *alpha) 
     double *gp = malloc(sizeof(double) * F3), s = 0;
     for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
     if (pr->dyn) dyn_terms(pr, p, gp);
+    twist_terms(n, p, gp, NULL);
     for (e = 0; e < n->nC; e++) {
         double P[24], g[ND];
         cell_pos(n, e, p, P);
@@ -496,6 +555,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
         memset(K, 0, sizeof(double) * F3 * F3);
         for (i = 0; i < F3; i++) { r[i] = -pr->load[i]; lsc2 += pr->load[i] * pr->load[i]; }
         if (pr->dyn) dyn_terms(pr, p, r);
+        twist_terms(n, p, r, K);
         for (e = 0; e < nC; e++) {
             double P[24], Kc[576], gc[24], *He = H + (size_t)ND * ND * e, *ge = G + (size_t)ND * e;
             cell_pos(n, e, p, P);
@@ -522,6 +582,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
             double *gp = calloc(F3, sizeof *gp);
             for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
             if (pr->dyn) dyn_terms(pr, p, gp);
+            twist_terms(n, p, gp, NULL);
             for (e = 0; e < nC; e++)
                 for (a = 0; a < 8; a++) {
                     unsigned va = m->cells[8 * e + a];
@@ -581,6 +642,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
             double *gp = calloc(F3, sizeof *gp);
             for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
             if (pr->dyn) dyn_terms(pr, p, gp);
+            twist_terms(n, p, gp, NULL);
             for (e = 0; e < nC; e++)
                 for (a = 0; a < 8; a++) {
                     unsigned va = m->cells[8 * e + a];
@@ -625,8 +687,10 @@ int nlref_static(nlref *n, snref_state *s, double tol, unsigned max_iter, nlref_
     skeleton_set(s, s->p);
     load_of(s, load);
     pr.n = n; pr.load = load;
+    n->tw_s = s;
     relax_bubbles(n, s->p, n->alpha);
     rc = newton(&pr, s->p, n->alpha, tol, max_iter, st);
+    n->tw_s = NULL;
     memset(s->v, 0, sizeof(double) * 3 * n->nV);
     free(load);
     return rc;
@@ -656,31 +720,47 @@ int nlref_step(nlref *n, snref_state *s, double tol, nlref_stats *st) {
     memset(&pr, 0, sizeof pr);
     pr.n = n; pr.load = load; pr.dyn = 1; pr.p0 = p0; pr.v0 = v0;
     pr.a1 = m->a1 * s->hscale * s->dscale; pr.b1 = m->b1 / s->hscale * s->dscale; pr.Kn = Kn;
+    n->tw_s = s;
     rc = newton(&pr, s->p, n->alpha, tol, 50, st);
+    n->tw_s = NULL;
     for (i = 0; i < N3; i++) s->v[i] = s->p[i] - p0[i];
     s->steps++;
     free(load); free(p0); free(v0); free(Kn);
     return rc;
 }
 
-void nlref_twist_cell(const nlref *n, unsigned e, const double a0[3], const double a1[3], double r, double kappa,
+static double seg_d2(const double p[3], const double a0[3], const double a1[3]) {
+    double ab[3], l2 = 0, t = 0, d2 = 0;
+    int k;
+    for (k = 0; k < 3; k++) { ab[k] = a1[k] - a0[k]; l2 += ab[k] * ab[k]; t += (p[k] - a0[k]) * ab[k]; }
+    t = l2 > 0 ? t / l2 : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    for (k = 0; k < 3; k++) { double d = p[k] - a0[k] - t * ab[k]; d2 += d * d; }
+    return d2;
+}
+
+void nlref_twist_cell(const nlref *n, unsigned e, int nseg, const double *A0, const double *A1, int sel, double r, double kappa,
                       int nsub, double T[64]) {
     static const double gp2[2] = {0.21132486540518711775, 0.78867513459481288225};
     const double *x0 = n->o.x + 3 * n->o.cells[8 * e];
-    double c = n->o.c, hs = n->hc * n->hc * n->hc, w = hs / (8.0 * nsub * nsub * nsub), ab[3], l2;
-    int sx, sy, sz, g, a, b, k;
-    for (k = 0; k < 3; k++) ab[k] = a1[k] - a0[k];
-    l2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    double c = n->o.c, hs = n->hc * n->hc * n->hc, w = hs / (8.0 * nsub * nsub * nsub);
+    int sx, sy, sz, g, a, b, k, o;
     memset(T, 0, sizeof(double) * 64);
     for (sz = 0; sz < nsub; sz++) for (sy = 0; sy < nsub; sy++) for (sx = 0; sx < nsub; sx++)
         for (g = 0; g < 8; g++) {
-            double t[3], p[3], N[8], s, d2 = 0;
+            double t[3], p[3], N[8], d2;
+            int mine = 1;
             t[0] = (sx + gp2[g & 1]) / nsub; t[1] = (sy + gp2[(g >> 1) & 1]) / nsub; t[2] = (sz + gp2[(g >> 2) & 1]) / nsub;
             for (k = 0; k < 3; k++) p[k] = x0[k] + t[k] * c;
-            s = l2 > 0 ? ((p[0] - a0[0]) * ab[0] + (p[1] - a0[1]) * ab[1] + (p[2] - a0[2]) * ab[2]) / l2 : 0;
-            s = s < 0 ? 0 : s > 1 ? 1 : s;
-            for (k = 0; k < 3; k++) { double d = p[k] - a0[k] - s * ab[k]; d2 += d * d; }
+            d2 = seg_d2(p, A0 + 3 * sel, A1 + 3 * sel);
             if (d2 > r * r) continue;
+            for (o = 0; o < nseg && mine; o++) {   /* nearest bone only (ties: the lower index) */
+                double d2o;
+                if (o == sel) continue;
+                d2o = seg_d2(p, A0 + 3 * o, A1 + 3 * o);
+                if (d2o < d2 || (d2o == d2 && o < sel)) mine = 0;
+            }
+            if (!mine) continue;
             sb_shape(t, N, NULL);
             for (a = 0; a < 8; a++) for (b = 0; b < 8; b++) T[8 * a + b] += kappa * w * N[a] * N[b];
         }

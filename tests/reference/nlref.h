@@ -56,6 +56,12 @@ typedef struct nlref {
     unsigned n_trilinear;/* cells without bubbles */
     double *alpha;       /* nC*9 bubble amplitudes of the last solve (internal units) */
     double *lin_dmp;     /* scratch */
+    /* twist penalty (nlref_set_twist; none by default) */
+    unsigned ntw;        /* entries: (cell, bone) pairs with a non-zero T */
+    unsigned *tw_cell;
+    int *tw_joint;       /* joint whose transform moves the bone */
+    double *tw_T;        /* 64 per entry */
+    const snref_state *tw_s; /* pose of the bones during a solve */
 } nlref;
 
 typedef struct nlref_stats {
@@ -95,11 +101,18 @@ int nlref_static(nlref *n, snref_state *s, double tol, unsigned max_iter, nlref_
 int nlref_step(nlref *n, snref_state *s, double tol, nlref_stats *st);
 
 /* Twist (seed 000 eq. 25-26), test-side (the tool's term is retired): the
- * 8x8 scalar matrix T_ab = kappa * integral over cell e (rest) of the points
- * within radius r (mesh units) of segment a0-a1 (mesh units, model space) of
- * N_a N_b, by nsub^3 sub-boxes with 2x2x2 Gauss points and a 0/1 inside test
- * per point (internal units^3 volume). */
-void nlref_twist_cell(const nlref *n, unsigned e, const double a0[3], const double a1[3], double r, double kappa,
+ * 8x8 scalar matrix T_ab = kappa * integral over cell e (rest) of N_a N_b over
+ * the points within radius r (mesh units) of bone sel (segments A0[i]-A1[i],
+ * mesh units, model space) that have no other of the nseg bones nearer, by
+ * nsub^3 sub-boxes with 2x2x2 Gauss points and a 0/1 test per point (volume
+ * in internal units^3). */
+void nlref_twist_cell(const nlref *n, unsigned e, int nseg, const double *A0, const double *A1, int sel, double r, double kappa,
                       int nsub, double T[64]);
+
+/* Add the twist penalty U = 1/2 kappa int_{within r of a bone, nearest bone} |p - T_bone(x)|^2
+ * (seed 000 eq. 25-26; d relative to the rigidly moved bone) to the
+ * nonlinear solves: kappa in internal units (energy / internal length^5),
+ * r in mesh units, nsub as nlref_twist_cell. kappa <= 0 removes it. 0 or -1. */
+int nlref_set_twist(nlref *n, double kappa, double r, int nsub);
 
 #endif
