@@ -18,10 +18,10 @@
 #include "nlref.h"
 #include <string.h>
 
-#ifdef NL_PICTURES
 #include "raster.h"
 #include "png.h"
-#endif
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define LIMB "tools/examples/limb/limb.sinew"
 #define COW "tools/examples/cow/cow.sinew"
@@ -224,6 +224,75 @@ static void check_dynamic(nlref *n, const char *name, double eps, unsigned steps
 /* ---- 2./3. the comparison ---- */
 typedef struct { dist_t lin, warp, skin, nldisp; double vol_nl, vol_w, vol_lin, vol_skin; } cmp_t;
 
+/* one panel: surf (mesh units), coloured by |surf - base| / scale when base (as sinew-bake --static) */
+static void panel(rs_image *out, const snref_model *m, const double *surf, const double *base, double scale,
+                  const float lo[3], const float hi[3], const char *l1, const char *l2) {
+    static const float flesh[3] = {0.78f, 0.60f, 0.44f};
+    static const uint8_t ink[3] = {25, 28, 38};
+    rs_image big;
+    rs_camera cam;
+    float *pos = malloc(3 * (size_t)m->nS * sizeof *pos), *col = malloc(3 * (size_t)m->nS * sizeof *col);
+    uint32_t *tri = malloc(3 * (size_t)m->nT * sizeof *tri + 4);
+    unsigned i, k;
+    if (!pos || !col || !tri || rs_image_alloc(&big, 2 * out->w, 2 * out->h)) { free(pos); free(col); free(tri); return; }
+    for (i = 0; i < 3 * m->nS; i++) pos[i] = (float)surf[i];
+    for (i = 0; i < 3 * m->nT; i++) tri[i] = m->tris[i];
+    for (i = 0; i < m->nS; i++) {
+        float h = 0;
+        if (base && scale > 0) {
+            double d = 0;
+            for (k = 0; k < 3; k++) d += (surf[3 * i + k] - base[3 * i + k]) * (surf[3 * i + k] - base[3 * i + k]);
+            h = (float)(sqrt(d) / scale);
+            if (h > 1) h = 1;
+        }
+        col[3 * i] = flesh[0] + h * (0.95f - flesh[0]);
+        col[3 * i + 1] = flesh[1] + h * (0.12f - flesh[1]);
+        col[3 * i + 2] = flesh[2] + h * (0.05f - flesh[2]);
+    }
+    rs_camera_frame(&cam, lo, hi, big.w, big.h, 0.0f, 10.0f);
+    cam.ground_y = lo[1];
+    rs_clear(&big, &cam);
+    rs_draw_mesh_colors(&big, &cam, pos, (int)m->nS, tri, (int)m->nT, col);
+    rs_downsample2(&big, out);
+    rs_image_free(&big);
+    if (l1) rs_draw_text(out, 8, 8, 2, l1, ink);
+    if (l2) rs_draw_text(out, 8, 28, 1, l2, ink);
+    free(pos); free(col); free(tri);
+}
+
+/* $BUILD/nonlinear/elbow120.png: nonlinear | warped | global linear, the last
+ * two coloured by their distance from the nonlinear surface (red = 1 cell) */
+static void nl_picture(const nlref *n, const sols_t *s, const cmp_t *c, const char *name) {
+    enum { PW = 420, PH = 360 };
+    const char *b = getenv("BUILD");
+    char path[600], dir[512], err[300], l2[96];
+    const double *sf[3] = {s->nl, s->warp, s->lin};
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    uint8_t line[3] = {90, 90, 90};
+    rs_image img, pane;
+    unsigned i, k, j;
+    snprintf(dir, sizeof dir, "%s/nonlinear", b ? b : "build");
+    mkdir(dir, 0777);
+    snprintf(path, sizeof path, "%s/elbow120%s.png", dir, strcmp(name, "limb") ? "_half" : "");
+    for (j = 0; j < 3; j++)
+        for (i = 0; i < n->m.nS; i++)
+            for (k = 0; k < 3; k++) { float x = (float)sf[j][3 * i + k]; lo[k] = x < lo[k] ? x : lo[k]; hi[k] = x > hi[k] ? x : hi[k]; }
+    if (rs_image_alloc(&img, 3 * PW, PH) || rs_image_alloc(&pane, PW, PH)) return;
+    panel(&pane, &n->m, s->nl, NULL, 0, lo, hi, "nonlinear", "St. Venant-Kirchhoff, Newton");
+    rs_blit(&img, 0, 0, &pane);
+    snprintf(l2, sizeof l2, "rms %.3f max %.3f from nonlinear", c->warp.rms, c->warp.max);
+    panel(&pane, &n->m, s->warp, s->nl, n->o.c, lo, hi, "warped (shipped)", l2);
+    rs_blit(&img, PW, 0, &pane);
+    snprintf(l2, sizeof l2, "rms %.3f max %.3f from nonlinear", c->lin.rms, c->lin.max);
+    panel(&pane, &n->m, s->lin, s->nl, n->o.c, lo, hi, "global linear", l2);
+    rs_blit(&img, 2 * PW, 0, &pane);
+    rs_fill(&img, PW - 1, 0, 2, PH, line);
+    rs_fill(&img, 2 * PW - 1, 0, 2, PH, line);
+    if (png_write(path, img.rgb, img.w, img.h, err, sizeof err) == 0) printf("  wrote %s\n", path);
+    else T_CHECK(0, "%s", err);
+    rs_image_free(&pane); rs_image_free(&img);
+}
+
 static cmp_t compare(nlref *n, const snref_xform *pose, const char *name, const char *what, double V0, const double *rest) {
     sols_t s;
     cmp_t c;
@@ -238,25 +307,26 @@ static cmp_t compare(nlref *n, const snref_xform *pose, const char *name, const 
     c.vol_w = 100 * (snref_surface_volume(&n->m, s.warp) / V0 - 1);
     c.vol_lin = 100 * (snref_surface_volume(&n->m, s.lin) / V0 - 1);
     c.vol_skin = 100 * (snref_surface_volume(&n->m, s.skin) / V0 - 1);
-    printf("  %-6s %-14s | %6.3f %6.3f | %6.3f %6.3f | %6.3f %6.3f | %6.3f | %+7.2f %+7.2f %+7.2f %+7.2f | %u it\n", name, what,
-           c.lin.rms, c.lin.max, c.warp.rms, c.warp.max, c.skin.rms, c.skin.max, c.nldisp.rms,
-           c.vol_lin, c.vol_w, c.vol_nl, c.vol_skin, s.st.iters);
-#ifdef NL_PICTURES
-    if (figures && pose && !strcmp(what, "elbow 120")) {
-        extern void nl_picture(const nlref *n, const sols_t *s);
-        nl_picture(n, &s);
+    {   /* inverted quadrature points of the nonlinear solution (SVK lets elements invert), points at least half inside */
+        unsigned ninv;
+        double npt = (double)n->d.subdiv * n->d.subdiv * n->d.subdiv * 8;
+        double jmin = nlref_min_jacobian(n, s.latn, n->alpha, 0.5 * n->hc * n->hc * n->hc / npt, &ninv);
+        printf("  %-6s %-14s | %6.3f %6.3f | %6.3f %6.3f | %6.3f %6.3f | %6.3f | %+7.2f %+7.2f %+7.2f %+7.2f | %5.2f %4u | %u it\n", name, what,
+               c.lin.rms, c.lin.max, c.warp.rms, c.warp.max, c.skin.rms, c.skin.max, c.nldisp.rms,
+               c.vol_lin, c.vol_w, c.vol_nl, c.vol_skin, jmin, ninv, s.st.iters);
     }
-#endif
+    if (figures && !strcmp(what, "elbow 120")) nl_picture(n, &s, &c, name);
     sols_free(&s);
     return c;
 }
 
 static void header(void) {
-    printf("  asset  pose           | global linear | warped (ship) | skinned       | nl disp| volume change %%: linear warped nonlinear skinned\n");
-    printf("                        |  rms    max   |  rms    max   |  rms    max   |  rms   |\n");
+    printf("  distances of the surface from the nonlinear one and the nonlinear displacement from rest (mesh units); surface volume change; nonlinear min det F, points det F <= 0\n");
+    printf("  asset  pose           | global linear | warped (ship) | skinned       | nl disp|  linear  warped nonlin skinned %% | min J  inv | Newton\n");
+    printf("                        |  rms    max   |  rms    max   |  rms    max   |  rms   |                                  |            |\n");
 }
 
-static void limb_table(nlref *n) {
+static void limb_table(nlref *n, const char *name) {
     snref_xform pose[16];
     snref_state s0;
     double z[3] = {0, 0, 1}, V0, *rest = malloc(3 * n->m.nS * sizeof *rest);
@@ -274,7 +344,7 @@ static void limb_table(nlref *n) {
         char w[32];
         snprintf(w, sizeof w, "elbow %.0f", ang[a]);
         one_joint_pose(&n->m, el, z, ang[a], pose);
-        c[a] = compare(n, pose, "limb", w, V0, rest);
+        c[a] = compare(n, pose, name, w, V0, rest);
         T_CHECK(c[a].warp.rms < c[a].lin.rms && c[a].warp.max < c[a].lin.max,
                 "limb elbow %.0f: warped closer to nonlinear than global linear (rms %.4g vs %.4g, max %.4g vs %.4g)", ang[a], c[a].warp.rms, c[a].lin.rms, c[a].warp.max, c[a].lin.max);
     }
@@ -445,10 +515,36 @@ int main(int argc, char **argv) {
     check_quadratic(&n, "limb", 0.02);
     check_dynamic(&n, "limb", 0.02, figures ? 120 : 30);
     header();
-    limb_table(&n);
+    limb_table(&n, "limb");
     check_twist(&n);
     twisted_limb(&n);
     nlref_close(&n);
+    if (figures) {   /* the limb at half the cell: does the ordering hold on a finer lattice? */
+        char dir[512], desc[600], line[512], cwd[400];
+        const char *b = getenv("BUILD");
+        FILE *in = fopen(LIMB, "r"), *out;
+        snprintf(dir, sizeof dir, "%s/nonlinear", b ? b : "build");
+        mkdir(dir, 0777);
+        snprintf(desc, sizeof desc, "%s/limb_half.sinew", dir);
+        out = fopen(desc, "w");
+        if (in && out && getcwd(cwd, sizeof cwd)) {
+            while (fgets(line, sizeof line, in)) {
+                if (!strncmp(line, "mesh ", 5)) fprintf(out, "mesh %s/tools/examples/limb/limb.obj\n", cwd);
+                else if (!strncmp(line, "cell ", 5)) fprintf(out, "cell 0.5\n");
+                else fputs(line, out);
+            }
+        }
+        if (in) fclose(in);
+        if (out) fclose(out);
+        if (nlref_open(&n, desc, err, sizeof err)) T_CHECK(0, "limb at half the cell: %s", err);
+        else {
+            printf("limb, cell 0.5 (%u cells, %u free vertices)\n", n.nC, n.nF);
+            check_reference(&n, "limb/2");
+            header();
+            limb_table(&n, "limb/2");
+            nlref_close(&n);
+        }
+    }
     if (nlref_open(&n, COW, err, sizeof err)) { T_CHECK(0, "cow: %s", err); return T_END(); }
     check_reference(&n, "cow");
     check_quadratic(&n, "cow", 0.02);

@@ -765,3 +765,26 @@ void nlref_twist_cell(const nlref *n, unsigned e, int nseg, const double *A0, co
             for (a = 0; a < 8; a++) for (b = 0; b < 8; b++) T[8 * a + b] += kappa * w * N[a] * N[b];
         }
 }
+
+double nlref_min_jacobian(const nlref *n, const double *p, const double *alpha, double wmin, unsigned *ninv) {
+    unsigned e, q, a, i, k;
+    double jmin = HUGE_VAL, h = n->hc;
+    if (ninv) *ninv = 0;
+    for (e = 0; e < n->nC; e++) {
+        double P[24];
+        cell_pos(n, e, p, P);
+        for (q = n->efirst[e]; q < n->efirst[e + 1]; q++) {
+            const double *pw = n->emw + 4 * (size_t)q;
+            double N[8], dN[8][3], F[9] = {0}, J;
+            if (pw[3] < wmin) continue;
+            sb_shape(pw, N, dN);
+            for (a = 0; a < 8; a++) for (i = 0; i < 3; i++) for (k = 0; k < 3; k++) F[3 * i + k] += P[3 * a + i] * dN[a][k] / h;
+            if (n->inc[e] && alpha)
+                for (a = 0; a < 3; a++) for (i = 0; i < 3; i++) F[3 * i + a] += alpha[9 * e + 3 * a + i] * 4.0 * (1.0 - 2.0 * pw[a]) / h;
+            J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+            if (J < jmin) jmin = J;
+            if (J <= 0 && ninv) (*ninv)++;
+        }
+    }
+    return jmin;
+}

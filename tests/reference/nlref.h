@@ -19,13 +19,16 @@
  *
  * Energy density (seed 000 eq. 10-12): E = 1/2 (F^T F - I),
  * W = mu E:E + lambda/2 (tr E)^2, Lame parameters of the material at each
- * quadrature point. Quadrature: the tool's 27-node moment-fitted rule per
- * cell and material (weights = moments of the inside-weighted sub-box Gauss
- * points against the Lagrange basis through the 3-point Gauss-Legendre
- * nodes). It is exact for integrands of degree <= 2 per axis (so at rest it
- * gives the tool's matrices exactly), and for wholly inside cells, where it is
- * the 3x3x3 Gauss rule, exact up to degree 5 (W is of degree <= 4 per axis):
- * the nonlinear energy of a partially filled cell is the rule's approximation.
+ * quadrature point. Quadrature: a wholly inside (or wholly air) cell of one
+ * material uses the 3x3x3 Gauss rule (exact to degree 5 per axis; W is of
+ * degree <= 4 per axis, so exact); any other cell uses the tool's own points
+ * (subdiv^3 sub-boxes x 2x2x2 Gauss, weighted by the inside fraction of the
+ * point's box plus air outside, sb_box_fractions), all weights positive. The
+ * tool integrates the same points (through its 27-node moment rule, equal
+ * for its degree-2 integrands), so at rest the matrices agree to round-off.
+ * (The moment rule itself has negative weights on partly filled cells: fine
+ * for the tool's quadratic form, but the quartic SVK energy is then unbounded
+ * below, and the first version of this reference diverged on the cow.)
  *
  * Static: minimise Pi(p_F, alpha) = sum_e psi_e - load . p_F (skeleton fixed at
  * the pose, load = the blob's gravity as snref applies it) by Newton's method
@@ -49,9 +52,9 @@ typedef struct nlref {
     double L;            /* metres per internal unit */
     double hc;           /* cell edge, internal units */
     unsigned nC, nF, nV;
-    unsigned *efirst;    /* nC+1: material entries of cell e */
-    double *elam, *emu;  /* per entry: Lame parameters in internal units (x h^2 L / m0) */
-    double *emw;         /* per entry: 27 moment weights, internal units^3 */
+    unsigned *efirst;    /* nC+1: quadrature points of cell e */
+    double *elam, *emu;  /* per point: Lame parameters in internal units (x h^2 L / m0) */
+    double *emw;         /* per point: t[3] in the cell, weight (internal units^3) */
     unsigned char *inc;  /* per cell: 1 = bubbles (incompatible modes) */
     unsigned n_trilinear;/* cells without bubbles */
     double *alpha;       /* nC*9 bubble amplitudes of the last solve (internal units) */
@@ -108,6 +111,11 @@ int nlref_step(nlref *n, snref_state *s, double tol, nlref_stats *st);
  * in internal units^3). */
 void nlref_twist_cell(const nlref *n, unsigned e, int nseg, const double *A0, const double *A1, int sel, double r, double kappa,
                       int nsub, double T[64]);
+
+/* Smallest det F over the quadrature points of weight >= wmin (internal
+ * units^3; e.g. half a point's inside weight to leave air points out) at
+ * positions p and bubbles alpha; *ninv (if non-NULL) = points with det F <= 0. */
+double nlref_min_jacobian(const nlref *n, const double *p, const double *alpha, double wmin, unsigned *ninv);
 
 /* Add the twist penalty U = 1/2 kappa int_{within r of a bone, nearest bone} |p - T_bone(x)|^2
  * (seed 000 eq. 25-26; d relative to the rigidly moved bone) to the
