@@ -7,6 +7,8 @@
 
 #define ND 33   /* dofs per cell: 8 corners x 3, then 3 bubbles x 3 */
 
+static double inv_wmin(const nlref *n);
+
 static const double gl3[3] = {0.11270166537925831148, 0.5, 0.88729833462074168852};
 static const double gw3[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
 
@@ -552,6 +554,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
     for (it = 0;; it++) {
         double gn2 = 0, fsc2 = 0, lsc2 = 0, res, D, Pi0, t, kmax = 0, sh = 0;
         int tries = 0;
+        unsigned ninv0 = 0;
         memset(K, 0, sizeof(double) * F3 * F3);
         for (i = 0; i < F3; i++) { r[i] = -pr->load[i]; lsc2 += pr->load[i] * pr->load[i]; }
         if (pr->dyn) dyn_terms(pr, p, r);
@@ -652,10 +655,16 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
             free(gp);
         }
         Pi0 = pi_value(pr, p, alpha);
+        if (n->keep_orientation) nlref_min_jacobian(n, p, alpha, inv_wmin(n), &ninv0);
         for (t = 1; t > 1e-12; t *= 0.5) {
             double Pt;
             for (i = 0; i < 3 * n->nV; i++) pt[i] = p[i] + t * dp[i];
             for (i = 0; i < 9 * nC; i++) at[i] = alpha[i] + t * dal[i];
+            if (n->keep_orientation) {   /* no step may invert more quadrature points */
+                unsigned ninv;
+                nlref_min_jacobian(n, pt, at, inv_wmin(n), &ninv);
+                if (ninv > ninv0) continue;
+            }
             Pt = pi_value(pr, pt, at);
             /* Armijo; near convergence Pi's round-off hides the decrease: a full
              * step that halves the gradient is taken too (quadratic convergence) */
@@ -772,6 +781,9 @@ double nlref_min_jacobian(const nlref *n, const double *p, const double *alpha, 
     if (ninv) *ninv = 0;
     for (e = 0; e < n->nC; e++) {
         double P[24];
+        int free_ = 0;
+        for (a = 0; a < 8; a++) free_ |= n->m.cells[8 * e + a] < n->nF;
+        if (!free_) continue;   /* every corner on a bone: the pose alone decides it */
         cell_pos(n, e, p, P);
         for (q = n->efirst[e]; q < n->efirst[e + 1]; q++) {
             const double *pw = n->emw + 4 * (size_t)q;
@@ -787,4 +799,8 @@ double nlref_min_jacobian(const nlref *n, const double *p, const double *alpha, 
         }
     }
     return jmin;
+}
+
+static double inv_wmin(const nlref *n) {
+    return 0.5 * n->hc * n->hc * n->hc / ((double)n->d.subdiv * n->d.subdiv * n->d.subdiv * 8);
 }

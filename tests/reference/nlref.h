@@ -59,6 +59,9 @@ typedef struct nlref {
     unsigned n_trilinear;/* cells without bubbles */
     double *alpha;       /* nC*9 bubble amplitudes of the last solve (internal units) */
     double *lin_dmp;     /* scratch */
+    int keep_orientation;/* 1: the line search refuses steps that invert more quadrature points
+                          * (weight >= half an inside point, cells with a free corner) than the
+                          * current iterate has: stays in the basin of the start. 0 (default): plain */
     /* twist penalty (nlref_set_twist; none by default) */
     unsigned ntw;        /* entries: (cell, bone) pairs with a non-zero T */
     unsigned *tw_cell;
@@ -113,7 +116,8 @@ void nlref_twist_cell(const nlref *n, unsigned e, int nseg, const double *A0, co
                       int nsub, double T[64]);
 
 /* Smallest det F over the quadrature points of weight >= wmin (internal
- * units^3; e.g. half a point's inside weight to leave air points out) at
+ * units^3; e.g. half a point's inside weight to leave air points out) of the
+ * cells with at least one free corner, at
  * positions p and bubbles alpha; *ninv (if non-NULL) = points with det F <= 0. */
 double nlref_min_jacobian(const nlref *n, const double *p, const double *alpha, double wmin, unsigned *ninv);
 
