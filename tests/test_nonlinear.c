@@ -134,7 +134,7 @@ static void solve_pose(nlref *n, const snref_xform *pose, double gscale, int kee
             memcpy(s.p, o->latw, 3 * nV * sizeof(double));
             memset(n->alpha, 0, sizeof(double) * 9 * n->nC);
             n->keep_orientation = 1;
-            o->nlrc2 = nlref_static(n, &s, NL_TOL, 200, &o->st2);
+            o->nlrc2 = nlref_static(n, &s, NL_TOL, 40, &o->st2);
             n->keep_orientation = 0;
             snref_get_surface(&s, o->nlk);
             o->jk = nlref_min_jacobian(n, s.p, n->alpha, wmin, &o->ik);
@@ -321,6 +321,8 @@ static cmp_t compare(nlref *n, const snref_xform *pose, const char *name, const 
     solve_pose(n, pose, 1.0, figures, &s);
     T_CHECK(s.nlrc == 0 && s.st.relres <= NL_TOL, "%s %s: nonlinear Newton converged: %u iterations (%u shifted), relative residual %.3g (tol %g)",
             name, what, s.st.iters, s.st.shifts, s.st.relres, NL_TOL);
+    /* hook: blended local linearization (seed 000 sec. 4.5, issue 13 item 4) is not built; its
+     * solution at the pose belongs beside s.lin and s.warp here (a fourth column) once it exists */
     c.lin = sdist(s.lin, s.nl, nS); c.warp = sdist(s.warp, s.nl, nS); c.skin = sdist(s.skin, s.nl, nS);
     c.nldisp = sdist(s.nl, rest, nS);
     c.vol_nl = 100 * (snref_surface_volume(&n->m, s.nl) / V0 - 1);

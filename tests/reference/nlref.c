@@ -538,7 +538,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
     double *H = malloc(sizeof(double) * ND * ND * nC), *G = malloc(sizeof(double) * ND * nC);
     double *fac = malloc(sizeof(double) * 81 * nC), *Y = malloc(sizeof(double) * 225 * nC), *dal = malloc(sizeof(double) * 9 * nC);
     double *pt = malloc(sizeof(double) * 3 * n->nV), *at = malloc(sizeof(double) * 9 * nC), *Md = NULL;
-    int rc = -1;
+    int rc = -1, small = 0;
     nlref_stats s0;
     if (!st) st = &s0;
     memset(st, 0, sizeof *st);
@@ -671,6 +671,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
             if (Pt <= Pi0 + 1e-4 * t * D || (t == 1 && grad_norm(pr, pt, at) <= 0.5 * res)) break;
         }
         if (!(t > 1e-12)) break;   /* line search failed */
+        if (t < 1e-3 && ++small >= 5) break;   /* stalled (an orientation-keeping solve against a fold) */
         memcpy(p, pt, sizeof(double) * 3 * n->nV);
         memcpy(alpha, at, sizeof(double) * 9 * nC);
     }
