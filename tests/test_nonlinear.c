@@ -177,6 +177,33 @@ static void check_reference(nlref *n, const char *name) {
         fsc = fmaxabs * n->hc;   /* force of a one-cell displacement through the largest entry */
         T_FIGURE("%s: rigid motion (73 deg about (0.3,-0.8,0.52), translation): |f|max %.3g = %.3g of a cell-displacement force, energy %.3g", name, fm, fm / fsc, E);
         T_CHECK(fm <= 1e-12 * fsc, "%s: rigid motion: elastic force %.3g of %.3g (1e-12 relative)", name, fm, fsc);
+        {   /* the same through the skeleton: the root turned and moved (every bone the same rigid motion), then a
+             * nonlinear static solve without gravity must stay at the rigidly moved rest (skinned) shape */
+            snref_state s;
+            snref_xform *pose = calloc(n->m.nJ, sizeof *pose);
+            double *lq = calloc(4 * n->m.nJ, sizeof *lq), dmax = 0;
+            nlref_stats st;
+            unsigned j, root = 0;
+            for (j = 0; j < n->m.nJ; j++) { lq[4 * j + 3] = 1; if (n->m.jparent[j] < 0) root = j; }
+            snref_quat_axis_angle(ax, 73.0, lq + 4 * root);
+            pose_from_local(&n->m, lq, pose);
+            for (j = 0; j < n->m.nJ; j++) { pose[j].t[0] += 3.0; pose[j].t[1] -= 1.5; pose[j].t[2] += 0.25; }
+            snref_init(&s, &n->m);
+            s.gscale = 0; s.rig_scale = 0;
+            snref_set_pose(&s, pose);   /* the first pose places the flesh at R x + c */
+            memcpy(p, s.p, 3 * nV * sizeof *p);
+            nlref_force(n, p, NULL, f);
+            fm = 0;
+            for (i = 0; i < F3; i++) fm = fmax(fm, fabs(f[i]));
+            memset(n->alpha, 0, sizeof(double) * 9 * n->nC);
+            nlref_static(n, &s, NL_TOL, 20, &st);
+            for (i = 0; i < 3 * nV; i++) dmax = fmax(dmax, fabs(s.p[i] - p[i]));
+            T_FIGURE("%s: root joint turned 73 deg and moved: nonlinear force at the skinned shape %.3g of a cell-displacement force; static solve moves it %.3g cells",
+                     name, fm / fsc, dmax / n->hc);
+            T_CHECK(fm <= 1e-12 * fsc && dmax <= 1e-9 * n->hc, "%s: rigidly moved skeleton: no nonlinear elastic force (%.3g) and the static solution is the rigid shape (%.3g cells)",
+                    name, fm / fsc, dmax / n->hc);
+            snref_release(&s); free(pose); free(lq);
+        }
         free(p); free(f);
     }
 }
