@@ -26,9 +26,10 @@
  * point's box plus air outside, sb_box_fractions), all weights positive. The
  * tool integrates the same points (through its 27-node moment rule, equal
  * for its degree-2 integrands), so at rest the matrices agree to round-off.
- * (The moment rule itself has negative weights on partly filled cells: fine
- * for the tool's quadratic form, but the quartic SVK energy is then unbounded
- * below, and the first version of this reference diverged on the cow.)
+ * (With the moment rule itself the first version of this reference diverged
+ * on the cow's head turn; an interpolatory rule for a non-uniform weight may
+ * have negative weights, harmless for the tool's quadratic form but not for
+ * the quartic SVK energy. Not checked directly.)
  *
  * Static: minimise Pi(p_F, alpha) = sum_e psi_e - load . p_F (skeleton fixed at
  * the pose, load = the blob's gravity as snref applies it) by Newton's method
