@@ -177,3 +177,20 @@ $(BUILD)/tests/test_runtime_force_float: $(FORCE_RT_DEPS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force_float
+
+# Nonlinear St. Venant-Kirchhoff reference (issue 13 items 5-6,
+# tests/reference/NONLINEAR.md): bakes the limb and the cow with the tool
+# library itself and compares global linear, warped and nonlinear solutions.
+NL_SRC = tests/reference/nlref.c tools/ref/snref.c ports/desktop/raster.c ports/desktop/png.c
+NL_HDR = tests/reference/nlref.h tools/ref/snref.h tools/sb.h tests/sn_test.h ports/desktop/raster.h ports/desktop/png.h
+$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) -lm
+TEST_BINS += $(BUILD)/tests/test_nonlinear
+
+# make nonlinear-figures: the same tables with a longer dynamic run, the limb
+# also at half the cell, and $(BUILD)/nonlinear/elbow120.png (nonlinear |
+# warped | global linear at the 120-degree elbow).
+.PHONY: nonlinear-figures
+nonlinear-figures: $(BUILD)/tests/test_nonlinear
+	BUILD=$(BUILD) $(BUILD)/tests/test_nonlinear --figures
