@@ -468,6 +468,7 @@ int snref_init(snref_state *s, const snref_model *m) {
     s->dscale = 1.0;
     s->path_slerp = 1;
     s->first_pose_moves_free = 1;
+    if (snref_set_regions(s, 0, NULL, NULL)) { snref_release(s); return -1; }
     snref_reset(s);
     return 0;
 }
@@ -476,6 +477,7 @@ void snref_release(snref_state *s) {
     band_free(s->band);
     free(s->p); free(s->v); free(s->dv); free(s->R); free(s->c); free(s->Rc); free(s->jq); free(s->jt); free(s->work);
     free(s->ctl);
+    free(s->rbone); free(s->rw);
     memset(s, 0, sizeof *s);
 }
 
@@ -1086,6 +1088,389 @@ static void limits_and_health(snref_state *s) {
     if (s->energy > s->energy_max) s->energy_max = s->energy;
 }
 
+/* ---------------- blended local linearization (SNREF_BLENDED, seed 000 sec. 4.5) ---------------- */
+
+int snref_set_regions(snref_state *s, unsigned nreg, const int *rbone, const double *W) {
+    const snref_model *m = s->m;
+    unsigned r, a;
+    int *nb;
+    double *nw;
+    if (!W) nreg = m->nJ;
+    if (nreg == 0 && !W) { free(s->rbone); free(s->rw); s->rbone = NULL; s->rw = NULL; s->nreg = 0; return 0; }   /* no joints: no regions */
+    if (nreg == 0) return -1;
+    nb = malloc(nreg * sizeof *nb);
+    nw = calloc((size_t)nreg * m->nV, sizeof *nw);
+    if (!nb || !nw) { free(nb); free(nw); return -1; }
+    if (!W) {   /* one region per joint; W from the vertex frames (FRAMES: a partition of unity over bones) */
+        for (r = 0; r < nreg; r++) nb[r] = (int)r;
+        for (a = 0; a < m->nV; a++) {
+            nw[(size_t)m->fb1[a] * m->nV + a] += 1.0 - m->fw[a];
+            nw[(size_t)m->fb2[a] * m->nV + a] += m->fw[a];
+        }
+    } else {
+        for (r = 0; r < nreg; r++)
+            if (rbone[r] < 0 || (unsigned)rbone[r] >= m->nJ) { free(nb); free(nw); return -1; }
+        memcpy(nb, rbone, nreg * sizeof *nb);
+        memcpy(nw, W, (size_t)nreg * m->nV * sizeof *nw);
+        for (a = 0; a < m->nF; a++) {
+            double sum = 0;
+            for (r = 0; r < nreg; r++) {
+                double x = nw[(size_t)r * m->nV + a];
+                if (!(x >= 0)) { free(nb); free(nw); return -1; }
+                sum += x;
+            }
+            if (fabs(sum - 1.0) > 1e-9) { free(nb); free(nw); return -1; }
+        }
+    }
+    free(s->rbone); free(s->rw);
+    s->rbone = nb; s->rw = nw; s->nreg = nreg;
+    return 0;
+}
+
+/* One region at the current pose: frame R^r of its bone, its cells (a free
+ * vertex of positive weight), its unknowns (free vertices of those cells; with
+ * blend_hold only those of positive weight). */
+typedef struct { double R[9]; const double *W; unsigned char *cm, *vm; unsigned nc, nu; } blend_region;
+
+static int region_setup(const snref_state *s, unsigned r, blend_region *g) {
+    const snref_model *m = s->m;
+    unsigned e, a;
+    g->W = s->rw + (size_t)r * m->nV;
+    g->cm = calloc(m->nC + 1, 1);
+    g->vm = calloc(m->nV + 1, 1);
+    g->nc = g->nu = 0;
+    if (!g->cm || !g->vm) return -1;
+    snref_quat_to_mat(s->jq + 4 * s->rbone[r], g->R);
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        for (a = 0; a < 8; a++)
+            if (cv[a] < m->nF && g->W[cv[a]] > 0) { g->cm[e] = 1; break; }
+        if (!g->cm[e]) continue;
+        g->nc++;
+        for (a = 0; a < 8; a++)
+            if (cv[a] < m->nF && (!s->blend_hold || g->W[cv[a]] > 0)) g->vm[cv[a]] = 1;
+    }
+    for (a = 0; a < m->nF; a++) g->nu += g->vm[a];
+    return 0;
+}
+
+static void region_release(blend_region *g) { free(g->cm); free(g->vm); g->cm = g->vm = NULL; }
+
+/* cell_terms over the region's cells with every cell frame = R^r: out_a -= R^r g_a (free a). */
+static double region_terms(const snref_state *s, const blend_region *g, const double *p, const double *w, double *out) {
+    const snref_model *m = s->m;
+    double E = 0, sc = sscale(s);
+    unsigned e, a, i, k;
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *K = KE(m, e);
+        double dd[24], dw[24], gg[24];
+        if (!g->cm[e]) continue;
+        for (a = 0; a < 8; a++) {
+            double u[3], x[3];
+            for (k = 0; k < 3; k++) u[k] = p[3 * cv[a] + k] - p[3 * cv[0] + k];
+            matT_vec(g->R, u, x);
+            for (k = 0; k < 3; k++) dd[3 * a + k] = x[k] - (m->rest[3 * cv[a] + k] - m->rest[3 * cv[0] + k]);
+            if (w) {
+                for (k = 0; k < 3; k++) u[k] = w[3 * cv[a] + k] - w[3 * cv[0] + k];
+                matT_vec(g->R, u, dw + 3 * a);
+            } else dw[3 * a] = dw[3 * a + 1] = dw[3 * a + 2] = 0;
+        }
+        for (i = 0; i < 24; i++) {
+            double t = 0, tw = 0;
+            for (k = 0; k < 24; k++) { t += K[24 * i + k] * dd[k]; tw += K[24 * i + k] * dw[k]; }
+            E += 0.5 * sc * dd[i] * t;
+            gg[i] = sc * (t + tw);
+        }
+        if (out)
+            for (a = 0; a < 8; a++) {
+                double y[3];
+                if (cv[a] >= m->nF) continue;
+                mat_vec(g->R, gg + 3 * a, y);
+                for (k = 0; k < 3; k++) out[3 * cv[a] + k] -= y[k];
+            }
+    }
+    return E;
+}
+
+/* y = A^r x on the region's unknowns: (1+a1) M^ x + (1+b1) K^r x, x zero off the unknowns, other rows 0. */
+static void region_amul(const snref_state *s, const blend_region *g, const double *x, double *y) {
+    const snref_model *m = s->m;
+    unsigned e, a, b, i, k;
+    double ca = 1.0 + a1_of(s), sc = sscale(s) * (1.0 + b1_of(s));
+    mass_mul(s, x, y, 0);
+    for (i = 0; i < 3 * m->nF; i++) y[i] *= ca;
+    for (e = 0; e < m->nC; e++) {
+        const unsigned *cv = m->cells + 8 * e;
+        const double *K = KE(m, e);
+        double loc[24];
+        if (!g->cm[e]) continue;
+        for (b = 0; b < 8; b++) {
+            if (cv[b] >= m->nF || !g->vm[cv[b]]) { loc[3 * b] = loc[3 * b + 1] = loc[3 * b + 2] = 0; continue; }
+            matT_vec(g->R, x + 3 * cv[b], loc + 3 * b);
+        }
+        for (a = 0; a < 8; a++) {
+            double t[3] = { 0, 0, 0 }, z[3];
+            if (cv[a] >= m->nF || !g->vm[cv[a]]) continue;
+            for (i = 0; i < 3; i++)
+                for (k = 0; k < 24; k++) t[i] += K[24 * (3 * a + i) + k] * loc[k];
+            mat_vec(g->R, t, z);
+            for (k = 0; k < 3; k++) y[3 * cv[a] + k] += sc * z[k];
+        }
+    }
+    for (i = 0; i < m->nF; i++)
+        if (!g->vm[i]) y[3 * i] = y[3 * i + 1] = y[3 * i + 2] = 0;
+}
+
+/* PCG on the region's system (block Jacobi R^r P_i R^rT), `iters` iterations or to convergence (0). */
+static double region_pcg(snref_state *s, const blend_region *g, const double *b, double *x, unsigned iters) {
+    const snref_model *m = s->m;
+    unsigned n = 3 * m->nF, it, i, maxit = iters ? iters : 20 * n + 100;
+    double *r = malloc(n * sizeof *r), *z = malloc(n * sizeof *z), *d = malloc(n * sizeof *d), *Ad = malloc(n * sizeof *Ad);
+    const double *P = precond_blocks(s);
+    double rz, bn = sqrt(dot(b, b, n)), res;
+#define REGION_PRE(rr, zz) \
+    for (i = 0; i < m->nF; i++) { \
+        double a_[3], b_[3]; \
+        if (!g->vm[i]) { zz[3 * i] = zz[3 * i + 1] = zz[3 * i + 2] = 0; continue; } \
+        matT_vec(g->R, rr + 3 * i, a_); mat_vec(P + 9 * i, a_, b_); mat_vec(g->R, b_, zz + 3 * i); \
+    }
+    region_amul(s, g, x, Ad);
+    for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
+    REGION_PRE(r, z)
+    memcpy(d, z, n * sizeof *d);
+    rz = dot(r, z, n);
+    for (it = 0; it < maxit; it++) {
+        double dAd, alpha, rz2, beta;
+        if (!iters && sqrt(dot(r, r, n)) <= 1e-14 * bn) break;
+        region_amul(s, g, d, Ad);
+        dAd = dot(d, Ad, n);
+        alpha = dAd > 0 ? rz / dAd : 0.0;
+        for (i = 0; i < n; i++) { x[i] += alpha * d[i]; r[i] -= alpha * Ad[i]; }
+        REGION_PRE(r, z)
+        rz2 = dot(r, z, n);
+        beta = rz > 0 ? rz2 / rz : 0.0;
+        for (i = 0; i < n; i++) d[i] = z[i] + beta * d[i];
+        rz = rz2;
+    }
+#undef REGION_PRE
+    region_amul(s, g, x, Ad);
+    for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
+    res = bn > 0 ? sqrt(dot(r, r, n)) / bn : 0.0;
+    free(r); free(z); free(d); free(Ad);
+    return res;
+}
+
+/* Steps 5-6 of the blended step: bc = the step's right-hand side without the
+ * elastic terms (gravity, rigs, mass terms; free rows); per region add
+ * -K^r-terms (force and damping w), solve, merge dv = sum_r W^r dv^r. */
+static void blended_solve(snref_state *s, const double *pp, const double *w, const double *bc, double *dv) {
+    const snref_model *m = s->m;
+    unsigned n = 3 * m->nF, r, a, k;
+    double *br = malloc(n * sizeof *br), *x = malloc(n * sizeof *x), *acc = calloc(n, sizeof *acc), worst = 0;
+    for (r = 0; r < s->nreg; r++) {
+        blend_region g;
+        double res;
+        if (region_setup(s, r, &g) || g.nu == 0) { region_release(&g); continue; }
+        memcpy(br, bc, n * sizeof *br);
+        region_terms(s, &g, pp, w, br);
+        for (a = 0; a < m->nF; a++)
+            for (k = 0; k < 3; k++) {
+                if (!g.vm[a]) br[3 * a + k] = 0;
+                x[3 * a + k] = (s->warm && g.vm[a]) ? dv[3 * a + k] : 0.0;
+            }
+        res = region_pcg(s, &g, br, x, s->exact ? 0u : s->iters);
+        if (res > worst) worst = res;
+        for (a = 0; a < m->nF; a++)
+            for (k = 0; k < 3; k++) acc[3 * a + k] += g.W[a] * x[3 * a + k];
+        region_release(&g);
+    }
+    memcpy(dv, acc, n * sizeof *dv);
+    s->last_cg_relres = worst;
+    free(br); free(x); free(acc);
+}
+
+/* Dense LU with partial pivoting (in place), and its solve. */
+static int lu_factor(double *A, unsigned *piv, unsigned n) {
+    unsigned i, j, k;
+    for (k = 0; k < n; k++) {
+        unsigned p = k;
+        double mx = fabs(A[(size_t)k * n + k]);
+        for (i = k + 1; i < n; i++)
+            if (fabs(A[(size_t)i * n + k]) > mx) { mx = fabs(A[(size_t)i * n + k]); p = i; }
+        piv[k] = p;
+        if (mx == 0) return -1;
+        if (p != k)
+            for (j = 0; j < n; j++) { double t = A[(size_t)k * n + j]; A[(size_t)k * n + j] = A[(size_t)p * n + j]; A[(size_t)p * n + j] = t; }
+        for (i = k + 1; i < n; i++) {
+            double l = A[(size_t)i * n + k] / A[(size_t)k * n + k];
+            A[(size_t)i * n + k] = l;
+            if (l != 0)
+                for (j = k + 1; j < n; j++) A[(size_t)i * n + j] -= l * A[(size_t)k * n + j];
+        }
+    }
+    return 0;
+}
+static void lu_solve(const double *A, const unsigned *piv, unsigned n, double *b) {
+    unsigned i, j, k;
+    for (k = 0; k < n; k++)   /* all row swaps first: lu_factor swaps whole rows, L included */
+        if (piv[k] != k) { double t = b[k]; b[k] = b[piv[k]]; b[piv[k]] = t; }
+    for (k = 0; k < n; k++)
+        for (i = k + 1; i < n; i++) b[i] -= A[(size_t)i * n + k] * b[k];
+    for (i = n; i-- > 0;) {
+        double t = b[i];
+        for (j = i + 1; j < n; j++) t -= A[(size_t)i * n + j] * b[j];
+        b[i] = t / A[(size_t)i * n + i];
+    }
+}
+
+/* snref_static in SNREF_BLENDED: the steady state of the blended step at the
+ * fixed pose. With v = 0 the step's merged update is
+ *     G(p) = sum_r W^r (A^r)^-1 rr(p),  rr = region force + gravity + rigs
+ * (region unknowns), affine in p_F with dG/dp_F = -sum_r W^r (A^r)^-1 K^r.
+ * Built densely per region (A^r, K^r assembled from S^_e and M^), one dense
+ * LU of J (+ 1e-10 I), then refinement passes (G re-evaluated with the stored region
+ * factors) until |G| stops falling. Returns |G(p)| / max(|G(p_start)|, |G of the load
+ * alone|) (0 if both are 0). */
+typedef struct { unsigned N, *u, *piv; double *A; } blend_fac;
+
+static void region_rhs(snref_state *s, const blend_region *g, const blend_fac *f, double *full, double *loc, int with_force) {
+    const snref_model *m = s->m;
+    unsigned i, k;
+    memset(full, 0, 3 * m->nF * sizeof *full);
+    if (with_force) region_terms(s, g, s->p, NULL, full);
+    gravity_add(s, full);
+    snref_rig_add(s, full);
+    for (i = 0; i < f->N / 3; i++)
+        for (k = 0; k < 3; k++) loc[3 * i + k] = full[3 * f->u[i] + k];
+    lu_solve(f->A, f->piv, f->N, loc);
+}
+
+static double blended_static(snref_state *s) {
+    const snref_model *m = s->m;
+    unsigned n = 3 * m->nF, r, i, j, k, a, b, e, pass, nr = s->nreg;
+    double *J = calloc((size_t)n * n, sizeof *J), *G = calloc(n, sizeof *G), *full = malloc(n * sizeof *full), *dx = malloc(n * sizeof *dx);
+    unsigned *piv = malloc(n * sizeof *piv);
+    int *loc = malloc(m->nV * sizeof *loc), *cloc = malloc(m->nV * sizeof *cloc);
+    unsigned *cu = malloc(m->nV * sizeof *cu);
+    memset(dx, 0, n * sizeof *dx);
+    blend_fac *F = calloc(nr + 1, sizeof *F);
+    blend_region *Rg = calloc(nr + 1, sizeof *Rg);
+    double g0 = 0, gn = 0, prev = HUGE_VAL, ca = 1.0 + a1_of(s), cb = 1.0 + b1_of(s), sc = sscale(s);
+    if (!s->posed) {
+        snref_xform *id = calloc(m->nJ, sizeof *id);
+        for (i = 0; i < m->nJ; i++) id[i].q[3] = 1;
+        snref_set_pose(s, id);
+        free(id);
+    }
+    for (k = m->nF; k < m->nV; k++) { skeleton_pos(s, k, s->p + 3 * k); s->v[3 * k] = s->v[3 * k + 1] = s->v[3 * k + 2] = 0; }
+    /* per region: A^r (LU) and the rows W^r (A^r)^-1 K^r of -J */
+    for (r = 0; r < nr; r++) {
+        blend_fac *f = F + r;
+        blend_region *g = Rg + r;
+        double *K, *col;
+        unsigned N, Nc = 0;
+        if (region_setup(s, r, g) || g->nu == 0) continue;
+        N = f->N = 3 * g->nu;
+        f->u = malloc(g->nu * sizeof *f->u);
+        f->piv = malloc(N * sizeof *f->piv);
+        f->A = calloc((size_t)N * N, sizeof *f->A);
+        for (i = 0; i < m->nV; i++) loc[i] = cloc[i] = -1;
+        for (i = 0, j = 0; i < m->nF; i++) if (g->vm[i]) { f->u[j] = i; loc[i] = (int)j++; }
+        /* G's columns: every free vertex of the region's cells (with blend_hold the held ones move rr too) */
+        for (e = 0; e < m->nC; e++)
+            if (g->cm[e])
+                for (a = 0; a < 8; a++) {
+                    unsigned v = m->cells[8 * e + a];
+                    if (v < m->nF && cloc[v] < 0) { cu[Nc] = v; cloc[v] = (int)Nc++; }
+                }
+        Nc *= 3;
+        K = calloc((size_t)N * Nc, sizeof *K);
+        col = malloc(N * sizeof *col);
+        for (i = 0; i < m->nF; i++) {   /* mass, restricted */
+            if (loc[i] < 0) continue;
+            for (k = 0; k < 3; k++) f->A[(size_t)(3 * loc[i] + k) * N + 3 * loc[i] + k] += ca * m->mdiag[i];
+            for (e = m->rowptr[i]; e < m->rowptr[i + 1]; e++) {
+                unsigned jj = m->cols[e];
+                if (jj >= m->nF || loc[jj] < 0) continue;
+                for (k = 0; k < 3; k++) {
+                    f->A[(size_t)(3 * loc[i] + k) * N + 3 * loc[jj] + k] += ca * m->moff[e];
+                    f->A[(size_t)(3 * loc[jj] + k) * N + 3 * loc[i] + k] += ca * m->moff[e];
+                }
+            }
+        }
+        for (e = 0; e < m->nC; e++) {   /* K^r = sum R^r S^_e R^rT over the region's cells */
+            const unsigned *cv = m->cells + 8 * e;
+            const double *Ke = KE(m, e);
+            if (!g->cm[e]) continue;
+            for (a = 0; a < 8; a++) {
+                if (cv[a] >= m->nF || loc[cv[a]] < 0) continue;
+                for (b = 0; b < 8; b++) {
+                    double B[9], T[9], C[9];
+                    unsigned p, q, t;
+                    if (cv[b] >= m->nF) continue;
+                    for (p = 0; p < 3; p++) for (q = 0; q < 3; q++) B[3 * p + q] = Ke[24 * (3 * a + p) + 3 * b + q];
+                    for (p = 0; p < 3; p++) for (q = 0; q < 3; q++) { T[3 * p + q] = 0; for (t = 0; t < 3; t++) T[3 * p + q] += g->R[3 * p + t] * B[3 * t + q]; }
+                    for (p = 0; p < 3; p++) for (q = 0; q < 3; q++) { C[3 * p + q] = 0; for (t = 0; t < 3; t++) C[3 * p + q] += T[3 * p + t] * g->R[3 * q + t]; }
+                    for (p = 0; p < 3; p++)
+                        for (q = 0; q < 3; q++) {
+                            K[(size_t)(3 * loc[cv[a]] + p) * Nc + 3 * (unsigned)cloc[cv[b]] + q] += sc * C[3 * p + q];
+                            if (loc[cv[b]] >= 0) f->A[(size_t)(3 * loc[cv[a]] + p) * N + 3 * loc[cv[b]] + q] += cb * sc * C[3 * p + q];
+                        }
+                }
+            }
+        }
+        if (lu_factor(f->A, f->piv, N)) { free(K); free(col); continue; }
+        for (j = 0; j < Nc; j++) {      /* column j of (A^r)^-1 K^r, scattered with W^r into -J */
+            unsigned gj = 3 * cu[j / 3] + j % 3;
+            for (i = 0; i < N; i++) col[i] = K[(size_t)i * Nc + j];
+            lu_solve(f->A, f->piv, N, col);
+            for (i = 0; i < N; i++) {
+                double wv = g->W[f->u[i / 3]];
+                if (wv > 0) J[(size_t)(3 * f->u[i / 3] + i % 3) * n + gj] += wv * col[i];
+            }
+        }
+        free(K); free(col);
+    }
+    /* J can be singular where K^r is: free flesh that spins about a straight chain of skeleton vertices at no
+     * cost (see snref_static). Factor J + 1e-10 I (J is dimensionless, eigenvalues in [0, 1]); the refinement
+     * passes converge to the exact fixed point where J is regular, to the one nearest the start where it is not. */
+    for (i = 0; i < n; i++) J[(size_t)i * n + i] += 1e-10;
+    if (lu_factor(J, piv, n) == 0)
+        for (pass = 0; pass < 16; pass++) {
+            memset(G, 0, n * sizeof *G);
+            for (r = 0; r < nr; r++) {
+                double *lv;
+                if (!F[r].N) continue;
+                lv = malloc(F[r].N * sizeof *lv);
+                region_rhs(s, Rg + r, F + r, full, lv, 1);
+                for (i = 0; i < F[r].N; i++) G[3 * F[r].u[i / 3] + i % 3] += Rg[r].W[F[r].u[i / 3]] * lv[i];
+                if (pass == 0) {   /* the scale: the merged update of the load alone */
+                    region_rhs(s, Rg + r, F + r, full, lv, 0);
+                    for (i = 0; i < F[r].N; i++) dx[3 * F[r].u[i / 3] + i % 3] += Rg[r].W[F[r].u[i / 3]] * lv[i];
+                }
+                free(lv);
+            }
+            gn = sqrt(dot(G, G, n));
+#ifdef SNREF_TRACE
+            fprintf(stderr, "blended static pass %u: |G| %.3g\n", pass, gn);
+#endif
+            if (pass == 0) { g0 = fmax(gn, sqrt(dot(dx, dx, n))); if (g0 == 0) break; }
+            if (gn <= 1e-15 * g0 || (pass >= 2 && gn >= 0.5 * prev)) break;
+            prev = gn;
+            memcpy(dx, G, n * sizeof *dx);      /* -J dx = G  (J stored negated) */
+            lu_solve(J, piv, n, dx);
+            for (i = 0; i < n; i++) s->p[i] += dx[i];
+        }
+    else gn = g0 = 1;
+    memset(s->v, 0, 3 * m->nF * sizeof *s->v);
+    memset(s->dv, 0, 3 * m->nF * sizeof *s->dv);
+    for (r = 0; r < nr; r++) { free(F[r].u); free(F[r].piv); free(F[r].A); region_release(Rg + r); }
+    free(F); free(Rg); free(J); free(G); free(full); free(dx); free(piv); free(loc); free(cloc); free(cu);
+    s->blend_fixres = g0 > 0 ? gn / g0 : 0;
+    return s->blend_fixres;
+}
+
 void snref_step(snref_state *s) {
     const snref_model *m = s->m;
     unsigned i, k, nF = m->nF, nV = m->nV;
@@ -1112,7 +1497,8 @@ void snref_step(snref_state *s) {
     for (i = 0; i < 3 * nF; i++) { vstar[i] = s->v[i]; w[i] = (1.0 + b1) * s->v[i]; }
     for (i = 3 * nF; i < 3 * nV; i++) { vstar[i] = vnewS[i]; w[i] = b1 * vnewS[i]; }
     memset(b, 0, 3 * nF * sizeof *b);
-    if (s->force == SNREF_FORCE_CELL) s->e_el = cell_terms(s, pp, w, b);
+    if (s->mode == SNREF_BLENDED) s->e_el = cell_terms(s, pp, NULL, NULL);   /* the elastic terms come per region in step 6; E_el (health) at the warped frames */
+    else if (s->force == SNREF_FORCE_CELL) s->e_el = cell_terms(s, pp, w, b);
     else {
         vertex_force(s, pp, b);
         stiff_mul(s, w, b, 1, 0, -1.0);
@@ -1134,7 +1520,8 @@ void snref_step(snref_state *s) {
     {
         double *x = s->dv;
         if (!s->warm) memset(x, 0, 3 * nF * sizeof *x);
-        if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
+        if (s->mode == SNREF_BLENDED) blended_solve(s, pp, w, b, x);
+        else if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
         else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
     }
     /* 7. update */
@@ -1304,6 +1691,7 @@ double snref_static(snref_state *s, unsigned dense_max) {
     double *r = malloc(n * sizeof *r), *dx = malloc(n * sizeof *dx), g0, res = 0, prev = HUGE_VAL;
     double *A = NULL, hs = 0, ms = 0, reg;
     snref_band *B = NULL;
+    if (s->mode == SNREF_BLENDED) { free(r); free(dx); return blended_static(s); }
     if (!s->posed) {
         snref_xform *id = calloc(m->nJ, sizeof *id);
         for (i = 0; i < m->nJ; i++) id[i].q[3] = 1;

@@ -82,7 +82,24 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
 int snref_load_file(snref_model *m, const char *path, char *err, size_t errn);
 void snref_free(snref_model *m);
 
-enum { SNREF_WARPED = 0, SNREF_UNWARPED = 1 };
+enum { SNREF_WARPED = 0, SNREF_UNWARPED = 1, SNREF_BLENDED = 2 };
+/* SNREF_BLENDED: blended local linearization (seed 000 sec. 4.5, eq. 18, 22-24;
+ * DESIGN.md). Per step, for each region r (bone b = rbone[r], transform
+ * T^r = (R^r, t^r) of the current pose): the region's cells K^r are the cells
+ * with a free vertex of positive weight W^r; its unknowns are their free
+ * vertices; its elastic energy is linear elasticity of the displacement from
+ * the rest state moved by T^r, measured in the bone's frame (floating frame):
+ * d_b = R^rT (p_b - T^r(x_b)) over the cells of K^r, i.e. the warped model
+ * with every cell frame = R^r (S^_e annihilates translations, so t^r drops
+ * out). Stiffness K^r = sum_{e in K^r} R^r S^_e R^rT, mass the global M^
+ * restricted to the region's unknowns; the region's step system (NUMERICS
+ * step 5-6 with these) is solved by PCG (`iters` iterations, warm start from
+ * the previous merged dv; to convergence if `exact`); then
+ * dv_a = sum_r W^r_a dv^r_a. Vertex and cell frames stay the warped ones
+ * (preconditioner, gravity with REST_MODELLED, limits, health, skinned).
+ * snref_static in this mode: the steady state of that step at the fixed
+ * pose (v = 0: sum_r W^r (A^r)^-1 r^r(p) = 0, r^r the region's force
+ * residual), by dense LU of the affine fixed-point map (small lattices). */
 /* Elastic force model. CELL: NUMERICS.md step 4 (per-cell frames, element
  * energy, K~ = sum_e R_e S^_e R_e^T). VERTEX: format 1.0 / seed 003 eq. 7 with
  * per-vertex frames, f_i = -R_i sum_j S_ij (R_i^T (p_j - c_i) - x_j), S
@@ -128,6 +145,16 @@ typedef struct snref_state {
      * (1 by default; 0 = rigs off, for with/without comparisons) */
     double *ctl;
     double rig_scale;
+    /* blended local linearization (SNREF_BLENDED; seed 000 sec. 4.5): regions.
+     * Default after init: one region per joint j (rbone[j] = j) with W^j_a the
+     * vertex's frame weights (FRAMES: (1 - w) on bone1, w on bone2; a
+     * partition of unity over bones). snref_set_regions replaces them. */
+    unsigned nreg;
+    int *rbone;    /* nreg: the joint whose transform T^r region r follows */
+    double *rw;    /* nreg*nV: W^r_a (row r) */
+    int blend_hold;/* 0 (default, the paper): every free vertex of the region's cells is an unknown of its
+                    * solve; 1: vertices of the region's cells with W^r_a = 0 are held (dv = 0) in it */
+    double blend_fixres; /* snref_static in SNREF_BLENDED: fixed-point residual |G(p)| / max(|G(p_start)|, |G of the load alone|) */
 } snref_state;
 
 int snref_init(snref_state *s, const snref_model *m);
@@ -176,6 +203,12 @@ struct snref_band *snref_factor(snref_state *s);
 void snref_factor_solve(const struct snref_band *B, const double *load, double *x);
 void snref_factor_free(struct snref_band *B);
 void snref_hess_mul(const snref_state *s, const double *x, double *y);
+
+/* Regions of SNREF_BLENDED: nreg regions, region r follows joint rbone[r],
+ * W (nreg*nV) its weights over lattice vertices; every free vertex's weights
+ * must be >= 0 and sum to 1 (1e-9). NULL W: the default (one region per
+ * joint, weights from the vertex frames). Returns 0, or -1 (nothing changed). */
+int snref_set_regions(snref_state *s, unsigned nreg, const int *rbone, const double *W);
 
 /* Net force residual f + m^g^ [- m^ R g^] + f_rig (internal units) at the current positions, free rows. */
 void snref_residual(const snref_state *s, double *out);
