@@ -177,3 +177,15 @@ $(BUILD)/tests/test_runtime_force_float: $(FORCE_RT_DEPS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force_float
+
+# Preconditioner study (issue 15 item 3; NUMERICS.md "Preconditioners
+# measured"): double precision, the reference stepping the examples' clips,
+# every step's system solved by each candidate. Not part of make test.
+$(BUILD)/tests/precond_study: tests/precond_study.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
+.PHONY: precond-study
+precond-study: $(BUILD)/tests/precond_study $(EX)/cow.blob $(EX)/limb.blob $(EX)/beast.blob
+	$(BUILD)/tests/precond_study $(EX)/cow.blob tools/examples/cow/trot.clip tools/examples/cow/head_turn.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/limb.blob tools/examples/limb/flex.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/beast.blob tools/examples/beast/walk.clip tools/examples/beast/head_turn.clip -every 2

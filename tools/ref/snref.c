@@ -1134,6 +1134,7 @@ void snref_step(snref_state *s) {
     {
         double *x = s->dv;
         if (!s->warm) memset(x, 0, 3 * nF * sizeof *x);
+        if (s->solve_hook) s->solve_hook(s->hook_ctx, s, b, x);
         if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
         else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
     }
