@@ -680,6 +680,67 @@ static void hook(void *ctx, const snref_state *s, const double *b, const double 
 
 static int cmpu(const void *a, const void *b) { unsigned x = *(const unsigned *)a, y = *(const unsigned *)b; return x < y ? -1 : x > y; }
 
+/* Step every state through the clips in lockstep (reset at each clip);
+ * err[j] (if non-NULL): max over steps of the max surface distance of state
+ * j from state 0, mesh units; err[n] gets the max elastic displacement of
+ * state 0 (surface minus the surface of the skinned lattice). */
+static int drive_clips(const pu_rt *rt, const snref_model *m, const char **clips, unsigned nclip, snref_state **st, unsigned ns,
+                       double *err) {
+    unsigned c, k, j, i, q;
+    double *s0 = err ? malloc(sizeof(double) * 3 * m->nS) : NULL, *sj = err ? malloc(sizeof(double) * 3 * m->nS) : NULL;
+    double *skin = err ? malloc(sizeof(double) * 3 * m->nV) : NULL, *ss = err ? malloc(sizeof(double) * 3 * m->nS) : NULL;
+    if (err) for (j = 0; j <= ns; j++) err[j] = 0;
+    for (c = 0; c < nclip; c++) {
+        char *text; size_t n; char e[SN_CLIP_ERR_LEN];
+        sn_clip *clip = malloc(sizeof *clip);
+        sn_quat *local = malloc(sizeof(sn_quat) * rt->info.joints);
+        sn_xform *xf = malloc(sizeof(sn_xform) * rt->info.joints);
+        snref_xform *rx = malloc(sizeof(snref_xform) * rt->info.joints);
+        unsigned steps;
+        text = pu_read(clips[c], &n);
+        if (!text || sn_clip_parse(clip, text, n, e, sizeof e) || sn_clip_bind(clip, rt->blob, e, sizeof e)) {
+            fprintf(stderr, "%s: %s\n", clips[c], text ? e : "cannot read"); return 1;
+        }
+        for (j = 0; j < ns; j++) snref_reset(st[j]);
+        steps = (unsigned)ceil((clip->duration / 65536.0) / (m->h > 0 ? m->h : 1.0 / 60));
+        for (k = 0; k < steps; k++) {
+            unsigned ch;
+            sn_clip_pose(clip, rt->blob, k, local, xf);
+            pu_pose_to_ref(xf, rt->info.joints, rx);
+            for (j = 0; j < ns; j++) {
+                snref_set_pose(st[j], rx);
+                for (ch = 0; ch < clip->n_channels; ch++)
+                    if (clip->chan[ch].kind == SN_CLIP_CONTROL && clip->chan[ch].joint >= 0) {
+                        int kc = snref_find_control(m, clip->chan[ch].name);
+                        if (kc >= 0) snref_set_control(st[j], (unsigned)kc, sn_clip_control_at(clip, ch, sn_clip_time(clip, sn_clip_timestep_q16(rt->blob), k)) / 65536.0);
+                    }
+                snref_step(st[j]);
+            }
+            if (err) {
+                snref_get_surface(st[0], s0);
+                for (j = 1; j < ns; j++) {
+                    double d;
+                    snref_get_surface(st[j], sj);
+                    d = pu_maxdist(s0, sj, m->nS);
+                    if (d > err[j]) err[j] = d;
+                }
+                for (i = 0; i < m->nV; i++) {
+                    const double *R = st[0]->R + 9 * i, *x = m->rest + 3 * i;
+                    for (q = 0; q < 3; q++) skin[3 * i + q] = (R[3 * q] * x[0] + R[3 * q + 1] * x[1] + R[3 * q + 2] * x[2] + st[0]->c[3 * i + q]) * m->unit;
+                }
+                snref_surface_from_lattice(m, skin, ss);
+                { double d = pu_maxdist(ss, s0, m->nS); if (d > err[ns]) err[ns] = d; }
+            }
+        }
+        free(text); free(clip); free(local); free(xf); free(rx);
+    }
+    free(s0); free(sj); free(skin); free(ss);
+    return 0;
+}
+
+static int hook_kind;
+static void phook(void *ctx, const snref_state *s, const double *r, double *z) { (void)ctx; S_ = s; prec_apply(hook_kind, r, z); }
+
 int main(int argc, char **argv) {
     pu_rt rt;
     snref_model m;
@@ -772,32 +833,10 @@ int main(int argc, char **argv) {
     }
 
     s.solve_hook = hook;
-    for (c = 0; c < nclip; c++) {
-        char *text; size_t n; char err[SN_CLIP_ERR_LEN];
-        sn_clip *clip = malloc(sizeof *clip);
-        sn_quat *local = malloc(sizeof(sn_quat) * rt.info.joints);
-        sn_xform *xf = malloc(sizeof(sn_xform) * rt.info.joints);
-        snref_xform *rx = malloc(sizeof(snref_xform) * rt.info.joints);
-        unsigned steps;
-        text = pu_read(clips[c], &n);
-        if (!text || sn_clip_parse(clip, text, n, err, sizeof err) || sn_clip_bind(clip, rt.blob, err, sizeof err)) {
-            fprintf(stderr, "%s: %s\n", clips[c], text ? err : "cannot read"); return 1;
-        }
-        snref_reset(&s);
-        steps = (unsigned)ceil((clip->duration / 65536.0) / (m.h > 0 ? m.h : 1.0 / 60));
-        for (k = 0; k < steps; k++) {
-            unsigned ch;
-            sn_clip_pose(clip, rt.blob, k, local, xf);
-            pu_pose_to_ref(xf, rt.info.joints, rx);
-            snref_set_pose(&s, rx);
-            for (ch = 0; ch < clip->n_channels; ch++)
-                if (clip->chan[ch].kind == SN_CLIP_CONTROL && clip->chan[ch].joint >= 0) {
-                    int kc = snref_find_control(&m, clip->chan[ch].name);
-                    if (kc >= 0) snref_set_control(&s, (unsigned)kc, sn_clip_control_at(clip, ch, sn_clip_time(clip, sn_clip_timestep_q16(rt.blob), k)) / 65536.0);
-                }
-            snref_step(&s);
-        }
-        free(text); free(clip); free(local); free(xf); free(rx);
+    {
+        snref_state *one[1];
+        one[0] = &s;
+        if (drive_clips(&rt, &m, clips, nclip, one, 1, NULL)) return 1;
     }
     printf("%s: nF %u, nC %u, blob N = %u block-Jacobi iterations; %u steps sampled (every %u; %u at rest skipped), clips:",
            argv[1], nF_, m.nC, m.cg_default, nsamp, every, nskip);
@@ -823,6 +862,33 @@ int main(int argc, char **argv) {
         solve = setupMA[p] + matvecMA + pMA[p] + 3.0 * nF_ + kw * iterMA;
         printf("| %s | %s%u | %u | %u | %.3f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f |\n", pname[p], kw > MAXIT ? ">" : "", kw > MAXIT ? MAXIT : kw,
                srt[(nsamp * 9) / 10], srt[nsamp / 2], contr[p] / contr_n, pMA[p], iterMA, setupMA[p], solve, solve + rhsMA, solve - (kw + 1) * (matvecMA - ffMA), memB[p]);
+    }
+    if (nsamp) {   /* whole runs: exact solves, today's N BJ iterations, IC0 at 1..worst-case count */
+        snref_state ex, bj, ic[16], *st[18];
+        double er[19];
+        unsigned srt[MAXS], kw, j, ns;
+        memcpy(srt, ktab[P_IC0], nsamp * sizeof(unsigned));
+        qsort(srt, nsamp, sizeof(unsigned), cmpu);
+        kw = srt[nsamp - 1] > 16 ? 16 : srt[nsamp - 1];
+        snref_init(&ex, &m); snref_init(&bj, &m);
+        ex.exact = 1;
+        st[0] = &ex; st[1] = &bj; ns = 2;
+        for (j = 0; j < kw; j++) { snref_init(&ic[j], &m); ic[j].precond_hook = phook; ic[j].iters = j + 1; st[ns++] = &ic[j]; }
+        hook_kind = P_IC0;
+        if (drive_clips(&rt, &m, clips, nclip, st, ns, er) == 0) {
+            printf("  whole clips, max surface error against exact solves / max elastic displacement (%.4g mesh units): BJ %u it. %.3e; IC0",
+                   er[ns], m.cg_default, er[1] / er[ns]);
+            for (j = 0; j < kw; j++) printf(" %u it. %.3e%s", j + 1, er[2 + j] / er[ns], j + 1 < kw ? "," : "\n");
+            for (j = 0; j < kw && er[2 + j] > er[1]; j++) {}
+            if (j < kw) {
+                double kk = j + 1, sIC = matvecMA + pMA[P_IC0] + 3.0 * nF_ + kk * (matvecMA + vecMA + pMA[P_IC0]);
+                double sBJ = matvecMA + pMA[P_BJ] + 3.0 * nF_ + m.cg_default * (matvecMA + vecMA + pMA[P_BJ]);
+                printf("  => IC0 matches today's whole-clip accuracy with %u iterations: solve %.0f MA/step (BJ %u: %.0f); with the free-corner mat-vec %.0f (BJ: %.0f)\n",
+                       j + 1, sIC, m.cg_default, sBJ, sIC - (kk + 1) * (matvecMA - ffMA), sBJ - (m.cg_default + 1.0) * (matvecMA - ffMA));
+            }
+        }
+        snref_release(&ex); snref_release(&bj);
+        for (j = 0; j < kw; j++) snref_release(&ic[j]);
     }
     if (nsamp) {
         double nb = A0.rp[nF_], asm_mv = 9.0 * nb + 6.0 * nF_, its;

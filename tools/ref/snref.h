@@ -132,6 +132,8 @@ typedef struct snref_state {
      * right-hand side b and the start x0 (the warm start) of A dv = b, the
      * frames of the step already in R and Rc (NULL: none; tests/precond_study.c) */
     void (*solve_hook)(void *ctx, const struct snref_state *s, const double *b, const double *x0);
+    /* replaces the preconditioner z = R_i P_i R_i^T r_i of the N-iteration PCG (NULL: none) */
+    void (*precond_hook)(void *ctx, const struct snref_state *s, const double *r, double *z);
     void *hook_ctx;
 } snref_state;
 
