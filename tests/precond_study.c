@@ -773,7 +773,46 @@ static int drive_clips(const pu_rt *rt, const snref_model *m, const char **clips
 }
 
 static int hook_kind;
-static void phook(void *ctx, const snref_state *s, const double *r, double *z) { (void)ctx; S_ = s; prec_apply(hook_kind, r, z); }
+/* The design's fixed-point IC0 emulated in double: forces on the Q19 grid
+ * (k_i = 0, the coarsest force format), z on Q22; block LDL^T sweeps rounding
+ * each block-row contribution, D^-1 rounded to Q22, rotations exact. */
+static double *ldl_Di, *qy, *qw;
+static int q_bj;
+static double rq(double x, int q) { return ldexp(floor(ldexp(x, q) + 0.5), -q); }
+static void ldl_apply_q(const snref_state *s, const double *r, double *z) {
+    unsigned i, p, k, a;
+    if (!ldl_Di) {
+        ldl_Di = malloc(sizeof(double) * 9 * nF_); qy = malloc(sizeof(double) * n3_); qw = malloc(sizeof(double) * n3_);
+        for (i = 0; i < nF_; i++) {
+            double Li[9];
+            inv3(lb + 9 * (size_t)(lbp[i + 1] - 1), Li);
+            for (a = 0; a < 3; a++) for (k = 0; k < 3; k++) { double sm = 0; unsigned q; for (q = 0; q < 3; q++) sm += Li[3 * q + a] * Li[3 * q + k]; ldl_Di[9 * i + 3 * a + k] = sm; }
+        }
+    }
+    for (i = 0; i < nF_; i++) { const double *Ri = s->R + 9 * i; for (k = 0; k < 3; k++) qy[3 * i + k] = rq(Ri[k] * r[3 * i] + Ri[3 + k] * r[3 * i + 1] + Ri[6 + k] * r[3 * i + 2], 19); }
+    if (q_bj) { /* today's block Jacobi with the same roundings */
+        for (i = 0; i < nF_; i++) { double t[3]; m3v(M_->precond + 9 * i, qy + 3 * i, qw + 3 * i); m3v(s->R + 9 * i, qw + 3 * i, t); for (k = 0; k < 3; k++) z[3 * i + k] = rq(rq(t[k], 22), 22); }
+        return;
+    }
+    for (i = 0; i < nF_; i++) {
+        for (p = lbp[i]; p + 1 < lbp[i + 1]; p++) { double t[3]; m3v(ldl_L + 9 * (size_t)p, qy + 3 * lbc[p], t); for (k = 0; k < 3; k++) qy[3 * i + k] -= rq(t[k], 19); }
+        m3v(ldl_Di + 9 * i, qy + 3 * i, qw + 3 * i);
+        for (k = 0; k < 3; k++) qw[3 * i + k] = rq(qw[3 * i + k], 22);
+    }
+    for (i = nF_; i-- > 0;)
+        for (p = lbp[i]; p + 1 < lbp[i + 1]; p++) {
+            const double *B = ldl_L + 9 * (size_t)p;
+            unsigned j = lbc[p];
+            for (a = 0; a < 3; a++) qw[3 * j + a] -= rq(B[a] * qw[3 * i] + B[3 + a] * qw[3 * i + 1] + B[6 + a] * qw[3 * i + 2], 22);
+        }
+    for (i = 0; i < nF_; i++) { double t[3]; m3v(s->R + 9 * i, qw + 3 * i, t); for (k = 0; k < 3; k++) z[3 * i + k] = rq(t[k], 22); }
+}
+static void phook(void *ctx, const snref_state *s, const double *r, double *z) {
+    (void)ctx; S_ = s;
+    if (hook_kind < 0) ldl_apply_q(s, r, z); else prec_apply(hook_kind, r, z);
+}
+static void phook_q(void *ctx, const snref_state *s, const double *r, double *z) { (void)ctx; q_bj = 0; ldl_apply_q(s, r, z); }
+static void phook_qbj(void *ctx, const snref_state *s, const double *r, double *z) { (void)ctx; q_bj = 1; ldl_apply_q(s, r, z); }
 
 int main(int argc, char **argv) {
     pu_rt rt;
@@ -901,8 +940,8 @@ int main(int argc, char **argv) {
     printf("  IC0 as block LDL^T (unit lower L^ = L_ij L_jj^-1, D^-1 blocks): max |L^ entry| %.3g; forward sweep (I+L^)^-1 on the steps' residuals grows max|.| by at most %.3g\n",
            ldl_lmax, ldl_grow);
     if (nsamp) {   /* whole runs: exact solves, today's N BJ iterations, IC0 at 1..worst-case count */
-        snref_state ex, bj, ic[16], *st[18];
-        double er[19];
+        snref_state ex, bj, bjq, ic[16], icq[16], *st[35];
+        double er[36];
         unsigned srt[MAXS], kw, j, ns;
         memcpy(srt, ktab[P_IC0], nsamp * sizeof(unsigned));
         qsort(srt, nsamp, sizeof(unsigned), cmpu);
@@ -911,11 +950,16 @@ int main(int argc, char **argv) {
         ex.exact = 1;
         st[0] = &ex; st[1] = &bj; ns = 2;
         for (j = 0; j < kw; j++) { snref_init(&ic[j], &m); ic[j].precond_hook = phook; ic[j].iters = j + 1; st[ns++] = &ic[j]; }
+        for (j = 0; j < kw; j++) { snref_init(&icq[j], &m); icq[j].precond_hook = phook_q; icq[j].iters = j + 1; st[ns++] = &icq[j]; }
+        snref_init(&bjq, &m); bjq.precond_hook = phook_qbj; st[ns++] = &bjq;
         hook_kind = P_IC0;
         if (drive_clips(&rt, &m, clips, nclip, st, ns, er) == 0) {
             printf("  whole clips, max surface error against exact solves / max elastic displacement (%.4g mesh units): BJ %u it. %.3e; IC0",
                    er[ns], m.cg_default, er[1] / er[ns]);
             for (j = 0; j < kw; j++) printf(" %u it. %.3e%s", j + 1, er[2 + j] / er[ns], j + 1 < kw ? "," : "\n");
+            printf("  the same with fixed-point rounding in the preconditioner only (forces Q19 = k_i 0, the coarsest; z Q22): BJ %u it. %.3e; IC0 (LDL^T sweeps):",
+                   m.cg_default, er[2 + 2 * kw] / er[ns]);
+            for (j = 0; j < kw; j++) printf(" %u it. %.3e%s", j + 1, er[2 + kw + j] / er[ns], j + 1 < kw ? "," : "\n");
             for (j = 0; j < kw && er[2 + j] > er[1]; j++) {}
             if (j < kw) {
                 double kk = j + 1, sIC = matvecMA + pMA[P_IC0] + 3.0 * nF_ + kk * (matvecMA + vecMA + pMA[P_IC0]);
@@ -925,7 +969,8 @@ int main(int argc, char **argv) {
             }
         }
         snref_release(&ex); snref_release(&bj);
-        for (j = 0; j < kw; j++) snref_release(&ic[j]);
+        for (j = 0; j < kw; j++) { snref_release(&ic[j]); snref_release(&icq[j]); }
+        snref_release(&bjq);
     }
     if (nsamp) {
         double nb = A0.rp[nF_], asm_mv = 9.0 * nb + 6.0 * nF_, its;
