@@ -194,3 +194,26 @@ TEST_BINS += $(BUILD)/tests/test_nonlinear
 .PHONY: nonlinear-figures
 nonlinear-figures: $(BUILD)/tests/test_nonlinear
 	BUILD=$(BUILD) $(BUILD)/tests/test_nonlinear --figures
+
+# Preconditioner study (issue 15 item 3; NUMERICS.md "Preconditioners
+# measured"): double precision, the reference stepping the examples' clips,
+# every step's system solved by each candidate. Not part of make test.
+$(BUILD)/tests/precond_study: tests/precond_study.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
+.PHONY: precond-study
+precond-study: $(BUILD)/tests/precond_study $(EX)/cow.blob $(EX)/limb.blob $(EX)/beast.blob
+	$(BUILD)/tests/precond_study $(EX)/cow.blob tools/examples/cow/trot.clip tools/examples/cow/head_turn.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/limb.blob tools/examples/limb/flex.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/beast.blob tools/examples/beast/walk.clip tools/examples/beast/head_turn.clip -every 2
+
+# Stiffness storage study (issue 15 item 4; NUMERICS.md "Narrower stiffness
+# storage, measured"): the float64 blob's cell matrices re-quantized, the
+# reference's 600-step error against float64. Not part of make test.
+$(BUILD)/tests/quant_study: tests/quant_study.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+.PHONY: quant-study
+quant-study: $(BUILD)/tests/quant_study $(EX)/cow.blob $(EX)/cow_double.blob $(EX)/limb.blob $(EX)/limb_double.blob
+	$(BUILD)/tests/quant_study $(EX)/cow.blob $(EX)/cow_double.blob cow
+	$(BUILD)/tests/quant_study $(EX)/limb.blob $(EX)/limb_double.blob limb

@@ -841,7 +841,7 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     double rz, bn = sqrt(dot(b, b, n));
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
-    precond_apply(s, P, r, z);
+    if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
     memcpy(d, z, n * sizeof *d);
     rz = dot(r, z, n);
     for (it = 0; it < maxit; it++) {
@@ -851,7 +851,7 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         dAd = dot(d, Ad, n);
         alpha = dAd > 0 ? rz / dAd : 0.0;
         for (i = 0; i < n; i++) { x[i] += alpha * d[i]; r[i] -= alpha * Ad[i]; }
-        precond_apply(s, P, r, z);
+        if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
         rz2 = dot(r, z, n);
         beta = rz > 0 ? rz2 / rz : 0.0;
         for (i = 0; i < n; i++) d[i] = z[i] + beta * d[i];
@@ -1134,6 +1134,7 @@ void snref_step(snref_state *s) {
     {
         double *x = s->dv;
         if (!s->warm) memset(x, 0, 3 * nF * sizeof *x);
+        if (s->solve_hook) s->solve_hook(s->hook_ctx, s, b, x);
         if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
         else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
     }

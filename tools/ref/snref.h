@@ -128,6 +128,13 @@ typedef struct snref_state {
      * (1 by default; 0 = rigs off, for with/without comparisons) */
     double *ctl;
     double rig_scale;
+    /* called in snref_step just before the solve of step 6 with the step's
+     * right-hand side b and the start x0 (the warm start) of A dv = b, the
+     * frames of the step already in R and Rc (NULL: none; tests/precond_study.c) */
+    void (*solve_hook)(void *ctx, const struct snref_state *s, const double *b, const double *x0);
+    /* replaces the preconditioner z = R_i P_i R_i^T r_i of the N-iteration PCG (NULL: none) */
+    void (*precond_hook)(void *ctx, const struct snref_state *s, const double *r, double *z);
+    void *hook_ctx;
 } snref_state;
 
 int snref_init(snref_state *s, const snref_model *m);
