@@ -285,7 +285,7 @@ static void check_blob(const char *desc, int flavour, int print)
     for (k = 0; k < SN_SEC_COUNT; k++) {
         off[k] = u32(B + SN_H_SECTIONS + 16 * k); cnt[k] = u32(B + SN_H_SECTIONS + 16 * k + 8); es[k] = u32(B + SN_H_SECTIONS + 16 * k + 12);
     }
-    T_CHECK(u16(B + SN_H_VER_MAJOR) == 4, "%s %s: format 4", desc, fl[flavour]);
+    T_CHECK(u16(B + SN_H_VER_MAJOR) == SN_FORMAT_MAJOR, "%s %s: format %d", desc, fl[flavour], SN_FORMAT_MAJOR);
     T_CHECK(cnt[SN_SEC_CONTROLS] == (uint32_t)o.nctl && cnt[SN_SEC_RIGS] == (uint32_t)o.nrig, "%s: %u controls, %u rigs", desc, cnt[SN_SEC_CONTROLS], cnt[SN_SEC_RIGS]);
     T_CHECK(es[SN_SEC_CONTROLS] == 40u + 4u * (uint32_t)rs && es[SN_SEC_RIGS] == 16 && es[SN_SEC_RIG_SAMPLES] == 2u * (uint32_t)rs &&
                 es[SN_SEC_RIG_VERTS] == 2 && es[SN_SEC_RIG_FORCES] == 3u * (uint32_t)rs, "%s: element sizes", desc);

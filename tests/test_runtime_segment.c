@@ -51,8 +51,8 @@ typedef struct tmesh {
     double att_p[4][3];
 } tmesh;
 
-/* Replace the test blob's segment sections (the last three) with meshes;
- * returns the blob size. */
+/* Replace the test blob's segment sections with meshes (the crease
+ * sections after them dropped); returns the blob size. */
 static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
     uint32_t off = tb_sec(b, SN_SEC_SEGMESH), cnt[3] = {0, 0, 0}, elem[3], segB = 0, at;
     int m, i, k, sec;
@@ -73,6 +73,12 @@ static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
         tb_u32(b + SN_H_SECTIONS + 16 * (SN_SEC_SEGMESH + sec) + 4, cnt[sec] * elem[sec]);
         tb_u32(b + SN_H_SECTIONS + 16 * (SN_SEC_SEGMESH + sec) + 8, cnt[sec]);
         at += cnt[sec] * elem[sec];
+    }
+    at = (at + 7u) & ~7u;
+    for (sec = SN_SEC_CREASE; sec < SN_SEC_COUNT; sec++) { /* crease sections dropped (empty) */
+        tb_u32(b + SN_H_SECTIONS + 16 * sec, at);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 4, 0);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 8, 0);
     }
     {
         unsigned char *r = b + tb_sec(b, SN_SEC_SEGMESH), *nd = b + tb_sec(b, SN_SEC_SEGNODES);

@@ -8,7 +8,8 @@
 static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
-                                             "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH"};
+                                             "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH",
+                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
@@ -28,7 +29,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         return -1;
     }
     if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_force_build(&d, o) ||
-        sb_segment_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
+        sb_segment_build(&d, &m, o) || sb_crease_build(&d, o, quiet) || sb_blob_make(o, flavour, b)) {
         sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }

@@ -1,6 +1,6 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h runtime/src/sn_format.h
@@ -20,8 +20,8 @@ $(TOOLS_LIB): $(TOOLS_LIB_OBJ)
 # sinew-bake --static (tools/sb_static.c): the double-precision reference
 # model (tools/ref/snref.c), the clip parser (ports/common/sn_clip.c: no
 # runtime calls) and the desktop rasterizer and PNG writer.
-STATIC_SRC = tools/sb_static.c tools/ref/snref.c ports/common/sn_clip.c ports/desktop/raster.c ports/desktop/png.c
-STATIC_OBJ = $(BUILD)/tools/static/sb_static.o $(BUILD)/tools/static/snref.o $(BUILD)/tools/static/sn_clip.o \
+STATIC_SRC = tools/sb_static.c ports/common/sn_clip.c ports/desktop/raster.c ports/desktop/png.c
+STATIC_OBJ = $(BUILD)/tools/static/sb_static.o $(BUILD)/tools/static/sn_clip.o \
              $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
 STATIC_INC = -Itools -Itools/ref -Iruntime/include -Iruntime/src -Iports/common -Iports/desktop
 STATIC_HDR = tools/sb_static.h tools/ref/snref.h ports/common/sn_clip.h ports/desktop/raster.h ports/desktop/png.h $(TOOLS_HDR)

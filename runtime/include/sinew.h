@@ -261,6 +261,12 @@ typedef struct sn_stats {
     uint32_t force_drops;  ///< sn_apply_force / sn_apply_impulse calls refused since init/reset because the step's force slots were full
     sn_real  seg_gap;      ///< largest segment-mesh constraint gap left after the last step's fixed sweeps, in segment lengths (Q16.16 / float)
     sn_real  seg_gap_max;  ///< largest seg_gap since init/reset
+    uint32_t crease_list;        ///< self-collision near creases (seed 003 §3.4): pairs in the collision list C after the last step's detection (0 without crease data)
+    uint32_t crease_active;      ///< active prefix n_a of C after the last step's detection (constraints produced: at most the blob's max_active)
+    uint32_t crease_list_full;   ///< penetrations found but not added since init/reset because C was full (the blob's max_list)
+    uint32_t crease_active_over; ///< active constraints not produced since init/reset because max_active was reached or the row store was full
+    uint32_t crease_added;       ///< pairs added to C since init/reset
+    uint32_t crease_removed;     ///< pairs removed from C since init/reset (vertex back outside, or slid off its triangle)
 } sn_stats;
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.

@@ -390,6 +390,31 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         cnt[SN_SEC_SEGMESH] = v.nM;
         cnt[SN_SEC_SEGNODES] = v.nSN;
         cnt[SN_SEC_SEGATTACH] = v.nSA;
+        /* crease (format 5.0): the parameters fix the other three counts */
+        v.nCR = sn_rd_u32(t + SN_SEC_CREASE * SN_SECTION_ENTRY);
+        v.nD = sn_rd_u32(t + SN_SEC_CREASE_PAIRS * SN_SECTION_ENTRY);
+        if (v.nCR > 1 || v.nD > SN_CREASE_MAX_PAIRS || (v.nCR == 0 && v.nD != 0)) return SN_ERR_SECTION;
+        cnt[SN_SEC_CREASE] = v.nCR;
+        cnt[SN_SEC_CREASE_PAIRS] = v.nD;
+        cnt[SN_SEC_CREASE_VNBR] = 0;
+        cnt[SN_SEC_CREASE_TNBR] = 0;
+        if (v.nCR) {
+            const unsigned char *ce = p + SN_H_SECTIONS + SN_SEC_CREASE * SN_SECTION_ENTRY;
+            uint32_t coff = sn_rd_u32(ce);
+            /* the record is read only once it lies inside the blob */
+            if ((coff & 7u) != 0 || coff > total || total - coff < SN_ELEM_CREASE(SN_REAL_BYTES)) return SN_ERR_SECTION;
+            v.cr_list = sn_rd_u16(p + coff);
+            v.cr_active = sn_rd_u16(p + coff + 2);
+            v.cr_nv = p[coff + 4];
+            v.cr_nt = p[coff + 5];
+            if (v.cr_list < 1 || v.cr_list > SN_CREASE_MAX_LIST || v.cr_active < 1 || v.cr_active > v.cr_list ||
+                v.cr_active > SN_CREASE_MAX_ACTIVE || v.cr_nv < 1 || v.cr_nv > SN_CREASE_MAX_NBR_V || v.cr_nt < 1 ||
+                v.cr_nt > SN_CREASE_MAX_NBR_T || v.nS < 1 || v.nT < 1)
+                return SN_ERR_VALUE;
+            cnt[SN_SEC_CREASE_VNBR] = v.nS * v.cr_nv;
+            cnt[SN_SEC_CREASE_TNBR] = v.nS * v.cr_nt;
+            v.crB = SN_CREASE_STATE_BYTES(v.nS, v.cr_list, v.cr_active);
+        }
     }
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
@@ -401,7 +426,8 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
-            SN_ELEM_SEGATTACH(SN_REAL_BYTES)};
+            SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
+            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -428,8 +454,10 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (st != SN_OK) return st;
     st = sn_check_segments(&v, &v.segB);
     if (st != SN_OK) return st;
+    st = sn_check_crease(&v);
+    if (st != SN_OK) return st;
     /* the instance size is the runtime's layout (one source: sn_instance.c) */
-    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB)) return SN_ERR_HEADER;
+    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB, v.crB)) return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }
@@ -470,6 +498,8 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->flags = p[SN_H_FLAGS];
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
+    v->nCR = v->nD = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->crB = 0;
+    v->cr_depth = v->cr_push = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
@@ -486,6 +516,18 @@ static void sn_view_sections(sn_view *v) {
     v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
     v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
     v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);
+    v->nCR = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CREASE * SN_SECTION_ENTRY + 8);
+    v->nD = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CREASE_PAIRS * SN_SECTION_ENTRY + 8);
+    if (v->nCR) { /* parameters (validate: read once the record is known to be inside the blob) */
+        const unsigned char *c = v->sec[SN_SEC_CREASE];
+        v->cr_list = sn_rd_u16(c);
+        v->cr_active = sn_rd_u16(c + 2);
+        v->cr_nv = c[4];
+        v->cr_nt = c[5];
+        v->cr_depth = SN_RD_REAL(c + 12);
+        v->cr_push = SN_RD_REAL(c + 12 + SN_REAL_BYTES);
+        v->crB = SN_CREASE_STATE_BYTES(v->nS, v->cr_list, v->cr_active);
+    }
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */

@@ -268,6 +268,11 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_SEGMESH] = 0; el[SN_SEC_SEGMESH] = SN_ELEM_SEGMESH(R);
         cnt[SN_SEC_SEGNODES] = 0; el[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(R);
         cnt[SN_SEC_SEGATTACH] = 0; el[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(R);
+        /* format 5.0: no crease sections */
+        cnt[SN_SEC_CREASE] = 0; el[SN_SEC_CREASE] = SN_ELEM_CREASE(R);
+        cnt[SN_SEC_CREASE_PAIRS] = 0; el[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
+        cnt[SN_SEC_CREASE_VNBR] = 0; el[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
+        cnt[SN_SEC_CREASE_TNBR] = 0; el[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;
