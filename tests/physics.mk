@@ -41,6 +41,16 @@ $(BUILD)/tests/test_physics_$(1)_float: tests/test_physics_$(1).c $(REF_SRC) $(P
 	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $$@ $$< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 endef
 $(foreach t,$(PHYS_TESTS),$(eval $(call PHYS_TEST_RULE,$(t))))
+
+# Crease self-collision in the runtime (seed 003 §3.4; tests/test_runtime_crease.c):
+# the physics tests' helpers and the runtime's internal headers
+$(BUILD)/tests/test_runtime_crease: tests/test_runtime_crease.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_crease_float: tests/test_runtime_crease.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_crease $(BUILD)/tests/test_runtime_crease_float
 TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)
 
 # make soak-adversarial: test_physics_soak (issue 16 item 6) run long, fixed and

@@ -10,8 +10,9 @@
  * than the crease depth: the runtime's inside test (sb_crease_inside). The
  * seed set D is the sequence of (vertex, triangle corner nearest the
  * projection) pairs in the order found, each vertex once per pose, duplicates
- * over poses dropped. Triangles with a corner within two rings of the vertex
- * are never tested (neighbours fold with the skin and are not collisions).
+ * over poses dropped. Triangles with a corner in the vertex's neighbourhood
+ * (VNBR row, below) are never tested, as in the runtime (neighbours fold with
+ * the skin and are not collisions).
  *
  * Unlike the paper, the slow motion runs without the contact constraints
  * (the reference model has none): after a vertex is recorded the surface
@@ -318,18 +319,16 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
             fprintf(stderr, "sinew-bake: warning: crease: %d vertex and %d triangle neighbourhoods truncated to %u / %u entries (lower the ring)\n",
                     trunc_v, trunc_t, SN_CREASE_MAX_NBR_V, SN_CREASE_MAX_NBR_T);
     }
-    /* the 2-ring of each vertex: triangles touching it are never collisions */
+    /* each vertex's neighbourhood, sorted: triangles touching it are never collisions (as the runtime) */
     excl_ptr = sb_alloc(sizeof(int) * (size_t)(ns + 1));
-    for (s = 0; s < ns; s++) mark[s] = -1;
+    excl = sb_alloc(sizeof(int) * ((size_t)ns * (size_t)kv + 1));
     {
-        int total = 0, cap = 16 * ns + 16;
-        excl = sb_alloc(sizeof(int) * (size_t)cap);
+        int total = 0;
         for (s = 0; s < ns; s++) {
-            int n = rings(&vv, s, 2, buf, rg, ns, mark, s), q;
+            int q, n0 = total;
             excl_ptr[s] = total;
-            if (total + n > cap) { cap = 2 * (total + n); excl = realloc(excl, sizeof(int) * (size_t)cap); if (!excl) { fprintf(stderr, "out of memory\n"); exit(1); } }
-            for (q = 0; q < n; q++) excl[total++] = buf[q];
-            qsort(excl + excl_ptr[s], (size_t)n, sizeof(int), cmp_int);
+            for (q = 0; q < kv; q++) if (o->cr_vnbr[(size_t)s * (size_t)kv + (size_t)q] >= 0) excl[total++] = o->cr_vnbr[(size_t)s * (size_t)kv + (size_t)q];
+            qsort(excl + n0, (size_t)(total - n0), sizeof(int), cmp_int);
         }
         excl_ptr[ns] = total;
     }

@@ -46,6 +46,7 @@ static uint8_t *cr_member(const sn_ihdr *h) {
 
 const sn_crease_pair *sn_crease_list(const sn_ihdr *h) { return h->v.nCR ? cr_pairs(h) : NULL; }
 const sn_row *sn_crease_rows(const sn_ihdr *h) { return h->v.nCR ? cr_rowbuf(h) : NULL; }
+const sn_q *sn_crease_surface(const sn_ihdr *h) { return h->v.nCR ? cr_surf(h) : NULL; }
 
 /* ---- TEMPORARY (sn_crease.h): the row store until sn_constraint.h lands ---- */
 int sn_rows_push(sn_ihdr *h, const sn_row *r) {
@@ -138,10 +139,19 @@ static void cr_tri(const sn_ihdr *h, const sn_q *S, const sn_q ra[3], uint32_t t
     if (full && g->below) cr_finish(ra, p0, g, sat);
 }
 
+/* Is surface vertex x in VNBR row a (a's neighbourhood, a itself first)? */
+static int cr_near(const sn_ihdr *h, uint32_t a, uint32_t x) {
+    const unsigned char *row = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)a * h->v.cr_nv;
+    uint32_t k, hit = 0;
+    for (k = 0; k < h->v.cr_nv; k++) hit |= (uint32_t)(sn_rd_u16(row + 2u * k) == x);
+    return (int)hit;
+}
+
 /* Search row rowv of TNBR for a triangle that surface vertex a (position
- * ra) has penetrated: not a corner of it, behind it, its projection inside
- * it, no deeper than the baked depth. The first such triangle of the row
- * (increasing index) wins. Returns 1 and *tri, *corner (surface vertex). */
+ * ra) has penetrated: no corner of it in a's neighbourhood (VNBR row a: a
+ * fold of the skin next to a is not a collision), behind it, its projection
+ * inside it, no deeper than the baked depth. The first such triangle of the
+ * row (increasing index) wins. Returns 1 and *tri, *corner (surface vertex). */
 static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t rowv, uint32_t *tri,
                      uint32_t *corner, uint32_t *sat) {
     const unsigned char *row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)rowv * h->v.cr_nt;
@@ -150,7 +160,7 @@ static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[
         uint32_t t = sn_rd_u16(row + 2u * k);
         cr_geo g;
         if (t == SN_CREASE_NONE) break; /* the row's tail is all NONE (validated) */
-        if (cr_tri_corner(h, t, 0) == a || cr_tri_corner(h, t, 1) == a || cr_tri_corner(h, t, 2) == a) continue;
+        if (cr_near(h, a, cr_tri_corner(h, t, 0)) || cr_near(h, a, cr_tri_corner(h, t, 1)) || cr_near(h, a, cr_tri_corner(h, t, 2))) continue;
         cr_tri(h, S, ra, t, &g, 0, sat);
         if (!g.below || !g.inside) continue;
         cr_finish(ra, S + 3u * cr_tri_corner(h, t, 0), &g, sat);

@@ -46,5 +46,8 @@ typedef struct sn_crease_pair {
  * pushed by the last step (temporary buffer, cr_rows entries). */
 const sn_crease_pair *sn_crease_list(const sn_ihdr *h);
 const sn_row *sn_crease_rows(const sn_ihdr *h);
+/* The surface positions (internal units, 3 per surface vertex) the last
+ * step's detection used: lattice after the pose, before the solve. */
+const sn_q *sn_crease_surface(const sn_ihdr *h);
 
 #endif /* SN_CREASE_H */
