@@ -72,7 +72,7 @@ SN_INLINE uint32_t cr_tri_corner(const sn_ihdr *h, uint32_t t, uint32_t k) {
  * |n|^2 - B - G <= 9 2^54: exact in int64 (NUMERICS.md). */
 typedef struct cr_geo {
     int ok;          /* non-degenerate triangle */
-    int below;       /* (r_i - a).n < 0: behind the triangle's plane */
+    int below;       /* (r_i - a).n < 0: behind the triangle's plane (the fields below only when below) */
     int inside;      /* the projection lies in the triangle (every barycentric >= 0) */
     int off;         /* the projection lies off the triangle by more than 1/4 (a barycentric < -1/4) */
     uint32_t corner; /* 0, 1, 2: the corner with the largest barycentric (ties: lowest) */
@@ -101,6 +101,15 @@ static void cr_test(const sn_q ri[3], const sn_q ra[3], const sn_q rb[3], const 
     n[2] = e1[0] * e2[1] + (-e1[1]) * e2[0];
     N2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
     dn = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
+    /* normal kept unnormalized until cr_finish (|n_k| <= 2^27 fits sn_q) */
+    g->n[0] = (sn_q)n[0]; g->n[1] = (sn_q)n[1]; g->n[2] = (sn_q)n[2]; g->n[3] = 0;
+    g->d = 0;
+    g->ok = N2 > 0;
+    g->below = g->ok && dn < 0;
+    if (!g->below) { /* in front (or degenerate): nothing else is used (every caller drops such a pair) */
+        g->inside = 0; g->off = 1; g->corner = 0;
+        return;
+    }
     x[0] = u[1] * e2[2] + (-u[2]) * e2[1]; /* u x e2 */
     x[1] = u[2] * e2[0] + (-u[0]) * e2[2];
     x[2] = u[0] * e2[1] + (-u[1]) * e2[0];
@@ -110,14 +119,9 @@ static void cr_test(const sn_q ri[3], const sn_q ra[3], const sn_q rb[3], const 
     x[2] = e1[0] * u[1] + (-e1[1]) * u[0];
     G = x[0] * n[0] + x[1] * n[1] + x[2] * n[2];
     A = N2 - B - G;
-    g->ok = N2 > 0;
-    g->below = g->ok && dn < 0;
-    g->inside = g->ok && A >= 0 && B >= 0 && G >= 0;
-    g->off = !g->ok || 4 * A < -N2 || 4 * B < -N2 || 4 * G < -N2;
+    g->inside = A >= 0 && B >= 0 && G >= 0;
+    g->off = 4 * A < -N2 || 4 * B < -N2 || 4 * G < -N2;
     g->corner = (B > A && B >= G) ? 1u : ((G > A && G > B) ? 2u : 0u);
-    /* normal kept unnormalized until cr_finish (|n_k| <= 2^27 fits sn_q) */
-    g->n[0] = (sn_q)n[0]; g->n[1] = (sn_q)n[1]; g->n[2] = (sn_q)n[2]; g->n[3] = 0;
-    g->d = 0;
 }
 
 /* Unit normal (Q30) and the signed distance d = (r_i - a).n (Q22): one
@@ -139,11 +143,10 @@ static void cr_tri(const sn_ihdr *h, const sn_q *S, const sn_q ra[3], uint32_t t
     if (full && g->below) cr_finish(ra, p0, g, sat);
 }
 
-/* Is surface vertex x in VNBR row a (a's neighbourhood, a itself first)? */
-static int cr_near(const sn_ihdr *h, uint32_t a, uint32_t x) {
-    const unsigned char *row = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)a * h->v.cr_nv;
+/* Is any of x0, x1, x2 among the n entries of nb (a's neighbourhood)? */
+static int cr_near(const uint16_t *nb, uint32_t n, uint32_t x0, uint32_t x1, uint32_t x2) {
     uint32_t k, hit = 0;
-    for (k = 0; k < h->v.cr_nv; k++) hit |= (uint32_t)(sn_rd_u16(row + 2u * k) == x);
+    for (k = 0; k < n; k++) hit |= (uint32_t)(nb[k] == x0) | (uint32_t)(nb[k] == x1) | (uint32_t)(nb[k] == x2);
     return (int)hit;
 }
 
@@ -155,12 +158,18 @@ static int cr_near(const sn_ihdr *h, uint32_t a, uint32_t x) {
 static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t rowv, uint32_t *tri,
                      uint32_t *corner, uint32_t *sat) {
     const unsigned char *row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)rowv * h->v.cr_nt;
-    uint32_t k;
+    const unsigned char *vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)a * h->v.cr_nv;
+    uint16_t nb[SN_CREASE_MAX_NBR_V];
+    uint32_t k, nn;
+    for (nn = 0; nn < h->v.cr_nv; nn++) { /* a's neighbourhood, once per search */
+        nb[nn] = (uint16_t)sn_rd_u16(vrow + 2u * nn);
+        if (nb[nn] == SN_CREASE_NONE) break;
+    }
     for (k = 0; k < h->v.cr_nt; k++) {
         uint32_t t = sn_rd_u16(row + 2u * k);
         cr_geo g;
         if (t == SN_CREASE_NONE) break; /* the row's tail is all NONE (validated) */
-        if (cr_near(h, a, cr_tri_corner(h, t, 0)) || cr_near(h, a, cr_tri_corner(h, t, 1)) || cr_near(h, a, cr_tri_corner(h, t, 2))) continue;
+        if (cr_near(nb, nn, cr_tri_corner(h, t, 0), cr_tri_corner(h, t, 1), cr_tri_corner(h, t, 2))) continue;
         cr_tri(h, S, ra, t, &g, 0, sat);
         if (!g.below || !g.inside) continue;
         cr_finish(ra, S + 3u * cr_tri_corner(h, t, 0), &g, sat);
