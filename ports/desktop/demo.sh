@@ -151,6 +151,16 @@ run "limb biceps (150 steps)" "$PLAY" "$LIMB" --clip tools/examples/limb/flex.cl
     --compare-rigs "$OUT/limb_biceps_rigs.png" --rig-off-blob "$BUILD/examples/norig/limb.blob" --heat 0.1 --view 0,10
 run "beast flex and breathe (150 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/flex.clip" --frames 150 \
     --compare-rigs "$OUT/beast_rigs.png" --rig-off-blob "$BUILD/examples/norig/beast.blob" --heat 3 --view 10,10 --size 600x450
+# Self-collision near the elbow crease (seed 003 §3.4, fig. 2): the limb at
+# 120 degrees (crease.clip at 3 s) without crease data, and with it: the
+# contacts the runtime lists (red dots). Until the constraint projection
+# (issue 12 item 1) enforces their rows, both shapes are the same: the
+# flesh still interpenetrates; with it, it will bulge instead.
+run "limb 120 deg, no crease data (180 steps)" "$PLAY" "$LIMB" --clip tools/examples/limb/crease.clip --frames 180 \
+    --png "$OUT/limb_crease_without.png" --view 0,5 --title "limb at 120 deg: no crease data"
+run "limb 120 deg, crease contacts (180 steps)" "$PLAY" "$BUILD/examples/limb_crease.blob" --clip tools/examples/limb/crease.clip \
+    --frames 180 --png "$OUT/limb_crease_contacts.png" --view 0,5 --crease-marks \
+    --title "limb_crease at 120 deg: contacts (not yet enforced)"
 rm -f "$OUT/run.out"
 
 echo

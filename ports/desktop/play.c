@@ -56,6 +56,7 @@ static void usage(FILE *f) {
         "  --rig-off-blob B   the same character baked without its rigs (same lattice and surface), for\n"
         "                     the rigs-off panel of --compare-rigs (pose-driven rigs cannot be switched off)\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
+        "  --crease-marks     draw the surface vertices in the crease collision list (seed 003 §3.4) in red\n"
         "  --seg-impulse M:N:X,Y,Z[@K]  impulse (newton-seconds, world axes) at node N of segment mesh M\n"
         "                     during step K (default 1); repeatable (at most 16)\n"
         "  --seg-floor Y      floor under the segment meshes at height Y (world mesh units, normal +y)\n"
@@ -147,6 +148,8 @@ typedef struct {
     float flo[3], fhi[3];       /* box the camera frames (default: lo, hi plus a margin) */
     float az, el;
     int lattice;
+    int marks;                  /* --crease-marks: surface vertices in the crease collision list drawn red */
+    uint32_t *cr_list;          /* their indices (scratch) */
     /* rigid skinning by the lattice frames: --heat and the camera's box */
     float heat;                 /* mesh units drawn at full colour; 0 = off */
     float *rest, *skin;         /* lattice rest / skinned positions, model space, mesh units */
@@ -405,10 +408,18 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     fetch(s, inst);
     if (s->heat > 0 && s->ref) ref_colours(s);
     else if (s->heat > 0) heat_colours(s);
+    if (s->marks && s->col && s->cr_list) {   /* crease contacts (seed 003 §3.4) in red over the flesh */
+        uint32_t n = sn_get_crease_contacts(inst, s->cr_list, s->info.surface_vertices), i;
+        if (s->heat <= 0)
+            for (i = 0; i < s->info.surface_vertices; i++) memcpy(s->col + 3 * i, cow_colour, sizeof cow_colour);
+        for (i = 0; i < n && i < s->info.surface_vertices; i++) {
+            s->col[3 * s->cr_list[i]] = 0.85f; s->col[3 * s->cr_list[i] + 1] = 0.05f; s->col[3 * s->cr_list[i] + 2] = 0.05f;
+        }
+    }
     rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
     cam.ground_y = s->lo[1];   /* the ground stays under the feet */
     rs_clear(&big, &cam);
-    if (s->heat > 0) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
+    if (s->heat > 0 || (s->marks && s->col && s->cr_list)) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
     else rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
     if (s->lattice) {
         const uint8_t lc[3] = {30, 60, 140}, sc[3] = {200, 30, 30};
@@ -418,6 +429,11 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
         for (v = s->info.free_vertices; v < s->info.vertices; v++) rs_draw_dot(&big, &cam, s->lpos + 3 * v, r, sc);
     }
     if (s->segments) draw_segments(s, &big, &cam);
+    if (s->marks && s->cr_list) {   /* contacts as dots over everything: most lie inside the other surface */
+        const uint8_t mc[3] = {215, 20, 20};
+        uint32_t n = sn_get_crease_contacts(inst, s->cr_list, s->info.surface_vertices), i;
+        for (i = 0; i < n && i < s->info.surface_vertices; i++) rs_draw_dot(&big, &cam, s->pos + 3 * s->cr_list[i], (float)big.w / 220.0f, mc);
+    }
     rs_downsample2(&big, out);
     rs_image_free(&big);
     if (label) rs_draw_text(out, 8, 8, out->w >= 480 ? 2 : 1, label, ink);
@@ -432,7 +448,7 @@ typedef struct {
     const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
     int n_held, rigs_off;
     long frames, iterations, health;
-    int unwarped, hash, lattice, quiet, w, h, have_size;
+    int unwarped, hash, lattice, marks, quiet, w, h, have_size;
     float az, el, box[6], heat;
     int have_box;
     /* segment meshes: --seg-impulse, --seg-floor, --segments */
@@ -581,6 +597,7 @@ static int parse_args(int argc, char **argv, options *o) {
         else if (!strcmp(a, "--unwarped")) o->unwarped = 1;
         else if (!strcmp(a, "--hash")) o->hash = 1;
         else if (!strcmp(a, "--lattice")) o->lattice = 1;
+        else if (!strcmp(a, "--crease-marks")) o->marks = 1;
         else if (!strcmp(a, "--quiet")) o->quiet = 1;
         else if (a[0] == '-' && a[1]) { fprintf(stderr, PROG ": unknown option '%s' (try --help)\n", a); return 2; }
         else if (!o->blob_path) o->blob_path = a;
@@ -914,7 +931,7 @@ int main(int argc, char **argv) {
     }
 
     /* scratch */
-    s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat;
+    s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat; s.marks = o.marks;
     local = malloc(s.info.joints * sizeof *local);
     xf = malloc(s.info.joints * sizeof *xf);
     rest_xf = malloc(s.info.joints * sizeof *rest_xf);
@@ -958,6 +975,7 @@ int main(int argc, char **argv) {
     pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
+    if (o.marks && !(s.cr_list = malloc(((size_t)s.info.surface_vertices + 1) * sizeof *s.cr_list))) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
     for (i = 0; i < s.info.joints; i++) {
         local[i].x = local[i].y = local[i].z = 0;
@@ -1237,6 +1255,6 @@ done:
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
     free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
-    free(fctl); free(bytes2); free(refpos);
+    free(fctl); free(bytes2); free(refpos); free(s.cr_list);
     return rc;
 }

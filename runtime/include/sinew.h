@@ -268,6 +268,13 @@ typedef struct sn_stats {
     uint32_t crease_added;       ///< pairs added to C since init/reset
     uint32_t crease_removed;     ///< pairs removed from C since init/reset (vertex back outside, or slid off its triangle)
 } sn_stats;
+/// Self-collision near creases (seed 003 §3.4): the surface vertices in the
+/// collision list after the last step's detection, in the order they entered
+/// it (the first crease_active of them produced contact constraints). Writes
+/// at most max of them into vertices (may be NULL when max is 0) and returns
+/// the list's length (0 without crease data or for an invalid instance).
+uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uint32_t max);
+
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.
 sn_status sn_get_stats(const sn_instance *inst, sn_stats *out);

@@ -48,6 +48,18 @@ const sn_crease_pair *sn_crease_list(const sn_ihdr *h) { return h->v.nCR ? cr_pa
 const sn_row *sn_crease_rows(const sn_ihdr *h) { return h->v.nCR ? cr_rowbuf(h) : NULL; }
 const sn_q *sn_crease_surface(const sn_ihdr *h) { return h->v.nCR ? cr_surf(h) : NULL; }
 
+uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uint32_t max) {
+    const sn_ihdr *h;
+    const sn_crease_pair *C;
+    uint32_t k;
+    if (inst_status(inst) != SN_OK) return 0;
+    h = chdr_of(inst);
+    if (!h->v.nCR) return 0;
+    C = cr_pairs(h);
+    for (k = 0; vertices && k < h->cr_n && k < max; k++) vertices[k] = C[k].vertex;
+    return h->cr_n;
+}
+
 /* ---- TEMPORARY (sn_crease.h): the row store until sn_constraint.h lands ---- */
 int sn_rows_push(sn_ihdr *h, const sn_row *r) {
     if (!h->v.nCR || h->cr_rows >= h->v.cr_active) return 0;
