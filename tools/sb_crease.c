@@ -350,7 +350,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
         memset(&g, 0, sizeof g);
         o->cr_pairs = sb_alloc(sizeof(int) * 2 * (size_t)cap);
         o->cr_nD = 0;
-        cellh = fmax(o->c, 2 * o->cr_depth); /* grid cell: a lattice cell (triangles are smaller) */
+        cellh = 0; /* the grid's cell: set from the rest surface (step 0 of the first pose) */
         for (ci = 0; ci < d->ncrease && !fail; ci++) {
             const sb_creasedef *cd = &d->creases[ci];
             int N = cd->steps, hold = cd->steps / 4, step, found = 0;
@@ -369,6 +369,18 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                 if (step > 0) snref_step(&st);
                 memcpy(prev, cur, sizeof(double) * 3 * (size_t)ns);
                 snref_get_surface(&st, cur);
+                if (step == 0 && cellh == 0) {   /* twice the mean rest edge, at least twice the depth */
+                    double sum = 0;
+                    int t, c, k;
+                    for (t = 0; t < nt; t++)
+                        for (c = 0; c < 3; c++) {
+                            const double *p0 = cur + 3 * o->tri[3 * t + c], *p1 = cur + 3 * o->tri[3 * t + (c + 1) % 3];
+                            double d2 = 0;
+                            for (k = 0; k < 3; k++) d2 += (p1[k] - p0[k]) * (p1[k] - p0[k]);
+                            sum += sqrt(d2);
+                        }
+                    cellh = fmax(2 * sum / (3.0 * nt), 2 * o->cr_depth);
+                }
                 if (step == 0) continue;
                 grid_build(&g, o, cur, o->cr_depth, cellh);
                 for (i = 0; i < ns; i++) {
