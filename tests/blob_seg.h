@@ -21,4 +21,15 @@ static inline uint32_t seg_state_bytes(const unsigned char *b) {
     }
     return tot;
 }
+/* The constraint state bytes (format 5.0): SN_CONS_BYTES of the CONSTRAINTS
+ * record's maxima, 0 without the record. */
+static inline uint32_t cons_state_bytes(const unsigned char *b) {
+    const unsigned char *e = b + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CONSTRAINTS;
+    const unsigned char *r = b + bs_u32(e);
+    uint32_t ct;
+    if (bs_u32(e + 8) != 1u) return 0;
+    ct = (uint32_t)r[2] | (uint32_t)r[3] << 8;
+    if (!r[0] && !r[1] && !ct) return 0;
+    return SN_CONS_BYTES(r[0], r[1], SN_ROWS_CAP(r[0], ct));
+}
 #endif

@@ -390,6 +390,7 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         cnt[SN_SEC_SEGMESH] = v.nM;
         cnt[SN_SEC_SEGNODES] = v.nSN;
         cnt[SN_SEC_SEGATTACH] = v.nSA;
+        cnt[SN_SEC_CONSTRAINTS] = 0; /* 0 or 1: taken from the table below */
     }
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
@@ -401,12 +402,13 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
-            SN_ELEM_SEGATTACH(SN_REAL_BYTES)};
+            SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
             uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
             if ((k == SN_SEC_LIMIT || k == SN_SEC_VSHARE) && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
+            if (k == SN_SEC_CONSTRAINTS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -428,8 +430,10 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (st != SN_OK) return st;
     st = sn_check_segments(&v, &v.segB);
     if (st != SN_OK) return st;
+    st = sn_check_constraints(&v);
+    if (st != SN_OK) return st;
     /* the instance size is the runtime's layout (one source: sn_instance.c) */
-    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB)) return SN_ERR_HEADER;
+    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB, v.conB)) return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }
@@ -470,6 +474,7 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->flags = p[SN_H_FLAGS];
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
+    v->nCon = v->nCol = v->nCt = v->nRows = v->conB = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
@@ -486,6 +491,7 @@ static void sn_view_sections(sn_view *v) {
     v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
     v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
     v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);
+    sn_view_constraints(v);
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */
@@ -526,6 +532,10 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->rig_entries = v.nRE;
     info->force_slots = v.nFrc;
     info->force_profiles = v.nP;
+    info->max_constraints = v.nCon;
+    info->max_colliders = v.nCol;
+    info->max_contacts = v.nCt;
+    info->max_rows = v.nRows;
 }
 
 static const unsigned char *sn_section(const sn_blob *blob, int k) {

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 4.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 5.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -15,7 +15,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 4
+#define SN_FORMAT_MAJOR 5
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -136,6 +136,10 @@ enum {
     SN_SEC_SEGNODES,     /* sum of nodes x R[3]: rest node positions, model space, Q22 (sheets row-major) */
     SN_SEC_SEGATTACH,    /* sum of n_attach x {u16 node (< the mesh's nodes), u8 kind (SN_SEGATT_*), u8 0, u16 target, u16 0,
                             R point[3] (JOINT: attachment point at rest, model space Q22; SURFACE: 0)} */
+    /* ---- constraints and contact (seed 000 §4.4, seed 003 §3.4 eq. 9), format 5.0; count 0 or 1 ---- */
+    SN_SEC_CONSTRAINTS,  /* 0 or 1 x {u8 max_constraints (0..SN_MAX_CONSTRAINTS), u8 max_colliders (0..SN_MAX_COLLIDERS),
+                            u16 max_contacts (0..SN_MAX_CONTACTS), u32 0}; 3 max_constraints + max_contacts (+ the rows
+                            of later producers) <= SN_MAX_ROWS. Count 0: no constraints, colliders or contacts */
     SN_SEC_COUNT
 };
 
@@ -167,6 +171,7 @@ enum {
 #define SN_ELEM_SEGMESH(R)  (16 + 9 * (R))
 #define SN_ELEM_SEGNODES(R) (3 * (R))
 #define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
+#define SN_ELEM_CONSTRAINTS 8
 
 /* external forces: levels fine, coarse 1..3 (2, 4, 8 cells), rigid */
 #define SN_LEVELS 5
@@ -202,6 +207,24 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
     }
 }
 
+/* constraints and contact (runtime/NUMERICS.md "Constraints and contact") */
+#define SN_MAX_CONSTRAINTS 64u   /* user constraints (sn_set_constraints), up to 3 rows each */
+#define SN_MAX_COLLIDERS 16u     /* world colliders (sn_set_colliders) */
+#define SN_MAX_CONTACTS 256u     /* contact rows per step */
+#define SN_MAX_ROWS 512u         /* constraint rows per step, every producer together */
+#define SN_CON_BYTES 80u         /* instance bytes per user constraint */
+#define SN_COL_BYTES 64u         /* instance bytes per collider */
+#define SN_ROW_BYTES 120u        /* instance bytes per row (sn_row, runtime/src/sn_constraint.h) */
+#define SN_ROWAUX_BYTES 16u      /* instance bytes per row of factorization state */
+/* Rows per step: the sum of every producer's baked maximum (user constraints
+ * give up to 3 rows each, a contact one). A later producer adds its term. */
+#define SN_ROWS_CAP(ncon, ncontacts) (3u * (uint32_t)(ncon) + (uint32_t)(ncontacts))
+/* Instance bytes of the constraint state: records, rows, per-row state and the
+ * packed lower-triangular Cholesky factor of the rows' Gram matrix (int32/float). */
+#define SN_CONS_BYTES(ncon, ncol, nrows) \
+    ((uint32_t)(ncon) * SN_CON_BYTES + (uint32_t)(ncol) * SN_COL_BYTES + \
+     (uint32_t)(nrows) * (SN_ROW_BYTES + SN_ROWAUX_BYTES) + 4u * ((uint32_t)(nrows) * ((uint32_t)(nrows) + 1u) / 2u))
+
 /* control kinds (CONTROLS.kind) */
 #define SN_CTL_ABSTRACT 0   /* set by the game: sn_set_control */
 #define SN_CTL_ANGLE    1   /* read from the pose each step: angle (degrees) of joint's rotation relative to its parent about axis */
@@ -236,10 +259,11 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * the header to equal it, and test_runtime_blob checks this macro against it. */
 #define SN_INSTANCE_HDR_BYTES 768u /* the instance header before the arrays */
 /* nFrc: force slots (header MAX_FORCES); segB: segment state bytes, the sum
- * over meshes of SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts). */
-#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB) \
-    ((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
+ * over meshes of SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts);
+ * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record (0 without). */
+#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB, conB) \
+    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
       12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
-      SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u)
+      SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u) + (uint32_t)(conB) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */
