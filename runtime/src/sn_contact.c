@@ -139,7 +139,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         const sn_col *cl = cols + c;
         for (q = 0; q < 3; q++) {
             A[c][q] = ct_to_int(h, cl->a[q], h->origin[q], sat);
-            B[c][q] = ct_to_int(h, cl->b[q], h->origin[q], sat);
+            B[c][q] = cl->kind == SN_COLLIDER_CAPSULE ? ct_to_int(h, cl->b[q], h->origin[q], sat) : 0; /* a plane's b is its normal */
 #if defined(SN_FLOAT)
             V[c][q] = pub_to_int(h, cl->vel[q] * v->timestep);
 #else
