@@ -41,15 +41,18 @@ typedef char sn_con_fits_[sizeof(sn_con) <= SN_CON_BYTES ? 1 : -1];
 /* drop rule: a row is kept when its squared length over the free vertices
  * (its Gram diagonal) is at least 2^-8 (a point almost wholly on skeleton
  * vertices would need huge free velocities), the part of it orthogonal to
- * the kept rows before it has at least 2^-SN_DROP_BITS of that, and at
- * least 2^-12 absolutely: L_jj >= 2^-6, so 1/L_jj <= 2^6 (Q24 < 2^31) */
-#define SN_DROP_BITS 8
+ * the kept rows before it has at least 2^-SN_DROP_BITS of that (a nearly
+ * dependent row would make G^-1 large: the multipliers of the projection
+ * would leave their range), and at least 2^-10 absolutely: L_jj >= 2^-5,
+ * so 1/L_jj <= 2^5 (Q24 < 2^31) */
+#define SN_DROP_BITS 4
 #if defined(SN_FLOAT)
 #define G_TINY (1.0f / 256.0f)
-#define P_TINY (1.0f / 4096.0f)
+#define P_TINY (1.0f / 1024.0f)
+#define P_REL (1.0f / 16.0f)
 #else
 #define G_TINY ((int64_t)1 << 48) /* 2^-8 in Q56 */
-#define P_TINY ((int64_t)1 << 44) /* 2^-12 in Q56 */
+#define P_TINY ((int64_t)1 << 46) /* 2^-10 in Q56 */
 #endif
 
 /* ---- the section ---- */
@@ -272,7 +275,11 @@ void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat) {
     rows_apply_acc(h, acc, y, force_like, sat);
 }
 
-void sn_rows_fix(sn_ihdr *h, sn_q *y, int fine, uint32_t *sat) {
+void sn_rows_fix(sn_ihdr *h, sn_q *y, int fine, uint32_t *sat_state) {
+    /* the fine pass corrects rounding: a clamp of its multipliers (beyond
+     * 1/4 unit, after a coarse pass that clamped) limits the correction and
+     * is not a state clamp */
+    uint32_t fine_clamps = 0, *sat = fine ? &fine_clamps : sat_state;
     const sn_row *r = sn_rows(h);
     sn_rowx *x = ARR(h, o_rx, sn_rowx);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
@@ -291,7 +298,7 @@ void sn_rows_fix(sn_ihdr *h, sn_q *y, int fine, uint32_t *sat) {
     for (j = 0; j < m; j++)
         if (x[j].inv != 0) row_acc(h, r + j, x[j].s, acc, sat);
     (void)kk;
-    rows_apply_acc(h, acc, y, fine ? -8 : 0, sat);
+    rows_apply_acc(h, acc, y, fine ? -8 : 0, sat_state);
 }
 
 /* Gram matrix and its Cholesky factor, row by row (Cholesky-Crout), with the
@@ -352,7 +359,7 @@ static uint32_t rows_factor(sn_ihdr *h, uint32_t *sat) {
         piv = gjj;
         for (l = 0; l < j; l++) piv -= sn_mul(L[LIDX(j, l)], L[LIDX(j, l)]);
 #if defined(SN_FLOAT)
-        if (!(gjj >= G_TINY) || !(piv > gjj * (1.0f / 256.0f)) || !(piv >= P_TINY)) {
+        if (!(gjj >= G_TINY) || !(piv > gjj * P_REL) || !(piv >= P_TINY)) {
 #else
         if (gjj < G_TINY || piv <= (gjj >> SN_DROP_BITS) || piv < P_TINY) {
 #endif

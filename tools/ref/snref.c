@@ -836,7 +836,7 @@ static void precond_apply(const snref_state *s, const double *P, const double *r
  * Dense: C (3nF x m, column j the row's coefficients over free vertices),
  * G = C^T C = L L^T by Cholesky with the runtime's drop rule (a row whose
  * squared length is below 2^-8, or whose part orthogonal to the kept rows
- * before it has less than 2^-8 of that or less than 2^-12, is dropped). */
+ * before it has less than 2^-4 of that or less than 2^-10, is dropped). */
 typedef struct { unsigned m, n3; double *C, *L, *a, *t; int *kept; } rowsys;
 static void rows_build(const snref_state *s, rowsys *q, const double *vstar) {
     unsigned j, l, p, k, c, nF = s->m->nF;
@@ -864,7 +864,7 @@ static void rows_build(const snref_state *s, rowsys *q, const double *vstar) {
         }
         piv = g;
         for (p = 0; p < j; p++) piv -= q->L[j * q->m + p] * q->L[j * q->m + p];
-        if (g < ldexp(1.0, -8) || piv <= g * ldexp(1.0, -8) || piv < ldexp(1.0, -12)) {
+        if (g < ldexp(1.0, -8) || piv <= g * ldexp(1.0, -4) || piv < ldexp(1.0, -10)) {
             for (p = 0; p < j; p++) q->L[j * q->m + p] = 0;
             continue;
         }
