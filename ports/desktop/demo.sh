@@ -58,6 +58,17 @@ run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_tur
 # global share profile; "rest | no hit | hit" 0.15 s later, the hit panel
 # coloured by its distance from the no-hit run (red at 0.5 mesh units for
 # the beast, 0.1 for the cow).
+# Constraints and contact (issue 12): the trot on a ground plane 0.05 above
+# the lowest resting hoof, a sphere rising into the belly, a belt (the
+# surface near x = 2 pinned in y and z) while the cow breathes
+run "cow trot on the ground (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 --ground -3.59 \
+    --sheet "$OUT/cow_ground.png" --title "trot on a ground plane (sn_set_colliders)"
+run "cow sphere in the belly (120 steps)" "$PLAY" "$COW" --frames 120 --sphere 1,-2.6,0,1@0,0.3,0 \
+    --sheet "$OUT/cow_sphere.png" --title "a sphere rising into the belly" --view 5,-5 --frame-box -2,-3.8,-2,4,0.5,2
+run "cow belt while breathing (180 steps)" "$PLAY" "$COW" --clip "$CLIPS/breathe.clip" --frames 180 --belt 2.0 \
+    --sheet "$OUT/cow_belt.png" --heat 0.15 --title "belt at x = 2 (32 pins) while breathing" --view 60,10
+run "cow belt float (180 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/breathe.clip" --frames 180 --belt 2.0 --hash
+
 BEAST=$BUILD/examples/beast.blob
 for p in local torso global; do
     run "beast punch, profile $p (9 steps)" "$PLAY" "$BEAST" --clip tools/examples/beast/punch_$p.clip --frames 9 \
