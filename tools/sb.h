@@ -165,6 +165,8 @@ typedef struct sb_desc {
     sb_control *ctls; int nctl;      /* 'control' */
     sb_rigdef *rigs; int nrig;       /* 'rig', 'tau' */
     int force_slots;                 /* 'forces N': external forces per step (default 8) */
+    int max_cons;                    /* 'constraints N': position constraints (default 0) */
+    int max_cols, max_contacts;      /* 'colliders N CONTACTS': colliders and contact rows per step (default 0 0) */
     sb_shares *shares; int nshares;  /* 'shares' */
     sb_sharerule *srules; int nsr;   /* 'shares_region' */
     sb_segdef *segs; int nseg;       /* 'chain', 'sheet', 'attach' */
@@ -241,6 +243,7 @@ typedef struct sb_model {
     /* external forces (sb_force.c, sb_force_build): slots per step, share profiles
      * (fine, coarse 1..3, rigid; each sums to 1), profile of each free vertex (NULL: all 0) */
     int max_forces;
+    int max_cons, max_cols, max_contacts; /* constraint section (0 0 0: none) */
     int nprof;
     double (*prof)[5];
     unsigned char *vprof;

@@ -299,6 +299,17 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         cnt[SN_SEC_SEGNODES] = nodes;              esz[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(rs);
         cnt[SN_SEC_SEGATTACH] = natt;              esz[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(rs);
     }
+    {   /* constraints and contact: one record of maxima, or none */
+        int any = o->max_cons || o->max_cols || o->max_contacts;
+        if (o->max_cons < 0 || o->max_cons > (int)SN_MAX_CONSTRAINTS || o->max_cols < 0 || o->max_cols > (int)SN_MAX_COLLIDERS ||
+            o->max_contacts < 0 || o->max_contacts > (int)SN_MAX_CONTACTS ||
+            SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0) > SN_MAX_ROWS || (o->max_cols > 0 && o->max_contacts == 0)) {
+            free(P); free(lump);
+            return sb_fail("constraints %d, colliders %d, contacts %d: at most %u, %u, %u, 3 constraints + contacts + crease rows <= %u, contacts >= 1 with colliders",
+                           o->max_cons, o->max_cols, o->max_contacts, SN_MAX_CONSTRAINTS, SN_MAX_COLLIDERS, SN_MAX_CONTACTS, SN_MAX_ROWS);
+        }
+        cnt[SN_SEC_CONSTRAINTS] = any ? 1u : 0u;   esz[SN_SEC_CONSTRAINTS] = SN_ELEM_CONSTRAINTS;
+    }
     {   /* self-collision near creases (sb_crease.c) */
         uint32_t on = o->crease ? 1u : 0u;
         cnt[SN_SEC_CREASE] = on;                                   esz[SN_SEC_CREASE] = SN_ELEM_CREASE(rs);
@@ -339,7 +350,11 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
     put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc, (uint32_t)o->nctl, (uint32_t)o->max_forces,
                                                        sb_segment_state_bytes(o) +
-                                                       (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list, o->cr_active) : 0u)));
+                                                       (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u),
+                                                       (o->max_cons || o->max_cols || o->max_contacts || o->crease)
+                                                           ? SN_CONS_BYTES(o->max_cons, o->max_cols,
+                                                                           SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
+                                                           : 0u));
     put_u8(&w, SN_H_MAX_FORCES, (unsigned)o->max_forces);
     put_u8(&w, SN_H_FLAGS, o->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
     put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
@@ -457,6 +472,11 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             } else put_real(&w, at, o->prof[i][k], 0);
         }
     if (o->vprof) for (i = 0; i < nF; i++) put_u8(&w, off[SN_SEC_VSHARE] + (size_t)i, o->vprof[i]);
+    if (cnt[SN_SEC_CONSTRAINTS]) {
+        put_u8(&w, off[SN_SEC_CONSTRAINTS], (unsigned)o->max_cons);
+        put_u8(&w, off[SN_SEC_CONSTRAINTS] + 1, (unsigned)o->max_cols);
+        put_u16(&w, off[SN_SEC_CONSTRAINTS] + 2, (unsigned)o->max_contacts);
+    }
     if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s, m0) != 0) { sb_blob_free(b); return -1; }
     if (o->crease) {   /* CREASE record, seed pairs, neighbourhood rows (SN_CREASE_NONE for -1) */
         size_t at = off[SN_SEC_CREASE];

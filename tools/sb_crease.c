@@ -432,9 +432,9 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
     if (!quiet) {
         uint32_t rs = 4, bytes = SN_ELEM_CREASE(rs) + SN_ELEM_CREASE_PAIRS * (uint32_t)o->cr_nD + 2u * (uint32_t)ns * (uint32_t)(kv + kt);
         printf("  crease    %d seed pairs from %d pose(s); neighbourhoods ring %d: %d vertices, %d triangles per row; list %d, active %d, "
-               "depth %g, push %g mesh units; %u blob bytes (4-byte reals), %u instance bytes (%.2f s)\n",
+               "depth %g, push %g mesh units; %u blob bytes (4-byte reals), %u instance bytes of crease state (its rows: see contact) (%.2f s)\n",
                o->cr_nD, d->ncrease, d->cr_ring, kv, kt, o->cr_list, o->cr_active, o->cr_depth, o->cr_push, (unsigned)bytes,
-               (unsigned)SN_CREASE_STATE_BYTES(ns, o->cr_list, o->cr_active), sb_now() - t0);
+               (unsigned)SN_CREASE_STATE_BYTES(ns, o->cr_list), sb_now() - t0);
     }
     rc = 0;
 done:

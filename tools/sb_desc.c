@@ -1,5 +1,6 @@
 /* sb_desc.c -- the text character description (format: tools/DESCRIPTION.md). */
 #include "sb.h"
+#include "../runtime/src/sn_format.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -488,6 +489,21 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (nargs(c, 1) || num(c, 1, &n_)) return -1;
         if (!(n_ >= 0 && n_ <= 32 && n_ == floor(n_))) return sb_fail("%s:%d: forces: slots per step must be a whole number in 0..32", c->path, c->line);
         d->force_slots = (int)n_;
+    } else if (!strcmp(kw, "constraints")) {
+        double n_;
+        if (nargs(c, 1) || num(c, 1, &n_)) return -1;
+        if (!(n_ >= 0 && n_ <= SN_MAX_CONSTRAINTS && n_ == floor(n_)))
+            return sb_fail("%s:%d: constraints: the maximum must be a whole number in 0..%u", c->path, c->line, SN_MAX_CONSTRAINTS);
+        d->max_cons = (int)n_;
+    } else if (!strcmp(kw, "colliders")) {
+        double n_, k_;
+        if (nargs(c, 2) || num(c, 1, &n_) || num(c, 2, &k_)) return -1;
+        if (!(n_ >= 0 && n_ <= SN_MAX_COLLIDERS && n_ == floor(n_)))
+            return sb_fail("%s:%d: colliders: the maximum must be a whole number in 0..%u", c->path, c->line, SN_MAX_COLLIDERS);
+        if (!(k_ >= (n_ > 0 ? 1 : 0) && k_ <= SN_MAX_CONTACTS && k_ == floor(k_)))
+            return sb_fail("%s:%d: colliders: contacts per step must be a whole number in %d..%u", c->path, c->line, n_ > 0 ? 1 : 0, SN_MAX_CONTACTS);
+        d->max_cols = (int)n_;
+        d->max_contacts = (int)k_;
     } else if (!strcmp(kw, "shares")) {
         sb_shares *p_;
         double sum = 0;

@@ -67,5 +67,5 @@ endif
 
 # make demo: bake the cow, play both clips in both flavours, write pictures.
 demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
-      $(BUILD)/examples/limb.blob $(BUILD)/examples/limb_crease.blob $(BUILD)/examples/beast.blob $(COW_CLIPS) $(SHEET_BLOBS)
+      $(BUILD)/examples/limb.blob $(BUILD)/examples/limb_crease.blob $(BUILD)/examples/limb_crease_none.blob $(BUILD)/examples/beast.blob $(COW_CLIPS) $(SHEET_BLOBS)
 	@BUILD=$(BUILD) sh ports/desktop/demo.sh

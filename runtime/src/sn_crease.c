@@ -20,8 +20,9 @@
  *      C full: counted in cr_list_full, nothing written
  *   3. n_a: the smallest prefix such that every later pair separates at
  *      least at its target speed with the last step's velocities
- *      (chi_k = (v_i - v_b).n >= target_k); the rows of pairs k < n_a are
- *      pushed, at most max_active (the rest counted)
+ *      (chi_k = (v_i - v_b).n >= target_k); sn_crease_rows_push (called by
+ *      the constraint projection's collection, sn_constrain_begin) pushes
+ *      the rows of pairs k < n_a, at most max_active (the rest counted)
  *
  * Cost per step, with nS surface vertices, D seeds, L = max_list, Kv, Kt the
  * neighbourhood widths, A = max_active: c1 nS + c2 L + Kt (2 D + L Kv) c3 +
@@ -33,19 +34,13 @@
 /* ---------------- instance arrays (layout: SN_CREASE_STATE_BYTES) ---------------- */
 
 static unsigned char *cr_base(const sn_ihdr *h) { return (unsigned char *)(uintptr_t)h + h->o_crs; }
-static sn_row *cr_rowbuf(const sn_ihdr *h) { return (sn_row *)(void *)cr_base(h); }
-static sn_q *cr_surf(const sn_ihdr *h) {
-    return (sn_q *)(void *)(cr_base(h) + SN_CREASE_ROW_BYTES * h->v.cr_active);
-}
+static sn_q *cr_surf(const sn_ihdr *h) { return (sn_q *)(void *)cr_base(h); }
 static sn_crease_pair *cr_pairs(const sn_ihdr *h) {
-    return (sn_crease_pair *)(void *)(cr_base(h) + SN_CREASE_ROW_BYTES * h->v.cr_active + 12u * h->v.nS);
+    return (sn_crease_pair *)(void *)(cr_base(h) + 12u * h->v.nS);
 }
-static uint8_t *cr_member(const sn_ihdr *h) {
-    return cr_base(h) + SN_CREASE_ROW_BYTES * h->v.cr_active + 12u * h->v.nS + 8u * h->v.cr_list;
-}
+static uint8_t *cr_member(const sn_ihdr *h) { return cr_base(h) + 12u * h->v.nS + 8u * h->v.cr_list; }
 
 const sn_crease_pair *sn_crease_list(const sn_ihdr *h) { return h->v.nCR ? cr_pairs(h) : NULL; }
-const sn_row *sn_crease_rows(const sn_ihdr *h) { return h->v.nCR ? cr_rowbuf(h) : NULL; }
 const sn_q *sn_crease_surface(const sn_ihdr *h) { return h->v.nCR ? cr_surf(h) : NULL; }
 
 uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uint32_t max) {
@@ -58,13 +53,6 @@ uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uin
     C = cr_pairs(h);
     for (k = 0; vertices && k < h->cr_n && k < max; k++) vertices[k] = C[k].vertex;
     return h->cr_n;
-}
-
-/* ---- TEMPORARY (sn_crease.h): the row store until sn_constraint.h lands ---- */
-int sn_rows_push(sn_ihdr *h, const sn_row *r) {
-    if (!h->v.nCR || h->cr_rows >= h->v.cr_active) return 0;
-    cr_rowbuf(h)[h->cr_rows++] = *r;
-    return 1;
 }
 
 /* ---------------- geometry ---------------- */
@@ -247,7 +235,7 @@ static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_
     r->target = -g.d < h->v.cr_push ? -g.d : h->v.cr_push; /* d <= 0 for a listed pair (step 1 keeps only those) */
     r->target = r->target < 0 ? 0 : r->target;
     r->one_sided = 1;
-    r->source = SN_ROW_SRC_CREASE;
+    r->source = SN_ROW_SRC(SN_SRC_CREASE, P - cr_pairs(h));
     for (a = 0; a < r->n; a++)
         for (k = 0; k < 3; k++) acc[k] += sn_mul(r->w[a], vel[3u * r->vtx[a] + k]); /* 16 x 2^30 x 2^28 < 2^63 */
     for (k = 0; k < 3; k++) rv[k] = sn_out(acc[k], SN_Q_ROT, sat);
@@ -318,14 +306,23 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
         if (chi < r.target) na = k + 1;
     }
     h->cr_na = na;
-    for (k = 0; k < na; k++) {
+    if (na > v->cr_active) h->cr_active_over = sn_count(h->cr_active_over, na - v->cr_active);
+}
+
+/* The rows of the active pairs k < min(n_a, max_active), for the projection
+ * (called by sn_constrain_begin after the other producers). */
+void sn_crease_rows_push(sn_ihdr *h, uint32_t *sat) {
+    const sn_crease_pair *C;
+    uint32_t k, n;
+    h->cr_rows = 0;
+    if (!h->v.nCR) return;
+    C = cr_pairs(h);
+    n = h->cr_na < h->v.cr_active ? h->cr_na : h->v.cr_active;
+    for (k = 0; k < n; k++) {
         sn_row r;
-        if (k >= v->cr_active) {
-            h->cr_active_over = sn_count(h->cr_active_over, na - k);
-            break;
-        }
         (void)cr_row(h, &C[k], &r, sat);
-        if (!sn_rows_push(h, &r)) h->cr_active_over = sn_count(h->cr_active_over, 1);
+        if (sn_rows_push(h, &r)) h->cr_rows++;
+        else h->cr_active_over = sn_count(h->cr_active_over, 1); /* the step's row store full (also counted there) */
     }
 }
 

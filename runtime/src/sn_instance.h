@@ -10,6 +10,8 @@
  *   sn_crease.c    self-collision near creases: list C, detection, rows (seed 003 §3.4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
+ *   sn_constraint.c constraint rows, their factorization and the CG's projection (seed 000 §4.4)
+ *   sn_contact.c   the game's colliders -> one-sided contact rows (seed 003 eq. 9)
  *   sn_step.c      the step: the stages in order
  */
 #ifndef SN_INSTANCE_H
@@ -51,6 +53,13 @@ typedef struct sn_ihdr {
     uint32_t cr_list_full;  /* penetrations not added since init/reset: C full */
     uint32_t cr_active_over;/* active constraints not pushed since init/reset: max_active reached or row store full */
     uint32_t cr_added, cr_removed; /* pairs added to / removed from C since init/reset */
+    /* constraints and contact (sn_constraint.c, sn_contact.c) */
+    uint32_t o_con, o_col, o_row, o_rx, o_L; /* user constraints, colliders, rows, row state, packed factor */
+    uint32_t n_con, n_col;  /* user constraints and colliders in force (settings: kept until replaced or reset) */
+    uint32_t n_rows;        /* rows collected for the current step */
+    uint32_t rows_kept;     /* rows enforced in the last step (after the factorization's drops) */
+    uint32_t contacts;      /* contact rows collected in the last step */
+    uint32_t row_drops, contact_overflow, row_overflow, con_refused, con_clamps; /* since init/reset */
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -163,6 +172,8 @@ uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 void sn_crease_step(sn_ihdr *h, uint32_t *sat);    /* 3b: crease list C: detect, drop, n_a, rows (sn_crease.c) */
 uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh); /* list C into the FNV-1a hash (unchanged without CREASE) */
+void sn_cons_layout(sn_ihdr *h, uint32_t off);      /* constraint arrays from offset off (sn_constraint.c) */
+void sn_cons_reset(sn_ihdr *h);                     /* no constraints, colliders or rows; counters 0 */
 
 /* ---- shared by the outputs, forces and segment meshes (sn_embed.c) ---- */
 void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out);  /* origin + p, public units */
