@@ -172,7 +172,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
-        if (fw < (int64_t)1 << 52) continue; /* Q60 */
+        if (fw < (int64_t)1 << 52) continue; /* 2^-8 in Q60 */
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
