@@ -506,6 +506,71 @@ static void test_sphere(void) {
     pu_rt_close(&r);
 }
 
+/* 4b. friction: a sphere pressed into the belly then dragged sideways drags
+ * the flesh with mu = 1, hardly with mu = 0 */
+static void test_friction(void) {
+    pu_rt r[2];
+    sn_xform pose[64];
+    double moved[2] = {0, 0}, z0[2] = {0, 0};
+    uint32_t contacts[2] = {0, 0}, sat[2] = {0, 0};
+    int m;
+    for (m = 0; m < 2; m++) {
+        sn_collider c;
+        sn_stats st;
+        uint32_t step, s_at = 0;
+        double p[3], *buf;
+        if (open_cow(&r[m])) { T_CHECK(0, "cow blob"); return; }
+        buf = malloc(3 * r[m].info.surface_vertices * sizeof *buf);
+        pu_identity(pose, r[m].info.joints);
+        sn_set_pose(r[m].inst, pose, r[m].info.joints);
+        memset(&c, 0, sizeof c);
+        c.kind = SN_COLLIDER_SPHERE;
+        c.radius = rl(1.0);
+        c.friction = m ? rl(1.0) : 0;
+        for (step = 0; step < 120; step++) {
+            double y = -2.55 + (step < 60 ? 0.3 * step / 60.0 : 0.3), z = step < 60 ? 0 : 0.4 * (step - 60) / 60.0;
+            c.a.x = rl(1.0); c.a.y = rl(y); c.a.z = rl(z);
+            c.velocity.y = step < 60 ? rl(0.3) : 0;
+            c.velocity.z = step < 60 ? 0 : rl(0.4);
+            sn_set_colliders(r[m].inst, &c, 1);
+            sn_step(r[m].inst);
+            if (step == 59) { /* the flesh vertex nearest the sphere's top */
+                double best = 1e30;
+                uint32_t i;
+                pu_rt_surface(&r[m], buf);
+                for (i = 0; i < r[m].info.surface_vertices; i++) {
+                    double dx = buf[3 * i] - 1.0, dy = buf[3 * i + 1] - (y + 1.0), dz = buf[3 * i + 2];
+                    double d = dx * dx + dy * dy + dz * dz;
+                    if (d < best && free_w2(&r[m], i) >= 0.05) { best = d; s_at = i; }
+                }
+                surf_of(&r[m], s_at, p);
+                z0[m] = p[2];
+            }
+        }
+        surf_of(&r[m], s_at, p);
+        moved[m] = p[2] - z0[m];
+        sn_get_stats(r[m].inst, &st);
+        contacts[m] = st.contacts;
+        sat[m] = st.saturations;
+        free(buf);
+    }
+    T_FIGURE("friction: a sphere dragged 0.4 sideways under the belly moves the flesh at its top %.4g (mu 0) / %.4g (mu 1); contact rows in the last step %u / %u",
+             moved[0], moved[1], contacts[0], contacts[1]);
+    T_CHECK(moved[1] > moved[0], "mu = 1 drags the flesh along further (%.4g vs %.4g)", moved[1], moved[0]);
+    T_CHECK(sat[0] == 0 && finite_state(&r[0]) && finite_state(&r[1]), "frictionless: no saturation (%u); both states finite", sat[0]);
+#if defined(SN_FLOAT)
+    T_CHECK(sat[1] == 0, "with friction: no saturation (%u)", sat[1]);
+#else
+    /* the velocity-level stick/slip rule is decided before the solve; in
+     * fixed point the slide rows of neighbouring cells can be nearly
+     * dependent (above the drop rule's 1/16) and a multiplier of the
+     * projection reaches the state range: counted, state finite */
+    PU_KNOWN_MISS(sat[1], 0, 8, "nearly dependent friction rows clamp a projection multiplier", "fixed friction run: %u saturations in 120 steps", sat[1]);
+#endif
+    pu_rt_close(&r[0]);
+    pu_rt_close(&r[1]);
+}
+
 /* 5. every maximum overflowing: counted, finite, deterministic */
 static void test_overflow(void) {
     pu_rt r, r2;
@@ -636,6 +701,7 @@ int main(void) {
     test_reference();
     test_ground();
     test_sphere();
+    test_friction();
     test_overflow();
     test_api();
     return T_END();

@@ -432,7 +432,7 @@ int main(void) {
          * side. Farther from the apex line every penetrated triangle is
          * tested: half an edge (0.25) covers the detection lag and the
          * contact row's approximation of the triangle point's velocity by its
-         * nearest corner's cell. Measured: fixed 0.26 and 0.19, float 0.26
+         * nearest corner's cell. Measured: fixed 0.25 and 0.20, float 0.26
          * and 0.23, against 0.43 without crease data (a cut of 40% or more,
          * checked). */
         T_CHECK(worst_run <= 0.3, "with crease collision no crease-side vertex is more than 0.3 mesh units inside the other segment over the "

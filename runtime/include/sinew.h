@@ -505,7 +505,7 @@ typedef struct sn_collider {
     sn_vec3  b;         ///< plane: outward normal (any length > 0); capsule: the other end; sphere: ignored
     sn_real  radius;    ///< sphere, capsule: radius (mesh units, >= 0); plane: ignored
     sn_vec3  velocity;  ///< the solid's velocity, mesh units per second (it moves rigidly, without turning)
-    sn_real  friction;  ///< Coulomb coefficient mu >= 0 (0: frictionless); rule in runtime/NUMERICS.md
+    sn_real  friction;  ///< Coulomb coefficient mu >= 0 (0: frictionless): a contact sticks to the solid when its predicted slip is at most mu times the normal velocity change it takes, else slides with its slip reduced by that (runtime/NUMERICS.md; uses contact rows)
 } sn_collider;
 
 /// Replace the colliders in force by list[0 .. count-1] (count 0: none).

@@ -151,7 +151,7 @@ SN_INLINE int32_t to32(int64_t x, uint32_t *sat) {
 
 /* c^T y of one row over free vertices: Q22 (velocity-like y) or Q19
  * (force-like y, Q(19+k_i) per vertex). Sum in Q52 / Q49: |.| <= 3.47 * 2^9 * 2^49 < 2^60. */
-static sn_q row_dot(const sn_ihdr *h, const sn_row *r, const sn_q *y, int force_like, uint32_t *sat) {
+static sn_acc row_dot_raw(const sn_ihdr *h, const sn_row *r, const sn_q *y, int force_like, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t k, nF = h->v.nF;
     sn_acc s = 0;
@@ -165,8 +165,9 @@ static sn_q row_dot(const sn_ihdr *h, const sn_row *r, const sn_q *y, int force_
         s += force_like ? CN_SH(t, kk[a]) : t;
     }
     SN_RANGE(SN_WITHIN(s, 61), "constraint row dot beyond 2^61", s);
-    return sn_out(s, 30, sat);
+    return s; /* Q52 (velocity-like) / Q49 (force-like) */
 }
+
 
 /* acc += c_j lambda at the row's free entries, exactly (fixed: Q52 for
  * velocity-like y, Q49 for force-like; saturating at 2^62, never reached:
@@ -196,9 +197,10 @@ static void rows_zero_acc(const sn_ihdr *h, sn_acc *acc) {
             if (r[j].vtx[k] < nF) acc[3 * r[j].vtx[k]] = acc[3 * r[j].vtx[k] + 1] = acc[3 * r[j].vtx[k] + 2] = 0;
 }
 /* y += acc (rounded once per entry to y's format) over the rows' free
- * entries, acc back to 0 there. force_like: 1 force-like y; 0 velocity-like;
- * -8 velocity-like with lambda in Q30 (the fine correction) */
-static void rows_apply_acc(const sn_ihdr *h, sn_acc *acc, sn_q *y, int force_like, uint32_t *sat) {
+ * entries, acc back to 0 there. The multipliers carry the block exponent e
+ * (lambda_true = lambda 2^e): the shift is 30 - e (velocity-like) or
+ * 30 - k_a - e (force-like), >= 0 for e <= 15. */
+static void rows_apply_acc(const sn_ihdr *h, sn_acc *acc, sn_q *y, int force_like, int e, uint32_t *sat) {
     const sn_row *r = CARR(h, o_row, sn_row);
     const sn_rowx *x = CARR(h, o_rx, sn_rowx);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
@@ -211,7 +213,7 @@ static void rows_apply_acc(const sn_ihdr *h, sn_acc *acc, sn_q *y, int force_lik
             for (c = 0; c < 3; c++) {
                 sn_acc *t = acc + 3 * a + c;
                 if (*t == 0) continue;
-                y[3 * a + c] = sn_add(y[3 * a + c], sn_out(*t, force_like > 0 ? 30 - kk[a] : 30 - force_like, sat), sat);
+                y[3 * a + c] = sn_add(y[3 * a + c], sn_out(*t, (force_like ? 30 - kk[a] : 30) - e, sat), sat);
                 *t = 0;
             }
         }
@@ -262,43 +264,68 @@ static void gram_solve(sn_ihdr *h, uint32_t *sat) {
 
 /* The accumulator array (free between sn_solve's passes) sums the rows'
  * corrections of each entry before the one rounding. */
+/* Block exponent of the step's C^T y (NUMERICS.md): the multipliers are
+ * solved in units of 2^e LSB, e chosen so the largest |s_j| has 18 bits:
+ * 10 bits of headroom below the state clamp (2^28) for G^-1's growth
+ * (|G^-1| <= max 1/L_jj^2 <= 2^10 by the drop rule), and a residual of a
+ * few LSB gets 8 more fraction bits (e = -8); e in [-8, 15] (the apply
+ * shift 30 - k_a - e stays >= 0). Float: e = 0. */
+static int block_exp(uint64_t o) {
+#if defined(SN_FLOAT)
+    (void)o;
+    return 0;
+#else
+    int e = bitlen64(o) - 30 - 18;
+    return e < -8 ? -8 : (e > 15 ? 15 : e);
+#endif
+}
+#if defined(SN_FLOAT)
+#define ABS64(x) ((x) != (x) ? 1u : 0u) /* unused in float (e = 0) */
+#else
+#define ABS64(x) ((uint64_t)((x) < 0 ? -(x) : (x)))
+#endif
+
 void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat) {
     const sn_row *r = sn_rows(h);
     sn_rowx *x = ARR(h, o_rx, sn_rowx);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
     uint32_t j, m = h->n_rows;
-    for (j = 0; j < m; j++) x[j].s = x[j].inv != 0 ? row_dot(h, r + j, y, force_like, sat) : 0;
+    uint64_t o = 0;
+    int e;
+    for (j = 0; j < m; j++)
+        if (x[j].inv != 0) { sn_acc t = row_dot_raw(h, r + j, y, force_like, sat); o |= ABS64(t); }
+    e = block_exp(o);
+    for (j = 0; j < m; j++) x[j].s = x[j].inv != 0 ? sn_out(row_dot_raw(h, r + j, y, force_like, sat), 30 + e, sat) : 0;
     gram_solve(h, sat);
     rows_zero_acc(h, acc);
     for (j = 0; j < m; j++)
         if (x[j].inv != 0) row_acc(h, r + j, (sn_q)-x[j].s, acc, sat);
-    rows_apply_acc(h, acc, y, force_like, sat);
+    rows_apply_acc(h, acc, y, force_like, e, sat);
 }
 
-void sn_rows_fix(sn_ihdr *h, sn_q *y, int fine, uint32_t *sat_state) {
-    /* the fine pass corrects rounding: a clamp of its multipliers (beyond
-     * 1/4 unit, after a coarse pass that clamped) limits the correction and
-     * is not a state clamp */
-    uint32_t fine_clamps = 0, *sat = fine ? &fine_clamps : sat_state;
+void sn_rows_fix(sn_ihdr *h, sn_q *y, uint32_t *sat) {
     const sn_row *r = sn_rows(h);
     sn_rowx *x = ARR(h, o_rx, sn_rowx);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
-    const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t j, m = h->n_rows;
-    for (j = 0; j < m; j++) {
-        sn_q e = x[j].inv != 0 ? sn_add(x[j].a, -row_dot(h, r + j, y, 0, sat), sat) : 0;
+    uint64_t o = 0;
+    int e;
+    /* residual a_j - c_j^T y in Q52: |a| 2^30 < 2^58.1, |c^T y| < 2^59.8 */
 #if defined(SN_FLOAT)
-        x[j].s = e;
+#define FIX_RES(j) ((sn_acc)x[j].a - row_dot_raw(h, r + (j), y, 0, sat))
 #else
-        x[j].s = fine ? sn_out((int64_t)e * 256, 0, sat) : e; /* Q30: residuals of a few LSB */
+#define FIX_RES(j) ((int64_t)x[j].a * ((int64_t)1 << 30) - row_dot_raw(h, r + (j), y, 0, sat))
 #endif
-    }
+    for (j = 0; j < m; j++)
+        if (x[j].inv != 0) { sn_acc t = FIX_RES(j); o |= ABS64(t); }
+    e = block_exp(o);
+    for (j = 0; j < m; j++) x[j].s = x[j].inv != 0 ? sn_out(FIX_RES(j), 30 + e, sat) : 0;
+#undef FIX_RES
     gram_solve(h, sat);
     rows_zero_acc(h, acc);
     for (j = 0; j < m; j++)
         if (x[j].inv != 0) row_acc(h, r + j, x[j].s, acc, sat);
-    (void)kk;
-    rows_apply_acc(h, acc, y, fine ? -8 : 0, sat_state);
+    rows_apply_acc(h, acc, y, 0, e, sat);
 }
 
 /* Gram matrix and its Cholesky factor, row by row (Cholesky-Crout), with the
@@ -461,7 +488,7 @@ uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, uint32_t *sat) {
     h->row_drops = sn_count(h->row_drops, m - kept);
     h->rows_kept = kept;
     if (kept == 0) { h->n_rows = 0; return 0; }
-    sn_rows_fix(h, x, 0, sat);
+    sn_rows_fix(h, x, sat);
     return kept;
 }
 

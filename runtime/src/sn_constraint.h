@@ -71,10 +71,11 @@ uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, uint32_t *sat);
 /* y -= C G^-1 C^T y over the kept rows: force_like selects the per-vertex
  * format Q(19 + k_i) (r, q) instead of Q22 (x, z, d). */
 void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat);
-/* x += C G^-1 (a - C^T x): the rows hold again after the CG's rounding.
- * fine = 1: the multipliers carry 8 more bits (Q30; for residuals of a few
- * LSB, clamped beyond 1/4 unit): a last pass after a coarse one. */
-void sn_rows_fix(sn_ihdr *h, sn_q *x, int fine, uint32_t *sat);
+/* x += C G^-1 (a - C^T x): the rows hold (again, after the CG's rounding).
+ * The multipliers are solved in a block exponent fitted to the residual
+ * (a second call after one that fixed large residuals corrects the
+ * rounding with 8 more fraction bits). */
+void sn_rows_fix(sn_ihdr *h, sn_q *x, uint32_t *sat);
 
 /* The material point under a world point (sn_force.c): its cell and
  * trilinear coordinates (Q15). */

@@ -16,7 +16,14 @@
  * dependent row). Up to max_contacts per step, in surface-vertex order;
  * more are counted in contact_overflow.
  *
- * Friction (mu > 0): see sn_friction_rows below and NUMERICS.md.
+ * Friction (mu > 0; a velocity-level Coulomb rule decided before the
+ * solve, NUMERICS.md): after every normal contact is collected, each
+ * contact of a collider with mu > 0 compares its predicted tangential slip
+ * relative to the solid, s = (v_pred - u) - n n.(v_pred - u), with mu times
+ * the normal velocity change the contact imposes, dn = target - n.v_pred.
+ * |s| <= mu dn: it sticks (two tangential rows: it moves with the solid);
+ * else it slides, its slip reduced by mu dn (one row along s). Friction
+ * rows share the contacts' baked rows (max_contacts), after the normal ones.
  */
 #include "sn_constraint.h"
 
@@ -124,6 +131,8 @@ static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, co
     return 1;
 }
 
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat);
+
 void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
@@ -163,7 +172,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
-        if (fw < (int64_t)1 << 52) continue; /* Q60 */
+        if (fw < (int64_t)1 << 52) continue; /* 2^-8 in Q60 */
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
@@ -222,6 +231,93 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 rx[j].spare = score;
             }
         }
+    }
+    friction_rows(h, first, h->n_rows, (const sn_q (*)[3])V, sat);
+}
+
+/* one tangential row of contact row r along t (Q30) with target t.u + extra */
+static void push_tangent(sn_ihdr *h, const sn_row *r, const sn_q t[3], const sn_q u[3], sn_q extra, uint32_t *sat) {
+    sn_row f = *r;
+    uint32_t q;
+    for (q = 0; q < 3; q++) f.dir[q] = t[q];
+    f.target = sn_add(sn_out(sn_mul(t[0], u[0]) + sn_mul(t[1], u[1]) + sn_mul(t[2], u[2]), 30, sat), extra, sat);
+    f.one_sided = 0;
+    if (sn_rows_push(h, &f)) h->contacts++;
+}
+/* a x b for unit vectors (Q30, |.| <= 1: beyond the state clamp, rounded without it) */
+static void cross30(const sn_q a[3], const sn_q b[3], sn_q o[3], uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)sat;
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+#else
+    (void)sat;
+    o[0] = clamp32(sn_rshr64(sn_mul(a[1], b[2]) + sn_mul(-a[2], b[1]), 30));
+    o[1] = clamp32(sn_rshr64(sn_mul(a[2], b[0]) + sn_mul(-a[0], b[2]), 30));
+    o[2] = clamp32(sn_rshr64(sn_mul(a[0], b[1]) + sn_mul(-a[1], b[0]), 30));
+#endif
+}
+
+/* Friction rows for the normal contacts rows[first .. end) (see the top). */
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_col *cols = CARR(h, o_col, sn_col);
+    const sn_q *vel = CARR(h, o_vel, sn_q);
+    uint32_t j, k, q;
+    for (j = first; j < end; j++) {
+        sn_row r = sn_rows(h)[j];
+        uint32_t c = r.source & 0xFFu;
+        const sn_col *cl = cols + c;
+        sn_acc sv[3] = {0, 0, 0};
+        sn_q vp[3], rel[3], s[3], t1[3], t2[3], slen, dn, vn, limit;
+#if defined(SN_FLOAT)
+        if (!(cl->mu > 0.0f)) continue;
+#else
+        if (cl->mu <= 0) continue;
+#endif
+        if (h->contacts + 1u > v->nCt) { h->contact_overflow = sn_count(h->contact_overflow, 1); continue; }
+        for (k = 0; k < r.n; k++)
+            for (q = 0; q < 3; q++) {
+                sn_q vq = vel[3 * r.vtx[k] + q];
+                if (r.vtx[k] < v->nF) vq = sn_add(vq, v->grav[q], sat);
+                sv[q] += sn_mul(r.w[k], vq);
+            }
+        for (q = 0; q < 3; q++) {
+            vp[q] = sn_out(sv[q], 30, sat);
+            rel[q] = sn_add(vp[q], -V[c][q], sat);
+        }
+        vn = sn_out(sn_mul(r.dir[0], vp[0]) + sn_mul(r.dir[1], vp[1]) + sn_mul(r.dir[2], vp[2]), 30, sat);
+        dn = sn_add(r.target, -vn, sat); /* the normal velocity change the contact imposes */
+        if (!(dn > 0)) continue;
+        {
+            sn_q rn = sn_out(sn_mul(r.dir[0], rel[0]) + sn_mul(r.dir[1], rel[1]) + sn_mul(r.dir[2], rel[2]), 30, sat);
+            for (q = 0; q < 3; q++) s[q] = sn_add(rel[q], -sn_mulq(r.dir[q], rn, 30, sat), sat);
+        }
+#if defined(SN_FLOAT)
+        limit = cl->mu * dn;
+#else
+        limit = sn_out((int64_t)cl->mu * dn, 16, sat); /* mu Q16.16 */
+#endif
+        ct_unit(s, t1, &slen);
+#if defined(SN_FLOAT)
+        if (!(slen > 1e-6f)) {
+#else
+        if (slen < 16) { /* no slip to speak of: any tangent pair */
+#endif
+            sn_q e[3] = {0, 0, 0};
+            e[(r.dir[0] < 0 ? -r.dir[0] : r.dir[0]) < CT_ONE30 / 2 ? 0 : 1] = CT_ONE30;
+            cross30(r.dir, e, s, sat);
+            ct_unit(s, t1, &slen);
+            slen = 0;
+        }
+        if (!(slen > limit)) { /* stick: both tangents move with the solid */
+            cross30(r.dir, t1, t2, sat);
+            if (h->contacts + 2u > v->nCt) { h->contact_overflow = sn_count(h->contact_overflow, 1); continue; }
+            push_tangent(h, &r, t1, V[c], 0, sat);
+            push_tangent(h, &r, t2, V[c], 0, sat);
+        } else /* slide: the slip along t1, reduced by mu dn */
+            push_tangent(h, &r, t1, V[c], sn_add(slen, -limit, sat), sat);
     }
 }
 

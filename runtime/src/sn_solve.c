@@ -424,9 +424,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
         rz = rz1;
     }
-    if (rows) { /* the CG's rounding off the rows again; a finer pass takes the first's rounding */
-        sn_rows_fix(h, x, 0, sat);
-        sn_rows_fix(h, x, 1, sat);
+    if (rows) { /* the CG's rounding off the rows again; the second pass, in finer units, takes the first's rounding */
+        sn_rows_fix(h, x, sat);
+        sn_rows_fix(h, x, sat);
     }
     /* v += dv, p += h v  (velocities are per step: h folded in) */
     for (i = 0; i < n3; i++) {
