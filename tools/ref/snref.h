@@ -99,7 +99,9 @@ enum { SNREF_WARPED = 0, SNREF_UNWARPED = 1, SNREF_BLENDED = 2 };
  * (preconditioner, gravity with REST_MODELLED, limits, health, skinned).
  * snref_static in this mode: the steady state of that step at the fixed
  * pose (v = 0: sum_r W^r (A^r)^-1 r^r(p) = 0, r^r the region's force
- * residual), by dense LU of the affine fixed-point map (small lattices). */
+ * residual), by dense LU of the affine fixed-point map (small lattices).
+ * Not applied in this mode: constraint rows (`rows`), precond_hook; the
+ * solve_hook sees b without the elastic terms (they come per region). */
 /* Elastic force model. CELL: NUMERICS.md step 4 (per-cell frames, element
  * energy, K~ = sum_e R_e S^_e R_e^T). VERTEX: format 1.0 / seed 003 eq. 7 with
  * per-vertex frames, f_i = -R_i sum_j S_ij (R_i^T (p_j - c_i) - x_j), S
@@ -155,7 +157,30 @@ typedef struct snref_state {
     int blend_hold;/* 0 (default, the paper): every free vertex of the region's cells is an unknown of its
                     * solve; 1: vertices of the region's cells with W^r_a = 0 are held (dv = 0) in it */
     double blend_fixres; /* snref_static in SNREF_BLENDED: fixed-point residual |G(p)| / max(|G(p_start)|, |G of the load alone|) */
+    /* called in snref_step just before the solve of step 6 with the step's
+     * right-hand side b and the start x0 (the warm start) of A dv = b, the
+     * frames of the step already in R and Rc (NULL: none; tests/precond_study.c) */
+    void (*solve_hook)(void *ctx, const struct snref_state *s, const double *b, const double *x0);
+    /* replaces the preconditioner z = R_i P_i R_i^T r_i of the N-iteration PCG (NULL: none) */
+    void (*precond_hook)(void *ctx, const struct snref_state *s, const double *r, double *z);
+    void *hook_ctx;
+    /* constraint rows for the next steps (runtime/src/sn_constraint.h in
+     * double; NULL: none; the caller owns them): sum_k w_k dir . v_new[vtx_k]
+     * = target (per-step velocity units), skeleton vertices' new velocity
+     * moved to the right-hand side; the solve is the Baraff-Witkin filtered
+     * PCG with an exact projection (rows dropped by the runtime's rule) */
+    const struct snref_row *rows;
+    unsigned nrows;
+    unsigned rows_kept;  /* after the last step's drops */
 } snref_state;
+
+typedef struct snref_row {
+    unsigned n;
+    unsigned vtx[16];
+    double w[16];
+    double dir[3];
+    double target;
+} snref_row;
 
 int snref_init(snref_state *s, const snref_model *m);
 void snref_release(snref_state *s);
