@@ -382,9 +382,9 @@ static cmp_t compare(nlref *n, const snref_xform *pose, const char *name, const 
                c.blendh.rms, c.blendh.max, bb.rms, bb.max, bw.rms, bw.max);
     }
     if (s.nlk) {
-        dist_t a = sdist(s.lin, s.nlk, nS), b = sdist(s.warp, s.nlk, nS), d = sdist(s.nl, s.nlk, nS);
-        printf("  %-6s   keeping orient.| %6.3f %6.3f | %6.3f %6.3f | (from plain nonlinear: %6.3f %6.3f) %+7.2f %% | %5.2f %4u | %s, %u it, residual %.2g\n",
-               "", a.rms, a.max, b.rms, b.max, d.rms, d.max, 100 * (snref_surface_volume(&n->m, s.nlk) / V0 - 1), s.jk, s.ik,
+        dist_t a = sdist(s.lin, s.nlk, nS), b = sdist(s.warp, s.nlk, nS), d = sdist(s.nl, s.nlk, nS), bl = sdist(s.blend, s.nlk, nS);
+        printf("  %-6s   keeping orient.| %6.3f %6.3f | %6.3f %6.3f | %6.3f %6.3f | (from plain nonlinear: %6.3f %6.3f) %+7.2f %% | %5.2f %4u | %s, %u it, residual %.2g\n",
+               "", a.rms, a.max, bl.rms, bl.max, b.rms, b.max, d.rms, d.max, 100 * (snref_surface_volume(&n->m, s.nlk) / V0 - 1), s.jk, s.ik,
                s.nlrc2 == 0 ? "converged" : "NOT converged", s.st2.iters, s.st2.relres);
     }
     if (figures && !strcmp(what, "elbow 120")) nl_picture(n, &s, &c, name);
