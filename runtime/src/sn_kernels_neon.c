@@ -1,0 +1,82 @@
+/* sn_kernels_neon.c -- ARM NEON kernels of sn_kernels.h (aarch64; armhf
+ * built with -mfpu=neon), fixed flavour.
+ *
+ * cell_mul: a corner's sum as x,y in one int64x2 and z as an int64x2 of
+ * two partial sums plus one scalar. Block (a,b) = B:
+ *   VLD3 of B0..B5 de-interleaves the first two rows into the columns
+ *   (B0,B3) (B1,B4) (B2,B5); VLD1 gives (B6,B7); B8 alone.
+ *   L_a.xy += (B0,B3) u_b.x + (B1,B4) u_b.y + (B2,B5) u_b.z   (VMLAL by scalar)
+ *   L_a.z  += (B6,B7) . (u_b.x, u_b.y) + B8 u_b.z
+ *   L_b.xy += (B0,B1) u_a.x + (B3,B4) u_a.y + (B6,B7) u_a.z   (B^T u_a)
+ *   L_b.z  += (B2,B5) . (u_a.x, u_a.y) + B8 u_a.z
+ * Exact int32 x int32 -> int64 products (SMLAL), the same sums as the
+ * scalar reference in another order (sn_kernels.h, NUMERICS.md). The blob
+ * is little-endian and so are these targets (the build refuses otherwise). */
+#include "sn_kernels.h"
+
+#if defined(SN_KERNELS_NEON)
+#include <arm_neon.h>
+
+#if !SN_HOST_LE
+#error "sn_kernels_neon.c reads blob reals as native int32: little-endian only (build with SIMD=scalar)"
+#endif
+
+void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+    int64x2_t xy[8], zz[8];
+    int64_t z1[8];
+    int a, b;
+    for (a = 0; a < 8; a++) {
+        xy[a] = vdupq_n_s64(0);
+        zz[a] = vdupq_n_s64(0);
+        z1[a] = 0;
+    }
+    for (a = 0; a < 8; a++) {
+        const int32_t *B = (const int32_t *)(const void *)K;
+        const int32_t ua0 = u[3 * a], ua1 = u[3 * a + 1], ua2 = u[3 * a + 2];
+        const int32x2_t ua01 = vld1_s32(u + 3 * a);
+        int32x2x3_t c = vld3_s32(B);
+        int32x2_t r2 = vld1_s32(B + 6);
+        int64x2_t axy = xy[a], az = zz[a];
+        int64_t az1 = z1[a];
+        /* diagonal block (a,a), stored in full: L_a += B u_a */
+        axy = vmlal_n_s32(axy, c.val[0], ua0);
+        axy = vmlal_n_s32(axy, c.val[1], ua1);
+        axy = vmlal_n_s32(axy, c.val[2], ua2);
+        az = vmlal_s32(az, r2, ua01);
+        az1 += (int64_t)B[8] * ua2;
+        K += 9 * 4;
+        for (b = a + 1; b < 8; b++, K += 9 * 4) {
+            const int32_t *Bb = (const int32_t *)(const void *)K;
+            const int32x2_t ub01 = vld1_s32(u + 3 * b);
+            const int32_t ub2 = u[3 * b + 2];
+            c = vld3_s32(Bb);
+            r2 = vld1_s32(Bb + 6);
+            axy = vmlal_n_s32(axy, c.val[0], vget_lane_s32(ub01, 0));
+            axy = vmlal_n_s32(axy, c.val[1], vget_lane_s32(ub01, 1));
+            axy = vmlal_n_s32(axy, c.val[2], ub2);
+            az = vmlal_s32(az, r2, ub01);
+            az1 += (int64_t)Bb[8] * ub2;
+            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb), ua0);
+            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb + 3), ua1);
+            xy[b] = vmlal_n_s32(xy[b], r2, ua2);
+            zz[b] = vmlal_s32(zz[b], c.val[2], ua01);
+            z1[b] += (int64_t)Bb[8] * ua2;
+        }
+        xy[a] = axy;
+        zz[a] = az;
+        z1[a] = az1;
+    }
+    for (a = 0; a < 8; a++) {
+        l[3 * a] = vgetq_lane_s64(xy[a], 0);
+        l[3 * a + 1] = vgetq_lane_s64(xy[a], 1);
+        l[3 * a + 2] = vgetq_lane_s64(zz[a], 0) + vgetq_lane_s64(zz[a], 1) + z1[a];
+        SN_RANGE(SN_WITHIN(l[3 * a], 60) && SN_WITHIN(l[3 * a + 1], 60) && SN_WITHIN(l[3 * a + 2], 60),
+                 "cell row beyond 24 * 2^55", l[3 * a + 2]);
+    }
+}
+
+const char *sn_kernels_name(void) { return "neon"; }
+
+#else
+typedef int sn_kernels_neon_unused_; /* ISO C: no empty translation unit */
+#endif
