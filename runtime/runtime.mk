@@ -124,4 +124,4 @@ $(BUILD)/bench/sn_herd_float: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FLOAT)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -o $@ $< $(SN_LIB_FLOAT) -lm
 bench: $(BUILD)/bench/sn_herd $(BUILD)/bench/sn_herd_float
 bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
-	BUILD=$(BUILD) sh runtime/bench/bench.sh $(BUILD)
+	BUILD=$(BUILD) SIMD=$(SIMD) sh runtime/bench/bench.sh $(BUILD)
