@@ -155,6 +155,10 @@ endef
 $(eval $(call det_float,float-gcc-O0,gcc,-O0))
 $(eval $(call det_float,float-gcc-O2,gcc,-O2))
 $(eval $(call det_float,float-clang-O2,clang,-O2))
+# the float flavour keeps the scalar kernels on every SIMD setting (same hash;
+# clang's -mavx512f implies FMA: -ffp-contract=off, as above, keeps it equal)
+$(eval $(call det_float,float-gcc-O2-avx2,gcc,-O2 -mavx2))
+$(eval $(call det_float,float-clang-O2-avx512,clang,-O2 -mavx2 -mavx512f -mavx512vl))
 
 # every driver whose compiler is installed (make deps installs them all)
 CROSS_HAVE = $(foreach d,x86_64-gcc-O2:gcc x86_64-clang-O2:clang i686-gcc-O2:i686-linux-gnu-gcc \

@@ -66,7 +66,9 @@ want_cpu x86_64-gcc-O2-avx512 gcc avx512f avx512vl
 if have clang; then
     want_cpu x86_64-clang-O2-avx2 clang avx2
     want_cpu x86_64-clang-O2-avx512 clang avx512f avx512vl
+    want_cpu float-clang-O2-avx512 clang avx512f avx512vl
 fi
+want_cpu float-gcc-O2-avx2 gcc avx2
 want armhf-gcc-O2-neon arm-linux-gnueabihf-gcc qemu-arm
 want aarch64-gcc-O2  aarch64-linux-gnu-gcc qemu-aarch64
 want aarch64-gcc-O2-scalar aarch64-linux-gnu-gcc qemu-aarch64
