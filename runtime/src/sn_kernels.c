@@ -35,7 +35,30 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
 }
 
 const char *sn_kernels_name(void) { return "scalar"; }
+#endif /* SN_KERNELS_SCALAR */
 
-#else
-typedef int sn_kernels_scalar_unused_; /* ISO C: no empty translation unit */
+#if !defined(SN_FLOAT) && !defined(SN_KERNELS_AVX2) && !defined(SN_KERNELS_NEON)
+/* The bound uses the OR of the magnitudes (same bit length as their
+ * maximum, no compares). */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
+    int s;
+    int64_t sum = 0;
+    for (i = 0; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    for (i = 0; i < nv; i++) {
+        int sh = s + kk[i];
+        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+    }
+    *e = s;
+    return sum;
+}
 #endif
+
+typedef int sn_kernels_c_unused_; /* ISO C: never an empty translation unit */

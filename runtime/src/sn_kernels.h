@@ -40,6 +40,15 @@
  * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
 void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]);
 
+#if !defined(SN_FLOAT)
+/* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a
+ * force-like (Q(19+k_i) per vertex i, n = 3 nv values), b velocity-like;
+ * picks s so n * max|a| * max|b| < 2^62 after shifting each product right
+ * by s + k_i (round half up), returns the sum and *e = s. Each product is
+ * rounded alone, so the sum is exact and order-free (|sum| < 2^62). */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e);
+#endif
+
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */
 const char *sn_kernels_name(void);
 

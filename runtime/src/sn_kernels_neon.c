@@ -13,6 +13,7 @@
  * scalar reference in another order (sn_kernels.h, NUMERICS.md). The blob
  * is little-endian and so are these targets (the build refuses otherwise). */
 #include "sn_kernels.h"
+#include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_NEON)
 #include <arm_neon.h>
@@ -73,6 +74,47 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
         SN_RANGE(SN_WITHIN(l[3 * a], 60) && SN_WITHIN(l[3 * a + 1], 60) && SN_WITHIN(l[3 * a + 2], 60),
                  "cell row beyond 24 * 2^55", l[3 * a + 2]);
     }
+}
+
+/* Block-floating dot product: magnitudes ORed 4 lanes at a time (VABS of a
+ * clamped int32 has the bits of the scalar's uint32 magnitude); then two
+ * vertices = 6 products as 3 pairs (VMULL.S32), each rounded by VRSHL with
+ * the negated shift s + k of its vertex: (x + 2^(sh-1)) >> sh, exactly the
+ * scalar rounding (sh = 0 leaves x). */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
+    int s;
+    int64_t sum;
+    uint32x4_t va = vdupq_n_u32(0), vb = vdupq_n_u32(0);
+    int64x2_t acc = vdupq_n_s64(0);
+    for (i = 0; i + 4 <= n; i += 4) {
+        va = vorrq_u32(va, vreinterpretq_u32_s32(vabsq_s32(vld1q_s32(a + i))));
+        vb = vorrq_u32(vb, vreinterpretq_u32_s32(vabsq_s32(vld1q_s32(b + i))));
+    }
+    oa = vgetq_lane_u32(va, 0) | vgetq_lane_u32(va, 1) | vgetq_lane_u32(va, 2) | vgetq_lane_u32(va, 3);
+    ob = vgetq_lane_u32(vb, 0) | vgetq_lane_u32(vb, 1) | vgetq_lane_u32(vb, 2) | vgetq_lane_u32(vb, 3);
+    for (; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    for (i = 0; i + 2 <= nv; i += 2) {
+        const sn_q *pa = a + 3 * i, *pb = b + 3 * i;
+        const int64x1_t n0 = vdup_n_s64(-(int64_t)(s + kk[i])), n1 = vdup_n_s64(-(int64_t)(s + kk[i + 1]));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa), vld1_s32(pb)), vcombine_s64(n0, n0)));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa + 2), vld1_s32(pb + 2)), vcombine_s64(n0, n1)));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa + 4), vld1_s32(pb + 4)), vcombine_s64(n1, n1)));
+    }
+    sum = vgetq_lane_s64(acc, 0) + vgetq_lane_s64(acc, 1);
+    for (; i < nv; i++) {
+        int sh = s + kk[i];
+        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+    }
+    *e = s;
+    return sum;
 }
 
 const char *sn_kernels_name(void) { return "neon"; }

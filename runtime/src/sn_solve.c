@@ -299,28 +299,12 @@ typedef struct { int64_t m; int e; } sn_dotv;
 #define SN_Q_SCAL 28 /* alpha, beta in Q28 */
 
 /* a force-like (Q(19+k_i) per vertex), b velocity-like (Q22): sum of a.b in
- * Q41, times 2^e. The bound uses the OR of the magnitudes (same bit length as
- * their maximum, no compares); products are shifted right by s + k_i. */
+ * Q41, times 2^e (sn_kernels.h sn_k_dot: the scalar reference or the
+ * build's SIMD path, the same integers). */
 static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
     sn_dotv r;
-    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
-    int s;
-    int64_t sum = 0;
-    for (i = 0; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
-    for (i = 0; i < nv; i++) {
-        int sh = s + kk[i];
-        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
-        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
-    }
-    SN_RANGE(SN_WITHIN(sum, 62), "block-floating dot product beyond 2^62", sum);
-    r.m = sum;
-    r.e = s;
+    r.m = sn_k_dot(a, b, kk, n, &r.e);
+    SN_RANGE(SN_WITHIN(r.m, 62), "block-floating dot product beyond 2^62", r.m);
     return r;
 }
 /* num/den in Q28, 0 when den <= 0 or num <= 0 (converged: not a clamp);
