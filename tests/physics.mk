@@ -41,6 +41,18 @@ $(BUILD)/tests/test_physics_$(1)_float: tests/test_physics_$(1).c $(REF_SRC) $(P
 	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $$@ $$< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 endef
 $(foreach t,$(PHYS_TESTS),$(eval $(call PHYS_TEST_RULE,$(t))))
+
+# Crease self-collision in the runtime (seed 003 §3.4; tests/test_runtime_crease.c):
+# the physics tests' helpers and the runtime's internal headers
+# and the host tool's inside test (tools/sb_mesh.c)
+CREASE_TSRC = tools/sb_mesh.c tools/sb_util.c
+$(BUILD)/tests/test_runtime_crease: tests/test_runtime_crease.c $(REF_SRC) $(CREASE_TSRC) $(PHYS_HDRS) tools/sb.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Itools -o $@ $< $(REF_SRC) $(CREASE_TSRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_crease_float: tests/test_runtime_crease.c $(REF_SRC) $(CREASE_TSRC) $(PHYS_HDRS) tools/sb.h $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Itools -DSN_FLOAT -o $@ $< $(REF_SRC) $(CREASE_TSRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_crease $(BUILD)/tests/test_runtime_crease_float
 TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)
 
 # make soak-adversarial: test_physics_soak (issue 16 item 6) run long, fixed and
@@ -177,3 +189,65 @@ $(BUILD)/tests/test_runtime_force_float: $(FORCE_RT_DEPS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force_float
+
+# Nonlinear St. Venant-Kirchhoff reference (issue 13 items 5-6,
+# tests/reference/NONLINEAR.md): bakes the limb and the cow with the tool
+# library itself and compares global linear, warped and nonlinear solutions.
+NL_SRC = tests/reference/nlref.c tools/ref/snref.c ports/desktop/raster.c ports/desktop/png.c
+NL_HDR = tests/reference/nlref.h tools/ref/snref.h tools/sb.h tests/sn_test.h ports/desktop/raster.h ports/desktop/png.h
+$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) -lm
+TEST_BINS += $(BUILD)/tests/test_nonlinear
+
+# make nonlinear-figures: the same tables with a longer dynamic run, the limb
+# also at half the cell, and $(BUILD)/nonlinear/elbow120.png (nonlinear |
+# warped | global linear at the 120-degree elbow).
+.PHONY: nonlinear-figures
+nonlinear-figures: $(BUILD)/tests/test_nonlinear
+	BUILD=$(BUILD) $(BUILD)/tests/test_nonlinear --figures
+
+# Preconditioner study (issue 15 item 3; NUMERICS.md "Preconditioners
+# measured"): double precision, the reference stepping the examples' clips,
+# every step's system solved by each candidate. Not part of make test.
+$(BUILD)/tests/precond_study: tests/precond_study.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
+.PHONY: precond-study
+precond-study: $(BUILD)/tests/precond_study $(EX)/cow.blob $(EX)/limb.blob $(EX)/beast.blob
+	$(BUILD)/tests/precond_study $(EX)/cow.blob tools/examples/cow/trot.clip tools/examples/cow/head_turn.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/limb.blob tools/examples/limb/flex.clip -every 1
+	$(BUILD)/tests/precond_study $(EX)/beast.blob tools/examples/beast/walk.clip tools/examples/beast/head_turn.clip -every 2
+
+# Stiffness storage study (issue 15 item 4; NUMERICS.md "Narrower stiffness
+# storage, measured"): the float64 blob's cell matrices re-quantized, the
+# reference's 600-step error against float64. Not part of make test.
+$(BUILD)/tests/quant_study: tests/quant_study.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+.PHONY: quant-study
+quant-study: $(BUILD)/tests/quant_study $(EX)/cow.blob $(EX)/cow_double.blob $(EX)/limb.blob $(EX)/limb_double.blob
+	$(BUILD)/tests/quant_study $(EX)/cow.blob $(EX)/cow_double.blob cow
+	$(BUILD)/tests/quant_study $(EX)/limb.blob $(EX)/limb_double.blob limb
+
+# Position constraints and colliders (issue 12 items 1 and 3): rows hold,
+# the double reference's constrained solve, drops, ground and sphere,
+# overflow, API; white box (sn_constraint.h), fixed and float.
+CONS_RT_DEPS = tests/test_runtime_constraint.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h
+CONS_RT_SRCS = $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c
+$(BUILD)/tests/test_runtime_constraint: $(CONS_RT_DEPS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Iports/common -o $@ $< $(CONS_RT_SRCS) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_constraint_float: $(CONS_RT_DEPS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Iports/common -DSN_FLOAT -o $@ $< $(CONS_RT_SRCS) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_constraint $(BUILD)/tests/test_runtime_constraint_float
+# the cow with 8 contacts a step: the contact maximum overflows (test_runtime_constraint)
+$(PHYS_EX)/cow_c8/cow.sinew: tools/examples/cow/cow.sinew tests/physics.mk
+	@mkdir -p $(@D)
+	sed -e 's|^mesh .*|mesh $(CURDIR)/tools/examples/cow/cow.obj|' -e 's|^colliders .*|colliders 4 8|' $< > $@
+$(PHYS_EX)/cow_c8.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(PHYS_EX)/cow_c8_float.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+TEST_DEPS += $(PHYS_EX)/cow_c8.blob $(PHYS_EX)/cow_c8_float.blob

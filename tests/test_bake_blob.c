@@ -36,7 +36,7 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
     T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
             u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], seg_state_bytes(b)),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], seg_state_bytes(b) + crease_state_bytes(b), cons_state_bytes(b)),
             "%s: instance bytes from SN_INSTANCE_BYTES", what);
     for (k = 0; k < SN_SEC_COUNT; k++) {
         uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);
@@ -75,14 +75,15 @@ static uint32_t spec_crc32(const unsigned char *p, size_t n)
 static void check_spec(const sb_blob *bl, int flavour, const char *what)
 {
     const unsigned char *b = bl->bytes;
-    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 26u;
+    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 31u;
     uint32_t total = u32(b + 16), nV = u32(b + 32), nF = u32(b + 36), nC = u32(b + 40), nJ = u32(b + 44), nS = u32(b + 48),
              nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
-    const uint32_t elem[26] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
-                               40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R};
-    uint32_t want[26], inst, segB = 0;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 4 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 4.0", what);
+    const uint32_t elem[31] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
+                               40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R, 8,
+                               12 + 2 * R, 4, 2, 2};
+    uint32_t want[31], inst, segB = 0, conB = 0, crB = 0, crRows = 0;
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 5 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 5.0", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
@@ -121,9 +122,20 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         nsamp += r[2]; nent += u32(r + 12);
     }
     {
-        const uint32_t w[26] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
-                                u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0};
+        const uint32_t w[31] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
+                                u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0, 0, 0, 0, 0, 0};
         memcpy(want, w, sizeof want);
+    }
+    {   /* CREASE (0 or 1): its record fixes the row widths; state 13 per surface vertex + 8 per list entry; max_active rows */
+        uint32_t on = u32(b + 176 + 16 * 27 + 8);
+        want[27] = on > 1 ? 1 : on;
+        want[28] = u32(b + 176 + 16 * 28 + 8);
+        if (on == 1) {
+            const unsigned char *r = b + u32(b + 176 + 16 * 27);
+            want[29] = nS * r[4]; want[30] = nS * r[5];
+            crB = (13u * nS + 8u * u16(r) + 7u) & ~7u;
+            crRows = u16(r + 2);
+        }
     }
     want[22] = u32(b + 176 + 16 * 22 + 8) == 0 ? 0 : nF;   /* VSHARE: 0 or nF */
     {   /* SEGMESH: nodes and attachments are the running sums; state bytes 64 per segment + 24 per node, every level */
@@ -141,6 +153,15 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         want[24] = nodes; want[25] = att;
     }
     want[13] = u32(b + 176 + 16 * 13 + 8) == 0 ? 0 : nF;   /* LIMIT: 0 or nF */
+    want[26] = u32(b + 176 + 16 * 26 + 8) == 0 ? 0 : 1;    /* CONSTRAINTS: 0 or 1 record {u8 constraints, u8 colliders, u16 contacts, u32 0} */
+    {   /* state: 80 per constraint, 64 per collider, 136 per row, 4 per entry of the rows' lower triangle;
+         * rows: 3 per constraint, 1 per contact, the crease's max_active */
+        const unsigned char *r = b + u32(b + 176 + 16 * 26);
+        uint32_t c0 = want[26] ? r[0] : 0, c1 = want[26] ? r[1] : 0, c2 = want[26] ? u16(r + 2) : 0, rows = 3u * c0 + c2 + crRows;
+        if (want[26])
+            T_CHECK(r[0] <= 64 && r[1] <= 16 && u16(r + 2) <= 256 && rows <= 512 && u32(r + 4) == 0, "%s: spec: constraint maxima in range", what);
+        if (rows || c1) conB = 80u * c0 + 64u * c1 + 136u * rows + 4u * (rows * (rows + 1u) / 2u);
+    }
     for (k = 0, prev = 176 + 16 * NSEC; k < NSEC; k++) {
         const unsigned char *e = b + 176 + 16 * k;
         uint32_t off = u32(e), size = u32(e + 4), cnt = u32(e + 8), es = u32(e + 12), i;
@@ -153,7 +174,8 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     }
     for (k = prev; k < total; k++) if (b[k]) break;
     T_CHECK(k == total, "%s: spec: trailing padding is zero", what);
-    inst = (768u + (76u + 48u) * nJ + 84u * nV + 73u * nF + 12u * (nV - nF) + 36u * nC + 4u * nK + 64u * b[78] + segB + 7u) & ~7u;
+    inst = (768u + (76u + 48u) * nJ + 84u * nV + 73u * nF + 12u * (nV - nF) + 36u * nC + 4u * nK + 64u * b[78] + segB + crB + 7u) & ~7u;
+    inst = (inst + conB + 7u) & ~7u;
     T_CHECK(u32(b + 60) == inst, "%s: spec: instance bytes %u, README formula %u", what, u32(b + 60), inst);
 }
 

@@ -325,6 +325,19 @@ int main(void)
             printf("  surface rig (cow smile target, omega 1e-5): residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations, %.3f s\n",
                    100 * rmsf, 100 * maxf, rr.iterations, sb_now() - t0);
             T_CHECK(maxf <= 0.01, "cow smile recovered within 1%% of its displacement (max %.3g%%)", 100 * maxf);
+            {   /* the exact solve (CG) against L-BFGS-B on the same cost; the reach bound below the fit */
+                sb_opt_result r2;
+                sb_surf_reach reach;
+                double f_cg = rr.f;
+                F.surf_lbfgsb = 1;
+                sb_fit_surface(&F, target, 1e-5, &oo, &r2, etaf, NULL);
+                F.surf_lbfgsb = 0;
+                printf("  surface rig cost: conjugate gradients %.12g (%d iterations), L-BFGS-B %.12g (%d iterations)\n", f_cg, rr.iterations, r2.f, r2.iterations);
+                T_CHECK(rr.status == SB_OPT_PGTOL && f_cg <= r2.f * (1 + 1e-9), "CG converged to the minimum (%.12g vs L-BFGS-B %.12g)", f_cg, r2.f);
+                T_CHECK(sb_fit_surface_reach(&F, target, &oo, &reach, NULL) == 0, "reach");
+                printf("  reach: best rms %.3g%% (skeleton freed %.3g%%), %.3g%% of sum |d|^2 on half-bone-carried surface\n", 100 * reach.rms, 100 * reach.rms_all, 100 * reach.skel_half);
+                T_CHECK(reach.rms <= rmsf + 1e-6 && reach.rms_all <= reach.rms + 1e-6, "best reachable %.3g%% <= fit %.3g%%, freed %.3g%%", 100 * reach.rms, 100 * rmsf, 100 * reach.rms_all);
+            }
             free(target); free(base); free(fit); free(etaf);
         }
         free(pose);

@@ -107,8 +107,10 @@ static void test_header(void) {
     CASE(SN_ERR_ENDIAN, "wrong endian mark", tb_u32(b + SN_H_ENDIAN, 0x01020305u));
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
-    CASE(SN_ERR_VERSION, "major 5", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 6", tb_u16(b + SN_H_VER_MAJOR, 6));
+    CASE(SN_ERR_VERSION, "major 4 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
+    CASE(SN_ERR_VERSION, "major 4 (format 4.0, no constraint section: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
     CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0200));
     CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
@@ -171,16 +173,28 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
     CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB) - 8));
     CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, TB_SEGB)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB)));
     CASE(SN_ERR_HEADER, "instance_bytes larger than the formula (a blob cannot ask for memory)",
          tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
     CASE(SN_ERR_HEADER, "instance_bytes without the control values",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, TB_SEGB)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB)));
 
     /* physics scalars */
 #define RL(i) (b + SN_H_REALS + 4 * (i))
+    /* constraint section (format 5.0): every field bounded by the arithmetic it feeds */
+#define CON (b + tb_sec(b, SN_SEC_CONSTRAINTS))
+    CASE(SN_ERR_VALUE, "constraints beyond SN_MAX_CONSTRAINTS", CON[0] = SN_MAX_CONSTRAINTS + 1);
+    CASE(SN_ERR_VALUE, "colliders beyond SN_MAX_COLLIDERS", CON[1] = SN_MAX_COLLIDERS + 1);
+    CASE(SN_ERR_VALUE, "contacts beyond SN_MAX_CONTACTS", tb_u16(CON + 2, SN_MAX_CONTACTS + 1));
+    CASE(SN_ERR_VALUE, "rows beyond SN_MAX_ROWS (3 x 64 + 256 + ...)", { CON[0] = 64; tb_u16(CON + 2, 256 + 1); });
+    CASE(SN_ERR_VALUE, "colliders without contact rows", tb_u16(CON + 2, 0));
+    CASE(SN_ERR_VALUE, "constraint record's reserved word not 0", CON[5] = 1);
+    CASE(SN_ERR_HEADER, "constraint maxima changed: instance bytes no longer the layout's", CON[0] = 1);
+    CASE(SN_ERR_SECTION, "constraint record count 2", tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CONSTRAINTS + 8, 2));
+    CASE(SN_ERR_SECTION, "constraint record element size 4", tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CONSTRAINTS + 12, 4));
+#undef CON
     CASE(SN_ERR_VALUE, "a1 < 0", tb_real(RL(SN_R_A1), -0.001, SN_Q_COEF));
     CASE(SN_ERR_VALUE, "a1 > 16", put_over(RL(SN_R_A1), 1 << 28, SN_Q_COEF));
     CASE(SN_OK, "a1 = 16", put_at(RL(SN_R_A1), 1 << 28, SN_Q_COEF));
@@ -266,6 +280,7 @@ static void test_header(void) {
         tb_u32(TAB(SN_SEC_TRIS, 1), 0);
         tb_u32(TAB(SN_SEC_TRIS, 2), 0);
         memset(SEC(SN_SEC_TRIS), 0, 12);
+        tb_drop_crease(b); /* crease data needs triangles */
         tb_fix_crc(b);
         expect("no triangles", sn_blob_validate(b, g_total, &blob), SN_OK);
         expect("get_triangle without triangles", sn_get_triangle(blob, 0, idx), SN_ERR_ARG);
@@ -440,7 +455,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)
@@ -587,13 +602,15 @@ static void test_instance_size_formula(void) {
     static const uint32_t nv[] = {2, 12, 233, 65535}, nf[] = {1, 8, 126, 65534}, nj[] = {1, 2, 15, 255};
     static const uint32_t nc[] = {1, 2, 106, 65535}, nk[] = {0, 1, 3, 256};
     static const uint32_t nfr[] = {0, 1, 32}, sgb[] = {0, 88, 1234568};
+    static const uint32_t cnb[] = {0, SN_CONS_BYTES(1, 0, 3), SN_CONS_BYTES(2, 1, 9), SN_CONS_BYTES(64, 16, 448)};
+    static const uint32_t crb[] = {0, SN_CREASE_STATE_BYTES(4, 4), SN_CREASE_STATE_BYTES(65535, 256)};
     int a, b, c, d, e, f, bad = 0, n = 0;
     for (a = 0; a < 4; a++) for (b = 0; b < 4; b++) for (c = 0; c < 4; c++) for (d = 0; d < 4; d++) for (e = 0; e < 4; e++)
     for (f = 0; f < 3; f++) {
         if (nf[b] >= nv[a]) continue;
         n++;
-        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3]) !=
-               sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3]);
+        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3] + crb[(c + e) % 3], cnb[(b + e) % 4]) !=
+               sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3], crb[(c + e) % 3], cnb[(b + e) % 4]);
     }
     T_CHECK(n > 300 && bad == 0, "SN_INSTANCE_BYTES == the runtime layout's size for %d count sets (%d differ)", n, bad);
 }

@@ -51,12 +51,13 @@ typedef struct tmesh {
     double att_p[4][3];
 } tmesh;
 
-/* Replace the test blob's segment sections (the last three) with meshes;
- * returns the blob size. */
+/* Replace the test blob's segment sections with meshes (the crease
+ * sections after them dropped); returns the blob size. */
 static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
-    uint32_t off = tb_sec(b, SN_SEC_SEGMESH), cnt[3] = {0, 0, 0}, elem[3], segB = 0, at;
+    uint32_t off = tb_sec(b, SN_SEC_SEGMESH), cnt[4] = {0, 0, 0, 1}, elem[4], segB = 0, at;
     int m, i, k, sec;
     elem[0] = (uint32_t)SN_ELEM_SEGMESH(TRB); elem[1] = (uint32_t)SN_ELEM_SEGNODES(TRB); elem[2] = (uint32_t)SN_ELEM_SEGATTACH(TRB);
+    elem[3] = SN_ELEM_CONSTRAINTS; /* the constraint record follows, as tb_build wrote it */
     for (m = 0; m < nm; m++) {
         uint32_t s, n;
         cnt[0]++;
@@ -67,12 +68,18 @@ static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
     }
     memset(b + off, 0, CAP - off);
     at = off;
-    for (sec = 0; sec < 3; sec++) {
+    for (sec = 0; sec < 4; sec++) {
         at = (at + 7u) & ~7u;
         tb_u32(b + SN_H_SECTIONS + 16 * (SN_SEC_SEGMESH + sec), at);
         tb_u32(b + SN_H_SECTIONS + 16 * (SN_SEC_SEGMESH + sec) + 4, cnt[sec] * elem[sec]);
         tb_u32(b + SN_H_SECTIONS + 16 * (SN_SEC_SEGMESH + sec) + 8, cnt[sec]);
         at += cnt[sec] * elem[sec];
+    }
+    at = (at + 7u) & ~7u;
+    for (sec = SN_SEC_CREASE; sec < SN_SEC_COUNT; sec++) { /* crease sections dropped (empty) */
+        tb_u32(b + SN_H_SECTIONS + 16 * sec, at);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 4, 0);
+        tb_u32(b + SN_H_SECTIONS + 16 * sec + 8, 0);
     }
     {
         unsigned char *r = b + tb_sec(b, SN_SEC_SEGMESH), *nd = b + tb_sec(b, SN_SEC_SEGNODES);
@@ -104,7 +111,11 @@ static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
         }
     }
     tb_u32(b + SN_H_TOTAL_SIZE, at);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, segB));
+    b[tb_sec(b, SN_SEC_CONSTRAINTS)] = TB_NCON;
+    b[tb_sec(b, SN_SEC_CONSTRAINTS) + 1] = TB_NCOL;
+    tb_u16(b + tb_sec(b, SN_SEC_CONSTRAINTS) + 2, TB_NCT);
+    at = (at + 7u) & ~7u;
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, segB, TB_CONB_NOCR));
     tb_fix_crc(b);
     return at;
 }

@@ -139,6 +139,14 @@ typedef struct sb_segdef {
 } sb_segdef;
 
 struct sb_gltf;
+/* self-collision near creases (seed 003 §3.4; tools/DESCRIPTION.md "Creases"):
+ * 'crease POSE [steps N]' target poses, 'crease_settings ...' the runtime's maxima */
+typedef struct sb_creasedef {
+    char pose[1024];        /* "JOINT:AX,AY,AZ,DEG[+JOINT:...]" */
+    int steps;              /* slow-motion steps from rest to the pose */
+    int line;
+} sb_creasedef;
+
 typedef struct sb_desc {
     char path[1024];
     char mesh_path[1024];   /* resolved relative to the description's directory ('mesh' or 'gltf') */
@@ -170,9 +178,15 @@ typedef struct sb_desc {
     sb_control *ctls; int nctl;      /* 'control' */
     sb_rigdef *rigs; int nrig;       /* 'rig', 'tau' */
     int force_slots;                 /* 'forces N': external forces per step (default 8) */
+    int max_cons;                    /* 'constraints N': position constraints (default 0) */
+    int max_cols, max_contacts;      /* 'colliders N CONTACTS': colliders and contact rows per step (default 0 0) */
     sb_shares *shares; int nshares;  /* 'shares' */
     sb_sharerule *srules; int nsr;   /* 'shares_region' */
     sb_segdef *segs; int nseg;       /* 'chain', 'sheet', 'attach' */
+    sb_creasedef *creases; int ncrease; /* 'crease' */
+    int cr_list, cr_active, cr_ring; /* 'crease_settings': list size, active rows, neighbourhood ring */
+    double cr_depth, cr_push;        /* mesh units; < 0: default (half a cell; a quarter of depth) */
+    int cr_line;                     /* line of 'crease_settings' (0: none) */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -265,6 +279,7 @@ typedef struct sb_model {
     /* external forces (sb_force.c, sb_force_build): slots per step, share profiles
      * (fine, coarse 1..3, rigid; each sums to 1), profile of each free vertex (NULL: all 0) */
     int max_forces;
+    int max_cons, max_cols, max_contacts; /* constraint section (0 0 0: none) */
     int nprof;
     double (*prof)[5];
     unsigned char *vprof;
@@ -272,6 +287,15 @@ typedef struct sb_model {
     int nsm;
     struct sb_segmesh *sm;
     sb_srcmap src;          /* 'gltf': the surface's glTF vertex order (sb_bake_file); nsrc 0 otherwise */
+    /* self-collision near creases (sb_crease.c, sb_crease_build): crease = 1
+     * writes the four CREASE sections */
+    int crease;
+    int cr_nD;              /* seed pairs */
+    int *cr_pairs;          /* cr_nD x 2 surface vertices (i, j) */
+    int cr_kv, cr_kt;       /* neighbourhood row widths */
+    int *cr_vnbr, *cr_tnbr; /* ns x kv, ns x kt; -1 = unused */
+    int cr_list, cr_active;
+    double cr_depth, cr_push; /* mesh units */
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -386,6 +410,18 @@ void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach
 /* write the three segment sections at their offsets (blob bytes, rs: real size,
  * flavour SB_*, internal unit 2^len_shift mesh units, mass unit m0 kg); 0 or -1 (sb_fail) */
 int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t *off, int flavour, int rs, int len_shift, double m0);
+
+/* ---- self-collision near creases (sb_crease.c) ---- */
+/* Neighbourhoods of the surface and the seed set D from slow motion to each
+ * 'crease' pose with the double-precision model (seed 003 §3.4.1). Needs the
+ * rest of the model built (it bakes a float64 blob of it). */
+int sb_crease_build(const sb_desc *d, sb_model *o, int quiet);
+void sb_crease_free(sb_model *o);
+/* Penetration of point p into triangle (a, b, c) (counter-clockwise from
+ * outside), as the runtime tests it: behind the plane by at most depth, the
+ * projection inside the triangle. Returns 1 and *dist (signed, < 0) and the
+ * corner 0..2 with the largest barycentric. */
+int sb_crease_inside(const double p[3], const double a[3], const double b[3], const double c[3], double depth, double *dist, int *corner);
 
 /* ---- blob (sb_blob.c) ---- */
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };

@@ -8,7 +8,8 @@
 static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
-                                             "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH"};
+                                             "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
+                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
@@ -26,7 +27,7 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         return -1;
     }
     if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_force_build(&d, o) ||
-        sb_segment_build(&d, &m, o) || sb_blob_make(o, flavour, b)) {
+        sb_segment_build(&d, &m, o) || sb_crease_build(&d, o, quiet) || sb_blob_make(o, flavour, b)) {
         sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d); sb_srcmap_free(&src);
         return -1;
     }
@@ -67,6 +68,11 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
                    r->def.name, o->ctl[r->def.control].name, sb_rig_tpl_name(r->def.tpl), r->def.s, r->n, r->qmax,
                    sqrt(r->total[0] * r->total[0] + r->total[1] * r->total[1] + r->total[2] * r->total[2]), fr);
         }
+        if (o->max_cons || o->max_cols || o->crease)
+            printf("  contact   %d constraints, %d colliders, %d contacts, %d crease rows per step: %u rows, %u instance bytes\n", o->max_cons,
+                   o->max_cols, o->max_contacts, o->crease ? o->cr_active : 0,
+                   SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0),
+                   SN_CONS_BYTES(o->max_cons, o->max_cols, SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0)));
         printf("  forces    %d per step (sn_apply_force), %d share profile%s (fine, 2, 4, 8 cells, rigid)%s\n", o->max_forces, o->nprof,
                o->nprof == 1 ? "" : "s", o->nprof ? ":" : "");
         for (k = 0; k < o->nprof; k++) {

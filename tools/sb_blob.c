@@ -299,6 +299,24 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         cnt[SN_SEC_SEGNODES] = nodes;              esz[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(rs);
         cnt[SN_SEC_SEGATTACH] = natt;              esz[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(rs);
     }
+    {   /* constraints and contact: one record of maxima, or none */
+        int any = o->max_cons || o->max_cols || o->max_contacts;
+        if (o->max_cons < 0 || o->max_cons > (int)SN_MAX_CONSTRAINTS || o->max_cols < 0 || o->max_cols > (int)SN_MAX_COLLIDERS ||
+            o->max_contacts < 0 || o->max_contacts > (int)SN_MAX_CONTACTS ||
+            SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0) > SN_MAX_ROWS || (o->max_cols > 0 && o->max_contacts == 0)) {
+            free(P); free(lump);
+            return sb_fail("constraints %d, colliders %d, contacts %d: at most %u, %u, %u, 3 constraints + contacts + crease rows <= %u, contacts >= 1 with colliders",
+                           o->max_cons, o->max_cols, o->max_contacts, SN_MAX_CONSTRAINTS, SN_MAX_COLLIDERS, SN_MAX_CONTACTS, SN_MAX_ROWS);
+        }
+        cnt[SN_SEC_CONSTRAINTS] = any ? 1u : 0u;   esz[SN_SEC_CONSTRAINTS] = SN_ELEM_CONSTRAINTS;
+    }
+    {   /* self-collision near creases (sb_crease.c) */
+        uint32_t on = o->crease ? 1u : 0u;
+        cnt[SN_SEC_CREASE] = on;                                   esz[SN_SEC_CREASE] = SN_ELEM_CREASE(rs);
+        cnt[SN_SEC_CREASE_PAIRS] = on ? (uint32_t)o->cr_nD : 0u;   esz[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
+        cnt[SN_SEC_CREASE_VNBR] = on ? (uint32_t)(o->ns * o->cr_kv) : 0u; esz[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
+        cnt[SN_SEC_CREASE_TNBR] = on ? (uint32_t)(o->ns * o->cr_kt) : 0u; esz[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
+    }
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -331,7 +349,12 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, SN_H_N_TRIANGLES, (uint32_t)o->nt);
     put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
     put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc, (uint32_t)o->nctl, (uint32_t)o->max_forces,
-                                                       sb_segment_state_bytes(o)));
+                                                       sb_segment_state_bytes(o) +
+                                                       (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u),
+                                                       (o->max_cons || o->max_cols || o->max_contacts || o->crease)
+                                                           ? SN_CONS_BYTES(o->max_cons, o->max_cols,
+                                                                           SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
+                                                           : 0u));
     put_u8(&w, SN_H_MAX_FORCES, (unsigned)o->max_forces);
     put_u8(&w, SN_H_FLAGS, o->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
     put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
@@ -449,7 +472,29 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             } else put_real(&w, at, o->prof[i][k], 0);
         }
     if (o->vprof) for (i = 0; i < nF; i++) put_u8(&w, off[SN_SEC_VSHARE] + (size_t)i, o->vprof[i]);
+    if (cnt[SN_SEC_CONSTRAINTS]) {
+        put_u8(&w, off[SN_SEC_CONSTRAINTS], (unsigned)o->max_cons);
+        put_u8(&w, off[SN_SEC_CONSTRAINTS] + 1, (unsigned)o->max_cols);
+        put_u16(&w, off[SN_SEC_CONSTRAINTS] + 2, (unsigned)o->max_contacts);
+    }
     if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s, m0) != 0) { sb_blob_free(b); return -1; }
+    if (o->crease) {   /* CREASE record, seed pairs, neighbourhood rows (SN_CREASE_NONE for -1) */
+        size_t at = off[SN_SEC_CREASE];
+        double dep = o->cr_depth / U, push = o->cr_push / U;
+        if (dep * 4194304.0 < 1 || dep * 4194304.0 > (double)SN_CREASE_DEPTH_MAX) { sb_blob_free(b); return sb_fail("crease depth %g mesh units out of range (%g..%g)", o->cr_depth, U / 4194304.0, U * 16); }
+        put_u16(&w, at, (unsigned)o->cr_list); put_u16(&w, at + 2, (unsigned)o->cr_active);
+        put_u8(&w, at + 4, (unsigned)o->cr_kv); put_u8(&w, at + 5, (unsigned)o->cr_kt);
+        put_real(&w, at + 12, dep, SN_Q_LEN);
+        put_real(&w, at + 12 + (size_t)rs, fmin(push, dep), SN_Q_LEN);
+        for (i = 0; i < o->cr_nD; i++) {
+            put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i, (unsigned)o->cr_pairs[2 * i]);
+            put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i + 2, (unsigned)o->cr_pairs[2 * i + 1]);
+        }
+        for (i = 0; i < o->ns * o->cr_kv; i++)
+            put_u16(&w, off[SN_SEC_CREASE_VNBR] + 2 * (size_t)i, o->cr_vnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_vnbr[i]);
+        for (i = 0; i < o->ns * o->cr_kt; i++)
+            put_u16(&w, off[SN_SEC_CREASE_TNBR] + 2 * (size_t)i, o->cr_tnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_tnbr[i]);
+    }
     if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
     if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }
     put_u32(&w, SN_H_CRC32, sb_crc32(b->bytes + 16, total - 16));

@@ -1,6 +1,7 @@
 /* sb_desc.c -- the text character description (format: tools/DESCRIPTION.md). */
 #include "sb.h"
 #include "sb_gltf.h"
+#include "../runtime/src/sn_format.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -506,6 +507,21 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (nargs(c, 1) || num(c, 1, &n_)) return -1;
         if (!(n_ >= 0 && n_ <= 32 && n_ == floor(n_))) return sb_fail("%s:%d: forces: slots per step must be a whole number in 0..32", c->path, c->line);
         d->force_slots = (int)n_;
+    } else if (!strcmp(kw, "constraints")) {
+        double n_;
+        if (nargs(c, 1) || num(c, 1, &n_)) return -1;
+        if (!(n_ >= 0 && n_ <= SN_MAX_CONSTRAINTS && n_ == floor(n_)))
+            return sb_fail("%s:%d: constraints: the maximum must be a whole number in 0..%u", c->path, c->line, SN_MAX_CONSTRAINTS);
+        d->max_cons = (int)n_;
+    } else if (!strcmp(kw, "colliders")) {
+        double n_, k_;
+        if (nargs(c, 2) || num(c, 1, &n_) || num(c, 2, &k_)) return -1;
+        if (!(n_ >= 0 && n_ <= SN_MAX_COLLIDERS && n_ == floor(n_)))
+            return sb_fail("%s:%d: colliders: the maximum must be a whole number in 0..%u", c->path, c->line, SN_MAX_COLLIDERS);
+        if (!(k_ >= (n_ > 0 ? 1 : 0) && k_ <= SN_MAX_CONTACTS && k_ == floor(k_)))
+            return sb_fail("%s:%d: colliders: contacts per step must be a whole number in %d..%u", c->path, c->line, n_ > 0 ? 1 : 0, SN_MAX_CONTACTS);
+        d->max_cols = (int)n_;
+        d->max_contacts = (int)k_;
     } else if (!strcmp(kw, "shares")) {
         sb_shares *p_;
         double sum = 0;
@@ -658,6 +674,49 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (seg_line(c, d)) return -1;
     } else if (!strcmp(kw, "attach")) {
         if (attach_line(c, d)) return -1;
+    } else if (!strcmp(kw, "crease")) {
+        sb_creasedef cd;
+        memset(&cd, 0, sizeof cd);
+        cd.steps = 120;
+        cd.line = c->line;
+        if (c->nt != 2 && c->nt != 4) return sb_fail("%s:%d: %s: 'crease JOINT:AX,AY,AZ,DEG[+JOINT:...] [steps N]'", c->path, c->line, c->nt < 2 ? "missing value" : "wrong number of values");
+        if (strlen(c->tok[1]) >= sizeof cd.pose) return sb_fail("%s:%d: crease pose too long", c->path, c->line);
+        strcpy(cd.pose, c->tok[1]);
+        if (c->nt == 4) {
+            double n_;
+            if (strcmp(c->tok[2], "steps")) return sb_fail("%s:%d: unknown crease option '%s' (want steps N)", c->path, c->line, c->tok[2]);
+            if (num(c, 3, &n_)) return -1;
+            if (!(n_ >= 1 && n_ <= 100000 && n_ == floor(n_))) return sb_fail("%s:%d: crease steps must be a whole number in 1..100000", c->path, c->line);
+            cd.steps = (int)n_;
+        }
+        if (d->ncrease >= 64) return sb_fail("%s:%d: more than 64 crease poses", c->path, c->line);
+        GROW(d->creases, d->ncrease);
+        d->creases[d->ncrease++] = cd;
+    } else if (!strcmp(kw, "crease_settings")) {
+        if (d->cr_line) return sb_fail("%s:%d: crease_settings given twice (first at line %d)", c->path, c->line, d->cr_line);
+        if (c->nt < 3 || (c->nt - 1) % 2) return sb_fail("%s:%d: 'crease_settings [list N] [active N] [ring K] [depth D] [push P]'", c->path, c->line);
+        d->cr_line = c->line;
+        for (k = 1; k + 1 < c->nt; k += 2) {
+            double x;
+            const char *o_ = c->tok[k];
+            if (!strcmp(o_, "depth") || !strcmp(o_, "push")) {
+                if (len_num(c, k + 1, &x)) return -1;
+                if (!(x > 0) && !(x == 0 && !strcmp(o_, "push"))) return sb_fail("%s:%d: crease %s must be %s", c->path, c->line, o_, !strcmp(o_, "push") ? ">= 0" : "> 0");
+                if (!strcmp(o_, "depth")) d->cr_depth = x; else d->cr_push = x;
+                continue;
+            }
+            if (num(c, k + 1, &x)) return -1;
+            if (!strcmp(o_, "list")) {
+                if (!(x >= 1 && x <= 256 && x == floor(x))) return sb_fail("%s:%d: crease list size must be a whole number in 1..256", c->path, c->line);
+                d->cr_list = (int)x;
+            } else if (!strcmp(o_, "active")) {
+                if (!(x >= 1 && x <= 64 && x == floor(x))) return sb_fail("%s:%d: crease active rows must be a whole number in 1..64", c->path, c->line);
+                d->cr_active = (int)x;
+            } else if (!strcmp(o_, "ring")) {
+                if (!(x >= 1 && x <= 3 && x == floor(x))) return sb_fail("%s:%d: crease ring must be 1, 2 or 3", c->path, c->line);
+                d->cr_ring = (int)x;
+            } else return sb_fail("%s:%d: unknown crease setting '%s' (want list, active, ring, depth or push)", c->path, c->line, o_);
+        }
     } else if (!strcmp(kw, "rest_shape")) {
         if (nargs(c, 1)) return -1;
         if (!strcmp(c->tok[1], "modelled")) d->rest_modelled = 1;
@@ -689,6 +748,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->element = SB_ELEM_INCOMPATIBLE;
     d->bone_radius = -1;
     d->force_slots = 8;
+    d->cr_list = 64; d->cr_active = 32; d->cr_ring = 1; d->cr_depth = -1; d->cr_push = -1;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
     memset(&c, 0, sizeof c);
@@ -712,6 +772,8 @@ int sb_desc_load(const char *path, sb_desc *d)
     if (!seen[2]) return sb_fail("%s: missing 'cell SIZE'", path);
     if (d->nj == 0) return sb_fail("%s: no joints", path);
     if (d->nm == 0) return sb_fail("%s: no materials", path);
+    if (d->cr_active > d->cr_list) return sb_fail("%s:%d: crease active rows (%d) exceed the list size (%d)", path, d->cr_line, d->cr_active, d->cr_list);
+    if (d->cr_depth > 0 && d->cr_push > d->cr_depth) return sb_fail("%s:%d: crease push (%g) exceeds depth (%g)", path, d->cr_line, d->cr_push, d->cr_depth);
     /* resolve parents (they may be declared after their children) */
     for (i = 0, j = 0; i < d->nj; i++) {
         sb_joint *jt = &d->joints[i];
@@ -768,5 +830,6 @@ void sb_desc_free(sb_desc *d)
     free(d->ctls); free(d->rigs);
     for (i = 0; i < d->nseg; i++) free(d->segs[i].att);
     free(d->segs);
+    free(d->creases);
     memset(d, 0, sizeof *d);
 }

@@ -213,13 +213,14 @@ typedef struct {
     const double *d;     /* nS x 3 target displacement from surf0 */
     double omega, inv_ns, inv_ne;
     double *r;           /* nS x 3 residual scratch */
+    unsigned nfree;      /* lattice vertices that move: nF (the rig), nV (a diagnostic: skeleton vertices freed too) */
 } surf_ctx;
 
 static double surf_fn(void *ctx, const double *z, double *g)
 {
     surf_ctx *S = ctx;
     const snref_model *m = &S->F->m;
-    unsigned s, k, c, e, nF = m->nF;
+    unsigned s, k, c, e, nF = S->nfree;
     static const unsigned char ed[12][2] = {{0,1},{2,3},{4,5},{6,7},{0,2},{1,3},{4,6},{5,7},{0,4},{1,5},{2,6},{3,7}};
     double cs = 0, cm = 0;
     memset(g, 0, 3 * (size_t)nF * sizeof *g);
@@ -247,21 +248,116 @@ static double surf_fn(void *ctx, const double *z, double *g)
     return S->inv_ns * cs + S->omega * S->inv_ne * cm;
 }
 
+/* The surface cost is quadratic in z: C(z) = z^T H z - 2 b^T z + 1, the same
+ * H for x, y and z (sparse, the lattice's 27-point stencil), so its minimum
+ * is the solution of the normal equations H z = b. Solved by conjugate
+ * gradients preconditioned by diag(H) (Jacobi): exact to rounding in a few
+ * hundred iterations, where L-BFGS-B on the raw displacements needs thousands
+ * (omega 1e-5 leaves the interior vertices, which only the smoothing term
+ * sees, 1e5 times softer than the surface's). Products H p by surf_fn with a
+ * zero target (gradient 2 H p). omega 0 is allowed (H then singular but the
+ * system consistent: CG from 0 stays in H's range and reaches the
+ * least-squares fit of minimum norm). Deterministic: fixed order of
+ * operations. Returns the status (SB_OPT_PGTOL or SB_OPT_MAXITER). */
+static int surf_cg(surf_ctx *S, double *z, const sb_opt_opts *oo, sb_opt_result *res)
+{
+    const snref_model *m = &S->F->m;
+    static const unsigned char ed[12][2] = {{0,1},{2,3},{4,5},{6,7},{0,2},{1,3},{4,6},{5,7},{0,4},{1,5},{2,6},{3,7}};
+    size_t n = 3 * (size_t)S->nfree, i;
+    unsigned nF = S->nfree, s, k, e;
+    double *r = malloc(n * sizeof *r), *p = malloc(n * sizeof *p), *q = malloc(n * sizeof *q), *h = calloc(nF + 1, sizeof *h);
+    double *zero = calloc(3 * (size_t)m->nS + 1, sizeof *zero), rz, rz1, g0 = 0, gi = 0, f;
+    const double *d = S->d;
+    const char *label = oo->label ? oo->label : "cg";
+    int it = 0, st = SB_OPT_MAXITER;
+    if (!r || !p || !q || !h || !zero) { free(r); free(p); free(q); free(h); free(zero); return -1; }
+    /* diag(H) per vertex (the same for its three components) */
+    for (s = 0; s < m->nS; s++) {
+        unsigned cell[8];
+        double w[8];
+        embed(m, s, cell, w);
+        for (k = 0; k < 8; k++) if (cell[k] < nF) h[cell[k]] += S->inv_ns * w[k] * w[k];
+    }
+    for (e = 0; e < m->nC; e++)
+        for (k = 0; k < 12; k++) {
+            unsigned a = m->cells[8 * e + ed[k][0]], b = m->cells[8 * e + ed[k][1]];
+            if (a < nF) h[a] += S->omega * S->inv_ne;
+            if (b < nF) h[b] += S->omega * S->inv_ne;
+        }
+    for (i = 0; i < nF; i++) if (!(h[i] > 0)) h[i] = 1;   /* a row of zeros: its residual stays 0 */
+    /* r = b - H z = -g(z) / 2 */
+    f = surf_fn(S, z, r);
+    for (i = 0; i < n; i++) { r[i] *= -0.5; g0 = fmax(g0, 2 * fabs(r[i])); }
+    if (oo->verbose > 0) fprintf(stderr, "%s: iter %5d  f %.15g  |pg|inf %.3e\n", label, 0, f, g0);
+    for (i = 0, rz = 0; i < n; i++) { p[i] = r[i] / h[i / 3]; rz += r[i] * p[i]; }
+    gi = g0;
+    while (gi > oo->pgtol && gi > 1e-14 * g0) {
+        double pq = 0, a;
+        if (it >= oo->max_iter) break;
+        S->d = zero; surf_fn(S, p, q); S->d = d;   /* q = 2 H p */
+        for (i = 0; i < n; i++) { q[i] *= 0.5; pq += p[i] * q[i]; }
+        if (!(pq > 0)) break;
+        a = rz / pq;
+        for (i = 0, rz1 = 0, gi = 0; i < n; i++) {
+            z[i] += a * p[i]; r[i] -= a * q[i];
+            rz1 += r[i] * r[i] / h[i / 3]; gi = fmax(gi, 2 * fabs(r[i]));
+        }
+        for (i = 0; i < n; i++) p[i] = r[i] / h[i / 3] + rz1 / rz * p[i];
+        rz = rz1;
+        it++;
+        if (oo->verbose > 0 && it % oo->verbose == 0)
+            fprintf(stderr, "%s: iter %5d  f %.15g  |pg|inf %.3e\n", label, it, surf_fn(S, z, q), gi);
+    }
+    /* the true gradient at the end (not the recurrence's) */
+    f = surf_fn(S, z, q);
+    for (i = 0, gi = 0; i < n; i++) gi = fmax(gi, fabs(q[i]));
+    if (gi <= oo->pgtol || gi <= 1e-12 * g0) st = SB_OPT_PGTOL;
+    if (oo->verbose > 0)
+        fprintf(stderr, "%s: conjugate gradients %s after %d iterations: f %.15g, |pg|inf %.3e\n", label,
+                st == SB_OPT_PGTOL ? "converged" : "stopped at max_iter", it, f, gi);
+    if (res) { res->iterations = it; res->evaluations = it + 2; res->f = f; res->pgnorm = gi; res->status = st; }
+    free(r); free(p); free(q); free(h); free(zero);
+    return st;
+}
+
+static int surf_setup(sb_fit *F, const double *target, double omega, surf_ctx *S, double **d)
+{
+    const snref_model *m = &F->m;
+    double D2 = 0;
+    unsigned i;
+    if (!(*d = malloc(3 * (size_t)m->nS * sizeof **d))) return -1;
+    for (i = 0; i < 3 * m->nS; i++) { (*d)[i] = target[i] - F->surf0[i]; D2 += (*d)[i] * (*d)[i]; }
+    D2 /= m->nS;
+    if (!(D2 > 0)) D2 = 1;
+    S->F = F; S->d = *d; S->omega = omega; S->inv_ns = 1.0 / (m->nS * D2); S->inv_ne = 1.0 / (12.0 * m->nC * D2); S->r = NULL; S->nfree = m->nF;
+    return 0;
+}
+
+/* surface of p0 + z (z in mesh units, as the optimizer's variables) */
+static void surf_fit(const sb_fit *F, const double *z, unsigned nfree, double *fit)
+{
+    const snref_model *m = &F->m;
+    unsigned s, k, c;
+    for (s = 0; s < m->nS; s++) {
+        unsigned cell[8];
+        double w[8];
+        embed(m, s, cell, w);
+        for (c = 0; c < 3; c++) fit[3 * s + c] = F->surf0[3 * s + c];
+        for (k = 0; k < 8; k++) if (cell[k] < nfree) for (c = 0; c < 3; c++) fit[3 * s + c] += w[k] * z[3 * cell[k] + c];
+    }
+}
+
 int sb_fit_surface(sb_fit *F, const double *target, double omega, const sb_opt_opts *oo, sb_opt_result *res,
                    double *eta_rest, double *fit)
 {
     const snref_model *m = &F->m;
     surf_ctx S;
-    unsigned nF = m->nF, i, s, k, c;
-    double *z = calloc(3 * (size_t)nF + 1, sizeof *z), *d = malloc(3 * (size_t)m->nS * sizeof *d), *eta = calloc(3 * (size_t)nF + 1, sizeof *eta);
-    double D2 = 0;
+    unsigned nF = m->nF, i, k;
+    double *z = calloc(3 * (size_t)nF + 1, sizeof *z), *d = NULL, *eta = calloc(3 * (size_t)nF + 1, sizeof *eta);
     int st;
-    if (!z || !d || !eta) { free(z); free(d); free(eta); return -1; }
-    for (i = 0; i < 3 * m->nS; i++) { d[i] = target[i] - F->surf0[i]; D2 += d[i] * d[i]; }
-    D2 /= m->nS;
-    if (!(D2 > 0)) D2 = 1;
-    S.F = F; S.d = d; S.omega = omega; S.inv_ns = 1.0 / (m->nS * D2); S.inv_ne = 1.0 / (12.0 * m->nC * D2); S.r = NULL;
-    st = sb_lbfgsb(3 * (int)nF, z, NULL, NULL, surf_fn, &S, oo, res, NULL);
+    if (!z || !eta || surf_setup(F, target, omega, &S, &d)) { free(z); free(d); free(eta); return -1; }
+    st = F->surf_lbfgsb ? sb_lbfgsb(3 * (int)nF, z, NULL, NULL, surf_fn, &S, oo, res, NULL) : surf_cg(&S, z, oo, res);
+    if (fit) surf_fit(F, z, m->nF, fit);
     /* eta = A z (internal units), then newtons in each vertex's rest frame */
     for (i = 0; i < 3 * nF; i++) z[i] /= m->unit;
     snref_hess_mul(&F->s, z, eta);
@@ -269,16 +365,58 @@ int sb_fit_surface(sb_fit *F, const double *target, double omega, const sb_opt_o
         const double *R = F->s.R + 9 * i, *e = eta + 3 * i;
         for (k = 0; k < 3; k++) eta_rest[3 * i + k] = (R[k] * e[0] + R[3 + k] * e[1] + R[6 + k] * e[2]) / F->nscale;
     }
-    if (fit) {
-        for (s = 0; s < m->nS; s++) {
-            unsigned cell[8];
-            double w[8];
-            embed(m, s, cell, w);
-            for (c = 0; c < 3; c++) fit[3 * s + c] = F->surf0[3 * s + c];
-            for (k = 0; k < 8; k++) if (cell[k] < nF) for (c = 0; c < 3; c++) fit[3 * s + c] += w[k] * z[3 * cell[k] + c] * m->unit;
-        }
-    }
     free(z); free(d); free(eta);
+    return st < 0 ? -1 : 0;
+}
+
+int sb_fit_surface_reach(sb_fit *F, const double *target, const sb_opt_opts *oo, sb_surf_reach *out, double *best)
+{
+    const snref_model *m = &F->m;
+    surf_ctx S;
+    sb_opt_opts o1 = *oo;
+    sb_opt_result rr;
+    unsigned nF = m->nF, s, k, c;
+    double *z = calloc(3 * (size_t)nF + 1, sizeof *z), *d = NULL, *fit = malloc(3 * (size_t)m->nS * sizeof *fit);
+    double *fit0 = malloc(3 * (size_t)m->nS * sizeof *fit0), d2 = 0, dm = 0;
+    int st = 0, pass;
+    memset(out, 0, sizeof *out);
+    if (!z || !fit || !fit0 || surf_setup(F, target, 0, &S, &d)) { free(z); free(d); free(fit); free(fit0); return -1; }
+    for (s = 0; s < m->nS; s++) {   /* where the target's displacement sits */
+        unsigned cell[8];
+        double w[8], ws = 0, dd = 0;
+        embed(m, s, cell, w);
+        for (k = 0; k < 8; k++) if (cell[k] >= nF) ws += w[k];
+        for (c = 0; c < 3; c++) dd += d[3 * s + c] * d[3 * s + c];
+        d2 += dd; dm = fmax(dm, dd);
+        if (ws >= 0.5) out->skel_half += dd;
+        if (ws > 1 - 1e-12) out->skel_all += dd;
+    }
+    if (d2 > 0) { out->skel_half /= d2; out->skel_all /= d2; }
+    o1.verbose = 0;
+    for (pass = 0; pass < 2; pass++) {   /* 0: the free vertices (the rig); 1: every lattice vertex (as if no bone carried any) */
+        double r2 = 0, rm = 0;
+        if (pass == 1) {
+            free(z);
+            if (!(z = calloc(3 * (size_t)m->nV + 1, sizeof *z))) { free(d); free(fit); free(fit0); return -1; }
+            S.nfree = m->nV;
+        }
+        st = surf_cg(&S, z, &o1, &rr);
+        if (pass == 0) out->iterations = rr.iterations, out->status = st;
+        surf_fit(F, z, S.nfree, pass ? fit : fit0);
+        for (s = 0; s < m->nS; s++) {
+            double r = 0;
+            for (c = 0; c < 3; c++) {
+                double e = (pass ? fit : fit0)[3 * s + c] - target[3 * s + c];
+                r += e * e;
+            }
+            r2 += r; rm = fmax(rm, r);
+        }
+        if (pass) { out->rms_all = d2 > 0 ? sqrt(r2 / d2) : 0; out->max_all = dm > 0 ? sqrt(rm / dm) : 0; }
+        else { out->rms = d2 > 0 ? sqrt(r2 / d2) : 0; out->max = dm > 0 ? sqrt(rm / dm) : 0; }
+        if (st < 0) break;
+    }
+    if (best) memcpy(best, fit0, 3 * (size_t)m->nS * sizeof *best);
+    free(z); free(d); free(fit); free(fit0);
     return st < 0 ? -1 : 0;
 }
 

@@ -31,6 +31,9 @@ typedef struct sb_fit {
      * rigs times pose_rig_scale (one solve per evaluation, sag included) */
     int pose_static;
     double pose_rig_scale;
+    /* sb_fit_surface: 0 (default) conjugate gradients on the normal equations
+     * (the cost is quadratic, the solve exact), 1 L-BFGS-B (the former method) */
+    int surf_lbfgsb;
 } sb_fit;
 
 /* bake desc (float64), load the reference model, read the mesh. 0, or -1 with a message on stderr */
@@ -63,9 +66,30 @@ int sb_fit_pose(sb_fit *F, const int *feat, int nfeat, const double *target, con
  * z = 0 on skeleton vertices), then eta = A z: the generalized force whose
  * equilibrium is exactly p0 + z (eq. 10). eta_rest (o.nf x 3): eta in newtons,
  * each vertex's rest frame (R_i^T), for a rig file. fit (nS x 3, may be NULL):
- * the fitted surface. */
+ * the fitted surface. C is quadratic in z: solved exactly by Jacobi-
+ * preconditioned conjugate gradients on the normal equations until
+ * |grad C|inf <= oo->pgtol (at most oo->max_iter iterations; progress lines as
+ * L-BFGS-B's, oo->verbose), or by L-BFGS-B if F->surf_lbfgsb. res: iterations,
+ * f, |grad|inf, status (SB_OPT_PGTOL converged, SB_OPT_MAXITER). */
 int sb_fit_surface(sb_fit *F, const double *target, double omega, const sb_opt_opts *oo, sb_opt_result *res,
                    double *eta_rest, double *fit);
+
+/* What a surface rig can reach of a target (at the current pose): skel_half /
+ * skel_all, the shares of the target's sum |d|^2 (d = target - surf0) on surface
+ * vertices with at least half / all of their embedding weight on skeleton
+ * vertices (carried rigidly by the bones: z = 0 there); rms / max, the residual
+ * of the best fit of the target by the free lattice vertices' displacements
+ * alone (C_surf minimized with omega = 0: a lower bound for any rig at this
+ * pose, whatever the optimizer), as fractions of the target's displacement
+ * (rms: sqrt(sum r^2 / sum d^2), max: max |r| / max |d|); rms_all / max_all:
+ * the same with every lattice vertex free (as if no bone carried any: what is
+ * left is the trilinear lattice's resolution). best (nS x 3, may be NULL): the
+ * free vertices' best surface. */
+typedef struct sb_surf_reach {
+    double skel_half, skel_all, rms, max, rms_all, max_all;
+    int iterations, status;
+} sb_surf_reach;
+int sb_fit_surface_reach(sb_fit *F, const double *target, const sb_opt_opts *oo, sb_surf_reach *out, double *best);
 
 /* Point-drag template fit (§4.2) at the current pose (p0 with every rig on):
  * strengths eta_a of the template rigs rigs[0..nr) minimizing

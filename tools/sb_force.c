@@ -10,6 +10,9 @@
 int sb_force_build(const sb_desc *d, sb_model *o) {
     int i, k;
     o->max_forces = d->force_slots;
+    o->max_cons = d->max_cons;
+    o->max_cols = d->max_cols;
+    o->max_contacts = d->max_contacts;
     o->nprof = d->nshares;
     o->prof = NULL;
     o->vprof = NULL;

@@ -727,6 +727,7 @@ void sb_model_free(sb_model *o)
     sb_rig_free(o); /* idempotent: callers that freed the rigs first are fine */
     sb_force_free(o);
     sb_segment_free(o);
+    sb_crease_free(o);
     free(o->joints); free(o->desc_to_sorted); free(o->seg_child); free(o->gpos); free(o->gjoint); free(o->gvert);
     free(o->v_grid); free(o->x); free(o->cells); free(o->cell_grid); free(o->cell_fill); free(o->fb1); free(o->fb2); free(o->fw);
     free(o->nbptr); free(o->nb); free(o->M); free(o->S); free(o->T); free(o->emb_cell); free(o->emb_t); free(o->tri);

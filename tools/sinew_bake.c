@@ -20,6 +20,8 @@ static void usage(FILE *f)
             "  --name SYMBOL     C symbol of the array (default sinew_blob); SYMBOL_size holds the size\n"
             "  --flavour F       fixed (default, int32 Q formats), float (float32), double (float64, host/tests)\n"
             "  --quiet           no summary or progress (warnings still go to stderr)\n"
+            "  --no-triangles    leave the surface triangles out of the blob (TRIS empty: for an engine that\n"
+            "                    keeps its own index buffer; sn_get_normals and sn_get_triangle then refuse)\n"
             "  --check           check the model (interior volume within 1%% of the mesh volume, embedding\n"
             "                    error <= 1e-5 of the bbox diagonal, rigid translations and rotations in the\n"
             "                    null space of S), print one 'check:' line (also with --quiet); on failure\n"
@@ -81,7 +83,7 @@ int main(int argc, char **argv)
 {
     const char *desc = NULL, *out = NULL, *carray = NULL, *name = "sinew_blob";
     char mapname[1100] = "";
-    int flavour = SB_FIXED, quiet = 0, check = 0, i;
+    int flavour = SB_FIXED, quiet = 0, check = 0, no_tris = 0, i;
     sb_static_opts st = { NULL, NULL, NULL, NULL, 30, 15, 0 };
     double t0;
     sb_model o;
@@ -91,6 +93,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
         else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) quiet = 1;
         else if (!strcmp(a, "--check")) check = 1;
+        else if (!strcmp(a, "--no-triangles")) no_tris = 1;
         else if (!strcmp(a, "--static") || !strcmp(a, "--controls") || !strcmp(a, "--png") || !strcmp(a, "--view")) {
             if (i + 1 >= argc) { fprintf(stderr, "sinew-bake: %s needs a value\n", a); return 2; }
             if (!strcmp(a, "--static")) st.pose = argv[++i];
@@ -131,6 +134,15 @@ int main(int argc, char **argv)
     t0 = sb_now();
     if (sb_bake_file(desc, flavour, quiet, &o, &b)) { fprintf(stderr, "sinew-bake: error: %s\n", sb_error()); return 1; }
     t0 = sb_now() - t0;
+    if (no_tris) {   /* the same model written again with an empty TRIS section */
+        int nt = o.nt;
+        unsigned long with = (unsigned long)b.size;
+        sb_blob_free(&b);
+        o.nt = 0;
+        if (sb_blob_make(&o, flavour, &b)) { fprintf(stderr, "sinew-bake: error: %s\n", sb_error()); o.nt = nt; sb_rig_free(&o); sb_model_free(&o); return 1; }
+        o.nt = nt;
+        if (!quiet) printf("  blob      %lu bytes without the %d triangles (--no-triangles; %lu with them)\n", (unsigned long)b.size, nt, with);
+    }
     if (!quiet) bone_summary(&o);
     if (check && run_check(desc, &o, t0)) { sb_blob_free(&b); sb_rig_free(&o); sb_model_free(&o); return 1; }
     if (out && o.src.nsrc) snprintf(mapname, sizeof mapname, "%s.gltfmap", out);

@@ -27,11 +27,13 @@ static void usage(FILE *f)
 {
     fprintf(f,
         "usage: sinew-rig COMMAND DESCRIPTION [options]\n"
-        "Rig fitting (seed 003 4.2-4.3) at the static equilibrium of eq. 10, double precision, L-BFGS-B.\n"
+        "Rig fitting (seed 003 4.2-4.3) at the static equilibrium of eq. 10, double precision, L-BFGS-B\n"
+        "(the surface rig: conjugate gradients on its quadratic cost).\n"
         "Commands:\n"
         "  fit-surface DESC --target T.obj[@GAMMA] [--target ...] --control NAME -o OUT.rig\n"
         "              [--pose POSE | --features V1,V2,... [--joints J1,J2,...]] [--controls N=V,...]\n"
         "              [--omega W] [--rigs-off] [--name RIG] [--png PIC.png] [--view AZ,EL] [--max-iter N]\n"
+        "              [--optimizer cg|lbfgsb]\n"
         "      a surface rig: the generalized force whose equilibrium matches the target mesh (same\n"
         "      vertices as the description's mesh), stored as a rig file (DESCRIPTION.md 'Rig files')\n"
         "      for 'rig_file RIG OUT.rig CONTROL tau ...' (the line is printed). GAMMA: the control's\n"
@@ -41,7 +43,9 @@ static void usage(FILE *f)
         "      non-root joint) on the static equilibrium (--pose-skinned: on the rigidly skinned shape,\n"
         "      faster, ignores sag); --omega: smoothness weight (default 1e-5); --rigs-off: the description's\n"
         "      rigs off during the fit (default on at the controls' values); --png: rest | unrigged | rigged\n"
-        "      | target\n"
+        "      | target; the rig is solved exactly (conjugate gradients on the normal equations; --optimizer\n"
+        "      lbfgsb: L-BFGS-B, --max-iter iterations); then what any rig at the pose could reach: the\n"
+        "      target's share on bone-carried surface and the best fit by the free lattice vertices alone\n"
         "  fit-pose DESC --target T.obj --features V1,V2,... [--joints J1,...] [--pose-skinned]\n"
         "              [--controls N=V,...] [--rigs-off] [-o POSE.txt]\n"
         "      the pose (local joint rotations, as --static/--pose take them) whose static shape (or\n"
@@ -54,6 +58,10 @@ static void usage(FILE *f)
         "      writes the rig lines with the fitted parameters (to replace the description's)\n"
         "  export DESC RIG -o OUT.rig\n"
         "      a rig of the description (template or file) as a rig file\n"
+        "  retarget A.sinew B.sinew --rig R1,R2,... -o OUT.rig [options]\n"
+        "      rigs of character A carried to character B (seed 003 4.4): a map of A's lattice onto B,\n"
+        "      its Jacobians, the rig moved as a displacement; written as a rig file of B\n"
+        "      (sinew-rig retarget --help)\n"
         "Common options: --quiet (no progress or summary), --progress N (a progress line every N\n"
         "iterations, default 10), --help.\n"
         "Progress lines (stderr): LABEL: iter N  f COST  |pg|inf PROJECTED-GRADIENT. Exit status: 0, 1 (a\n"
@@ -279,7 +287,7 @@ static void residual(const double *a, const double *target, const double *base, 
 typedef struct {
     const char *cmd, *desc, *out, *pose, *features, *joints, *controls, *control, *points, *rigs, *png, *name, *bounds, *export_rig;
     const char *target[SB_TAU_MAX];
-    int ntarget, quiet, rigs_off, max_iter, progress, geometry, pose_skinned;
+    int ntarget, quiet, rigs_off, max_iter, progress, geometry, pose_skinned, lbfgsb;
     double omega, lambda, az, el;
 } opts_t;
 
@@ -292,7 +300,7 @@ static int parse(int argc, char **argv, opts_t *o)
     for (i = 1; i < argc; i++) if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { usage(stdout); return 1; }
     o->cmd = argv[1];
     if (strcmp(o->cmd, "fit-surface") && strcmp(o->cmd, "fit-pose") && strcmp(o->cmd, "fit-points") && strcmp(o->cmd, "export")) {
-        fprintf(stderr, PROG ": unknown command '%s' (fit-surface, fit-pose, fit-points, export; --help)\n", o->cmd);
+        fprintf(stderr, PROG ": unknown command '%s' (fit-surface, fit-pose, fit-points, export, retarget; --help)\n", o->cmd);
         return 2;
     }
     for (i = 2; i < argc; i++) {
@@ -329,6 +337,11 @@ static int parse(int argc, char **argv, opts_t *o)
         if (!strcmp(a, "--rigs-off")) { o->rigs_off = 1; continue; }
         if (!strcmp(a, "--geometry")) { o->geometry = 1; continue; }
         if (!strcmp(a, "--pose-skinned")) { o->pose_skinned = 1; continue; }
+        if (!strcmp(a, "--optimizer")) {   /* fit-surface: cg (default, exact) or lbfgsb */
+            if (!more || (strcmp(argv[i + 1], "cg") && strcmp(argv[i + 1], "lbfgsb"))) { fprintf(stderr, PROG ": --optimizer cg|lbfgsb\n"); return 2; }
+            o->lbfgsb = !strcmp(argv[++i], "lbfgsb");
+            continue;
+        }
         if (a[0] == '-') { fprintf(stderr, PROG ": unknown option '%s' (--help)\n", a); return 2; }
         if (!o->desc) o->desc = a;
         else if (!strcmp(o->cmd, "export") && !o->export_rig) o->export_rig = a;
@@ -447,7 +460,9 @@ static int cmd_fit_surface(const opts_t *o)
 {
     sb_fit F;
     const snref_model *m;
-    double *tg[SB_TAU_MAX], gam[SB_TAU_MAX], *local = NULL, *eta = NULL, *fit = NULL, *base = NULL, *rest = NULL, secs_pose, t0, rms, mx, dmax;
+    double *tg[SB_TAU_MAX], gam[SB_TAU_MAX], *local = NULL, *eta = NULL, *fit = NULL, *base = NULL, *rest = NULL, *best = NULL, secs_pose, t0, rms, mx, dmax;
+    double rrms = 0, rmx = 0;
+    sb_surf_reach reach;
     double samples[2 * SB_TAU_MAX];
     snref_xform *pose = NULL;
     char what[4096], tau[512], *comment = NULL;
@@ -496,6 +511,7 @@ static int cmd_fit_surface(const opts_t *o)
     fit = malloc(3 * (size_t)m->nS * sizeof *fit);
     base = malloc(3 * (size_t)m->nS * sizeof *base);
     rest = malloc(3 * (size_t)m->nS * sizeof *rest);
+    best = malloc(3 * (size_t)m->nS * sizeof *best);
     if ((rc = get_pose(&F, o, tg[primary], local, pose, what, sizeof what, &secs_pose, &it_pose))) goto done;
     rc = 1;
     {   /* the rest shape for the picture */
@@ -521,13 +537,28 @@ static int cmd_fit_surface(const opts_t *o)
                           o->desc, what, o->control, gam[primary], m->nF, 3 * m->nF, o->omega);
     sb_opt_defaults(&oo);
     oo.pgtol = 1e-10; oo.ftol = 1e-15; oo.max_iter = o->max_iter; oo.verbose = o->quiet ? 0 : o->progress; oo.label = "fit-surface";
+    oo.max_iter = o->lbfgsb ? o->max_iter : 100000;   /* the CG solve is exact: the cap only guards against a broken system */
+    F.surf_lbfgsb = o->lbfgsb;
     t0 = sb_now();
     if (sb_fit_surface(&F, tg[primary], o->omega, &oo, &rr, eta, fit)) goto done;
     residual(fit, tg[primary], base, m->nS, &rms, &mx, &dmax);
-    if (!o->quiet) printf("fit-surface: %d iterations (%s), %.2f s: residual rms %.3g%%, max %.3g%% of the target's displacement (largest %.4g mesh units); "
+    if (!o->quiet) printf("fit-surface: %d iterations (%s, %s), %.2f s: residual rms %.3g%%, max %.3g%% of the target's displacement (largest %.4g mesh units); "
                           "worst at mesh vertex %u (%.4g, %.4g, %.4g)\n",
-                          rr.iterations, rr.status == 0 ? "converged" : rr.status == 1 ? "converged (ftol)" : rr.status == 2 ? "max-iter" : "line search failed",
+                          rr.iterations, o->lbfgsb ? "L-BFGS-B" : "conjugate gradients",
+                          rr.status == 0 ? "converged" : rr.status == 1 ? "converged (ftol)" : rr.status == 2 ? "max-iter" : "line search failed",
                           sb_now() - t0, 100 * rms, 100 * mx, dmax, worst_at, tg[primary][3 * worst_at], tg[primary][3 * worst_at + 1], tg[primary][3 * worst_at + 2]);
+    /* what any rig at this pose can reach: the target's share on bone-carried surface, the best fit by the free vertices alone */
+    if (sb_fit_surface_reach(&F, tg[primary], &oo, &reach, best)) goto done;
+    residual(fit, best, base, m->nS, &rrms, &rmx, NULL);
+    if (!o->quiet) {
+        printf("fit-surface: target on bone-carried surface: %.2g%% of its sum |d|^2 on vertices with at least half their embedding weight on skeleton vertices (%.2g%% all)\n",
+               100 * reach.skel_half, 100 * reach.skel_all);
+        printf("fit-surface: best reachable (free lattice vertices alone, omega 0; a lower bound): residual rms %.3g%%, max %.3g%% of the target's displacement\n",
+               100 * reach.rms, 100 * reach.max);
+        printf("fit-surface: the fit against that best (the reachable part): rms %.3g%%, max %.3g%% of its displacement\n", 100 * rrms, 100 * rmx);
+        printf("fit-surface: with the skeleton vertices free too (as if no bone carried any; the lattice's resolution): best rms %.3g%%, max %.3g%%\n",
+               100 * reach.rms_all, 100 * reach.max_all);
+    }
     /* tau samples: (0, 0), the primary at 1, the others by least squares on the rig's shape */
     samples[ns * 2] = gam[primary]; samples[ns * 2 + 1] = 1; ns++;
     for (i = 0; i < o->ntarget; i++) {
@@ -566,6 +597,9 @@ static int cmd_fit_surface(const opts_t *o)
         for (i = 0; i < o->ntarget && n < cl; i++) n += (size_t)snprintf(comment + n, cl - n, "target %s\n", o->target[i]);
         n += (size_t)snprintf(comment + n, cl - n, "pose %s\ncontrol %s, omega %g%s\n", what, o->control, o->omega, o->rigs_off ? ", description rigs off" : "");
         n += (size_t)snprintf(comment + n, cl - n, "residual rms %.3g%%, max %.3g%% of the target displacement; %d iterations\n", 100 * rms, 100 * mx, rr.iterations);
+        n += (size_t)snprintf(comment + n, cl - n, "best reachable (free lattice vertices alone): rms %.3g%%, max %.3g%%; the fit against it: rms %.3g%%, max %.3g%%\n"
+                              "best with the skeleton vertices free too: rms %.3g%%, max %.3g%%\n",
+                              100 * reach.rms, 100 * reach.max, 100 * rrms, 100 * rmx, 100 * reach.rms_all, 100 * reach.max_all);
         {   /* the file's own name (not its directory): the bytes depend on the inputs only */
             const char *b = strrchr(o->out, '/');
             snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, b ? b + 1 : o->out, o->control, tau);
@@ -579,7 +613,7 @@ static int cmd_fit_surface(const opts_t *o)
     }
 done:
     for (i = 0; i < o->ntarget; i++) free(tg[i]);
-    free(local); free(pose); free(eta); free(fit); free(base); free(rest); free(comment);
+    free(local); free(pose); free(eta); free(fit); free(base); free(rest); free(best); free(comment);
     sb_fit_close(&F);
     return rc;
 }
@@ -724,10 +758,14 @@ done:
     return rc;
 }
 
+int sb_retarget_cli(int argc, char **argv, const char *prog);   /* tools/sb_retarget_cli.c */
+
 int main(int argc, char **argv)
 {
     opts_t o;
-    int rc = parse(argc, argv, &o);
+    int rc;
+    if (argc >= 2 && !strcmp(argv[1], "retarget")) return sb_retarget_cli(argc - 1, argv + 1, PROG " retarget");
+    rc = parse(argc, argv, &o);
     if (rc) return rc == 1 ? 0 : rc;
     {   FILE *f = check_readable(o.desc, "description"); if (!f) return 2; fclose(f); }
     if (!strcmp(o.cmd, "export")) return cmd_export(&o);

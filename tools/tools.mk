@@ -1,9 +1,9 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c tools/sb_retarget.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
-TOOLS_HDR = tools/sb.h tools/sb_lbfgsb.h runtime/src/sn_format.h
+TOOLS_HDR = tools/sb.h tools/sb_lbfgsb.h tools/sb_retarget.h runtime/src/sn_format.h
 # the glTF reader (issue 17): its own headers
 GLTF_HDR = tools/sb_json.h tools/sb_gltf.h tools/sb_gltf_int.h
 $(BUILD)/tools/sb_json.o $(BUILD)/tools/sb_gltf_data.o $(BUILD)/tools/sb_gltf.o $(BUILD)/tools/sb_gltf_bake.o $(BUILD)/tools/sb_gltf_anim.o $(BUILD)/tools/sb_desc.o $(BUILD)/tools/sb_lattice.o $(BUILD)/tests/test_bake_gltf: $(GLTF_HDR)
@@ -20,8 +20,8 @@ $(TOOLS_LIB): $(TOOLS_LIB_OBJ)
 # sinew-bake --static (tools/sb_static.c): the double-precision reference
 # model (tools/ref/snref.c), the clip parser (ports/common/sn_clip.c: no
 # runtime calls) and the desktop rasterizer and PNG writer.
-STATIC_SRC = tools/sb_static.c tools/ref/snref.c ports/common/sn_clip.c ports/desktop/raster.c ports/desktop/png.c
-STATIC_OBJ = $(BUILD)/tools/static/sb_static.o $(BUILD)/tools/static/snref.o $(BUILD)/tools/static/sn_clip.o \
+STATIC_SRC = tools/sb_static.c ports/common/sn_clip.c ports/desktop/raster.c ports/desktop/png.c
+STATIC_OBJ = $(BUILD)/tools/static/sb_static.o $(BUILD)/tools/static/sn_clip.o \
              $(BUILD)/tools/static/raster.o $(BUILD)/tools/static/png.o
 STATIC_INC = -Itools -Itools/ref -Iruntime/include -Iruntime/src -Iports/common -Iports/desktop
 STATIC_HDR = tools/sb_static.h tools/ref/snref.h ports/common/sn_clip.h ports/desktop/raster.h ports/desktop/png.h $(TOOLS_HDR)
@@ -45,11 +45,11 @@ $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 # sinew-rig (issue 11): rig fitting on the double-precision reference model,
 # tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
 RIGTOOL = $(BUILD)/sinew-rig
-RIG_SRC = tools/sb_fit.c tools/sinew_rig.c   # + TOOLS_LIB_SRC and STATIC_SRC (the CMake build reads this list)
+RIG_SRC = tools/sb_fit.c tools/sinew_rig.c tools/sb_retarget_cli.c   # + TOOLS_LIB_SRC and STATIC_SRC (the CMake build reads this list)
 FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
 $(FIT_OBJ) $(BUILD)/tools/static/sinew_rig.o: tools/sb_fit.h
-$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
-	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
+	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
 all: $(RIGTOOL)
 $(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
 	@mkdir -p $(dir $@)
@@ -88,6 +88,35 @@ $(EX)/limb_double.blob: $(LIMB_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/limb/limb.sinew -o $@ --flavour double --quiet
 
+# the limb with crease self-collision (seed 003 §3.4); _small: list 2,
+# active 1 (the overflow test)
+LIMBC_DEPS = tools/examples/limb/limb_crease.sinew tools/examples/limb/limb.obj $(BAKE)
+$(EX)/limb_crease.blob: $(LIMBC_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/limb/limb_crease.sinew -o $@ --quiet
+$(EX)/limb_crease_float.blob: $(LIMBC_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/limb/limb_crease.sinew -o $@ --flavour float --quiet
+$(EX)/limb_crease_small/limb.sinew: tools/examples/limb/limb_crease.sinew tools/examples/limb/limb.obj
+	@mkdir -p $(@D)
+	sed 's/^crease_settings .*/crease_settings list 2 active 1 ring 1 depth 0.5 push 0.125/' $< > $@
+	cp tools/examples/limb/limb.obj $(@D)/limb.obj
+$(EX)/limb_crease_small.blob: $(EX)/limb_crease_small/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(EX)/limb_crease_small_float.blob: $(EX)/limb_crease_small/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+# _none: the same lattice without crease data (the comparison without collision)
+$(EX)/limb_crease_none/limb.sinew: tools/examples/limb/limb_crease.sinew tools/examples/limb/limb.obj
+	@mkdir -p $(@D)
+	sed '/^crease/d' $< > $@
+	cp tools/examples/limb/limb.obj $(@D)/limb.obj
+$(EX)/limb_crease_none.blob: $(EX)/limb_crease_none/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(EX)/limb_crease_none_float.blob: $(EX)/limb_crease_none/limb.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+CREASE_BLOBS = $(EX)/limb_crease.blob $(EX)/limb_crease_float.blob $(EX)/limb_crease_small.blob $(EX)/limb_crease_small_float.blob \
+               $(EX)/limb_crease_none.blob $(EX)/limb_crease_none_float.blob
+
 # cantilever beams with 1, 2, 4 cells through the height (generated by
 # tools/examples/beam/make_beam.sh into $(EX)/beamN/); beam.blob = 2 cells.
 BEAM_GEN = tools/examples/beam/make_beam.sh tools/examples/make_box.sh
@@ -107,7 +136,7 @@ EXAMPLE_BLOBS = $(EX)/cow.blob $(EX)/cow_float.blob $(EX)/cow_double.blob $(EX)/
                 $(EX)/limb.blob $(EX)/limb_float.blob $(EX)/limb_double.blob $(EX)/limb_blob.c \
                 $(EX)/beam.blob $(EX)/beam1.blob $(EX)/beam2.blob $(EX)/beam4.blob \
                 $(EX)/beam1_float.blob $(EX)/beam2_float.blob $(EX)/beam4_float.blob \
-                $(EX)/beam1_double.blob $(EX)/beam2_double.blob $(EX)/beam4_double.blob
+                $(EX)/beam1_double.blob $(EX)/beam2_double.blob $(EX)/beam4_double.blob $(CREASE_BLOBS)
 TEST_DEPS += $(EXAMPLE_BLOBS)
 
 all: $(BAKE) $(EXAMPLE_BLOBS)
@@ -173,3 +202,11 @@ SHEET_BLOBS = $(EX)/sheet.blob $(patsubst %,$(EX)/sheet_%.blob,$(SHEET_VARIANTS)
               $(patsubst %,$(EX)/sheet_%_float.blob,$(SHEET_VARIANTS))
 all: $(SHEET_BLOBS)
 TEST_DEPS += $(SHEET_BLOBS)
+
+# sinew-rig retarget (seed 003 §4.4): tools/sb_retarget_cli.c, the sub-command's own file, linked into $(RIGTOOL) above
+# Spot (tools/examples/spot): the retargeting target, with the cow's smile as a rig file
+SPOT_DEPS = tools/examples/spot/spot.sinew tools/examples/spot/spot.obj tools/examples/spot/spot_smile.rig $(BAKE)
+$(EX)/spot.blob: $(SPOT_DEPS)
+	@mkdir -p $(EX)
+	$(BAKE) tools/examples/spot/spot.sinew -o $@ --quiet
+all: $(EX)/spot.blob

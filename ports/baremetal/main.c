@@ -152,5 +152,9 @@ int main(void) {
     put_kv("stack_bytes: ", sn_bm_stack_used());
     sn_det_hex64(hash, hex);
     sn_bm_puts("hash: "); sn_bm_puts(hex); sn_bm_puts("\n");
+    if (sn_det_contact(&det)) { /* the constrained scenario (issue 12) */
+        sn_det_hex64(sn_det_run(&det, SN_DET_CONTACT_STEPS), hex);
+        sn_bm_puts("hash-contact: "); sn_bm_puts(hex); sn_bm_puts("\n");
+    }
     return 0;
 }

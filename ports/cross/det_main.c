@@ -94,6 +94,14 @@ int main(int argc, char **argv) {
         sn_get_stats(det.inst, &st);
         printf("steps: %" PRIu32 " saturations: %" PRIu32 "\n", st.steps, st.saturations);
     }
+    if (sn_det_contact(&det)) { /* the constrained scenario: every platform checks it too */
+        sn_stats st;
+        sn_det_hex64(sn_det_run(&det, SN_DET_CONTACT_STEPS), hex);
+        printf("hash-contact: %s\n", hex);
+        sn_get_stats(det.inst, &st);
+        printf("contact steps: %" PRIu32 " rows: %" PRIu32 " contacts: %" PRIu32 " drops: %" PRIu32 " saturations: %" PRIu32 "\n",
+               st.steps, st.constraint_rows, st.contacts, st.constraint_drops, st.saturations);
+    }
     free(mem); free(blob); free(clip_text);
     return 0;
 }

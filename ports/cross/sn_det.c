@@ -1,5 +1,6 @@
 /* sn_det.c -- determinism workload (see sn_det.h). Integer-only in the fixed
  * flavour; in the float flavour only the final conversions are float. */
+#include <string.h>
 #include "sn_det.h"
 
 #ifdef SN_FLOAT
@@ -78,6 +79,44 @@ uint64_t sn_det_run(sn_det *d, uint32_t n) {
     uint32_t i;
     for (i = 0; i < n; i++) { sn_det_pose(d); sn_det_step(d); }
     return sn_state_hash(d->inst);
+}
+
+int sn_det_contact(sn_det *d) {
+    sn_blob_info bi;
+    sn_collider col[2];
+    sn_constraint con[4];
+    sn_vec3 p;
+    sn_real ylow = 0;
+    uint32_t s, i;
+    sn_blob_get_info(d->blob, &bi);
+    if (bi.max_constraints < 4 || bi.max_colliders < 2 || bi.surface_vertices < 4) return 0;
+    (void)sn_reset(d->inst);
+    d->k = 0;
+    for (s = 0; s < bi.surface_vertices; s++) { /* rest positions before the first step */
+        (void)sn_get_surface(d->inst, &p, s, 1);
+        if (s == 0 || p.y < ylow) ylow = p.y;
+    }
+    memset(col, 0, sizeof col);
+    col[0].kind = SN_COLLIDER_PLANE;
+    col[0].a.y = ylow + from_q16(3277);          /* 0.05 */
+    col[0].b.y = from_q16(65536);
+    col[1].kind = SN_COLLIDER_SPHERE;
+    col[1].a.y = ylow - from_q16(45875);         /* 0.7 below the lowest point: 0.3 of it inside the ground's flesh */
+    col[1].radius = from_q16(65536);
+    col[1].velocity.y = from_q16(19661);         /* 0.3 per second */
+    memset(con, 0, sizeof con);
+    for (i = 0; i < 4; i++) {
+        static const uint32_t pick[4] = {2126u, 2362u, 1732u, 2901u}; /* cow.obj: vertices the flesh carries (not the bones) */
+        con[i].at = SN_AT_SURFACE;
+        con[i].vertex = pick[i] % bi.surface_vertices;
+        (void)sn_get_surface(d->inst, &p, con[i].vertex, 1);
+        con[i].target = p;
+        con[i].target.y = p.y + from_q16(6554);  /* 0.1 */
+        con[i].axes = i == 3 ? SN_AXIS_Y : 0;
+    }
+    (void)sn_set_colliders(d->inst, col, 2);
+    (void)sn_set_constraints(d->inst, con, 4);
+    return 1;
 }
 
 void sn_det_hex64(uint64_t h, char out[17]) {

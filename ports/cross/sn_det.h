@@ -43,6 +43,18 @@ void sn_det_step(sn_det *d);
 /// n times pose + step; returns sn_state_hash.
 uint64_t sn_det_run(sn_det *d, uint32_t n);
 
+/// Steps of the constrained scenario (sn_det_contact).
+#define SN_DET_CONTACT_STEPS 200u
+
+/// The constrained scenario (issue 12), for blobs that bake constraints
+/// (max_constraints and max_colliders > 0; returns 0 and does nothing
+/// otherwise, else 1): back to rest (sn_reset, step 0), a ground plane 0.05
+/// mesh units above the lowest rest surface vertex, a sphere of radius 1
+/// rising into the flesh under the middle at 0.3 mesh units a second, and
+/// four surface vertices pinned 0.1 above their rest positions (one of them
+/// along y only). Then run SN_DET_CONTACT_STEPS steps of the same poses.
+int sn_det_contact(sn_det *d);
+
 /// 16 lowercase hex digits of h plus NUL into out[17].
 void sn_det_hex64(uint64_t h, char out[17]);
 

@@ -58,6 +58,17 @@ run "demo picture (head_turn, 130 steps)" "$PLAY" "$COW" --clip "$CLIPS/head_tur
 # global share profile; "rest | no hit | hit" 0.15 s later, the hit panel
 # coloured by its distance from the no-hit run (red at 0.5 mesh units for
 # the beast, 0.1 for the cow).
+# Constraints and contact (issue 12): the trot on a ground plane 0.05 above
+# the lowest resting hoof, a sphere rising into the belly, a belt (the
+# surface near x = 2 pinned in y and z) while the cow breathes
+run "cow trot on the ground (72 steps)" "$PLAY" "$COW" --clip "$CLIPS/trot.clip" --frames 72 --ground -3.59 \
+    --sheet "$OUT/cow_ground.png" --title "trot on a ground plane (sn_set_colliders)"
+run "cow sphere in the belly (120 steps)" "$PLAY" "$COW" --frames 120 --sphere 1,-2.6,0,1@0,0.3,0 \
+    --sheet "$OUT/cow_sphere.png" --title "a sphere rising into the belly" --view 5,-5 --frame-box -2,-3.8,-2,4,0.5,2
+run "cow belt while breathing (180 steps)" "$PLAY" "$COW" --clip "$CLIPS/breathe.clip" --frames 180 --belt 2.0 \
+    --sheet "$OUT/cow_belt.png" --heat 0.15 --title "belt at x = 2 (32 pins) while breathing" --view 60,10
+run "cow belt float (180 steps)" "$PLAYF" "$COWF" --clip "$CLIPS/breathe.clip" --frames 180 --belt 2.0 --hash
+
 BEAST=$BUILD/examples/beast.blob
 for p in local torso global; do
     run "beast punch, profile $p (9 steps)" "$PLAY" "$BEAST" --clip tools/examples/beast/punch_$p.clip --frames 9 \
@@ -151,6 +162,15 @@ run "limb biceps (150 steps)" "$PLAY" "$LIMB" --clip tools/examples/limb/flex.cl
     --compare-rigs "$OUT/limb_biceps_rigs.png" --rig-off-blob "$BUILD/examples/norig/limb.blob" --heat 0.1 --view 0,10
 run "beast flex and breathe (150 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/flex.clip" --frames 150 \
     --compare-rigs "$OUT/beast_rigs.png" --rig-off-blob "$BUILD/examples/norig/beast.blob" --heat 3 --view 10,10 --size 600x450
+# Self-collision near the elbow crease (seed 003 §3.4, fig. 2): the limb at
+# 120 degrees (crease.clip at 3 s) without crease data (the same lattice),
+# and with it: the contacts the runtime lists (red dots) enforced by the
+# constraint projection: the flesh bulges instead of interpenetrating.
+run "limb 120 deg, no crease data (180 steps)" "$PLAY" "$BUILD/examples/limb_crease_none.blob" --clip tools/examples/limb/crease.clip \
+    --frames 180 --png "$OUT/limb_crease_without.png" --view 0,5 --title "limb at 120 deg: no crease collision"
+run "limb 120 deg, crease collision (180 steps)" "$PLAY" "$BUILD/examples/limb_crease.blob" --clip tools/examples/limb/crease.clip \
+    --frames 180 --png "$OUT/limb_crease_with.png" --view 0,5 --crease-marks \
+    --title "limb at 120 deg: crease collision (contacts red)"
 rm -f "$OUT/run.out"
 
 # Rig fitting (issue 11, seed 003 fig. 5-6): sinew-rig fits surface rigs to
@@ -160,6 +180,16 @@ if [ -x "$BUILD/sinew-rig" ]; then
     BUILD=$BUILD sh tools/examples/rigfit/rigfit.sh "$OUT/rigfit" > "$OUT/rigfit.log" 2>&1 || { cat "$OUT/rigfit.log"; exit 1; }
     cat "$OUT/rigfit/figures.txt"
 fi
+
+# Retargeting (seed 003 §4.4): the cow's two-bump smile carried to Spot
+# (tools/examples/spot): A rest | A rigged | B rest | B rigged (static
+# equilibria at rest) | the cow's surface under the map, framed on the heads.
+echo "== retarget the cow's smile onto spot"
+"$BUILD/sinew-rig" retarget tools/examples/cow/cow.sinew tools/examples/spot/spot.sinew --rig smile_l,smile_r --name smile \
+    --w-surf 1000 -o "$OUT/spot_smile.rig" --png "$OUT/retarget_spot_smile.png" --view-a 50,10 --view-b 140,10 \
+    --frame-a 3.3,-0.8,-1.5,6.2,2.8,1.5 --frame-b -0.5,-0.2,-0.75,0.5,1.0,0.0 > "$OUT/retarget.log" 2>&1 ||
+    { cat "$OUT/retarget.log"; exit 1; }
+grep -v "^retarget: round " "$OUT/retarget.log"
 
 echo
 echo "Time of one sn_step in microseconds on this machine (CPU = thread CPU time,"

@@ -52,6 +52,11 @@ static void usage(FILE *f) {
         "  --rigs on|off      off: every abstract control held at 0, the clip's control tracks ignored\n"
         "                     (pose-driven rigs stay on: bake the description without its rig lines for those)\n"
         "  --frames N         steps to run (default: one clip length, or 60 without a clip)\n"
+        "  --ground Y         a ground plane y = Y (mesh units) the surface may not enter (sn_set_colliders)\n"
+        "  --sphere X,Y,Z,R[@VX,VY,VZ]  a sphere collider (repeatable), moving at V mesh units per second\n"
+        "  --pin V[,V..]      pin surface vertices where they are before the first step (sn_set_constraints)\n"
+        "  --belt X[,W]       pin (in y and z) the surface vertices within W (default 0.08) of the plane x = X:\n"
+        "                     a belt around the body, at most the blob's max_constraints of them, evenly spread\n"
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
@@ -77,7 +82,9 @@ static void usage(FILE *f) {
         "  --frame-box X0,Y0,Z0,X1,Y1,Z1  box the camera frames, model space (mesh units relative to the root joint;\n"
         "                     default: the skinned surface over the whole run)\n"
         "  --title TEXT       caption on the pictures\n"
-        "  --health N         every N steps a line: frame, displacement (cells), energy (J), saturations\n"
+        "  --health N         every N steps a line: frame, displacement (cells), energy (J), saturations\n");
+    fprintf(f,   /* a second string: C99 compilers need only take 4095 characters in one */
+        "  --crease-marks     draw the surface vertices in the crease collision list (seed 003 §3.4) in red\n"
         "  --stats-csv FILE   per step: frame,t_s,disp_cells,energy_J,saturations,bound_steps,limit_clamps,\n"
         "                     then ctl_NAME per rig control (abstract: value; pose: degrees, as measured)\n"
         "  --plot FILE        line plot (PNG) of energy, displacement and the rig controls per step (see also sinew-plot)\n"
@@ -158,6 +165,8 @@ typedef struct {
     float flo[3], fhi[3];       /* box the camera frames (default: lo, hi plus a margin) */
     float az, el;
     int lattice;
+    int marks;                  /* --crease-marks: surface vertices in the crease collision list drawn red */
+    uint32_t *cr_list;          /* their indices (scratch) */
     /* rigid skinning by the lattice frames: --heat and the camera's box */
     float heat;                 /* mesh units drawn at full colour; 0 = off */
     float *rest, *skin;         /* lattice rest / skinned positions, model space, mesh units */
@@ -172,6 +181,12 @@ typedef struct {
     float *spos;                /* n_snodes x 3, mesh m's nodes from sm_first[m] */
     uint32_t *sm_first;
     int segments;               /* draw them */
+    /* constraints and colliders to draw */
+    int have_ground;
+    float ground_y;
+    int n_sph;
+    float sph[4][4];            /* current centre and radius */
+    uint32_t n_pins, *pins;     /* pinned surface vertices */
 } scene;
 
 static int cmp_edge(const void *a, const void *b) {
@@ -407,6 +422,30 @@ static void ref_colours(scene *s) {
 }
 static const uint8_t ink[3] = {25, 28, 38};
 
+/* A sphere (centre, radius) as a 12 x 24 triangle mesh. */
+static void draw_sphere(rs_image *im, const rs_camera *cam, const float c[4], const float colour[3]) {
+    enum { NLAT = 12, NLON = 24 };
+    float pos[(NLAT + 1) * NLON * 3];
+    uint32_t tri[NLAT * NLON * 6];
+    int a, b, nt = 0;
+    for (a = 0; a <= NLAT; a++)
+        for (b = 0; b < NLON; b++) {
+            float th = 3.14159265f * (float)a / NLAT, ph = 6.2831853f * (float)b / NLON;
+            float *p = pos + 3 * (a * NLON + b);
+            p[0] = c[0] + c[3] * sinf(th) * cosf(ph);
+            p[1] = c[1] + c[3] * cosf(th);
+            p[2] = c[2] + c[3] * sinf(th) * sinf(ph);
+        }
+    for (a = 0; a < NLAT; a++)
+        for (b = 0; b < NLON; b++) {
+            uint32_t i00 = (uint32_t)(a * NLON + b), i01 = (uint32_t)(a * NLON + (b + 1) % NLON);
+            uint32_t i10 = i00 + NLON, i11 = i01 + NLON;
+            tri[3 * nt] = i00; tri[3 * nt + 1] = i01; tri[3 * nt + 2] = i10; nt++;
+            tri[3 * nt] = i01; tri[3 * nt + 1] = i11; tri[3 * nt + 2] = i10; nt++;
+        }
+    rs_draw_mesh(im, cam, pos, (NLAT + 1) * NLON, tri, nt, colour);
+}
+
 /* Render the instance into out (w x h) at 2x2 supersampling. */
 static int render(scene *s, const sn_instance *inst, rs_image *out, const char *label, const char *label2) {
     rs_image big;
@@ -416,10 +455,18 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
     fetch(s, inst);
     if (s->heat > 0 && s->ref) ref_colours(s);
     else if (s->heat > 0) heat_colours(s);
+    if (s->marks && s->col && s->cr_list) {   /* crease contacts (seed 003 §3.4) in red over the flesh */
+        uint32_t n = sn_get_crease_contacts(inst, s->cr_list, s->info.surface_vertices), i;
+        if (s->heat <= 0)
+            for (i = 0; i < s->info.surface_vertices; i++) memcpy(s->col + 3 * i, cow_colour, sizeof cow_colour);
+        for (i = 0; i < n && i < s->info.surface_vertices; i++) {
+            s->col[3 * s->cr_list[i]] = 0.85f; s->col[3 * s->cr_list[i] + 1] = 0.05f; s->col[3 * s->cr_list[i] + 2] = 0.05f;
+        }
+    }
     rs_camera_frame(&cam, s->flo, s->fhi, big.w, big.h, s->az, s->el);
-    cam.ground_y = s->lo[1];   /* the ground stays under the feet */
+    cam.ground_y = s->have_ground ? s->ground_y : s->lo[1];   /* the ground stays under the feet (or is the collider) */
     rs_clear(&big, &cam);
-    if (s->heat > 0) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
+    if (s->heat > 0 || (s->marks && s->col && s->cr_list)) rs_draw_mesh_colors(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, s->col);
     else rs_draw_mesh(&big, &cam, s->pos, (int)s->info.surface_vertices, s->tri, (int)s->info.triangles, cow_colour);
     if (s->lattice) {
         const uint8_t lc[3] = {30, 60, 140}, sc[3] = {200, 30, 30};
@@ -429,6 +476,18 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
         for (v = s->info.free_vertices; v < s->info.vertices; v++) rs_draw_dot(&big, &cam, s->lpos + 3 * v, r, sc);
     }
     if (s->segments) draw_segments(s, &big, &cam);
+    if (s->marks && s->cr_list) {   /* contacts as dots over everything: most lie inside the other surface */
+        const uint8_t mc[3] = {215, 20, 20};
+        uint32_t n = sn_get_crease_contacts(inst, s->cr_list, s->info.surface_vertices), i;
+        for (i = 0; i < n && i < s->info.surface_vertices; i++) rs_draw_dot(&big, &cam, s->pos + 3 * s->cr_list[i], (float)big.w / 220.0f, mc);
+    }
+    {   /* colliders and pins */
+        static const float sphere_colour[3] = {0.55f, 0.62f, 0.75f};
+        static const uint8_t pin_colour[3] = {200, 30, 30};
+        int q;
+        for (q = 0; q < s->n_sph; q++) draw_sphere(&big, &cam, s->sph[q], sphere_colour);
+        for (v = 0; v < s->n_pins; v++) rs_draw_dot(&big, &cam, s->pos + 3 * s->pins[v], (float)big.w / 240.0f, pin_colour);
+    }
     rs_downsample2(&big, out);
     rs_image_free(&big);
     if (label) rs_draw_text(out, 8, 8, out->w >= 480 ? 2 : 1, label, ink);
@@ -445,13 +504,17 @@ typedef struct {
     const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
     int n_held, rigs_off;
     long frames, iterations, health;
-    int unwarped, hash, lattice, quiet, w, h, have_size;
+    int unwarped, hash, lattice, marks, quiet, w, h, have_size;
     float az, el, box[6], heat;
     int have_box;
     /* segment meshes: --seg-impulse, --seg-floor, --segments */
     int n_imp, have_floor, no_segments;
     struct { unsigned mesh, node; long step; double j[3]; } imp[16];
     double floor_y;
+    /* constraints and colliders: --ground, --sphere, --pin, --belt */
+    int have_ground, n_sph, n_pin, have_belt;
+    double ground_y, sph[4][7], belt_x, belt_w;
+    uint32_t pin[64];
 } options;
 
 #define MAX_FRAMES 10000000L
@@ -498,7 +561,7 @@ static int parse_args(int argc, char **argv, options *o) {
     static const char *const valued[] = {"--clip", "--obj-dir", "--obj-frames", "--png", "--sheet", "--compare", "--title",
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
-                                         "--seg-impulse", "--seg-floor", "--segments",
+                                         "--seg-impulse", "--seg-floor", "--segments", "--ground", "--sphere", "--pin", "--belt",
                                          "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
@@ -568,6 +631,37 @@ static int parse_args(int argc, char **argv, options *o) {
             o->floor_y = strtod(v, &end);
             if (!*v || *end || !isfinite(o->floor_y) || fabs(o->floor_y) > 16384) { fprintf(stderr, PROG ": --seg-floor: want a height in mesh units, got '%s'\n", v); return 2; }
             o->have_floor = 1;
+        } else if (!strcmp(a, "--ground")) {
+            o->ground_y = strtod(v, &end);
+            if (!*v || *end || !isfinite(o->ground_y) || fabs(o->ground_y) > 16384) { fprintf(stderr, PROG ": --ground: want a height in mesh units, got '%s'\n", v); return 2; }
+            o->have_ground = 1;
+        } else if (!strcmp(a, "--sphere")) {
+            double *q;
+            int used = 0, used2 = 0;
+            if (o->n_sph >= 4) { fprintf(stderr, PROG ": --sphere: at most 4\n"); return 2; }
+            q = o->sph[o->n_sph];
+            q[4] = q[5] = q[6] = 0;
+            if (sscanf(v, "%lf,%lf,%lf,%lf%n", &q[0], &q[1], &q[2], &q[3], &used) != 4 || q[3] < 0 ||
+                (v[used] && (sscanf(v + used, "@%lf,%lf,%lf%n", &q[4], &q[5], &q[6], &used2) != 3 || v[used + used2]))) {
+                fprintf(stderr, PROG ": --sphere: want X,Y,Z,R[@VX,VY,VZ] (mesh units, R >= 0), got '%s'\n", v); return 2;
+            }
+            for (j = 0; j < 7; j++) if (!isfinite(q[j]) || fabs(q[j]) > 16384) { fprintf(stderr, PROG ": --sphere: value out of range in '%s'\n", v); return 2; }
+            o->n_sph++;
+        } else if (!strcmp(a, "--pin")) {
+            const char *p = v;
+            while (*p) {
+                unsigned long n = strtoul(p, &end, 10);
+                if (end == p || (*end && *end != ',') || n > 65535) { fprintf(stderr, PROG ": --pin: want surface vertices V[,V..], got '%s'\n", v); return 2; }
+                if (o->n_pin >= 64) { fprintf(stderr, PROG ": --pin: at most 64 vertices\n"); return 2; }
+                o->pin[o->n_pin++] = (uint32_t)n;
+                p = *end ? end + 1 : end;
+            }
+        } else if (!strcmp(a, "--belt")) {
+            int used = 0;
+            o->belt_w = 0.08;
+            if (sscanf(v, "%lf%n", &o->belt_x, &used) != 1 || (v[used] && (sscanf(v + used, ",%lf", &o->belt_w) != 1)) ||
+                !isfinite(o->belt_x) || !isfinite(o->belt_w) || o->belt_w <= 0) { fprintf(stderr, PROG ": --belt: want X[,W] (mesh units, W > 0), got '%s'\n", v); return 2; }
+            o->have_belt = 1;
         } else if (!strcmp(a, "--segments")) {
             if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --segments: want on or off, got '%s'\n", v); return 2; }
             o->no_segments = !strcmp(v, "off");
@@ -603,6 +697,7 @@ static int parse_args(int argc, char **argv, options *o) {
         else if (!strcmp(a, "--unwarped")) o->unwarped = 1;
         else if (!strcmp(a, "--hash")) o->hash = 1;
         else if (!strcmp(a, "--lattice")) o->lattice = 1;
+        else if (!strcmp(a, "--crease-marks")) o->marks = 1;
         else if (!strcmp(a, "--quiet")) o->quiet = 1;
         else if (a[0] == '-' && a[1]) { fprintf(stderr, PROG ": unknown option '%s' (try --help)\n", a); return 2; }
         else if (!o->blob_path) o->blob_path = a;
@@ -952,7 +1047,7 @@ int main(int argc, char **argv) {
     }
 
     /* scratch */
-    s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat;
+    s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat; s.marks = o.marks;
     local = malloc(s.info.joints * sizeof *local);
     xf = malloc(s.info.joints * sizeof *xf);
     rest_xf = malloc(s.info.joints * sizeof *rest_xf);
@@ -993,9 +1088,53 @@ int main(int argc, char **argv) {
         if (sn_set_segment_floor(inst, up, R(o.floor_y)) != SN_OK) { die("--seg-floor: refused"); goto done; }
         if (inst2) sn_set_segment_floor(inst2, up, R(o.floor_y));
     }
+    /* constraints and colliders: pins where the surface is before the first step */
+    s.have_ground = o.have_ground;
+    s.ground_y = (float)o.ground_y;
+    if (o.n_pin || o.have_belt) {
+        sn_constraint *cs;
+        uint32_t nc = 0, cap = s.info.max_constraints, nb = 0;
+        if (!cap) { fprintf(stderr, PROG ": --pin/--belt: %s bakes no constraints (description line 'constraints N')\n", o.blob_path); goto done; }
+        cs = calloc(cap + 1, sizeof *cs);
+        s.pins = calloc(cap + 1, sizeof *s.pins);
+        if (!cs || !s.pins) { free(cs); die("out of memory"); goto done; }
+        sn_get_surface(inst, s.surf, 0, s.info.surface_vertices);
+        for (i = 0; i < (uint32_t)o.n_pin && nc < cap; i++) {
+            if (o.pin[i] >= s.info.surface_vertices) {
+                fprintf(stderr, PROG ": --pin %u: %s has %u surface vertices\n", o.pin[i], o.blob_path, s.info.surface_vertices);
+                free(cs); goto done;
+            }
+            cs[nc].at = SN_AT_SURFACE; cs[nc].vertex = o.pin[i]; cs[nc].target = s.surf[o.pin[i]];
+            s.pins[nc] = o.pin[i];
+            nc++;
+        }
+        if (o.have_belt) {   /* the vertices near the plane x = X, evenly picked up to the remaining constraints */
+            uint32_t left = cap - nc, taken = 0, seen = 0;
+            for (i = 0; i < s.info.surface_vertices; i++) if (fabs(D(s.surf[i].x) - o.belt_x) < o.belt_w) nb++;
+            for (i = 0; i < s.info.surface_vertices && taken < left; i++) {
+                if (!(fabs(D(s.surf[i].x) - o.belt_x) < o.belt_w)) continue;
+                seen++;
+                if (nb > left && (uint64_t)seen * left / nb == (uint64_t)(seen - 1) * left / nb) continue; /* every nb/left-th */
+                cs[nc].at = SN_AT_SURFACE; cs[nc].vertex = i; cs[nc].target = s.surf[i]; cs[nc].axes = SN_AXIS_Y | SN_AXIS_Z;
+                s.pins[nc++] = i;
+                taken++;
+            }
+            if (!o.quiet) printf("belt: %u of %u surface vertices within %.3g of x = %.3g pinned in y and z\n", taken, nb, o.belt_w, o.belt_x);
+        }
+        s.n_pins = nc;
+        st = sn_set_constraints(inst, cs, nc);
+        if (inst2) sn_set_constraints(inst2, cs, nc);
+        free(cs);
+        if (st != SN_OK) { fprintf(stderr, PROG ": sn_set_constraints: %s\n", sn_status_str(st)); goto done; }
+    }
+    if ((o.have_ground || o.n_sph) && !s.info.max_colliders) {
+        fprintf(stderr, PROG ": --ground/--sphere: %s bakes no colliders (description line 'colliders N CONTACTS')\n", o.blob_path); goto done;
+    }
+    s.n_sph = o.n_sph;
     pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits || o.apng;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
+    if (o.marks && !(s.cr_list = malloc(((size_t)s.info.surface_vertices + 1) * sizeof *s.cr_list))) { die("out of memory"); goto done; }
     /* rest pose: identity local rotations */
     for (i = 0; i < s.info.joints; i++) {
         local[i].x = local[i].y = local[i].z = 0;
@@ -1114,6 +1253,26 @@ int main(int argc, char **argv) {
                 if (sn_apply_segment_impulse(inst, o.imp[i].mesh, o.imp[i].node, j) != SN_OK) { die("--seg-impulse: refused"); goto done; }
                 if (inst2) sn_apply_segment_impulse(inst2, o.imp[i].mesh, o.imp[i].node, j);
             }
+        if (o.have_ground || o.n_sph) {   /* the colliders at the start of step k (spheres moved since step 1) */
+            sn_collider cl[5];
+            int q, nq = 0;
+            memset(cl, 0, sizeof cl);
+            if (o.have_ground) { cl[0].kind = SN_COLLIDER_PLANE; cl[0].a.y = R(o.ground_y); cl[0].b.y = R(1.0); nq = 1; }
+            for (q = 0; q < o.n_sph; q++, nq++) {
+                double tk = (double)(k - 1) * h_s;
+                cl[nq].kind = SN_COLLIDER_SPHERE;
+                cl[nq].a.x = R(o.sph[q][0] + o.sph[q][4] * tk); cl[nq].a.y = R(o.sph[q][1] + o.sph[q][5] * tk);
+                cl[nq].a.z = R(o.sph[q][2] + o.sph[q][6] * tk);
+                cl[nq].radius = R(o.sph[q][3]);
+                cl[nq].velocity.x = R(o.sph[q][4]); cl[nq].velocity.y = R(o.sph[q][5]); cl[nq].velocity.z = R(o.sph[q][6]);
+                s.sph[q][0] = (float)(o.sph[q][0] + o.sph[q][4] * (double)k * h_s); /* drawn where it is after the step */
+                s.sph[q][1] = (float)(o.sph[q][1] + o.sph[q][5] * (double)k * h_s);
+                s.sph[q][2] = (float)(o.sph[q][2] + o.sph[q][6] * (double)k * h_s);
+                s.sph[q][3] = (float)o.sph[q][3];
+            }
+            if (sn_set_colliders(inst, cl, (uint32_t)nq) != SN_OK) { die("sn_set_colliders: refused (the blob's max_colliders is %u)", s.info.max_colliders); goto done; }
+            if (inst2) sn_set_colliders(inst2, cl, (uint32_t)nq);
+        }
         c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
         t0 = now_us(CLOCK_MONOTONIC);
         sn_step(inst);
@@ -1320,9 +1479,9 @@ done:
     rs_image_free(&sheet); rs_image_free(&panel); rs_image_free(&cmp); rs_image_free(&aframe);
     pg_out_free(&gout); png_anim_abort(&apng); free(gltf_clip);
     free(bytes); free(mem); free(mem2); free(local); free(xf); free(rest_xf); free(times); free(cpu);
-    free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges);
+    free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges); free(s.pins);
     free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
-    free(fctl); free(bytes2); free(refpos);
+    free(fctl); free(bytes2); free(refpos); free(s.cr_list);
     return rc;
 }

@@ -141,6 +141,10 @@ typedef struct sn_blob_info {
     uint32_t rig_entries;       ///< (rig, free vertex) force entries: the rigs' per-step cost
     uint32_t force_slots;       ///< external forces (sn_apply_force / sn_apply_impulse) accepted per step
     uint32_t force_profiles;    ///< share profiles baked for them (0: every force acts on the fine lattice)
+    uint32_t max_constraints;   ///< position constraints sn_set_constraints accepts (0: none)
+    uint32_t max_colliders;     ///< colliders sn_set_colliders accepts (0: none)
+    uint32_t max_contacts;      ///< contact rows enforced per step (surface points touching colliders)
+    uint32_t max_rows;          ///< constraint rows per step, every producer together (3 per constraint + contacts)
     sn_real  timestep;          ///< h in seconds (fixed: Q16.16)
 } sn_blob_info;
 
@@ -261,7 +265,27 @@ typedef struct sn_stats {
     uint32_t force_drops;  ///< sn_apply_force / sn_apply_impulse calls refused since init/reset because the step's force slots were full
     sn_real  seg_gap;      ///< largest segment-mesh constraint gap left after the last step's fixed sweeps, in segment lengths (Q16.16 / float)
     sn_real  seg_gap_max;  ///< largest seg_gap since init/reset
+    uint32_t crease_list;        ///< self-collision near creases (seed 003 §3.4): pairs in the collision list C after the last step's detection (0 without crease data)
+    uint32_t crease_active;      ///< active prefix n_a of C after the last step's detection (constraints produced: at most the blob's max_active)
+    uint32_t crease_list_full;   ///< penetrations found but not added since init/reset because C was full (the blob's max_list)
+    uint32_t crease_active_over; ///< active constraints not produced since init/reset because max_active was reached or the row store was full
+    uint32_t crease_added;       ///< pairs added to C since init/reset
+    uint32_t crease_removed;     ///< pairs removed from C since init/reset (vertex back outside, or slid off its triangle)
+    uint32_t constraint_rows;    ///< constraint and contact rows enforced in the last step (after drops)
+    uint32_t constraint_drops;   ///< rows dropped since init/reset as (nearly) dependent on earlier rows: duplicate, conflicting or rank-deficient constraints (runtime/NUMERICS.md)
+    uint32_t contacts;           ///< contact rows collected in the last step
+    uint32_t contact_overflow;   ///< contacts not enforced since init/reset because the step's max_contacts were taken
+    uint32_t row_overflow;       ///< rows refused since init/reset because the step's rows were full
+    uint32_t constraint_refused; ///< constraints or colliders beyond the blob's maxima refused by the setters since init/reset
+    uint32_t constraint_clamps;  ///< row targets clamped to one lattice cell per step since init/reset (a far or fast target is approached at that speed)
 } sn_stats;
+/// Self-collision near creases (seed 003 §3.4): the surface vertices in the
+/// collision list after the last step's detection, in the order they entered
+/// it (the first crease_active of them produced contact constraints). Writes
+/// at most max of them into vertices (may be NULL when max is 0) and returns
+/// the list's length (0 without crease data or for an invalid instance).
+uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uint32_t max);
+
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.
 sn_status sn_get_stats(const sn_instance *inst, sn_stats *out);
@@ -318,7 +342,8 @@ sn_status sn_get_control(const sn_instance *inst, uint32_t c, sn_real *value);
 /// Where an external force acts.
 typedef enum sn_force_at {
     SN_AT_SURFACE = 0, ///< surface vertex `vertex`, wherever the flesh carries it
-    SN_AT_POINT = 1    ///< world point `point`: the flesh under it now (the cell whose rest box holds the point, carried back to rest by the nearest lattice vertex's frame; clamped to the nearest cell when outside)
+    SN_AT_POINT = 1,   ///< world point `point`: the flesh under it now (the cell whose rest box holds the point, carried back to rest by the nearest lattice vertex's frame; clamped to the nearest cell when outside)
+    SN_AT_LATTICE = 2  ///< free lattice vertex `vertex` (sn_set_constraints only; forces refuse it)
 } sn_force_at;
 
 /// An external force or impulse on the flesh.
@@ -420,6 +445,82 @@ sn_status sn_apply_segment_impulse(sn_instance *inst, uint32_t mesh, uint32_t no
 /// no friction). A zero normal removes the floor. A setting: kept by
 /// sn_reset. SN_ERR_ARG, and nothing changes, if (float) a value is not finite.
 sn_status sn_set_segment_floor(sn_instance *inst, sn_vec3 normal, sn_real offset);
+
+/* ---- position constraints and colliders (seed 000 §4.4, seed 003 §3.4 eq. 9) ----
+ * The game pins points of the flesh to world positions and puts world
+ * solids (ground, a hand, a rail) in its way. Both become scalar velocity
+ * constraints on the lattice ("rows") that the step enforces inside its CG
+ * (Baraff-Witkin filtered PCG): at the start of the solve the velocity is
+ * made to satisfy them, the CG moves only in the directions they leave free,
+ * and its rounding is corrected at the end (runtime/NUMERICS.md "Constraints
+ * and contact"). Rows that are (nearly) dependent on earlier ones
+ * (duplicates, conflicting targets for the same point, two pins in one cell
+ * along one axis) are dropped in list order and counted in
+ * sn_stats.constraint_drops. The blob bakes the maxima (sn_blob_info
+ * max_constraints, max_colliders, max_contacts), so the instance memory and
+ * the step's cost bound are fixed: a step costs O(rows^3 / 6) for the
+ * factorization plus O(rows^2 + 16 rows) per CG iteration over the rows in
+ * force. Both settings are kept until replaced (a call with count 0 clears)
+ * or sn_reset. */
+
+/// sn_constraint.axes: bit per world axis, or SN_AXIS_DIR for one direction.
+#define SN_AXIS_X 1u
+#define SN_AXIS_Y 2u
+#define SN_AXIS_Z 4u
+#define SN_AXIS_ALL 7u
+#define SN_AXIS_DIR 8u
+
+/// A position constraint: at the end of every step the point is at `target`
+/// (along the chosen axes, or along `dir` only). A target farther than one
+/// lattice cell from where the point is is approached at one cell per step
+/// (counted in sn_stats.constraint_clamps).
+typedef struct sn_constraint {
+    uint32_t at;      ///< sn_force_at: SN_AT_SURFACE (surface vertex), SN_AT_LATTICE (free lattice vertex), SN_AT_POINT (the flesh under a world point now)
+    uint32_t vertex;  ///< SN_AT_SURFACE: surface vertex; SN_AT_LATTICE: free lattice vertex (< free_vertices)
+    sn_vec3  point;   ///< SN_AT_POINT: world point, mesh units (the material point there is found once, at the call)
+    sn_vec3  target;  ///< world position, mesh units
+    uint32_t axes;    ///< SN_AXIS_* bits (0 = all three), or SN_AXIS_DIR
+    sn_vec3  dir;     ///< SN_AXIS_DIR: the constrained direction, any length > 0 (normalized); otherwise ignored
+} sn_constraint;
+
+/// Replace the constraints in force by list[0 .. count-1] (count 0, list may
+/// be NULL: none). Kept until replaced or sn_reset. SN_ERR_ARG, and nothing
+/// changes, for a bad kind, vertex (a skeleton lattice vertex is not an
+/// unknown), axes or zero direction, or (float) a non-finite value or one
+/// beyond 1e9. SN_ERR_FULL if count exceeds max_constraints: the first
+/// max_constraints are set and the rest counted in sn_stats.constraint_refused.
+sn_status sn_set_constraints(sn_instance *inst, const sn_constraint *list, uint32_t count);
+
+/// Collider shapes.
+typedef enum sn_collider_kind {
+    SN_COLLIDER_PLANE = 0,   ///< half-space behind the plane through `a` with outward normal `b`
+    SN_COLLIDER_SPHERE = 1,  ///< ball of `radius` about `a`
+    SN_COLLIDER_CAPSULE = 2  ///< points within `radius` of the segment a-b
+} sn_collider_kind;
+
+/// A world solid the surface may not enter.
+typedef struct sn_collider {
+    uint32_t kind;      ///< sn_collider_kind
+    sn_vec3  a;         ///< plane: a point on it; sphere: centre; capsule: one end of its axis (world, mesh units)
+    sn_vec3  b;         ///< plane: outward normal (any length > 0); capsule: the other end; sphere: ignored
+    sn_real  radius;    ///< sphere, capsule: radius (mesh units, >= 0); plane: ignored
+    sn_vec3  velocity;  ///< the solid's velocity, mesh units per second (it moves rigidly, without turning)
+    sn_real  friction;  ///< Coulomb coefficient mu >= 0 (0: frictionless): a contact sticks to the solid when its predicted slip is at most mu times the normal velocity change it takes, else slides with its slip reduced by that (runtime/NUMERICS.md; uses contact rows)
+} sn_collider;
+
+/// Replace the colliders in force by list[0 .. count-1] (count 0: none).
+/// Kept until replaced or sn_reset: set them every frame with the solids'
+/// current placement. Each step, every surface vertex is tested against them
+/// at the start of the step; a vertex inside, or whose predicted motion
+/// (its velocity plus gravity's) would end inside, is held on the surface
+/// by a one-sided contact row: the deepest such vertex per (collider,
+/// lattice cell), up to max_contacts per step (more: counted in
+/// sn_stats.contact_overflow). SN_ERR_ARG, and nothing changes, for a bad
+/// kind, a zero plane normal, a negative radius or friction, or (float) a
+/// non-finite value or one beyond 1e9. SN_ERR_FULL if count exceeds
+/// max_colliders: the first max_colliders are set, the rest counted in
+/// sn_stats.constraint_refused.
+sn_status sn_set_colliders(sn_instance *inst, const sn_collider *list, uint32_t count);
 
 #ifdef __cplusplus
 }

@@ -390,6 +390,35 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         cnt[SN_SEC_SEGMESH] = v.nM;
         cnt[SN_SEC_SEGNODES] = v.nSN;
         cnt[SN_SEC_SEGATTACH] = v.nSA;
+        /* crease (format 5.0): the parameters fix the other three counts */
+        {
+            uint32_t ncr = sn_rd_u32(t + SN_SEC_CREASE * SN_SECTION_ENTRY);
+            v.nD = sn_rd_u32(t + SN_SEC_CREASE_PAIRS * SN_SECTION_ENTRY);
+            if (ncr > 1 || v.nD > SN_CREASE_MAX_PAIRS || (ncr == 0 && v.nD != 0)) return SN_ERR_SECTION;
+            v.nCR = (uint16_t)ncr;
+        }
+        cnt[SN_SEC_CREASE] = v.nCR;
+        cnt[SN_SEC_CREASE_PAIRS] = v.nD;
+        cnt[SN_SEC_CREASE_VNBR] = 0;
+        cnt[SN_SEC_CREASE_TNBR] = 0;
+        if (v.nCR) {
+            const unsigned char *ce = p + SN_H_SECTIONS + SN_SEC_CREASE * SN_SECTION_ENTRY;
+            uint32_t coff = sn_rd_u32(ce);
+            /* the record is read only once it lies inside the blob */
+            if ((coff & 7u) != 0 || coff > total || total - coff < SN_ELEM_CREASE(SN_REAL_BYTES)) return SN_ERR_SECTION;
+            v.cr_list = (uint16_t)sn_rd_u16(p + coff);
+            v.cr_active = (uint16_t)sn_rd_u16(p + coff + 2);
+            v.cr_nv = p[coff + 4];
+            v.cr_nt = p[coff + 5];
+            if (v.cr_list < 1 || v.cr_list > SN_CREASE_MAX_LIST || v.cr_active < 1 || v.cr_active > v.cr_list ||
+                v.cr_active > SN_CREASE_MAX_ACTIVE || v.cr_nv < 1 || v.cr_nv > SN_CREASE_MAX_NBR_V || v.cr_nt < 1 ||
+                v.cr_nt > SN_CREASE_MAX_NBR_T || v.nS < 1 || v.nT < 1)
+                return SN_ERR_VALUE;
+            cnt[SN_SEC_CREASE_VNBR] = v.nS * v.cr_nv;
+            cnt[SN_SEC_CREASE_TNBR] = v.nS * v.cr_nt;
+            v.crB = SN_CREASE_STATE_BYTES(v.nS, v.cr_list);
+        }
+        cnt[SN_SEC_CONSTRAINTS] = 0; /* 0 or 1: taken from the table below */
     }
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
@@ -401,12 +430,14 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
-            SN_ELEM_SEGATTACH(SN_REAL_BYTES)};
+            SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
+            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
             uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
             if ((k == SN_SEC_LIMIT || k == SN_SEC_VSHARE) && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
+            if (k == SN_SEC_CONSTRAINTS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -428,8 +459,12 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (st != SN_OK) return st;
     st = sn_check_segments(&v, &v.segB);
     if (st != SN_OK) return st;
+    st = sn_check_crease(&v);
+    if (st != SN_OK) return st;
+    st = sn_check_constraints(&v); /* after the crease record: its rows count */
+    if (st != SN_OK) return st;
     /* the instance size is the runtime's layout (one source: sn_instance.c) */
-    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB)) return SN_ERR_HEADER;
+    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB, v.crB, v.conB)) return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }
@@ -470,6 +505,10 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->flags = p[SN_H_FLAGS];
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
+    v->nD = v->crB = 0;
+    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_pad = 0;
+    v->cr_depth = v->cr_push = 0;
+    v->nCon = v->nCol = v->nCt = v->nRows = v->conB = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
@@ -486,6 +525,19 @@ static void sn_view_sections(sn_view *v) {
     v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
     v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
     v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);
+    v->nCR = (uint16_t)(sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CREASE * SN_SECTION_ENTRY + 8) != 0); /* validated: 0 or 1 */
+    v->nD = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CREASE_PAIRS * SN_SECTION_ENTRY + 8);
+    if (v->nCR) { /* parameters (validate: read once the record is known to be inside the blob) */
+        const unsigned char *c = v->sec[SN_SEC_CREASE];
+        v->cr_list = (uint16_t)sn_rd_u16(c);
+        v->cr_active = (uint16_t)sn_rd_u16(c + 2);
+        v->cr_nv = c[4];
+        v->cr_nt = c[5];
+        v->cr_depth = SN_RD_REAL(c + 12);
+        v->cr_push = SN_RD_REAL(c + 12 + SN_REAL_BYTES);
+        v->crB = SN_CREASE_STATE_BYTES(v->nS, v->cr_list);
+    }
+    sn_view_constraints(v);
 }
 
 /* Decode a blob that sn_blob_validate() accepted (no checks). */
@@ -526,6 +578,10 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->rig_entries = v.nRE;
     info->force_slots = v.nFrc;
     info->force_profiles = v.nP;
+    info->max_constraints = v.nCon;
+    info->max_colliders = v.nCol;
+    info->max_contacts = v.nCt;
+    info->max_rows = v.nRows;
 }
 
 static const unsigned char *sn_section(const sn_blob *blob, int k) {

@@ -20,7 +20,7 @@
  * number of forces is the caller's (at most the blob's MAX_FORCES), known
  * before the step runs.
  */
-#include "sn_instance.h"
+#include "sn_constraint.h"
 
 #define SHARE_ELEM SN_ELEM_SHARES(SN_REAL_BYTES)
 #define NO_PROFILE 0xFFFFu
@@ -477,7 +477,7 @@ void sn_forces_clear(sn_ihdr *h) { h->n_forces = 0; }
  * its frame, x = x_i + R_i^T (P - p_i); the cell whose rest box holds x (or
  * is nearest to it) and x's trilinear coordinates in it, clamped to the box.
  * O(nF + nC), in the call, not in the step. */
-static void locate(const sn_ihdr *h, const sn_vec3 *P, uint32_t *cell, uint16_t t[3]) {
+void sn_locate(const sn_ihdr *h, const sn_vec3 *P, uint32_t *cell, uint16_t t[3]) {
     const sn_view *v = &h->v;
     const sn_q *pos = CARR(h, o_pos, sn_q), *R = CARR(h, o_R, sn_q);
     const unsigned char *rest = v->sec[SN_SEC_REST], *cells = v->sec[SN_SEC_CELLS];
@@ -558,7 +558,7 @@ static sn_status apply(sn_instance *inst, const sn_force *f, int impulse) {
         s->cell = sn_rd_u16(e);
         for (c = 0; c < 3; c++) s->t[c] = (uint16_t)sn_rd_u16(e + 2 + 2 * c);
     } else {
-        locate(h, &f->point, &s->cell, s->t);
+        sn_locate(h, &f->point, &s->cell, s->t);
     }
     /* profile: the caller's, or that of the cell's free corner with the largest weight */
     if (v->nP == 0) s->prof = NO_PROFILE;

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 4.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 5.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -15,7 +15,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 4
+#define SN_FORMAT_MAJOR 5
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -136,6 +136,20 @@ enum {
     SN_SEC_SEGNODES,     /* sum of nodes x R[3]: rest node positions, model space, Q22 (sheets row-major) */
     SN_SEC_SEGATTACH,    /* sum of n_attach x {u16 node (< the mesh's nodes), u8 kind (SN_SEGATT_*), u8 0, u16 target, u16 0,
                             R point[3] (JOINT: attachment point at rest, model space Q22; SURFACE: 0)} */
+    /* ---- constraints and contact (seed 000 §4.4, seed 003 §3.4 eq. 9), format 5.0; count 0 or 1 ---- */
+    SN_SEC_CONSTRAINTS,  /* 0 or 1 x {u8 max_constraints (0..SN_MAX_CONSTRAINTS), u8 max_colliders (0..SN_MAX_COLLIDERS),
+                            u16 max_contacts (0..SN_MAX_CONTACTS), u32 0}; 3 max_constraints + max_contacts (+ CREASE's
+                            max_active) <= SN_MAX_ROWS. Count 0: no constraints, colliders or contacts */
+    /* ---- self-collision near creases (seed 003 §3.4), format 5.0; all four have count 0, or CREASE has count 1 ---- */
+    SN_SEC_CREASE,       /* 0 or 1 x {u16 max_list (1..SN_CREASE_MAX_LIST), u16 max_active (1..min(max_list, SN_CREASE_MAX_ACTIVE)),
+                            u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 0, u32 0,
+                            R depth (deepest detected penetration, Q22 internal, [1, SN_CREASE_DEPTH_MAX]),
+                            R push (push-out cap per step, Q22, [0, depth])} */
+    SN_SEC_CREASE_PAIRS, /* nD x {u16 i, u16 j}: the seed set D, surface vertices i != j (< nS), in the order found; nD <= SN_CREASE_MAX_PAIRS */
+    SN_SEC_CREASE_VNBR,  /* nS * nbr_v x u16: row s = the surface vertices near s (s itself first, then by ring, then index),
+                            unused tail entries SN_CREASE_NONE; every entry < nS */
+    SN_SEC_CREASE_TNBR,  /* nS * nbr_t x u16: row s = the triangles touching a vertex of VNBR row s, increasing, unused tail
+                            entries SN_CREASE_NONE; every entry < nT */
     SN_SEC_COUNT
 };
 
@@ -167,6 +181,26 @@ enum {
 #define SN_ELEM_SEGMESH(R)  (16 + 9 * (R))
 #define SN_ELEM_SEGNODES(R) (3 * (R))
 #define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
+#define SN_ELEM_CONSTRAINTS 8
+#define SN_ELEM_CREASE(R)   (12 + 2 * (R))
+#define SN_ELEM_CREASE_PAIRS 4
+#define SN_ELEM_CREASE_VNBR  2
+#define SN_ELEM_CREASE_TNBR  2
+
+/* self-collision near creases (seed 003 §3.4; sn_crease.c, NUMERICS.md "Self-collision") */
+#define SN_CREASE_MAX_LIST   256u   /* collision list C entries (eq. 8) */
+#define SN_CREASE_MAX_ACTIVE 64u    /* active constraints pushed per step */
+#define SN_CREASE_MAX_NBR_V  32u    /* vertices per neighbourhood row */
+#define SN_CREASE_MAX_NBR_T  64u    /* triangles per neighbourhood row */
+#define SN_CREASE_MAX_PAIRS  4096u  /* seed pairs D */
+#define SN_CREASE_DEPTH_MAX  ((int32_t)1 << 26) /* Q22: 16 internal units */
+#define SN_CREASE_NONE       0xFFFFu
+/* crease state bytes (multiple of 8): the step's surface positions (3 reals
+ * per surface vertex), the list (8 bytes per entry), one membership byte per
+ * surface vertex; 0 without CREASE. Its max_active rows per step are part of
+ * the constraint rows (SN_ROWS_CAP, SN_CONS_BYTES). */
+#define SN_CREASE_STATE_BYTES(nS, max_list) \
+    ((13u * (uint32_t)(nS) + 8u * (uint32_t)(max_list) + 7u) & ~7u)
 
 /* external forces: levels fine, coarse 1..3 (2, 4, 8 cells), rigid */
 #define SN_LEVELS 5
@@ -202,6 +236,24 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
     }
 }
 
+/* constraints and contact (runtime/NUMERICS.md "Constraints and contact") */
+#define SN_MAX_CONSTRAINTS 64u   /* user constraints (sn_set_constraints), up to 3 rows each */
+#define SN_MAX_COLLIDERS 16u     /* world colliders (sn_set_colliders) */
+#define SN_MAX_CONTACTS 256u     /* contact rows per step */
+#define SN_MAX_ROWS 512u         /* constraint rows per step, every producer together */
+#define SN_CON_BYTES 80u         /* instance bytes per user constraint */
+#define SN_COL_BYTES 64u         /* instance bytes per collider */
+#define SN_ROW_BYTES 120u        /* instance bytes per row (sn_row, runtime/src/sn_constraint.h) */
+#define SN_ROWAUX_BYTES 16u      /* instance bytes per row of factorization state */
+/* Rows per step: the sum of every producer's baked maximum (user constraints
+ * give up to 3 rows each, a contact one, crease collision its max_active). */
+#define SN_ROWS_CAP(ncon, ncontacts, ncrease) (3u * (uint32_t)(ncon) + (uint32_t)(ncontacts) + (uint32_t)(ncrease))
+/* Instance bytes of the constraint state: records, rows, per-row state and the
+ * packed lower-triangular Cholesky factor of the rows' Gram matrix (int32/float). */
+#define SN_CONS_BYTES(ncon, ncol, nrows) \
+    ((uint32_t)(ncon) * SN_CON_BYTES + (uint32_t)(ncol) * SN_COL_BYTES + \
+     (uint32_t)(nrows) * (SN_ROW_BYTES + SN_ROWAUX_BYTES) + 4u * ((uint32_t)(nrows) * ((uint32_t)(nrows) + 1u) / 2u))
+
 /* control kinds (CONTROLS.kind) */
 #define SN_CTL_ABSTRACT 0   /* set by the game: sn_set_control */
 #define SN_CTL_ANGLE    1   /* read from the pose each step: angle (degrees) of joint's rotation relative to its parent about axis */
@@ -235,11 +287,16 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
  * the header to equal it, and test_runtime_blob checks this macro against it. */
 #define SN_INSTANCE_HDR_BYTES 768u /* the instance header before the arrays */
-/* nFrc: force slots (header MAX_FORCES); segB: segment state bytes, the sum
- * over meshes of SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts). */
-#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB) \
-    ((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
+/* nFrc: force slots (header MAX_FORCES); segB: the extra state bytes before
+ * the constraint state: the segment state, the sum over meshes of
+ * SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts), plus the
+ * crease state SN_CREASE_STATE_BYTES (0 without a CREASE section; a multiple
+ * of 8, so the sum rounds as the runtime's separate arrays do);
+ * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record and
+ * the crease rows (0 without either). */
+#define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB, conB) \
+    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
       12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
-      SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u)
+      SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u) + (uint32_t)(conB) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

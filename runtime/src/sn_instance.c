@@ -6,22 +6,26 @@
 
 /* hdr | acc nF*3 acc | per joint: wrench | force slots | segment state |
  * per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
- * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value | per free: k (u8)
+ * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value |
+ * crease state (crB: surface positions, list, membership; sn_crease.c) | per free: k (u8) |
+ * (8-aligned) constraint state: records, colliders, rows, row state, factor (sn_cons_layout)
  * The 8-byte arrays come first (the header and each of them are multiples
  * of 8). Array offsets into off[] in the order of SN_LAYOUT_ARRAYS; returns
  * the total, rounded up to 8. Counts are validated (nV <= 65535 ...): no wrap. */
-#define SN_LAYOUT_ARRAYS 21
+#define SN_LAYOUT_ARRAYS 23
 static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                               uint32_t nFrc, uint32_t segB, uint32_t off[SN_LAYOUT_ARRAYS]) {
+                               uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t off[SN_LAYOUT_ARRAYS]) {
     const uint32_t bytes[SN_LAYOUT_ARRAYS] = {
         nF * 3u * 8u, /* acc: 8 bytes per accumulator in both flavours */
         nJ * SN_WRENCH_BYTES, nFrc * SN_FORCE_SLOT_BYTES, segB,          /* wrench frc seg */
         nJ * 4u * 4u, nJ * 3u * 4u, nJ * 9u * 4u, nJ * 3u * 4u,          /* pq pt jR jT */
         nV * 9u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, /* R c pos vel u */
         nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u,          /* x r d q */
-        (nV - nF) * 3u * 4u, nC * 9u * 4u, nK * 4u, nF};                 /* ds cR ctl k */
+        (nV - nF) * 3u * 4u, nC * 9u * 4u, nK * 4u, crB, nF,             /* ds cR ctl crease k */
+        conB};                                                            /* constraint state (sn_constraint.c), 8-aligned */
     uint32_t o = SN_HDR_BYTES, i;
     for (i = 0; i < SN_LAYOUT_ARRAYS; i++) {
+        if (i == SN_LAYOUT_ARRAYS - 1) o = (o + 7u) & ~7u;
         off[i] = o;
         o += bytes[i];
     }
@@ -29,19 +33,20 @@ static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t n
 }
 
 uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                           uint32_t nFrc, uint32_t segB) {
+                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB) {
     uint32_t off[SN_LAYOUT_ARRAYS];
-    return layout_offsets(nV, nF, nJ, nC, nK, nFrc, segB, off);
+    return layout_offsets(nV, nF, nJ, nC, nK, nFrc, segB, crB, conB, off);
 }
 
 static void layout(sn_ihdr *h) {
     uint32_t off[SN_LAYOUT_ARRAYS];
-    (void)layout_offsets(h->v.nV, h->v.nF, h->v.nJ, h->v.nC, h->v.nK, h->v.nFrc, h->v.segB, off);
+    (void)layout_offsets(h->v.nV, h->v.nF, h->v.nJ, h->v.nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
     h->o_acc = off[0]; h->o_wr = off[1]; h->o_frc = off[2]; h->o_seg = off[3];
     h->o_pq = off[4]; h->o_pt = off[5]; h->o_jR = off[6]; h->o_jT = off[7];
     h->o_R = off[8]; h->o_c = off[9]; h->o_pos = off[10]; h->o_vel = off[11]; h->o_u = off[12];
     h->o_x = off[13]; h->o_r = off[14]; h->o_d = off[15]; h->o_q = off[16];
-    h->o_ds = off[17]; h->o_cR = off[18]; h->o_ctl = off[19]; h->o_k = off[20];
+    h->o_ds = off[17]; h->o_cR = off[18]; h->o_ctl = off[19]; h->o_crs = off[20]; h->o_k = off[21];
+    sn_cons_layout(h, off[22]);
 }
 
 #if !defined(SN_FLOAT)
@@ -169,6 +174,8 @@ sn_status sn_reset(sn_instance *inst) {
     h->disp = h->disp_max = h->energy = h->energy_max = 0;
     h->n_forces = h->force_drops = 0;
     h->seg_gap = h->seg_gap_max = 0;
+    h->cr_n = h->cr_na = h->cr_rows = 0;
+    h->cr_list_full = h->cr_active_over = h->cr_added = h->cr_removed = 0;
     /* rest pose: identity rotations (the quaternion tracking starts here), zero translations */
     for (i = 0; i < nJ; i++) {
         pq[4 * i + 3] = SN_ONE_ROT;
@@ -190,6 +197,7 @@ sn_status sn_reset(sn_instance *inst) {
     set_identity(ARR(h, o_cR, sn_q), v->nC);
     sn_controls_reset(h);
     sn_segments_reset(h);
+    sn_cons_reset(h);
     return SN_OK;
 }
 
@@ -232,6 +240,19 @@ sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
     out->force_drops = h->force_drops;
     out->seg_gap = h->seg_gap;
     out->seg_gap_max = h->seg_gap_max;
+    out->crease_list = h->cr_n;
+    out->crease_active = h->cr_na;
+    out->crease_list_full = h->cr_list_full;
+    out->crease_active_over = h->cr_active_over;
+    out->crease_added = h->cr_added;
+    out->crease_removed = h->cr_removed;
+    out->constraint_rows = h->rows_kept;
+    out->constraint_drops = h->row_drops;
+    out->contacts = h->contacts;
+    out->contact_overflow = h->contact_overflow;
+    out->row_overflow = h->row_overflow;
+    out->constraint_refused = h->con_refused;
+    out->constraint_clamps = h->con_clamps;
     return SN_OK;
 }
 
@@ -269,5 +290,6 @@ uint64_t sn_state_hash(const sn_instance *inst) {
     for (i = 0; i < 3 * h->v.nV; i++) hsh = fnv_q(hsh, vel[i]);
     for (i = 0; i < 3 * h->v.nF; i++) hsh = fnv_q(hsh, x[i]);
     for (i = 0; i < h->v.nK; i++) hsh = fnv_q(hsh, CARR(h, o_ctl, sn_q)[i]); /* control values (none: unchanged) */
-    return sn_segments_hash(h, hsh); /* no segment meshes: unchanged */
+    hsh = sn_segments_hash(h, hsh); /* no segment meshes: unchanged */
+    return sn_crease_hash(h, hsh);   /* no crease sections: unchanged */
 }

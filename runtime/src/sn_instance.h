@@ -7,8 +7,11 @@
  *   sn_rig.c       controls, tau maps, rig forces (seed 003 §4)
  *   sn_force.c     external forces and impulses, multilevel shares, joint wrench (seed 004 ch. 4)
  *   sn_segment.c   segment meshes: chains and sheets (seed 004 ch. 3-4)
+ *   sn_crease.c    self-collision near creases: list C, detection, rows (seed 003 §3.4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
+ *   sn_constraint.c constraint rows, their factorization and the CG's projection (seed 000 §4.4)
+ *   sn_contact.c   the game's colliders -> one-sided contact rows (seed 003 eq. 9)
  *   sn_step.c      the step: the stages in order
  */
 #ifndef SN_INSTANCE_H
@@ -32,7 +35,7 @@ typedef struct sn_ihdr {
 #endif
     /* byte offsets of the arrays from the instance start */
     uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds,
-        o_k, o_cR, o_ctl, o_wr, o_frc, o_seg;
+        o_k, o_cR, o_ctl, o_wr, o_frc, o_seg, o_crs;
     uint32_t n_forces;      /* force slots filled since the last step (sn_force.c) */
     uint32_t force_drops;   /* forces refused since init/reset: slots full */
     sn_real seg_gap;        /* largest segment constraint gap after the last step's sweeps, fraction of a segment (public Q16.16 / float) */
@@ -43,6 +46,20 @@ typedef struct sn_ihdr {
     uint32_t floor_on;      /* sn_set_segment_floor: a floor plane is set (a setting: survives reset) */
     sn_q floor_n[3];        /* its unit normal (Q30 / float) */
     sn_real floor_off;      /* n.p >= floor_off, world public units */
+    /* self-collision near creases (sn_crease.c) */
+    uint32_t cr_n;          /* entries of the collision list C (eq. 8) */
+    uint32_t cr_na;         /* active prefix n_a of C after the last step's detection */
+    uint32_t cr_rows;       /* rows in the temporary row buffer (sn_rows_push) */
+    uint32_t cr_list_full;  /* penetrations not added since init/reset: C full */
+    uint32_t cr_active_over;/* active constraints not pushed since init/reset: max_active reached or row store full */
+    uint32_t cr_added, cr_removed; /* pairs added to / removed from C since init/reset */
+    /* constraints and contact (sn_constraint.c, sn_contact.c) */
+    uint32_t o_con, o_col, o_row, o_rx, o_L; /* user constraints, colliders, rows, row state, packed factor */
+    uint32_t n_con, n_col;  /* user constraints and colliders in force (settings: kept until replaced or reset) */
+    uint32_t n_rows;        /* rows collected for the current step */
+    uint32_t rows_kept;     /* rows enforced in the last step (after the factorization's drops) */
+    uint32_t contacts;      /* contact rows collected in the last step */
+    uint32_t row_drops, contact_overflow, row_overflow, con_refused, con_clamps; /* since init/reset */
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -153,6 +170,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat);   /* 8b: segment meshes after 
 void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const sn_q T1[3], uint32_t *sat);
 uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into the FNV-1a hash */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
+void sn_crease_step(sn_ihdr *h, uint32_t *sat);    /* 3b: crease list C: detect, drop, n_a, rows (sn_crease.c) */
+uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh); /* list C into the FNV-1a hash (unchanged without CREASE) */
+void sn_cons_layout(sn_ihdr *h, uint32_t off);      /* constraint arrays from offset off (sn_constraint.c) */
+void sn_cons_reset(sn_ihdr *h);                     /* no constraints, colliders or rows; counters 0 */
 
 /* ---- shared by the outputs, forces and segment meshes (sn_embed.c) ---- */
 void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out);  /* origin + p, public units */

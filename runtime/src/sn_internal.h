@@ -213,6 +213,11 @@ typedef struct sn_view {
     uint32_t nK, nR, nRS, nRE; /* controls, rigs, rig samples, rig entries (section counts) */
     uint32_t nP, nVP, nFrc;    /* share profiles, vertex profile entries (0 or nF), force slots */
     uint32_t nM, nSN, nSA, segB; /* segment meshes, nodes, attachments; segment state bytes */
+    uint32_t nD, crB;          /* crease: seed pairs, state bytes (SN_CREASE_STATE_BYTES, 0 without) */
+    uint16_t nCR, cr_list, cr_active, cr_nv, cr_nt, cr_pad; /* crease: CREASE count (0 or 1), max list, max active,
+                                                              VNBR / TNBR row widths (0 without), 0 (16-bit: the view sits in the 768-byte instance header) */
+    sn_q cr_depth, cr_push;    /* crease: deepest detected penetration, push-out cap per step (Q22) */
+    uint32_t nCon, nCol, nCt, nRows, conB; /* max constraints, colliders, contacts; rows per step; constraint state bytes */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;
     int len_shift, frac_S, frac_M, frac_P, frac_E, frac_F;
     sn_q a1, b1, grav[3], timestep;
@@ -223,7 +228,7 @@ typedef struct sn_view {
 /* Instance bytes for these counts: the runtime's layout (sn_instance.c), the
  * one source of the size (SN_INSTANCE_BYTES in sn_format.h is tested equal). */
 uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                           uint32_t nFrc, uint32_t segB);
+                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB);
 
 /* One stored real in range (validator helper, sn_blob.c): fixed, the stored
  * integer in [lo, hi]; float, finite and in [lo, hi] / 2^q (q <= 30). */
@@ -232,8 +237,17 @@ int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q);
 /* Segment sections (sn_segment.c): contents valid, and *segB = the state
  * bytes they need. Called by the validator once the table is checked. */
 sn_status sn_check_segments(const sn_view *v, uint32_t *segB);
+/* Crease sections (sn_crease.c): contents valid (table counts already
+ * checked against the parameters). */
+sn_status sn_check_crease(const sn_view *v);
 /* Force sections (sn_force.c): profiles and vertex profiles valid. */
 sn_status sn_check_forces(const sn_view *v);
+
+/* Constraint section (sn_constraint.c): the record's maxima within their
+ * bounds (SN_MAX_*, rows <= SN_MAX_ROWS), reserved bytes 0; fills the view's
+ * nCon, nCol, nCt, nRows, conB (sn_view_constraints). */
+sn_status sn_check_constraints(sn_view *v);
+void sn_view_constraints(sn_view *v); /* decode only (validated blob) */
 
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob);

@@ -9,8 +9,8 @@
  * rows (sn_instance_init checks it), each |R t| <= sqrt(3) 2^58, so < 2^61.8.
  * The mass pass is the assembled one of format 1 (<= 53 block products).
  */
-#include "sn_instance.h"
-#include "sn_kernels.h" /* sn_k_cell_mul: scalar reference or the build's SIMD/DSP path */
+#include "sn_constraint.h"
+#include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
 
 /* l += D e, D symmetric stored xx yy zz xy xz yz */
 SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
@@ -349,13 +349,19 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
-    uint32_t clamps = 0;
+    uint32_t clamps = 0, rows;
 
     rhs(h, r, sat);
-    /* PCG, warm-started from the previous step's solution, fixed iterations */
+    /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
+    rows = sn_constrain_begin(h, x, sat);
+    /* PCG, warm-started from the previous step's solution, fixed iterations;
+     * with rows, residuals and preconditioned residuals are projected onto
+     * the free directions (Baraff-Witkin filtered PCG) */
     matvec(h, x, q, sat);
     for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    if (rows) sn_rows_filter(h, r, 1, sat);
     precond(h, r, z, sat);
+    if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
     rz = dot(r, z, kk, n3);
     for (it = 0; it < h->iterations; it++) {
@@ -367,11 +373,17 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
+        if (rows) sn_rows_filter(h, r, 1, sat);
         precond(h, r, z, sat);
+        if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz, &clamps);
         for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
         rz = rz1;
+    }
+    if (rows) { /* the CG's rounding off the rows again; the second pass, in finer units, takes the first's rounding */
+        sn_rows_fix(h, x, sat);
+        sn_rows_fix(h, x, sat);
     }
     /* v += dv, p += h v  (velocities are per step: h folded in) */
     for (i = 0; i < n3; i++) {

@@ -16,6 +16,7 @@ sn_status sn_step(sn_instance *inst) {
     h = hdr_of(inst);
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
+    sn_crease_step(h, &sat);
     sn_solve(h, &sat);
     sn_limits(h, &sat);
     sn_segments_step(h, &sat);

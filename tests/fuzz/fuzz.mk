@@ -42,9 +42,11 @@ $(FUZZ_DIR)/fuzz_clip: tests/fuzz/lf_clip.c tests/fuzz/lf_common.h ports/common/
                        ports/common/sn_clip.h $(SN_SRCS) $(SN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Iports/common -o $@ $< ports/common/sn_clip.c ports/common/sn_clip_pose.c $(LF_RT) -lm
-$(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h tools/sb_desc.c tools/sb_util.c tools/sb.h
+# the description reader reads `gltf FILE` lines through the glTF bake (and its mesh checks)
+LF_DESC_SRC = tools/sb_desc.c tools/sb_util.c tools/sb_mesh.c tools/sb_gltf_bake.c tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_gltf_anim.c tools/sb_json.c
+$(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h $(LF_DESC_SRC) tools/sb.h $(GLTF_HDR)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_desc.c tools/sb_util.c -lm
+	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< $(LF_DESC_SRC) -lm
 $(FUZZ_DIR)/fuzz_obj: tests/fuzz/lf_obj.c tests/fuzz/lf_common.h tools/sb_mesh.c tools/sb_util.c tools/sb.h
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< tools/sb_mesh.c tools/sb_util.c -lm
@@ -117,5 +119,6 @@ test: $(BUILD)/tests/blob_patch
 # meant to alter the simulation. (Kept in this fragment so the Makefile
 # gains a single include line.)
 .PHONY: update-hashes
-update-hashes: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(EX)/cow.blob $(EX)/cow_float.blob
+update-hashes: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(EX)/cow.blob $(EX)/cow_float.blob \
+               $(BUILD)/cross/det_x86_64-gcc-O2 $(BUILD)/cross/det_float-gcc-O2 $(EX)/limb_crease.blob $(EX)/limb_crease_float.blob
 	BUILD=$(BUILD) sh tests/scripts/update_hashes.sh

@@ -183,6 +183,30 @@ static void exercise(const sn_blob *blob) {
     root.z = g_pose == 2 ? REAL(-30000.0f, -30000 * 65536) : 0;
     sn_pose_from_local(blob, local, &root, xf);
     (void)sn_set_pose(inst, xf, info.joints);
+    {   /* constraints and colliders (format 5.0): hostile arguments refused
+         * with a status, accepted ones stepped (far targets, huge and
+         * zero-size solids, out-of-range vertices) */
+        sn_constraint fc[3];
+        sn_collider fk[3];
+        sn_status cs_;
+        memset(fc, 0, sizeof fc);
+        memset(fk, 0, sizeof fk);
+        fc[0].at = SN_AT_SURFACE; fc[0].vertex = info.surface_vertices ? info.surface_vertices - 1 : 0;
+        fc[0].target.x = REAL(3.0e4f, INT32_MAX); fc[0].target.y = REAL(-3.0e4f, INT32_MIN);
+        fc[1].at = SN_AT_LATTICE; fc[1].vertex = 0; fc[1].axes = SN_AXIS_DIR; fc[1].dir.x = REAL(1.0e-30f, 1); fc[1].dir.z = REAL(-1.0f, -65536);
+        fc[2].at = SN_AT_POINT; fc[2].point.x = REAL(-3.0e4f, INT32_MIN); fc[2].axes = SN_AXIS_Y;
+        cs_ = sn_set_constraints(inst, fc, 3);
+        if (info.surface_vertices == 0 && cs_ == SN_ERR_ARG) cs_ = sn_set_constraints(inst, fc + 1, 2);
+        fc[0].vertex = info.surface_vertices; /* out of range: refused, nothing changes */
+        (void)sn_set_constraints(inst, fc, 1);
+        fk[0].kind = SN_COLLIDER_PLANE; fk[0].b.y = REAL(3.0e4f, INT32_MAX); fk[0].a.y = REAL(-0.2f, -13107);
+        fk[1].kind = SN_COLLIDER_SPHERE; fk[1].radius = REAL(3.0e4f, INT32_MAX); fk[1].velocity.x = REAL(1.0e9f, INT32_MAX);
+        fk[2].kind = SN_COLLIDER_CAPSULE; fk[2].a.x = REAL(-1.0f, -65536); fk[2].b.x = REAL(-1.0f, -65536); fk[2].radius = REAL(0.5f, 32768);
+        (void)sn_set_colliders(inst, fk, 3);
+        fk[1].kind = 7; /* refused */
+        (void)sn_set_colliders(inst, fk, 3);
+        (void)cs_;
+    }
     (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
     (void)sn_set_mode(inst, SN_MODE_WARPED);
     for (s = 0; s < g_steps; s++) {
@@ -422,6 +446,7 @@ static int run_crafted(const char *name, size_t (*make)(void), int posetype, int
         if (!g_finite) _exit(5);
         if (expect == 1 && g_last_stats.saturations == 0) _exit(4);
         if (expect == 2 && g_last_stats.limit_clamps == 0) _exit(4);
+        if (expect == 3 && (g_last_stats.crease_added == 0 || g_last_stats.crease_list > 1)) _exit(4);
         _exit(0);
     }
     if (pid < 0 || waitpid(pid, &status, 0) != pid) { printf("FAIL: crafted %s: fork failed\n", name); return 1; }
@@ -435,7 +460,37 @@ static int run_crafted(const char *name, size_t (*make)(void), int posetype, int
     return 1;
 }
 
-#define N_CRAFTED 8
+/* Crease contact (seed 003 §3.4.2): surface vertex 1 moved inside the body
+ * at cell 1's (0.1, 0.9, 0.5) = (0.55, 0.2, 0) x 2^ls, 0.25 behind triangle
+ * 1 = (0, 2, 3) in the plane z = 0.25 (normal +z) and inside it in the xy
+ * projection; the seed (1, 3) makes the runtime test it against triangle 1;
+ * neighbourhood rows {s} only (no triangle is excluded but the vertex's own).
+ * Record: list, active, depth, push (internal units); instance bytes follow. */
+static void crease_set(unsigned char *b, uint32_t list, uint32_t active, double depth, double push) {
+    unsigned char *cr = b + tb_sec(b, SN_SEC_CREASE), *vn = b + tb_sec(b, SN_SEC_CREASE_VNBR);
+    unsigned char *e1 = b + tb_sec(b, SN_SEC_EMBED) + 8;
+    int i;
+    tb_u16(e1, 1);
+    tb_u16(e1 + 2, 3277); tb_u16(e1 + 4, 29491); tb_u16(e1 + 6, 16384);
+    for (i = 0; i < TB_NS; i++) tb_u16(vn + 4 * i + 2, SN_CREASE_NONE);
+    tb_u16(b + tb_sec(b, SN_SEC_CREASE_PAIRS), 1);
+    tb_u16(b + tb_sec(b, SN_SEC_CREASE_PAIRS) + 2, 3);
+    tb_u16(cr, list);
+    tb_u16(cr + 2, active);
+    tb_real(cr + 12, depth, SN_Q_LEN);
+    tb_real(cr + 16, push, SN_Q_LEN);
+    tb_u32(b + SN_H_INSTANCE_BYTES,
+           SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + SN_CREASE_STATE_BYTES(TB_NS, list),
+                             SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, active))));
+}
+static size_t craft_crease(void) {
+    size_t n = tb_build(g_craft.b, sizeof g_craft.b, 0);
+    crease_set(g_craft.b, 1, 1, 0.5, 0.05);
+    tb_fix_crc(g_craft.b);
+    return n;
+}
+
+#define N_CRAFTED 9
 static int crafted_all(void) {
     int fails = 0;
     fails += run_crafted("2000 triangles on one vertex (normals)", craft_valence, 0, 2, 0);
@@ -449,6 +504,7 @@ static int crafted_all(void) {
     fails += run_crafted("LIMIT 1 LSB on every free vertex", craft_limits_tiny, 0, 10, 2);
     fails += run_crafted("rig forces, etas, gammas and axes at their bounds, controls at their type's extremes",
                          craft_rig_max, 1, 20, 1);
+    fails += run_crafted("crease contact: a vertex 0.25 behind the opposite triangle, list 1, active 1", craft_crease, 0, 10, 3);
     return fails;
 }
 
@@ -776,6 +832,10 @@ static void e_rest_ls24(unsigned char *b, int hi) { coords(b, 24, hi, 1, 0); }
 static void e_joint(unsigned char *b, int hi) { coords(b, 0, hi, 0, 1); }
 static void e_joint_ls(unsigned char *b, int hi) { coords(b, hi ? 24 : -24, hi, 0, 1); }
 /* everything at once */
+static void e_crease_depth(unsigned char *b, int hi) {
+    crease_set(b, TB_CR_LIST, TB_CR_ACTIVE, hi ? 16.0 : ldexp(1.0, -22), hi ? 16.0 : 0.0);
+}
+static void e_crease_list(unsigned char *b, int hi) { crease_set(b, hi ? 256 : 1, hi ? 64 : 1, 0.5, 0.05); }
 static void e_all(unsigned char *b, int hi) {
     e_fracs_all(b, hi);
     e_frac_e(b, !hi);
@@ -789,6 +849,7 @@ static void e_all(unsigned char *b, int hi) {
     e_limit(b, hi);
     e_rig_frac(b, hi);
     e_axis_diag(b, hi);
+    crease_set(b, hi ? 256 : 1, hi ? 64 : 1, hi ? 16.0 : ldexp(1.0, -22), hi ? 16.0 : 0.0);
     coords(b, hi ? 24 : -24, hi, 1, 0);
     coords(b, hi ? 24 : -24, hi, 0, 1);
 }
@@ -835,6 +896,8 @@ static const mx_row g_rows[] = {
     {"rest coords, len_shift 24", "all -2^12", "all +2^12", e_rest_ls24, 0},
     {"joint coords, len_shift 0", "all -2^27", "all +2^27", e_joint, 0},
     {"joint coords, len_shift -+24", "-2^27, ls -24", "+2^12, ls 24", e_joint_ls, 0},
+    {"crease depth, push (a contact)", "1 LSB, 0", "2^26, 2^26", e_crease_depth, 0},
+    {"crease list, active (a contact)", "1, 1", "256, 64", e_crease_list, 0},
     {"everything at once", "all min", "all max", e_all, 0},
 };
 #define N_ROWS ((int)(sizeof g_rows / sizeof g_rows[0]))

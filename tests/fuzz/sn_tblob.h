@@ -19,7 +19,8 @@
  * meshes (format 4.0): a chain of 5 nodes 0.1 apart hanging along -y from
  * the tip end (x = 1), node 0 pinned to the tip joint; a 3x3 sheet (2 levels,
  * shares 1/2 1/2, no gravity) in the plane y = -0.25 from surface vertex 0
- * (0.25, -0.25, 0.25), its node 0, pinned there. Flavour
+ * (0.25, -0.25, 0.25), its node 0, pinned there. Crease sections (format
+ * 5.0): list 4, active 2, one seed pair, two-entry neighbourhoods. Flavour
  * follows SN_FLOAT of the including file (fixed: Q formats of NUMERICS.md;
  * float: true values).
  */
@@ -52,8 +53,20 @@
 #define TB_NSN 14    /* segment nodes: 5 + 3x3 */
 #define TB_NSA 2     /* segment attachments */
 #define TB_SEG_LEN 0.1
+#define TB_NCON 2    /* constraints (format 5.0) */
+#define TB_NCOL 1    /* colliders */
+#define TB_NCT 3     /* contacts per step */
+/* constraint state with the crease rows (TB_CR_ACTIVE, below) */
+#define TB_CONB SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, TB_CR_ACTIVE))
+#define TB_CONB_NOCR SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, 0))
 /* segment state bytes: chain 4 segs 5 nodes; sheet side 3 levels 2: 12 + 6 segs, 9 + 4 nodes */
 #define TB_SEGB (SN_SEG_SEG_BYTES * (4u + 18u) + SN_SEG_NODE_BYTES * (5u + 13u))
+/* crease sections (format 5.0): list 4, active 2, rows of 2 vertices and 2
+ * triangles, one seed pair (0, 2); depth 0.25, push 0.05 internal units */
+#define TB_CR_LIST 4u
+#define TB_CR_ACTIVE 2u
+#define TB_ND 1u
+#define TB_CRB SN_CREASE_STATE_BYTES(TB_NS, TB_CR_LIST)
 
 static void tb_u16(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); }
 static void tb_u32(unsigned char *p, uint32_t v) {
@@ -174,6 +187,11 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_SEGMESH] = TB_NM;      elem[SN_SEC_SEGMESH] = (uint32_t)SN_ELEM_SEGMESH(R);
     cnt[SN_SEC_SEGNODES] = TB_NSN;    elem[SN_SEC_SEGNODES] = (uint32_t)SN_ELEM_SEGNODES(R);
     cnt[SN_SEC_SEGATTACH] = TB_NSA;   elem[SN_SEC_SEGATTACH] = (uint32_t)SN_ELEM_SEGATTACH(R);
+    cnt[SN_SEC_CONSTRAINTS] = 1;      elem[SN_SEC_CONSTRAINTS] = SN_ELEM_CONSTRAINTS;
+    cnt[SN_SEC_CREASE] = 1;           elem[SN_SEC_CREASE] = (uint32_t)SN_ELEM_CREASE(R);
+    cnt[SN_SEC_CREASE_PAIRS] = TB_ND; elem[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
+    cnt[SN_SEC_CREASE_VNBR] = 2 * TB_NS; elem[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
+    cnt[SN_SEC_CREASE_TNBR] = 2 * TB_NS; elem[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -184,6 +202,10 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         tb_u32(b + SN_H_SECTIONS + 16 * sec + 12, elem[sec]);
         off += cnt[sec] * elem[sec];
     }
+    /* constraints: maxima */
+    b[secoff[SN_SEC_CONSTRAINTS]] = TB_NCON;
+    b[secoff[SN_SEC_CONSTRAINTS] + 1] = TB_NCOL;
+    tb_u16(b + secoff[SN_SEC_CONSTRAINTS] + 2, TB_NCT);
     /* joints: root at the origin, tip at (0.5, 0, 0) */
     tb_u16(b + secoff[SN_SEC_JOINTS], 0xFFFFu);
     tb_u16(b + secoff[SN_SEC_JOINTS] + elem[SN_SEC_JOINTS], 0);
@@ -319,6 +341,23 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         tb_real(at + 8, 2 * cell, SN_Q_LEN);
         at[elem[SN_SEC_SEGATTACH] + 2] = SN_SEGATT_SURFACE;
     }
+    {   /* crease: record, the seed pair (0, 2), rows {s, s+1 mod 4} and {0, 1} */
+        unsigned char *cr = b + secoff[SN_SEC_CREASE];
+        tb_u16(cr, TB_CR_LIST);
+        tb_u16(cr + 2, TB_CR_ACTIVE);
+        cr[4] = 2;
+        cr[5] = 2;
+        tb_real(cr + 12, 0.25, SN_Q_LEN);
+        tb_real(cr + 12 + R, 0.05, SN_Q_LEN);
+        tb_u16(b + secoff[SN_SEC_CREASE_PAIRS], 0);
+        tb_u16(b + secoff[SN_SEC_CREASE_PAIRS] + 2, 2);
+        for (i = 0; i < TB_NS; i++) {
+            tb_u16(b + secoff[SN_SEC_CREASE_VNBR] + 4 * i, (uint32_t)i);
+            tb_u16(b + secoff[SN_SEC_CREASE_VNBR] + 4 * i + 2, (uint32_t)((i + 1) % TB_NS));
+            tb_u16(b + secoff[SN_SEC_CREASE_TNBR] + 4 * i, 0);
+            tb_u16(b + secoff[SN_SEC_CREASE_TNBR] + 4 * i + 2, 1);
+        }
+    }
     /* header */
     b[0] = 'S'; b[1] = 'N'; b[2] = 'W'; b[3] = 'B';
     tb_u16(b + SN_H_VER_MAJOR, SN_FORMAT_MAJOR);
@@ -338,7 +377,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB));
     b[SN_H_MAX_FORCES] = TB_NFRC;
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);
@@ -372,7 +411,19 @@ static inline void tb_drop_limit(unsigned char *b) {
     tb_u32(e + 8, 0);
     tb_fix_crc(b);
 }
-/* Empty the sections after TRIS (rigs, force shares, segment meshes),
+/* Empty the crease sections (bytes zeroed, count and size 0, offsets kept);
+ * instance bytes without the crease state. No CRC. */
+static inline void tb_drop_crease(unsigned char *b) {
+    int k;
+    for (k = SN_SEC_CREASE; k <= SN_SEC_CREASE_TNBR; k++) {
+        unsigned char *e = b + SN_H_SECTIONS + 16 * k;
+        memset(b + tb_rd32(e), 0, tb_rd32(e + 4));
+        tb_u32(e + 4, 0);
+        tb_u32(e + 8, 0);
+    }
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB, TB_CONB_NOCR));
+}
+/* Empty the sections after TRIS (rigs, force shares, segment meshes, crease),
  * placing them (8-aligned) at offset at (the end of what the caller keeps);
  * instance bytes follow nK = 0 and no segment state. No CRC. */
 static inline void tb_drop_rigs(unsigned char *b, uint32_t at) {
@@ -383,6 +434,6 @@ static inline void tb_drop_rigs(unsigned char *b, uint32_t at) {
         tb_u32(b + SN_H_SECTIONS + 16 * k + 4, 0);
         tb_u32(b + SN_H_SECTIONS + 16 * k + 8, 0);
     }
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, 0));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, 0, 0));
 }
 #endif

@@ -268,6 +268,12 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_SEGMESH] = 0; el[SN_SEC_SEGMESH] = SN_ELEM_SEGMESH(R);
         cnt[SN_SEC_SEGNODES] = 0; el[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(R);
         cnt[SN_SEC_SEGATTACH] = 0; el[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(R);
+        cnt[SN_SEC_CONSTRAINTS] = 0; el[SN_SEC_CONSTRAINTS] = SN_ELEM_CONSTRAINTS;
+        /* format 5.0: no crease sections */
+        cnt[SN_SEC_CREASE] = 0; el[SN_SEC_CREASE] = SN_ELEM_CREASE(R);
+        cnt[SN_SEC_CREASE_PAIRS] = 0; el[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
+        cnt[SN_SEC_CREASE_VNBR] = 0; el[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
+        cnt[SN_SEC_CREASE_TNBR] = 0; el[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;
@@ -288,7 +294,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         w_u32(&w, SN_H_ONE_HI, bx->flavour == SN_FLAVOUR_FLOAT64 ? SN_ONE_FLOAT64_HI : 0u);
         w_u32(&w, SN_H_N_VERTICES, nV); w_u32(&w, SN_H_N_FREE, nF); w_u32(&w, SN_H_N_CELLS, nC);
         w_u32(&w, SN_H_N_JOINTS, nJ); w_u32(&w, SN_H_N_SURFACE, nV); w_u32(&w, SN_H_N_TRIANGLES, 0);
-        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC, 0, 0, 0));
+        w_u32(&w, SN_H_N_OFFDIAG, nnz); w_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, nC, 0, 0, 0, 0));
         w_u16(&w, SN_H_CG_DEFAULT, bx->cg_default); w_u16(&w, SN_H_CG_MAX, 256);
         w_u8(&w, SN_H_LEN_SHIFT, (unsigned)(len_shift & 255));
         {
@@ -499,10 +505,10 @@ unsigned char *snsyn_with_rigs(const unsigned char *blob, size_t size, const sns
     {   /* the instance grows by the controls (force slots and segment state as the input blob had them) */
         uint32_t ib0 = rs_u32(blob + SN_H_INSTANCE_BYTES), nk0 = rs_u32(blob + SN_H_SECTIONS + SN_SEC_CONTROLS * SN_SECTION_ENTRY + 8);
         ib = SN_INSTANCE_BYTES(rs_u32(o + SN_H_N_VERTICES), rs_u32(o + SN_H_N_FREE), rs_u32(o + SN_H_N_JOINTS), rs_u32(o + SN_H_N_CELLS), nk,
-                               blob[SN_H_MAX_FORCES], 0);
+                               blob[SN_H_MAX_FORCES], 0, 0);
         /* segment state: whatever the input's instance had beyond its own count formula */
         ib += ib0 - SN_INSTANCE_BYTES(rs_u32(o + SN_H_N_VERTICES), rs_u32(o + SN_H_N_FREE), rs_u32(o + SN_H_N_JOINTS), rs_u32(o + SN_H_N_CELLS),
-                                      nk0, blob[SN_H_MAX_FORCES], 0);
+                                      nk0, blob[SN_H_MAX_FORCES], 0, 0);
     }
     ws_u32(o + SN_H_INSTANCE_BYTES, ib);   /* the validator wants exactly the runtime's formula */
     ws_u32(o + SN_H_TOTAL_SIZE, (uint32_t)pos);

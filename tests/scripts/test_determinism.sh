@@ -118,21 +118,59 @@ EOF2
 wait
 echo "note: runs took $(( $(date +%s) - start ))s wall"
 
-fixed=""; float=""
+fixed=""; float=""; fixedc=""; floatc=""
 while read -r name target runner; do
     [ -n "$name" ] && [ -f "$L/rc_$name" ] || continue
     set -- $(cat "$L/rc_$name"); rc=$1; secs=$2
     h=$(hash_of "$L/run_$name.log")
+    hc=$(hashc_of "$L/run_$name.log")
     if [ "$rc" -ne 0 ] || [ -z "$h" ]; then
         bad "$name: run failed (rc $rc)"; tail -n 5 "$L/run_$name.log" | sed 's/^/    /'; continue
     fi
-    echo "determinism: $name $h (${secs}s)"
+    echo "determinism: $name $h contact ${hc:-none} (${secs}s)"
     case $name in float-*) float="$float$name $h
+"; [ -n "$hc" ] && floatc="$floatc$name $hc
 " ;; *) fixed="$fixed$name $h
+"; [ -n "$hc" ] && fixedc="$fixedc$name $hc
 " ;; esac
 done <<EOF2
 $plats
 EOF2
+
+# ---- crease collision active (seed 003 §3.4): the limb with its elbow
+# crease (limb_crease.blob) folding to 120 degrees and back
+# (tools/examples/limb/crease.clip), CR_STEPS steps, on every hosted platform
+# (the Cortex-M4 image links the cow only) and sinew-play ----
+CR_STEPS=400
+CR_CLIP=tools/examples/limb/crease.clip
+crfixed=""; crfloat=""
+pmake "$BUILD/examples/limb_crease.blob" "$BUILD/examples/limb_crease_float.blob" > "$L/build_crease.log" 2>&1 || \
+    { bad "crease: blobs failed to bake"; tail -n 5 "$L/build_crease.log"; }
+while read -r name target runner; do
+    case $name in cortex-*|"") continue ;; esac
+    [ -f "$L/rc_$name" ] && [ -x "$target" ] || continue
+    case $name in float-*) b=$BUILD/examples/limb_crease_float.blob ;; *) b=$BUILD/examples/limb_crease.blob ;; esac
+    case $runner in -) c="$target $b --steps $CR_STEPS --clip $CR_CLIP" ;; *) c="$runner $target $b --steps $CR_STEPS --clip $CR_CLIP" ;; esac
+    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
+    if timeout 600 $c < /dev/null > "$L/run_crease_$name.log" 2>&1 && h=$(hash_of "$L/run_crease_$name.log") && [ -n "$h" ]; then
+        echo "determinism: crease $name $h"
+        case $name in float-*) crfloat="$crfloat$name $h
+" ;; *) crfixed="$crfixed$name $h
+" ;; esac
+    else bad "crease $name: run failed"; tail -n 5 "$L/run_crease_$name.log" | sed 's/^/    /'; fi
+done <<EOF2
+$plats
+EOF2
+for fl in "" _float; do
+    p=$BUILD/sinew-play$fl
+    if pmake "$p" > "$L/build_crease_play$fl.log" 2>&1 && run_log "$L/run_crease_play$fl.log" 600 "$p" "$BUILD/examples/limb_crease$fl.blob" \
+            --clip "$CR_CLIP" --frames "$CR_STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_crease_play$fl.log")" ]; then
+        h=$(hash_of "$L/run_crease_play$fl.log"); echo "determinism: crease sinew-play$fl $h"
+        if [ -z "$fl" ]; then crfixed="${crfixed}sinew-play $h
+"; else crfloat="${crfloat}sinew-play-float $h
+"; fi
+    else bad "crease sinew-play$fl: run failed"; tail -n 5 "$L/run_crease_play$fl.log" | sed 's/^/    /'; fi
+done
 
 # desktop player (fixed): sinew-play on the blob file of the same bake
 if pmake "$BUILD/sinew-play" "$BUILD/examples/cow.blob" > "$L/build_play.log" 2>&1; then
@@ -185,6 +223,11 @@ EOF2
     rm -f "$L/trace_ref.log"
 fi
 agree "float flavour" "$float" 3
+# the constrained scenario (issue 12: ground, sphere, pins), every driver but the players
+agree "fixed flavour, constraints and contact" "$fixedc" 2
+agree "float flavour, constraints and contact" "$floatc" 2
+agree "crease, fixed flavour" "$crfixed" 2
+agree "crease, float flavour" "$crfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -200,6 +243,10 @@ expect_hash() {  # label list key
 if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "fixed flavour" "$fixed" fixed
     expect_hash "float flavour" "$float" float
+    expect_hash "fixed flavour, constraints and contact" "$fixedc" fixed-contact
+    expect_hash "float flavour, constraints and contact" "$floatc" float-contact
+    expect_hash "crease, fixed flavour" "$crfixed" crease_fixed
+    expect_hash "crease, float flavour" "$crfloat" crease_float
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi

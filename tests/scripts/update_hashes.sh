@@ -20,6 +20,20 @@ fixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" --clip "$CLIP" --frames $STEPS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 float=$(hash_of "$T")
 [ -n "$fixed" ] && [ -n "$float" ] || { echo "update_hashes: a player printed no hash"; exit 1; }
+# the constrained scenario (sn_det_contact: ground, sphere, pins; issue 12)
+# from the determinism driver, which every platform runs
+hashc_of() { sed -n 's/^hash-contact: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }
+"$BUILD/cross/det_x86_64-gcc-O2" --steps $STEPS --clip "$CLIP" > "$T" 2>&1 || { cat "$T"; exit 1; }
+fixedc=$(hashc_of "$T")
+"$BUILD/cross/det_float-gcc-O2" "$BUILD/examples/cow_float.blob" --steps $STEPS --clip "$CLIP" > "$T" 2>&1 || { cat "$T"; exit 1; }
+floatc=$(hashc_of "$T")
+[ -n "$fixedc" ] && [ -n "$floatc" ] || { echo "update_hashes: the determinism driver printed no contact hash"; exit 1; }
+CR_CLIP=tools/examples/limb/crease.clip
+"$BUILD/sinew-play" "$BUILD/examples/limb_crease.blob" --clip "$CR_CLIP" --frames 400 --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+crfixed=$(hash_of "$T")
+"$BUILD/sinew-play-float" "$BUILD/examples/limb_crease_float.blob" --clip "$CR_CLIP" --frames 400 --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+crfloat=$(hash_of "$T")
+[ -n "$fixed" ] && [ -n "$float" ] && [ -n "$crfixed" ] && [ -n "$crfloat" ] || { echo "update_hashes: a player printed no hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -32,5 +46,15 @@ cat > "$OUT" <<EOT
 # (tests/scripts/update_hashes.sh), then commit it with the change.
 fixed $fixed
 float $float
+# The constrained scenario (ports/cross/sn_det.c sn_det_contact: after the
+# run above, back to rest, a ground plane, a rising sphere and four pinned
+# surface points, 200 steps of the same clip), printed as hash-contact.
+fixed-contact $fixedc
+float-contact $floatc
+# The limb with crease collision active (tools/examples/limb/limb_crease.sinew)
+# after 400 steps of tools/examples/limb/crease.clip (the elbow folding to 120
+# degrees and back), checked on every hosted platform and sinew-play.
+crease_fixed $crfixed
+crease_float $crfloat
 EOT
-echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float ($OUT)"
+echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"

@@ -292,20 +292,22 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             m->nF + 1, m->nnz, m->nnz, m->nC, m->nC, m->nC, m->nF, m->nS, m->nT,
             SEC_CNT(SN_SEC_CONTROLS), SEC_CNT(SN_SEC_RIGS), SEC_CNT(SN_SEC_RIG_SAMPLES),
             SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_SHARES), m->nF,
-            SEC_CNT(SN_SEC_SEGMESH), SEC_CNT(SN_SEC_SEGNODES), SEC_CNT(SN_SEC_SEGATTACH) };
+            SEC_CNT(SN_SEC_SEGMESH), SEC_CNT(SN_SEC_SEGNODES), SEC_CNT(SN_SEC_SEGATTACH), 1u,
+            SEC_CNT(SN_SEC_CREASE), SEC_CNT(SN_SEC_CREASE_PAIRS), SEC_CNT(SN_SEC_CREASE_VNBR), SEC_CNT(SN_SEC_CREASE_TNBR) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(R),
             SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS, SN_ELEM_CONTROLS(R), SN_ELEM_RIGS,
             SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R), SN_ELEM_SHARES(R), SN_ELEM_VSHARE,
-            SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R) };
+            SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R), SN_ELEM_CONSTRAINTS,
+            SN_ELEM_CREASE(R), SN_ELEM_CREASE_PAIRS, SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR };
 #undef SEC_CNT
-        typedef char sec_count_check[SN_SEC_COUNT == 26 ? 1 : -1];   /* format 4.0: update the tables above */
+        typedef char sec_count_check[SN_SEC_COUNT == 31 ? 1 : -1];   /* format 5.0: update the tables above (the crease sections are not read: the reference has no crease contact) */
         (void)sizeof(sec_count_check);
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
             uint32_t off = rd_u32(e), sz = rd_u32(e + 4), cnt = rd_u32(e + 8), el = rd_u32(e + 12);
-            int cnt_ok = cnt == expect_cnt[i] || ((i == SN_SEC_LIMIT || i == SN_SEC_VSHARE) && cnt == 0);
+            int cnt_ok = cnt == expect_cnt[i] || ((i == SN_SEC_LIMIT || i == SN_SEC_VSHARE || i == SN_SEC_CONSTRAINTS) && cnt == 0);
             if (!cnt_ok || el != expect_el[i] || (uint64_t)cnt * el != sz || (uint64_t)off + sz > total)
                 FAIL("section %u: off %u size %u count %u elem %u", i, (unsigned)off, (unsigned)sz,
                      (unsigned)cnt, (unsigned)el);
@@ -832,6 +834,76 @@ static void precond_apply(const snref_state *s, const double *P, const double *r
     }
 }
 
+/* ---- constraint rows (runtime/NUMERICS.md "Constraints and contact") ----
+ * Dense: C (3nF x m, column j the row's coefficients over free vertices),
+ * G = C^T C = L L^T by Cholesky with the runtime's drop rule (a row whose
+ * squared length is below 2^-8, or whose part orthogonal to the kept rows
+ * before it has less than 2^-4 of that or less than 2^-10, is dropped). */
+typedef struct { unsigned m, n3; double *C, *L, *a, *t; int *kept; } rowsys;
+static void rows_build(const snref_state *s, rowsys *q, const double *vstar) {
+    unsigned j, l, p, k, c, nF = s->m->nF;
+    q->m = s->nrows; q->n3 = 3 * nF;
+    q->C = calloc((size_t)q->n3 * q->m + 1, sizeof *q->C);
+    q->L = calloc((size_t)q->m * q->m + 1, sizeof *q->L);
+    q->a = calloc(q->m + 1, sizeof *q->a);
+    q->t = calloc(q->m + 1, sizeof *q->t);
+    q->kept = calloc(q->m + 1, sizeof *q->kept);
+    for (j = 0; j < q->m; j++) {
+        const snref_row *r = s->rows + j;
+        double sv = 0, g, piv;
+        for (k = 0; k < r->n; k++)
+            for (c = 0; c < 3; c++) {
+                sv += r->w[k] * r->dir[c] * vstar[3 * r->vtx[k] + c];
+                if (r->vtx[k] < nF) q->C[(size_t)j * q->n3 + 3 * r->vtx[k] + c] += r->w[k] * r->dir[c];
+            }
+        q->a[j] = r->target - sv;
+        for (l = 0; l <= j; l++) {
+            g = dot(q->C + (size_t)j * q->n3, q->C + (size_t)l * q->n3, q->n3);
+            if (l == j) break;
+            if (!q->kept[l]) continue;
+            for (p = 0; p < l; p++) g -= q->L[j * q->m + p] * q->L[l * q->m + p];
+            q->L[j * q->m + l] = g / q->L[l * q->m + l];
+        }
+        piv = g;
+        for (p = 0; p < j; p++) piv -= q->L[j * q->m + p] * q->L[j * q->m + p];
+        if (g < ldexp(1.0, -8) || piv <= g * ldexp(1.0, -4) || piv < ldexp(1.0, -10)) {
+            for (p = 0; p < j; p++) q->L[j * q->m + p] = 0;
+            continue;
+        }
+        q->kept[j] = 1;
+        q->L[j * q->m + j] = sqrt(piv);
+    }
+}
+static void rows_free(rowsys *q) { free(q->C); free(q->L); free(q->a); free(q->t); free(q->kept); }
+/* t = G^-1 t over the kept rows */
+static void rows_gsolve(const rowsys *q) {
+    unsigned j, l;
+    for (j = 0; j < q->m; j++) {
+        double u = q->t[j];
+        if (!q->kept[j]) { q->t[j] = 0; continue; }
+        for (l = 0; l < j; l++) u -= q->L[j * q->m + l] * q->t[l];
+        q->t[j] = u / q->L[j * q->m + j];
+    }
+    for (j = q->m; j-- > 0;) {
+        double u = q->t[j];
+        if (!q->kept[j]) continue;
+        for (l = j + 1; l < q->m; l++) u -= q->L[l * q->m + j] * q->t[l];
+        q->t[j] = u / q->L[j * q->m + j];
+    }
+}
+/* y -= C G^-1 C^T y (fix = 0) or y += C G^-1 (a - C^T y) (fix = 1) */
+static void rows_apply(const rowsys *q, double *y, int fix) {
+    unsigned j, i;
+    for (j = 0; j < q->m; j++) {
+        double d = q->kept[j] ? dot(q->C + (size_t)j * q->n3, y, q->n3) : 0;
+        q->t[j] = fix ? q->a[j] - d : d;
+    }
+    rows_gsolve(q);
+    for (j = 0; j < q->m; j++)
+        for (i = 0; i < q->n3; i++) y[i] += (fix ? 1.0 : -1.0) * q->C[(size_t)j * q->n3 + i] * q->t[j];
+}
+static const rowsys *g_rows; /* the step's rows while pcg runs (NULL: none) */
+
 /* PCG, exactly `iters` iterations (or to convergence if iters == 0). x in/out. */
 static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     const snref_model *m = s->m;
@@ -839,11 +911,15 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     double *r = WK(s, S_R), *z = WK(s, S_Z), *d = WK(s, S_D), *Ad = WK(s, S_AD);
     const double *P = precond_blocks(s);
     double rz, bn = sqrt(dot(b, b, n));
+    if (g_rows) rows_apply(g_rows, x, 1);
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
-    precond_apply(s, P, r, z);
+    if (g_rows) rows_apply(g_rows, r, 0);
+    if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
+    if (g_rows) rows_apply(g_rows, z, 0);
     memcpy(d, z, n * sizeof *d);
     rz = dot(r, z, n);
+    if (g_rows) bn = sqrt(dot(r, r, n)); /* converged relative to the filtered start */
     for (it = 0; it < maxit; it++) {
         double dAd, alpha, rz2, beta;
         if (!iters && sqrt(dot(r, r, n)) <= 1e-14 * bn) break;
@@ -851,7 +927,9 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         dAd = dot(d, Ad, n);
         alpha = dAd > 0 ? rz / dAd : 0.0;
         for (i = 0; i < n; i++) { x[i] += alpha * d[i]; r[i] -= alpha * Ad[i]; }
-        precond_apply(s, P, r, z);
+        if (g_rows) rows_apply(g_rows, r, 0);
+        if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
+        if (g_rows) rows_apply(g_rows, z, 0);
         rz2 = dot(r, z, n);
         beta = rz > 0 ? rz2 / rz : 0.0;
         for (i = 0; i < n; i++) d[i] = z[i] + beta * d[i];
@@ -869,8 +947,10 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         }
 #endif
     }
+    if (g_rows) rows_apply(g_rows, x, 1);
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
+    if (g_rows) rows_apply(g_rows, r, 0);
     return bn > 0 ? sqrt(dot(r, r, n)) / bn : 0.0;
 }
 
@@ -1134,7 +1214,17 @@ void snref_step(snref_state *s) {
     {
         double *x = s->dv;
         if (!s->warm) memset(x, 0, 3 * nF * sizeof *x);
-        if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
+        if (s->solve_hook) s->solve_hook(s->hook_ctx, s, b, x);
+        if (s->nrows) {   /* constrained: the filtered PCG (to convergence in exact mode) */
+            rowsys q;
+            unsigned j;
+            rows_build(s, &q, vstar);
+            for (s->rows_kept = 0, j = 0; j < q.m; j++) s->rows_kept += (unsigned)q.kept[j];
+            g_rows = &q;
+            s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
+            g_rows = NULL;
+            rows_free(&q);
+        } else if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
         else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
     }
     /* 7. update */

@@ -128,7 +128,30 @@ typedef struct snref_state {
      * (1 by default; 0 = rigs off, for with/without comparisons) */
     double *ctl;
     double rig_scale;
+    /* called in snref_step just before the solve of step 6 with the step's
+     * right-hand side b and the start x0 (the warm start) of A dv = b, the
+     * frames of the step already in R and Rc (NULL: none; tests/precond_study.c) */
+    void (*solve_hook)(void *ctx, const struct snref_state *s, const double *b, const double *x0);
+    /* replaces the preconditioner z = R_i P_i R_i^T r_i of the N-iteration PCG (NULL: none) */
+    void (*precond_hook)(void *ctx, const struct snref_state *s, const double *r, double *z);
+    void *hook_ctx;
+    /* constraint rows for the next steps (runtime/src/sn_constraint.h in
+     * double; NULL: none; the caller owns them): sum_k w_k dir . v_new[vtx_k]
+     * = target (per-step velocity units), skeleton vertices' new velocity
+     * moved to the right-hand side; the solve is the Baraff-Witkin filtered
+     * PCG with an exact projection (rows dropped by the runtime's rule) */
+    const struct snref_row *rows;
+    unsigned nrows;
+    unsigned rows_kept;  /* after the last step's drops */
 } snref_state;
+
+typedef struct snref_row {
+    unsigned n;
+    unsigned vtx[16];
+    double w[16];
+    double dir[3];
+    double target;
+} snref_row;
 
 int snref_init(snref_state *s, const snref_model *m);
 void snref_release(snref_state *s);

@@ -1,0 +1,387 @@
+/* sn_contact.c -- the game's colliders (plane, sphere, capsule) as one-sided
+ * velocity constraints on the surface, like seed 003 eq. 9 against a moving
+ * world solid: n . v_point >= n . v_solid - gap, enforced through the rows
+ * of sn_constraint.c (runtime/NUMERICS.md "Constraints and contact").
+ *
+ * Active set (decided before the solve, once per step): surface vertex s
+ * touches collider c when it is inside (gap g < 0), or when its predicted
+ * motion, its velocity at the start of the step plus gravity's increment,
+ * would end inside: g + n . (v_pred - v_c) < 0. An active contact is
+ * enforced as the equality n . v = n . v_c - g (it lands on the surface;
+ * a vertex inside is pushed out by at most an eighth of a cell per step).
+ * Vertices the bones carry (their cell's free corners' squared weights sum
+ * below 2^-8) take no contact: no velocity of the flesh can hold them.
+ * One contact per (collider, lattice cell): the vertex with the smallest
+ * g + n . (v_pred - v_c) (a second vertex of the cell would give a nearly
+ * dependent row). Up to max_contacts per step, in surface-vertex order;
+ * more are counted in contact_overflow.
+ *
+ * Friction (mu > 0; a velocity-level Coulomb rule decided before the
+ * solve, NUMERICS.md): after every normal contact is collected, each
+ * contact of a collider with mu > 0 compares its predicted tangential slip
+ * relative to the solid, s = (v_pred - u) - n n.(v_pred - u), with mu times
+ * the normal velocity change the contact imposes, dn = target - n.v_pred.
+ * |s| <= mu dn: it sticks (two tangential rows: it moves with the solid);
+ * else it slides, its slip reduced by mu dn (one row along s). Friction
+ * rows share the contacts' baked rows (max_contacts), after the normal ones.
+ */
+#include "sn_constraint.h"
+
+typedef struct sn_col {
+    uint32_t kind;
+    sn_real a[3], b[3];  /* public units, world */
+    sn_real radius;      /* public units */
+    sn_real vel[3];      /* public units per second */
+    sn_real mu;          /* Q16.16 / float */
+    sn_q n[3];           /* plane: unit outward normal, Q30 */
+} sn_col;
+typedef char sn_col_fits_[sizeof(sn_col) <= SN_COL_BYTES ? 1 : -1];
+
+#if defined(SN_FLOAT)
+#define CT_ONE30 1.0f
+#else
+#define CT_ONE30 ((int32_t)1 << 30)
+#endif
+
+/* world public point -> internal (relative to the origin) */
+static sn_q ct_to_int(const sn_ihdr *h, sn_real p, sn_real o, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)sat;
+    return pub_to_int(h, p - o);
+#else
+    return pub_to_int_sat(h, (int64_t)p - o, sat);
+#endif
+}
+
+/* a unit vector (Q30) along d (Q22 internal); *len = |d| (Q22). d = 0: +y. */
+static void ct_unit(const sn_q d[3], sn_q n[3], sn_q *len) {
+#if defined(SN_FLOAT)
+    float l2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    int c;
+    if (!(l2 > 1e-20f)) { n[0] = 0; n[1] = 1.0f; n[2] = 0; *len = 0; return; }
+    {
+        float il = sn_frsqrt(l2);
+        for (c = 0; c < 3; c++) n[c] = d[c] * il;
+        *len = l2 * il;
+    }
+#else
+    int64_t l2 = 0;
+    uint32_t l;
+    int c;
+    for (c = 0; c < 3; c++) l2 += (int64_t)d[c] * d[c]; /* |d| <= 2^29.6: < 2^59.2 */
+    l = sn_isqrt64((uint64_t)l2);
+    *len = (int32_t)(l > (uint32_t)SN_LIM ? (uint32_t)SN_LIM : l);
+    if (l == 0) { n[0] = 0; n[1] = CT_ONE30; n[2] = 0; return; }
+    for (c = 0; c < 3; c++) {
+        int64_t num = (int64_t)d[c] * ((int64_t)1 << 30); /* < 2^59 */
+        uint64_t q = sn_udiv64((uint64_t)(num < 0 ? -num : num) + (l >> 1), l);
+        n[c] = (int32_t)(num < 0 ? -(int64_t)q : (int64_t)q);
+    }
+#endif
+}
+
+/* gap g (Q22) and outward normal n (Q30) of internal point P against a
+ * collider given internally (A, B, R); 0 when P is far: farther than
+ * reach beyond the surface (no contact possible this step). */
+static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, const sn_q P[3], sn_q reach,
+                  sn_q *g, sn_q n[3], uint32_t *sat) {
+    sn_q d[3], C[3], len;
+    int c;
+    if (cl->kind == SN_COLLIDER_PLANE) {
+        sn_acc s = 0;
+        for (c = 0; c < 3; c++) s += sn_mul(cl->n[c], sn_add(P[c], -A[c], sat));
+        *g = sn_out(s, 30, sat);
+        for (c = 0; c < 3; c++) n[c] = cl->n[c];
+        return *g <= reach;
+    }
+    for (c = 0; c < 3; c++) C[c] = A[c];
+    if (cl->kind == SN_COLLIDER_CAPSULE) { /* closest point of the axis */
+        sn_q ab[3], ap[3];
+        sn_acc dt = 0, ab2 = 0;
+        for (c = 0; c < 3; c++) {
+            ab[c] = sn_add(B[c], -A[c], sat);
+            ap[c] = sn_add(P[c], -A[c], sat);
+            dt += sn_mul(ab[c], ap[c]);
+            ab2 += sn_mul(ab[c], ab[c]);
+        }
+        if (dt >= ab2) for (c = 0; c < 3; c++) C[c] = B[c];
+        else if (dt > 0) {
+#if defined(SN_FLOAT)
+            float t = dt / ab2;
+            for (c = 0; c < 3; c++) C[c] = A[c] + t * ab[c];
+#else
+            int sh = bitlen64((uint64_t)ab2) - 32;
+            uint64_t num, den, t;
+            sh = sh < 0 ? 0 : sh;
+            num = (uint64_t)dt >> sh;
+            den = (uint64_t)ab2 >> sh;
+            t = den ? sn_udiv64(num << 30, den) : 0; /* Q30, <= 2^30 */
+            for (c = 0; c < 3; c++) C[c] = sn_add(A[c], sn_mulq((int32_t)t, ab[c], 30, sat), sat);
+#endif
+        }
+    }
+    for (c = 0; c < 3; c++) d[c] = sn_add(P[c], -C[c], sat);
+    {   /* far: |d| > R + reach, tested on squares before any root */
+        sn_acc d2 = sn_mul(d[0], d[0]) + sn_mul(d[1], d[1]) + sn_mul(d[2], d[2]);
+        sn_acc rr = (sn_acc)R + (sn_acc)(reach > 0 ? reach : 0);
+        if (d2 > rr * rr) return 0;
+    }
+    ct_unit(d, n, &len);
+    *g = sn_add(len, -R, sat);
+    return 1;
+}
+
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat);
+
+void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_col *cols = CARR(h, o_col, sn_col);
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    sn_rowx *rx = ARR(h, o_rx, sn_rowx);
+    sn_row *rows = sn_rows(h);
+    sn_q A[SN_MAX_COLLIDERS][3], B[SN_MAX_COLLIDERS][3], R[SN_MAX_COLLIDERS], V[SN_MAX_COLLIDERS][3];
+    sn_q cap = (sn_q)(v->cell / 8);
+    uint32_t c, s, k, first = h->n_rows, ncol = h->n_col;
+    uint32_t q;
+    if (ncol == 0) return;
+    for (c = 0; c < ncol; c++) { /* the solids at the start of the step, internal units; velocity per step */
+        const sn_col *cl = cols + c;
+        for (q = 0; q < 3; q++) {
+            A[c][q] = ct_to_int(h, cl->a[q], h->origin[q], sat);
+            B[c][q] = cl->kind == SN_COLLIDER_CAPSULE ? ct_to_int(h, cl->b[q], h->origin[q], sat) : 0; /* a plane's b is its normal */
+#if defined(SN_FLOAT)
+            V[c][q] = pub_to_int(h, cl->vel[q] * v->timestep);
+#else
+            V[c][q] = pub_to_int_sat(h, sn_rshr64((int64_t)cl->vel[q] * v->timestep, 16), sat);
+#endif
+        }
+        R[c] = ct_to_int(h, cl->radius, 0, sat);
+    }
+    for (s = 0; s < v->nS; s++) {
+        const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
+        const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+        uint32_t t[3], vx[8];
+        sn_q phi[8], P[3], Vp[3];
+        sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
+        for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
+        sn_trilinear(t, phi);
+        /* a vertex the bones carry (its row's squared length over free
+         * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
+        for (k = 0; k < 8; k++)
+            if (sn_rd_u16(cell + 2 * k) < v->nF) fw += sn_mul(phi[k], phi[k]);
+#if defined(SN_FLOAT)
+        if (fw < 1.0f / 256.0f) continue;
+#else
+        if (fw < (int64_t)1 << 52) continue; /* 2^-8 in Q60 */
+#endif
+        /* the point at the start of the step (skeleton corners where they
+         * were) and its predicted velocity (free corners: v + h^2 g) */
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cell + 2 * k);
+            vx[k] = a;
+            for (q = 0; q < 3; q++) {
+                sn_q vq = vel[3 * a + q];
+                sn_q pq = a < v->nF ? pos[3 * a + q] : sn_add(pos[3 * a + q], -vq, sat);
+                if (a < v->nF) vq = sn_add(vq, v->grav[q], sat);
+                sp[q] += sn_mul(phi[k], pq);
+                sv[q] += sn_mul(phi[k], vq);
+            }
+        }
+        for (q = 0; q < 3; q++) {
+            P[q] = sn_out(sp[q], 30, sat);
+            Vp[q] = sn_out(sv[q], 30, sat);
+        }
+        for (c = 0; c < ncol; c++) {
+            sn_q g, n[3], rel[3], reach, vr, score, vcn, target;
+            uint32_t j;
+            for (q = 0; q < 3; q++) rel[q] = sn_add(Vp[q], -V[c][q], sat);
+            /* |rel| <= its 1-norm: how far the point can come this step */
+#if defined(SN_FLOAT)
+            reach = (rel[0] < 0 ? -rel[0] : rel[0]) + (rel[1] < 0 ? -rel[1] : rel[1]) + (rel[2] < 0 ? -rel[2] : rel[2]);
+#else
+            reach = clamp32((int64_t)(rel[0] < 0 ? -(int64_t)rel[0] : rel[0]) + (rel[1] < 0 ? -(int64_t)rel[1] : rel[1]) +
+                            (rel[2] < 0 ? -(int64_t)rel[2] : rel[2]));
+#endif
+            if (!ct_gap(cols + c, A[c], B[c], R[c], P, reach, &g, n, sat)) continue;
+            vr = sn_out(sn_mul(n[0], rel[0]) + sn_mul(n[1], rel[1]) + sn_mul(n[2], rel[2]), 30, sat);
+            score = sn_add(g, vr, sat);
+            if (!(score < 0) && !(g < 0)) continue;
+            vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
+            target = g >= 0 ? sn_add(vcn, -g, sat) : sn_add(vcn, -g > cap ? cap : (sn_q)-g, sat);
+            /* one contact per (collider, cell): the row of this cell, if any */
+            for (j = first; j < h->n_rows; j++)
+                if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && rows[j].vtx[0] == vx[0]) break;
+            if (j < h->n_rows && !(score < rx[j].spare)) continue;
+            if (j == h->n_rows && h->contacts >= v->nCt) {
+                h->contact_overflow = sn_count(h->contact_overflow, 1);
+                continue;
+            }
+            {
+                sn_row r;
+                memset(&r, 0, sizeof r);
+                r.n = 8;
+                for (k = 0; k < 8; k++) { r.vtx[k] = (uint16_t)vx[k]; r.w[k] = phi[k]; }
+                for (q = 0; q < 3; q++) r.dir[q] = n[q];
+                r.target = target;
+                r.one_sided = 1;
+                r.source = SN_ROW_SRC(SN_SRC_CONTACT, c);
+                if (j < h->n_rows) rows[j] = r;
+                else if (sn_rows_push(h, &r)) h->contacts++;
+                else continue;
+                rx[j].spare = score;
+            }
+        }
+    }
+    friction_rows(h, first, h->n_rows, (const sn_q (*)[3])V, sat);
+}
+
+/* one tangential row of contact row r along t (Q30) with target t.u + extra */
+static void push_tangent(sn_ihdr *h, const sn_row *r, const sn_q t[3], const sn_q u[3], sn_q extra, uint32_t *sat) {
+    sn_row f = *r;
+    uint32_t q;
+    for (q = 0; q < 3; q++) f.dir[q] = t[q];
+    f.target = sn_add(sn_out(sn_mul(t[0], u[0]) + sn_mul(t[1], u[1]) + sn_mul(t[2], u[2]), 30, sat), extra, sat);
+    f.one_sided = 0;
+    if (sn_rows_push(h, &f)) h->contacts++;
+}
+/* a x b for unit vectors (Q30, |.| <= 1: beyond the state clamp, rounded without it) */
+static void cross30(const sn_q a[3], const sn_q b[3], sn_q o[3], uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)sat;
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+#else
+    (void)sat;
+    o[0] = clamp32(sn_rshr64(sn_mul(a[1], b[2]) + sn_mul(-a[2], b[1]), 30));
+    o[1] = clamp32(sn_rshr64(sn_mul(a[2], b[0]) + sn_mul(-a[0], b[2]), 30));
+    o[2] = clamp32(sn_rshr64(sn_mul(a[0], b[1]) + sn_mul(-a[1], b[0]), 30));
+#endif
+}
+
+/* Friction rows for the normal contacts rows[first .. end) (see the top). */
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_col *cols = CARR(h, o_col, sn_col);
+    const sn_q *vel = CARR(h, o_vel, sn_q);
+    uint32_t j, k, q;
+    for (j = first; j < end; j++) {
+        sn_row r = sn_rows(h)[j];
+        uint32_t c = r.source & 0xFFu;
+        const sn_col *cl = cols + c;
+        sn_acc sv[3] = {0, 0, 0};
+        sn_q vp[3], rel[3], s[3], t1[3], t2[3], slen, dn, vn, limit;
+#if defined(SN_FLOAT)
+        if (!(cl->mu > 0.0f)) continue;
+#else
+        if (cl->mu <= 0) continue;
+#endif
+        if (h->contacts + 1u > v->nCt) { h->contact_overflow = sn_count(h->contact_overflow, 1); continue; }
+        for (k = 0; k < r.n; k++)
+            for (q = 0; q < 3; q++) {
+                sn_q vq = vel[3 * r.vtx[k] + q];
+                if (r.vtx[k] < v->nF) vq = sn_add(vq, v->grav[q], sat);
+                sv[q] += sn_mul(r.w[k], vq);
+            }
+        for (q = 0; q < 3; q++) {
+            vp[q] = sn_out(sv[q], 30, sat);
+            rel[q] = sn_add(vp[q], -V[c][q], sat);
+        }
+        vn = sn_out(sn_mul(r.dir[0], vp[0]) + sn_mul(r.dir[1], vp[1]) + sn_mul(r.dir[2], vp[2]), 30, sat);
+        dn = sn_add(r.target, -vn, sat); /* the normal velocity change the contact imposes */
+        if (!(dn > 0)) continue;
+        {
+            sn_q rn = sn_out(sn_mul(r.dir[0], rel[0]) + sn_mul(r.dir[1], rel[1]) + sn_mul(r.dir[2], rel[2]), 30, sat);
+            for (q = 0; q < 3; q++) s[q] = sn_add(rel[q], -sn_mulq(r.dir[q], rn, 30, sat), sat);
+        }
+#if defined(SN_FLOAT)
+        limit = cl->mu * dn;
+#else
+        limit = sn_out((int64_t)cl->mu * dn, 16, sat); /* mu Q16.16 */
+#endif
+        ct_unit(s, t1, &slen);
+#if defined(SN_FLOAT)
+        if (!(slen > 1e-6f)) {
+#else
+        if (slen < 16) { /* no slip to speak of: any tangent pair */
+#endif
+            sn_q e[3] = {0, 0, 0};
+            e[(r.dir[0] < 0 ? -r.dir[0] : r.dir[0]) < CT_ONE30 / 2 ? 0 : 1] = CT_ONE30;
+            cross30(r.dir, e, s, sat);
+            ct_unit(s, t1, &slen);
+            slen = 0;
+        }
+        if (!(slen > limit)) { /* stick: both tangents move with the solid */
+            cross30(r.dir, t1, t2, sat);
+            if (h->contacts + 2u > v->nCt) { h->contact_overflow = sn_count(h->contact_overflow, 1); continue; }
+            push_tangent(h, &r, t1, V[c], 0, sat);
+            push_tangent(h, &r, t2, V[c], 0, sat);
+        } else /* slide: the slip along t1, reduced by mu dn */
+            push_tangent(h, &r, t1, V[c], sn_add(slen, -limit, sat), sat);
+    }
+}
+
+/* ---- public API ---- */
+#if defined(SN_FLOAT)
+static int ct_fin(float x) { return x >= -1.0e9f && x <= 1.0e9f; }
+#endif
+
+sn_status sn_set_colliders(sn_instance *inst, const sn_collider *list, uint32_t count) {
+    sn_ihdr *h;
+    sn_col *cs;
+    uint32_t i, n;
+    SN_CHECK_INST(inst);
+    h = hdr_of(inst);
+    if (count && !list) return SN_ERR_NULL;
+    n = count < h->v.nCol ? count : h->v.nCol;
+    for (i = 0; i < n; i++) {
+        const sn_collider *q = list + i;
+        if (q->kind > SN_COLLIDER_CAPSULE || q->radius < 0 || q->friction < 0) return SN_ERR_ARG;
+        if (q->kind == SN_COLLIDER_PLANE && q->b.x == 0 && q->b.y == 0 && q->b.z == 0) return SN_ERR_ARG;
+#if defined(SN_FLOAT)
+        if (!ct_fin(q->a.x) || !ct_fin(q->a.y) || !ct_fin(q->a.z) || !ct_fin(q->b.x) || !ct_fin(q->b.y) || !ct_fin(q->b.z) ||
+            !ct_fin(q->radius) || !ct_fin(q->velocity.x) || !ct_fin(q->velocity.y) || !ct_fin(q->velocity.z) || !ct_fin(q->friction))
+            return SN_ERR_ARG;
+#endif
+    }
+    cs = ARR(h, o_col, sn_col);
+    for (i = 0; i < n; i++) {
+        const sn_collider *q = list + i;
+        sn_col *cl = cs + i;
+        memset(cl, 0, sizeof *cl);
+        cl->kind = q->kind;
+        cl->a[0] = q->a.x; cl->a[1] = q->a.y; cl->a[2] = q->a.z;
+        cl->b[0] = q->b.x; cl->b[1] = q->b.y; cl->b[2] = q->b.z;
+        cl->radius = q->radius;
+        cl->vel[0] = q->velocity.x; cl->vel[1] = q->velocity.y; cl->vel[2] = q->velocity.z;
+        cl->mu = q->friction;
+        if (q->kind == SN_COLLIDER_PLANE) {
+            sn_q d[3], len;
+#if defined(SN_FLOAT)
+            d[0] = q->b.x; d[1] = q->b.y; d[2] = q->b.z;
+            {   /* scale into a safe range before squaring */
+                float m = 0.0f;
+                int c;
+                for (c = 0; c < 3; c++) m = (d[c] < 0 ? -d[c] : d[c]) > m ? (d[c] < 0 ? -d[c] : d[c]) : m;
+                for (c = 0; c < 3; c++) d[c] /= m;
+            }
+#else
+            /* Q16.16 normal scaled so its largest component has 28 bits */
+            int64_t m = 0;
+            int c, b;
+            const int32_t nb[3] = {q->b.x, q->b.y, q->b.z};
+            for (c = 0; c < 3; c++) m |= nb[c] < 0 ? -(int64_t)nb[c] : nb[c];
+            b = bitlen64((uint64_t)m) - 28;
+            for (c = 0; c < 3; c++) d[c] = (int32_t)(b > 0 ? sn_rshr64(nb[c], b) : (int64_t)nb[c] * ((int64_t)1 << -b));
+#endif
+            ct_unit(d, cl->n, &len);
+            (void)len;
+        }
+    }
+    h->n_col = n;
+    if (count > n) {
+        h->con_refused = sn_count(h->con_refused, count - n);
+        return SN_ERR_FULL;
+    }
+    return SN_OK;
+}
