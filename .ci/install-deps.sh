@@ -24,6 +24,7 @@ PKGS=(
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross
     gcc-mips-linux-gnu libc6-dev-mips-cross
     gcc-i686-linux-gnu libc6-dev-i386-cross
+    gcc-aarch64-linux-gnu libc6-dev-arm64-cross
 )
 
 missing=()

@@ -4,6 +4,25 @@
 # Sources: every runtime/src/*.c (wildcard), compiled warning-clean with
 # $(SN_WARN); objects in $(BUILD)/runtime/{fixed,float}/.
 SN_INC   = -Iruntime/include
+# SIMD path of the kernels (runtime/src/sn_kernels.h), chosen at build time:
+#   auto    what the compiler targets (x86-64: AVX2 if -mavx2/-march says so,
+#           else the scalar reference; aarch64: NEON; Cortex-M4: DSP)
+#   scalar  the portable reference everywhere
+#   sse2    x86-64 baseline (no AVX2: the scalar reference, see NUMERICS.md)
+#   avx2 / avx512   x86-64 (-mavx2 / -mavx512f -mavx512vl)
+#   neon    ARM NEON (armhf: -mfpu=neon; aarch64 has it by default)
+# Every path gives the same fixed-flavour state hash (test_determinism.sh).
+SIMD ?= auto
+SN_SIMD_FLAGS_auto   =
+SN_SIMD_FLAGS_scalar = -DSN_SIMD_SCALAR
+SN_SIMD_FLAGS_sse2   = -mno-avx2
+SN_SIMD_FLAGS_avx2   = -mavx2
+SN_SIMD_FLAGS_avx512 = -mavx2 -mavx512f -mavx512vl
+SN_SIMD_FLAGS_neon   = $(if $(findstring aarch64,$(CC)),,-mfpu=neon)
+SN_SIMD_FLAGS = $(SN_SIMD_FLAGS_$(SIMD))
+ifeq ($(filter $(SIMD),auto scalar sse2 avx2 avx512 neon),)
+$(error SIMD=$(SIMD): one of auto scalar sse2 avx2 avx512 neon)
+endif
 SN_WARN  = $(WARN) -Wvla -Wshadow
 SN_SRCS  = $(wildcard runtime/src/*.c)
 SN_HDRS  = runtime/include/sinew.h $(wildcard runtime/src/*.h)
@@ -17,11 +36,11 @@ all: $(SN_LIB_FIXED) $(SN_LIB_FLOAT)
 
 $(BUILD)/runtime/fixed/%.o: runtime/src/%.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_WARN) $(CFLAGS) $(SN_INC) -c $< -o $@
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -c $< -o $@
 
 $(BUILD)/runtime/float/%.o: runtime/src/%.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_WARN) $(CFLAGS) -DSN_FLOAT $(SN_INC) -c $< -o $@
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) -DSN_FLOAT $(SN_INC) -c $< -o $@
 
 $(SN_LIB_FIXED): $(SN_OBJS_FIXED)
 	@rm -f $@
@@ -96,5 +115,13 @@ $(BUILD)/bench/sn_bench: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FIXED)
 $(BUILD)/bench/sn_bench_float: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FLOAT) -lm
+# many instances sharing one blob (issue 15 item 5): runtime/bench/herd.c
+$(BUILD)/bench/sn_herd: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(SN_INC) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/bench/sn_herd_float: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -o $@ $< $(SN_LIB_FLOAT) -lm
+bench: $(BUILD)/bench/sn_herd $(BUILD)/bench/sn_herd_float
 bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
-	BUILD=$(BUILD) sh runtime/bench/bench.sh $(BUILD)
+	BUILD=$(BUILD) SIMD=$(SIMD) sh runtime/bench/bench.sh $(BUILD)

@@ -133,6 +133,18 @@ $(eval $(call det_driver,mips-be-gcc-O2,mips-linux-gnu-gcc,-O2 -static))
 # clang as a cross compiler, on the cross gcc's sysroot and libgcc
 $(eval $(call det_driver,i686-clang-O2,clang --target=i686-linux-gnu,-O2 -static))
 $(eval $(call det_driver,mips-be-clang-O2,clang --target=mips-linux-gnu,-O2 -static))
+# SIMD kernel paths (runtime/src/sn_kernels.h): the plain x86_64 drivers above
+# build the SSE2 baseline (scalar kernels), these the others; aarch64 = NEON
+$(eval $(call det_driver,x86_64-gcc-O2-scalar,gcc,-O2 -DSN_SIMD_SCALAR))
+$(eval $(call det_driver,x86_64-gcc-O2-avx2,gcc,-O2 -mavx2))
+$(eval $(call det_driver,x86_64-gcc-O0-avx2,gcc,-O0 -mavx2))
+$(eval $(call det_driver,x86_64-clang-O2-avx2,clang,-O2 -mavx2))
+$(eval $(call det_driver,x86_64-gcc-O2-avx512,gcc,-O2 -mavx2 -mavx512f -mavx512vl))
+$(eval $(call det_driver,x86_64-clang-O2-avx512,clang,-O2 -mavx2 -mavx512f -mavx512vl))
+$(eval $(call det_driver,armhf-gcc-O2-neon,arm-linux-gnueabihf-gcc,-O2 -mfpu=neon -static))
+$(eval $(call det_driver,aarch64-gcc-O2,aarch64-linux-gnu-gcc,-O2 -static))
+$(eval $(call det_driver,aarch64-gcc-O2-scalar,aarch64-linux-gnu-gcc,-O2 -DSN_SIMD_SCALAR -static))
+$(eval $(call det_driver,aarch64-clang-O2,clang --target=aarch64-linux-gnu,-O2 -static))
 # float flavour: desktop only, no FMA contraction so -O0/-O2 and gcc/clang
 # agree; the blob comes from the file (the target builds it too)
 define det_float
@@ -143,10 +155,15 @@ endef
 $(eval $(call det_float,float-gcc-O0,gcc,-O0))
 $(eval $(call det_float,float-gcc-O2,gcc,-O2))
 $(eval $(call det_float,float-clang-O2,clang,-O2))
+# the float flavour keeps the scalar kernels on every SIMD setting (same hash;
+# clang's -mavx512f implies FMA: -ffp-contract=off, as above, keeps it equal)
+$(eval $(call det_float,float-gcc-O2-avx2,gcc,-O2 -mavx2))
+$(eval $(call det_float,float-clang-O2-avx512,clang,-O2 -mavx2 -mavx512f -mavx512vl))
 
 # every driver whose compiler is installed (make deps installs them all)
 CROSS_HAVE = $(foreach d,x86_64-gcc-O2:gcc x86_64-clang-O2:clang i686-gcc-O2:i686-linux-gnu-gcc \
-               armhf-gcc-O2:arm-linux-gnueabihf-gcc mips-be-gcc-O2:mips-linux-gnu-gcc,\
+               armhf-gcc-O2:arm-linux-gnueabihf-gcc mips-be-gcc-O2:mips-linux-gnu-gcc \
+               aarch64-gcc-O2:aarch64-linux-gnu-gcc armhf-gcc-O2-neon:arm-linux-gnueabihf-gcc,\
                $(if $(shell command -v $(word 2,$(subst :, ,$(d))) 2>/dev/null),$(CROSS_DIR)/det_$(word 1,$(subst :, ,$(d)))))
 ports-cross: $(CROSS_HAVE)
 ports: ports-baremetal ports-cross

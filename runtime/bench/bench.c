@@ -22,6 +22,7 @@
 
 #include "sinew.h"
 #include "sn_format.h"
+#include "sn_kernels.h" /* sn_kernels_name: the library's SIMD path */
 
 #if defined(SN_FLOAT)
 #define FLAV "float"
@@ -173,10 +174,10 @@ static int bench_blob(const char *path, int only_steps) {
         macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, info.offdiag_blocks, nnzff,
                          info.cg_iters_default);
         printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
-               "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u\n",
+               "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u; kernels %s\n",
                path, FLAV, info.blob_bytes, (unsigned)need, info.vertices, info.free_vertices, info.joints,
                info.cells, info.surface_vertices, info.triangles, info.offdiag_blocks, nnzff, blended,
-               info.cg_iters_default);
+               info.cg_iters_default, sn_kernels_name());
         printf("  figure: %s step time: median %.1f us, min %.1f us, mean %.1f us, p90 %.1f us (%d steps); "
                "get_surface %.1f us\n", FLAV, 1e6 * ts[n / 2], 1e6 * ts[0], 1e6 * sum / n, 1e6 * ts[n * 9 / 10], n,
                1e6 * (now() - t0) / rep);

@@ -7,7 +7,7 @@ STEPS=${BENCH_STEPS:-20}
 tmp=$(mktemp -d /tmp/sn_bench.XXXXXX) || exit 1
 trap 'rm -rf "$tmp"' EXIT INT TERM
 rc=0
-echo "== runtime bench: cow, default CG iterations ($(uname -m), ${CC:-cc})"
+echo "== runtime bench: cow, default CG iterations ($(uname -m), ${CC:-cc}, SIMD=${SIMD:-auto})"
 for flav in fixed float; do
     if [ $flav = fixed ]; then bin=$BUILD/bench/sn_bench; blob=$BUILD/examples/cow.blob
     else bin=$BUILD/bench/sn_bench_float; blob=$BUILD/examples/cow_float.blob; fi
@@ -28,5 +28,14 @@ for flav in fixed float; do
     else
         echo "  SKIPPED: valgrind not installed (no instruction counts)"
     fi
+done
+# many instances sharing one blob (issue 15 item 5): per-cow step cost of a
+# herd of 1, 10, 100 cows on one core, and the working set against the caches
+echo "== herd: N cows sharing one blob, stepped one after another on one core"
+for flav in fixed float; do
+    if [ $flav = fixed ]; then bin=$BUILD/bench/sn_herd; blob=$BUILD/examples/cow.blob
+    else bin=$BUILD/bench/sn_herd_float; blob=$BUILD/examples/cow_float.blob; fi
+    [ -f "$blob" ] && [ -x "$bin" ] || { echo "SKIPPED: $bin or $blob missing"; continue; }
+    "$bin" "$blob" ${HERD_SIZES:-1 10 100} || rc=1
 done
 exit $rc

@@ -10,14 +10,8 @@
  * The mass pass is the assembled one of format 1 (<= 53 block products).
  */
 #include "sn_constraint.h"
+#include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
 
-/* Overflow freedom without clamps (fixed): entries |e| <= 2^27 (validator),
- * operands |x| <= 2^28 (every sn_q is clamped), so one block row is < 3*2^55. */
-SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
-    l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
-    l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
-    l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
-}
 /* l += D e, D symmetric stored xx yy zz xy xz yz */
 SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
     sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
@@ -38,12 +32,6 @@ SN_INLINE void row_done(sn_acc *acc, const sn_acc l[3]) {
     acc[2] += l[2];
 }
 
-/* acc += B^T e (scatter of the transposed block) */
-SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    acc[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) + sn_mul(rd_real(b, 6), e[2]);
-    acc[1] += sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 7), e[2]);
-    acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
-}
 /* acc += m e (scalar block) */
 SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
     acc[0] += sn_mul(m, e[0]);
@@ -62,21 +50,6 @@ SN_INLINE void rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
     acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);
     acc[1] += sn_mul(R[3], t[0]) + sn_mul(R[4], t[1]) + sn_mul(R[5], t[2]);
     acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
-}
-
-/* l = S^_e u for one cell: the 36 stored upper blocks used as (a,b) and (b,a). */
-static void cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
-    uint32_t a, b;
-    acc_zero(l, 24);
-    for (a = 0; a < 8; a++) {
-        blk_row(l + 3 * a, K, u + 3 * a); /* diagonal block (a,a), stored in full */
-        K += 9 * RB;
-        for (b = a + 1; b < 8; b++, K += 9 * RB) {
-            blk_row(l + 3 * a, K, u + 3 * b);
-            blk_mac_t(l + 3 * b, K, u + 3 * a);
-        }
-    }
-    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
 }
 
 /* Saturating sum of non-negative energy terms (fixed: at 2^62). */
@@ -128,8 +101,8 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        cell_mul(K, d, ld);
-        cell_mul(K, uu, lu);
+        sn_k_cell_mul(K, d, ld);
+        sn_k_cell_mul(K, uu, lu);
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
@@ -258,7 +231,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
             if (a < nF) sn_rot_t(R, d + 3 * a, u + 3 * k, sat);
             else u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0; /* skeleton: no unknown */
         }
-        cell_mul(K, u, l);
+        sn_k_cell_mul(K, u, l);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3];
@@ -326,28 +299,12 @@ typedef struct { int64_t m; int e; } sn_dotv;
 #define SN_Q_SCAL 28 /* alpha, beta in Q28 */
 
 /* a force-like (Q(19+k_i) per vertex), b velocity-like (Q22): sum of a.b in
- * Q41, times 2^e. The bound uses the OR of the magnitudes (same bit length as
- * their maximum, no compares); products are shifted right by s + k_i. */
+ * Q41, times 2^e (sn_kernels.h sn_k_dot: the scalar reference or the
+ * build's SIMD path, the same integers). */
 static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
     sn_dotv r;
-    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
-    int s;
-    int64_t sum = 0;
-    for (i = 0; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
-    for (i = 0; i < nv; i++) {
-        int sh = s + kk[i];
-        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
-        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
-    }
-    SN_RANGE(SN_WITHIN(sum, 62), "block-floating dot product beyond 2^62", sum);
-    r.m = sum;
-    r.e = s;
+    r.m = sn_k_dot(a, b, kk, n, &r.e);
+    SN_RANGE(SN_WITHIN(r.m, 62), "block-floating dot product beyond 2^62", r.m);
     return r;
 }
 /* num/den in Q28, 0 when den <= 0 or num <= 0 (converged: not a clamp);

@@ -3,7 +3,9 @@
 # and bare metal: the fixed-flavour cow after 1000 steps of its clip must give
 # the same sn_state_hash on x86-64 (gcc -O0/-O2, clang -O2), i686 (gcc, clang),
 # 32-bit ARM Linux and big-endian MIPS (gcc, clang; static, qemu user mode),
-# the Cortex-M4 image (QEMU mps2-an386) and the desktop player. Float
+# the Cortex-M4 image (QEMU mps2-an386) and the desktop player; and every
+# SIMD kernel path: x86-64 scalar/AVX2/AVX-512, aarch64 NEON (gcc, clang) and
+# scalar, armhf NEON (qemu user mode), the Cortex-M4 DSP kernels. Float
 # flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
 # and sinew-play-float).
 # Every platform must also give the hash committed in tests/expected_hashes.txt
@@ -42,6 +44,35 @@ want float-gcc-O0   gcc -
 want i686-gcc-O2     i686-linux-gnu-gcc -
 if have clang; then want i686-clang-O2 i686-linux-gnu-gcc -; else skip "i686-clang-O2: no clang"; fi
 want x86_64-gcc-O2   gcc -
+# SIMD kernel paths (runtime/src/sn_kernels.h; the plain x86_64 builds are the
+# SSE2 baseline): each must give the scalar build's hash. A path this CPU
+# cannot run is built and reported skipped with the reason (not a CI
+# failure: the runner's CPU decides, not the install).
+want x86_64-gcc-O2-scalar gcc -
+want_cpu() {  # name compiler cpu-flag...
+    n=$1; c=$2; shift 2
+    for f in "$@"; do
+        if ! grep -qw "$f" /proc/cpuinfo 2>/dev/null; then
+            SKIPS=$((SKIPS + 1)); echo "SKIPPED: $n: this CPU has no $f (built only)"
+            pmake "$D/det_$n" > "$L/build_$n.log" 2>&1 || bad "$n: build failed (see $L/build_$n.log)"
+            return
+        fi
+    done
+    want "$n" "$c" -
+}
+want_cpu x86_64-gcc-O2-avx2 gcc avx2
+want_cpu x86_64-gcc-O0-avx2 gcc avx2
+want_cpu x86_64-gcc-O2-avx512 gcc avx512f avx512vl
+if have clang; then
+    want_cpu x86_64-clang-O2-avx2 clang avx2
+    want_cpu x86_64-clang-O2-avx512 clang avx512f avx512vl
+    want_cpu float-clang-O2-avx512 clang avx512f avx512vl
+fi
+want_cpu float-gcc-O2-avx2 gcc avx2
+want armhf-gcc-O2-neon arm-linux-gnueabihf-gcc qemu-arm
+want aarch64-gcc-O2  aarch64-linux-gnu-gcc qemu-aarch64
+want aarch64-gcc-O2-scalar aarch64-linux-gnu-gcc qemu-aarch64
+if have clang; then want aarch64-clang-O2 aarch64-linux-gnu-gcc qemu-aarch64; else skip "aarch64-clang-O2: no clang"; fi
 want x86_64-clang-O2 clang -
 want float-gcc-O2   gcc -
 want float-clang-O2 clang -

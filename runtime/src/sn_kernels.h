@@ -1,0 +1,55 @@
+/* sn_kernels.h -- the solve's innermost kernels, one portable scalar
+ * reference (sn_kernels.c) and per-ISA versions beside it
+ * (sn_kernels_avx2.c, sn_kernels_neon.c, sn_kernels_m4.c), chosen at build
+ * time from the compiler's target macros (make SIMD=..., runtime/runtime.mk):
+ *
+ *   SN_SIMD_SCALAR defined, or the float flavour  -> scalar reference
+ *   __AVX2__ (also under AVX-512)                  -> sn_kernels_avx2.c
+ *   __ARM_NEON (aarch64; armhf with -mfpu=neon)    -> sn_kernels_neon.c
+ *   __ARM_FEATURE_DSP, no NEON (Cortex-M4/M7)      -> sn_kernels_m4.c
+ *   anything else (SSE2-only x86-64, i686, MIPS)   -> scalar reference
+ *
+ * Fixed flavour: every path returns the same integers. A kernel's outputs
+ * are sums of exact int32 x int32 -> int64 products with no rounding inside
+ * the kernel, and every partial sum of any subset of those products is
+ * bounded below 2^63 (NUMERICS.md "SIMD kernels"), so any summation order
+ * gives the same int64. Rounding happens only in the callers, unchanged.
+ * Float flavour: always the scalar reference (float sums are not
+ * associative; one order everywhere keeps the float hash the same too).
+ */
+#ifndef SN_KERNELS_H
+#define SN_KERNELS_H
+
+#include "sn_internal.h"
+
+#if defined(SN_FLOAT) || defined(SN_SIMD_SCALAR)
+#define SN_KERNELS_SCALAR 1
+#elif defined(__AVX2__)
+#define SN_KERNELS_AVX2 1
+#elif defined(__ARM_NEON) || defined(__ARM_NEON__)
+#define SN_KERNELS_NEON 1
+#elif defined(__ARM_FEATURE_DSP) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+#define SN_KERNELS_M4 1
+#else
+#define SN_KERNELS_SCALAR 1
+#endif
+
+/* l = S^_e u for one cell: K the cell's 36 stored upper 3x3 blocks
+ * (row-major, little-endian reals, order (0,0),(0,1)..(0,7),(1,1)..(7,7)),
+ * used as (a,b) and (b,a); u 8 corner 3-vectors; l 8 corner sums.
+ * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
+void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]);
+
+#if !defined(SN_FLOAT)
+/* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a
+ * force-like (Q(19+k_i) per vertex i, n = 3 nv values), b velocity-like;
+ * picks s so n * max|a| * max|b| < 2^62 after shifting each product right
+ * by s + k_i (round half up), returns the sum and *e = s. Each product is
+ * rounded alone, so the sum is exact and order-free (|sum| < 2^62). */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e);
+#endif
+
+/* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */
+const char *sn_kernels_name(void);
+
+#endif /* SN_KERNELS_H */

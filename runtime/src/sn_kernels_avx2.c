@@ -1,0 +1,129 @@
+/* sn_kernels_avx2.c -- x86-64 AVX2 (and AVX-512VL: the same code, EVEX
+ * encoded) kernels of sn_kernels.h, fixed flavour.
+ *
+ * cell_mul: one 3x3 block as 4 int64 lanes (the 4th unused) per column or
+ * row: two overlapping unaligned loads (B0..B7, B1..B8), VPERMD puts a
+ * column or row in the even int32 slots, VPMULDQ multiplies the signed low
+ * halves exactly into int64 lanes (the odd slots are ignored), VPADDQ
+ * accumulates. Block (a,b): L_a += B col_c * u_b[c], L_b += B row_r * u_a[r]
+ * (that is B^T u_a). Same integer sums as the scalar reference in another
+ * order: exact, bounded (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+#include "sn_kernels.h"
+#include "sn_instance.h" /* bitlen64 */
+
+#if defined(SN_KERNELS_AVX2)
+#include <immintrin.h>
+
+#define LD(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
+#define MUL(v, idx, s) _mm256_mul_epi32(_mm256_permutevar8x32_epi32((v), (idx)), (s))
+
+void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+    /* the 4th lane of each index vector reads B0 (a harmless product, never stored) */
+    const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0); /* col 0 from B0..B7 */
+    const __m256i ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0); /* col 1 from B0..B7, col 2 from B1..B8 */
+    const __m256i ir0 = _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0); /* row 0 from B0..B7 */
+    const __m256i ir1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0); /* row 1 from B0..B7 */
+    const __m256i ir2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0); /* row 2 from B1..B8 */
+    __m256i L[8];
+    int a, b;
+    for (a = 0; a < 8; a++) L[a] = _mm256_setzero_si256();
+    for (a = 0; a < 8; a++) {
+        const __m256i ua0 = _mm256_set1_epi32(u[3 * a]), ua1 = _mm256_set1_epi32(u[3 * a + 1]);
+        const __m256i ua2 = _mm256_set1_epi32(u[3 * a + 2]);
+        __m256i v0 = LD(K), v1 = LD(K + 4), la;
+        /* diagonal block (a,a), stored in full: L_a += B u_a */
+        la = _mm256_add_epi64(L[a], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
+                                                      MUL(v1, ic1, ua2)));
+        K += 9 * 4;
+        for (b = a + 1; b < 8; b++, K += 9 * 4) {
+            const __m256i ub0 = _mm256_set1_epi32(u[3 * b]), ub1 = _mm256_set1_epi32(u[3 * b + 1]);
+            const __m256i ub2 = _mm256_set1_epi32(u[3 * b + 2]);
+            v0 = LD(K);
+            v1 = LD(K + 4);
+            la = _mm256_add_epi64(la, _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ub0), MUL(v0, ic1, ub1)),
+                                                        MUL(v1, ic1, ub2)));
+            L[b] = _mm256_add_epi64(L[b], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),
+                                                            MUL(v1, ir2, ua2)));
+        }
+        L[a] = la;
+    }
+    for (a = 0; a < 8; a++) {
+        int64_t t[4];
+        _mm256_storeu_si256((__m256i *)(void *)t, L[a]);
+        l[3 * a] = t[0];
+        l[3 * a + 1] = t[1];
+        l[3 * a + 2] = t[2];
+        SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60),
+                 "cell row beyond 24 * 2^55", t[0]);
+    }
+}
+
+/* Block-floating dot product: magnitudes ORed 8 lanes at a time (VPABSD of
+ * a clamped int32 has the bits of the scalar's uint32 magnitude); then 4
+ * vertices = 12 products per iteration in three 4-lane groups, each lane
+ * shifted by s + k of its vertex: round half up (VPSLLVQ by sh-1 = -1 gives
+ * 0 for sh = 0), arithmetic shift as x ^ m >> sh ^ m. */
+SN_INLINE __m256i rshr4(__m256i x, __m256i sh) {
+    const __m256i one = _mm256_set1_epi64x(1);
+    __m256i y = _mm256_add_epi64(x, _mm256_sllv_epi64(one, _mm256_sub_epi64(sh, one)));
+    __m256i m = _mm256_cmpgt_epi64(_mm256_setzero_si256(), y);
+    return _mm256_xor_si256(_mm256_srlv_epi64(_mm256_xor_si256(y, m), sh), m);
+}
+#define LD4(p) _mm256_cvtepi32_epi64(_mm_loadu_si128((const __m128i *)(const void *)(p)))
+
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3, t[8];
+    int s;
+    int64_t sum = 0, lanes[4];
+    __m256i va = _mm256_setzero_si256(), vb = _mm256_setzero_si256(), acc = _mm256_setzero_si256();
+    for (i = 0; i + 8 <= n; i += 8) {
+        va = _mm256_or_si256(va, _mm256_abs_epi32(_mm256_loadu_si256((const __m256i *)(const void *)(a + i))));
+        vb = _mm256_or_si256(vb, _mm256_abs_epi32(_mm256_loadu_si256((const __m256i *)(const void *)(b + i))));
+    }
+    _mm256_storeu_si256((__m256i *)(void *)t, va);
+    for (k = 0; k < 8; k++) oa |= t[k];
+    _mm256_storeu_si256((__m256i *)(void *)t, vb);
+    for (k = 0; k < 8; k++) ob |= t[k];
+    for (; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    {
+        const __m256i vs = _mm256_set1_epi64x(s);
+        for (i = 0; i + 4 <= nv; i += 4) {
+            const sn_q *pa = a + 3 * i, *pb = b + 3 * i;
+            uint32_t k4;
+            __m256i kv, s0, s1, s2;
+            memcpy(&k4, kk + i, 4);
+            kv = _mm256_add_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)k4)), vs);
+            s0 = _mm256_permute4x64_epi64(kv, 0x40); /* k0 k0 k0 k1 */
+            s1 = _mm256_permute4x64_epi64(kv, 0xA5); /* k1 k1 k2 k2 */
+            s2 = _mm256_permute4x64_epi64(kv, 0xFE); /* k2 k3 k3 k3 */
+            acc = _mm256_add_epi64(acc, rshr4(_mm256_mul_epi32(LD4(pa), LD4(pb)), s0));
+            acc = _mm256_add_epi64(acc, rshr4(_mm256_mul_epi32(LD4(pa + 4), LD4(pb + 4)), s1));
+            acc = _mm256_add_epi64(acc, rshr4(_mm256_mul_epi32(LD4(pa + 8), LD4(pb + 8)), s2));
+        }
+    }
+    _mm256_storeu_si256((__m256i *)(void *)lanes, acc);
+    sum = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+    for (; i < nv; i++) {
+        int sh = s + kk[i];
+        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+    }
+    *e = s;
+    return sum;
+}
+
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+const char *sn_kernels_name(void) { return "avx512"; }
+#else
+const char *sn_kernels_name(void) { return "avx2"; }
+#endif
+
+#else
+typedef int sn_kernels_avx2_unused_; /* ISO C: no empty translation unit */
+#endif

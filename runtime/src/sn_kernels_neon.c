@@ -1,0 +1,124 @@
+/* sn_kernels_neon.c -- ARM NEON kernels of sn_kernels.h (aarch64; armhf
+ * built with -mfpu=neon), fixed flavour.
+ *
+ * cell_mul: a corner's sum as x,y in one int64x2 and z as an int64x2 of
+ * two partial sums plus one scalar. Block (a,b) = B:
+ *   VLD3 of B0..B5 de-interleaves the first two rows into the columns
+ *   (B0,B3) (B1,B4) (B2,B5); VLD1 gives (B6,B7); B8 alone.
+ *   L_a.xy += (B0,B3) u_b.x + (B1,B4) u_b.y + (B2,B5) u_b.z   (VMLAL by scalar)
+ *   L_a.z  += (B6,B7) . (u_b.x, u_b.y) + B8 u_b.z
+ *   L_b.xy += (B0,B1) u_a.x + (B3,B4) u_a.y + (B6,B7) u_a.z   (B^T u_a)
+ *   L_b.z  += (B2,B5) . (u_a.x, u_a.y) + B8 u_a.z
+ * Exact int32 x int32 -> int64 products (SMLAL), the same sums as the
+ * scalar reference in another order (sn_kernels.h, NUMERICS.md). The blob
+ * is little-endian and so are these targets (the build refuses otherwise). */
+#include "sn_kernels.h"
+#include "sn_instance.h" /* bitlen64 */
+
+#if defined(SN_KERNELS_NEON)
+#include <arm_neon.h>
+
+#if !SN_HOST_LE
+#error "sn_kernels_neon.c reads blob reals as native int32: little-endian only (build with SIMD=scalar)"
+#endif
+
+void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+    int64x2_t xy[8], zz[8];
+    int64_t z1[8];
+    int a, b;
+    for (a = 0; a < 8; a++) {
+        xy[a] = vdupq_n_s64(0);
+        zz[a] = vdupq_n_s64(0);
+        z1[a] = 0;
+    }
+    for (a = 0; a < 8; a++) {
+        const int32_t *B = (const int32_t *)(const void *)K;
+        const int32_t ua0 = u[3 * a], ua1 = u[3 * a + 1], ua2 = u[3 * a + 2];
+        const int32x2_t ua01 = vld1_s32(u + 3 * a);
+        int32x2x3_t c = vld3_s32(B);
+        int32x2_t r2 = vld1_s32(B + 6);
+        int64x2_t axy = xy[a], az = zz[a];
+        int64_t az1 = z1[a];
+        /* diagonal block (a,a), stored in full: L_a += B u_a */
+        axy = vmlal_n_s32(axy, c.val[0], ua0);
+        axy = vmlal_n_s32(axy, c.val[1], ua1);
+        axy = vmlal_n_s32(axy, c.val[2], ua2);
+        az = vmlal_s32(az, r2, ua01);
+        az1 += (int64_t)B[8] * ua2;
+        K += 9 * 4;
+        for (b = a + 1; b < 8; b++, K += 9 * 4) {
+            const int32_t *Bb = (const int32_t *)(const void *)K;
+            const int32x2_t ub01 = vld1_s32(u + 3 * b);
+            const int32_t ub2 = u[3 * b + 2];
+            c = vld3_s32(Bb);
+            r2 = vld1_s32(Bb + 6);
+            axy = vmlal_n_s32(axy, c.val[0], vget_lane_s32(ub01, 0));
+            axy = vmlal_n_s32(axy, c.val[1], vget_lane_s32(ub01, 1));
+            axy = vmlal_n_s32(axy, c.val[2], ub2);
+            az = vmlal_s32(az, r2, ub01);
+            az1 += (int64_t)Bb[8] * ub2;
+            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb), ua0);
+            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb + 3), ua1);
+            xy[b] = vmlal_n_s32(xy[b], r2, ua2);
+            zz[b] = vmlal_s32(zz[b], c.val[2], ua01);
+            z1[b] += (int64_t)Bb[8] * ua2;
+        }
+        xy[a] = axy;
+        zz[a] = az;
+        z1[a] = az1;
+    }
+    for (a = 0; a < 8; a++) {
+        l[3 * a] = vgetq_lane_s64(xy[a], 0);
+        l[3 * a + 1] = vgetq_lane_s64(xy[a], 1);
+        l[3 * a + 2] = vgetq_lane_s64(zz[a], 0) + vgetq_lane_s64(zz[a], 1) + z1[a];
+        SN_RANGE(SN_WITHIN(l[3 * a], 60) && SN_WITHIN(l[3 * a + 1], 60) && SN_WITHIN(l[3 * a + 2], 60),
+                 "cell row beyond 24 * 2^55", l[3 * a + 2]);
+    }
+}
+
+/* Block-floating dot product: magnitudes ORed 4 lanes at a time (VABS of a
+ * clamped int32 has the bits of the scalar's uint32 magnitude); then two
+ * vertices = 6 products as 3 pairs (VMULL.S32), each rounded by VRSHL with
+ * the negated shift s + k of its vertex: (x + 2^(sh-1)) >> sh, exactly the
+ * scalar rounding (sh = 0 leaves x). */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
+    int s;
+    int64_t sum;
+    uint32x4_t va = vdupq_n_u32(0), vb = vdupq_n_u32(0);
+    int64x2_t acc = vdupq_n_s64(0);
+    for (i = 0; i + 4 <= n; i += 4) {
+        va = vorrq_u32(va, vreinterpretq_u32_s32(vabsq_s32(vld1q_s32(a + i))));
+        vb = vorrq_u32(vb, vreinterpretq_u32_s32(vabsq_s32(vld1q_s32(b + i))));
+    }
+    oa = vgetq_lane_u32(va, 0) | vgetq_lane_u32(va, 1) | vgetq_lane_u32(va, 2) | vgetq_lane_u32(va, 3);
+    ob = vgetq_lane_u32(vb, 0) | vgetq_lane_u32(vb, 1) | vgetq_lane_u32(vb, 2) | vgetq_lane_u32(vb, 3);
+    for (; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    for (i = 0; i + 2 <= nv; i += 2) {
+        const sn_q *pa = a + 3 * i, *pb = b + 3 * i;
+        const int64x1_t n0 = vdup_n_s64(-(int64_t)(s + kk[i])), n1 = vdup_n_s64(-(int64_t)(s + kk[i + 1]));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa), vld1_s32(pb)), vcombine_s64(n0, n0)));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa + 2), vld1_s32(pb + 2)), vcombine_s64(n0, n1)));
+        acc = vaddq_s64(acc, vrshlq_s64(vmull_s32(vld1_s32(pa + 4), vld1_s32(pb + 4)), vcombine_s64(n1, n1)));
+    }
+    sum = vgetq_lane_s64(acc, 0) + vgetq_lane_s64(acc, 1);
+    for (; i < nv; i++) {
+        int sh = s + kk[i];
+        int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+    }
+    *e = s;
+    return sum;
+}
+
+const char *sn_kernels_name(void) { return "neon"; }
+
+#else
+typedef int sn_kernels_neon_unused_; /* ISO C: no empty translation unit */
+#endif
