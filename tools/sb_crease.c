@@ -142,6 +142,12 @@ static int rings(const csr_t *vv, int s, int r, int *out, int *ring, int max, in
     return n;
 }
 
+static double rdist2(const double *x, int a, int b)
+{
+    double d0 = x[3 * a] - x[3 * b], d1 = x[3 * a + 1] - x[3 * b + 1], d2 = x[3 * a + 2] - x[3 * b + 2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
+}
+
 static int cmp_int(const void *a, const void *b) { int x = *(const int *)a, y = *(const int *)b; return (x > y) - (x < y); }
 
 /* ---------------- pose ---------------- */
@@ -348,7 +354,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
         double *axis = sb_alloc(sizeof(double) * 3 * m.nJ), *deg = sb_alloc(sizeof(double) * m.nJ);
         double *local = sb_alloc(sizeof(double) * 4 * m.nJ), *cur = sb_alloc(sizeof(double) * 3 * (size_t)ns);
         double *prev = sb_alloc(sizeof(double) * 3 * (size_t)ns), *rest = sb_alloc(sizeof(double) * 3 * (size_t)ns);
-        double zero3[3] = {0, 0, 0}, ex2 = o->cr_exclude * o->cr_exclude;
+        double zero3[3] = {0, 0, 0}, ex2 = o->cr_exclude * o->cr_exclude, th2 = d->cr_thin * d->cr_thin;
         int have_rest = 0;
         snref_xform *pose = sb_alloc(sizeof(snref_xform) * m.nJ);
         unsigned char *done_v = sb_alloc((size_t)ns);
@@ -425,7 +431,11 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                     if (best >= 0) {
                         int jv = o->tri[3 * best + bestc], q;
                         done_v[i] = 1;
-                        for (q = 0; q < o->cr_nD; q++) if (o->cr_pairs[2 * q] == i && o->cr_pairs[2 * q + 1] == jv) break;
+                        for (q = 0; q < o->cr_nD; q++) {
+                            int i0 = o->cr_pairs[2 * q], j0 = o->cr_pairs[2 * q + 1];
+                            if (i0 == i && j0 == jv) break;
+                            if (th2 > 0 && rdist2(rest, i0, i) < th2 && rdist2(rest, j0, jv) < th2) break; /* 'thin': a seed this close already */
+                        }
                         if (q < o->cr_nD) continue;
                         if (o->cr_nD >= (int)SN_CREASE_MAX_PAIRS) { if (!quiet) fprintf(stderr, "sinew-bake: warning: crease: more than %u seed pairs: the rest dropped\n", SN_CREASE_MAX_PAIRS); fail = 2; break; }
                         if (o->cr_nD == cap) { cap *= 2; o->cr_pairs = realloc(o->cr_pairs, sizeof(int) * 2 * (size_t)cap); if (!o->cr_pairs) { fprintf(stderr, "out of memory\n"); exit(1); } }
