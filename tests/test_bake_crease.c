@@ -177,6 +177,17 @@ static void test_limb(void)
         T_FIGURE("limb seed pairs: 90 deg %d, 120 deg %d", o.cr_nD, n120);
         sb_blob_free(&b); sb_model_free(&o);
     }
+    /* rest-distance rules: exclude (no pair closer in the rest pose; 20 mesh
+     * units covers the whole limb) and thin (one seed per patch) */
+    if (!write_limb("excl", "crease elbow:0,0,1,120 steps 120\ncrease_settings exclude 20\n", path, sizeof path) && !bake(path, SB_FIXED, &o, &b)) {
+        T_CHECK(o.crease == 1 && o.cr_nD == 0, "exclude 20 (beyond the limb's length): no seed pair (%d)", o.cr_nD);
+        sb_blob_free(&b); sb_model_free(&o);
+    }
+    if (!write_limb("thin", "crease elbow:0,0,1,120 steps 120\ncrease_settings thin 1.5\n", path, sizeof path) && !bake(path, SB_FIXED, &o, &b)) {
+        T_CHECK(o.cr_nD > 0 && o.cr_nD < n120, "thin 1.5: fewer seed pairs (%d) than without (%d), not none", o.cr_nD, n120);
+        T_FIGURE("limb seed pairs at 120 deg: %d, thin 1.5: %d", n120, o.cr_nD);
+        sb_blob_free(&b); sb_model_free(&o);
+    }
     sb_mesh_free(&m);
 }
 
@@ -191,6 +202,7 @@ static void test_errors(void)
         {"crease elbow:0,0,1,90\ncrease_settings list 300\n", "1..256"},
         {"crease elbow:0,0,1,90\ncrease_settings depth 0.1 push 0.2\n", "exceeds depth"},
         {"crease elbow:0,0,1,90\ncrease_settings colour 3\n", "unknown crease setting"},
+        {"crease elbow:0,0,1,90\ncrease_settings thin -1\n", "must be >= 0"},
     };
     int k;
     for (k = 0; k < (int)(sizeof E / sizeof E[0]); k++) {

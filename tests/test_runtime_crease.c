@@ -361,6 +361,8 @@ int main(void) {
     T_CHECK(st.crease_list_full == 0 && st.crease_active_over == 0, "no overflow with list 64 / active 32 (%u, %u)", st.crease_list_full,
             st.crease_active_over);
     T_CHECK(st.saturations == 0, "no saturation (%u)", st.saturations);
+    T_FIGURE("%s: over the bend, hold and return %u crease pairs added; the projection dropped %u rows as dependent (constraint_drops)",
+             PU_FLAVOUR_NAME, st.crease_added, st.constraint_drops);
     T_FIGURE("%s: at 120 deg %u pairs, n_a %u; largest list %u, rows %u; deepest listed penetration %.4g internal units (%.4g mesh units); "
              "%u steps with pairs", PU_FLAVOUR_NAME, hold.crease_list, hold.crease_active, rs.max_list, rs.max_rows, rs.deepest,
              rs.deepest * pow(2.0, ((const sn_ihdr *)(const void *)r.inst)->v.len_shift), rs.steps_with_pairs);

@@ -186,6 +186,8 @@ typedef struct sb_desc {
     sb_creasedef *creases; int ncrease; /* 'crease' */
     int cr_list, cr_active, cr_ring; /* 'crease_settings': list size, active rows, neighbourhood ring */
     double cr_depth, cr_push;        /* mesh units; < 0: default (half a cell; a quarter of depth) */
+    double cr_thin;                  /* mesh units; 0: off: a seed pair whose two vertices are both within this rest distance of an earlier pair's is dropped */
+    double cr_exclude;               /* mesh units; < 0: default (one cell): seed pairs closer than this in the rest pose are not collisions */
     int cr_line;                     /* line of 'crease_settings' (0: none) */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
@@ -296,6 +298,7 @@ typedef struct sb_model {
     int *cr_vnbr, *cr_tnbr; /* ns x kv, ns x kt; -1 = unused */
     int cr_list, cr_active;
     double cr_depth, cr_push; /* mesh units */
+    double cr_exclude;        /* mesh units: seed pairs closer in the rest pose are not collisions */
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);

@@ -12,7 +12,11 @@
  * projection) pairs in the order found, each vertex once per pose, duplicates
  * over poses dropped. Triangles with a corner in the vertex's neighbourhood
  * (VNBR row, below) are never tested, as in the runtime (neighbours fold with
- * the skin and are not collisions).
+ * the skin and are not collisions), nor triangles with a corner closer to the
+ * vertex in the rest pose than 'exclude' (default one lattice cell: on a fine
+ * surface over a coarse lattice the one ring is a few mesh units wide and
+ * the skin folding within a cell, which the lattice cannot resolve, gave
+ * thousands of seeds).
  *
  * Unlike the paper, the slow motion runs without the contact constraints
  * (the reference model has none): after a vertex is recorded the surface
@@ -28,6 +32,7 @@
  */
 #include "sb.h"
 #include "ref/snref.h"
+#include "sb_static.h"
 #include "../runtime/src/sn_format.h"
 
 #include <math.h>
@@ -137,14 +142,20 @@ static int rings(const csr_t *vv, int s, int r, int *out, int *ring, int max, in
     return n;
 }
 
+static double rdist2(const double *x, int a, int b)
+{
+    double d0 = x[3 * a] - x[3 * b], d1 = x[3 * a + 1] - x[3 * b + 1], d2 = x[3 * a + 2] - x[3 * b + 2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
+}
+
 static int cmp_int(const void *a, const void *b) { int x = *(const int *)a, y = *(const int *)b; return (x > y) - (x < y); }
 
-/* ---------------- pose (as sb_static.c) ---------------- */
+/* ---------------- pose ---------------- */
 
 /* local rotations (x,y,z,w) per blob joint -> per-joint transforms (mesh
- * units), as sn_pose_from_local; a copy of sb_static.c's pose_from_local */
-static void pose_from_local(const snref_model *m, const double *local, snref_xform *out)
-{
+ * units), as sn_pose_from_local, the root moved by root (sb_static.h; here in
+ * the tool library so sb_static.c, sb_fit.c and the crease slow motion share it) */
+void sb_pose_from_local(const snref_model *m, const double *local, const double root[3], snref_xform *out) {
     unsigned j, k;
     for (j = 0; j < m->nJ; j++) {
         double R[9], x[3], rx[3], dd[3], q[4], n = 0;
@@ -157,7 +168,7 @@ static void pose_from_local(const snref_model *m, const double *local, snref_xfo
         for (k = 0; k < 3; k++) { rx[k] = R[3 * k] * x[0] + R[3 * k + 1] * x[1] + R[3 * k + 2] * x[2]; dd[k] = x[k] - rx[k]; }
         if (p < 0) {
             memcpy(out[j].q, q, sizeof q);
-            for (k = 0; k < 3; k++) out[j].t[k] = dd[k];
+            for (k = 0; k < 3; k++) out[j].t[k] = dd[k] + root[k];
         } else {
             double Rp[9];
             snref_quat_to_mat(out[p].q, Rp);
@@ -279,6 +290,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
     o->cr_list = d->cr_list; o->cr_active = d->cr_active;
     o->cr_depth = d->cr_depth > 0 ? d->cr_depth : 0.5 * o->c;
     o->cr_push = d->cr_push >= 0 ? d->cr_push : 0.25 * o->cr_depth;
+    o->cr_exclude = d->cr_exclude >= 0 ? d->cr_exclude : o->c;
     if (o->cr_push > o->cr_depth) return sb_fail("%s: crease push %g exceeds depth %g", d->path, o->cr_push, o->cr_depth);
     build_adj(o, &vv, &vt);
     buf = sb_alloc(sizeof(int) * (size_t)(ns + 1));
@@ -341,7 +353,9 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
     {
         double *axis = sb_alloc(sizeof(double) * 3 * m.nJ), *deg = sb_alloc(sizeof(double) * m.nJ);
         double *local = sb_alloc(sizeof(double) * 4 * m.nJ), *cur = sb_alloc(sizeof(double) * 3 * (size_t)ns);
-        double *prev = sb_alloc(sizeof(double) * 3 * (size_t)ns);
+        double *prev = sb_alloc(sizeof(double) * 3 * (size_t)ns), *rest = sb_alloc(sizeof(double) * 3 * (size_t)ns);
+        double zero3[3] = {0, 0, 0}, ex2 = o->cr_exclude * o->cr_exclude, th2 = d->cr_thin * d->cr_thin;
+        int have_rest = 0;
         snref_xform *pose = sb_alloc(sizeof(snref_xform) * m.nJ);
         unsigned char *done_v = sb_alloc((size_t)ns);
         int cap = 64, ci, fail = 0;
@@ -364,11 +378,12 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                 double f = step >= N ? 1.0 : (double)step / N;
                 int i;
                 for (j = 0; j < m.nJ; j++) snref_quat_axis_angle(axis + 3 * j, deg[j] * f, local + 4 * j);
-                pose_from_local(&m, local, pose);
+                sb_pose_from_local(&m, local, zero3, pose);
                 snref_set_pose(&st, pose);
                 if (step > 0) snref_step(&st);
                 memcpy(prev, cur, sizeof(double) * 3 * (size_t)ns);
                 snref_get_surface(&st, cur);
+                if (step == 0 && !have_rest) { memcpy(rest, cur, sizeof(double) * 3 * (size_t)ns); have_rest = 1; }
                 if (step == 0 && cellh == 0) {   /* twice the mean rest edge, at least twice the depth */
                     double sum = 0;
                     int t, c, k;
@@ -396,6 +411,11 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                             lo_ = excl_ptr[i]; hi_ = excl_ptr[i + 1] - 1;
                             while (lo_ <= hi_) { a = (lo_ + hi_) / 2; if (excl[a] == tv[c]) { skip = 1; break; } if (excl[a] < tv[c]) lo_ = a + 1; else hi_ = a - 1; }
                         }
+                        for (c = 0; c < 3 && !skip; c++) { /* a corner closer than 'exclude' in the rest pose? */
+                            const double *x0 = rest + 3 * i, *x1 = rest + 3 * tv[c];
+                            double d2 = (x1[0] - x0[0]) * (x1[0] - x0[0]) + (x1[1] - x0[1]) * (x1[1] - x0[1]) + (x1[2] - x0[2]) * (x1[2] - x0[2]);
+                            skip = d2 < ex2;
+                        }
                         if (skip) continue;
                         if (!sb_crease_inside(cur + 3 * i, cur + 3 * tv[0], cur + 3 * tv[1], cur + 3 * tv[2], o->cr_depth, &dist, &corner)) continue;
                         /* crossed the plane since the last step (was in front) */
@@ -411,7 +431,11 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                     if (best >= 0) {
                         int jv = o->tri[3 * best + bestc], q;
                         done_v[i] = 1;
-                        for (q = 0; q < o->cr_nD; q++) if (o->cr_pairs[2 * q] == i && o->cr_pairs[2 * q + 1] == jv) break;
+                        for (q = 0; q < o->cr_nD; q++) {
+                            int i0 = o->cr_pairs[2 * q], j0 = o->cr_pairs[2 * q + 1];
+                            if (i0 == i && j0 == jv) break;
+                            if (th2 > 0 && rdist2(rest, i0, i) < th2 && rdist2(rest, j0, jv) < th2) break; /* 'thin': a seed this close already */
+                        }
                         if (q < o->cr_nD) continue;
                         if (o->cr_nD >= (int)SN_CREASE_MAX_PAIRS) { if (!quiet) fprintf(stderr, "sinew-bake: warning: crease: more than %u seed pairs: the rest dropped\n", SN_CREASE_MAX_PAIRS); fail = 2; break; }
                         if (o->cr_nD == cap) { cap *= 2; o->cr_pairs = realloc(o->cr_pairs, sizeof(int) * 2 * (size_t)cap); if (!o->cr_pairs) { fprintf(stderr, "out of memory\n"); exit(1); } }
@@ -425,15 +449,15 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
             if (!quiet && !fail) printf(" %d seed pairs (%.2f s)\n", found, sb_now() - t0);
         }
         free(g.start); free(g.tris);
-        free(axis); free(deg); free(local); free(cur); free(prev); free(pose); free(done_v);
+        free(axis); free(deg); free(local); free(cur); free(prev); free(rest); free(pose); free(done_v);
         if (fail) goto done;
     }
     o->crease = 1;
     if (!quiet) {
         uint32_t rs = 4, bytes = SN_ELEM_CREASE(rs) + SN_ELEM_CREASE_PAIRS * (uint32_t)o->cr_nD + 2u * (uint32_t)ns * (uint32_t)(kv + kt);
         printf("  crease    %d seed pairs from %d pose(s); neighbourhoods ring %d: %d vertices, %d triangles per row; list %d, active %d, "
-               "depth %g, push %g mesh units; %u blob bytes (4-byte reals), %u instance bytes of crease state (its rows: see contact) (%.2f s)\n",
-               o->cr_nD, d->ncrease, d->cr_ring, kv, kt, o->cr_list, o->cr_active, o->cr_depth, o->cr_push, (unsigned)bytes,
+               "depth %g, push %g, exclude %g mesh units; %u blob bytes (4-byte reals), %u instance bytes of crease state (its rows: see contact) (%.2f s)\n",
+               o->cr_nD, d->ncrease, d->cr_ring, kv, kt, o->cr_list, o->cr_active, o->cr_depth, o->cr_push, o->cr_exclude, (unsigned)bytes,
                (unsigned)SN_CREASE_STATE_BYTES(ns, o->cr_list), sb_now() - t0);
     }
     rc = 0;

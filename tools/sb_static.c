@@ -19,8 +19,8 @@
  * abstract controls at that time (--controls overrides them).
  */
 #include "sb.h"
-#include "sb_static.h"
 #include "snref.h"
+#include "sb_static.h"
 #include "sn_clip.h"
 #include "raster.h"
 #include "png.h"
@@ -36,30 +36,8 @@
 
 /* ---------------- pose ---------------- */
 
-/* local rotations (x,y,z,w) per blob joint and a root offset (mesh units) ->
- * per-joint transforms, as sn_pose_from_local (runtime/include/sinew.h) */
-static void pose_from_local(const snref_model *m, const double *local, const double root[3], snref_xform *out) {
-    unsigned j, k;
-    for (j = 0; j < m->nJ; j++) {
-        double R[9], x[3], rx[3], dd[3], q[4], n = 0;
-        int p = m->jparent[j];
-        for (k = 0; k < 4; k++) n += local[4 * j + k] * local[4 * j + k];
-        n = sqrt(n);
-        for (k = 0; k < 4; k++) q[k] = local[4 * j + k] / n;
-        for (k = 0; k < 3; k++) x[k] = m->jrest[3 * j + k] * m->unit;
-        snref_quat_to_mat(q, R);
-        for (k = 0; k < 3; k++) { rx[k] = R[3 * k] * x[0] + R[3 * k + 1] * x[1] + R[3 * k + 2] * x[2]; dd[k] = x[k] - rx[k]; }
-        if (p < 0) {
-            memcpy(out[j].q, q, sizeof q);
-            for (k = 0; k < 3; k++) out[j].t[k] = dd[k] + root[k];
-        } else {
-            double Rp[9];
-            snref_quat_to_mat(out[p].q, Rp);
-            snref_quat_mul(out[p].q, q, out[j].q);
-            for (k = 0; k < 3; k++) out[j].t[k] = Rp[3 * k] * dd[0] + Rp[3 * k + 1] * dd[1] + Rp[3 * k + 2] * dd[2] + out[p].t[k];
-        }
-    }
-}
+/* sb_pose_from_local (sb_static.h) lives in the tool library (sb_crease.c),
+ * shared with the crease slow motion */
 
 static int find_joint(const snref_model *m, const char *name, size_t n) {
     unsigned j;
@@ -260,14 +238,13 @@ int sb_static_pose(snref_state *s, const char *spec, snref_xform *pose, double *
     if (!local) { fprintf(stderr, PROG ": out of memory\n"); return 2; }
     rc = sb_static_pose_(s, m, spec, local, root, what, whatn);
     if (!rc) {
-        pose_from_local(m, local, root, pose);
+        sb_pose_from_local(m, local, root, pose);
         if (local_out) memcpy(local_out, local, 4 * (size_t)m->nJ * sizeof *local);
     }
     free(local);
     return rc;
 }
 
-void sb_pose_from_local(const snref_model *m, const double *local, const double root[3], snref_xform *out) { pose_from_local(m, local, root, out); }
 
 /* ---------------- controls ---------------- */
 

@@ -37,7 +37,7 @@ $(BUILD)/tools/static/%.o: ports/common/%.c $(STATIC_HDR)
 $(BUILD)/tools/static/%.o: ports/desktop/%.c $(STATIC_HDR)
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -c $< -o $@
-$(BUILD)/tools/sinew_bake.o: tools/sb_static.h
+$(BUILD)/tools/sinew_bake.o $(BUILD)/tools/sb_crease.o: tools/sb_static.h
 
 $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/sinew_bake.o $(STATIC_OBJ) $(TOOLS_LIB) -lm

@@ -267,7 +267,7 @@ typedef struct sn_stats {
     sn_real  seg_gap_max;  ///< largest seg_gap since init/reset
     uint32_t crease_list;        ///< self-collision near creases (seed 003 §3.4): pairs in the collision list C after the last step's detection (0 without crease data)
     uint32_t crease_active;      ///< active prefix n_a of C after the last step's detection (constraints produced: at most the blob's max_active)
-    uint32_t crease_list_full;   ///< penetrations found but not added since init/reset because C was full (the blob's max_list)
+    uint32_t crease_list_full;   ///< penetrations found but not added since init/reset because C was full (the blob's max_list); lost detections: a vertex counts again each step it stays out, once per search reaching it (NUMERICS.md)
     uint32_t crease_active_over; ///< active constraints not produced since init/reset because max_active was reached or the row store was full
     uint32_t crease_added;       ///< pairs added to C since init/reset
     uint32_t crease_removed;     ///< pairs removed from C since init/reset (vertex back outside, or slid off its triangle)
