@@ -11,6 +11,10 @@
  * a vertex inside is pushed out by at most an eighth of a cell per step).
  * Vertices the bones carry (their cell's free corners' squared weights sum
  * below 2^-8) take no contact: no velocity of the flesh can hold them.
+ * A contact yields to the bones (ct_yield): it asks its cell's free corners
+ * for no more than a velocity change of cell/2 and an end point cell/2
+ * beyond their skinned place along n (minimum-norm share), so a vertex the
+ * skeleton drives through a collider is left behind, not fought.
  * One contact per (collider, lattice cell): the vertex with the smallest
  * g + n . (v_pred - v_c) (a second vertex of the cell would give a nearly
  * dependent row). Up to max_contacts per step, in surface-vertex order;
