@@ -131,7 +131,7 @@ done <<EOF2
 $plats
 EOF2
 for fl in "" _float; do
-    p=$BUILD/sinew-play$fl
+    p=$BUILD/sinew-play$(printf %s "$fl" | tr _ -) # sinew-play, sinew-play-float
     if pmake "$p" > "$L/build_crease_play$fl.log" 2>&1 && run_log "$L/run_crease_play$fl.log" 600 "$p" "$BUILD/examples/limb_crease$fl.blob" \
             --clip "$CR_CLIP" --frames "$CR_STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_crease_play$fl.log")" ]; then
         h=$(hash_of "$L/run_crease_play$fl.log"); echo "determinism: crease sinew-play$fl $h"
