@@ -250,4 +250,4 @@ $(PHYS_EX)/cow_c8.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
 	$(BAKE) $< -o $@ --quiet
 $(PHYS_EX)/cow_c8_float.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
-TEST_DEPS += $(PHYS_EX)/cow_c8.blob $(PHYS_EX)/cow_c8_float.blob
+TEST_DEPS += $(PHYS_EX)/cow_c8.blob $(PHYS_EX)/cow_c8_float.blob $(EX)/beast.blob $(EX)/beast_float.blob

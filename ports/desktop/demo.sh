@@ -121,6 +121,11 @@ done
 BEASTVIEW="--view 25,10 --size 280x300"
 run "beast walk sheet (144 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/walk.clip" --frames 144 \
     --sheet "$OUT/beast_walk_sheet.png" --title "beast walk (fixed point)" $BEASTVIEW
+# the walk on a ground plane 0.07 above the resting soles (model space:
+# relative to the root joint, soles at y = -130.94); contacts yield to the
+# bones that carry the feet (runtime/NUMERICS.md "Contacts")
+run "beast walk on the ground (144 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/walk.clip" --frames 144 --ground -130.87 \
+    --sheet "$OUT/beast_ground.png" --title "beast walk on a ground plane (sn_set_colliders)" $BEASTVIEW
 run "beast violent sheet (480 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/violent.clip" --frames 480 \
     --sheet "$OUT/beast_violent_sheet.png" --title "head 180 deg in 0.1 s, then 170, chest 170" $BEASTVIEW
 run "beast head_turn compare (180 steps)" "$PLAY" "$BEAST" --clip "$BEAST_SRC/head_turn.clip" --frames 180 \

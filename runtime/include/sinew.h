@@ -277,7 +277,7 @@ typedef struct sn_stats {
     uint32_t contact_overflow;   ///< contacts not enforced since init/reset because the step's max_contacts were taken
     uint32_t row_overflow;       ///< rows refused since init/reset because the step's rows were full
     uint32_t constraint_refused; ///< constraints or colliders beyond the blob's maxima refused by the setters since init/reset
-    uint32_t constraint_clamps;  ///< row targets clamped to one lattice cell per step since init/reset (a far or fast target is approached at that speed)
+    uint32_t constraint_clamps;  ///< row targets clamped since init/reset: a constraint to one lattice cell per step (a far or fast target is approached at that speed), a contact to its yield bound (runtime/NUMERICS.md "Contacts")
 } sn_stats;
 /// Self-collision near creases (seed 003 §3.4): the surface vertices in the
 /// collision list after the last step's detection, in the order they entered

@@ -270,12 +270,13 @@ static void gram_solve(sn_ihdr *h, uint32_t *sat) {
  * (|G^-1| <= max 1/L_jj^2 <= 2^10 by the drop rule), and a residual of a
  * few LSB gets 8 more fraction bits (e = -8); e in [-8, 15] (the apply
  * shift 30 - k_a - e stays >= 0). Float: e = 0. */
+#define SN_BLOCK_BITS 14
 static int block_exp(uint64_t o) {
 #if defined(SN_FLOAT)
     (void)o;
     return 0;
 #else
-    int e = bitlen64(o) - 30 - 18;
+    int e = bitlen64(o) - 30 - SN_BLOCK_BITS;
     return e < -8 ? -8 : (e > 15 ? 15 : e);
 #endif
 }

@@ -11,6 +11,10 @@
  * a vertex inside is pushed out by at most an eighth of a cell per step).
  * Vertices the bones carry (their cell's free corners' squared weights sum
  * below 2^-8) take no contact: no velocity of the flesh can hold them.
+ * A contact yields to the bones (ct_yield): it asks its cell's free corners
+ * for no more than a velocity change of cell/2 and an end point cell/2
+ * beyond their skinned place along n (minimum-norm share), so a vertex the
+ * skeleton drives through a collider is left behind, not fought.
  * One contact per (collider, lattice cell): the vertex with the smallest
  * g + n . (v_pred - v_c) (a second vertex of the cell would give a nearly
  * dependent row). Up to max_contacts per step, in surface-vertex order;
@@ -39,8 +43,10 @@ typedef char sn_col_fits_[sizeof(sn_col) <= SN_COL_BYTES ? 1 : -1];
 
 #if defined(SN_FLOAT)
 #define CT_ONE30 1.0f
+#define SN_LIM_OR_BIG 1.0e30f
 #else
 #define CT_ONE30 ((int32_t)1 << 30)
+#define SN_LIM_OR_BIG SN_LIM
 #endif
 
 /* world public point -> internal (relative to the origin) */
@@ -133,6 +139,50 @@ static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, co
 
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat);
 
+/* The yield bound (NUMERICS.md "Contacts"): the most normal velocity change
+ * a contact row may ask of its point so that no free corner of its cell
+ * changes its velocity by more than cell/2 this step or ends more than
+ * cell/2 beyond its skinned position along n (the bones' place for it).
+ * The row's minimum-norm free change moves corner a by phi_a dn / S2
+ * (S2 = sum of the free phi^2), so dn <= S2 min_a room_a / phi_a with
+ * room_a = min(cell/2, cell/2 - n.(p_a + v_a + g^ - skin_a)). Skeleton
+ * corners are the bones' own: the row never moves them. Returns the bound
+ * (<= 0: no room, no row). Q22; S2 Q60 (fixed). */
+static sn_q ct_yield(sn_ihdr *h, const uint32_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    const sn_q dv = (sn_q)(v->cell / 2), dmax = (sn_q)(v->cell / 2);
+    sn_q m = SN_LIM_OR_BIG;
+    uint32_t k, q;
+    for (k = 0; k < 8; k++) {
+        uint32_t a = vx[k];
+        sn_q sk[3], dev, room, ratio;
+        sn_acc d = 0;
+        if (a >= v->nF || !(phi[k] > 0)) continue;
+        sn_skinned(h, a, sk, sat);
+        for (q = 0; q < 3; q++)
+            d += sn_mul(n[q], sn_add(sn_add(pos[3 * a + q], sn_add(vel[3 * a + q], v->grav[q], sat), sat), -sk[q], sat));
+        dev = sn_out(d, 30, sat);
+        room = sn_add(dmax, -dev, sat);
+        if (room > dv) room = dv;
+        if (!(room > 0)) return 0;
+#if defined(SN_FLOAT)
+        ratio = room / phi[k];
+#else
+        {   /* room (Q22) / phi (Q30) in Q22, at most the state range */
+            uint64_t t = sn_udiv64((uint64_t)room << 30, (uint64_t)phi[k]);
+            ratio = t > (uint64_t)SN_LIM ? SN_LIM : (sn_q)t;
+        }
+#endif
+        if (ratio < m) m = ratio;
+    }
+#if defined(SN_FLOAT)
+    return S2 * m;
+#else
+    return sn_out(sn_mul((sn_q)(S2 >> 30), m), 30, sat); /* S2 <= 2^60: Q30 <= 2^30 */
+#endif
+}
+
 void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
@@ -192,7 +242,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             Vp[q] = sn_out(sv[q], 30, sat);
         }
         for (c = 0; c < ncol; c++) {
-            sn_q g, n[3], rel[3], reach, vr, score, vcn, target;
+            sn_q g, n[3], rel[3], reach, vr, score, vcn, target, want, dn, lim;
             uint32_t j;
             for (q = 0; q < 3; q++) rel[q] = sn_add(Vp[q], -V[c][q], sat);
             /* |rel| <= its 1-norm: how far the point can come this step */
@@ -206,8 +256,22 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             vr = sn_out(sn_mul(n[0], rel[0]) + sn_mul(n[1], rel[1]) + sn_mul(n[2], rel[2]), 30, sat);
             score = sn_add(g, vr, sat);
             if (!(score < 0) && !(g < 0)) continue;
+            /* what the contact wants relative to the solid: approach by at
+             * most g (outside), move out by min(-g, cap) (inside); dn, the
+             * normal velocity change beyond the prediction it asks of the
+             * flesh, at most the yield bound (bone-aware: ct_yield) */
+            want = g >= 0 ? (sn_q)-g : (-g > cap ? cap : (sn_q)-g);
+            dn = sn_add(want, -vr, sat);
             vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
-            target = g >= 0 ? sn_add(vcn, -g, sat) : sn_add(vcn, -g > cap ? cap : (sn_q)-g, sat);
+            target = sn_add(vcn, want, sat);
+            if (dn > 0) {
+                lim = ct_yield(h, vx, phi, n, fw, sat);
+                if (!(lim > 0)) continue; /* the free corners are already as far out as the bound lets them: no row */
+                if (dn > lim) {           /* yield: ask only what the free corners can give within the bound */
+                    target = sn_add(sn_add(vcn, vr, sat), lim, sat);
+                    h->con_clamps = sn_count(h->con_clamps, 1);
+                }
+            }
             /* one contact per (collider, cell): the row of this cell, if any */
             for (j = first; j < h->n_rows; j++)
                 if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && rows[j].vtx[0] == vx[0]) break;

@@ -4,7 +4,7 @@
 #include "sn_instance.h"
 
 /* Skinned (rigidly warped) position s_i = R_i x_i + c_i of lattice vertex i. */
-static void skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat) {
+void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat) {
     const sn_q *R = CARR(h, o_R, sn_q), *c = CARR(h, o_c, sn_q);
     const unsigned char *rest = h->v.sec[SN_SEC_REST];
     sn_q x[3], rx[3];
@@ -38,7 +38,7 @@ void sn_limits(sn_ihdr *h, uint32_t *sat) {
         sn_q L = rd_real(lim, i), s[3], d[3];
         sn_len2 d2;
         if (!(L > 0)) continue;
-        skinned(h, i, s, sat);
+        sn_skinned(h, i, s, sat);
         for (k = 0; k < 3; k++) d[k] = sn_add(pos[3 * i + k], -s[k], sat);
         d2 = len2(d);
 #if defined(SN_FLOAT)
@@ -110,7 +110,7 @@ void sn_health(sn_ihdr *h, uint32_t step_clamps) {
          * vertex is ~1e-3 of an interior one (bake weight `air`), and its
          * sag says nothing about the surface */
         if (rd_real(ml, i) < mmin) continue;
-        skinned(h, i, s, &local);
+        sn_skinned(h, i, s, &local);
         for (k = 0; k < 3; k++) d[k] = sn_add(pos[3 * i + k], -s[k], &local);
         d2 = len2(d);
         m2 = d2 > m2 ? d2 : m2;

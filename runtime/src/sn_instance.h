@@ -158,6 +158,7 @@ void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vert
 void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
+void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat); /* free vertex i carried rigidly by its frame (R x_rest + c; sn_health.c) */
 void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */
 void sn_controls_reset(sn_ihdr *h);                 /* abstract controls to their baked values */
 void sn_forces_rhs(sn_ihdr *h, sn_q *b, uint32_t *sat); /* 5: b += applied forces' fine and coarse shares (sn_force.c) */
