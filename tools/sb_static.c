@@ -310,42 +310,11 @@ static int write_obj(const char *path, const snref_model *m, const double *surf,
     return rc;
 }
 
-static const float flesh[3] = { 0.78f, 0.60f, 0.44f };
-static const uint8_t ink[3] = { 25, 28, 38 };
 
 /* one panel: surf (mesh units), coloured by |surf - base| / scale when base */
 static int panel(rs_image *out, const snref_model *m, const double *surf, const double *base, double scale,
                  const float lo[3], const float hi[3], double az, double el, const char *l1, const char *l2) {
-    rs_image big;
-    rs_camera cam;
-    float *pos = malloc(3 * (size_t)m->nS * sizeof *pos), *col = malloc(3 * (size_t)m->nS * sizeof *col);
-    uint32_t *tri = malloc(3 * (size_t)m->nT * sizeof *tri + 4);
-    unsigned i, k;
-    if (!pos || !col || !tri || rs_image_alloc(&big, 2 * out->w, 2 * out->h)) { free(pos); free(col); free(tri); return -1; }
-    for (i = 0; i < 3 * m->nS; i++) pos[i] = (float)surf[i];
-    for (i = 0; i < 3 * m->nT; i++) tri[i] = m->tris[i];
-    for (i = 0; i < m->nS; i++) {
-        float h = 0;
-        if (base && scale > 0) {
-            double d = 0;
-            for (k = 0; k < 3; k++) d += (surf[3 * i + k] - base[3 * i + k]) * (surf[3 * i + k] - base[3 * i + k]);
-            h = (float)(sqrt(d) / scale);
-            if (h > 1) h = 1;
-        }
-        col[3 * i] = flesh[0] + h * (0.95f - flesh[0]);
-        col[3 * i + 1] = flesh[1] + h * (0.12f - flesh[1]);
-        col[3 * i + 2] = flesh[2] + h * (0.05f - flesh[2]);
-    }
-    rs_camera_frame(&cam, lo, hi, big.w, big.h, (float)az, (float)el);
-    cam.ground_y = lo[1];
-    rs_clear(&big, &cam);
-    rs_draw_mesh_colors(&big, &cam, pos, (int)m->nS, tri, (int)m->nT, col);
-    rs_downsample2(&big, out);
-    rs_image_free(&big);
-    if (l1) rs_draw_text(out, 8, 8, 2, l1, ink);
-    if (l2) rs_draw_text(out, 8, 28, 1, l2, ink);
-    free(pos); free(col); free(tri);
-    return 0;
+    return rs_heat_panel(out, surf, base, scale, m->nS, m->tris, m->nT, lo, hi, az, el, l1, l2);
 }
 
 static int write_png(const char *path, const snref_model *m, const double *a, const double *b, double scale,

@@ -193,42 +193,12 @@ static void pose_string(const snref_model *m, const double *local, char *out, si
 
 /* ---------------- picture ---------------- */
 
-static const uint8_t ink[3] = {25, 28, 38};
 
 /* one panel: surf coloured red by |surf - ref| / scale (ref NULL: flesh) */
 static int panel(rs_image *out, const snref_model *m, const double *surf, const double *ref, double scale, const float lo[3], const float hi[3],
                  double az, double el, const char *l1, const char *l2)
 {
-    rs_image big;
-    rs_camera cam;
-    float *pos = malloc(3 * (size_t)m->nS * sizeof *pos), *col = malloc(3 * (size_t)m->nS * sizeof *col);
-    uint32_t *tri = malloc(3 * (size_t)m->nT * sizeof *tri + 4);
-    unsigned i, k;
-    if (!pos || !col || !tri || rs_image_alloc(&big, 2 * out->w, 2 * out->h)) { free(pos); free(col); free(tri); return -1; }
-    for (i = 0; i < 3 * m->nS; i++) pos[i] = (float)surf[i];
-    for (i = 0; i < 3 * m->nT; i++) tri[i] = m->tris[i];
-    for (i = 0; i < m->nS; i++) {
-        float h = 0;
-        if (ref && scale > 0) {
-            double d = 0;
-            for (k = 0; k < 3; k++) d += (surf[3 * i + k] - ref[3 * i + k]) * (surf[3 * i + k] - ref[3 * i + k]);
-            h = (float)(sqrt(d) / scale);
-            if (h > 1) h = 1;
-        }
-        col[3 * i] = 0.78f + h * (0.95f - 0.78f);
-        col[3 * i + 1] = 0.60f + h * (0.12f - 0.60f);
-        col[3 * i + 2] = 0.44f + h * (0.05f - 0.44f);
-    }
-    rs_camera_frame(&cam, lo, hi, big.w, big.h, (float)az, (float)el);
-    cam.ground_y = lo[1];
-    rs_clear(&big, &cam);
-    rs_draw_mesh_colors(&big, &cam, pos, (int)m->nS, tri, (int)m->nT, col);
-    rs_downsample2(&big, out);
-    rs_image_free(&big);
-    if (l1) rs_draw_text(out, 8, 8, 2, l1, ink);
-    if (l2) rs_draw_text(out, 8, 28, 1, l2, ink);
-    free(pos); free(col); free(tri);
-    return 0;
+    return rs_heat_panel(out, surf, ref, scale, m->nS, m->tris, m->nT, lo, hi, az, el, l1, l2);
 }
 
 static int picture(const char *path, const snref_model *m, int np, const double *const *surf, const double *const *ref, const double *scale,

@@ -357,3 +357,38 @@ void rs_fill(rs_image *im, int x0, int y0, int w, int h, const uint8_t color[3])
     for (y = y0; y < y0 + h; y++)
         for (x = x0; x < x0 + w; x++) blend(im, x, y, color, 1.0f);
 }
+
+int rs_heat_panel(rs_image *out, const double *surf, const double *base, double scale, unsigned ns,
+                  const unsigned *tris, unsigned nt, const float lo[3], const float hi[3], double az, double el,
+                  const char *l1, const char *l2) {
+    static const float flesh[3] = {0.78f, 0.60f, 0.44f}, red[3] = {0.95f, 0.12f, 0.05f};
+    static const uint8_t ink[3] = {25, 28, 38};
+    rs_image big;
+    rs_camera cam;
+    float *pos = malloc(3 * (size_t)ns * sizeof *pos + 4), *col = malloc(3 * (size_t)ns * sizeof *col + 4);
+    uint32_t *tri = malloc(3 * (size_t)nt * sizeof *tri + 4);
+    unsigned i, k;
+    if (!pos || !col || !tri || rs_image_alloc(&big, 2 * out->w, 2 * out->h)) { free(pos); free(col); free(tri); return -1; }
+    for (i = 0; i < 3 * ns; i++) pos[i] = (float)surf[i];
+    for (i = 0; i < 3 * nt; i++) tri[i] = tris[i];
+    for (i = 0; i < ns; i++) {
+        float h = 0;
+        if (base && scale > 0) {
+            double d = 0;
+            for (k = 0; k < 3; k++) d += (surf[3 * i + k] - base[3 * i + k]) * (surf[3 * i + k] - base[3 * i + k]);
+            h = (float)(sqrt(d) / scale);
+            if (h > 1) h = 1;
+        }
+        for (k = 0; k < 3; k++) col[3 * i + k] = flesh[k] + h * (red[k] - flesh[k]);
+    }
+    rs_camera_frame(&cam, lo, hi, big.w, big.h, (float)az, (float)el);
+    cam.ground_y = lo[1];
+    rs_clear(&big, &cam);
+    rs_draw_mesh_colors(&big, &cam, pos, (int)ns, tri, (int)nt, col);
+    rs_downsample2(&big, out);
+    rs_image_free(&big);
+    if (l1) rs_draw_text(out, 8, 8, 2, l1, ink);
+    if (l2) rs_draw_text(out, 8, 28, 1, l2, ink);
+    free(pos); free(col); free(tri);
+    return 0;
+}

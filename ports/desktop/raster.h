@@ -59,4 +59,15 @@ void rs_blit(rs_image *dst, int x0, int y0, const rs_image *src);
 /// Fill a rectangle.
 void rs_fill(rs_image *im, int x0, int y0, int w, int h, const uint8_t color[3]);
 
+/// One picture panel of a surface (ns vertices as doubles, nt triangles):
+/// drawn at twice out's size from (az, el) degrees framing [lo, hi] (ground
+/// at lo[1]), downsampled into out; flesh-coloured, shaded towards red by
+/// |surf - base| / scale (clamped at 1; base NULL or scale <= 0: plain
+/// flesh); label l1 (large) and l2 (small) at the top left when not NULL.
+/// The heat pictures of sinew-bake --static, sinew-rig and test_nonlinear.
+/// Returns 0, or -1 when out of memory (out untouched).
+int rs_heat_panel(rs_image *out, const double *surf, const double *base, double scale, unsigned ns,
+                  const unsigned *tris, unsigned nt, const float lo[3], const float hi[3], double az, double el,
+                  const char *l1, const char *l2);
+
 #endif
