@@ -42,6 +42,22 @@ static void affine(const double *p, double *o)
 }
 
 /* a box [x0,x1]x[y0,y1]x[z0,z1] split n per unit, counter-clockwise from outside, moved by affine() if mv */
+/* Largest |J_i - G| / |G| over A's lattice vertices: how far the map's
+ * Jacobians are from the affine map the test built B with. */
+static double jacobian_error(const sb_retarget *rt)
+{
+    double worst = 0, gn = 0;
+    int i, k;
+    for (k = 0; k < 9; k++) gn += G[k] * G[k];
+    gn = sqrt(gn);
+    for (i = 0; i < rt->nv; i++) {
+        double e = 0;
+        for (k = 0; k < 9; k++) e += (rt->J[9 * i + k] - G[k]) * (rt->J[9 * i + k] - G[k]);
+        worst = fmax(worst, sqrt(e) / gn);
+    }
+    return worst;
+}
+
 static void write_box(const char *path, int mv)
 {
     const double lo[3] = { -0.5, -1, -1 }, hi[3] = { 8.5, 1, 1 };
@@ -219,13 +235,9 @@ int main(void)
     T_CHECK(sb_rt_solve(&rt) == 0, "solve: %s", sb_error());
     T_CHECK(sb_rt_jacobians(&rt) == 0, "jacobians: %s", sb_error());
     {
-        double worst = 0, gn = 0, hx = 0;
-        for (k = 0; k < 9; k++) gn += G[k] * G[k];
-        gn = sqrt(gn);
+        double worst = jacobian_error(&rt), hx = 0;
         for (i = 0; i < rt.nv; i++) {
-            double e = 0, q[3];
-            for (k = 0; k < 9; k++) e += (rt.J[9 * i + k] - G[k]) * (rt.J[9 * i + k] - G[k]);
-            worst = fmax(worst, sqrt(e) / gn);
+            double q[3];
             affine(ca.o.x + 3 * i, q);
             for (a = 0; a < 3; a++) hx = fmax(hx, fabs(rt.h[3 * i + a] - q[a]));
         }
@@ -348,20 +360,14 @@ int main(void)
 
     /* ---- the same with L-BFGS-B (tools/sb_lbfgsb.c) as the inner optimizer ---- */
     {
-        double worst = 0, gn = 0;
+        double worst;
         opt.optimizer = SB_RT_OPT_LBFGSB;
         opt.cg_tol = 1e-12;
         opt.cg_max = 50000;
         T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) == 0, "init: %s", sb_error());
         T_CHECK(sb_rt_solve(&rt) == 0, "solve (L-BFGS-B): %s", sb_error());
         T_CHECK(sb_rt_jacobians(&rt) == 0, "jacobians: %s", sb_error());
-        for (k = 0; k < 9; k++) gn += G[k] * G[k];
-        gn = sqrt(gn);
-        for (i = 0; i < rt.nv; i++) {
-            double e = 0;
-            for (k = 0; k < 9; k++) e += (rt.J[9 * i + k] - G[k]) * (rt.J[9 * i + k] - G[k]);
-            worst = fmax(worst, sqrt(e) / gn);
-        }
+        worst = jacobian_error(&rt);
         T_FIGURE("affine copy by L-BFGS-B: %d iterations, %.2f s, cost %.3e; largest |J_i - G| / |G| = %.3e", rt.cg_iters, rt.secs, rt.cost, worst);
         T_CHECK(worst <= 1e-6, "L-BFGS-B: J_i = G within 1e-6 (got %.3g)", worst);
         sb_rt_free(&rt);
@@ -370,19 +376,13 @@ int main(void)
 
     /* ---- closest points on the same pair (no correspondence used) ---- */
     {
-        double worst = 0, gn = 0;
+        double worst;
         opt.corr = SB_RT_CORR_CLOSEST;
         opt.cg_tol = 1e-10;
         T_CHECK(sb_rt_init(&rt, &ca.o, &ca.m, &cb.o, &cb.m, &opt) == 0, "init: %s", sb_error());
         T_CHECK(sb_rt_solve(&rt) == 0, "solve: %s", sb_error());
         T_CHECK(sb_rt_jacobians(&rt) == 0, "jacobians: %s", sb_error());
-        for (k = 0; k < 9; k++) gn += G[k] * G[k];
-        gn = sqrt(gn);
-        for (i = 0; i < rt.nv; i++) {
-            double e = 0;
-            for (k = 0; k < 9; k++) e += (rt.J[9 * i + k] - G[k]) * (rt.J[9 * i + k] - G[k]);
-            worst = fmax(worst, sqrt(e) / gn);
-        }
+        worst = jacobian_error(&rt);
         T_FIGURE("closest points: %d rounds, %d CG iterations, %.2f s; surface rms %.2e max %.2e, skeleton rms %.2e (mesh units); largest |J_i - G|/|G| %.2e",
                  rt.rounds, rt.cg_iters, rt.secs, rt.surf_rms, rt.surf_max, rt.skel_rms, worst);
         T_CHECK(rt.surf_max < 1e-2 * rt.L, "closest points: the affine copy is matched within 1%% of its size (surface max %.3g)", rt.surf_max);

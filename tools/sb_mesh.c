@@ -102,11 +102,43 @@ static int closed_check(const char *path, const sb_mesh *m)
     return 0;
 }
 
+/* The checks every mesh passes once its vertices and triangles are read:
+ * counts, closed and oriented, extent, positive volume. `after` qualifies
+ * the vertex count ("" or " after welding"); vline_lo/hi (OBJ line of the
+ * extreme vertex per axis) may be NULL when the input has no lines. */
+static int mesh_finish(const char *path, sb_mesh *m, const char *after, const int *vline_lo, const int *vline_hi)
+{
+    int i, k;
+    if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
+    if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices%s; a blob holds at most 65535 surface vertices", path, m->nv, after);
+    if (closed_check(path, m)) return -1;
+    for (k = 0; k < 3; k++) { m->lo[k] = HUGE_VAL; m->hi[k] = -HUGE_VAL; }
+    for (i = 0; i < m->nv; i++)
+        for (k = 0; k < 3; k++) {
+            if (m->v[3 * i + k] < m->lo[k]) m->lo[k] = m->v[3 * i + k];
+            if (m->v[3 * i + k] > m->hi[k]) m->hi[k] = m->v[3 * i + k];
+        }
+    for (k = 0; k < 3; k++) {
+        if (m->hi[k] - m->lo[k] <= SB_MESH_EXTENT_MAX) continue;
+        if (vline_lo && vline_hi)
+            return sb_fail("%s:%d: vertex at %c = %g is %g mesh units from the vertex at line %d (%c = %g): a mesh may span at "
+                           "most %g mesh units along each axis (a blob holds positions within 16384 mesh units of the root "
+                           "joint): scale the mesh down and the description's 'unit' up",
+                           path, vline_hi[k], "xyz"[k], m->hi[k], m->hi[k] - m->lo[k], vline_lo[k], "xyz"[k], m->lo[k],
+                           SB_MESH_EXTENT_MAX);
+        return sb_fail("%s: the mesh spans %g mesh units along %c; at most %g (scale the mesh down and the description's 'unit' up)",
+                       path, m->hi[k] - m->lo[k], "xyz"[k], SB_MESH_EXTENT_MAX);
+    }
+    if (sb_mesh_volume(m) <= 0.0)
+        return sb_fail("%s: mesh encloses a non-positive volume: faces must be counter-clockwise seen from outside", path);
+    return 0;
+}
+
 int sb_mesh_load_obj(const char *path, sb_mesh *m)
 {
     FILE *f = fopen(path, "r");
     char line[4096];
-    int lineno = 0, capv = 1024, k, i;
+    int lineno = 0, capv = 1024, k;
     int *pidx = NULL, *pstart = NULL, *pline = NULL, np = 0, capi = 4096, capp = 1024, ntri = 0;
     int vmin[3] = {0, 0, 0}, vmax[3] = {0, 0, 0}, vline_lo[3] = {0, 0, 0}, vline_hi[3] = {0, 0, 0};
     memset(m, 0, sizeof *m);
@@ -201,25 +233,7 @@ int sb_mesh_load_obj(const char *path, sb_mesh *m)
     }
     free(pidx); free(pstart); free(pline);
     fclose(f);
-    if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
-    if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices; a blob holds at most 65535 surface vertices", path, m->nv);
-    if (closed_check(path, m)) return -1;
-    for (k = 0; k < 3; k++) { m->lo[k] = HUGE_VAL; m->hi[k] = -HUGE_VAL; }
-    for (i = 0; i < m->nv; i++)
-        for (k = 0; k < 3; k++) {
-            if (m->v[3 * i + k] < m->lo[k]) m->lo[k] = m->v[3 * i + k];
-            if (m->v[3 * i + k] > m->hi[k]) m->hi[k] = m->v[3 * i + k];
-        }
-    for (k = 0; k < 3; k++)
-        if (m->hi[k] - m->lo[k] > SB_MESH_EXTENT_MAX)
-            return sb_fail("%s:%d: vertex at %c = %g is %g mesh units from the vertex at line %d (%c = %g): a mesh may span at "
-                           "most %g mesh units along each axis (a blob holds positions within 16384 mesh units of the root "
-                           "joint): scale the mesh down and the description's 'unit' up",
-                           path, vline_hi[k], "xyz"[k], m->hi[k], m->hi[k] - m->lo[k], vline_lo[k], "xyz"[k], m->lo[k],
-                           SB_MESH_EXTENT_MAX);
-    if (sb_mesh_volume(m) <= 0.0)
-        return sb_fail("%s: mesh encloses a non-positive volume: faces must be counter-clockwise seen from outside", path);
-    return 0;
+    return mesh_finish(path, m, "", vline_lo, vline_hi);
 }
 
 void sb_mesh_free(sb_mesh *m)
@@ -436,20 +450,5 @@ int sb_mesh_from_points(const char *path, int nsrc, const double *pos, int nsrc_
         m->tri[3 * m->nt] = a, m->tri[3 * m->nt + 1] = b, m->tri[3 * m->nt + 2] = c;
         m->nt++;
     }
-    if (m->nv == 0 || m->nt == 0) return sb_fail("%s: mesh has no vertices or no faces", path);
-    if ((unsigned)m->nv > 65535u) return sb_fail("%s: %d vertices after welding; a blob holds at most 65535 surface vertices", path, m->nv);
-    if (closed_check(path, m)) return -1;
-    for (k = 0; k < 3; k++) { m->lo[k] = HUGE_VAL; m->hi[k] = -HUGE_VAL; }
-    for (i = 0; i < m->nv; i++)
-        for (k = 0; k < 3; k++) {
-            if (m->v[3 * i + k] < m->lo[k]) m->lo[k] = m->v[3 * i + k];
-            if (m->v[3 * i + k] > m->hi[k]) m->hi[k] = m->v[3 * i + k];
-        }
-    for (k = 0; k < 3; k++)
-        if (m->hi[k] - m->lo[k] > SB_MESH_EXTENT_MAX)
-            return sb_fail("%s: the mesh spans %g mesh units along %c; at most %g (scale the mesh down and the description's 'unit' up)",
-                           path, m->hi[k] - m->lo[k], "xyz"[k], SB_MESH_EXTENT_MAX);
-    if (sb_mesh_volume(m) <= 0.0)
-        return sb_fail("%s: mesh encloses a non-positive volume: faces must be counter-clockwise seen from outside", path);
-    return 0;
+    return mesh_finish(path, m, " after welding", NULL, NULL);
 }

@@ -530,6 +530,24 @@ static double grad_norm(const prob_t *pr, const double *p, const double *alpha) 
 }
 
 /* Newton on pr from (p, alpha); p skeleton rows already set. */
+/* The gradient of Pi over the free p rows (uncondensed: the cells' element
+ * gradients G, not their bubble-condensed form), as a new calloc'd array. */
+static double *true_gradient(const prob_t *pr, const double *p, const double *G) {
+    const nlref *n = pr->n;
+    const snref_model *m = &n->m;
+    unsigned F3 = 3 * n->nF, e, a, i;
+    double *gp = calloc(F3, sizeof *gp);
+    for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
+    if (pr->dyn) dyn_terms(pr, p, gp);
+    twist_terms(n, p, gp, NULL);
+    for (e = 0; e < n->nC; e++)
+        for (a = 0; a < 8; a++) {
+            unsigned va = m->cells[8 * e + a];
+            if (va < n->nF) for (i = 0; i < 3; i++) gp[3 * va + i] += G[(size_t)ND * e + 3 * a + i];
+        }
+    return gp;
+}
+
 static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsigned max_iter, nlref_stats *st) {
     nlref *n = pr->n;
     const snref_model *m = &n->m;
@@ -582,15 +600,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
         }
         /* true gradient norm: free p rows (uncondensed g_p) and alpha */
         {
-            double *gp = calloc(F3, sizeof *gp);
-            for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
-            if (pr->dyn) dyn_terms(pr, p, gp);
-            twist_terms(n, p, gp, NULL);
-            for (e = 0; e < nC; e++)
-                for (a = 0; a < 8; a++) {
-                    unsigned va = m->cells[8 * e + a];
-                    if (va < n->nF) for (i = 0; i < 3; i++) gp[3 * va + i] += G[(size_t)ND * e + 3 * a + i];
-                }
+            double *gp = true_gradient(pr, p, G);
             for (i = 0; i < F3; i++) gn2 += gp[i] * gp[i];
             free(gp);
         }
@@ -642,15 +652,7 @@ static int newton(const prob_t *pr, double *p, double *alpha, double tol, unsign
             for (i = 0; i < 9; i++) { dal[9 * e + i] = -x[i]; D += ge[24 + i] * dal[9 * e + i]; }
         }
         {   /* directional derivative of Pi: true gradient . (dp, dalpha) */
-            double *gp = calloc(F3, sizeof *gp);
-            for (i = 0; i < F3; i++) gp[i] = -pr->load[i];
-            if (pr->dyn) dyn_terms(pr, p, gp);
-            twist_terms(n, p, gp, NULL);
-            for (e = 0; e < nC; e++)
-                for (a = 0; a < 8; a++) {
-                    unsigned va = m->cells[8 * e + a];
-                    if (va < n->nF) for (i = 0; i < 3; i++) gp[3 * va + i] += G[(size_t)ND * e + 3 * a + i];
-                }
+            double *gp = true_gradient(pr, p, G);
             for (i = 0; i < F3; i++) D += gp[i] * dp[i];
             free(gp);
         }
