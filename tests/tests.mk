@@ -4,5 +4,16 @@ TEST_BINS ?=
 TEST_DEPS ?=
 include tests/physics.mk
 include tests/health.mk
-test: $(TEST_BINS) $(TEST_DEPS)
-	sh tests/run_tests.sh $(BUILD)
+# The build runs in TEST_JOBS lanes (default 2, the CI machine's cores), then
+# the suites; `make test-build` alone builds what they need.
+TEST_JOBS ?= 2
+.PHONY: test-build
+test:
+	$(MAKE) -j$(TEST_JOBS) test-build
+	TEST_JOBS=$(TEST_JOBS) sh tests/run_tests.sh $(BUILD)
+test-build: $(TEST_BINS) $(TEST_DEPS)
+# every build of the determinism matrix (make test runs a slice of it, see
+# tests/scripts/test_determinism.sh)
+.PHONY: determinism
+determinism:
+	DET_SET=full BUILD=$(BUILD) sh tests/scripts/test_determinism.sh
