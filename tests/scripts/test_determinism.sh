@@ -184,7 +184,7 @@ for fl in "" _float; do
     p=$BUILD/sinew-play; [ -n "$fl" ] && p=$BUILD/sinew-play-float   # the float player's name has a dash, the blob's an underscore
     if pmake "$p" > "$L/build_crease_play$fl.log" 2>&1 && run_log "$L/run_crease_play$fl.log" 600 "$p" "$BUILD/examples/limb_crease$fl.blob" \
             --clip "$CR_CLIP" --frames "$CR_STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_crease_play$fl.log")" ]; then
-        h=$(hash_of "$L/run_crease_play$fl.log"); echo "determinism: crease sinew-play$fl $h"
+        h=$(hash_of "$L/run_crease_play$fl.log"); echo "determinism: crease $(basename "$p") $h"
         if [ -z "$fl" ]; then crfixed="${crfixed}sinew-play $h
 "; else crfloat="${crfloat}sinew-play-float $h
 "; fi
