@@ -5,9 +5,7 @@
 BUILD=${BUILD:-build}
 BAKE=$BUILD/sinew-bake
 CC=${CC:-cc}
-pass=0; fail=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
+. tests/scripts/cli_lib.sh
 [ -x "$BAKE" ] || { echo "FAIL: $BAKE not built"; echo "0 passed, 1 failed"; exit 1; }
 T=$(mktemp -d "${TMPDIR:-/tmp}/sinew_bake_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT

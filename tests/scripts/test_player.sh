@@ -13,24 +13,9 @@ BLOBF=$BUILD/examples/cow_float.blob
 CLIP=tools/examples/cow/head_turn.clip
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/sn_player.XXXXXX") || exit 1
 trap 'rm -rf "$TMP"' EXIT
-pass=0; fail=0
+. tests/scripts/cli_lib.sh
 
-ok()  { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-# expect STATUS PATTERN CMD...: exit status STATUS ("nz" = any non-zero) and
-# PATTERN (grep -E) in stdout+stderr.
-expect() {
-    want=$1; pat=$2; shift 2
-    out=$("$@" 2>&1); rc=$?
-    if [ "$want" = nz ]; then [ "$rc" -ne 0 ] || { bad "$* exited 0, want non-zero"; return; }
-    else [ "$rc" -eq "$want" ] || { bad "$* exited $rc, want $want: $out"; return; }; fi
-    echo "$out" | grep -Eq -e "$pat" || { bad "$*: output lacks /$pat/: $out"; return; }
-    ok
-}
-
-for f in "$PLAY" "$PLAYF" "$PLOT" "$BLOB" "$BLOBF" "$CLIP"; do
-    [ -e "$f" ] || { echo "FAIL: missing $f (run make first)"; echo "0 passed, 1 failed"; exit 1; }
-done
+need "$PLAY" "$PLAYF" "$PLOT" "$BLOB" "$BLOBF" "$CLIP"
 
 # usage
 expect 0 'usage: sinew-play BLOB' "$PLAY" --help

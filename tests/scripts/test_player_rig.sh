@@ -18,26 +18,11 @@ COWF=$BUILD/examples/cow_float.blob
 LIMB=$BUILD/examples/limb.blob
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/sn_player_rig.XXXXXX") || exit 1
 trap 'rm -rf "$TMP"' EXIT
-pass=0; fail=0
-
-ok()  { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-# expect STATUS PATTERN CMD...: exit status STATUS ("nz" = any non-zero) and
-# PATTERN (grep -E) in stdout+stderr.
-expect() {
-    want=$1; pat=$2; shift 2
-    out=$("$@" 2>&1); rc=$?
-    if [ "$want" = nz ]; then [ "$rc" -ne 0 ] || { bad "$* exited 0, want non-zero"; return; }
-    else [ "$rc" -eq "$want" ] || { bad "$* exited $rc, want $want: $out"; return; }; fi
-    echo "$out" | grep -Eq -e "$pat" || { bad "$*: output lacks /$pat/: $out"; return; }
-    ok
-}
+. tests/scripts/cli_lib.sh
 # hash PLAYER BLOB ARGS...: the state hash line after the run ("" on failure)
 hash() { p=$1; b=$2; shift 2; "$p" "$b" --hash --quiet "$@" 2>/dev/null | grep '^hash: '; }
 
-for f in "$PLAY" "$PLAYF" "$BAKE" "$COW" "$COWF" "$LIMB"; do
-    [ -e "$f" ] || { echo "FAIL: missing $f (run make first)"; echo "0 passed, 1 failed"; exit 1; }
-done
+need "$PLAY" "$PLAYF" "$BAKE" "$COW" "$COWF" "$LIMB"
 for c in breath smile nostrils; do
     "$PLAY" "$COW" --control "$c=0" --frames 0 --quiet > /dev/null 2>&1 ||
         { echo "FAIL: $COW has no abstract control '$c' (baked before the cow's rigs?)"; echo "0 passed, 1 failed"; exit 1; }

@@ -6,9 +6,7 @@
 # write nothing.
 BUILD=${BUILD:-build}
 RIG=$BUILD/sinew-rig
-pass=0; fail=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
+. tests/scripts/cli_lib.sh
 [ -x "$RIG" ] || { echo "FAIL: $RIG not built"; echo "0 passed, 1 failed"; exit 1; }
 T=$(mktemp -d "${TMPDIR:-/tmp}/sinew_retarget_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT

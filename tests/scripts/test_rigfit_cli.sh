@@ -8,21 +8,11 @@
 BUILD=${BUILD:-build}
 RIG=$BUILD/sinew-rig
 BAKE=$BUILD/sinew-bake
-pass=0; fail=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
+. tests/scripts/cli_lib.sh
 for f in "$RIG" "$BAKE"; do [ -x "$f" ] || { echo "FAIL: $f not built"; echo "0 passed, 1 failed"; exit 1; }; done
 T=$(mktemp -d "${TMPDIR:-/tmp}/sinew_rig_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT
 ROOT=$(pwd)
-# expect STATUS PATTERN CMD...: exit status and a pattern in stdout+stderr
-expect() {
-    want=$1; pat=$2; shift 2
-    out=$("$@" 2>&1); rc=$?
-    [ "$rc" -eq "$want" ] || { bad "$*: exit $rc, want $want: $out"; return; }
-    echo "$out" | grep -Eq -e "$pat" || { bad "$*: output lacks /$pat/: $out"; return; }
-    ok "$(echo "$*" | sed "s|$T/||g; s|$BUILD/||g") -> $want /$pat/"
-}
 
 expect 0 'fit-surface' "$RIG" --help
 expect 2 'unknown command' "$RIG" fit-everything tools/examples/limb/limb.sinew
