@@ -174,7 +174,7 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     }
     for (k = prev; k < total; k++) if (b[k]) break;
     T_CHECK(k == total, "%s: spec: trailing padding is zero", what);
-    inst = (768u + (76u + 48u) * nJ + 24u * nV + 109u * nF + 12u * (nV - nF > nF ? nV - nF : nF) + 36u * nC + 4u * nK + 64u * b[78] +
+    inst = (768u + (76u + 48u) * nJ + 24u * nV + 97u * nF + 12u * (nV - nF > nF ? nV - nF : nF) + 36u * nC + 4u * nK + 64u * b[78] +
             segB + crB + 7u) & ~7u;
     inst = (inst + conB + 7u) & ~7u;
     T_CHECK(u32(b + 60) == inst, "%s: spec: instance bytes %u, README formula %u", what, u32(b + 60), inst);

@@ -294,11 +294,11 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * of 8, so the sum rounds as the runtime's separate arrays do);
  * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record and
  * the crease rows (0 without either). Per vertex 24 (position, velocity),
- * per free vertex 108 + 1 (accumulators, frame, w, CG vectors x r q; k_i),
- * and 12 max(nF, nV - nF) for d, whose storage the skeleton's velocity
- * change shares. */
+ * per free vertex 96 + 1 (accumulators, frame, CG vectors x r q -- z and w
+ * share q's storage; k_i), and 12 max(nF, nV - nF) for d, whose storage the
+ * skeleton's velocity change shares. */
 #define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB, conB) \
-    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 24u * (uint32_t)(nV) + 108u * (uint32_t)(nF) + \
+    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 24u * (uint32_t)(nV) + 96u * (uint32_t)(nF) + \
       12u * ((uint32_t)(nV) - (uint32_t)(nF) > (uint32_t)(nF) ? (uint32_t)(nV) - (uint32_t)(nF) : (uint32_t)(nF)) + \
       (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
       SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u) + (uint32_t)(conB) + 7u) & ~7u)

@@ -135,7 +135,7 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     const unsigned char *ml = v->sec[SN_SEC_MLUMP];
     const sn_q *R = CARR(h, o_R, sn_q), *vel = CARR(h, o_vel, sn_q);
     const sn_q *ds = CARR(h, o_ds, sn_q); /* in d's storage: d is not live yet */
-    sn_q *u = ARR(h, o_u, sn_q);
+    sn_q *u = ARR(h, o_q, sn_q); /* w, in q's storage: q and z are live only in the PCG */
     sn_acc *acc = ARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF, nV = v->nV, esat = 0;
@@ -358,7 +358,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     uint32_t it, i, n3 = 3 * v->nF;
     sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
-    sn_q *q = ARR(h, o_q, sn_q), *z = ARR(h, o_u, sn_q); /* z shares u: never live together */
+    /* z shares q's storage: q is dead from r -= alpha q to the next mat-vec,
+     * z from d = z + beta d to the next preconditioner call */
+    sn_q *q = ARR(h, o_q, sn_q), *z = q;
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
