@@ -197,7 +197,7 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
 #endif
         }
     }
-    for (i = 0; i < v->nF; i++) /* skeleton vertices: their bone's jR */
+    for (i = 0; i < v->nF; i++) /* free vertices only: a skeleton vertex's frame is its bone's jR */
         frame_of(h, fr + 4 * i, R + 9 * i);
     for (i = 0; i < v->nC; i++)
         frame_of(h, cfr + 4 * i, cR + 9 * i);
