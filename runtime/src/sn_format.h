@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 5.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 6.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -15,7 +15,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 5
+#define SN_FORMAT_MAJOR 6
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -293,10 +293,14 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * crease state SN_CREASE_STATE_BYTES (0 without a CREASE section; a multiple
  * of 8, so the sum rounds as the runtime's separate arrays do);
  * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record and
- * the crease rows (0 without either). */
+ * the crease rows (0 without either). Per vertex 24 (position, velocity),
+ * per free vertex 96 + 1 (accumulators, frame, CG vectors x r q -- z and w
+ * share q's storage; k_i), and 12 max(nF, nV - nF) for d, whose storage the
+ * skeleton's velocity change shares. */
 #define SN_INSTANCE_BYTES(nV, nF, nJ, nC, nK, nFrc, segB, conB) \
-    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 84u * (uint32_t)(nV) + 72u * (uint32_t)(nF) + \
-      12u * ((uint32_t)(nV) - (uint32_t)(nF)) + (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
+    ((((SN_INSTANCE_HDR_BYTES + (76u + SN_WRENCH_BYTES) * (uint32_t)(nJ) + 24u * (uint32_t)(nV) + 96u * (uint32_t)(nF) + \
+      12u * ((uint32_t)(nV) - (uint32_t)(nF) > (uint32_t)(nF) ? (uint32_t)(nV) - (uint32_t)(nF) : (uint32_t)(nF)) + \
+      (uint32_t)(nF) + 36u * (uint32_t)(nC) + 4u * (uint32_t)(nK) + \
       SN_FORCE_SLOT_BYTES * (uint32_t)(nFrc) + (uint32_t)(segB) + 7u) & ~7u) + (uint32_t)(conB) + 7u) & ~7u)
 
 #endif /* SN_FORMAT_H */

@@ -5,13 +5,14 @@
 
 /* Skinned (rigidly warped) position s_i = R_i x_i + c_i of lattice vertex i. */
 void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat) {
-    const sn_q *R = CARR(h, o_R, sn_q), *c = CARR(h, o_c, sn_q);
+    const sn_q *R = CARR(h, o_R, sn_q);
     const unsigned char *rest = h->v.sec[SN_SEC_REST];
-    sn_q x[3], rx[3];
+    sn_q x[3], rx[3], c[3];
     uint32_t k;
     for (k = 0; k < 3; k++) x[k] = rd_real(rest, 3 * i + k);
     sn_rot(R + 9 * i, x, rx, sat);
-    for (k = 0; k < 3; k++) s[k] = sn_add(rx[k], c[3 * i + k], sat);
+    sn_vertex_origin(h, i, c);
+    for (k = 0; k < 3; k++) s[k] = sn_add(rx[k], c[k], sat);
 }
 
 /* |d|^2 of a state difference (fixed: |d_k| <= 2^29, so < 2^59.6) */

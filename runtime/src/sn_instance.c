@@ -5,23 +5,34 @@
 #include "sn_instance.h"
 
 /* hdr | acc nF*3 acc | per joint: wrench | force slots | segment state |
- * per joint: pose q4 t3, R9, T3 | per vertex: R9 c3 pos3 vel3 u3 |
- * per free: x3 r3 d3 q3 | per skeleton: ds3 | per cell: R9 | per control: value |
+ * per joint: pose q4 t3, R9, T3 | per vertex: pos3 vel3 |
+ * per free: R9 x3 r3 | d3 (max(nF, nV-nF) rows: ds shares it) | per free: q3 (z and w share it) |
+ * per cell: R9 | per control: value |
  * crease state (crB: surface positions, list, membership; sn_crease.c) | per free: k (u8) |
  * (8-aligned) constraint state: records, colliders, rows, row state, factor (sn_cons_layout)
+ * Only free vertices keep a frame: a skeleton vertex's is its bone's jR
+ * (BLOB.md: bone1 = bone2, w = 0), and every frame origin c is computed
+ * where it is read (sn_vertex_origin). ds (skeleton velocity change) is live
+ * from sn_skeleton to rhs's mass pass, d only inside the PCG loop: one
+ * storage. q (the mat-vec's output) is dead from r -= alpha q to the next
+ * mat-vec, z (the preconditioned residual) from d = z + beta d to the next
+ * preconditioner call, and w (rhs's velocity term, over free vertices;
+ * cell_forces computes the skeleton part) outside the PCG: one storage.
  * The 8-byte arrays come first (the header and each of them are multiples
  * of 8). Array offsets into off[] in the order of SN_LAYOUT_ARRAYS; returns
  * the total, rounded up to 8. Counts are validated (nV <= 65535 ...): no wrap. */
-#define SN_LAYOUT_ARRAYS 23
+#define SN_LAYOUT_ARRAYS 20
 static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
                                uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t off[SN_LAYOUT_ARRAYS]) {
+    const uint32_t nDS = nV - nF > nF ? nV - nF : nF; /* rows of d's storage: d (nF) or ds (nV - nF) */
     const uint32_t bytes[SN_LAYOUT_ARRAYS] = {
         nF * 3u * 8u, /* acc: 8 bytes per accumulator in both flavours */
         nJ * SN_WRENCH_BYTES, nFrc * SN_FORCE_SLOT_BYTES, segB,          /* wrench frc seg */
         nJ * 4u * 4u, nJ * 3u * 4u, nJ * 9u * 4u, nJ * 3u * 4u,          /* pq pt jR jT */
-        nV * 9u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, nV * 3u * 4u, /* R c pos vel u */
-        nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u, nF * 3u * 4u,          /* x r d q */
-        (nV - nF) * 3u * 4u, nC * 9u * 4u, nK * 4u, crB, nF,             /* ds cR ctl crease k */
+        nV * 3u * 4u, nV * 3u * 4u,                                      /* pos vel */
+        nF * 9u * 4u, nF * 3u * 4u, nF * 3u * 4u,                       /* R x r */
+        nDS * 3u * 4u, nF * 3u * 4u,                                     /* d (and ds) q */
+        nC * 9u * 4u, nK * 4u, crB, nF,                                  /* cR ctl crease k */
         conB};                                                            /* constraint state (sn_constraint.c), 8-aligned */
     uint32_t o = SN_HDR_BYTES, i;
     for (i = 0; i < SN_LAYOUT_ARRAYS; i++) {
@@ -43,10 +54,10 @@ static void layout(sn_ihdr *h) {
     (void)layout_offsets(h->v.nV, h->v.nF, h->v.nJ, h->v.nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
     h->o_acc = off[0]; h->o_wr = off[1]; h->o_frc = off[2]; h->o_seg = off[3];
     h->o_pq = off[4]; h->o_pt = off[5]; h->o_jR = off[6]; h->o_jT = off[7];
-    h->o_R = off[8]; h->o_c = off[9]; h->o_pos = off[10]; h->o_vel = off[11]; h->o_u = off[12];
-    h->o_x = off[13]; h->o_r = off[14]; h->o_d = off[15]; h->o_q = off[16];
-    h->o_ds = off[17]; h->o_cR = off[18]; h->o_ctl = off[19]; h->o_crs = off[20]; h->o_k = off[21];
-    sn_cons_layout(h, off[22]);
+    h->o_pos = off[8]; h->o_vel = off[9]; h->o_R = off[10]; h->o_x = off[11]; h->o_r = off[12];
+    h->o_d = off[13]; h->o_ds = off[13]; h->o_q = off[14];
+    h->o_cR = off[15]; h->o_ctl = off[16]; h->o_crs = off[17]; h->o_k = off[18];
+    sn_cons_layout(h, off[19]);
 }
 
 #if !defined(SN_FLOAT)
@@ -193,7 +204,7 @@ sn_status sn_reset(sn_instance *inst) {
     for (i = 0; i < nV; i++)
         for (k = 0; k < 3; k++) pos[3 * i + k] = rd_real(v->sec[SN_SEC_REST], 3 * i + k);
     /* rest-pose frames so getters work before the first step */
-    set_identity(ARR(h, o_R, sn_q), nV);
+    set_identity(ARR(h, o_R, sn_q), v->nF);
     set_identity(ARR(h, o_cR, sn_q), v->nC);
     sn_controls_reset(h);
     sn_segments_reset(h);

@@ -34,8 +34,9 @@ typedef struct sn_ihdr {
     float to_int, to_pub;   /* mesh units <-> internal units */
 #endif
     /* byte offsets of the arrays from the instance start */
-    uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_c, o_pos, o_vel, o_u, o_x, o_r, o_d, o_q, o_ds,
+    uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_pos, o_vel, o_x, o_r, o_d, o_q, o_ds, /* o_ds = o_d; q, z, w share o_q */
         o_k, o_cR, o_ctl, o_wr, o_frc, o_seg, o_crs;
+    uint32_t frame_mode;    /* the mode the frames (R, cR, jT) were last built in: the origins sn_vertex_origin derives follow it */
     uint32_t n_forces;      /* force slots filled since the last step (sn_force.c) */
     uint32_t force_drops;   /* forces refused since init/reset: slots full */
     sn_real seg_gap;        /* largest segment constraint gap after the last step's sweeps, fraction of a segment (public Q16.16 / float) */
@@ -156,6 +157,10 @@ int64_t int_to_pub64(const sn_ihdr *h, sn_q v);
 /* ---- stages (NUMERICS.md "One step") ---- */
 void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vertex and cell frames */
 void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
+/* Frame origin c of lattice vertex i (free or skeleton) from the joint
+ * translations jT of the last frames, as they were built (frame_mode): not
+ * stored, the same bits frame_of computed (sn_pose.c). */
+void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]);
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
 void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat); /* free vertex i carried rigidly by its frame (R x_rest + c; sn_health.c) */

@@ -107,34 +107,52 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local, const sn_vec3
     }
 }
 
-/* Frame of a vertex or cell from its (b1, b2, w) entry: R = slerp_path(q_b1,
- * q_b2, w) and, for vertices (c != NULL), c = (1-w) T_b1 + w T_b2. */
-static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_q *c, uint32_t *sat) {
-    const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+/* Origin c = (1-w) T_b1 + w T_b2 of a (b1, b2, w) frame entry in `mode`
+ * (unwarped: the root's T). A convex combination of translations within the
+ * state range (w <= 1 validated; each T clamped): never clamped, so it is
+ * computed where it is read instead of stored. */
+static void origin_of(const sn_ihdr *h, const unsigned char *f, uint32_t mode, sn_q c[3]) {
+    const sn_q *jT = CARR(h, o_jT, sn_q);
     uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
-    if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I, c = root */
+    if (mode == SN_MODE_UNWARPED) {
+        for (k = 0; k < 3; k++) c[k] = jT[k];
+    } else if (b1 == b2 || w == 0) {
+        memcpy(c, jT + 3 * b1, 3 * sizeof(sn_q));
+    } else {
+#if defined(SN_FLOAT)
+        sn_q t = (float)w * (1.0f / 32768.0f);
+        for (k = 0; k < 3; k++) c[k] = jT[3 * b1 + k] + t * (jT[3 * b2 + k] - jT[3 * b1 + k]);
+#else
+        uint32_t none = 0; /* |result| <= SN_LIM: no clamp */
+        for (k = 0; k < 3; k++) {
+            int64_t a = jT[3 * b1 + k], b = jT[3 * b2 + k];
+            c[k] = sn_out(a * 32768 + (b - a) * (int64_t)w, SN_Q_W, &none);
+        }
+#endif
+    }
+}
+
+void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]) {
+    origin_of(h, h->v.sec[SN_SEC_FRAMES] + 4 * (size_t)i, h->frame_mode, c);
+}
+
+/* Rotation of a vertex's or cell's frame from its (b1, b2, w) entry:
+ * R = slerp_path(q_b1, q_b2, w) (seed 003 §3.3), the bone's jR when w = 0. */
+static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R) {
+    const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q);
+    uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
+    if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I */
         for (k = 0; k < 9; k++) R[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
-        if (c) for (k = 0; k < 3; k++) c[k] = jT[k];
     } else if (b1 == b2 || w == 0) {
         memcpy(R, jR + 9 * b1, 9 * sizeof(sn_q));
-        if (c) memcpy(c, jT + 3 * b1, 3 * sizeof(sn_q));
     } else {
         sn_q q[4];
 #if defined(SN_FLOAT)
         sn_q t = (float)w * (1.0f / 32768.0f);
-        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
-        if (c)
-            for (k = 0; k < 3; k++) c[k] = jT[3 * b1 + k] + t * (jT[3 * b2 + k] - jT[3 * b1 + k]);
-        (void)sat;
 #else
         sn_q t = (sn_q)(w << (SN_Q_ROT - SN_Q_W));
-        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
-        if (c)
-            for (k = 0; k < 3; k++) {
-                int64_t a = jT[3 * b1 + k], b = jT[3 * b2 + k];
-                c[k] = sn_out(a * 32768 + (b - a) * (int64_t)w, SN_Q_W, sat);
-            }
 #endif
+        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
         sn_qtomat(q, R);
     }
 }
@@ -159,11 +177,11 @@ static void joint_rotations(sn_ihdr *h, sn_real target[3], uint32_t *sat) {
 }
 
 /* Effective joint translations T_j = R_j x_root + (t_j - o) (internal units),
- * then the frames of every lattice vertex and cell. */
+ * then the frames of every free vertex and cell. */
 static void joint_frames(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *pt = CARR(h, o_pt, sn_q), *jR = CARR(h, o_jR, sn_q);
-    sn_q *jT = ARR(h, o_jT, sn_q), *R = ARR(h, o_R, sn_q), *c = ARR(h, o_c, sn_q);
+    sn_q *jT = ARR(h, o_jT, sn_q), *R = ARR(h, o_R, sn_q);
     sn_q *cR = ARR(h, o_cR, sn_q), xroot[3], rx[3];
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
     uint32_t i, j, k;
@@ -179,10 +197,11 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
 #endif
         }
     }
-    for (i = 0; i < v->nV; i++)
-        frame_of(h, fr + 4 * i, R + 9 * i, c + 3 * i, sat);
+    for (i = 0; i < v->nF; i++) /* free vertices only: a skeleton vertex's frame is its bone's jR */
+        frame_of(h, fr + 4 * i, R + 9 * i);
     for (i = 0; i < v->nC; i++)
-        frame_of(h, cfr + 4 * i, cR + 9 * i, NULL, sat);
+        frame_of(h, cfr + 4 * i, cR + 9 * i);
+    h->frame_mode = h->mode;
 }
 
 /* Steps 1-2: rigid joint transforms, the origin, and the frames of every
@@ -244,10 +263,34 @@ static void carry(const sn_q *M, const sn_q a[3], sn_q out[3], uint32_t *sat) {
                         SN_Q_ROT, sat);
 }
 
+/* Pass 1 of the teleport's carry for vertex i, with M = A B^T (A the new
+ * frame, B the old; exactly I when they hold the same bits, so a pure move
+ * is exact): pos <- M (p - c) with the old origin c (jT and frame_mode are
+ * still the old frames'), vel <- M vel, and the warm start x of a free vertex. */
+static void carry_vertex(sn_ihdr *h, uint32_t i, const sn_q *A, const sn_q *B, uint32_t *sat) {
+    sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q), *x = ARR(h, o_x, sn_q);
+    sn_q M[9], off[3], c[3];
+    uint32_t k, diff = 0;
+    mul_abt(A, B, M);
+    for (k = 0; k < 9; k++) diff |= A[k] != B[k]; /* no memcmp: libc */
+    if (!diff)
+        for (k = 0; k < 9; k++) M[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+    sn_vertex_origin(h, i, c);
+    for (k = 0; k < 3; k++) off[k] = sn_add(pos[3 * i + k], -c[k], sat);
+    carry(M, off, pos + 3 * i, sat);
+    memcpy(off, vel + 3 * i, sizeof off);
+    carry(M, off, vel + 3 * i, sat);
+    if (i < h->v.nF) {
+        memcpy(off, x + 3 * i, sizeof off);
+        carry(M, off, x + 3 * i, sat);
+    }
+}
+
 sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_joints) {
     sn_ihdr *h;
     const sn_view *v;
-    sn_q *pq, *R, *c, *pos, *vel, *x, *jR;
+    const unsigned char *fr;
+    sn_q *pq, *R, *pos, *jR;
     sn_q d0[4], q0old[4], Rroot[9], T0old[3];
     sn_real target[3];
     uint32_t i, j, k, sat = 0;
@@ -256,9 +299,9 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
     h = hdr_of(inst);
     if (!h->have_prev) return sn_set_pose(inst, joints, n_joints); /* nothing to carry yet */
     v = &h->v;
+    fr = v->sec[SN_SEC_FRAMES];
     pq = ARR(h, o_pq, sn_q); jR = ARR(h, o_jR, sn_q);
-    R = ARR(h, o_R, sn_q); c = ARR(h, o_c, sn_q);
-    pos = ARR(h, o_pos, sn_q); vel = ARR(h, o_vel, sn_q); x = ARR(h, o_x, sn_q);
+    R = ARR(h, o_R, sn_q); pos = ARR(h, o_pos, sn_q);
     memcpy(q0old, pq, sizeof q0old);
     memcpy(Rroot, jR, sizeof Rroot); /* the root's rotation of the state's frames */
     memcpy(T0old, ARR(h, o_jT, sn_q), sizeof T0old); /* the root's internal position (segment meshes) */
@@ -276,40 +319,45 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
         sn_qmul(d0, pq + 4 * j, ref); /* the old quaternion (still stored) carried by D */
         store_joint(h, j, &joints[j], ref);
     }
-    /* the origin jumps to the new root position exactly: nothing is shifted */
-    joint_rotations(h, target, &sat);
-    for (k = 0; k < 3; k++) h->origin[k] = target[k];
     /* each vertex keeps its offset from its frame, p' = M (p - c) + c', and its
      * velocity and warm start turn with it, v' = M v, with M = R' R^T (the
      * root's turn in the unwarped mode, whose frames do not rotate). Pass 1:
-     * pos <- M (p - c) with the old frames (frame_of reads only the new jR
-     * for R'); pass 2, after the new translations and frames: pos += c'. */
+     * pos <- M (p - c) with the old frames; pass 2, after the new
+     * translations and frames: pos += c'. Skeleton vertices first, while jR
+     * still holds the old rotations: a skeleton vertex's frame is its bone's
+     * (BLOB.md: bone1 = bone2, w = 0), R = old jR_b (I if the frames were
+     * built unwarped), R' = the new one by joint_rotations' own conversion. */
     {
-        const unsigned char *fr = v->sec[SN_SEC_FRAMES];
-        for (i = 0; i < v->nV; i++) {
-            sn_q Rn[9], M[9], off[3];
-            frame_of(h, fr + 4 * i, Rn, NULL, &sat); /* R' only: the new c' comes with the new T_j */
-            if (h->mode == SN_MODE_UNWARPED) mul_abt(jR, Rroot, M);
-            else mul_abt(Rn, R + 9 * i, M);
-            {   /* unturned (the same frame bits): exactly I, so a pure move is exact */
-                const sn_q *a = h->mode == SN_MODE_UNWARPED ? jR : Rn, *b = h->mode == SN_MODE_UNWARPED ? Rroot : R + 9 * i;
-                uint32_t diff = 0;
-                for (k = 0; k < 9; k++) diff |= a[k] != b[k]; /* no memcmp: libc */
-                if (!diff)
-                    for (k = 0; k < 9; k++) M[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
-            }
-            for (k = 0; k < 3; k++) off[k] = sn_add(pos[3 * i + k], -c[3 * i + k], &sat);
-            carry(M, off, pos + 3 * i, &sat);
-            memcpy(off, vel + 3 * i, sizeof off);
-            carry(M, off, vel + 3 * i, &sat);
-            if (i < v->nF) {
-                memcpy(off, x + 3 * i, sizeof off);
-                carry(M, off, x + 3 * i, &sat);
+        sn_q Rn0[9], Rn[9], Rold[9];
+        sn_qtomat(pq, Rn0); /* the root's new jR */
+        for (i = v->nF; i < v->nV; i++) {
+            uint32_t b = fr[4 * i];
+            if (h->frame_mode == SN_MODE_UNWARPED)
+                for (k = 0; k < 9; k++) Rold[k] = (k % 4 == 0) ? SN_ONE_ROT : 0;
+            else memcpy(Rold, jR + 9 * b, sizeof Rold);
+            if (h->mode == SN_MODE_UNWARPED) carry_vertex(h, i, Rn0, Rroot, &sat);
+            else {
+                sn_qtomat(pq + 4 * b, Rn);
+                carry_vertex(h, i, Rn, Rold, &sat);
             }
         }
-        joint_frames(h, &sat); /* T_j for the new origin, R', c', cell frames */
-        for (i = 0; i < v->nV; i++)
-            for (k = 0; k < 3; k++) pos[3 * i + k] = sn_add(pos[3 * i + k], c[3 * i + k], &sat);
+    }
+    /* the origin jumps to the new root position exactly: nothing is shifted */
+    joint_rotations(h, target, &sat);
+    for (k = 0; k < 3; k++) h->origin[k] = target[k];
+    for (i = 0; i < v->nF; i++) { /* free vertices: frame_of reads only the new jR for R' */
+        sn_q Rn[9];
+        if (h->mode == SN_MODE_UNWARPED) carry_vertex(h, i, jR, Rroot, &sat);
+        else {
+            frame_of(h, fr + 4 * i, Rn);
+            carry_vertex(h, i, Rn, R + 9 * i, &sat);
+        }
+    }
+    joint_frames(h, &sat); /* T_j for the new origin, R', cell frames */
+    for (i = 0; i < v->nV; i++) {
+        sn_q c[3];
+        sn_vertex_origin(h, i, c); /* c' */
+        for (k = 0; k < 3; k++) pos[3 * i + k] = sn_add(pos[3 * i + k], c[k], &sat);
     }
     {   /* segment meshes: rigidly with the root (the root's turn, exactly I if unturned) */
         sn_q Mr[9];
@@ -330,8 +378,8 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
 void sn_skeleton(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
-    const sn_q *R = CARR(h, o_R, sn_q), *c = CARR(h, o_c, sn_q);
-    sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q), *ds = ARR(h, o_ds, sn_q);
+    const sn_q *R = CARR(h, o_R, sn_q);
+    sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q), *ds = ARR(h, o_ds, sn_q); /* ds: in d's storage, live until rhs */
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *rest = v->sec[SN_SEC_REST];
     uint32_t i, k;
     for (i = v->nF; i < v->nV; i++) {
@@ -350,11 +398,12 @@ void sn_skeleton(sn_ihdr *h, uint32_t *sat) {
     if (!h->have_prev) {
         sn_q *x = ARR(h, o_x, sn_q);
         for (i = 0; i < v->nF; i++) {
-            sn_q xr[3], p[3];
+            sn_q xr[3], p[3], c[3];
             for (k = 0; k < 3; k++) xr[k] = rd_real(rest, 3 * i + k);
             sn_rot(R + 9 * i, xr, p, sat);
+            sn_vertex_origin(h, i, c);
             for (k = 0; k < 3; k++) {
-                pos[3 * i + k] = sn_add(p[k], c[3 * i + k], sat);
+                pos[3 * i + k] = sn_add(p[k], c[k], sat);
                 vel[3 * i + k] = 0;
                 x[3 * i + k] = 0;
             }

@@ -69,14 +69,22 @@ SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
 #define E_Q32(x) sn_rshr64((x), 12)
 #endif
 
+/* w of corner a, component c: stored for free vertices ((1+b1) v), b1 v'
+ * for skeleton ones, computed here as rhs would have stored it (the same
+ * product; its clamps are counted once in rhs). */
+SN_INLINE sn_q w_at(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, uint32_t c) {
+    uint32_t counted = 0;
+    return a < h->v.nF ? w[3 * a + c] : coef(vel[3 * a + c], h->v.b1, &counted);
+}
+
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
  * acc_a = sum_e R_e S^_e (d_e + R_e^T (w - w_a0))_a over free corners, and twice
- * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per vertex. */
+ * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per free vertex. */
 static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
     const unsigned char *rest = v->sec[SN_SEC_REST];
-    const sn_q *cR = CARR(h, o_cR, sn_q), *pos = CARR(h, o_pos, sn_q);
+    const sn_q *cR = CARR(h, o_cR, sn_q), *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t e, k, c, nF = v->nF;
     uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
@@ -85,14 +93,15 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
-        sn_q d[24], uu[24];
+        sn_q d[24], uu[24], w0[3];
         sn_acc ld[24], lu[24], ec = 0;
+        for (c = 0; c < 3; c++) w0[c] = w_at(h, w, vel, a0, c);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3];
             for (c = 0; c < 3; c++) {
                 t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
-                s[c] = sn_add(w[3 * a + c], -w[3 * a0 + c], sat);
+                s[c] = sn_add(w_at(h, w, vel, a, c), -w0[c], sat);
             }
             sn_rot_t(R, t, l, sat);
             sn_rot_t(R, s, uu + 3 * k, sat);
@@ -125,17 +134,21 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
     const unsigned char *ml = v->sec[SN_SEC_MLUMP];
     const sn_q *R = CARR(h, o_R, sn_q), *vel = CARR(h, o_vel, sn_q);
-    const sn_q *ds = CARR(h, o_ds, sn_q);
-    sn_q *u = ARR(h, o_u, sn_q);
+    const sn_q *ds = CARR(h, o_ds, sn_q); /* in d's storage: d is not live yet */
+    sn_q *u = ARR(h, o_q, sn_q); /* w, in q's storage: q and z are live only in the PCG */
     sn_acc *acc = ARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF, nV = v->nV, esat = 0;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
     sn_acc e2 = 0;
 
-    /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v */
-    for (i = 0; i < nV; i++)
-        for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], i < nF ? ck : v->b1, sat);
+    /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
+     * Stored over free vertices; the skeleton's, computed in cell_forces
+     * (w_at), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
+    for (i = 0; i < nF; i++)
+        for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], ck, sat);
+    if (v->b1 > ONE_COEF)
+        for (i = 3 * nF; i < 3 * nV; i++) (void)coef(vel[i], v->b1, sat);
     cell_forces(h, u, acc, &e2, sat);
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
@@ -345,7 +358,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     uint32_t it, i, n3 = 3 * v->nF;
     sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
-    sn_q *q = ARR(h, o_q, sn_q), *z = ARR(h, o_u, sn_q); /* z shares u: never live together */
+    /* z shares q's storage: q is dead from r -= alpha q to the next mat-vec,
+     * z from d = z + beta d to the next preconditioner call */
+    sn_q *q = ARR(h, o_q, sn_q), *z = q;
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
