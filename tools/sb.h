@@ -262,6 +262,7 @@ typedef struct sb_model {
     /* per kept cell */
     double *Se;             /* nc x 24 x 24 elastic stiffness (N/m), row-major, dof = corner*3 + component;
                              * exactly the matrices summed into S */
+    double *Me;             /* NULL, or nc x 8 x 8 per-cell mass (kg) filled by sb_integrate_frac (sb_level.c sets it) */
     int *cfb1, *cfb2; double *cfw;   /* frame at the cell centre (same rule as free vertices) */
     /* per lattice vertex */
     double *limit;          /* largest distance from the skinned position (mesh units), 0 = none */
