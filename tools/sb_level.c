@@ -9,6 +9,7 @@
  * the hierarchical matrices with every function active are the finest nodal
  * matrices in another basis (tests/test_bake_level.c). */
 #include "sb_level.h"
+#include "../runtime/src/sn_format.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -484,4 +485,120 @@ void sb_hier_free(sb_hier *h)
     free(h->hlev); free(h->hvert); free(h->in_b); free(h->pptr); free(h->pidx); free(h->pval);
     free(h->hbptr); free(h->hb); free(h->Mh); free(h->Sh); free(h->gh);
     memset(h, 0, sizeof *h);
+}
+
+/* ---- level of detail: the finer level as a complete blob (sb_bake_file, 'levels 2') ---- */
+
+/* each point in a kept cell of L: the grid cell holding it (a point on a cell face may take
+ * the kept neighbour), else the nearest kept cell with t clamped to it; {cell, t Q15} x n.
+ * Returns the points that needed the nearest cell. */
+static int embed_points(const sb_model *L, const double *pts, int n, uint16_t *out)
+{
+    int nx = L->gn[0] - 1, ny = L->gn[1] - 1, ngc = nx * ny * (L->gn[2] - 1), i, k, c, far = 0;
+    int *g2c = sb_alloc(sizeof(int) * (size_t)ngc);
+    for (c = 0; c < ngc; c++) g2c[c] = -1;
+    for (c = 0; c < L->nc; c++) g2c[L->cell_grid[c]] = c;
+    for (i = 0; i < n; i++) {
+        const double *p = pts + 3 * i;
+        double u[3], t[3];
+        int lo[3], hi[3], best = -1, x, y, z;
+        for (k = 0; k < 3; k++) {
+            double r;
+            u[k] = (p[k] - L->gorg[k]) / L->c;
+            r = floor(u[k] + 0.5);
+            if (fabs(u[k] - r) < 1e-9) { lo[k] = (int)r - 1; hi[k] = (int)r; }   /* on a grid plane: either side */
+            else lo[k] = hi[k] = (int)floor(u[k]);
+        }
+        for (z = lo[2]; z <= hi[2] && best < 0; z++)
+            for (y = lo[1]; y <= hi[1] && best < 0; y++)
+                for (x = lo[0]; x <= hi[0] && best < 0; x++)
+                    if (x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < L->gn[2] - 1 && g2c[x + nx * (y + ny * z)] >= 0)
+                        best = g2c[x + nx * (y + ny * z)];
+        if (best < 0) {   /* outside every kept cell: the nearest one */
+            double bd = HUGE_VAL;
+            far++;
+            for (c = 0; c < L->nc; c++) {
+                const double *x0 = L->x + 3 * L->cells[8 * c];
+                double dd = 0;
+                for (k = 0; k < 3; k++) {
+                    double e = p[k] < x0[k] ? x0[k] - p[k] : p[k] > x0[k] + L->c ? p[k] - x0[k] - L->c : 0;
+                    dd += e * e;
+                }
+                if (dd < bd) { bd = dd; best = c; }
+            }
+        }
+        for (k = 0; k < 3; k++) {
+            t[k] = (p[k] - L->x[3 * L->cells[8 * best] + k]) / L->c;
+            t[k] = t[k] < 0 ? 0 : t[k] > 1 ? 1 : t[k];
+        }
+        out[4 * i] = (uint16_t)best;
+        for (k = 0; k < 3; k++) out[4 * i + 1 + k] = (uint16_t)floor(t[k] * 32768.0 + 0.5);
+    }
+    free(g2c);
+    return far;
+}
+
+static uint32_t inst_bytes(const sb_model *o, int nV, int nF, int nC)
+{
+    return SN_INSTANCE_BYTES((uint32_t)nV, (uint32_t)nF, (uint32_t)o->nj, (uint32_t)nC, (uint32_t)o->nctl, (uint32_t)o->max_forces,
+                             sb_segment_state_bytes(o) + (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u),
+                             (o->max_cons || o->max_cols || o->max_contacts || o->crease)
+                                 ? SN_CONS_BYTES(o->max_cons, o->max_cols, SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
+                                 : 0u);
+}
+
+int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, int quiet, sb_blob *b, sb_lodinfo *info)
+{
+    sb_desc d2 = *d;   /* shallow: only cell, origin, blend and crease differ */
+    sb_model o2;
+    sb_blob b0, b1;
+    uint16_t *up = NULL, *down = NULL;
+    int i, rc = -1, nF, nS, nC;
+    memset(&o2, 0, sizeof o2); memset(&b0, 0, sizeof b0); memset(&b1, 0, sizeof b1);
+    d2.cell = 0.5 * o->c;
+    d2.has_origin = 1;
+    for (i = 0; i < 3; i++) d2.origin[i] = o->gorg[i];   /* the coarse grid's corner: every coarse vertex is a fine one */
+    d2.blend = d->blend > 0 ? d->blend : d->cell;       /* the same frames */
+    d2.ncrease = 0;                                      /* the crease data is the surface's: shared */
+    /* bones: given radii stay; automatic ones are re-derived at the finer cell (at least 1.25 cells, so a
+     * thin limb keeps free flesh: with the coarse radii, rigs on thin parts touch no free vertex) */
+    if (sb_build(&d2, m, &o2, 1) || sb_rig_build(&d2, m, &o2) || sb_force_build(&d2, &o2) || sb_segment_build(&d2, m, &o2)) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", sb_error());
+        sb_fail("%s:%d: levels 2: the subdivided lattice (cell %g): %s", d->path, d->levels_line, d2.cell, msg);
+        goto done;
+    }
+    /* shared surface data */
+    o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
+    o2.cr_vnbr = o->cr_vnbr; o2.cr_tnbr = o->cr_tnbr; o2.cr_list = o->cr_list; o2.cr_active = o->cr_active;
+    o2.cr_depth = o->cr_depth; o2.cr_push = o->cr_push; o2.cr_exclude = o->cr_exclude;
+    if (sb_blob_make(&o2, flavour, &b1) || sb_blob_make(o, flavour, &b0)) goto done;
+    if (b0.len_shift != b1.len_shift) {   /* one length unit for both: the state is carried between them */
+        o->lshift_set = o2.lshift_set = 1;
+        o->lshift = o2.lshift = b0.len_shift > b1.len_shift ? b0.len_shift : b1.len_shift;
+        sb_blob_free(&b1);
+        if (sb_blob_make(&o2, flavour, &b1)) goto done;
+    }
+    up = sb_alloc(sizeof(uint16_t) * 4 * (size_t)o2.nv);
+    down = sb_alloc(sizeof(uint16_t) * 4 * (size_t)o->nv);
+    info->up_far = embed_points(o, o2.x, o2.nv, up);
+    info->down_far = embed_points(&o2, o->x, o->nv, down);
+    info->nv1 = o2.nv; info->nf1 = o2.nf; info->nc1 = o2.nc; info->size1 = (uint32_t)b1.size;
+    nF = o->nf > o2.nf ? o->nf : o2.nf;
+    nS = o->nv - o->nf > o2.nv - o2.nf ? o->nv - o->nf : o2.nv - o2.nf;
+    nC = o->nc > o2.nc ? o->nc : o2.nc;
+    o->lod_blob = b1.bytes; o->lod_size = (uint32_t)b1.size; o->lod_nv1 = (uint32_t)o2.nv;
+    o->lod_up = up; o->lod_down = down;
+    o->lod_inst_bytes = inst_bytes(o, nF + nS, nF, nC);
+    info->inst0 = inst_bytes(o, o->nv, o->nf, o->nc); info->inst1 = inst_bytes(&o2, o2.nv, o2.nf, o2.nc);
+    info->inst = o->lod_inst_bytes;
+    rc = sb_blob_make(o, flavour, b);
+    o->lod_blob = NULL; o->lod_size = 0; o->lod_up = o->lod_down = NULL;
+    (void)quiet;
+done:
+    o2.cr_pairs = NULL; o2.cr_vnbr = o2.cr_tnbr = NULL; o2.crease = 0;   /* borrowed */
+    sb_model_free(&o2);
+    sb_blob_free(&b0); sb_blob_free(&b1);
+    free(up); free(down);
+    return rc;
 }

@@ -72,4 +72,16 @@ int sb_level_find(const int *ptr, const int *idx, int i, int j);
 /* value of the hat of level-lv vertex v at the finest-level vertex n (exact: dyadic) */
 double sb_level_hat(const sb_hier *h, int lv, int v, int n);
 
+/* Level of detail ('levels 2', tools/DESCRIPTION.md; runtime/LEVELS.md): o built from d and m
+ * with its rigs, forces, segment meshes and crease data; bakes the lattice subdivided once
+ * (cell c/2 on o's grid, o's bone radii and frame blend) as a complete blob and writes b =
+ * o's blob with it and the two vertex maps appended. */
+typedef struct sb_lodinfo {
+    int nv1, nf1, nc1;      /* the finer level's lattice */
+    uint32_t size1;         /* its blob's bytes */
+    int up_far, down_far;   /* vertices of one level outside every kept cell of the other (nearest cell, clamped) */
+    uint32_t inst0, inst1, inst;   /* instance bytes of level 0 alone, level 1 alone, the two-level instance */
+} sb_lodinfo;
+int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, int quiet, sb_blob *b, sb_lodinfo *info);
+
 #endif
