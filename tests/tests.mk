@@ -4,5 +4,6 @@ TEST_BINS ?=
 TEST_DEPS ?=
 include tests/physics.mk
 include tests/health.mk
+include tests/level.mk
 test: $(TEST_BINS) $(TEST_DEPS)
 	sh tests/run_tests.sh $(BUILD)
