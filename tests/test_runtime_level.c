@@ -93,6 +93,49 @@ static double rms_move(const sn_vec3 *a, const sn_vec3 *b, uint32_t n)
     return sqrt(s / n);
 }
 
+static uint32_t rd16(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8; }
+static uint32_t rd32(const unsigned char *p) { return rd16(p) | rd16(p + 2) << 16; }
+static const unsigned char *sec_of(const unsigned char *b, int k) { return b + rd32(b + SN_H_SECTIONS + SN_SECTION_ENTRY * k); }
+/* value of a map entry {cell, t Q15} over the cell's corners of the lattice `cells` */
+static void interp(const unsigned char *e, const unsigned char *cells, const double *val, double out[3])
+{
+    const unsigned char *c = cells + 16 * (size_t)rd16(e);
+    double t[3];
+    int a, k;
+    for (k = 0; k < 3; k++) t[k] = rd16(e + 2 + 2 * k) / 32768.0;
+    out[0] = out[1] = out[2] = 0;
+    for (a = 0; a < 8; a++) {
+        double w = ((a & 1) ? t[0] : 1 - t[0]) * ((a & 2) ? t[1] : 1 - t[1]) * ((a & 4) ? t[2] : 1 - t[2]);
+        for (k = 0; k < 3; k++) out[k] += w * val[3 * rd16(c + 2 * a) + k];
+    }
+}
+
+/* Adaptation's measure (seed 000 §4.7; runtime/LEVELS.md): on level 1, the detail of each free
+ * vertex, |p_i - (level-0 field sampled at the level-0 vertices, interpolated back at i)|, in
+ * level-0 cells; counts the free vertices above each threshold (what an adaptive step would
+ * keep active). */
+static void detail_counts(const unsigned char *top, const sn_instance *q, uint32_t nv1, uint32_t nf1, uint32_t nv0, double cell,
+                          const double *th, int nth, uint32_t *cnt)
+{
+    const unsigned char *fine = sec_of(top, SN_SEC_LEVEL_BLOB), *up = sec_of(top, SN_SEC_LEVEL_UP), *down = sec_of(top, SN_SEC_LEVEL_DOWN);
+    sn_vec3 *lat = malloc(sizeof *lat * nv1);
+    double *pf = malloc(sizeof(double) * 3 * nv1), *pc = malloc(sizeof(double) * 3 * nv0);
+    uint32_t i;
+    int k;
+    sn_get_lattice(q, lat, 0, nv1);
+    for (i = 0; i < nv1; i++) { pf[3 * i] = D(lat[i].x); pf[3 * i + 1] = D(lat[i].y); pf[3 * i + 2] = D(lat[i].z); }
+    for (i = 0; i < nv0; i++) interp(down + 8 * (size_t)i, sec_of(fine, SN_SEC_CELLS), pf, pc + 3 * i);
+    for (k = 0; k < nth; k++) cnt[k] = 0;
+    for (i = 0; i < nf1; i++) {
+        double b[3], d;
+        interp(up + 8 * (size_t)i, sec_of(top, SN_SEC_CELLS), pc, b);
+        d = sqrt((pf[3 * i] - b[0]) * (pf[3 * i] - b[0]) + (pf[3 * i + 1] - b[1]) * (pf[3 * i + 1] - b[1]) +
+                 (pf[3 * i + 2] - b[2]) * (pf[3 * i + 2] - b[2])) / cell;
+        for (k = 0; k < nth; k++) cnt[k] += d > th[k];
+    }
+    free(lat); free(pf); free(pc);
+}
+
 int main(int argc, char **argv)
 {
     size_t n0, n1;
@@ -187,6 +230,34 @@ int main(int argc, char **argv)
     T_CHECK(st.saturations == 0, "%s: %u saturations through the switches", name, st.saturations);
     T_FIGURE("%s [%s]: after 160 steps with 3 switches: largest displacement %.3g cells, energy %.4g J (max %.4g), bound steps %u",
              name, FL, D(st.disp_max), D(st.energy), D(st.energy_max), st.bound_steps);
+
+    /* figures for adaptation (not checks): free vertices of level 1 whose detail exceeds a threshold, over
+     * 100 steps of the swing on level 1 at rest (at rest: the sag's detail) */
+    {
+        static const double th[3] = {0.01, 0.03, 0.1};
+        uint32_t cnt[3], mx[3] = {0, 0, 0}, rest[3] = {0, 0, 0};
+        double mean[3] = {0, 0, 0};
+        sn_stats s1;
+        sn_reset(q);
+        sn_set_lod(q, 1);
+        sn_get_stats(q, &s1);
+        {
+            const unsigned char *fine = sec_of(b1, SN_SEC_LEVEL_BLOB);
+            uint32_t nv1 = rd32(fine + SN_H_N_VERTICES), nf1 = rd32(fine + SN_H_N_FREE);
+            for (k = 1; k <= 100; k++) {
+                int t;
+                pose_at(lod, i1.joints, k <= 30 ? 0 : k, xf);
+                sn_set_pose(q, xf, i1.joints);
+                sn_step(q);
+                detail_counts(b1, q, nv1, nf1, i1.vertices, cell, th, 3, cnt);
+                if (k == 30) memcpy(rest, cnt, sizeof rest);
+                for (t = 0; t < 3; t++) if (k > 30) { mx[t] = cnt[t] > mx[t] ? cnt[t] : mx[t]; mean[t] += cnt[t] / 70.0; }
+            }
+            T_FIGURE("%s [%s]: adaptation: of level 1's %u free vertices, detail over 0.01 / 0.03 / 0.1 level-0 cells: at rest %u / %u / %u, "
+                     "swinging mean %.0f / %.0f / %.0f, max %u / %u / %u", name, FL, nf1, rest[0], rest[1], rest[2], mean[0], mean[1], mean[2],
+                     mx[0], mx[1], mx[2]);
+        }
+    }
 
     /* 3. the level survives reset, and a reset instance steps as a fresh one set to that level */
     sn_set_lod(q, 1);
