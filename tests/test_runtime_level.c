@@ -12,6 +12,7 @@
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
+#include "fuzz/sn_tblob.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -152,6 +153,7 @@ int main(int argc, char **argv)
     const char *name = argc > 2 ? strrchr(argv[2], '/') : NULL;
     name = name ? name + 1 : argc > 2 ? argv[2] : "?";
     (void)t_seed;
+    (void)tb_build;   /* sn_tblob.h: only its checksum helper is used here */
     if (argc < 3) { printf("usage: %s PLAIN.blob LOD.blob\n", argv[0]); return 2; }
     b0 = load(argv[1], &n0); b1 = load(argv[2], &n1);
     if (!b0 || !b1) { T_CHECK(0, "cannot read %s / %s (make them: tests/level.mk)", argv[1], argv[2]); return T_END(); }
@@ -257,6 +259,34 @@ int main(int argc, char **argv)
                      "swinging mean %.0f / %.0f / %.0f, max %u / %u / %u", name, FL, nf1, rest[0], rest[1], rest[2], mean[0], mean[1], mean[2],
                      mx[0], mx[1], mx[2]);
         }
+    }
+
+    /* 4. the validator's pair checks (runtime/BLOB.md "Level of detail"), checksums fixed after each change */
+    {
+        unsigned char *h = malloc(n1 + 8);
+        const sn_blob *bb;
+        unsigned char *fine, *up, *down;
+        uint32_t nc0 = rd32(b1 + SN_H_N_CELLS), nc1;
+#define LV_CASE(want, what, change) do { \
+            memcpy(h, b1, n1); fine = h + rd32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_LEVEL_BLOB); \
+            up = h + rd32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_LEVEL_UP); \
+            down = h + rd32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_LEVEL_DOWN); (void)up; (void)down; \
+            change; tb_fix_crc(fine); tb_fix_crc(h); \
+            T_CHECK(sn_blob_validate(h, n1, &bb) == (want), "%s: %s: got %s, want %s", name, what, \
+                    sn_status_str(sn_blob_validate(h, n1, &bb)), sn_status_str(want)); } while (0)
+        nc1 = rd32(sec_of(b1, SN_SEC_LEVEL_BLOB) + SN_H_N_CELLS);
+        LV_CASE(SN_OK, "unchanged", (void)0);
+        LV_CASE(SN_ERR_INDEX, "LEVEL_UP cell = level 0's nC", tb_u16(up, (uint16_t)nc0));
+        LV_CASE(SN_ERR_INDEX, "LEVEL_DOWN cell = level 1's nC", tb_u16(down + 8, (uint16_t)nc1));
+        LV_CASE(SN_ERR_INDEX, "LEVEL_DOWN t = 32769", tb_u16(down + 2, 32769));
+        LV_CASE(SN_ERR_HEADER, "level 1 with another length unit", fine[SN_H_LEN_SHIFT]++);
+        LV_CASE(SN_ERR_VALUE, "level 1 with another joint rest position",
+                fine[rd32(fine + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_JOINTS) + 8 + SN_ELEM_JOINTS(4)] ^= 1);   /* joint 1, x (real 4 bytes in both runtime flavours) */
+        LV_CASE(SN_ERR_SECTION, "level 1 with a level of its own",
+                tb_u32(fine + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_LEVEL_UP + 8, 1));
+        LV_CASE(SN_ERR_HEADER, "instance bytes of level 0 alone", tb_u32(h + SN_H_INSTANCE_BYTES, i0.instance_bytes));
+#undef LV_CASE
+        free(h);
     }
 
     /* 3. the level survives reset, and a reset instance steps as a fresh one set to that level */
