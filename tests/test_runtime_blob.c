@@ -108,7 +108,7 @@ static void test_header(void) {
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
     CASE(SN_ERR_VERSION, "major 7", tb_u16(b + SN_H_VER_MAJOR, 7));
-    CASE(SN_ERR_VERSION, "major 5 (format 5.0, the larger instance layout: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
     CASE(SN_ERR_VERSION, "major 4 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 4 (format 4.0, no constraint section: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));

@@ -189,6 +189,7 @@ typedef struct sb_desc {
     double cr_thin;                  /* mesh units; 0: off: a seed pair whose two vertices are both within this rest distance of an earlier pair's is dropped */
     double cr_exclude;               /* mesh units; < 0: default (one cell): seed pairs closer than this in the rest pose are not collisions */
     int cr_line;                     /* line of 'crease_settings' (0: none) */
+    int levels, levels_line;         /* 'levels N': 1, or 2 with the lattice subdivided once (sb_level.c) */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -262,6 +263,7 @@ typedef struct sb_model {
     /* per kept cell */
     double *Se;             /* nc x 24 x 24 elastic stiffness (N/m), row-major, dof = corner*3 + component;
                              * exactly the matrices summed into S */
+    double *Me;             /* NULL, or nc x 8 x 8 per-cell mass (kg) filled by sb_integrate_frac (sb_level.c sets it) */
     int *cfb1, *cfb2; double *cfw;   /* frame at the cell centre (same rule as free vertices) */
     /* per lattice vertex */
     double *limit;          /* largest distance from the skinned position (mesh units), 0 = none */
@@ -299,6 +301,13 @@ typedef struct sb_model {
     int cr_list, cr_active;
     double cr_depth, cr_push; /* mesh units */
     double cr_exclude;        /* mesh units: seed pairs closer in the rest pose are not collisions */
+    /* level of detail (sb_level.c, sb_level_bake): the finer level's blob and the maps the writer appends
+     * (LEVEL_BLOB, LEVEL_UP, LEVEL_DOWN); lod_size 0: one level */
+    const unsigned char *lod_blob;
+    uint32_t lod_size, lod_nv1;   /* bytes; the finer level's lattice vertices */
+    const uint16_t *lod_up, *lod_down; /* lod_nv1 x 4, nv x 4: {cell, t[3] Q15} */
+    uint32_t lod_inst_bytes;      /* instance bytes for the larger level */
+    int lshift_set, lshift;       /* lshift_set: the blob's length unit is at least 2^lshift (both levels share it) */
 } sb_model;
 
 int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet);
@@ -430,7 +439,7 @@ int sb_crease_inside(const double p[3], const double a[3], const double b[3], co
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };
 typedef struct sb_blob {
     unsigned char *bytes; size_t size;
-    uint32_t sec_off[32], sec_size[32];   /* >= SN_SEC_COUNT */
+    uint32_t sec_off[40], sec_size[40];   /* >= SN_SEC_COUNT */
     int len_shift, frac_S, frac_M, frac_P;
     double m0;
     int *rig_frac;          /* per rig (fixed flavour): fractional bits of its RIG_FORCES; else 0 */

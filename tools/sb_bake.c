@@ -1,5 +1,6 @@
 /* sb_bake.c -- the whole bake: description -> mesh -> model -> blob, with a summary. */
 #include "sb.h"
+#include "sb_level.h"
 #include "../runtime/src/sn_format.h"
 #include <math.h>
 #include <stdio.h>
@@ -9,13 +10,15 @@ static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "F
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
-                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR"};
+                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
     sb_desc d;
     sb_mesh m;
     sb_srcmap src;
+    sb_lodinfo lod;
     double t0 = sb_now(), vol;
     int k;
     memset(o, 0, sizeof *o);
@@ -26,8 +29,10 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
         sb_mesh_free(&m); sb_desc_free(&d);
         return -1;
     }
+    memset(&lod, 0, sizeof lod);
     if (sb_build(&d, &m, o, quiet) || sb_rig_build(&d, &m, o) || sb_force_build(&d, o) ||
-        sb_segment_build(&d, &m, o) || sb_crease_build(&d, o, quiet) || sb_blob_make(o, flavour, b)) {
+        sb_segment_build(&d, &m, o) || sb_crease_build(&d, o, quiet) ||
+        (d.levels > 1 ? sb_level_bake(&d, &m, o, flavour, quiet, b, &lod) : sb_blob_make(o, flavour, b))) {
         sb_model_free(o); sb_mesh_free(&m); sb_desc_free(&d); sb_srcmap_free(&src);
         return -1;
     }
@@ -46,6 +51,11 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
                o->nj, o->nseg, o->joints[0].name, o->joints[0].pos[0], o->joints[0].pos[1], o->joints[0].pos[2]);
         printf("  lattice   %d vertices (%d free, %d skeleton), %d cells (mean fill %.2f, min %.3f), cell %g mesh units\n",
                o->nv, o->nf, o->nv - o->nf, o->nc, fsum / o->nc, fmin_, o->c);
+        if (d.levels > 1)
+            printf("  levels    2: level 1 (cell %g) %d vertices (%d free), %d cells, %u blob bytes; instance %u bytes (level 0 alone %u, level 1 alone %u); "
+                   "%d level-1 vertices outside the level-0 cells, %d level-0 vertices outside the level-1 cells (nearest cell)\n",
+                   0.5 * o->c, lod.nv1, lod.nf1, lod.nc1, (unsigned)lod.size1, (unsigned)lod.inst, (unsigned)lod.inst0, (unsigned)lod.inst1,
+                   lod.up_far, lod.down_far);
         printf("  quality   smallest Jacobian / cell volume %.3g (1: every cell an undistorted cube)\n", o->min_jac);
         printf("  mass      %.6g kg (interior volume %.6g m^3 = %.4f x mesh volume), m0 %.6g kg\n",
                o->mass, o->inside_volume, o->inside_volume / vol, b->m0);

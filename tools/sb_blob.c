@@ -222,6 +222,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (i = 0; i < nV; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->x[3 * i + k] - root[k]));
     for (i = 0; i < nJ; i++) for (k = 0; k < 3; k++) maxx = fmax(maxx, fabs(o->joints[i].pos[k] - root[k]));
     for (s = -60; s < 100 && !(maxx < ldexp(2.0, s)); s++) {}
+    if (o->lshift_set && s < o->lshift) s = o->lshift;   /* levels of detail share the length unit */
     if (s < -128 || s > 127) return sb_fail("model size out of range (len_shift %d)", s);
     U = ldexp(1.0, s);   /* internal unit in mesh units */
     /* joules per internal energy unit: m0 (U unit)^2 / h^2 (NUMERICS.md) */
@@ -317,6 +318,10 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         cnt[SN_SEC_CREASE_VNBR] = on ? (uint32_t)(o->ns * o->cr_kv) : 0u; esz[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
         cnt[SN_SEC_CREASE_TNBR] = on ? (uint32_t)(o->ns * o->cr_kt) : 0u; esz[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
     }
+    /* level of detail (sb_level.c) */
+    cnt[SN_SEC_LEVEL_BLOB] = o->lod_size;                      esz[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;
+    cnt[SN_SEC_LEVEL_UP] = o->lod_size ? o->lod_nv1 : 0u;      esz[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
+    cnt[SN_SEC_LEVEL_DOWN] = o->lod_size ? (uint32_t)nV : 0u;  esz[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -355,6 +360,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
                                                            ? SN_CONS_BYTES(o->max_cons, o->max_cols,
                                                                            SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
                                                            : 0u));
+    if (o->lod_size) put_u32(&w, SN_H_INSTANCE_BYTES, o->lod_inst_bytes);   /* laid out for the larger level */
     put_u8(&w, SN_H_MAX_FORCES, (unsigned)o->max_forces);
     put_u8(&w, SN_H_FLAGS, o->rest_modelled ? SN_FLAG_REST_MODELLED : 0u);
     put_u16(&w, SN_H_CG_DEFAULT, (unsigned)o->cg_def);
@@ -494,6 +500,11 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             put_u16(&w, off[SN_SEC_CREASE_VNBR] + 2 * (size_t)i, o->cr_vnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_vnbr[i]);
         for (i = 0; i < o->ns * o->cr_kt; i++)
             put_u16(&w, off[SN_SEC_CREASE_TNBR] + 2 * (size_t)i, o->cr_tnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_tnbr[i]);
+    }
+    if (o->lod_size) {   /* the finer level verbatim, then the two maps */
+        memcpy(b->bytes + off[SN_SEC_LEVEL_BLOB], o->lod_blob, o->lod_size);
+        for (i = 0; i < 4 * (int)o->lod_nv1; i++) put_u16(&w, off[SN_SEC_LEVEL_UP] + 2 * (size_t)i, o->lod_up[i]);
+        for (i = 0; i < 4 * nV; i++) put_u16(&w, off[SN_SEC_LEVEL_DOWN] + 2 * (size_t)i, o->lod_down[i]);
     }
     if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
     if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }

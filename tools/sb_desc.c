@@ -502,6 +502,12 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (r.dist < 0) return sb_fail("%s:%d: limit distance must be >= 0 (0 = no limit)", c->path, c->line);
         GROW(d->lrules, d->nlr);
         d->lrules[d->nlr++] = r;
+    } else if (!strcmp(kw, "levels")) {   /* level of detail: the lattice and its subdivision (sb_level.c) */
+        double n_;
+        if (nargs(c, 1) || num(c, 1, &n_)) return -1;
+        if (!(n_ >= 1 && n_ <= 2 && n_ == floor(n_))) return sb_fail("%s:%d: levels: 1 (the lattice) or 2 (and the lattice subdivided once)", c->path, c->line);
+        d->levels = (int)n_;
+        d->levels_line = c->line;
     } else if (!strcmp(kw, "forces")) {
         double n_;
         if (nargs(c, 1) || num(c, 1, &n_)) return -1;
@@ -754,6 +760,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->element = SB_ELEM_INCOMPATIBLE;
     d->bone_radius = -1;
     d->force_slots = 8;
+    d->levels = 1;
     d->cr_list = 64; d->cr_active = 32; d->cr_ring = 1; d->cr_depth = -1; d->cr_push = -1; d->cr_exclude = -1; d->cr_thin = 0;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));

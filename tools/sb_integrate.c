@@ -206,6 +206,7 @@ int sb_integrate_frac(const sb_desc *d, sb_model *o, const double *frac, const i
             for (b = 0; b < 8; b++) {
                 int e = sb_pattern_find(o, o->cells[8 * ci + a], o->cells[8 * ci + b]);
                 o->M[e] += Me[a][b];
+                if (o->Me) o->Me[64 * (size_t)ci + (size_t)(8 * a + b)] = Me[a][b];
                 for (k = 0; k < 9; k++) o->S[9 * (size_t)e + (size_t)k] += Se[a][b][k];
                 for (i = 0; i < 3; i++) for (j = 0; j < 3; j++) Sc[24 * (3 * a + i) + 3 * b + j] = Se[a][b][3 * i + j];
                 o->mass += Me[a][b];

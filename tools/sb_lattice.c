@@ -731,7 +731,7 @@ void sb_model_free(sb_model *o)
     free(o->joints); free(o->desc_to_sorted); free(o->seg_child); free(o->gpos); free(o->gjoint); free(o->gvert);
     free(o->v_grid); free(o->x); free(o->cells); free(o->cell_grid); free(o->cell_fill); free(o->fb1); free(o->fb2); free(o->fw);
     free(o->nbptr); free(o->nb); free(o->M); free(o->S); free(o->T); free(o->emb_cell); free(o->emb_t); free(o->tri);
-    free(o->Se); free(o->cfb1); free(o->cfb2); free(o->cfw); free(o->limit); free(o->vseg);
+    free(o->Se); free(o->Me); free(o->cfb1); free(o->cfb2); free(o->cfw); free(o->limit); free(o->vseg);
     free(o->seg_r); free(o->seg_flesh); free(o->seg_auto); free(o->seg_nv); free(o->seg_ncap);
     sb_srcmap_free(&o->src);
     memset(o, 0, sizeof *o);

@@ -1,6 +1,7 @@
 /* det_main.c -- headless determinism driver, built by every compiler and
  * cross compiler of tests/scripts/test_determinism.sh.
- *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K]
+ *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]
+ * --lod: sn_set_lod(L) before step K (a blob baked with 'levels 2', runtime/LEVELS.md).
  * Without BLOB it uses the array linked in with -DSN_DET_BLOB=sym
  * -DSN_DET_BLOB_SIZE=sym (the host tool's C-array output), copied to
  * malloc memory because the runtime wants 8-byte alignment.
@@ -39,15 +40,30 @@ int main(int argc, char **argv) {
     const char *blob_path = NULL, *clip_path = NULL;
     char *blob, *clip_text = NULL;
     size_t blob_n = 0, clip_n = 0, mem_n;
-    unsigned long steps = 1000, trace = 0, k;
+    unsigned long steps = 1000, trace = 0, k, lod_k[16];
+    unsigned lod_l[16];
     void *mem;
-    int i;
+    int i, n_lod = 0, j;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--clip") && i + 1 < argc) clip_path = argv[++i];
         else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--trace") && i + 1 < argc) trace = strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--lod") && i + 1 < argc) {
+            char *q = argv[++i], *e;
+            for (;;) {
+                if (n_lod >= 16) { fprintf(stderr, "det_main: --lod: at most 16 switches\n"); return 2; }
+                lod_k[n_lod] = strtoul(q, &e, 10);
+                if (e == q || *e != ':') { fprintf(stderr, "det_main: --lod: want K:L[,K:L..]\n"); return 2; }
+                q = e + 1;
+                lod_l[n_lod] = (unsigned)strtoul(q, &e, 10);
+                if (e == q || (*e && *e != ',')) { fprintf(stderr, "det_main: --lod: want K:L[,K:L..]\n"); return 2; }
+                n_lod++;
+                if (!*e) break;
+                q = e + 1;
+            }
+        }
         else if (argv[i][0] != '-' && !blob_path) blob_path = argv[i];
-        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K]\n"); return 2; }
+        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]\n"); return 2; }
     }
     if (blob_path) {
         blob = slurp(blob_path, &blob_n);
@@ -81,6 +97,8 @@ int main(int argc, char **argv) {
     }
     for (k = 0; k < steps; k++) {
         sn_det_pose(&det);
+        for (j = 0; j < n_lod; j++)   /* level switches before step k + 1 (as sinew-play --lod) */
+            if (lod_k[j] == k + 1 && sn_set_lod(det.inst, lod_l[j]) != SN_OK) { fprintf(stderr, "det_main: sn_set_lod %u refused\n", lod_l[j]); return 1; }
         sn_det_step(&det);
         if (trace && (k + 1) % trace == 0) {
             sn_det_hex64(sn_state_hash(det.inst), hex);

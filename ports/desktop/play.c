@@ -59,6 +59,7 @@ static void usage(FILE *f) {
         "  --belt X[,W]       pin (in y and z) the surface vertices within W (default 0.08) of the plane x = X:\n"
         "                     a belt around the body, at most the blob's max_constraints of them, evenly spread\n"
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
+        "  --lod K:L[,K:L..]  level of detail L (0 coarse, 1 fine; sn_set_lod) from step K on (blob baked with 'levels 2')\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
         "  --obj-frames LIST  with --obj-dir: only these frames, e.g. 0,10,20-30 (0: before the first step)\n"
@@ -516,6 +517,10 @@ typedef struct {
     int have_ground, n_sph, n_pin, have_belt;
     double ground_y, sph[4][7], belt_x, belt_w;
     uint32_t pin[64];
+    /* --lod: level switches before steps */
+    int n_lod;
+    long lod_step[16];
+    unsigned lod_level[16];
 } options;
 
 #define MAX_FRAMES 10000000L
@@ -563,7 +568,7 @@ static int parse_args(int argc, char **argv, options *o) {
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
                                          "--seg-impulse", "--seg-floor", "--segments", "--ground", "--sphere", "--pin", "--belt",
-                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", NULL};
+                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -663,6 +668,20 @@ static int parse_args(int argc, char **argv, options *o) {
             if (sscanf(v, "%lf%n", &o->belt_x, &used) != 1 || (v[used] && (sscanf(v + used, ",%lf", &o->belt_w) != 1)) ||
                 !isfinite(o->belt_x) || !isfinite(o->belt_w) || o->belt_w <= 0) { fprintf(stderr, PROG ": --belt: want X[,W] (mesh units, W > 0), got '%s'\n", v); return 2; }
             o->have_belt = 1;
+        } else if (!strcmp(a, "--lod")) {
+            const char *q = v;
+            for (;;) {
+                long kk, ll;
+                char *e2;
+                kk = strtol(q, &e2, 10);
+                if (e2 == q || *e2 != ':' || kk < 1 || kk > MAX_FRAMES || o->n_lod >= 16) { fprintf(stderr, PROG ": --lod: want K:L[,K:L..] (step K >= 1, at most 16), got '%s'\n", v); return 2; }
+                q = e2 + 1;
+                ll = strtol(q, &e2, 10);
+                if (e2 == q || ll < 0 || ll > 1 || (*e2 && *e2 != ',')) { fprintf(stderr, PROG ": --lod: level 0 or 1, got '%s'\n", v); return 2; }
+                o->lod_step[o->n_lod] = kk; o->lod_level[o->n_lod] = (unsigned)ll; o->n_lod++;
+                if (!*e2) break;
+                q = e2 + 1;
+            }
         } else if (!strcmp(a, "--segments")) {
             if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --segments: want on or off, got '%s'\n", v); return 2; }
             o->no_segments = !strcmp(v, "off");
@@ -1274,6 +1293,8 @@ int main(int argc, char **argv) {
             if (sn_set_colliders(inst, cl, (uint32_t)nq) != SN_OK) { die("sn_set_colliders: refused (the blob's max_colliders is %u)", s.info.max_colliders); goto done; }
             if (inst2) sn_set_colliders(inst2, cl, (uint32_t)nq);
         }
+        for (i = 0; i < (uint32_t)o.n_lod; i++)   /* level switches before this step */
+            if (o.lod_step[i] == k && sn_set_lod(inst, o.lod_level[i]) != SN_OK) { die("--lod %ld:%u: sn_set_lod refused (the blob has %u level(s): bake with 'levels 2')", k, o.lod_level[i], sn_lod_levels(s.blob)); goto done; }
         c0 = now_us(CLOCK_THREAD_CPUTIME_ID);
         t0 = now_us(CLOCK_MONOTONIC);
         sn_step(inst);

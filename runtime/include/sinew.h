@@ -278,6 +278,8 @@ typedef struct sn_stats {
     uint32_t row_overflow;       ///< rows refused since init/reset because the step's rows were full
     uint32_t constraint_refused; ///< constraints or colliders beyond the blob's maxima refused by the setters since init/reset
     uint32_t constraint_clamps;  ///< row targets clamped since init/reset: a constraint to one lattice cell per step (a far or fast target is approached at that speed), a contact to its yield bound (runtime/NUMERICS.md "Contacts")
+    uint32_t lod;                ///< level of detail in force (sn_set_lod): 0 the baked lattice, 1 the finer one
+    uint32_t lattice_vertices;   ///< lattice vertices of that level (free and skeleton): sn_get_lattice's range
 } sn_stats;
 /// Self-collision near creases (seed 003 §3.4): the surface vertices in the
 /// collision list after the last step's detection, in the order they entered
@@ -289,6 +291,22 @@ uint32_t sn_get_crease_contacts(const sn_instance *inst, uint32_t *vertices, uin
 /// Read the diagnostics. SN_ERR_NULL, or SN_ERR_INSTANCE with *out zeroed,
 /// if inst is not an initialised instance.
 sn_status sn_get_stats(const sn_instance *inst, sn_stats *out);
+
+/// Levels of detail the blob carries (description 'levels N', tools/DESCRIPTION.md;
+/// runtime/LEVELS.md): 1, or 2 when it also holds the lattice subdivided once.
+/// 0 for a NULL blob.
+uint32_t sn_lod_levels(const sn_blob *blob);
+
+/// Switch the level of detail: 0 runs the baked (coarse) lattice, 1 the finer
+/// one. The instance was sized for the larger level at init; a step costs
+/// what the active level's counts say. The state is carried through the
+/// blob's maps: coarse to fine interpolates the coarse displacement field
+/// (the surface does not move), fine to coarse samples the fine field at the
+/// coarse vertices (the finer detail is dropped). Pending forces and the
+/// constraints in force are cleared (they name vertices of the old level);
+/// colliders stay. The level survives sn_reset. SN_OK (nothing happens if
+/// the level is in force), SN_ERR_ARG for a level the blob does not have.
+sn_status sn_set_lod(sn_instance *inst, uint32_t level);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
 /// (free positions, velocities, warm start, skeleton state, step count, control

@@ -276,14 +276,14 @@ static sn_status sn_check_contents(const sn_view *v) {
     return sn_check_rigs(v);
 }
 
-sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
+/* One blob's own checks (a finer level's nested blob goes through the same:
+ * sn_blob_validate calls this for the blob, then for its LEVEL_BLOB). */
+static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     const unsigned char *p = (const unsigned char *)data;
     uint32_t total, cnt[SN_SEC_COUNT], prev_end, k;
     sn_view v;
     sn_status st;
 
-    if (!data || !out) return SN_ERR_NULL;
-    *out = NULL;
     if (((uintptr_t)data & 7u) != 0) return SN_ERR_ALIGN;
     if (size < SN_HEADER_BYTES) return SN_ERR_TRUNCATED;
 
@@ -419,6 +419,10 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             v.crB = SN_CREASE_STATE_BYTES(v.nS, v.cr_list);
         }
         cnt[SN_SEC_CONSTRAINTS] = 0; /* 0 or 1: taken from the table below */
+        /* levels (format 6.0): counts from the table, checked against the finer level by sn_check_levels */
+        cnt[SN_SEC_LEVEL_BLOB] = sn_rd_u32(t + SN_SEC_LEVEL_BLOB * SN_SECTION_ENTRY);
+        cnt[SN_SEC_LEVEL_UP] = sn_rd_u32(t + SN_SEC_LEVEL_UP * SN_SECTION_ENTRY);
+        cnt[SN_SEC_LEVEL_DOWN] = sn_rd_u32(t + SN_SEC_LEVEL_DOWN * SN_SECTION_ENTRY);
     }
     {
         static const uint16_t elem[SN_SEC_COUNT] = {
@@ -431,7 +435,7 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
-            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR};
+            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -463,8 +467,29 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     if (st != SN_OK) return st;
     st = sn_check_constraints(&v); /* after the crease record: its rows count */
     if (st != SN_OK) return st;
-    /* the instance size is the runtime's layout (one source: sn_instance.c) */
-    if (v.instance_bytes != sn_instance_bytes(v.nV, v.nF, v.nJ, v.nC, v.nK, v.nFrc, v.segB, v.crB, v.conB)) return SN_ERR_HEADER;
+    *vo = v;
+    return SN_OK;
+}
+
+sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
+    sn_view v, f;
+    sn_status st;
+    uint32_t nV, nF, nC;
+    if (!data || !out) return SN_ERR_NULL;
+    *out = NULL;
+    st = validate_one(data, size, &v);
+    if (st != SN_OK) return st;
+    if (sn_level_sec_count(&v, SN_SEC_LEVEL_BLOB) != 0) { /* a finer level: a complete blob, then the pair (sn_level.c) */
+        st = validate_one(v.sec[SN_SEC_LEVEL_BLOB], sn_level_sec_count(&v, SN_SEC_LEVEL_BLOB), &f);
+        if (st != SN_OK) return st;
+        st = sn_check_levels(&v, &f);
+        if (st != SN_OK) return st;
+    } else if (sn_level_sec_count(&v, SN_SEC_LEVEL_UP) != 0 || sn_level_sec_count(&v, SN_SEC_LEVEL_DOWN) != 0) {
+        return SN_ERR_SECTION;
+    }
+    /* the instance size is the runtime's layout (one source: sn_instance.c) for the largest level's counts */
+    sn_level_counts(&v, &nV, &nF, &nC);
+    if (v.instance_bytes != sn_instance_bytes(nV, nF, v.nJ, nC, v.nK, v.nFrc, v.segB, v.crB, v.conB)) return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }

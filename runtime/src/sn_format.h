@@ -150,6 +150,13 @@ enum {
                             unused tail entries SN_CREASE_NONE; every entry < nS */
     SN_SEC_CREASE_TNBR,  /* nS * nbr_t x u16: row s = the triangles touching a vertex of VNBR row s, increasing, unused tail
                             entries SN_CREASE_NONE; every entry < nT */
+    /* ---- level of detail (issue 13; runtime/LEVELS.md), format 6.0; all three have count 0, or LEVEL_BLOB holds the
+       finer level and the two maps carry the state between the levels (sn_set_lod) ---- */
+    SN_SEC_LEVEL_BLOB,   /* n x u8: the finer level (level 1): a complete blob of this format, flavour and length unit (its own
+                            lattice, cells, matrices, embedding, rigs), whose three LEVEL sections have count 0 and whose
+                            joints, surface, controls, segment meshes, crease and constraint sections equal this blob's */
+    SN_SEC_LEVEL_UP,     /* nV(level 1) x {u16 cell, u16 t[3] Q15}: each level-1 lattice vertex in a cell of this (level 0) lattice */
+    SN_SEC_LEVEL_DOWN,   /* nV(level 0) x {u16 cell, u16 t[3] Q15}: each level-0 lattice vertex in a cell of the level-1 lattice */
     SN_SEC_COUNT
 };
 
@@ -186,6 +193,8 @@ enum {
 #define SN_ELEM_CREASE_PAIRS 4
 #define SN_ELEM_CREASE_VNBR  2
 #define SN_ELEM_CREASE_TNBR  2
+#define SN_ELEM_LEVEL_BLOB   1
+#define SN_ELEM_LEVEL_MAP    8
 
 /* self-collision near creases (seed 003 §3.4; sn_crease.c, NUMERICS.md "Self-collision") */
 #define SN_CREASE_MAX_LIST   256u   /* collision list C entries (eq. 8) */
@@ -286,7 +295,7 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * writers (the host tool, the tests' blob writers). The runtime's layout
  * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
  * the header to equal it, and test_runtime_blob checks this macro against it. */
-#define SN_INSTANCE_HDR_BYTES 768u /* the instance header before the arrays */
+#define SN_INSTANCE_HDR_BYTES 816u /* the instance header before the arrays (format 6.0: 768 before; the three level sections and the level of detail) */
 /* nFrc: force slots (header MAX_FORCES); segB: the extra state bytes before
  * the constraint state: the segment state, the sum over meshes of
  * SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts), plus the

@@ -50,8 +50,9 @@ uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, u
 }
 
 static void layout(sn_ihdr *h) {
-    uint32_t off[SN_LAYOUT_ARRAYS];
-    (void)layout_offsets(h->v.nV, h->v.nF, h->v.nJ, h->v.nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
+    uint32_t off[SN_LAYOUT_ARRAYS], nV, nF, nC;
+    sn_level_counts(&h->v, &nV, &nF, &nC); /* the largest level (sn_level.c): one layout for every level */
+    (void)layout_offsets(nV, nF, h->v.nJ, nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
     h->o_acc = off[0]; h->o_wr = off[1]; h->o_frc = off[2]; h->o_seg = off[3];
     h->o_pq = off[4]; h->o_pt = off[5]; h->o_jR = off[6]; h->o_jT = off[7];
     h->o_pos = off[8]; h->o_vel = off[9]; h->o_R = off[10]; h->o_x = off[11]; h->o_r = off[12];
@@ -110,6 +111,12 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     h = (sn_ihdr *)mem;
     sn_view_init(&h->v, blob);
     layout(h);
+    h->lod_base = h->v.base;
+    if (sn_level_sec_count(&h->v, SN_SEC_LEVEL_BLOB) != 0) { /* the finer level's structure too, then level 0 */
+        sn_level_view(h->lod_base, 1, &h->v);
+        if (!structure_ok(h)) return SN_ERR_INDEX;
+        sn_view_init(&h->v, blob);
+    }
     if (!structure_ok(h)) return SN_ERR_INDEX;
     h->magic = SN_INST_MAGIC;
     h->iterations = h->v.cg_default;
@@ -123,6 +130,13 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
         h->to_int = 1.0f / h->to_pub;
     }
 #endif
+    sn_k_table(h);
+    *out = (sn_instance *)mem;
+    (void)sn_reset(*out);
+    return SN_OK;
+}
+
+void sn_k_table(sn_ihdr *h) {
     {   /* Force-like CG vectors (b, r, q) of free vertex i carry k_i extra
          * fractional bits. A row's forces scale with its diagonal block of A
          * (mass + stiffness of the vertex's support), so a barely-inside vertex
@@ -152,9 +166,6 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
 #endif
         }
     }
-    *out = (sn_instance *)mem;
-    (void)sn_reset(*out);
-    return SN_OK;
 }
 
 static void set_identity(sn_q *R, uint32_t n) {
@@ -264,6 +275,8 @@ sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
     out->row_overflow = h->row_overflow;
     out->constraint_refused = h->con_refused;
     out->constraint_clamps = h->con_clamps;
+    out->lod = h->lod;
+    out->lattice_vertices = h->v.nV;
     return SN_OK;
 }
 

@@ -61,6 +61,9 @@ typedef struct sn_ihdr {
     uint32_t rows_kept;     /* rows enforced in the last step (after the factorization's drops) */
     uint32_t contacts;      /* contact rows collected in the last step */
     uint32_t row_drops, contact_overflow, row_overflow, con_refused, con_clamps; /* since init/reset */
+    /* level of detail (sn_level.c): the blob given to init (v is the active level's view), the active level */
+    const unsigned char *lod_base;
+    uint32_t lod;
 } sn_ihdr;
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
@@ -180,6 +183,11 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat);    /* 3b: crease list C: detect,
 uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh); /* list C into the FNV-1a hash (unchanged without CREASE) */
 void sn_cons_layout(sn_ihdr *h, uint32_t off);      /* constraint arrays from offset off (sn_constraint.c) */
 void sn_cons_reset(sn_ihdr *h);                     /* no constraints, colliders or rows; counters 0 */
+
+/* ---- level of detail (sn_level.c) ---- */
+void sn_level_view(const unsigned char *top, uint32_t lod, sn_view *v); /* view of level lod of a validated blob */
+void sn_k_table(sn_ihdr *h);                        /* per free vertex force exponents k_i of the active level (sn_instance.c) */
+void sn_frames_refresh(sn_ihdr *h, uint32_t *sat);  /* joint translations, vertex and cell frames for the pose in force (sn_pose.c) */
 
 /* ---- shared by the outputs, forces and segment meshes (sn_embed.c) ---- */
 void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out);  /* origin + p, public units */

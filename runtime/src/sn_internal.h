@@ -215,7 +215,7 @@ typedef struct sn_view {
     uint32_t nM, nSN, nSA, segB; /* segment meshes, nodes, attachments; segment state bytes */
     uint32_t nD, crB;          /* crease: seed pairs, state bytes (SN_CREASE_STATE_BYTES, 0 without) */
     uint16_t nCR, cr_list, cr_active, cr_nv, cr_nt, cr_pad; /* crease: CREASE count (0 or 1), max list, max active,
-                                                              VNBR / TNBR row widths (0 without), 0 (16-bit: the view sits in the 768-byte instance header) */
+                                                              VNBR / TNBR row widths (0 without), 0 (16-bit: the view sits in the 816-byte instance header) */
     sn_q cr_depth, cr_push;    /* crease: deepest detected penetration, push-out cap per step (Q22) */
     uint32_t nCon, nCol, nCt, nRows, conB; /* max constraints, colliders, contacts; rows per step; constraint state bytes */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;
@@ -248,6 +248,14 @@ sn_status sn_check_forces(const sn_view *v);
  * nCon, nCol, nCt, nRows, conB (sn_view_constraints). */
 sn_status sn_check_constraints(sn_view *v);
 void sn_view_constraints(sn_view *v); /* decode only (validated blob) */
+
+/* Levels of detail (sn_level.c, format 6.0): a section's count from the
+ * blob's table; the finer level against the coarse one (both already
+ * validated alone); the layout's counts, the largest over the levels (the
+ * free and the skeleton vertices each at their largest). */
+uint32_t sn_level_sec_count(const sn_view *v, int sec);
+sn_status sn_check_levels(const sn_view *coarse, const sn_view *fine);
+void sn_level_counts(const sn_view *v, uint32_t *nV, uint32_t *nF, uint32_t *nC);
 
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob);

@@ -204,6 +204,8 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
     h->frame_mode = h->mode;
 }
 
+void sn_frames_refresh(sn_ihdr *h, uint32_t *sat) { joint_frames(h, sat); }
+
 /* Steps 1-2: rigid joint transforms, the origin, and the frames of every
  * lattice vertex and cell for the current pose. */
 void sn_frames(sn_ihdr *h, uint32_t *sat) {

@@ -216,6 +216,14 @@ static void exercise(const sn_blob *blob) {
             (void)sn_set_pose(inst, xf, info.joints);
         }
         sn_step(inst);
+        if (s == 0) { /* level of detail (format 6.0): the finer level from the second step on, if the blob has one */
+            if (sn_set_lod(inst, 7) != SN_ERR_ARG) { printf("FAIL: sn_set_lod accepted level 7 (%s)\n", g_case); exit(1); }
+            (void)sn_set_lod(inst, sn_lod_levels(blob) > 1 ? 1u : 0u);
+        }
+    }
+    if (sn_lod_levels(blob) > 1) { /* and back, one more step on level 0 */
+        (void)sn_set_lod(inst, 0);
+        sn_step(inst);
     }
     (void)sn_get_lattice(inst, lat, 0, info.vertices);
     sn_get_stats(inst, &g_last_stats);

@@ -192,6 +192,9 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_CREASE_PAIRS] = TB_ND; elem[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
     cnt[SN_SEC_CREASE_VNBR] = 2 * TB_NS; elem[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
     cnt[SN_SEC_CREASE_TNBR] = 2 * TB_NS; elem[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
+    cnt[SN_SEC_LEVEL_BLOB] = 0;       elem[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;   /* format 6.0: no finer level */
+    cnt[SN_SEC_LEVEL_UP] = 0;         elem[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
+    cnt[SN_SEC_LEVEL_DOWN] = 0;       elem[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;

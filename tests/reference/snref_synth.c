@@ -274,6 +274,9 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_CREASE_PAIRS] = 0; el[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
         cnt[SN_SEC_CREASE_VNBR] = 0; el[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
         cnt[SN_SEC_CREASE_TNBR] = 0; el[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
+        cnt[SN_SEC_LEVEL_BLOB] = 0; el[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;   /* format 6.0: one level */
+        cnt[SN_SEC_LEVEL_UP] = 0; el[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
+        cnt[SN_SEC_LEVEL_DOWN] = 0; el[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;

@@ -34,6 +34,14 @@ crfixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/examples/limb_crease_float.blob" --clip "$CR_CLIP" --frames 400 --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 crfloat=$(hash_of "$T")
 [ -n "$fixed" ] && [ -n "$float" ] && [ -n "$crfixed" ] && [ -n "$crfloat" ] || { echo "update_hashes: a player printed no hash"; exit 1; }
+# level of detail (tests/level.mk: the cow baked with 'levels 2'): the trot with
+# switches up, down and up again (sinew-play --lod)
+LOD_SW=250:1,500:0,750:1
+"$BUILD/sinew-play" "$BUILD/level/cow_lod.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+lodfixed=$(hash_of "$T")
+"$BUILD/sinew-play-float" "$BUILD/level/cow_lod_float.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+lodfloat=$(hash_of "$T")
+[ -n "$lodfixed" ] && [ -n "$lodfloat" ] || { echo "update_hashes: a player printed no level-of-detail hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -56,5 +64,10 @@ float-contact $floatc
 # degrees and back), checked on every hosted platform and sinew-play.
 crease_fixed $crfixed
 crease_float $crfloat
+# The cow baked with 'levels 2' (tests/level.mk), the same 1000 steps of the
+# trot with the level switched up, down and up (sinew-play --lod $LOD_SW),
+# checked by tests/scripts/test_level.sh.
+lod_fixed $lodfixed
+lod_float $lodfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"

@@ -1,0 +1,26 @@
+# Level of detail (runtime/src/sn_level.c, tests/test_runtime_level.c), fixed
+# and float, on the cow and the beast re-baked from their descriptions with
+# 'levels 2'; run by tests/scripts/test_level.sh (the binaries take the blob paths).
+LEVEL_EX = $(BUILD)/level
+define LEVEL_DESC_RULE
+$(LEVEL_EX)/$(1)/lod.sinew: tools/examples/$(1)/$(1).sinew tests/level.mk
+	@mkdir -p $$(@D)
+	sed 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/$(1)/\1|' $$< > $$@
+	echo 'levels 2' >> $$@
+endef
+$(foreach c,cow beast,$(eval $(call LEVEL_DESC_RULE,$(c))))
+$(LEVEL_EX)/%_lod.blob: $(LEVEL_EX)/%/lod.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_lod_float.blob: $(LEVEL_EX)/%/lod.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/lod.sinew
+LEVEL_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_lod.blob $(LEVEL_EX)/$(c)_lod_float.blob)
+
+$(BUILD)/tests/level_runtime: tests/test_runtime_level.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(LEVEL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(LEVEL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(BUILD)/examples/cow.blob \
+             $(BUILD)/examples/cow_float.blob $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob

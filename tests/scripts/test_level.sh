@@ -1,0 +1,31 @@
+#!/bin/sh
+# Level of detail on the cow and the beast, fixed and float
+# (tests/test_runtime_level.c; blobs from tests/level.mk).
+B=${BUILD:-build}
+L=$B/level
+p=0; f=0
+for fl in "" _float; do
+    for c in cow beast; do
+        out=$("$B/tests/level_runtime$fl" "$B/examples/$c$fl.blob" "$L/${c}_lod$fl.blob" 2>&1)
+        rc=$?
+        echo "== level_runtime$fl $c"
+        echo "$out"
+        line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
+        if [ -z "$line" ]; then f=$((f + 1)); continue; fi
+        p=$((p + ${line%% passed*}))
+        ff=${line#*passed, }; ff=${ff%% failed*}
+        f=$((f + ff))
+        [ "$rc" -eq 0 ] || [ "$ff" -ne 0 ] || f=$((f + 1))
+    done
+done
+# determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
+for fl in fixed float; do
+    if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_lod.blob; else P=$B/sinew-play-float; BL=$L/cow_lod_float.blob; fi
+    got=$("$P" "$BL" --clip tools/examples/cow/trot.clip --frames 1000 --lod 250:1,500:0,750:1 --hash --quiet 2>/dev/null |
+          sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' | tail -n 1)
+    want=$(sed -n "s/^lod_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
+    if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: lod_$fl hash $got"; p=$((p + 1));
+    else echo "FAIL: lod_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
+done
+echo "$p passed, $f failed"
+[ "$f" -eq 0 ]
