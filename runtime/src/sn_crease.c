@@ -150,17 +150,37 @@ static int cr_near(const uint16_t *nb, uint32_t n, uint32_t x0, uint32_t x1, uin
     return (int)hit;
 }
 
-/* Search row rowv of TNBR for a triangle that surface vertex a (position
- * ra) has penetrated: no corner of it in a's neighbourhood (VNBR row a: a
- * fold of the skin next to a is not a collision), behind it, its projection
- * inside it, no deeper than the baked depth. The first such triangle of the
- * row (increasing index) wins. Returns 1 and *tri, *corner (surface vertex). */
-static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t rowv, uint32_t *tri,
+/* The neighbourhood row of surface vertex s (format 6.0: rows only for the
+ * vertices the host tool found the runtime can query, their owners strictly
+ * increasing, validated): binary search over the rows' first entries, at most
+ * bits(nQ) <= 16 probes. SN_CREASE_NONE: s has no row (never searched). */
+static uint32_t cr_row_of(const sn_view *v, uint32_t s) {
+    const unsigned char *VN = v->sec[SN_SEC_CREASE_VNBR];
+    uint32_t lo = 0, hi = v->cr_nq; /* the row, if any, is in [lo, hi) */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2u, x = sn_rd_u16(VN + 2u * (size_t)mid * v->cr_nv);
+        if (x == s) return mid;
+        if (x < s) lo = mid + 1u; else hi = mid;
+    }
+    return SN_CREASE_NONE;
+}
+
+/* Search the TNBR row of surface vertex nbr for a triangle that surface
+ * vertex a (position ra) has penetrated: no corner of it in a's
+ * neighbourhood (a's VNBR row: a fold of the skin next to a is not a
+ * collision), behind it, its projection inside it, no deeper than the baked
+ * depth. The first such triangle of the row (increasing index) wins. Either
+ * vertex without a row: nothing found. Returns 1 and *tri, *corner (surface
+ * vertex). */
+static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t nbr, uint32_t *tri,
                      uint32_t *corner, uint32_t *sat) {
-    const unsigned char *row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)rowv * h->v.cr_nt;
-    const unsigned char *vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)a * h->v.cr_nv;
+    uint32_t qa = cr_row_of(&h->v, a), qt = cr_row_of(&h->v, nbr);
+    const unsigned char *row, *vrow;
     uint16_t nb[SN_CREASE_MAX_NBR_V];
     uint32_t k, nn;
+    if (qa == SN_CREASE_NONE || qt == SN_CREASE_NONE) return 0;
+    row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)qt * h->v.cr_nt;
+    vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)qa * h->v.cr_nv;
     for (nn = 0; nn < h->v.cr_nv; nn++) { /* a's neighbourhood, once per search */
         nb[nn] = (uint16_t)sn_rd_u16(vrow + 2u * nn);
         if (nb[nn] == SN_CREASE_NONE) break;
@@ -290,8 +310,9 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
     }
     n0 = h->cr_n;
     for (k = 0; k < n0; k++) {
-        const unsigned char *row = VN + 2u * (size_t)C[k].vertex * v->cr_nv;
-        uint32_t p = C[k].corner, a;
+        uint32_t q = cr_row_of(v, C[k].vertex), p = C[k].corner, a;
+        const unsigned char *row = VN + 2u * (size_t)q * v->cr_nv;
+        if (q == SN_CREASE_NONE) continue; /* (a listed vertex has a row: it entered through cr_search) */
         for (a = 0; a < v->cr_nv; a++) {
             uint32_t i2 = sn_rd_u16(row + 2u * a);
             if (i2 == SN_CREASE_NONE) break;
@@ -347,12 +368,13 @@ uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh) {
 /* ---------------- validation (sn_blob.c calls it once the table is checked) ----------------
  * CREASE: reserved fields 0, depth in [1, SN_CREASE_DEPTH_MAX] (Q22: the
  * cr_finish distance is compared against it, |d| <= 2^29), push in
- * [0, depth]; PAIRS: i != j, both < nS; VNBR rows: first entry the row's
- * vertex, entries < nS, SN_CREASE_NONE only as a tail; TNBR rows: entries
- * < nT, SN_CREASE_NONE only as a tail. The counts and widths are checked
+ * [0, depth]; PAIRS: i != j, both < nS; VNBR rows (nQ of them, format
+ * 6.0): entries < nS, SN_CREASE_NONE only as a tail, first entries (the
+ * rows' owners) present and strictly increasing (cr_row_of's binary
+ * search); TNBR rows: entries < nT, SN_CREASE_NONE only as a tail. The counts and widths are checked
  * with the section table (sn_blob.c). */
-static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, uint32_t lim, int self) {
-    uint32_t s, k;
+static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, uint32_t lim, int owners) {
+    uint32_t s, k, last = 0;
     for (s = 0; s < rows; s++) {
         const unsigned char *row = sec + 2u * (size_t)s * width;
         int tail = 0;
@@ -361,7 +383,11 @@ static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, u
             if (x == SN_CREASE_NONE) { tail = 1; continue; }
             if (tail || x >= lim) return 0;
         }
-        if (self && sn_rd_u16(row) != s) return 0;
+        if (owners) {
+            uint32_t o = sn_rd_u16(row);
+            if (o >= lim || (s > 0 && o <= last)) return 0; /* present (not NONE), increasing */
+            last = o;
+        }
     }
     return 1;
 }
@@ -371,7 +397,7 @@ sn_status sn_check_crease(const sn_view *v) {
     uint32_t k;
     if (!v->nCR) return SN_OK;
     c = v->sec[SN_SEC_CREASE];
-    if (sn_rd_u16(c + 6) != 0 || sn_rd_u32(c + 8) != 0) return SN_ERR_VALUE;
+    if (sn_rd_u32(c + 8) != 0) return SN_ERR_VALUE;
     if (!sn_real_ok(c + 12, 1, SN_CREASE_DEPTH_MAX, SN_Q_LEN) || !(v->cr_depth > 0)) return SN_ERR_VALUE;
     if (!sn_real_ok(c + 12 + SN_REAL_BYTES, 0, SN_CREASE_DEPTH_MAX, SN_Q_LEN) || !(v->cr_push >= 0) ||
         !(v->cr_push <= v->cr_depth))
@@ -382,7 +408,7 @@ sn_status sn_check_crease(const sn_view *v) {
         if (i >= v->nS || j >= v->nS) return SN_ERR_INDEX;
         if (i == j) return SN_ERR_VALUE;
     }
-    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_VNBR], v->nS, v->cr_nv, v->nS, 1)) return SN_ERR_INDEX;
-    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_TNBR], v->nS, v->cr_nt, v->nT, 0)) return SN_ERR_INDEX;
+    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_VNBR], v->cr_nq, v->cr_nv, v->nS, 1)) return SN_ERR_INDEX;
+    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_TNBR], v->cr_nq, v->cr_nt, v->nT, 0)) return SN_ERR_INDEX;
     return SN_OK;
 }

@@ -15,7 +15,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 5
+#define SN_FORMAT_MAJOR 6
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -142,13 +142,14 @@ enum {
                             max_active) <= SN_MAX_ROWS. Count 0: no constraints, colliders or contacts */
     /* ---- self-collision near creases (seed 003 §3.4), format 5.0; all four have count 0, or CREASE has count 1 ---- */
     SN_SEC_CREASE,       /* 0 or 1 x {u16 max_list (1..SN_CREASE_MAX_LIST), u16 max_active (1..min(max_list, SN_CREASE_MAX_ACTIVE)),
-                            u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 0, u32 0,
+                            u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 rows (nQ, 1..nS; format 6.0), u32 0,
                             R depth (deepest detected penetration, Q22 internal, [1, SN_CREASE_DEPTH_MAX]),
                             R push (push-out cap per step, Q22, [0, depth])} */
     SN_SEC_CREASE_PAIRS, /* nD x {u16 i, u16 j}: the seed set D, surface vertices i != j (< nS), in the order found; nD <= SN_CREASE_MAX_PAIRS */
-    SN_SEC_CREASE_VNBR,  /* nS * nbr_v x u16: row s = the surface vertices near s (s itself first, then by ring, then index),
-                            unused tail entries SN_CREASE_NONE; every entry < nS */
-    SN_SEC_CREASE_TNBR,  /* nS * nbr_t x u16: row s = the triangles touching a vertex of VNBR row s, increasing, unused tail
+    SN_SEC_CREASE_VNBR,  /* nQ * nbr_v x u16 (format 6.0: only the vertices the runtime can query, sparse): row q = the surface
+                            vertices near its owner s (s itself first, then by ring, then index), unused tail entries
+                            SN_CREASE_NONE; every entry < nS; owners (first entries) strictly increasing over q */
+    SN_SEC_CREASE_TNBR,  /* nQ * nbr_t x u16: row q = the triangles touching a vertex of VNBR row q, increasing, unused tail
                             entries SN_CREASE_NONE; every entry < nT */
     SN_SEC_COUNT
 };
