@@ -26,8 +26,9 @@
  * The surface neighbourhoods the runtime searches (§3.4.2): VNBR row s = the
  * vertices within 'ring' edges of s (s first, then by ring, then by index, at
  * most SN_CREASE_MAX_NBR_V), TNBR row s = the triangles with a corner in
- * VNBR row s (increasing, at most SN_CREASE_MAX_NBR_T; the outer ring's
- * triangles are dropped first). Output is deterministic: every loop runs in
+ * VNBR row s within 'tring' rings of s (default: all of the row; 0: the
+ * triangles around s) (increasing, at most SN_CREASE_MAX_NBR_T; the outer
+ * ring's triangles are dropped first). Output is deterministic: every loop runs in
  * index order and ties go to the lower index.
  */
 #include "sb.h"
@@ -328,7 +329,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
 {
     csr_t vv, vt;
     int ns = o->ns, nt = o->nt, s, rc = -1, *buf, *rg, *mark, *tb, kv = 1, kt = 1, trunc_v = 0, trunc_t = 0;
-    int *excl_ptr = NULL, *excl = NULL;
+    int *excl_ptr = NULL, *excl = NULL, tring;
     unsigned char *hit = NULL;
     sb_blob b;
     snref_model m;
@@ -342,6 +343,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
     o->cr_push = d->cr_push >= 0 ? d->cr_push : 0.25 * o->cr_depth;
     o->cr_exclude = d->cr_exclude >= 0 ? d->cr_exclude : o->c;
     if (o->cr_push > o->cr_depth) return sb_fail("%s: crease push %g exceeds depth %g", d->path, o->cr_push, o->cr_depth);
+    tring = d->cr_tring >= 0 && d->cr_tring < d->cr_ring ? d->cr_tring : d->cr_ring;
     build_adj(o, &vv, &vt);
     buf = sb_alloc(sizeof(int) * (size_t)(ns + 1));
     rg = sb_alloc(sizeof(int) * (size_t)(ns + 1));
@@ -356,8 +358,8 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
             for (s = 0; s < ns; s++) {
                 int n = rings(&vv, s, d->cr_ring, buf, rg, ns, mark, s), nv = n, q, ntb = 0, e;
                 if (nv > (int)SN_CREASE_MAX_NBR_V) { nv = (int)SN_CREASE_MAX_NBR_V; trunc_v += pass == 0; }
-                /* triangles by ring: a triangle counts from the first ring that touches it */
-                for (q = 0; q < nv; q++) {
+                /* triangles by ring: a triangle counts from the first ring that touches it; only the rings up to 'tring' */
+                for (q = 0; q < nv && rg[q] <= tring; q++) {
                     int v = buf[q];
                     for (e = vt.ptr[v]; e < vt.ptr[v + 1]; e++) {
                         int t = vt.idx[e], z;
