@@ -204,6 +204,9 @@ static void test_header(void) {
     CASE(SN_ERR_INDEX, "crease row owners 0, 0 (repeated)", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4, 0));
     CASE(SN_ERR_INDEX, "crease last row's owner NONE", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4 * (TB_NS - 1), SN_CREASE_NONE));
     CASE(SN_ERR_INDEX, "crease last row's owner nS", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4 * (TB_NS - 1), TB_NS));
+    CASE(SN_ERR_VALUE, "crease exclude -1 LSB", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, -ldexp(1.0, -22), SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "crease exclude 2^28 + 64 LSB", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, 64.0 + ldexp(1.0, -16), SN_Q_LEN));
+    CASE(SN_OK, "crease exclude 2^28 (64 internal units)", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, 64.0, SN_Q_LEN));
     CASE(SN_OK, "crease row 0: its owner only (tail NONE)",
          tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 2, SN_CREASE_NONE));
 #undef CON

@@ -486,6 +486,8 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         put_u8(&w, at + 4, (unsigned)o->cr_kv); put_u8(&w, at + 5, (unsigned)o->cr_kt); put_u16(&w, at + 6, (unsigned)o->cr_nq);
         put_real(&w, at + 12, dep, SN_Q_LEN);
         put_real(&w, at + 12 + (size_t)rs, fmin(push, dep), SN_Q_LEN);
+        if (o->cr_exclude / U * 4194304.0 > (double)SN_CREASE_EXCLUDE_MAX) { sb_blob_free(b); return sb_fail("crease exclude %g mesh units out of range (0..%g)", o->cr_exclude, U * 64); }
+        put_real(&w, at + 12 + 2 * (size_t)rs, o->cr_exclude / U, SN_Q_LEN);
         for (i = 0; i < o->cr_nD; i++) {
             put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i, (unsigned)o->cr_pairs[2 * i]);
             put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i + 2, (unsigned)o->cr_pairs[2 * i + 1]);

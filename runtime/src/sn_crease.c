@@ -143,6 +143,54 @@ static void cr_tri(const sn_ihdr *h, const sn_q *S, const sn_q ra[3], uint32_t t
     if (full && g->below) cr_finish(ra, p0, g, sat);
 }
 
+/* Lattice vertices and weights (Q30) of surface vertex s's cell. */
+static void cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[8], sn_q phi[8]) {
+    const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
+    const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+    uint32_t t[3], a;
+    for (a = 0; a < 3; a++) t[a] = sn_rd_u16(e + 2 + 2 * a);
+    sn_trilinear(t, phi);
+    for (a = 0; a < 8; a++) vtx[a] = sn_rd_u16(cell + 2 * a);
+}
+
+/* Rest position (Q22) of surface vertex s: its cell's REST corners
+ * trilinearly weighted (a convex combination of validated coordinates). */
+static void cr_rest(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
+    const unsigned char *rest = h->v.sec[SN_SEC_REST];
+    uint32_t vtx[8], a, k, dummy = 0;
+    sn_q phi[8];
+    sn_acc acc[3] = {0, 0, 0};
+    cr_cell(h, s, vtx, phi);
+    for (a = 0; a < 8; a++)
+        for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], SN_RD_REAL(rest + (size_t)SN_REAL_BYTES * (3u * vtx[a] + k)));
+    for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
+}
+
+/* Is a corner of triangle t closer to rest position ra than the baked
+ * 'exclude' in the rest pose (seed 003 §3.4: skin that close folds with the
+ * lattice; the host tool's slow motion uses the same rule)? Fixed: the
+ * differences are <= 2^29, a squared distance <= 3 2^58, exclude^2 <= 2^56:
+ * exact in int64. */
+static int cr_excluded(const sn_ihdr *h, const sn_q ra[3], uint32_t t) {
+    sn_q ex = SN_RD_REAL(h->v.sec[SN_SEC_CREASE] + 12 + 2 * SN_REAL_BYTES), rc[3];
+    uint32_t c, k;
+    if (!(ex > 0)) return 0;
+    for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+        float d2 = 0;
+        cr_rest(h, cr_tri_corner(h, t, c), rc);
+        for (k = 0; k < 3; k++) d2 += (rc[k] - ra[k]) * (rc[k] - ra[k]);
+        if (d2 < ex * ex) return 1;
+#else
+        int64_t d2 = 0;
+        cr_rest(h, cr_tri_corner(h, t, c), rc);
+        for (k = 0; k < 3; k++) d2 += ((int64_t)rc[k] - ra[k]) * ((int64_t)rc[k] - ra[k]);
+        if (d2 < (int64_t)ex * ex) return 1;
+#endif
+    }
+    return 0;
+}
+
 /* Is any of x0, x1, x2 among the n entries of nb (a's neighbourhood)? */
 static int cr_near(const uint16_t *nb, uint32_t n, uint32_t x0, uint32_t x1, uint32_t x2) {
     uint32_t k, hit = 0;
@@ -178,6 +226,8 @@ static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[
     const unsigned char *row, *vrow;
     uint16_t nb[SN_CREASE_MAX_NBR_V];
     uint32_t k, nn;
+    sn_q rest_a[3];
+    int have_rest = 0;
     if (qa == SN_CREASE_NONE || qt == SN_CREASE_NONE) return 0;
     row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)qt * h->v.cr_nt;
     vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)qa * h->v.cr_nv;
@@ -194,6 +244,8 @@ static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[
         if (!g.below || !g.inside) continue;
         cr_finish(ra, S + 3u * cr_tri_corner(h, t, 0), &g, sat);
         if (g.d < -h->v.cr_depth) continue;
+        if (!have_rest) { cr_rest(h, a, rest_a); have_rest = 1; }
+        if (cr_excluded(h, rest_a, t)) continue; /* last: the rarest to get here, the dearest test */
         *tri = t;
         *corner = cr_tri_corner(h, t, g.corner);
         return 1;
@@ -217,15 +269,6 @@ static void cr_try(sn_ihdr *h, const sn_q *S, uint32_t a, uint32_t rowv, uint32_
     h->cr_added = sn_count(h->cr_added, 1);
 }
 
-/* Lattice vertices and weights (Q30) of surface vertex s's cell. */
-static void cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[8], sn_q phi[8]) {
-    const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
-    const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-    uint32_t t[3], a;
-    for (a = 0; a < 3; a++) t[a] = sn_rd_u16(e + 2 + 2 * a);
-    sn_trilinear(t, phi);
-    for (a = 0; a < 8; a++) vtx[a] = sn_rd_u16(cell + 2 * a);
-}
 
 /* The contact row of pair P (eq. 9): (v_i - v_b).n >= target with v_i the
  * velocity of vertex i (its cell's weights, +phi) and v_b that of the
@@ -368,7 +411,7 @@ uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh) {
 /* ---------------- validation (sn_blob.c calls it once the table is checked) ----------------
  * CREASE: reserved fields 0, depth in [1, SN_CREASE_DEPTH_MAX] (Q22: the
  * cr_finish distance is compared against it, |d| <= 2^29), push in
- * [0, depth]; PAIRS: i != j, both < nS; VNBR rows (nQ of them, format
+ * [0, depth], exclude in [0, SN_CREASE_EXCLUDE_MAX] (squared in int64); PAIRS: i != j, both < nS; VNBR rows (nQ of them, format
  * 6.0): entries < nS, SN_CREASE_NONE only as a tail, first entries (the
  * rows' owners) present and strictly increasing (cr_row_of's binary
  * search); TNBR rows: entries < nT, SN_CREASE_NONE only as a tail. The counts and widths are checked
@@ -402,6 +445,7 @@ sn_status sn_check_crease(const sn_view *v) {
     if (!sn_real_ok(c + 12 + SN_REAL_BYTES, 0, SN_CREASE_DEPTH_MAX, SN_Q_LEN) || !(v->cr_push >= 0) ||
         !(v->cr_push <= v->cr_depth))
         return SN_ERR_VALUE;
+    if (!sn_real_ok(c + 12 + 2 * SN_REAL_BYTES, 0, SN_CREASE_EXCLUDE_MAX, SN_Q_LEN)) return SN_ERR_VALUE;
     D = v->sec[SN_SEC_CREASE_PAIRS];
     for (k = 0; k < v->nD; k++) {
         uint32_t i = sn_rd_u16(D + 4u * k), j = sn_rd_u16(D + 4u * k + 2);

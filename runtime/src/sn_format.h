@@ -144,7 +144,9 @@ enum {
     SN_SEC_CREASE,       /* 0 or 1 x {u16 max_list (1..SN_CREASE_MAX_LIST), u16 max_active (1..min(max_list, SN_CREASE_MAX_ACTIVE)),
                             u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 rows (nQ, 1..nS; format 6.0), u32 0,
                             R depth (deepest detected penetration, Q22 internal, [1, SN_CREASE_DEPTH_MAX]),
-                            R push (push-out cap per step, Q22, [0, depth])} */
+                            R push (push-out cap per step, Q22, [0, depth]),
+                            R exclude (format 6.0: a triangle with a corner closer than this to the vertex in the rest
+                            pose is no collision, Q22, [0, SN_CREASE_EXCLUDE_MAX])} */
     SN_SEC_CREASE_PAIRS, /* nD x {u16 i, u16 j}: the seed set D, surface vertices i != j (< nS), in the order found; nD <= SN_CREASE_MAX_PAIRS */
     SN_SEC_CREASE_VNBR,  /* nQ * nbr_v x u16 (format 6.0: only the vertices the runtime can query, sparse): row q = the surface
                             vertices near its owner s (s itself first, then by ring, then index), unused tail entries
@@ -183,7 +185,7 @@ enum {
 #define SN_ELEM_SEGNODES(R) (3 * (R))
 #define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
 #define SN_ELEM_CONSTRAINTS 8
-#define SN_ELEM_CREASE(R)   (12 + 2 * (R))
+#define SN_ELEM_CREASE(R)   (12 + 3 * (R))
 #define SN_ELEM_CREASE_PAIRS 4
 #define SN_ELEM_CREASE_VNBR  2
 #define SN_ELEM_CREASE_TNBR  2
@@ -195,6 +197,7 @@ enum {
 #define SN_CREASE_MAX_NBR_T  64u    /* triangles per neighbourhood row */
 #define SN_CREASE_MAX_PAIRS  4096u  /* seed pairs D */
 #define SN_CREASE_DEPTH_MAX  ((int32_t)1 << 26) /* Q22: 16 internal units */
+#define SN_CREASE_EXCLUDE_MAX ((int32_t)1 << 28) /* Q22: 64 internal units (its square <= 2^56, NUMERICS.md) */
 #define SN_CREASE_NONE       0xFFFFu
 /* crease state bytes (multiple of 8): the step's surface positions (3 reals
  * per surface vertex), the list (8 bytes per entry), one membership byte per

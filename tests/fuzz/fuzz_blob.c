@@ -812,6 +812,7 @@ static void e_joint_ls(unsigned char *b, int hi) { coords(b, hi ? 24 : -24, hi, 
 /* everything at once */
 static void e_crease_depth(unsigned char *b, int hi) {
     crease_set(b, TB_CR_LIST, TB_CR_ACTIVE, hi ? 16.0 : ldexp(1.0, -22), hi ? 16.0 : 0.0);
+    tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, hi ? 64.0 : ldexp(1.0, -22), SN_Q_LEN); /* exclude (format 6.0) */
 }
 static void e_crease_list(unsigned char *b, int hi) { crease_set(b, hi ? 256 : 1, hi ? 64 : 1, 0.5, 0.05); }
 static void e_all(unsigned char *b, int hi) {
@@ -874,7 +875,7 @@ static const mx_row g_rows[] = {
     {"rest coords, len_shift 24", "all -2^12", "all +2^12", e_rest_ls24, 0},
     {"joint coords, len_shift 0", "all -2^27", "all +2^27", e_joint, 0},
     {"joint coords, len_shift -+24", "-2^27, ls -24", "+2^12, ls 24", e_joint_ls, 0},
-    {"crease depth, push (a contact)", "1 LSB, 0", "2^26, 2^26", e_crease_depth, 0},
+    {"crease depth, push, exclude (a contact)", "1 LSB, 0, 1 LSB", "2^26, 2^26, 2^28", e_crease_depth, 0},
     {"crease list, active (a contact)", "1, 1", "256, 64", e_crease_list, 0},
     {"everything at once", "all min", "all max", e_all, 0},
 };

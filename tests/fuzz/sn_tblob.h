@@ -350,6 +350,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         tb_u16(cr + 6, TB_NS); /* rows (format 6.0): one per surface vertex */
         tb_real(cr + 12, 0.25, SN_Q_LEN);
         tb_real(cr + 12 + R, 0.05, SN_Q_LEN);
+        tb_real(cr + 12 + 2 * R, 0.0, SN_Q_LEN); /* exclude (format 6.0): off */
         tb_u16(b + secoff[SN_SEC_CREASE_PAIRS], 0);
         tb_u16(b + secoff[SN_SEC_CREASE_PAIRS] + 2, 2);
         for (i = 0; i < TB_NS; i++) {
