@@ -81,9 +81,9 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
     const uint32_t elem[31] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
                                40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R, 8,
-                               12 + 2 * R, 4, 2, 2};
+                               12 + 3 * R, 4, 2, 2};
     uint32_t want[31], inst, segB = 0, conB = 0, crB = 0, crRows = 0;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 5 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 5.0", what);
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 6.0", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
