@@ -126,14 +126,14 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
                                 u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0, 0, 0, 0, 0, 0};
         memcpy(want, w, sizeof want);
     }
-    {   /* CREASE (0 or 1): its record fixes the rows (format 6.0: u16 nQ at +6) and their widths; state 13 per surface vertex + 8 per list entry; max_active rows */
+    {   /* CREASE (0 or 1): its record fixes the rows (format 6.0: u16 nQ at +6) and their widths; state 14 per surface vertex + 8 per list entry; max_active rows */
         uint32_t on = u32(b + 176 + 16 * 27 + 8);
         want[27] = on > 1 ? 1 : on;
         want[28] = u32(b + 176 + 16 * 28 + 8);
         if (on == 1) {
             const unsigned char *r = b + u32(b + 176 + 16 * 27);
             want[29] = u16(r + 6) * r[4]; want[30] = u16(r + 6) * r[5];
-            crB = (13u * nS + 8u * u16(r) + 7u) & ~7u;
+            crB = (14u * nS + 8u * u16(r) + 7u) & ~7u;
             crRows = u16(r + 2);
         }
     }

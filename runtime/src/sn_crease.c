@@ -6,7 +6,8 @@
  * Model, formats and bounds: runtime/NUMERICS.md "Self-collision near creases".
  *
  * One step (called after the skeleton is posed, before the solve):
- *   0. the surface positions r_s of every surface vertex from the current
+ *   0. the surface positions r_s of the surface vertices the step reaches
+ *      (computed on first use, cr_pos) from the current
  *      lattice (free vertices: end of the last step; skeleton: this pose)
  *   1. maintenance: for each (i, T) in C, in order: r_i above T's plane
  *      ((r_i - r_b).n > 0, the paper's test): removed; projection slid off T
@@ -25,7 +26,7 @@
  *      the rows of pairs k < n_a, at most max_active (the rest counted)
  *
  * Cost per step, with nS surface vertices, D seeds, L = max_list, Kv, Kt the
- * neighbourhood widths, A = max_active: c1 nS + c2 L + Kt (2 D + L Kv) c3 +
+ * neighbourhood widths, A = max_active: c1 nS (clearing a byte; at most nS positions) + c2 L + Kt (2 D + L Kv) c3 +
  * L c4 + A c5, constants independent of the data (every loop bound is a
  * blob count or a baked maximum; a triangle test has no data-dependent loop).
  */
@@ -39,6 +40,18 @@ static sn_crease_pair *cr_pairs(const sn_ihdr *h) {
     return (sn_crease_pair *)(void *)(cr_base(h) + 12u * h->v.nS);
 }
 static uint8_t *cr_member(const sn_ihdr *h) { return cr_base(h) + 12u * h->v.nS + 8u * h->v.cr_list; }
+static uint8_t *cr_fresh(const sn_ihdr *h) { return cr_base(h) + 13u * h->v.nS + 8u * h->v.cr_list; }
+
+/* Surface position of vertex s this step (internal units), computed on first
+ * use: the step needs only the vertices its searches reach (the rows' owners,
+ * their neighbours and their triangles' corners), not all nS (format 6.0;
+ * the same values as computing every one, at a cost bounded by nS). */
+static const sn_q *cr_pos(const sn_ihdr *h, uint32_t s) {
+    sn_q *S = cr_surf(h);
+    uint8_t *f = cr_fresh(h);
+    if (!f[s]) { sn_surface_point(h, s, S + 3u * s); f[s] = 1; }
+    return S + 3u * s;
+}
 
 const sn_crease_pair *sn_crease_list(const sn_ihdr *h) { return h->v.nCR ? cr_pairs(h) : NULL; }
 const sn_q *sn_crease_surface(const sn_ihdr *h) { return h->v.nCR ? cr_surf(h) : NULL; }
@@ -137,8 +150,8 @@ static void cr_finish(const sn_q ri[3], const sn_q ra[3], cr_geo *g, uint32_t *s
 
 /* Test surface vertex a (position ra) against triangle t from the step's
  * surface positions; full = also normal and depth when it is behind and inside. */
-static void cr_tri(const sn_ihdr *h, const sn_q *S, const sn_q ra[3], uint32_t t, cr_geo *g, int full, uint32_t *sat) {
-    const sn_q *p0 = S + 3u * cr_tri_corner(h, t, 0), *p1 = S + 3u * cr_tri_corner(h, t, 1), *p2 = S + 3u * cr_tri_corner(h, t, 2);
+static void cr_tri(const sn_ihdr *h, const sn_q ra[3], uint32_t t, cr_geo *g, int full, uint32_t *sat) {
+    const sn_q *p0 = cr_pos(h, cr_tri_corner(h, t, 0)), *p1 = cr_pos(h, cr_tri_corner(h, t, 1)), *p2 = cr_pos(h, cr_tri_corner(h, t, 2));
     cr_test(ra, p0, p1, p2, g);
     if (full && g->below) cr_finish(ra, p0, g, sat);
 }
@@ -214,21 +227,23 @@ static uint32_t cr_row_of(const sn_view *v, uint32_t s) {
 }
 
 /* Search the TNBR row of surface vertex nbr for a triangle that surface
- * vertex a (position ra) has penetrated: no corner of it in a's
+ * vertex a has penetrated: no corner of it in a's
  * neighbourhood (a's VNBR row: a fold of the skin next to a is not a
  * collision), behind it, its projection inside it, no deeper than the baked
  * depth. The first such triangle of the row (increasing index) wins. Either
  * vertex without a row: nothing found. Returns 1 and *tri, *corner (surface
  * vertex). */
-static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t nbr, uint32_t *tri,
+static int cr_search(const sn_ihdr *h, uint32_t a, uint32_t nbr, uint32_t *tri,
                      uint32_t *corner, uint32_t *sat) {
     uint32_t qa = cr_row_of(&h->v, a), qt = cr_row_of(&h->v, nbr);
     const unsigned char *row, *vrow;
     uint16_t nb[SN_CREASE_MAX_NBR_V];
     uint32_t k, nn;
     sn_q rest_a[3];
+    const sn_q *ra;
     int have_rest = 0;
     if (qa == SN_CREASE_NONE || qt == SN_CREASE_NONE) return 0;
+    ra = cr_pos(h, a);
     row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)qt * h->v.cr_nt;
     vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)qa * h->v.cr_nv;
     for (nn = 0; nn < h->v.cr_nv; nn++) { /* a's neighbourhood, once per search */
@@ -240,9 +255,9 @@ static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[
         cr_geo g;
         if (t == SN_CREASE_NONE) break; /* the row's tail is all NONE (validated) */
         if (cr_near(nb, nn, cr_tri_corner(h, t, 0), cr_tri_corner(h, t, 1), cr_tri_corner(h, t, 2))) continue;
-        cr_tri(h, S, ra, t, &g, 0, sat);
+        cr_tri(h, ra, t, &g, 0, sat);
         if (!g.below || !g.inside) continue;
-        cr_finish(ra, S + 3u * cr_tri_corner(h, t, 0), &g, sat);
+        cr_finish(ra, cr_pos(h, cr_tri_corner(h, t, 0)), &g, sat);
         if (g.d < -h->v.cr_depth) continue;
         if (!have_rest) { cr_rest(h, a, rest_a); have_rest = 1; }
         if (cr_excluded(h, rest_a, t)) continue; /* last: the rarest to get here, the dearest test */
@@ -254,11 +269,11 @@ static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[
 }
 
 /* Step 2 for one candidate: vertex a against the triangles near rowv. */
-static void cr_try(sn_ihdr *h, const sn_q *S, uint32_t a, uint32_t rowv, uint32_t *sat) {
+static void cr_try(sn_ihdr *h, uint32_t a, uint32_t rowv, uint32_t *sat) {
     uint8_t *mem = cr_member(h);
     uint32_t t, c;
     if (mem[a]) return;
-    if (!cr_search(h, S, a, S + 3u * a, rowv, &t, &c, sat)) return;
+    if (!cr_search(h, a, rowv, &t, &c, sat)) return;
     if (h->cr_n >= h->v.cr_list) { h->cr_list_full = sn_count(h->cr_list_full, 1); return; }
     {
         sn_crease_pair *P = cr_pairs(h) + h->cr_n;
@@ -278,13 +293,13 @@ static void cr_try(sn_ihdr *h, const sn_q *S, uint32_t a, uint32_t rowv, uint32_
  * step, at most by the cap. Returns chi = (v_i - v_b).n of the last step's
  * velocities (Q22). */
 static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_t *sat) {
-    const sn_q *S = cr_surf(h), *vel = CARR(h, o_vel, sn_q);
+    const sn_q *vel = CARR(h, o_vel, sn_q);
     uint32_t vi[8], vp[8], a, b, k;
     sn_q pi[8], pp[8], rv[3];
     sn_acc acc[3] = {0, 0, 0}, chi = 0;
     cr_geo g;
-    cr_tri(h, S, S + 3u * P->vertex, P->tri, &g, 0, sat);
-    cr_finish(S + 3u * P->vertex, S + 3u * cr_tri_corner(h, P->tri, 0), &g, sat);
+    cr_tri(h, cr_pos(h, P->vertex), P->tri, &g, 0, sat);
+    cr_finish(cr_pos(h, P->vertex), cr_pos(h, cr_tri_corner(h, P->tri, 0)), &g, sat);
     cr_cell(h, P->vertex, vi, pi);
     cr_cell(h, P->corner, vp, pp);
     r->n = 0;
@@ -311,29 +326,28 @@ static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_
 void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     sn_crease_pair *C;
-    uint8_t *mem;
-    sn_q *S;
+    uint8_t *mem, *F;
     const unsigned char *D, *VN;
     uint32_t s, k, w, n0, na;
     if (!v->nCR) return;
-    C = cr_pairs(h); mem = cr_member(h); S = cr_surf(h);
+    C = cr_pairs(h); mem = cr_member(h); F = cr_fresh(h);
     D = v->sec[SN_SEC_CREASE_PAIRS]; VN = v->sec[SN_SEC_CREASE_VNBR];
     h->cr_rows = 0;
-    /* 0. surface positions of this step */
-    for (s = 0; s < v->nS; s++) sn_surface_point(h, s, S + 3u * s);
+    /* 0. surface positions of this step: none computed yet */
+    for (s = 0; s < v->nS; s++) F[s] = 0; /* computed on first use (cr_pos) */
     /* 1. maintenance (seed 003 §3.4.2 step 2), order kept */
     for (k = 0, w = 0; k < h->cr_n; k++) {
         sn_crease_pair P = C[k];
-        const sn_q *ri = S + 3u * P.vertex;
+        const sn_q *ri = cr_pos(h, P.vertex);
         cr_geo g;
         int keep = 0;
-        cr_tri(h, S, ri, P.tri, &g, 1, sat);
+        cr_tri(h, ri, P.tri, &g, 1, sat);
         if (g.below && !g.off) {
             keep = g.d >= -v->cr_depth;
             P.corner = (uint16_t)cr_tri_corner(h, P.tri, g.corner);
         } else if (g.below) { /* slid off T: the triangle it lies under now, near the corner */
             uint32_t t, c;
-            if (cr_search(h, S, P.vertex, ri, P.corner, &t, &c, sat)) {
+            if (cr_search(h, P.vertex, P.corner, &t, &c, sat)) {
                 P.tri = (uint16_t)t; P.corner = (uint16_t)c;
                 keep = 1;
             }
@@ -348,8 +362,8 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
     /* 2. detection over P = D u N(C) (steps 1 and 3) */
     for (k = 0; k < v->nD; k++) {
         uint32_t i = sn_rd_u16(D + 4u * k), j = sn_rd_u16(D + 4u * k + 2);
-        cr_try(h, S, i, j, sat);
-        cr_try(h, S, j, i, sat);
+        cr_try(h, i, j, sat);
+        cr_try(h, j, i, sat);
     }
     n0 = h->cr_n;
     for (k = 0; k < n0; k++) {
@@ -359,7 +373,7 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
         for (a = 0; a < v->cr_nv; a++) {
             uint32_t i2 = sn_rd_u16(row + 2u * a);
             if (i2 == SN_CREASE_NONE) break;
-            cr_try(h, S, i2, p, sat);
+            cr_try(h, i2, p, sat);
         }
     }
     /* 3. the active prefix n_a (step 4) and its rows */

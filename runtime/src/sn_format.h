@@ -200,11 +200,12 @@ enum {
 #define SN_CREASE_EXCLUDE_MAX ((int32_t)1 << 28) /* Q22: 64 internal units (its square <= 2^56, NUMERICS.md) */
 #define SN_CREASE_NONE       0xFFFFu
 /* crease state bytes (multiple of 8): the step's surface positions (3 reals
- * per surface vertex), the list (8 bytes per entry), one membership byte per
- * surface vertex; 0 without CREASE. Its max_active rows per step are part of
- * the constraint rows (SN_ROWS_CAP, SN_CONS_BYTES). */
+ * per surface vertex), the list (8 bytes per entry), one membership byte and
+ * (format 6.0) one byte "position computed this step" per surface vertex;
+ * 0 without CREASE. Its max_active rows per step are part of the constraint
+ * rows (SN_ROWS_CAP, SN_CONS_BYTES). */
 #define SN_CREASE_STATE_BYTES(nS, max_list) \
-    ((13u * (uint32_t)(nS) + 8u * (uint32_t)(max_list) + 7u) & ~7u)
+    ((14u * (uint32_t)(nS) + 8u * (uint32_t)(max_list) + 7u) & ~7u)
 
 /* external forces: levels fine, coarse 1..3 (2, 4, 8 cells), rigid */
 #define SN_LEVELS 5
