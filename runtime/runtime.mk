@@ -85,7 +85,7 @@ TEST_DEPS += $(BUILD)/tests/cost_probe
 # fuzzer with ASan + UBSan; _ck keeps the checksum (every flip must fail) ----
 SN_FUZZ_CFLAGS = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
                  -fno-sanitize-recover=all $(SN_INC) -Iruntime/src -Itests/fuzz
-SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h $(SN_SRCS) $(SN_HDRS)
+SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h tests/fuzz/sn_thostile.h $(SN_SRCS) $(SN_HDRS)
 $(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm

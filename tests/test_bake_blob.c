@@ -81,7 +81,7 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
     const uint32_t elem[34] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, 324 * R, R, 8, 6,
                                40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R, 8,
-                               12 + 2 * R, 4, 2, 2, 1, 8, 8};
+                               12 + 3 * R, 4, 2, 2, 1, 8, 8};
     uint32_t want[34], inst, segB = 0, conB = 0, crB = 0, crRows = 0;
     T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 0, "%s: spec: magic SNWB, version 6.0", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
@@ -127,14 +127,14 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
                                 0, 0, 0};   /* format 6.0: the level sections (none without 'levels 2') */
         memcpy(want, w, sizeof want);
     }
-    {   /* CREASE (0 or 1): its record fixes the row widths; state 13 per surface vertex + 8 per list entry; max_active rows */
+    {   /* CREASE (0 or 1): its record fixes the rows (format 6.0: u16 nQ at +6) and their widths; state 14 per surface vertex + 8 per list entry; max_active rows */
         uint32_t on = u32(b + 176 + 16 * 27 + 8);
         want[27] = on > 1 ? 1 : on;
         want[28] = u32(b + 176 + 16 * 28 + 8);
         if (on == 1) {
             const unsigned char *r = b + u32(b + 176 + 16 * 27);
-            want[29] = nS * r[4]; want[30] = nS * r[5];
-            crB = (13u * nS + 8u * u16(r) + 7u) & ~7u;
+            want[29] = u16(r + 6) * r[4]; want[30] = u16(r + 6) * r[5];
+            crB = (14u * nS + 8u * u16(r) + 7u) & ~7u;
             crRows = u16(r + 2);
         }
     }

@@ -88,7 +88,7 @@ static void test_limb(void)
     sb_model o, o2;
     sb_blob b, b2;
     sb_mesh m;
-    int s, k, bad_v = 0, bad_t = 0, bad_side = 0, bad_where = 0, n120;
+    int s, k, q_, bad_v = 0, bad_t = 0, bad_side = 0, bad_where = 0, n120;
     memset(&m, 0, sizeof m);
     if (write_limb("120", "crease elbow:0,0,1,120 steps 120\ncrease_settings list 64 active 32 ring 1 depth 0.5 push 0.125\n", path, sizeof path) ||
         bake(path, SB_FIXED, &o, &b) || sb_mesh_load_obj("tools/examples/limb/limb.obj", &m)) {
@@ -96,9 +96,20 @@ static void test_limb(void)
         return;
     }
     T_CHECK(o.crease == 1 && o.cr_nD > 0 && o.ns == m.nv, "120 degrees: %d seed pairs", o.cr_nD);
-    /* neighbourhood rows against edges recomputed from the triangles */
-    for (s = 0; s < o.ns; s++) {
+    /* neighbourhood rows (format 6.0: only for the vertices the runtime can query, owners increasing) against edges
+     * recomputed from the triangles; every seed vertex has a row */
+    T_CHECK(o.cr_nq >= 1 && o.cr_nq <= o.ns, "%d neighbourhood rows of %d surface vertices", o.cr_nq, o.ns);
+    for (k = 0; k < 2 * o.cr_nD; k++) {
+        int q;
+        for (q = 0; q < o.cr_nq && o.cr_vnbr[(size_t)q * o.cr_kv] != o.cr_pairs[k]; q++) {}
+        if (q == o.cr_nq) bad_v++;
+    }
+    T_CHECK(bad_v == 0, "every seed vertex owns a row (%d do not)", bad_v);
+    for (k = 1; k < o.cr_nq; k++) if (!(o.cr_vnbr[(size_t)k * o.cr_kv] > o.cr_vnbr[(size_t)(k - 1) * o.cr_kv])) bad_v++;
+    T_CHECK(bad_v == 0, "row owners strictly increasing (%d not)", bad_v);
+    for (q_ = 0; q_ < o.cr_nq; q_++) {
         int ring[64], nr = 0, t, e, want_t[128], nt = 0;
+        s = o.cr_vnbr[(size_t)q_ * o.cr_kv];
         for (t = 0; t < m.nt; t++)
             for (e = 0; e < 3; e++)
                 if (m.tri[3 * t + e] == s) {
@@ -111,10 +122,9 @@ static void test_limb(void)
                 }
         /* sort the ring */
         for (k = 1; k < nr; k++) { int x = ring[k], q = k - 1; while (q >= 0 && ring[q] > x) { ring[q + 1] = ring[q]; q--; } ring[q + 1] = x; }
-        if (o.cr_vnbr[(size_t)s * o.cr_kv] != s) bad_v++;
         for (k = 0; k < o.cr_kv; k++) {
             int want = k == 0 ? s : (k - 1 < nr ? ring[k - 1] : -1);
-            if (o.cr_vnbr[(size_t)s * o.cr_kv + k] != want) bad_v++;
+            if (o.cr_vnbr[(size_t)q_ * o.cr_kv + k] != want) bad_v++;
         }
         if (nr + 1 > o.cr_kv) bad_v++;
         for (t = 0; t < m.nt; t++) {
@@ -127,7 +137,7 @@ static void test_limb(void)
             if (hit && nt < 128) want_t[nt++] = t;
         }
         for (k = 0; k < o.cr_kt; k++)
-            if (o.cr_tnbr[(size_t)s * o.cr_kt + k] != (k < nt ? want_t[k] : -1)) bad_t++;
+            if (o.cr_tnbr[(size_t)q_ * o.cr_kt + k] != (k < nt ? want_t[k] : -1)) bad_t++;
         if (nt > o.cr_kt) bad_t++;
     }
     T_CHECK(bad_v == 0, "VNBR rows: the vertex, then its one-ring increasing, padded (%d bad entries; width %d)", bad_v, o.cr_kv);
@@ -145,20 +155,22 @@ static void test_limb(void)
     {
         const unsigned char *B = b.bytes, *r = B + sec_off(B, SN_SEC_CREASE);
         int ok = sec_cnt(B, SN_SEC_CREASE) == 1 && sec_cnt(B, SN_SEC_CREASE_PAIRS) == (uint32_t)o.cr_nD &&
-                 sec_cnt(B, SN_SEC_CREASE_VNBR) == (uint32_t)(o.ns * o.cr_kv) && sec_cnt(B, SN_SEC_CREASE_TNBR) == (uint32_t)(o.ns * o.cr_kt) &&
-                 u16(r) == 64 && u16(r + 2) == 32 && r[4] == o.cr_kv && r[5] == o.cr_kt && u16(r + 6) == 0 && u32(r + 8) == 0;
+                 sec_cnt(B, SN_SEC_CREASE_VNBR) == (uint32_t)(o.cr_nq * o.cr_kv) && sec_cnt(B, SN_SEC_CREASE_TNBR) == (uint32_t)(o.cr_nq * o.cr_kt) &&
+                 u16(r) == 64 && u16(r + 2) == 32 && r[4] == o.cr_kv && r[5] == o.cr_kt && u16(r + 6) == (unsigned)o.cr_nq && u32(r + 8) == 0;
         /* len_shift 3: 0.5 mesh units = 1/16 internal = 2^18 at Q22; push 0.125 = 2^16 */
         T_CHECK(ok && u32(r + 12) == (1u << 18) && u32(r + 16) == (1u << 16) && B[SN_H_LEN_SHIFT] == 3,
                 "CREASE record: list 64, active 32, widths, depth 2^18, push 2^16 (Q22, len_shift 3): depth %u push %u", u32(r + 12), u32(r + 16));
         for (k = 0; k < o.cr_nD; k++)
             ok &= u16(B + sec_off(B, SN_SEC_CREASE_PAIRS) + 4 * k) == (unsigned)o.cr_pairs[2 * k] &&
                   u16(B + sec_off(B, SN_SEC_CREASE_PAIRS) + 4 * k + 2) == (unsigned)o.cr_pairs[2 * k + 1];
-        for (k = 0; k < o.ns * o.cr_kt; k++)
+        for (k = 0; k < o.cr_nq * o.cr_kt; k++)
             ok &= u16(B + sec_off(B, SN_SEC_CREASE_TNBR) + 2 * k) == (o.cr_tnbr[k] < 0 ? 0xFFFFu : (unsigned)o.cr_tnbr[k]);
+        for (k = 0; k < o.cr_nq * o.cr_kv; k++)
+            ok &= u16(B + sec_off(B, SN_SEC_CREASE_VNBR) + 2 * k) == (o.cr_vnbr[k] < 0 ? 0xFFFFu : (unsigned)o.cr_vnbr[k]);
         T_CHECK(ok, "pairs and rows written as the model holds them");
-        T_FIGURE("limb at 120 deg: %d seed pairs; crease sections %u bytes (CREASE %d, PAIRS %d, VNBR %d, TNBR %d), blob %lu bytes",
-                 o.cr_nD, (unsigned)(SN_ELEM_CREASE(4) + 4 * o.cr_nD + 2 * o.ns * (o.cr_kv + o.cr_kt)), SN_ELEM_CREASE(4), 4 * o.cr_nD,
-                 2 * o.ns * o.cr_kv, 2 * o.ns * o.cr_kt, (unsigned long)b.size);
+        T_FIGURE("limb at 120 deg: %d seed pairs, %d of %d vertices with rows; crease sections %u bytes (CREASE %d, PAIRS %d, VNBR %d, TNBR %d), blob %lu bytes",
+                 o.cr_nD, o.cr_nq, o.ns, (unsigned)(SN_ELEM_CREASE(4) + 4 * o.cr_nD + 2 * o.cr_nq * (o.cr_kv + o.cr_kt)), SN_ELEM_CREASE(4), 4 * o.cr_nD,
+                 2 * o.cr_nq * o.cr_kv, 2 * o.cr_nq * o.cr_kt, (unsigned long)b.size);
     }
     n120 = o.cr_nD;
     /* determinism */

@@ -108,7 +108,7 @@ static void test_header(void) {
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
     CASE(SN_ERR_VERSION, "major 7", tb_u16(b + SN_H_VER_MAJOR, 7));
-    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout, dense crease rows: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
     CASE(SN_ERR_VERSION, "major 4 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 4 (format 4.0, no constraint section: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
@@ -195,6 +195,20 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "constraint maxima changed: instance bytes no longer the layout's", CON[0] = 1);
     CASE(SN_ERR_SECTION, "constraint record count 2", tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CONSTRAINTS + 8, 2));
     CASE(SN_ERR_SECTION, "constraint record element size 4", tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CONSTRAINTS + 12, 4));
+    /* crease neighbourhood rows (format 6.0: sparse, owners increasing; the test blob has one row per surface vertex) */
+    CASE(SN_ERR_VALUE, "crease rows 0", tb_u16(b + tb_sec(b, SN_SEC_CREASE) + 6, 0));
+    CASE(SN_ERR_VALUE, "crease rows nS + 1", tb_u16(b + tb_sec(b, SN_SEC_CREASE) + 6, TB_NS + 1));
+    CASE(SN_ERR_SECTION, "crease rows 2, VNBR/TNBR counts for nS rows", tb_u16(b + tb_sec(b, SN_SEC_CREASE) + 6, 2));
+    CASE(SN_ERR_INDEX, "crease row owners 1, 0 (not increasing)",
+         tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR), 1); tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4, 0));
+    CASE(SN_ERR_INDEX, "crease row owners 0, 0 (repeated)", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4, 0));
+    CASE(SN_ERR_INDEX, "crease last row's owner NONE", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4 * (TB_NS - 1), SN_CREASE_NONE));
+    CASE(SN_ERR_INDEX, "crease last row's owner nS", tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 4 * (TB_NS - 1), TB_NS));
+    CASE(SN_ERR_VALUE, "crease exclude -1 LSB", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, -ldexp(1.0, -22), SN_Q_LEN));
+    CASE(SN_ERR_VALUE, "crease exclude 2^28 + 64 LSB", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, 64.0 + ldexp(1.0, -16), SN_Q_LEN));
+    CASE(SN_OK, "crease exclude 2^28 (64 internal units)", tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, 64.0, SN_Q_LEN));
+    CASE(SN_OK, "crease row 0: its owner only (tail NONE)",
+         tb_u16(b + tb_sec(b, SN_SEC_CREASE_VNBR) + 2, SN_CREASE_NONE));
 #undef CON
     CASE(SN_ERR_VALUE, "a1 < 0", tb_real(RL(SN_R_A1), -0.001, SN_Q_COEF));
     CASE(SN_ERR_VALUE, "a1 > 16", put_over(RL(SN_R_A1), 1 << 28, SN_Q_COEF));

@@ -555,22 +555,29 @@ static void beast_go(pu_rt *r, const sn_clip *clip, uint32_t steps, int have_pla
     o->e_max = pu_len(st.energy_max);
     o->disp_max = pu_len(st.disp_max);
 }
+/* The beast at rest, for 4c and 4d: its blob opened, the identity pose set
+ * and stepped once, the surface (3 ns) in *buf (malloc'd, the caller frees
+ * it). Returns 0, or -1 (checked as failed) without the blob. */
+static int beast_open(pu_rt *r, sn_xform pose[64], double **buf) {
+    char path[512];
+    pu_example(path, sizeof path, "beast" PU_BLOB_SUFFIX);
+    if (pu_rt_open(r, path)) { T_CHECK(0, "beast blob"); return -1; }
+    *buf = malloc(3 * r->info.surface_vertices * sizeof **buf);
+    pu_identity(pose, r->info.joints);
+    sn_set_pose(r->inst, pose, r->info.joints);
+    sn_step(r->inst);
+    pu_rt_surface(r, *buf);
+    return 0;
+}
 static void test_beast(void) {
     static sn_clip clip;
     static const char *clips[2] = {"walk", "violent"};
     pu_rt r;
-    char path[512];
     double *buf, y0 = 1e30;
     uint32_t i, c, ns;
     sn_xform pose[64];
-    pu_example(path, sizeof path, "beast" PU_BLOB_SUFFIX);
-    if (pu_rt_open(&r, path)) { T_CHECK(0, "beast blob"); return; }
+    if (beast_open(&r, pose, &buf)) return;
     ns = r.info.surface_vertices;
-    buf = malloc(3 * ns * sizeof *buf);
-    pu_identity(pose, r.info.joints);
-    sn_set_pose(r.inst, pose, r.info.joints);
-    sn_step(r.inst);
-    pu_rt_surface(&r, buf);
     for (i = 0; i < ns; i++) y0 = buf[3 * i + 1] < y0 ? buf[3 * i + 1] : y0; /* the soles at rest */
     for (c = 0; c < 2; c++) {
         beast_run none, sole, above, hips;
@@ -619,20 +626,13 @@ static void test_beast(void) {
  * steps, held 60 */
 static void test_beast_sphere(void) {
     pu_rt r;
-    char path[512];
     sn_xform pose[64];
     sn_collider c;
     sn_stats st;
     double *buf, bx = 0, by = 18, bz = -1e30, rad = 15.0, worst = 0;
     uint32_t i, ns, step;
-    pu_example(path, sizeof path, "beast" PU_BLOB_SUFFIX);
-    if (pu_rt_open(&r, path)) { T_CHECK(0, "beast blob"); return; }
+    if (beast_open(&r, pose, &buf)) return;
     ns = r.info.surface_vertices;
-    buf = malloc(3 * ns * sizeof *buf);
-    pu_identity(pose, r.info.joints);
-    sn_set_pose(r.inst, pose, r.info.joints);
-    sn_step(r.inst);
-    pu_rt_surface(&r, buf);
     for (i = 0; i < ns; i++) /* the belly's front: the largest z within 4 of x = 0, y = 18 (mesh y 148) */
         if (fabs(buf[3 * i]) < 4 && fabs(buf[3 * i + 1] - by) < 4 && buf[3 * i + 2] > bz) bz = buf[3 * i + 2];
     sn_reset(r.inst);

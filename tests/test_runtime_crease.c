@@ -90,10 +90,18 @@ static int geo(const double *S, uint32_t i, const uint16_t tv[3], double *d, dou
     return 1;
 }
 
+/* The row of surface vertex a (format 6.0: sparse rows, owner first), by a
+ * linear scan (the runtime bisects); SN_CREASE_NONE: none. */
+static uint32_t row_of(const sn_view *v, uint32_t a) {
+    uint32_t q;
+    for (q = 0; q < v->cr_nq; q++) if (sn_rd_u16(v->sec[SN_SEC_CREASE_VNBR] + 2 * ((size_t)q * v->cr_nv)) == a) return q;
+    return SN_CREASE_NONE;
+}
+
 /* x in a's neighbourhood row (VNBR)? */
 static int in_row(const sn_view *v, uint32_t a, uint32_t x) {
-    uint32_t k;
-    for (k = 0; k < v->cr_nv; k++) if (sn_rd_u16(v->sec[SN_SEC_CREASE_VNBR] + 2 * ((size_t)a * v->cr_nv + k)) == x) return 1;
+    uint32_t k, q = row_of(v, a);
+    for (k = 0; q != SN_CREASE_NONE && k < v->cr_nv; k++) if (sn_rd_u16(v->sec[SN_SEC_CREASE_VNBR] + 2 * ((size_t)q * v->cr_nv + k)) == x) return 1;
     return 0;
 }
 
@@ -140,8 +148,8 @@ static void check_step(pu_rt *r, run_stats *rs) {
         for (k = 0; k < v->nD; k++) {
             int side;
             for (side = 0; side < 2; side++) {
-                uint32_t a = sn_rd_u16(D + 4 * k + 2 * (uint32_t)side), o = sn_rd_u16(D + 4 * k + 2 * (uint32_t)(1 - side)), e;
-                if (seen[a]) continue;
+                uint32_t a = sn_rd_u16(D + 4 * k + 2 * (uint32_t)side), o = row_of(v, sn_rd_u16(D + 4 * k + 2 * (uint32_t)(1 - side))), e;
+                if (seen[a] || o == SN_CREASE_NONE) continue; /* (every seed vertex has a row: test_bake_crease) */
                 for (e = 0; e < v->cr_nt; e++) {
                     uint32_t t = sn_rd_u16(TN + 2 * ((size_t)o * v->cr_nt + e));
                     uint16_t tv[3];
@@ -305,6 +313,102 @@ static void run(pu_rt *r, int k0, int k1, run_stats *rs, double *surf, sn_stats 
         if (surf) pu_rt_surface(r, surf + (size_t)k * 3 * r->info.surface_vertices);
         if (at_hold && k == N_BEND + N_HOLD - 1) sn_get_stats(r->inst, at_hold);
     }
+}
+
+
+/* The beast (tools/examples/beast, 32k surface vertices, cell 24) with its
+ * crease data (beast_crease: beast.sinew + crease.lines) against the same
+ * lattice without (beast): both elbows closed to 120 degrees about their
+ * bend axes over 120 steps and held 60 (crease.clip's bend, at 60 Hz).
+ * Sides (rest, model space = mesh - (0, 130, -6)): a vertex within 20 of
+ * an arm's bone is upper arm (-1) or forearm (+1) by the side of the elbow
+ * it lies on, more than 3 mesh units from it; the rest 0. Figures: deepest
+ * penetration (penetration(): ray-parity inside test, distance to the
+ * nearest triangle of the other side), volume, crease statistics. */
+static void beast_elbows(pu_rt *r, int k, sn_xform *xf) {
+    sn_quat local[64];
+    unsigned j;
+    double deg = k < 120 ? 120.0 * (k + 1) / 120.0 : 120.0;
+    for (j = 0; j < r->info.joints && j < 64; j++) local[j] = pu_qident();
+    pu_set_local(r->blob, local, "elbow_l", pu_axis_angle(-0.35, -0.93, -0.07, deg));
+    pu_set_local(r->blob, local, "elbow_r", pu_axis_angle(-0.35, 0.93, 0.07, deg));
+    sn_pose_from_local(r->blob, local, NULL, xf);
+}
+static double seg_dist(const double *p, const double a[3], const double b[3]) {
+    double ab[3], ap[3], t = 0, l2 = 0, d2 = 0;
+    int k;
+    for (k = 0; k < 3; k++) { ab[k] = b[k] - a[k]; ap[k] = p[k] - a[k]; t += ab[k] * ap[k]; l2 += ab[k] * ab[k]; }
+    t = t < 0 ? 0 : (t > l2 ? 1 : t / l2);
+    for (k = 0; k < 3; k++) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+    return sqrt(d2);
+}
+static void test_beast_crease(void) {
+    static const double J[2][3][3] = {{{42, 68, 20}, {72, 56, 32}, {102, 43, 58}}, {{-42, 68, 20}, {-72, 56, 32}, {-102, 43, 58}}};
+    char pc[600], pn[600];
+    pu_rt rc, rn;
+    sn_xform xf[64];
+    sn_stats st;
+    double *S, *R, depth[2], vol[2];
+    signed char *side;
+    unsigned char *only;
+    uint32_t ns, nt, i, k, worst[2], cnt[2], a, m, added = 0, list_max = 0, rows_max = 0;
+    snprintf(pc, sizeof pc, "%s/examples/beast_crease%s.blob", pu_build(), PU_BLOB_SUFFIX);
+    snprintf(pn, sizeof pn, "%s/examples/beast%s.blob", pu_build(), PU_BLOB_SUFFIX);
+    if (pu_rt_open(&rc, pc)) { printf("  SKIPPED: %s not found (make it: tools/tools.mk)\n", pc); return; }
+    if (pu_rt_open(&rn, pn)) { T_CHECK(0, "open %s", pn); pu_rt_close(&rc); return; }
+    ns = rc.info.surface_vertices; nt = rc.info.triangles;
+    S = malloc(3 * ns * sizeof *S); R = malloc(3 * ns * sizeof *R);
+    side = calloc(ns, 1); only = calloc(ns, 1);
+    beast_elbows(&rc, -1, xf); /* 0 degrees: the rest surface */
+    sn_set_pose(rc.inst, xf, rc.info.joints);
+    sn_step(rc.inst);
+    pu_rt_surface(&rc, R);
+    sn_reset(rc.inst);
+    for (i = 0; i < ns; i++)
+        for (a = 0; a < 2; a++) {
+            const double *p = R + 3 * i, *sh = J[a][0], *el = J[a][1], *wr = J[a][2];
+            double su = 0, sf = 0, du = seg_dist(p, sh, el), df = seg_dist(p, el, wr);
+            for (k = 0; k < 3; k++) { su += (p[k] - el[k]) * (sh[k] - el[k]); sf += (p[k] - el[k]) * (wr[k] - el[k]); }
+            su /= sqrt((sh[0] - el[0]) * (sh[0] - el[0]) + (sh[1] - el[1]) * (sh[1] - el[1]) + (sh[2] - el[2]) * (sh[2] - el[2]));
+            sf /= sqrt((wr[0] - el[0]) * (wr[0] - el[0]) + (wr[1] - el[1]) * (wr[1] - el[1]) + (wr[2] - el[2]) * (wr[2] - el[2]));
+            if (df < 20 && sf > 3 && (du >= 20 || sf - 3 > su)) side[i] = 1;
+            else if (du < 20 && su > 3) side[i] = -1;
+            if (side[i]) { only[i] = 1; break; }
+        }
+    for (m = 0; m < 2; m++) {
+        pu_rt *r = m == 0 ? &rc : &rn;
+        for (k = 0; k < 180; k++) {
+            beast_elbows(r, (int)k, xf);
+            sn_set_pose(r->inst, xf, r->info.joints);
+            sn_step(r->inst);
+            if (m == 0) {
+                sn_get_stats(r->inst, &st);
+                added = st.crease_added; /* since reset */
+                list_max = st.crease_list > list_max ? st.crease_list : list_max;
+                rows_max = st.crease_active > rows_max ? st.crease_active : rows_max;
+            }
+        }
+        pu_rt_surface(r, S);
+        depth[m] = penetration(r->blob, S, ns, nt, only, side, &worst[m], &cnt[m]);
+        vol[m] = volume(r->blob, S, nt);
+        sn_get_stats(r->inst, &st);
+        T_CHECK(st.saturations == 0, "beast %s: no saturation at 120 degrees (%u)", m == 0 ? "with crease" : "without", st.saturations);
+    }
+    T_FIGURE("%s beast, both elbows held at 120 deg (180 steps): deepest penetration of forearm and upper arm %.3g mesh units with crease "
+             "collision (%u vertices inside), %.3g without (%u inside); volume %.6g with, %.6g without; crease pairs added %u, list up to %u, n_a up to %u",
+             PU_FLAVOUR_NAME, depth[0], cnt[0], depth[1], cnt[1], vol[0], vol[1], added, list_max, rows_max);
+    /* Measured (branch crease3, list 128, active 48, rest-distance exclusion): fixed 322 vertices inside with, 612 without, the
+     * deepest 19.5 vs 21.0; float 389, 19.2 (fixed without the runtime's rest exclusion: 378, 21.4; list 256, active 64: fixed
+     * 343, 20.3, float 2 saturations): at 120 degrees the beast's forearm and upper arm overlap over more vertices than the list
+     * holds (full every step) and the lattice (cell 24) moves both sides of the fold with shared vertices. The goal (depth cut as on the limb) is a KNOWN MISS; the checks hold
+     * what is true: fewer vertices inside, and not deeper by more than 1 mesh unit (1/24 cell). */
+    T_CHECK(cnt[0] < cnt[1], "beast: crease collision leaves fewer arm vertices inside (%u vs %u)", cnt[0], cnt[1]);
+    T_CHECK(depth[0] <= depth[1] + 1.0, "beast: the deepest penetration not deeper by more than 1 mesh unit with crease collision (%.3g vs %.3g)",
+            depth[0], depth[1]);
+    T_FIGURE("KNOWN MISS (beast): crease collision does not reduce the elbows' deepest penetration (%.3g vs %.3g mesh units; the list full "
+             "at %u)", depth[0], depth[1], list_max);
+    free(S); free(R); free(side); free(only);
+    pu_rt_close(&rc); pu_rt_close(&rn);
 }
 
 int main(void) {
@@ -494,5 +598,6 @@ int main(void) {
     pu_rt_close(&r2);
     pu_rt_close(&r);
     pu_rt_close(&rp);
+    test_beast_crease();
     return T_END();
 }

@@ -185,6 +185,8 @@ typedef struct sb_desc {
     sb_segdef *segs; int nseg;       /* 'chain', 'sheet', 'attach' */
     sb_creasedef *creases; int ncrease; /* 'crease' */
     int cr_list, cr_active, cr_ring; /* 'crease_settings': list size, active rows, neighbourhood ring */
+    int cr_reach;                    /* 'crease_settings reach': rings around the slow motion's collisions that get rows */
+    int cr_tring;                    /* 'crease_settings tring': TNBR rows hold the triangles touching this many rings (< 0: ring) */
     double cr_depth, cr_push;        /* mesh units; < 0: default (half a cell; a quarter of depth) */
     double cr_thin;                  /* mesh units; 0: off: a seed pair whose two vertices are both within this rest distance of an earlier pair's is dropped */
     double cr_exclude;               /* mesh units; < 0: default (one cell): seed pairs closer than this in the rest pose are not collisions */
@@ -297,7 +299,8 @@ typedef struct sb_model {
     int cr_nD;              /* seed pairs */
     int *cr_pairs;          /* cr_nD x 2 surface vertices (i, j) */
     int cr_kv, cr_kt;       /* neighbourhood row widths */
-    int *cr_vnbr, *cr_tnbr; /* ns x kv, ns x kt; -1 = unused */
+    int cr_nq;              /* neighbourhood rows: the vertices the runtime can query (increasing owners) */
+    int *cr_vnbr, *cr_tnbr; /* nq x kv (owner first), nq x kt; -1 = unused */
     int cr_list, cr_active;
     double cr_depth, cr_push; /* mesh units */
     double cr_exclude;        /* mesh units: seed pairs closer in the rest pose are not collisions */

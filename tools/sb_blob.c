@@ -315,8 +315,8 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         uint32_t on = o->crease ? 1u : 0u;
         cnt[SN_SEC_CREASE] = on;                                   esz[SN_SEC_CREASE] = SN_ELEM_CREASE(rs);
         cnt[SN_SEC_CREASE_PAIRS] = on ? (uint32_t)o->cr_nD : 0u;   esz[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
-        cnt[SN_SEC_CREASE_VNBR] = on ? (uint32_t)(o->ns * o->cr_kv) : 0u; esz[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
-        cnt[SN_SEC_CREASE_TNBR] = on ? (uint32_t)(o->ns * o->cr_kt) : 0u; esz[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
+        cnt[SN_SEC_CREASE_VNBR] = on ? (uint32_t)(o->cr_nq * o->cr_kv) : 0u; esz[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
+        cnt[SN_SEC_CREASE_TNBR] = on ? (uint32_t)(o->cr_nq * o->cr_kt) : 0u; esz[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
     }
     /* level of detail (sb_level.c) */
     cnt[SN_SEC_LEVEL_BLOB] = o->lod_size;                      esz[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;
@@ -489,16 +489,18 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         double dep = o->cr_depth / U, push = o->cr_push / U;
         if (dep * 4194304.0 < 1 || dep * 4194304.0 > (double)SN_CREASE_DEPTH_MAX) { sb_blob_free(b); return sb_fail("crease depth %g mesh units out of range (%g..%g)", o->cr_depth, U / 4194304.0, U * 16); }
         put_u16(&w, at, (unsigned)o->cr_list); put_u16(&w, at + 2, (unsigned)o->cr_active);
-        put_u8(&w, at + 4, (unsigned)o->cr_kv); put_u8(&w, at + 5, (unsigned)o->cr_kt);
+        put_u8(&w, at + 4, (unsigned)o->cr_kv); put_u8(&w, at + 5, (unsigned)o->cr_kt); put_u16(&w, at + 6, (unsigned)o->cr_nq);
         put_real(&w, at + 12, dep, SN_Q_LEN);
         put_real(&w, at + 12 + (size_t)rs, fmin(push, dep), SN_Q_LEN);
+        if (o->cr_exclude / U * 4194304.0 > (double)SN_CREASE_EXCLUDE_MAX) { sb_blob_free(b); return sb_fail("crease exclude %g mesh units out of range (0..%g)", o->cr_exclude, U * 64); }
+        put_real(&w, at + 12 + 2 * (size_t)rs, o->cr_exclude / U, SN_Q_LEN);
         for (i = 0; i < o->cr_nD; i++) {
             put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i, (unsigned)o->cr_pairs[2 * i]);
             put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i + 2, (unsigned)o->cr_pairs[2 * i + 1]);
         }
-        for (i = 0; i < o->ns * o->cr_kv; i++)
+        for (i = 0; i < o->cr_nq * o->cr_kv; i++)
             put_u16(&w, off[SN_SEC_CREASE_VNBR] + 2 * (size_t)i, o->cr_vnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_vnbr[i]);
-        for (i = 0; i < o->ns * o->cr_kt; i++)
+        for (i = 0; i < o->cr_nq * o->cr_kt; i++)
             put_u16(&w, off[SN_SEC_CREASE_TNBR] + 2 * (size_t)i, o->cr_tnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_tnbr[i]);
     }
     if (o->lod_size) {   /* the finer level verbatim, then the two maps */

@@ -26,8 +26,9 @@
  * The surface neighbourhoods the runtime searches (§3.4.2): VNBR row s = the
  * vertices within 'ring' edges of s (s first, then by ring, then by index, at
  * most SN_CREASE_MAX_NBR_V), TNBR row s = the triangles with a corner in
- * VNBR row s (increasing, at most SN_CREASE_MAX_NBR_T; the outer ring's
- * triangles are dropped first). Output is deterministic: every loop runs in
+ * VNBR row s within 'tring' rings of s (default: all of the row; 0: the
+ * triangles around s) (increasing, at most SN_CREASE_MAX_NBR_T; the outer
+ * ring's triangles are dropped first). Output is deterministic: every loop runs in
  * index order and ties go to the lower index.
  */
 #include "sb.h"
@@ -44,7 +45,7 @@ void sb_crease_free(sb_model *o)
 {
     free(o->cr_pairs); free(o->cr_vnbr); free(o->cr_tnbr);
     o->cr_pairs = o->cr_vnbr = o->cr_tnbr = NULL;
-    o->crease = 0; o->cr_nD = 0;
+    o->crease = 0; o->cr_nD = 0; o->cr_nq = 0;
 }
 
 int sb_crease_inside(const double p[3], const double a[3], const double b[3], const double c[3], double depth, double *dist, int *corner)
@@ -210,6 +211,16 @@ static int parse_pose(const snref_model *m, const char *path, int line, const ch
     return 0;
 }
 
+/* (p - a).n with n = (b - a) x (c - a) of triangle tv in positions x: < 0 behind (sb_crease_inside's dn) */
+static double plane_side(const double *x, const int *tv, const double *p)
+{
+    const double *a = x + 3 * tv[0], *b = x + 3 * tv[1], *c = x + 3 * tv[2];
+    double e1[3], e2[3], u[3];
+    int k;
+    for (k = 0; k < 3; k++) { e1[k] = b[k] - a[k]; e2[k] = c[k] - a[k]; u[k] = p[k] - a[k]; }
+    return u[0] * (e1[1] * e2[2] - e1[2] * e2[1]) + u[1] * (e1[2] * e2[0] - e1[0] * e2[2]) + u[2] * (e1[0] * e2[1] - e1[1] * e2[0]);
+}
+
 /* ---------------- uniform grid of triangles ---------------- */
 
 typedef struct {
@@ -273,13 +284,53 @@ static int grid_cell(const grid_t *g, const double p[3])
     return c[0] + g->n[0] * (c[1] + g->n[1] * c[2]);
 }
 
+/* ---------------- sparse rows (format 6.0) ---------------- */
+
+/* Keep the neighbourhood rows (dense, one per surface vertex, as built) only
+ * for the vertices the runtime can query: those the slow motion found in a
+ * collision (the penetrating vertex and its triangle's corners: hit) and the
+ * 'reach' rings around them (the runtime walks a contact's neighbourhood
+ * each step, a ring at a time; beyond the rows it stops: a vertex without a
+ * row is never searched). Seed vertices are collision vertices. The widths
+ * shrink to the widest kept row. buf, rg, mark: ns scratch entries each. */
+static void compact_rows(sb_model *o, const csr_t *vv, const unsigned char *hit, int reach, int *buf, int *rg, int *mark)
+{
+    int ns = o->ns, s, q, nq = 0, kv = 1, kt = 1, n, *vn, *tn;
+    unsigned char *keep = sb_alloc((size_t)ns);
+    for (s = 0; s < ns; s++) mark[s] = -1;
+    for (s = 0; s < ns; s++) {
+        if (!hit[s]) continue;
+        n = rings(vv, s, reach, buf, rg, ns, mark, s);
+        for (q = 0; q < n; q++) keep[buf[q]] = 1;
+    }
+    for (q = 0; q < o->cr_nD; q++) keep[o->cr_pairs[2 * q]] = keep[o->cr_pairs[2 * q + 1]] = 1;
+    for (s = 0; s < ns; s++) {
+        if (!keep[s]) continue;
+        nq++;
+        for (q = 0; q < o->cr_kv; q++) if (o->cr_vnbr[(size_t)s * (size_t)o->cr_kv + (size_t)q] >= 0 && q + 1 > kv) kv = q + 1;
+        for (q = 0; q < o->cr_kt; q++) if (o->cr_tnbr[(size_t)s * (size_t)o->cr_kt + (size_t)q] >= 0 && q + 1 > kt) kt = q + 1;
+    }
+    if (nq == 0) { keep[0] = 1; nq = 1; } /* a row is required (BLOB.md); no collision: vertex 0's, never reached */
+    vn = sb_alloc(sizeof(int) * (size_t)nq * (size_t)kv);
+    tn = sb_alloc(sizeof(int) * (size_t)nq * (size_t)kt);
+    for (s = 0, n = 0; s < ns; s++) {
+        if (!keep[s]) continue;
+        for (q = 0; q < kv; q++) vn[(size_t)n * (size_t)kv + (size_t)q] = o->cr_vnbr[(size_t)s * (size_t)o->cr_kv + (size_t)q];
+        for (q = 0; q < kt; q++) tn[(size_t)n * (size_t)kt + (size_t)q] = o->cr_tnbr[(size_t)s * (size_t)o->cr_kt + (size_t)q];
+        n++;
+    }
+    free(o->cr_vnbr); free(o->cr_tnbr); free(keep);
+    o->cr_vnbr = vn; o->cr_tnbr = tn; o->cr_nq = nq; o->cr_kv = kv; o->cr_kt = kt;
+}
+
 /* ---------------- the build ---------------- */
 
 int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
 {
     csr_t vv, vt;
     int ns = o->ns, nt = o->nt, s, rc = -1, *buf, *rg, *mark, *tb, kv = 1, kt = 1, trunc_v = 0, trunc_t = 0;
-    int *excl_ptr = NULL, *excl = NULL;
+    int *excl_ptr = NULL, *excl = NULL, tring;
+    unsigned char *hit = NULL;
     sb_blob b;
     snref_model m;
     snref_state st;
@@ -292,11 +343,13 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
     o->cr_push = d->cr_push >= 0 ? d->cr_push : 0.25 * o->cr_depth;
     o->cr_exclude = d->cr_exclude >= 0 ? d->cr_exclude : o->c;
     if (o->cr_push > o->cr_depth) return sb_fail("%s: crease push %g exceeds depth %g", d->path, o->cr_push, o->cr_depth);
+    tring = d->cr_tring >= 0 && d->cr_tring < d->cr_ring ? d->cr_tring : d->cr_ring;
     build_adj(o, &vv, &vt);
     buf = sb_alloc(sizeof(int) * (size_t)(ns + 1));
     rg = sb_alloc(sizeof(int) * (size_t)(ns + 1));
     mark = sb_alloc(sizeof(int) * (size_t)(ns + 1));
     tb = sb_alloc(sizeof(int) * (size_t)(3 * nt + 1));
+    hit = sb_alloc((size_t)ns);
     for (s = 0; s < ns; s++) mark[s] = -1;
     /* ---- neighbourhoods ---- */
     {
@@ -305,8 +358,8 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
             for (s = 0; s < ns; s++) {
                 int n = rings(&vv, s, d->cr_ring, buf, rg, ns, mark, s), nv = n, q, ntb = 0, e;
                 if (nv > (int)SN_CREASE_MAX_NBR_V) { nv = (int)SN_CREASE_MAX_NBR_V; trunc_v += pass == 0; }
-                /* triangles by ring: a triangle counts from the first ring that touches it */
-                for (q = 0; q < nv; q++) {
+                /* triangles by ring: a triangle counts from the first ring that touches it; only the rings up to 'tring' */
+                for (q = 0; q < nv && rg[q] <= tring; q++) {
                     int v = buf[q];
                     for (e = vt.ptr[v]; e < vt.ptr[v + 1]; e++) {
                         int t = vt.idx[e], z;
@@ -358,7 +411,10 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
         int have_rest = 0;
         snref_xform *pose = sb_alloc(sizeof(snref_xform) * m.nJ);
         unsigned char *done_v = sb_alloc((size_t)ns);
-        int cap = 64, ci, fail = 0;
+        double *tn = sb_alloc(sizeof(double) * 5 * (size_t)nt);
+        int *vcell = sb_alloc(sizeof(int) * (size_t)ns), *vbest = sb_alloc(sizeof(int) * (size_t)ns), *vbestc = sb_alloc(sizeof(int) * (size_t)ns);
+        int cap = 64, ci, fail = 0, nhit = 0;
+        double last_note = sb_now();
         grid_t g;
         double cellh = 0;
         memset(&g, 0, sizeof g);
@@ -384,7 +440,7 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                 memcpy(prev, cur, sizeof(double) * 3 * (size_t)ns);
                 snref_get_surface(&st, cur);
                 if (step == 0 && !have_rest) { memcpy(rest, cur, sizeof(double) * 3 * (size_t)ns); have_rest = 1; }
-                if (step == 0 && cellh == 0) {   /* twice the mean rest edge, at least twice the depth */
+                if (step == 0 && cellh == 0) {   /* twice the mean rest edge, at least the depth (the cells hold the triangles padded by the depth) */
                     double sum = 0;
                     int t, c, k;
                     for (t = 0; t < nt; t++)
@@ -394,43 +450,71 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
                             for (k = 0; k < 3; k++) d2 += (p1[k] - p0[k]) * (p1[k] - p0[k]);
                             sum += sqrt(d2);
                         }
-                    cellh = fmax(2 * sum / (3.0 * nt), 2 * o->cr_depth);
+                    cellh = fmax(2 * sum / (3.0 * nt), o->cr_depth);
                 }
                 if (step == 0) continue;
+                if (!quiet && sb_now() - last_note >= 5.0) { /* progress on long bakes */
+                    last_note = sb_now();
+                    printf("\ncrease: pose %d/%d step %d/%d: %d seed pairs, %d collisions so far (%.0f s)", ci + 1, d->ncrease, step,
+                           N + hold, o->cr_nD, nhit, last_note - t0);
+                    fflush(stdout);
+                }
                 grid_build(&g, o, cur, o->cr_depth, cellh);
-                for (i = 0; i < ns; i++) {
+                for (i = 0; i < nt; i++) { /* each triangle's plane n.x = n.a this step (the filter above) */
+                    const int *tv = o->tri + 3 * i;
+                    const double *a = cur + 3 * tv[0], *b2 = cur + 3 * tv[1], *c2 = cur + 3 * tv[2];
+                    double e1[3], e2[3], *pn = tn + 5 * i;
+                    int k;
+                    for (k = 0; k < 3; k++) { e1[k] = b2[k] - a[k]; e2[k] = c2[k] - a[k]; }
+                    pn[0] = e1[1] * e2[2] - e1[2] * e2[1]; pn[1] = e1[2] * e2[0] - e1[0] * e2[2]; pn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                    pn[3] = pn[0] * a[0] + pn[1] * a[1] + pn[2] * a[2];
+                    pn[4] = sqrt(pn[0] * pn[0] + pn[1] * pn[1] + pn[2] * pn[2]);
+                }
+                {   /* each vertex's deepest new collision, the vertices taken cell by cell (the cell's planes stay in cache) */
+                    int nc = g.n[0] * g.n[1] * g.n[2], oi;
+                    int *cs = sb_alloc(sizeof(int) * (size_t)(nc + 1)), *ord = sb_alloc(sizeof(int) * (size_t)ns + 1);
+                    for (i = 0; i < ns; i++) { vcell[i] = grid_cell(&g, cur + 3 * i); cs[vcell[i] + 1]++; vbest[i] = -1; }
+                    for (oi = 0; oi < nc; oi++) cs[oi + 1] += cs[oi];
+                    for (i = 0; i < ns; i++) ord[cs[vcell[i]]++] = i; /* cs[c] now the end of cell c */
+                    for (oi = 0; oi < ns; oi++) {
                     int cell, e, best = -1, bestc = 0;
                     double bestd = 0;
+                    i = ord[oi];
                     if (done_v[i]) continue;
-                    cell = grid_cell(&g, cur + 3 * i);
+                    cell = vcell[i];
                     for (e = g.start[cell]; e < g.start[cell + 1]; e++) {
                         int t = g.tris[e], c, a, lo_, hi_, skip = 0, corner;
-                        double dist, cn;
+                        double dist;
                         const int *tv = o->tri + 3 * t;
-                        for (c = 0; c < 3 && !skip; c++) { /* corner within two rings of i? (sorted list: binary search) */
+                        /* cheapest rejections first (the result is the same in any order): behind the plane now and
+                         * in front of it at the last step (crossed), then inside, then the exclusions */
+                        {   /* the step's plane n.x = n.a, |n| (tn): a conservative filter, margin 1e-9 of the terms' size */
+                            const double *pn = tn + 5 * t, *pi = cur + 3 * i;
+                            double dot = pn[0] * pi[0] + pn[1] * pi[1] + pn[2] * pi[2], tol = 1e-9 * (fabs(dot) + fabs(pn[3]));
+                            if (dot - pn[3] > tol || dot - pn[3] < -o->cr_depth * pn[4] * (1 + 1e-9) - tol) continue; /* in front, or deeper than depth */
+                        }
+                        if (!(plane_side(cur, tv, cur + 3 * i) < 0) || plane_side(prev, tv, prev + 3 * i) < 0) continue;
+                        if (!sb_crease_inside(cur + 3 * i, cur + 3 * tv[0], cur + 3 * tv[1], cur + 3 * tv[2], o->cr_depth, &dist, &corner)) continue;
+                        for (c = 0; c < 3 && !skip; c++) { /* corner in i's neighbourhood? (sorted list: binary search) */
                             lo_ = excl_ptr[i]; hi_ = excl_ptr[i + 1] - 1;
                             while (lo_ <= hi_) { a = (lo_ + hi_) / 2; if (excl[a] == tv[c]) { skip = 1; break; } if (excl[a] < tv[c]) lo_ = a + 1; else hi_ = a - 1; }
                         }
-                        for (c = 0; c < 3 && !skip; c++) { /* a corner closer than 'exclude' in the rest pose? */
-                            const double *x0 = rest + 3 * i, *x1 = rest + 3 * tv[c];
-                            double d2 = (x1[0] - x0[0]) * (x1[0] - x0[0]) + (x1[1] - x0[1]) * (x1[1] - x0[1]) + (x1[2] - x0[2]) * (x1[2] - x0[2]);
-                            skip = d2 < ex2;
-                        }
+                        for (c = 0; c < 3 && !skip; c++) skip = rdist2(rest, i, tv[c]) < ex2; /* a corner closer than 'exclude' in the rest pose? */
                         if (skip) continue;
-                        if (!sb_crease_inside(cur + 3 * i, cur + 3 * tv[0], cur + 3 * tv[1], cur + 3 * tv[2], o->cr_depth, &dist, &corner)) continue;
-                        /* crossed the plane since the last step (was in front) */
-                        {
-                            double e1[3], e2[3], n[3], u[3];
-                            for (c = 0; c < 3; c++) { e1[c] = prev[3 * tv[1] + c] - prev[3 * tv[0] + c]; e2[c] = prev[3 * tv[2] + c] - prev[3 * tv[0] + c]; u[c] = prev[3 * i + c] - prev[3 * tv[0] + c]; }
-                            n[0] = e1[1] * e2[2] - e1[2] * e2[1]; n[1] = e1[2] * e2[0] - e1[0] * e2[2]; n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-                            cn = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
-                        }
-                        if (cn < 0) continue;
                         if (best < 0 || dist > bestd) { best = t; bestd = dist; bestc = corner; }
                     }
+                    vbest[i] = best; vbestc[i] = bestc;
+                    }
+                    free(cs); free(ord);
+                }
+                for (i = 0; i < ns; i++) {   /* in index order: the seeds' order does not depend on the grid */
+                    int best = vbest[i], bestc = vbestc[i];
                     if (best >= 0) {
-                        int jv = o->tri[3 * best + bestc], q;
+                        int jv = o->tri[3 * best + bestc], q, c;
                         done_v[i] = 1;
+                        hit[i] = 1; /* the runtime will query i and the triangle's corners: they get rows */
+                        for (c = 0; c < 3; c++) hit[o->tri[3 * best + c]] = 1;
+                        nhit++;
                         for (q = 0; q < o->cr_nD; q++) {
                             int i0 = o->cr_pairs[2 * q], j0 = o->cr_pairs[2 * q + 1];
                             if (i0 == i && j0 == jv) break;
@@ -449,15 +533,16 @@ int sb_crease_build(const sb_desc *d, sb_model *o, int quiet)
             if (!quiet && !fail) printf(" %d seed pairs (%.2f s)\n", found, sb_now() - t0);
         }
         free(g.start); free(g.tris);
-        free(axis); free(deg); free(local); free(cur); free(prev); free(rest); free(pose); free(done_v);
+        if (!fail) compact_rows(o, &vv, hit, d->cr_reach, buf, rg, mark);
+        free(axis); free(deg); free(local); free(cur); free(prev); free(rest); free(pose); free(done_v); free(tn); free(vcell); free(vbest); free(vbestc);
         if (fail) goto done;
     }
     o->crease = 1;
     if (!quiet) {
-        uint32_t rs = 4, bytes = SN_ELEM_CREASE(rs) + SN_ELEM_CREASE_PAIRS * (uint32_t)o->cr_nD + 2u * (uint32_t)ns * (uint32_t)(kv + kt);
-        printf("  crease    %d seed pairs from %d pose(s); neighbourhoods ring %d: %d vertices, %d triangles per row; list %d, active %d, "
+        uint32_t rs = 4, bytes = SN_ELEM_CREASE(rs) + SN_ELEM_CREASE_PAIRS * (uint32_t)o->cr_nD + 2u * (uint32_t)o->cr_nq * (uint32_t)(o->cr_kv + o->cr_kt);
+        printf("  crease    %d seed pairs from %d pose(s); %d neighbourhood rows (reach %d), ring %d: %d vertices, %d triangles per row; list %d, active %d, "
                "depth %g, push %g, exclude %g mesh units; %u blob bytes (4-byte reals), %u instance bytes of crease state (its rows: see contact) (%.2f s)\n",
-               o->cr_nD, d->ncrease, d->cr_ring, kv, kt, o->cr_list, o->cr_active, o->cr_depth, o->cr_push, o->cr_exclude, (unsigned)bytes,
+               o->cr_nD, d->ncrease, o->cr_nq, d->cr_reach, d->cr_ring, o->cr_kv, o->cr_kt, o->cr_list, o->cr_active, o->cr_depth, o->cr_push, o->cr_exclude, (unsigned)bytes,
                (unsigned)SN_CREASE_STATE_BYTES(ns, o->cr_list), sb_now() - t0);
     }
     rc = 0;
@@ -467,6 +552,6 @@ done:
     snref_free(&m);
     sb_blob_free(&b);
     free(vv.ptr); free(vv.idx); free(vt.ptr); free(vt.idx);
-    free(buf); free(rg); free(mark); free(tb); free(excl_ptr); free(excl);
+    free(buf); free(rg); free(mark); free(tb); free(excl_ptr); free(excl); free(hit);
     return rc;
 }

@@ -700,7 +700,7 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         d->creases[d->ncrease++] = cd;
     } else if (!strcmp(kw, "crease_settings")) {
         if (d->cr_line) return sb_fail("%s:%d: crease_settings given twice (first at line %d)", c->path, c->line, d->cr_line);
-        if (c->nt < 3 || (c->nt - 1) % 2) return sb_fail("%s:%d: 'crease_settings [list N] [active N] [ring K] [depth D] [push P] [exclude R] [thin R]'", c->path, c->line);
+        if (c->nt < 3 || (c->nt - 1) % 2) return sb_fail("%s:%d: 'crease_settings [list N] [active N] [ring K] [tring K] [reach K] [depth D] [push P] [exclude R] [thin R]'", c->path, c->line);
         d->cr_line = c->line;
         for (k = 1; k + 1 < c->nt; k += 2) {
             double x;
@@ -727,7 +727,13 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
             } else if (!strcmp(o_, "ring")) {
                 if (!(x >= 1 && x <= 3 && x == floor(x))) return sb_fail("%s:%d: crease ring must be 1, 2 or 3", c->path, c->line);
                 d->cr_ring = (int)x;
-            } else return sb_fail("%s:%d: unknown crease setting '%s' (want list, active, ring, depth, push, exclude or thin)", c->path, c->line, o_);
+            } else if (!strcmp(o_, "tring")) {
+                if (!(x >= 0 && x <= 3 && x == floor(x))) return sb_fail("%s:%d: crease tring must be 0, 1, 2 or 3 (at most ring)", c->path, c->line);
+                d->cr_tring = (int)x;
+            } else if (!strcmp(o_, "reach")) {
+                if (!(x >= 0 && x <= 16 && x == floor(x))) return sb_fail("%s:%d: crease reach must be a whole number of rings in 0..16", c->path, c->line);
+                d->cr_reach = (int)x;
+            } else return sb_fail("%s:%d: unknown crease setting '%s' (want list, active, ring, tring, reach, depth, push, exclude or thin)", c->path, c->line, o_);
         }
     } else if (!strcmp(kw, "rest_shape")) {
         if (nargs(c, 1)) return -1;
@@ -761,7 +767,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     d->bone_radius = -1;
     d->force_slots = 8;
     d->levels = 1;
-    d->cr_list = 64; d->cr_active = 32; d->cr_ring = 1; d->cr_depth = -1; d->cr_push = -1; d->cr_exclude = -1; d->cr_thin = 0;
+    d->cr_list = 64; d->cr_active = 32; d->cr_ring = 1; d->cr_reach = 2; d->cr_tring = -1; d->cr_depth = -1; d->cr_push = -1; d->cr_exclude = -1; d->cr_thin = 0;
     f = fopen(path, "r");
     if (!f) return sb_fail("%s: cannot open description: %s", path, strerror(errno));
     memset(&c, 0, sizeof c);

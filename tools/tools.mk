@@ -160,6 +160,15 @@ $(EX)/beast_double.blob: $(BEAST_DEPS)
 	@mkdir -p $(EX)
 	$(BAKE) tools/examples/beast/beast.sinew -o $@ --flavour double --quiet
 BEAST_BLOBS = $(EX)/beast.blob $(EX)/beast_float.blob $(EX)/beast_double.blob
+# the beast with crease self-collision (elbows, knees, arms against the flanks)
+$(EX)/beast_crease/beast.sinew: tools/examples/beast/beast.sinew tools/examples/beast/crease.lines tools/examples/beast/beast.obj
+	@mkdir -p $(@D)
+	cat tools/examples/beast/beast.sinew tools/examples/beast/crease.lines > $@
+	cp tools/examples/beast/beast.obj $(@D)/beast.obj
+$(EX)/beast_crease.blob: $(EX)/beast_crease/beast.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(EX)/beast_crease_float.blob: $(EX)/beast_crease/beast.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
 TEST_DEPS += $(BEAST_BLOBS)
 all: $(BEAST_BLOBS)
 

@@ -176,6 +176,14 @@ run "limb 120 deg, no crease data (180 steps)" "$PLAY" "$BUILD/examples/limb_cre
 run "limb 120 deg, crease collision (180 steps)" "$PLAY" "$BUILD/examples/limb_crease.blob" --clip tools/examples/limb/crease.clip \
     --frames 180 --png "$OUT/limb_crease_with.png" --view 0,5 --crease-marks \
     --title "limb at 120 deg: crease collision (contacts red)"
+# The beast's elbows at 120 degrees (tools/examples/beast/crease.clip at
+# 3 s), its left arm from the front: without crease data (beast.blob) and
+# with it (beast_crease.blob: beast.sinew + crease.lines), contacts red.
+run "beast elbows 120 deg, no crease data (180 steps)" "$PLAY" "$BUILD/examples/beast.blob" --clip tools/examples/beast/crease.clip \
+    --frames 180 --png "$OUT/beast_crease_without.png" --view 60,20 --frame-box 30,20,-10,130,110,90 --title "beast elbows at 120 deg: no crease collision"
+run "beast elbows 120 deg, crease collision (180 steps)" "$PLAY" "$BUILD/examples/beast_crease.blob" --clip tools/examples/beast/crease.clip \
+    --frames 180 --png "$OUT/beast_crease_with.png" --view 60,20 --frame-box 30,20,-10,130,110,90 --crease-marks \
+    --title "beast elbows at 120 deg: crease collision (contacts red)"
 rm -f "$OUT/run.out"
 
 # Rig fitting (issue 11, seed 003 fig. 5-6): sinew-rig fits surface rigs to

@@ -72,7 +72,7 @@ endif
 
 # make demo: bake the cow, play both clips in both flavours, write pictures.
 demo: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
-      $(BUILD)/examples/limb.blob $(BUILD)/examples/limb_crease.blob $(BUILD)/examples/limb_crease_none.blob $(BUILD)/examples/beast.blob $(COW_CLIPS) $(SHEET_BLOBS) $(BUILD)/sinew-rig $(BUILD)/sinew-bake
+      $(BUILD)/examples/limb.blob $(BUILD)/examples/limb_crease.blob $(BUILD)/examples/limb_crease_none.blob $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_crease.blob $(COW_CLIPS) $(SHEET_BLOBS) $(BUILD)/sinew-rig $(BUILD)/sinew-bake
 	@BUILD=$(BUILD) sh ports/desktop/demo.sh
 
 # ---- glTF with Blender (issue 17 item 5; tools/blender/) ----

@@ -410,12 +410,13 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             v.cr_active = (uint16_t)sn_rd_u16(p + coff + 2);
             v.cr_nv = p[coff + 4];
             v.cr_nt = p[coff + 5];
-            if (v.cr_list < 1 || v.cr_list > SN_CREASE_MAX_LIST || v.cr_active < 1 || v.cr_active > v.cr_list ||
+            v.cr_nq = (uint16_t)sn_rd_u16(p + coff + 6);
+            if (v.cr_nq < 1 || v.cr_nq > v.nS || v.cr_list < 1 || v.cr_list > SN_CREASE_MAX_LIST || v.cr_active < 1 || v.cr_active > v.cr_list ||
                 v.cr_active > SN_CREASE_MAX_ACTIVE || v.cr_nv < 1 || v.cr_nv > SN_CREASE_MAX_NBR_V || v.cr_nt < 1 ||
                 v.cr_nt > SN_CREASE_MAX_NBR_T || v.nS < 1 || v.nT < 1)
                 return SN_ERR_VALUE;
-            cnt[SN_SEC_CREASE_VNBR] = v.nS * v.cr_nv;
-            cnt[SN_SEC_CREASE_TNBR] = v.nS * v.cr_nt;
+            cnt[SN_SEC_CREASE_VNBR] = (uint32_t)v.cr_nq * v.cr_nv;
+            cnt[SN_SEC_CREASE_TNBR] = (uint32_t)v.cr_nq * v.cr_nt;
             v.crB = SN_CREASE_STATE_BYTES(v.nS, v.cr_list);
         }
         cnt[SN_SEC_CONSTRAINTS] = 0; /* 0 or 1: taken from the table below */
@@ -531,7 +532,7 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
     v->nD = v->crB = 0;
-    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_pad = 0;
+    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_nq = 0;
     v->cr_depth = v->cr_push = 0;
     v->nCon = v->nCol = v->nCt = v->nRows = v->conB = 0;
 }
@@ -558,6 +559,7 @@ static void sn_view_sections(sn_view *v) {
         v->cr_active = (uint16_t)sn_rd_u16(c + 2);
         v->cr_nv = c[4];
         v->cr_nt = c[5];
+        v->cr_nq = (uint16_t)sn_rd_u16(c + 6);
         v->cr_depth = SN_RD_REAL(c + 12);
         v->cr_push = SN_RD_REAL(c + 12 + SN_REAL_BYTES);
         v->crB = SN_CREASE_STATE_BYTES(v->nS, v->cr_list);

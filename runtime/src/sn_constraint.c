@@ -223,42 +223,44 @@ static void rows_apply_acc(const sn_ihdr *h, sn_acc *acc, sn_q *y, int force_lik
 /* packed lower triangle: entry (j, l), l <= j */
 #define LIDX(j, l) ((size_t)(j) * ((j) + 1u) / 2u + (l))
 
+/* One substitution step of gram_solve: s_j loaded into the accumulator
+ * (fixed: Q(28 + q), the L entries' 28 fraction bits) ... */
+SN_INLINE sn_acc gs_load(sn_q s) {
+#if defined(SN_FLOAT)
+    return s;
+#else
+    return (int64_t)s * ((int64_t)1 << 28);
+#endif
+}
+/* ... and, the earlier unknowns subtracted, scaled by 1/L_jj and stored. */
+SN_INLINE sn_q gs_store(sn_acc acc, sn_q inv, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    return sn_out(acc * inv, 0, sat);
+#else
+    return sn_out((int64_t)clamp32(sn_rshr64(acc, 28)) * inv, 24, sat);
+#endif
+}
+
 /* Solve G lam = s in place (aux[].s), over the kept rows: L u = s, L^T lam = u. */
 static void gram_solve(sn_ihdr *h, uint32_t *sat) {
     const sn_q *L = CARR(h, o_L, sn_q);
     sn_rowx *x = ARR(h, o_rx, sn_rowx);
     uint32_t j, l, m = h->n_rows;
-    for (j = 0; j < m; j++) {
+    for (j = 0; j < m; j++) { /* forward: L u = s */
         sn_acc acc;
         if (x[j].inv == 0) { x[j].s = 0; continue; }
-#if defined(SN_FLOAT)
-        acc = x[j].s;
-#else
-        acc = (int64_t)x[j].s * ((int64_t)1 << 28);
-#endif
+        acc = gs_load(x[j].s);
         for (l = 0; l < j; l++) acc -= sn_mul(L[LIDX(j, l)], x[l].s); /* dropped l: L = 0 */
         SN_RANGE(SN_WITHIN(acc, 62), "forward solve beyond 2^62", acc);
-#if defined(SN_FLOAT)
-        x[j].s = sn_out(acc * x[j].inv, 0, sat);
-#else
-        x[j].s = sn_out((int64_t)clamp32(sn_rshr64(acc, 28)) * x[j].inv, 24, sat);
-#endif
+        x[j].s = gs_store(acc, x[j].inv, sat);
     }
-    for (j = m; j-- > 0;) {
+    for (j = m; j-- > 0;) { /* back: L^T lam = u */
         sn_acc acc;
         if (x[j].inv == 0) { x[j].s = 0; continue; }
-#if defined(SN_FLOAT)
-        acc = x[j].s;
-#else
-        acc = (int64_t)x[j].s * ((int64_t)1 << 28);
-#endif
+        acc = gs_load(x[j].s);
         for (l = j + 1; l < m; l++) acc -= sn_mul(L[LIDX(l, j)], x[l].s);
         SN_RANGE(SN_WITHIN(acc, 62), "back solve beyond 2^62", acc);
-#if defined(SN_FLOAT)
-        x[j].s = sn_out(acc * x[j].inv, 0, sat);
-#else
-        x[j].s = sn_out((int64_t)clamp32(sn_rshr64(acc, 28)) * x[j].inv, 24, sat);
-#endif
+        x[j].s = gs_store(acc, x[j].inv, sat);
     }
 }
 

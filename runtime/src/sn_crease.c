@@ -6,7 +6,8 @@
  * Model, formats and bounds: runtime/NUMERICS.md "Self-collision near creases".
  *
  * One step (called after the skeleton is posed, before the solve):
- *   0. the surface positions r_s of every surface vertex from the current
+ *   0. the surface positions r_s of the surface vertices the step reaches
+ *      (computed on first use, cr_pos) from the current
  *      lattice (free vertices: end of the last step; skeleton: this pose)
  *   1. maintenance: for each (i, T) in C, in order: r_i above T's plane
  *      ((r_i - r_b).n > 0, the paper's test): removed; projection slid off T
@@ -25,7 +26,7 @@
  *      the rows of pairs k < n_a, at most max_active (the rest counted)
  *
  * Cost per step, with nS surface vertices, D seeds, L = max_list, Kv, Kt the
- * neighbourhood widths, A = max_active: c1 nS + c2 L + Kt (2 D + L Kv) c3 +
+ * neighbourhood widths, A = max_active: c1 nS (clearing a byte; at most nS positions) + c2 L + Kt (2 D + L Kv) c3 +
  * L c4 + A c5, constants independent of the data (every loop bound is a
  * blob count or a baked maximum; a triangle test has no data-dependent loop).
  */
@@ -39,6 +40,18 @@ static sn_crease_pair *cr_pairs(const sn_ihdr *h) {
     return (sn_crease_pair *)(void *)(cr_base(h) + 12u * h->v.nS);
 }
 static uint8_t *cr_member(const sn_ihdr *h) { return cr_base(h) + 12u * h->v.nS + 8u * h->v.cr_list; }
+static uint8_t *cr_fresh(const sn_ihdr *h) { return cr_base(h) + 13u * h->v.nS + 8u * h->v.cr_list; }
+
+/* Surface position of vertex s this step (internal units), computed on first
+ * use: the step needs only the vertices its searches reach (the rows' owners,
+ * their neighbours and their triangles' corners), not all nS (format 6.0;
+ * the same values as computing every one, at a cost bounded by nS). */
+static const sn_q *cr_pos(const sn_ihdr *h, uint32_t s) {
+    sn_q *S = cr_surf(h);
+    uint8_t *f = cr_fresh(h);
+    if (!f[s]) { sn_surface_point(h, s, S + 3u * s); f[s] = 1; }
+    return S + 3u * s;
+}
 
 const sn_crease_pair *sn_crease_list(const sn_ihdr *h) { return h->v.nCR ? cr_pairs(h) : NULL; }
 const sn_q *sn_crease_surface(const sn_ihdr *h) { return h->v.nCR ? cr_surf(h) : NULL; }
@@ -137,64 +150,10 @@ static void cr_finish(const sn_q ri[3], const sn_q ra[3], cr_geo *g, uint32_t *s
 
 /* Test surface vertex a (position ra) against triangle t from the step's
  * surface positions; full = also normal and depth when it is behind and inside. */
-static void cr_tri(const sn_ihdr *h, const sn_q *S, const sn_q ra[3], uint32_t t, cr_geo *g, int full, uint32_t *sat) {
-    const sn_q *p0 = S + 3u * cr_tri_corner(h, t, 0), *p1 = S + 3u * cr_tri_corner(h, t, 1), *p2 = S + 3u * cr_tri_corner(h, t, 2);
+static void cr_tri(const sn_ihdr *h, const sn_q ra[3], uint32_t t, cr_geo *g, int full, uint32_t *sat) {
+    const sn_q *p0 = cr_pos(h, cr_tri_corner(h, t, 0)), *p1 = cr_pos(h, cr_tri_corner(h, t, 1)), *p2 = cr_pos(h, cr_tri_corner(h, t, 2));
     cr_test(ra, p0, p1, p2, g);
     if (full && g->below) cr_finish(ra, p0, g, sat);
-}
-
-/* Is any of x0, x1, x2 among the n entries of nb (a's neighbourhood)? */
-static int cr_near(const uint16_t *nb, uint32_t n, uint32_t x0, uint32_t x1, uint32_t x2) {
-    uint32_t k, hit = 0;
-    for (k = 0; k < n; k++) hit |= (uint32_t)(nb[k] == x0) | (uint32_t)(nb[k] == x1) | (uint32_t)(nb[k] == x2);
-    return (int)hit;
-}
-
-/* Search row rowv of TNBR for a triangle that surface vertex a (position
- * ra) has penetrated: no corner of it in a's neighbourhood (VNBR row a: a
- * fold of the skin next to a is not a collision), behind it, its projection
- * inside it, no deeper than the baked depth. The first such triangle of the
- * row (increasing index) wins. Returns 1 and *tri, *corner (surface vertex). */
-static int cr_search(const sn_ihdr *h, const sn_q *S, uint32_t a, const sn_q ra[3], uint32_t rowv, uint32_t *tri,
-                     uint32_t *corner, uint32_t *sat) {
-    const unsigned char *row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)rowv * h->v.cr_nt;
-    const unsigned char *vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)a * h->v.cr_nv;
-    uint16_t nb[SN_CREASE_MAX_NBR_V];
-    uint32_t k, nn;
-    for (nn = 0; nn < h->v.cr_nv; nn++) { /* a's neighbourhood, once per search */
-        nb[nn] = (uint16_t)sn_rd_u16(vrow + 2u * nn);
-        if (nb[nn] == SN_CREASE_NONE) break;
-    }
-    for (k = 0; k < h->v.cr_nt; k++) {
-        uint32_t t = sn_rd_u16(row + 2u * k);
-        cr_geo g;
-        if (t == SN_CREASE_NONE) break; /* the row's tail is all NONE (validated) */
-        if (cr_near(nb, nn, cr_tri_corner(h, t, 0), cr_tri_corner(h, t, 1), cr_tri_corner(h, t, 2))) continue;
-        cr_tri(h, S, ra, t, &g, 0, sat);
-        if (!g.below || !g.inside) continue;
-        cr_finish(ra, S + 3u * cr_tri_corner(h, t, 0), &g, sat);
-        if (g.d < -h->v.cr_depth) continue;
-        *tri = t;
-        *corner = cr_tri_corner(h, t, g.corner);
-        return 1;
-    }
-    return 0;
-}
-
-/* Step 2 for one candidate: vertex a against the triangles near rowv. */
-static void cr_try(sn_ihdr *h, const sn_q *S, uint32_t a, uint32_t rowv, uint32_t *sat) {
-    uint8_t *mem = cr_member(h);
-    uint32_t t, c;
-    if (mem[a]) return;
-    if (!cr_search(h, S, a, S + 3u * a, rowv, &t, &c, sat)) return;
-    if (h->cr_n >= h->v.cr_list) { h->cr_list_full = sn_count(h->cr_list_full, 1); return; }
-    {
-        sn_crease_pair *P = cr_pairs(h) + h->cr_n;
-        P->vertex = (uint16_t)a; P->tri = (uint16_t)t; P->corner = (uint16_t)c; P->pad = 0;
-    }
-    mem[a] = 1;
-    h->cr_n++;
-    h->cr_added = sn_count(h->cr_added, 1);
 }
 
 /* Lattice vertices and weights (Q30) of surface vertex s's cell. */
@@ -207,6 +166,125 @@ static void cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[8], sn_q phi[8]) 
     for (a = 0; a < 8; a++) vtx[a] = sn_rd_u16(cell + 2 * a);
 }
 
+/* Rest position (Q22) of surface vertex s: its cell's REST corners
+ * trilinearly weighted (a convex combination of validated coordinates). */
+static void cr_rest(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
+    const unsigned char *rest = h->v.sec[SN_SEC_REST];
+    uint32_t vtx[8], a, k, dummy = 0;
+    sn_q phi[8];
+    sn_acc acc[3] = {0, 0, 0};
+    cr_cell(h, s, vtx, phi);
+    for (a = 0; a < 8; a++)
+        for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], SN_RD_REAL(rest + (size_t)SN_REAL_BYTES * (3u * vtx[a] + k)));
+    for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
+}
+
+/* Is a corner of triangle t closer to rest position ra than the baked
+ * 'exclude' in the rest pose (seed 003 §3.4: skin that close folds with the
+ * lattice; the host tool's slow motion uses the same rule)? Fixed: the
+ * differences are <= 2^29, a squared distance <= 3 2^58, exclude^2 <= 2^56:
+ * exact in int64. */
+static int cr_excluded(const sn_ihdr *h, const sn_q ra[3], uint32_t t) {
+    sn_q ex = SN_RD_REAL(h->v.sec[SN_SEC_CREASE] + 12 + 2 * SN_REAL_BYTES), rc[3];
+    uint32_t c, k;
+    if (!(ex > 0)) return 0;
+    for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+        float d2 = 0;
+        cr_rest(h, cr_tri_corner(h, t, c), rc);
+        for (k = 0; k < 3; k++) d2 += (rc[k] - ra[k]) * (rc[k] - ra[k]);
+        if (d2 < ex * ex) return 1;
+#else
+        int64_t d2 = 0;
+        cr_rest(h, cr_tri_corner(h, t, c), rc);
+        for (k = 0; k < 3; k++) d2 += ((int64_t)rc[k] - ra[k]) * ((int64_t)rc[k] - ra[k]);
+        if (d2 < (int64_t)ex * ex) return 1;
+#endif
+    }
+    return 0;
+}
+
+/* Is any of x0, x1, x2 among the n entries of nb (a's neighbourhood)? */
+static int cr_near(const uint16_t *nb, uint32_t n, uint32_t x0, uint32_t x1, uint32_t x2) {
+    uint32_t k, hit = 0;
+    for (k = 0; k < n; k++) hit |= (uint32_t)(nb[k] == x0) | (uint32_t)(nb[k] == x1) | (uint32_t)(nb[k] == x2);
+    return (int)hit;
+}
+
+/* The neighbourhood row of surface vertex s (format 6.0: rows only for the
+ * vertices the host tool found the runtime can query, their owners strictly
+ * increasing, validated): binary search over the rows' first entries, at most
+ * bits(nQ) <= 16 probes. SN_CREASE_NONE: s has no row (never searched). */
+static uint32_t cr_row_of(const sn_view *v, uint32_t s) {
+    const unsigned char *VN = v->sec[SN_SEC_CREASE_VNBR];
+    uint32_t lo = 0, hi = v->cr_nq; /* the row, if any, is in [lo, hi) */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2u, x = sn_rd_u16(VN + 2u * (size_t)mid * v->cr_nv);
+        if (x == s) return mid;
+        if (x < s) lo = mid + 1u; else hi = mid;
+    }
+    return SN_CREASE_NONE;
+}
+
+/* Search the TNBR row of surface vertex nbr for a triangle that surface
+ * vertex a has penetrated: no corner of it in a's
+ * neighbourhood (a's VNBR row: a fold of the skin next to a is not a
+ * collision), behind it, its projection inside it, no deeper than the baked
+ * depth. The first such triangle of the row (increasing index) wins. Either
+ * vertex without a row: nothing found. Returns 1 and *tri, *corner (surface
+ * vertex). */
+static int cr_search(const sn_ihdr *h, uint32_t a, uint32_t nbr, uint32_t *tri,
+                     uint32_t *corner, uint32_t *sat) {
+    uint32_t qa = cr_row_of(&h->v, a), qt = cr_row_of(&h->v, nbr);
+    const unsigned char *row, *vrow;
+    uint16_t nb[SN_CREASE_MAX_NBR_V];
+    uint32_t k, nn;
+    sn_q rest_a[3];
+    const sn_q *ra;
+    int have_rest = 0;
+    if (qa == SN_CREASE_NONE || qt == SN_CREASE_NONE) return 0;
+    ra = cr_pos(h, a);
+    row = h->v.sec[SN_SEC_CREASE_TNBR] + 2u * (size_t)qt * h->v.cr_nt;
+    vrow = h->v.sec[SN_SEC_CREASE_VNBR] + 2u * (size_t)qa * h->v.cr_nv;
+    for (nn = 0; nn < h->v.cr_nv; nn++) { /* a's neighbourhood, once per search */
+        nb[nn] = (uint16_t)sn_rd_u16(vrow + 2u * nn);
+        if (nb[nn] == SN_CREASE_NONE) break;
+    }
+    for (k = 0; k < h->v.cr_nt; k++) {
+        uint32_t t = sn_rd_u16(row + 2u * k);
+        cr_geo g;
+        if (t == SN_CREASE_NONE) break; /* the row's tail is all NONE (validated) */
+        if (cr_near(nb, nn, cr_tri_corner(h, t, 0), cr_tri_corner(h, t, 1), cr_tri_corner(h, t, 2))) continue;
+        cr_tri(h, ra, t, &g, 0, sat);
+        if (!g.below || !g.inside) continue;
+        cr_finish(ra, cr_pos(h, cr_tri_corner(h, t, 0)), &g, sat);
+        if (g.d < -h->v.cr_depth) continue;
+        if (!have_rest) { cr_rest(h, a, rest_a); have_rest = 1; }
+        if (cr_excluded(h, rest_a, t)) continue; /* last: the rarest to get here, the dearest test */
+        *tri = t;
+        *corner = cr_tri_corner(h, t, g.corner);
+        return 1;
+    }
+    return 0;
+}
+
+/* Step 2 for one candidate: vertex a against the triangles near rowv. */
+static void cr_try(sn_ihdr *h, uint32_t a, uint32_t rowv, uint32_t *sat) {
+    uint8_t *mem = cr_member(h);
+    uint32_t t, c;
+    if (mem[a]) return;
+    if (!cr_search(h, a, rowv, &t, &c, sat)) return;
+    if (h->cr_n >= h->v.cr_list) { h->cr_list_full = sn_count(h->cr_list_full, 1); return; }
+    {
+        sn_crease_pair *P = cr_pairs(h) + h->cr_n;
+        P->vertex = (uint16_t)a; P->tri = (uint16_t)t; P->corner = (uint16_t)c; P->pad = 0;
+    }
+    mem[a] = 1;
+    h->cr_n++;
+    h->cr_added = sn_count(h->cr_added, 1);
+}
+
+
 /* The contact row of pair P (eq. 9): (v_i - v_b).n >= target with v_i the
  * velocity of vertex i (its cell's weights, +phi) and v_b that of the
  * triangle point, taken as its nearest corner's (-phi of that corner's cell),
@@ -215,13 +293,13 @@ static void cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[8], sn_q phi[8]) 
  * step, at most by the cap. Returns chi = (v_i - v_b).n of the last step's
  * velocities (Q22). */
 static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_t *sat) {
-    const sn_q *S = cr_surf(h), *vel = CARR(h, o_vel, sn_q);
+    const sn_q *vel = CARR(h, o_vel, sn_q);
     uint32_t vi[8], vp[8], a, b, k;
     sn_q pi[8], pp[8], rv[3];
     sn_acc acc[3] = {0, 0, 0}, chi = 0;
     cr_geo g;
-    cr_tri(h, S, S + 3u * P->vertex, P->tri, &g, 0, sat);
-    cr_finish(S + 3u * P->vertex, S + 3u * cr_tri_corner(h, P->tri, 0), &g, sat);
+    cr_tri(h, cr_pos(h, P->vertex), P->tri, &g, 0, sat);
+    cr_finish(cr_pos(h, P->vertex), cr_pos(h, cr_tri_corner(h, P->tri, 0)), &g, sat);
     cr_cell(h, P->vertex, vi, pi);
     cr_cell(h, P->corner, vp, pp);
     r->n = 0;
@@ -248,29 +326,28 @@ static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_
 void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     sn_crease_pair *C;
-    uint8_t *mem;
-    sn_q *S;
+    uint8_t *mem, *F;
     const unsigned char *D, *VN;
     uint32_t s, k, w, n0, na;
     if (!v->nCR) return;
-    C = cr_pairs(h); mem = cr_member(h); S = cr_surf(h);
+    C = cr_pairs(h); mem = cr_member(h); F = cr_fresh(h);
     D = v->sec[SN_SEC_CREASE_PAIRS]; VN = v->sec[SN_SEC_CREASE_VNBR];
     h->cr_rows = 0;
-    /* 0. surface positions of this step */
-    for (s = 0; s < v->nS; s++) sn_surface_point(h, s, S + 3u * s);
+    /* 0. surface positions of this step: none computed yet */
+    for (s = 0; s < v->nS; s++) F[s] = 0; /* computed on first use (cr_pos) */
     /* 1. maintenance (seed 003 §3.4.2 step 2), order kept */
     for (k = 0, w = 0; k < h->cr_n; k++) {
         sn_crease_pair P = C[k];
-        const sn_q *ri = S + 3u * P.vertex;
+        const sn_q *ri = cr_pos(h, P.vertex);
         cr_geo g;
         int keep = 0;
-        cr_tri(h, S, ri, P.tri, &g, 1, sat);
+        cr_tri(h, ri, P.tri, &g, 1, sat);
         if (g.below && !g.off) {
             keep = g.d >= -v->cr_depth;
             P.corner = (uint16_t)cr_tri_corner(h, P.tri, g.corner);
         } else if (g.below) { /* slid off T: the triangle it lies under now, near the corner */
             uint32_t t, c;
-            if (cr_search(h, S, P.vertex, ri, P.corner, &t, &c, sat)) {
+            if (cr_search(h, P.vertex, P.corner, &t, &c, sat)) {
                 P.tri = (uint16_t)t; P.corner = (uint16_t)c;
                 keep = 1;
             }
@@ -285,17 +362,18 @@ void sn_crease_step(sn_ihdr *h, uint32_t *sat) {
     /* 2. detection over P = D u N(C) (steps 1 and 3) */
     for (k = 0; k < v->nD; k++) {
         uint32_t i = sn_rd_u16(D + 4u * k), j = sn_rd_u16(D + 4u * k + 2);
-        cr_try(h, S, i, j, sat);
-        cr_try(h, S, j, i, sat);
+        cr_try(h, i, j, sat);
+        cr_try(h, j, i, sat);
     }
     n0 = h->cr_n;
     for (k = 0; k < n0; k++) {
-        const unsigned char *row = VN + 2u * (size_t)C[k].vertex * v->cr_nv;
-        uint32_t p = C[k].corner, a;
+        uint32_t q = cr_row_of(v, C[k].vertex), p = C[k].corner, a;
+        const unsigned char *row = VN + 2u * (size_t)q * v->cr_nv;
+        if (q == SN_CREASE_NONE) continue; /* (a listed vertex has a row: it entered through cr_search) */
         for (a = 0; a < v->cr_nv; a++) {
             uint32_t i2 = sn_rd_u16(row + 2u * a);
             if (i2 == SN_CREASE_NONE) break;
-            cr_try(h, S, i2, p, sat);
+            cr_try(h, i2, p, sat);
         }
     }
     /* 3. the active prefix n_a (step 4) and its rows */
@@ -347,12 +425,13 @@ uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh) {
 /* ---------------- validation (sn_blob.c calls it once the table is checked) ----------------
  * CREASE: reserved fields 0, depth in [1, SN_CREASE_DEPTH_MAX] (Q22: the
  * cr_finish distance is compared against it, |d| <= 2^29), push in
- * [0, depth]; PAIRS: i != j, both < nS; VNBR rows: first entry the row's
- * vertex, entries < nS, SN_CREASE_NONE only as a tail; TNBR rows: entries
- * < nT, SN_CREASE_NONE only as a tail. The counts and widths are checked
+ * [0, depth], exclude in [0, SN_CREASE_EXCLUDE_MAX] (squared in int64); PAIRS: i != j, both < nS; VNBR rows (nQ of them, format
+ * 6.0): entries < nS, SN_CREASE_NONE only as a tail, first entries (the
+ * rows' owners) present and strictly increasing (cr_row_of's binary
+ * search); TNBR rows: entries < nT, SN_CREASE_NONE only as a tail. The counts and widths are checked
  * with the section table (sn_blob.c). */
-static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, uint32_t lim, int self) {
-    uint32_t s, k;
+static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, uint32_t lim, int owners) {
+    uint32_t s, k, last = 0;
     for (s = 0; s < rows; s++) {
         const unsigned char *row = sec + 2u * (size_t)s * width;
         int tail = 0;
@@ -361,7 +440,11 @@ static int cr_rows_ok(const unsigned char *sec, uint32_t rows, uint32_t width, u
             if (x == SN_CREASE_NONE) { tail = 1; continue; }
             if (tail || x >= lim) return 0;
         }
-        if (self && sn_rd_u16(row) != s) return 0;
+        if (owners) {
+            uint32_t o = sn_rd_u16(row);
+            if (o >= lim || (s > 0 && o <= last)) return 0; /* present (not NONE), increasing */
+            last = o;
+        }
     }
     return 1;
 }
@@ -371,18 +454,19 @@ sn_status sn_check_crease(const sn_view *v) {
     uint32_t k;
     if (!v->nCR) return SN_OK;
     c = v->sec[SN_SEC_CREASE];
-    if (sn_rd_u16(c + 6) != 0 || sn_rd_u32(c + 8) != 0) return SN_ERR_VALUE;
+    if (sn_rd_u32(c + 8) != 0) return SN_ERR_VALUE;
     if (!sn_real_ok(c + 12, 1, SN_CREASE_DEPTH_MAX, SN_Q_LEN) || !(v->cr_depth > 0)) return SN_ERR_VALUE;
     if (!sn_real_ok(c + 12 + SN_REAL_BYTES, 0, SN_CREASE_DEPTH_MAX, SN_Q_LEN) || !(v->cr_push >= 0) ||
         !(v->cr_push <= v->cr_depth))
         return SN_ERR_VALUE;
+    if (!sn_real_ok(c + 12 + 2 * SN_REAL_BYTES, 0, SN_CREASE_EXCLUDE_MAX, SN_Q_LEN)) return SN_ERR_VALUE;
     D = v->sec[SN_SEC_CREASE_PAIRS];
     for (k = 0; k < v->nD; k++) {
         uint32_t i = sn_rd_u16(D + 4u * k), j = sn_rd_u16(D + 4u * k + 2);
         if (i >= v->nS || j >= v->nS) return SN_ERR_INDEX;
         if (i == j) return SN_ERR_VALUE;
     }
-    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_VNBR], v->nS, v->cr_nv, v->nS, 1)) return SN_ERR_INDEX;
-    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_TNBR], v->nS, v->cr_nt, v->nT, 0)) return SN_ERR_INDEX;
+    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_VNBR], v->cr_nq, v->cr_nv, v->nS, 1)) return SN_ERR_INDEX;
+    if (!cr_rows_ok(v->sec[SN_SEC_CREASE_TNBR], v->cr_nq, v->cr_nt, v->nT, 0)) return SN_ERR_INDEX;
     return SN_OK;
 }

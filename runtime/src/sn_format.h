@@ -142,13 +142,16 @@ enum {
                             max_active) <= SN_MAX_ROWS. Count 0: no constraints, colliders or contacts */
     /* ---- self-collision near creases (seed 003 §3.4), format 5.0; all four have count 0, or CREASE has count 1 ---- */
     SN_SEC_CREASE,       /* 0 or 1 x {u16 max_list (1..SN_CREASE_MAX_LIST), u16 max_active (1..min(max_list, SN_CREASE_MAX_ACTIVE)),
-                            u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 0, u32 0,
+                            u8 nbr_v (1..SN_CREASE_MAX_NBR_V), u8 nbr_t (1..SN_CREASE_MAX_NBR_T), u16 rows (nQ, 1..nS; format 6.0), u32 0,
                             R depth (deepest detected penetration, Q22 internal, [1, SN_CREASE_DEPTH_MAX]),
-                            R push (push-out cap per step, Q22, [0, depth])} */
+                            R push (push-out cap per step, Q22, [0, depth]),
+                            R exclude (format 6.0: a triangle with a corner closer than this to the vertex in the rest
+                            pose is no collision, Q22, [0, SN_CREASE_EXCLUDE_MAX])} */
     SN_SEC_CREASE_PAIRS, /* nD x {u16 i, u16 j}: the seed set D, surface vertices i != j (< nS), in the order found; nD <= SN_CREASE_MAX_PAIRS */
-    SN_SEC_CREASE_VNBR,  /* nS * nbr_v x u16: row s = the surface vertices near s (s itself first, then by ring, then index),
-                            unused tail entries SN_CREASE_NONE; every entry < nS */
-    SN_SEC_CREASE_TNBR,  /* nS * nbr_t x u16: row s = the triangles touching a vertex of VNBR row s, increasing, unused tail
+    SN_SEC_CREASE_VNBR,  /* nQ * nbr_v x u16 (format 6.0: only the vertices the runtime can query, sparse): row q = the surface
+                            vertices near its owner s (s itself first, then by ring, then index), unused tail entries
+                            SN_CREASE_NONE; every entry < nS; owners (first entries) strictly increasing over q */
+    SN_SEC_CREASE_TNBR,  /* nQ * nbr_t x u16: row q = the triangles touching a vertex of VNBR row q, increasing, unused tail
                             entries SN_CREASE_NONE; every entry < nT */
     /* ---- level of detail (issue 13; runtime/LEVELS.md), format 6.0; all three have count 0, or LEVEL_BLOB holds the
        finer level and the two maps carry the state between the levels (sn_set_lod) ---- */
@@ -189,7 +192,7 @@ enum {
 #define SN_ELEM_SEGNODES(R) (3 * (R))
 #define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
 #define SN_ELEM_CONSTRAINTS 8
-#define SN_ELEM_CREASE(R)   (12 + 2 * (R))
+#define SN_ELEM_CREASE(R)   (12 + 3 * (R))
 #define SN_ELEM_CREASE_PAIRS 4
 #define SN_ELEM_CREASE_VNBR  2
 #define SN_ELEM_CREASE_TNBR  2
@@ -203,13 +206,15 @@ enum {
 #define SN_CREASE_MAX_NBR_T  64u    /* triangles per neighbourhood row */
 #define SN_CREASE_MAX_PAIRS  4096u  /* seed pairs D */
 #define SN_CREASE_DEPTH_MAX  ((int32_t)1 << 26) /* Q22: 16 internal units */
+#define SN_CREASE_EXCLUDE_MAX ((int32_t)1 << 28) /* Q22: 64 internal units (its square <= 2^56, NUMERICS.md) */
 #define SN_CREASE_NONE       0xFFFFu
 /* crease state bytes (multiple of 8): the step's surface positions (3 reals
- * per surface vertex), the list (8 bytes per entry), one membership byte per
- * surface vertex; 0 without CREASE. Its max_active rows per step are part of
- * the constraint rows (SN_ROWS_CAP, SN_CONS_BYTES). */
+ * per surface vertex), the list (8 bytes per entry), one membership byte and
+ * (format 6.0) one byte "position computed this step" per surface vertex;
+ * 0 without CREASE. Its max_active rows per step are part of the constraint
+ * rows (SN_ROWS_CAP, SN_CONS_BYTES). */
 #define SN_CREASE_STATE_BYTES(nS, max_list) \
-    ((13u * (uint32_t)(nS) + 8u * (uint32_t)(max_list) + 7u) & ~7u)
+    ((14u * (uint32_t)(nS) + 8u * (uint32_t)(max_list) + 7u) & ~7u)
 
 /* external forces: levels fine, coarse 1..3 (2, 4, 8 cells), rigid */
 #define SN_LEVELS 5

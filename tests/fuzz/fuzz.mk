@@ -32,10 +32,10 @@ LF_NAMES   = fuzz_blob_fixed fuzz_blob_float fuzz_clip fuzz_desc fuzz_obj fuzz_g
 LF_BINS    = $(addprefix $(FUZZ_DIR)/,$(LF_NAMES))
 LF_SEEDS   = $(addprefix $(FUZZ_DIR)/seeds/,$(addsuffix /.stamp,$(LF_NAMES)))
 
-$(FUZZ_DIR)/fuzz_blob_fixed: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h $(SN_SRCS) $(SN_HDRS)
+$(FUZZ_DIR)/fuzz_blob_fixed: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h tests/fuzz/sn_thostile.h $(SN_SRCS) $(SN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -o $@ $< $(LF_RT) -lm
-$(FUZZ_DIR)/fuzz_blob_float: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h $(SN_SRCS) $(SN_HDRS)
+$(FUZZ_DIR)/fuzz_blob_float: tests/fuzz/lf_blob.c tests/fuzz/lf_common.h tests/fuzz/sn_thostile.h $(SN_SRCS) $(SN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -DSN_FLOAT -o $@ $< $(LF_RT) -lm
 $(FUZZ_DIR)/fuzz_clip: tests/fuzz/lf_clip.c tests/fuzz/lf_common.h ports/common/sn_clip.c ports/common/sn_clip_pose.c \

@@ -50,6 +50,7 @@
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_tblob.h"
+#include "sn_thostile.h"
 
 #if defined(__has_include)
 #if __has_include(<sanitizer/common_interface_defs.h>)
@@ -183,30 +184,7 @@ static void exercise(const sn_blob *blob) {
     root.z = g_pose == 2 ? REAL(-30000.0f, -30000 * 65536) : 0;
     sn_pose_from_local(blob, local, &root, xf);
     (void)sn_set_pose(inst, xf, info.joints);
-    {   /* constraints and colliders (format 5.0): hostile arguments refused
-         * with a status, accepted ones stepped (far targets, huge and
-         * zero-size solids, out-of-range vertices) */
-        sn_constraint fc[3];
-        sn_collider fk[3];
-        sn_status cs_;
-        memset(fc, 0, sizeof fc);
-        memset(fk, 0, sizeof fk);
-        fc[0].at = SN_AT_SURFACE; fc[0].vertex = info.surface_vertices ? info.surface_vertices - 1 : 0;
-        fc[0].target.x = REAL(3.0e4f, INT32_MAX); fc[0].target.y = REAL(-3.0e4f, INT32_MIN);
-        fc[1].at = SN_AT_LATTICE; fc[1].vertex = 0; fc[1].axes = SN_AXIS_DIR; fc[1].dir.x = REAL(1.0e-30f, 1); fc[1].dir.z = REAL(-1.0f, -65536);
-        fc[2].at = SN_AT_POINT; fc[2].point.x = REAL(-3.0e4f, INT32_MIN); fc[2].axes = SN_AXIS_Y;
-        cs_ = sn_set_constraints(inst, fc, 3);
-        if (info.surface_vertices == 0 && cs_ == SN_ERR_ARG) cs_ = sn_set_constraints(inst, fc + 1, 2);
-        fc[0].vertex = info.surface_vertices; /* out of range: refused, nothing changes */
-        (void)sn_set_constraints(inst, fc, 1);
-        fk[0].kind = SN_COLLIDER_PLANE; fk[0].b.y = REAL(3.0e4f, INT32_MAX); fk[0].a.y = REAL(-0.2f, -13107);
-        fk[1].kind = SN_COLLIDER_SPHERE; fk[1].radius = REAL(3.0e4f, INT32_MAX); fk[1].velocity.x = REAL(1.0e9f, INT32_MAX);
-        fk[2].kind = SN_COLLIDER_CAPSULE; fk[2].a.x = REAL(-1.0f, -65536); fk[2].b.x = REAL(-1.0f, -65536); fk[2].radius = REAL(0.5f, 32768);
-        (void)sn_set_colliders(inst, fk, 3);
-        fk[1].kind = 7; /* refused */
-        (void)sn_set_colliders(inst, fk, 3);
-        (void)cs_;
-    }
+    th_hostile_contacts(inst, info.surface_vertices); /* constraints and colliders (format 5.0) */
     (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
     (void)sn_set_mode(inst, SN_MODE_WARPED);
     for (s = 0; s < g_steps; s++) {
@@ -302,7 +280,7 @@ static size_t craft_valence(void) {
         tb_u16(b + off + 6 * t + 4, 2 + (t & 1));
     }
     total = off + 6 * nT;
-    tb_drop_rigs(b, total);
+    tb_drop_after_tris(b, total);
     tb_u32(b + SN_H_N_TRIANGLES, nT);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 4, 6 * nT);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_TRIS + 8, nT);
@@ -842,6 +820,7 @@ static void e_joint_ls(unsigned char *b, int hi) { coords(b, hi ? 24 : -24, hi, 
 /* everything at once */
 static void e_crease_depth(unsigned char *b, int hi) {
     crease_set(b, TB_CR_LIST, TB_CR_ACTIVE, hi ? 16.0 : ldexp(1.0, -22), hi ? 16.0 : 0.0);
+    tb_real(b + tb_sec(b, SN_SEC_CREASE) + 20, hi ? 64.0 : ldexp(1.0, -22), SN_Q_LEN); /* exclude (format 6.0) */
 }
 static void e_crease_list(unsigned char *b, int hi) { crease_set(b, hi ? 256 : 1, hi ? 64 : 1, 0.5, 0.05); }
 static void e_all(unsigned char *b, int hi) {
@@ -904,7 +883,7 @@ static const mx_row g_rows[] = {
     {"rest coords, len_shift 24", "all -2^12", "all +2^12", e_rest_ls24, 0},
     {"joint coords, len_shift 0", "all -2^27", "all +2^27", e_joint, 0},
     {"joint coords, len_shift -+24", "-2^27, ls -24", "+2^12, ls 24", e_joint_ls, 0},
-    {"crease depth, push (a contact)", "1 LSB, 0", "2^26, 2^26", e_crease_depth, 0},
+    {"crease depth, push, exclude (a contact)", "1 LSB, 0, 1 LSB", "2^26, 2^26, 2^28", e_crease_depth, 0},
     {"crease list, active (a contact)", "1, 1", "256, 64", e_crease_list, 0},
     {"everything at once", "all min", "all max", e_all, 0},
 };

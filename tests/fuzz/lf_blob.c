@@ -26,6 +26,7 @@
 #include <math.h>
 #include "sinew.h"
 #include "sn_format.h"
+#include "sn_thostile.h"
 
 #if defined(SN_FLOAT)
 #define REAL(f, i) ((sn_real)(f))
@@ -136,30 +137,7 @@ static void exercise(const sn_blob *blob, uint32_t seed) {
     root.z = REAL(0.5f, 32768);
     sn_pose_from_local(blob, local, &root, xf);
     (void)sn_set_pose(inst, xf, info.joints);
-    {   /* constraints and colliders (format 5.0): hostile arguments refused
-         * with a status, accepted ones stepped (far targets, huge and
-         * zero-size solids, out-of-range vertices) */
-        sn_constraint fc[3];
-        sn_collider fk[3];
-        sn_status cs_;
-        memset(fc, 0, sizeof fc);
-        memset(fk, 0, sizeof fk);
-        fc[0].at = SN_AT_SURFACE; fc[0].vertex = info.surface_vertices ? info.surface_vertices - 1 : 0;
-        fc[0].target.x = REAL(3.0e4f, INT32_MAX); fc[0].target.y = REAL(-3.0e4f, INT32_MIN);
-        fc[1].at = SN_AT_LATTICE; fc[1].vertex = 0; fc[1].axes = SN_AXIS_DIR; fc[1].dir.x = REAL(1.0e-30f, 1); fc[1].dir.z = REAL(-1.0f, -65536);
-        fc[2].at = SN_AT_POINT; fc[2].point.x = REAL(-3.0e4f, INT32_MIN); fc[2].axes = SN_AXIS_Y;
-        cs_ = sn_set_constraints(inst, fc, 3);
-        if (info.surface_vertices == 0 && cs_ == SN_ERR_ARG) cs_ = sn_set_constraints(inst, fc + 1, 2);
-        fc[0].vertex = info.surface_vertices; /* out of range: refused, nothing changes */
-        (void)sn_set_constraints(inst, fc, 1);
-        fk[0].kind = SN_COLLIDER_PLANE; fk[0].b.y = REAL(3.0e4f, INT32_MAX); fk[0].a.y = REAL(-0.2f, -13107);
-        fk[1].kind = SN_COLLIDER_SPHERE; fk[1].radius = REAL(3.0e4f, INT32_MAX); fk[1].velocity.x = REAL(1.0e9f, INT32_MAX);
-        fk[2].kind = SN_COLLIDER_CAPSULE; fk[2].a.x = REAL(-1.0f, -65536); fk[2].b.x = REAL(-1.0f, -65536); fk[2].radius = REAL(0.5f, 32768);
-        (void)sn_set_colliders(inst, fk, 3);
-        fk[1].kind = 7; /* refused */
-        (void)sn_set_colliders(inst, fk, 3);
-        (void)cs_;
-    }
+    th_hostile_contacts(inst, info.surface_vertices); /* constraints and colliders (format 5.0) */
     for (j = 0; j < info.controls; j++) { /* abstract controls at their type's extremes (pose controls refuse) */
         sn_real cv;
         (void)sn_set_control(inst, j, ((seed >> 3) + j) & 1 ? REAL(-3.0e38f, -INT32_MAX) : REAL(3.0e38f, INT32_MAX));

@@ -350,8 +350,10 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         tb_u16(cr + 2, TB_CR_ACTIVE);
         cr[4] = 2;
         cr[5] = 2;
+        tb_u16(cr + 6, TB_NS); /* rows (format 6.0): one per surface vertex */
         tb_real(cr + 12, 0.25, SN_Q_LEN);
         tb_real(cr + 12 + R, 0.05, SN_Q_LEN);
+        tb_real(cr + 12 + 2 * R, 0.0, SN_Q_LEN); /* exclude (format 6.0): off */
         tb_u16(b + secoff[SN_SEC_CREASE_PAIRS], 0);
         tb_u16(b + secoff[SN_SEC_CREASE_PAIRS] + 2, 2);
         for (i = 0; i < TB_NS; i++) {
@@ -426,10 +428,11 @@ static inline void tb_drop_crease(unsigned char *b) {
     }
     tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB, TB_CONB_NOCR));
 }
-/* Empty the sections after TRIS (rigs, force shares, segment meshes, crease),
- * placing them (8-aligned) at offset at (the end of what the caller keeps);
- * instance bytes follow nK = 0 and no segment state. No CRC. */
-static inline void tb_drop_rigs(unsigned char *b, uint32_t at) {
+/* Empty every section after TRIS (rigs, force shares, segment meshes,
+ * constraints, crease), placing them (8-aligned) at offset at (the end of
+ * what the caller keeps); instance bytes follow nK = 0 and no segment state.
+ * No CRC. */
+static inline void tb_drop_after_tris(unsigned char *b, uint32_t at) {
     int k;
     at = (at + 7u) & ~7u;
     for (k = SN_SEC_CONTROLS; k < SN_SEC_COUNT; k++) {
