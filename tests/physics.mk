@@ -205,9 +205,9 @@ TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force
 # library itself and compares global linear, warped and nonlinear solutions.
 NL_SRC = tests/reference/nlref.c tools/ref/snref.c ports/desktop/raster.c ports/desktop/png.c
 NL_HDR = tests/reference/nlref.h tools/ref/snref.h tools/sb.h tests/sn_test.h ports/desktop/raster.h ports/desktop/png.h
-$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB)
+$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) -lm
+	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/include -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) $(SN_LIB_FIXED) -lm
 TEST_BINS += $(BUILD)/tests/test_nonlinear
 
 # make nonlinear-figures: the same tables with a longer dynamic run, the limb
