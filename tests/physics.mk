@@ -53,6 +53,16 @@ $(BUILD)/tests/test_runtime_crease_float: tests/test_runtime_crease.c $(REF_SRC)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Itools -DSN_FLOAT -o $@ $< $(REF_SRC) $(CREASE_TSRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_crease $(BUILD)/tests/test_runtime_crease_float
+
+# Blended local linearization (SN_MODE_BLENDED, seed 000 §4.5) against SNREF_BLENDED over clips
+BLEND_TSRC = ports/common/sn_clip.c ports/common/sn_clip_pose.c
+$(BUILD)/tests/test_physics_blended: tests/test_physics_blended.c $(REF_SRC) $(BLEND_TSRC) ports/common/sn_clip.h $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) $(BLEND_TSRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_physics_blended_float: tests/test_physics_blended.c $(REF_SRC) $(BLEND_TSRC) ports/common/sn_clip.h $(PHYS_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -DSN_FLOAT -o $@ $< $(REF_SRC) $(BLEND_TSRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_physics_blended $(BUILD)/tests/test_physics_blended_float
 TEST_BINS += $(foreach t,$(PHYS_TESTS),$(BUILD)/tests/test_physics_$(t) $(BUILD)/tests/test_physics_$(t)_float)
 
 # make soak-adversarial: test_physics_soak (issue 16 item 6) run long, fixed and
@@ -195,9 +205,9 @@ TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force
 # library itself and compares global linear, warped and nonlinear solutions.
 NL_SRC = tests/reference/nlref.c tools/ref/snref.c ports/desktop/raster.c ports/desktop/png.c
 NL_HDR = tests/reference/nlref.h tools/ref/snref.h tools/sb.h tests/sn_test.h ports/desktop/raster.h ports/desktop/png.h
-$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB)
+$(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) -lm
+	$(CC) $(HOST_CFLAGS) -Itests -Itests/reference -Itools -Itools/ref -Iruntime/include -Iruntime/src -Iports/desktop -o $@ tests/test_nonlinear.c $(NL_SRC) $(TOOLS_LIB) $(SN_LIB_FIXED) -lm
 TEST_BINS += $(BUILD)/tests/test_nonlinear
 
 # make nonlinear-figures: the same tables with a longer dynamic run, the limb

@@ -34,7 +34,11 @@ extern const uint32_t sn_bm_clip_len;
 uint32_t sn_bm_stack_used(void);
 
 static sn_det det;
-static uint64_t instance_mem[(SN_BM_INSTANCE_BYTES + 7u) / 8u];  /* 8-byte aligned */
+#if !defined(SN_BM_INSTANCE_BYTES_BLENDED) || SN_BM_BENCH
+#undef SN_BM_INSTANCE_BYTES_BLENDED
+#define SN_BM_INSTANCE_BYTES_BLENDED SN_BM_INSTANCE_BYTES /* no blended scenario */
+#endif
+static uint64_t instance_mem[(SN_BM_INSTANCE_BYTES_BLENDED + 7u) / 8u];  /* 8-byte aligned; the blended scenario's too */
 #if SN_BM_CLIP
 static sn_clip clip;   /* ~23 KB: only in images that play a clip */
 #define CLIP_MEM (&clip)
@@ -155,6 +159,10 @@ int main(void) {
     if (sn_det_contact(&det)) { /* the constrained scenario (issue 12) */
         sn_det_hex64(sn_det_run(&det, SN_DET_CONTACT_STEPS), hex);
         sn_bm_puts("hash-contact: "); sn_bm_puts(hex); sn_bm_puts("\n");
+    }
+    if (sn_det_blended(&det)) { /* SN_MODE_BLENDED (issue 13 item 4): given its memory above */
+        sn_det_hex64(sn_det_run(&det, SN_DET_BLENDED_STEPS), hex);
+        sn_bm_puts("hash-blended: "); sn_bm_puts(hex); sn_bm_puts("\n");
     }
     return 0;
 }

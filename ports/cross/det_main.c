@@ -87,7 +87,7 @@ int main(int argc, char **argv) {
         const sn_blob *b;
         sn_status s = sn_blob_validate(blob, blob_n, &b);
         if (s != SN_OK) { fprintf(stderr, "det_main: %s: %s\n", blob_path, sn_status_str(s)); return 1; }
-        mem_n = sn_instance_size(b);
+        mem_n = sn_instance_size_mode(b, SN_MODE_BLENDED); /* also the blended scenario's */
     }
     mem = malloc(mem_n);
     if (!mem) { fprintf(stderr, "det_main: out of memory\n"); return 2; }
@@ -119,6 +119,13 @@ int main(int argc, char **argv) {
         sn_get_stats(det.inst, &st);
         printf("contact steps: %" PRIu32 " rows: %" PRIu32 " contacts: %" PRIu32 " drops: %" PRIu32 " saturations: %" PRIu32 "\n",
                st.steps, st.constraint_rows, st.contacts, st.constraint_drops, st.saturations);
+    }
+    if (sn_det_blended(&det)) { /* blended local linearization (seed 000 §4.5): every platform checks it too */
+        sn_stats st;
+        sn_det_hex64(sn_det_run(&det, SN_DET_BLENDED_STEPS), hex);
+        printf("hash-blended: %s\n", hex);
+        sn_get_stats(det.inst, &st);
+        printf("blended steps: %" PRIu32 " saturations: %" PRIu32 "\n", st.steps, st.saturations);
     }
     free(mem); free(blob); free(clip_text);
     return 0;

@@ -26,6 +26,7 @@ run_log() {
 }
 hash_of() { sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }
 hashc_of() { sed -n 's/^hash-contact: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }  # the constrained scenario
+hashb_of() { sed -n 's/^hash-blended: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }  # the blended scenario
 
 # qemu-system-arm command for the mps2-an386 board
 BM_QEMU_RUN="qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none -semihosting-config enable=on,target=native"

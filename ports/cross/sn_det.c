@@ -119,6 +119,13 @@ int sn_det_contact(sn_det *d) {
     return 1;
 }
 
+int sn_det_blended(sn_det *d) {
+    if (sn_set_mode(d->inst, SN_MODE_BLENDED) != SN_OK) return 0;
+    (void)sn_reset(d->inst);
+    d->k = 0;
+    return 1;
+}
+
 void sn_det_hex64(uint64_t h, char out[17]) {
     int i;
     for (i = 15; i >= 0; i--) { out[i] = "0123456789abcdef"[h & 15u]; h >>= 4; }

@@ -55,6 +55,15 @@ uint64_t sn_det_run(sn_det *d, uint32_t n);
 /// along y only). Then run SN_DET_CONTACT_STEPS steps of the same poses.
 int sn_det_contact(sn_det *d);
 
+/// Steps of the blended scenario (sn_det_blended).
+#define SN_DET_BLENDED_STEPS 200u
+
+/// The blended scenario (issue 13 item 4): back to rest (sn_reset: no
+/// constraints or colliders, step 0) in SN_MODE_BLENDED, then
+/// SN_DET_BLENDED_STEPS steps of the same poses. Returns 0 and does nothing
+/// if the instance lacks the mode's memory (sn_instance_size_mode), else 1.
+int sn_det_blended(sn_det *d);
+
 /// 16 lowercase hex digits of h plus NUL into out[17].
 void sn_det_hex64(uint64_t h, char out[17]);
 

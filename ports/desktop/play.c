@@ -60,7 +60,8 @@ static void usage(FILE *f) {
         "                     a belt around the body, at most the blob's max_constraints of them, evenly spread\n"
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --lod K:L[,K:L..]  level of detail L (0 coarse, 1 fine; sn_set_lod) from step K on (blob baked with 'levels 2')\n"
-        "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5\n"
+        "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5 (= --mode unwarped)\n"
+        "  --mode M           warped (default), unwarped, or blended: blended local linearization, seed 000 sec. 4.5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
         "  --obj-frames LIST  with --obj-dir: only these frames, e.g. 0,10,20-30 (0: before the first step)\n"
         "  --png FILE         picture of the last frame\n"
@@ -568,7 +569,7 @@ static int parse_args(int argc, char **argv, options *o) {
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
                                          "--seg-impulse", "--seg-floor", "--segments", "--ground", "--sphere", "--pin", "--belt",
-                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", NULL};
+                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", "--mode", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -714,7 +715,13 @@ static int parse_args(int argc, char **argv, options *o) {
                 fprintf(stderr, PROG ": --view: want AZ,EL in degrees, got '%s'\n", v); return 2;
             }
         }
-        else if (!strcmp(a, "--unwarped")) o->unwarped = 1;
+        else if (!strcmp(a, "--unwarped")) o->unwarped = SN_MODE_UNWARPED;
+        else if (!strcmp(a, "--mode")) {   /* o->unwarped holds the sn_mode */
+            if (!strcmp(v, "warped")) o->unwarped = SN_MODE_WARPED;
+            else if (!strcmp(v, "unwarped")) o->unwarped = SN_MODE_UNWARPED;
+            else if (!strcmp(v, "blended")) o->unwarped = SN_MODE_BLENDED;
+            else { fprintf(stderr, PROG ": --mode: want warped, unwarped or blended, got '%s'\n", v); return 2; }
+        }
         else if (!strcmp(a, "--hash")) o->hash = 1;
         else if (!strcmp(a, "--lattice")) o->lattice = 1;
         else if (!strcmp(a, "--crease-marks")) o->marks = 1;
@@ -1014,14 +1021,16 @@ int main(int argc, char **argv) {
     }
 
     /* instance(s) in our own memory */
-    need = sn_instance_size(s.blob);
+    need = sn_instance_size_mode(s.blob, (sn_mode)o.unwarped); /* blended needs more */
     mem = malloc(need);
     if (!mem) { die("out of memory (%zu bytes of instance)", need); goto done; }
     if ((st = sn_instance_init(mem, need, s.blob, &inst)) != SN_OK) {
         fprintf(stderr, PROG ": sn_instance_init: %s\n", sn_status_str(st)); goto done;
     }
     if (o.iterations) sn_set_iterations(inst, (uint32_t)o.iterations);
-    if (o.unwarped) sn_set_mode(inst, SN_MODE_UNWARPED);
+    if (o.unwarped && (st = sn_set_mode(inst, (sn_mode)o.unwarped)) != SN_OK) {
+        fprintf(stderr, PROG ": sn_set_mode: %s\n", sn_status_str(st)); goto done;
+    }
     if (o.compare) {   /* a second instance, stepped in lockstep in the other mode */
         mem2 = malloc(need);
         if (!mem2 || sn_instance_init(mem2, need, s.blob, &inst2) != SN_OK) { die("cannot create the comparison instance"); goto done; }
@@ -1034,7 +1043,7 @@ int main(int argc, char **argv) {
         mem2 = malloc(need);
         if (!mem2 || sn_instance_init(mem2, need, s.blob, &inst2) != SN_OK) { die("cannot create the no-hit instance"); goto done; }
         if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
-        if (o.unwarped) sn_set_mode(inst2, SN_MODE_UNWARPED);
+        if (o.unwarped) sn_set_mode(inst2, (sn_mode)o.unwarped);
     }
     if (o.compare_rigs) {   /* the rigs-off instance, stepped in lockstep: abstract controls 0 */
         const sn_blob *b2 = s.blob;
@@ -1056,13 +1065,13 @@ int main(int argc, char **argv) {
                 goto done;
             }
             b2 = blob2;
-            need2 = sn_instance_size(blob2);
+            need2 = sn_instance_size_mode(blob2, (sn_mode)o.unwarped);
             n_ctl2 = i2.controls;
         }
         mem2 = malloc(need2);
         if (!mem2 || sn_instance_init(mem2, need2, b2, &inst2) != SN_OK) { die("cannot create the rigs-off instance"); goto done; }
         if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
-        if (o.unwarped) sn_set_mode(inst2, SN_MODE_UNWARPED);
+        if (o.unwarped) sn_set_mode(inst2, (sn_mode)o.unwarped);
         controls_zero(inst2, b2, n_ctl2);
     }
 
@@ -1214,7 +1223,7 @@ int main(int argc, char **argv) {
                o.blob_path, s.info.vertices, s.info.free_vertices, s.info.cells, s.info.joints,
                s.info.surface_vertices, s.info.triangles, h_s,
                o.iterations ? (uint32_t)o.iterations : s.info.cg_iters_default,
-               o.unwarped ? "unwarped" : "warped", need, s.info.blob_bytes);
+               o.unwarped == SN_MODE_BLENDED ? "blended" : o.unwarped ? "unwarped" : "warped", need, s.info.blob_bytes);
 
     /* contact sheet: 12 frames spread over the run */
     if (o.sheet) {
@@ -1436,7 +1445,7 @@ int main(int argc, char **argv) {
         render(&s, rest, &pane, "rest", NULL);
         s.pose = xf;
         rs_blit(&cmp, 0, 0, &pane);
-        render(&s, unwarped, &pane, "unwarped (global linear)", lab);
+        render(&s, unwarped, &pane, o.unwarped == SN_MODE_BLENDED ? "blended (local linear)" : "unwarped (global linear)", lab);
         rs_blit(&cmp, pw, 0, &pane);
         render(&s, warped, &pane, "warped", lab);
         rs_blit(&cmp, 2 * pw, 0, &pane);

@@ -226,11 +226,22 @@ sn_status sn_set_iterations(sn_instance *inst, uint32_t iterations);
 
 /// Stepping modes.
 typedef enum sn_mode {
-    SN_MODE_WARPED = 0,  ///< skeletally warped linear FEM (seed 003 eq. 7), the default
-    SN_MODE_UNWARPED = 1 ///< global linear FEM, all frames R = I (seed 000 fig. 5), for comparison
+    SN_MODE_WARPED = 0,   ///< skeletally warped linear FEM (seed 003 eq. 7), the default
+    SN_MODE_UNWARPED = 1, ///< global linear FEM, all frames R = I (seed 000 fig. 5), for comparison
+    SN_MODE_BLENDED = 2   ///< blended local linearization (seed 000 §4.5, eq. 18, 22-24), for comparison: one
+                          ///< linear solve per bone carrying flesh, in that bone's frame, merged with the skinning
+                          ///< weights; constraint and contact rows are not applied. Needs the larger
+                          ///< sn_instance_size_mode(blob, SN_MODE_BLENDED) at sn_instance_init.
 } sn_mode;
-/// Select the stepping mode; takes effect at the next step.
+/// Select the stepping mode; takes effect at the next step. SN_ERR_ARG for an
+/// unknown mode; SN_ERR_MEMORY for SN_MODE_BLENDED if the instance was
+/// initialised with less than sn_instance_size_mode(blob, SN_MODE_BLENDED) bytes.
 sn_status sn_set_mode(sn_instance *inst, sn_mode mode);
+/// Bytes of instance memory for stepping in this mode: sn_instance_size(blob)
+/// for warped and unwarped; more for SN_MODE_BLENDED (its per-region solve's
+/// vectors, scratch only). Pass it as mem_size to sn_instance_init; a byte copy
+/// of such an instance needs this many bytes too. 0 if blob is NULL.
+size_t sn_instance_size_mode(const sn_blob *blob, sn_mode mode);
 
 /// Deformed lattice vertex positions (mesh units, world), vertices [first, first+count).
 /// Vertex order is the blob's: free vertices first, then skeleton vertices.

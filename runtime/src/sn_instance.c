@@ -2,7 +2,7 @@
  * the determinism hash. The layout is the single source of the instance
  * size: the validator asks sn_instance_bytes for it, and writers' macro
  * SN_INSTANCE_BYTES (sn_format.h) is tested against it. */
-#include "sn_instance.h"
+#include "sn_blended.h" /* sn_instance.h, SN_VIEW_BLENDED */
 
 /* hdr | acc nF*3 acc | per joint: wrench | force slots | segment state |
  * per joint: pose q4 t3, R9, T3 | per vertex: pos3 vel3 |
@@ -119,6 +119,7 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     }
     if (!structure_ok(h)) return SN_ERR_INDEX;
     h->magic = SN_INST_MAGIC;
+    if (mem_size >= sn_instance_size_mode(blob, SN_MODE_BLENDED)) h->v.flags |= SN_VIEW_BLENDED;
     h->iterations = h->v.cg_default;
     h->mode = SN_MODE_WARPED;
 #if defined(SN_FLOAT)
@@ -236,7 +237,8 @@ sn_status sn_set_mode(sn_instance *inst, sn_mode mode) {
     sn_ihdr *h;
     SN_CHECK_INST(inst);
     h = hdr_of(inst);
-    if (mode != SN_MODE_WARPED && mode != SN_MODE_UNWARPED) return SN_ERR_ARG;
+    if (mode != SN_MODE_WARPED && mode != SN_MODE_UNWARPED && mode != SN_MODE_BLENDED) return SN_ERR_ARG;
+    if (mode == SN_MODE_BLENDED && !(h->v.flags & SN_VIEW_BLENDED)) return SN_ERR_MEMORY; /* init was not given sn_instance_size_mode bytes */
     h->mode = (uint32_t)mode;
     return SN_OK;
 }

@@ -8,6 +8,7 @@
  * onto the fine vertices (exact: the finer functions start at zero, seed 000
  * §3.1), and the fine field sampled at the coarse vertices (the detail
  * dropped). A step then costs what the active level's counts say. */
+#include "sn_blended.h" /* SN_VIEW_BLENDED */
 #include "sn_instance.h"
 
 uint32_t sn_level_sec_count(const sn_view *v, int sec) {
@@ -142,6 +143,10 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level) {
             for (k = 0; k < 3; k++) val[3 * i + k] = sn_out(acc[k], SN_Q_ROT, &sat);
         }
     }
+    /* the instance keeps its size and its blended memory (sn_blended.c sits
+     * after the top blob's instance_bytes, sized for the larger level) */
+    dst.instance_bytes = h->v.instance_bytes;
+    dst.flags |= h->v.flags & SN_VIEW_BLENDED;
     h->v = dst;
     h->lod = level;
     sn_k_table(h);

@@ -11,6 +11,7 @@
  */
 #include "sn_constraint.h"
 #include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
+#include "sn_blended.h" /* sn_rhs and the CG arithmetic, shared with the blended mode */
 
 /* l += D e, D symmetric stored xx yy zz xy xz yz */
 SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
@@ -127,8 +128,10 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
 }
 
 /* Right-hand side b (into r), NUMERICS.md step 5:
- * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S) + f_rig */
-static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
+ * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S) + f_rig;
+ * elastic = 0 leaves out the cell terms (-K~ w and the elastic force: the
+ * blended mode adds them per region) but still measures the energy. */
+void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
@@ -152,7 +155,7 @@ static void rhs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
     cell_forces(h, u, acc, &e2, sat);
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
-        b[i] = (sn_q)-sn_out(acc[i], SN_Q_ROT, sat); /* |.| <= SN_LIM */
+        b[i] = elastic ? (sn_q)-sn_out(acc[i], SN_Q_ROT, sat) : 0; /* |.| <= SN_LIM */
     }
     /* kinetic energy with the lumped mass: sum m^_i |v_i|^2 (twice the energy) */
     for (i = 0; i < nF; i++) {
@@ -366,7 +369,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_dotv rz;
     uint32_t clamps = 0, rows;
 
-    rhs(h, r, sat);
+    sn_rhs(h, r, 1, sat);
     /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
     rows = sn_constrain_begin(h, x, sat);
     /* PCG, warm-started from the previous step's solution, fixed iterations;
@@ -406,4 +409,32 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         pos[i] = sn_add(pos[i], vel[i], sat);
     }
     h->cg_clamps = sn_count(h->cg_clamps, clamps);
+}
+
+/* ---- the CG arithmetic of the blended mode (sn_blended.h): the same functions ---- */
+sn_cgdot sn_cg_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
+    sn_dotv d = dot(a, b, kk, n);
+    sn_cgdot o;
+    o.m = d.m;
+#if defined(SN_FLOAT)
+    o.e = 0;
+#else
+    o.e = d.e;
+#endif
+    return o;
+}
+sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) {
+    sn_dotv a, b;
+    a.m = num.m;
+    b.m = den.m;
+#if !defined(SN_FLOAT)
+    a.e = num.e;
+    b.e = den.e;
+#endif
+    return ratio(a, b, clamps);
+}
+void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) { axpy(y, s, x, n, sat); }
+void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat) {
+    uint32_t i;
+    for (i = 0; i < n; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
 }

@@ -7,7 +7,7 @@
  * Every loop is bounded by blob counts or the iteration count: the cost of a
  * step is known before it runs.
  */
-#include "sn_instance.h"
+#include "sn_blended.h"
 
 sn_status sn_step(sn_instance *inst) {
     sn_ihdr *h;
@@ -17,7 +17,8 @@ sn_status sn_step(sn_instance *inst) {
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
     sn_crease_step(h, &sat);
-    sn_solve(h, &sat);
+    if (h->mode == SN_MODE_BLENDED) sn_blended_solve(h, &sat); /* seed 000 §4.5 (sn_blended.c) */
+    else sn_solve(h, &sat);
     sn_limits(h, &sat);
     sn_segments_step(h, &sat);
     sn_forces_clear(h);

@@ -112,7 +112,7 @@ static uint32_t rd32(const unsigned char *p) {
 static void exercise(const sn_blob *blob) {
     sn_blob_info info;
     sn_instance *inst;
-    size_t need = sn_instance_size(blob);
+    size_t need = sn_instance_size_mode(blob, SN_MODE_BLENDED); /* the blended mode's memory too: stepped below */
     uint32_t j, idx[3];
     sn_quat *local;
     sn_xform *xf;
@@ -203,6 +203,10 @@ static void exercise(const sn_blob *blob) {
         (void)sn_set_lod(inst, 0);
         sn_step(inst);
     }
+    /* SN_MODE_BLENDED (sn_blended.c) from that state: a region per joint, the same hostile matrices */
+    if (sn_set_mode(inst, SN_MODE_BLENDED) != SN_OK) { printf("FAIL: blended mode refused with its memory (%s)\n", g_case); exit(1); }
+    sn_step(inst);
+    sn_step(inst);
     (void)sn_get_lattice(inst, lat, 0, info.vertices);
     sn_get_stats(inst, &g_last_stats);
     g_finite = 1;

@@ -88,7 +88,7 @@ static void check_stats(const sn_instance *inst) {
 static void exercise(const sn_blob *blob, uint32_t seed) {
     sn_blob_info info;
     sn_instance *inst;
-    size_t need = sn_instance_size(blob);
+    size_t need = sn_instance_size_mode(blob, SN_MODE_BLENDED); /* every mode can be stepped */
     uint32_t j, idx[3], it;
     sn_quat *local;
     sn_xform *xf;
@@ -145,7 +145,8 @@ static void exercise(const sn_blob *blob, uint32_t seed) {
     }
     it = info.cg_iters_max < 8u ? info.cg_iters_max : 8u;
     (void)sn_set_iterations(inst, it);
-    (void)sn_set_mode(inst, (seed & 4) ? SN_MODE_UNWARPED : SN_MODE_WARPED);
+    LF_REQUIRE(sn_set_mode(inst, (seed & 4) ? SN_MODE_UNWARPED : (seed & 32) ? SN_MODE_BLENDED : SN_MODE_WARPED) == SN_OK,
+               "a mode refused with sn_instance_size_mode(blob, SN_MODE_BLENDED) bytes");
     for (s = 0; s < LF_STEPS; s++) {
         sn_step(inst);
         check_stats(inst);

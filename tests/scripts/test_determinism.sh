@@ -137,16 +137,20 @@ EOF2
 wait
 echo "note: runs took $(( $(date +%s) - start ))s wall"
 
-fixed=""; float=""; fixedc=""; floatc=""
+fixed=""; float=""; fixedc=""; floatc=""; fixedb=""; floatb=""
 while read -r name target runner; do
     [ -n "$name" ] && [ -f "$L/rc_$name" ] || continue
     set -- $(cat "$L/rc_$name"); rc=$1; secs=$2
     h=$(hash_of "$L/run_$name.log")
     hc=$(hashc_of "$L/run_$name.log")
+    hb=$(hashb_of "$L/run_$name.log")
     if [ "$rc" -ne 0 ] || [ -z "$h" ]; then
         bad "$name: run failed (rc $rc)"; tail -n 5 "$L/run_$name.log" | sed 's/^/    /'; continue
     fi
-    echo "determinism: $name $h contact ${hc:-none} (${secs}s)"
+    echo "determinism: $name $h contact ${hc:-none} blended ${hb:-none} (${secs}s)"
+    case $name in float-*) [ -n "$hb" ] && floatb="$floatb$name $hb
+" ;; *) [ -n "$hb" ] && fixedb="$fixedb$name $hb
+" ;; esac
     case $name in float-*) float="$float$name $h
 "; [ -n "$hc" ] && floatc="$floatc$name $hc
 " ;; *) fixed="$fixed$name $h
@@ -245,6 +249,8 @@ agree "float flavour" "$float" 3
 # the constrained scenario (issue 12: ground, sphere, pins), every driver but the players
 agree "fixed flavour, constraints and contact" "$fixedc" 2
 agree "float flavour, constraints and contact" "$floatc" 2
+agree "fixed flavour, blended mode" "$fixedb" 2
+agree "float flavour, blended mode" "$floatb" 2
 agree "crease, fixed flavour" "$crfixed" 2
 agree "crease, float flavour" "$crfloat" 2
 
@@ -264,6 +270,8 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "float flavour" "$float" float
     expect_hash "fixed flavour, constraints and contact" "$fixedc" fixed-contact
     expect_hash "float flavour, constraints and contact" "$floatc" float-contact
+    expect_hash "fixed flavour, blended mode" "$fixedb" fixed-blended
+    expect_hash "float flavour, blended mode" "$floatb" float-blended
     expect_hash "crease, fixed flavour" "$crfixed" crease_fixed
     expect_hash "crease, float flavour" "$crfloat" crease_float
 else

@@ -157,6 +157,11 @@ echo "$h1" | grep -Eq '^hash: [0-9a-f]{16}$' && ok || bad "hash line malformed: 
 [ "$h1" = "$h2" ] && ok || bad "hash differs between runs: '$h1' vs '$h2'"
 h3=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet --unwarped 2>/dev/null | grep '^hash: ')
 [ "$h1" != "$h3" ] && ok || bad "--unwarped gives the same hash as warped"
+h4=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet --mode unwarped 2>/dev/null | grep '^hash: ')
+[ "$h3" = "$h4" ] && ok || bad "--mode unwarped differs from --unwarped: '$h4' vs '$h3'"
+h5=$("$PLAY" "$BLOB" --clip "$CLIP" --frames 30 --hash --quiet --mode blended 2>/dev/null | grep '^hash: ')
+echo "$h5" | grep -Eq '^hash: [0-9a-f]{16}$' && [ "$h5" != "$h1" ] && [ "$h5" != "$h3" ] && ok || bad "--mode blended: '$h5' (warped '$h1', unwarped '$h3')"
+expect 2 'mode: want warped, unwarped or blended' "$PLAY" "$BLOB" --mode bent
 echo "  determinism: sinew-play head_turn 30 steps $h1"
 expect 0 'step: median .*\(float' "$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash
 f1=$("$PLAYF" "$BLOBF" --clip "$CLIP" --frames 20 --hash --quiet | grep '^hash: ')

@@ -23,11 +23,13 @@ float=$(hash_of "$T")
 # the constrained scenario (sn_det_contact: ground, sphere, pins; issue 12)
 # from the determinism driver, which every platform runs
 hashc_of() { sed -n 's/^hash-contact: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }
+hashb_of() { sed -n 's/^hash-blended: \([0-9a-f]\{16\}\)$/\1/p' "$1" | tail -n 1; }
 "$BUILD/cross/det_x86_64-gcc-O2" --steps $STEPS --clip "$CLIP" > "$T" 2>&1 || { cat "$T"; exit 1; }
-fixedc=$(hashc_of "$T")
+fixedc=$(hashc_of "$T"); fixedb=$(hashb_of "$T")
 "$BUILD/cross/det_float-gcc-O2" "$BUILD/examples/cow_float.blob" --steps $STEPS --clip "$CLIP" > "$T" 2>&1 || { cat "$T"; exit 1; }
-floatc=$(hashc_of "$T")
+floatc=$(hashc_of "$T"); floatb=$(hashb_of "$T")
 [ -n "$fixedc" ] && [ -n "$floatc" ] || { echo "update_hashes: the determinism driver printed no contact hash"; exit 1; }
+[ -n "$fixedb" ] && [ -n "$floatb" ] || { echo "update_hashes: the determinism driver printed no blended hash"; exit 1; }
 CR_CLIP=tools/examples/limb/crease.clip
 "$BUILD/sinew-play" "$BUILD/examples/limb_crease.blob" --clip "$CR_CLIP" --frames 400 --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 crfixed=$(hash_of "$T")
@@ -59,6 +61,11 @@ float $float
 # surface points, 200 steps of the same clip), printed as hash-contact.
 fixed-contact $fixedc
 float-contact $floatc
+# The blended scenario (ports/cross/sn_det.c sn_det_blended: after the
+# above, back to rest in SN_MODE_BLENDED, 200 steps of the same clip),
+# printed as hash-blended.
+fixed-blended $fixedb
+float-blended $floatb
 # The limb with crease collision active (tools/examples/limb/limb_crease.sinew)
 # after 400 steps of tools/examples/limb/crease.clip (the elbow folding to 120
 # degrees and back), checked on every hosted platform and sinew-play.

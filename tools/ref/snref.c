@@ -843,7 +843,7 @@ static void precond_apply(const snref_state *s, const double *P, const double *r
  * G = C^T C = L L^T by Cholesky with the runtime's drop rule (a row whose
  * squared length is below 2^-8, or whose part orthogonal to the kept rows
  * before it has less than 2^-4 of that or less than 2^-10, is dropped). */
-typedef struct { unsigned m, n3; double *C, *L, *a, *t; int *kept; } rowsys;
+typedef struct snref_rowsys { unsigned m, n3; double *C, *L, *a, *t; int *kept; } rowsys;
 static void rows_build(const snref_state *s, rowsys *q, const double *vstar) {
     unsigned j, l, p, k, c, nF = s->m->nF;
     q->m = s->nrows; q->n3 = 3 * nF;
@@ -906,7 +906,6 @@ static void rows_apply(const rowsys *q, double *y, int fix) {
     for (j = 0; j < q->m; j++)
         for (i = 0; i < q->n3; i++) y[i] += (fix ? 1.0 : -1.0) * q->C[(size_t)j * q->n3 + i] * q->t[j];
 }
-static const rowsys *g_rows; /* the step's rows while pcg runs (NULL: none) */
 
 /* PCG, exactly `iters` iterations (or to convergence if iters == 0). x in/out. */
 static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
@@ -915,15 +914,16 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
     double *r = WK(s, S_R), *z = WK(s, S_Z), *d = WK(s, S_D), *Ad = WK(s, S_AD);
     const double *P = precond_blocks(s);
     double rz, bn = sqrt(dot(b, b, n));
-    if (g_rows) rows_apply(g_rows, x, 1);
+    const rowsys *cr = s->cg_rows; /* the step's rows (NULL: none) */
+    if (cr) rows_apply(cr, x, 1);
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
-    if (g_rows) rows_apply(g_rows, r, 0);
+    if (cr) rows_apply(cr, r, 0);
     if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
-    if (g_rows) rows_apply(g_rows, z, 0);
+    if (cr) rows_apply(cr, z, 0);
     memcpy(d, z, n * sizeof *d);
     rz = dot(r, z, n);
-    if (g_rows) bn = sqrt(dot(r, r, n)); /* converged relative to the filtered start */
+    if (cr) bn = sqrt(dot(r, r, n)); /* converged relative to the filtered start */
     for (it = 0; it < maxit; it++) {
         double dAd, alpha, rz2, beta;
         if (!iters && sqrt(dot(r, r, n)) <= 1e-14 * bn) break;
@@ -931,9 +931,9 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         dAd = dot(d, Ad, n);
         alpha = dAd > 0 ? rz / dAd : 0.0;
         for (i = 0; i < n; i++) { x[i] += alpha * d[i]; r[i] -= alpha * Ad[i]; }
-        if (g_rows) rows_apply(g_rows, r, 0);
+        if (cr) rows_apply(cr, r, 0);
         if (s->precond_hook) s->precond_hook(s->hook_ctx, s, r, z); else precond_apply(s, P, r, z);
-        if (g_rows) rows_apply(g_rows, z, 0);
+        if (cr) rows_apply(cr, z, 0);
         rz2 = dot(r, z, n);
         beta = rz > 0 ? rz2 / rz : 0.0;
         for (i = 0; i < n; i++) d[i] = z[i] + beta * d[i];
@@ -951,10 +951,10 @@ static double pcg(snref_state *s, const double *b, double *x, unsigned iters) {
         }
 #endif
     }
-    if (g_rows) rows_apply(g_rows, x, 1);
+    if (cr) rows_apply(cr, x, 1);
     a_mul(s, x, Ad);
     for (i = 0; i < n; i++) r[i] = b[i] - Ad[i];
-    if (g_rows) rows_apply(g_rows, r, 0);
+    if (cr) rows_apply(cr, r, 0);
     return bn > 0 ? sqrt(dot(r, r, n)) / bn : 0.0;
 }
 
@@ -1609,9 +1609,9 @@ void snref_step(snref_state *s) {
             unsigned j;
             rows_build(s, &q, vstar);
             for (s->rows_kept = 0, j = 0; j < q.m; j++) s->rows_kept += (unsigned)q.kept[j];
-            g_rows = &q;
+            s->cg_rows = &q;
             s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);
-            g_rows = NULL;
+            s->cg_rows = NULL;
             rows_free(&q);
         } else if (s->exact && exact_direct(s, b, x) == 0) s->last_cg_relres = 0;
         else s->last_cg_relres = pcg(s, b, x, s->exact ? 0u : s->iters);

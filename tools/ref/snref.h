@@ -172,6 +172,7 @@ typedef struct snref_state {
     const struct snref_row *rows;
     unsigned nrows;
     unsigned rows_kept;  /* after the last step's drops */
+    const struct snref_rowsys *cg_rows; /* internal: the step's factorized rows while its PCG runs (NULL otherwise) */
 } snref_state;
 
 typedef struct snref_row {
