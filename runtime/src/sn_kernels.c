@@ -20,18 +20,22 @@ SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3])
     acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
 }
 
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
-    uint32_t a, b;
-    for (a = 0; a < 24; a++) l[a] = 0;
-    for (a = 0; a < 8; a++) {
-        blk_row(l + 3 * a, K, u + 3 * a); /* diagonal block (a,a), stored in full */
-        K += 9 * RB;
-        for (b = a + 1; b < 8; b++, K += 9 * RB) {
-            blk_row(l + 3 * a, K, u + 3 * b);
-            blk_mac_t(l + 3 * b, K, u + 3 * a);
+/* The order of the partial sums is the full product's (rows ascending;
+ * corner b's row takes the transposed blocks of the rows above it, then its
+ * own row), so the float flavour's bits do not depend on the list. */
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    uint32_t i, j;
+    for (i = 0; i < 3 * nf; i++) l[i] = 0;
+    for (i = 0; i < nf; i++) {
+        uint32_t a = fc[i];
+        blk_row(l + 3 * i, K + (size_t)SN_K_BLK(a, a) * RB, u + 3 * i); /* diagonal block (a,a), stored in full */
+        for (j = i + 1; j < nf; j++) {
+            const unsigned char *B = K + (size_t)SN_K_BLK(a, fc[j]) * RB;
+            blk_row(l + 3 * i, B, u + 3 * j);
+            blk_mac_t(l + 3 * j, B, u + 3 * i);
         }
     }
-    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
+    for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
 }
 
 const char *sn_kernels_name(void) { return "scalar"; }

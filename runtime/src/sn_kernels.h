@@ -34,11 +34,21 @@
 #define SN_KERNELS_SCALAR 1
 #endif
 
-/* l = S^_e u for one cell: K the cell's 36 stored upper 3x3 blocks
- * (row-major, little-endian reals, order (0,0),(0,1)..(0,7),(1,1)..(7,7)),
- * used as (a,b) and (b,a); u 8 corner 3-vectors; l 8 corner sums.
+/* Offset (in reals) of stored upper block (a,b), a <= b, of a cell's 36:
+ * row r holds the 8 - r blocks (r,r)..(r,7). */
+#define SN_K_BLK(a, b) \
+    (9u * ((uint32_t)(a) * 8u - ((uint32_t)(a) * ((uint32_t)(a) - 1u)) / 2u + ((uint32_t)(b) - (uint32_t)(a))))
+
+/* l = S^_e u over a cell's listed corners: K the cell's 36 stored upper 3x3
+ * blocks (row-major, little-endian reals, order (0,0),(0,1)..(0,7),(1,1)..(7,7)),
+ * used as (a,b) and (b,a); fc[0..nf-1] the corners, strictly ascending
+ * (nf <= 8); u and l hold nf compacted corner 3-vectors (u_i belongs to
+ * corner fc[i]). The mat-vec lists only free corners: the others' operand is
+ * zero and their rows are dropped, so the 9 nf^2 multiply-adds give the same
+ * sums as the full 24x24 product (fixed: exact zeros; float: +-0 terms added
+ * to the same partial sums in the same order change no bit).
  * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]);
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
 
 #if !defined(SN_FLOAT)
 /* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a

@@ -17,7 +17,7 @@
 #define LD(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
 #define MUL(v, idx, s) _mm256_mul_epi32(_mm256_permutevar8x32_epi32((v), (idx)), (s))
 
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     /* the 4th lane of each index vector reads B0 (a harmless product, never stored) */
     const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0); /* col 0 from B0..B7 */
     const __m256i ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0); /* col 1 from B0..B7, col 2 from B1..B8 */
@@ -25,34 +25,36 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
     const __m256i ir1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0); /* row 1 from B0..B7 */
     const __m256i ir2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0); /* row 2 from B1..B8 */
     __m256i L[8];
-    int a, b;
-    for (a = 0; a < 8; a++) L[a] = _mm256_setzero_si256();
-    for (a = 0; a < 8; a++) {
-        const __m256i ua0 = _mm256_set1_epi32(u[3 * a]), ua1 = _mm256_set1_epi32(u[3 * a + 1]);
-        const __m256i ua2 = _mm256_set1_epi32(u[3 * a + 2]);
-        __m256i v0 = LD(K), v1 = LD(K + 4), la;
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) L[i] = _mm256_setzero_si256();
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        const __m256i ua0 = _mm256_set1_epi32(u[3 * i]), ua1 = _mm256_set1_epi32(u[3 * i + 1]);
+        const __m256i ua2 = _mm256_set1_epi32(u[3 * i + 2]);
+        const unsigned char *B = K + 4 * SN_K_BLK(a, a);
+        __m256i v0 = LD(B), v1 = LD(B + 4), la;
         /* diagonal block (a,a), stored in full: L_a += B u_a */
-        la = _mm256_add_epi64(L[a], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
+        la = _mm256_add_epi64(L[i], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
                                                       MUL(v1, ic1, ua2)));
-        K += 9 * 4;
-        for (b = a + 1; b < 8; b++, K += 9 * 4) {
-            const __m256i ub0 = _mm256_set1_epi32(u[3 * b]), ub1 = _mm256_set1_epi32(u[3 * b + 1]);
-            const __m256i ub2 = _mm256_set1_epi32(u[3 * b + 2]);
-            v0 = LD(K);
-            v1 = LD(K + 4);
+        for (j = i + 1; j < nf; j++) {
+            const __m256i ub0 = _mm256_set1_epi32(u[3 * j]), ub1 = _mm256_set1_epi32(u[3 * j + 1]);
+            const __m256i ub2 = _mm256_set1_epi32(u[3 * j + 2]);
+            B = K + 4 * SN_K_BLK(a, fc[j]);
+            v0 = LD(B);
+            v1 = LD(B + 4);
             la = _mm256_add_epi64(la, _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ub0), MUL(v0, ic1, ub1)),
                                                         MUL(v1, ic1, ub2)));
-            L[b] = _mm256_add_epi64(L[b], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),
+            L[j] = _mm256_add_epi64(L[j], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),
                                                             MUL(v1, ir2, ua2)));
         }
-        L[a] = la;
+        L[i] = la;
     }
-    for (a = 0; a < 8; a++) {
+    for (i = 0; i < nf; i++) {
         int64_t t[4];
-        _mm256_storeu_si256((__m256i *)(void *)t, L[a]);
-        l[3 * a] = t[0];
-        l[3 * a + 1] = t[1];
-        l[3 * a + 2] = t[2];
+        _mm256_storeu_si256((__m256i *)(void *)t, L[i]);
+        l[3 * i] = t[0];
+        l[3 * i + 1] = t[1];
+        l[3 * i + 2] = t[2];
         SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60),
                  "cell row beyond 24 * 2^55", t[0]);
     }

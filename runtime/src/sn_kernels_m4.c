@@ -17,8 +17,56 @@
 #error "sn_kernels_m4.c reads blob reals as native int32: little-endian only (build with SIMD=scalar)"
 #endif
 
-/* offset (in int32) of stored block (a,b), a <= b: rows 0..a-1 hold 8-r blocks each */
-#define BLK(a, b) (9 * ((a) * 8 - ((a) * ((a) - 1)) / 2 + ((b) - (a))))
+#define BLK(a, b) SN_K_BLK(a, b)
+
+/* Listed corners (the mat-vec's free corners): the same two passes in C,
+ * the compiler's SMLAL with word loads; blocks (a, fc[j]) of a row are not
+ * contiguous any more. */
+static void cell_mul_list(const int32_t *S, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    uint32_t i, j;
+    /* pass 1: L_i = sum_{j >= i} B(a_i, a_j) u_j */
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        int64_t s0 = 0, s1 = 0, s2 = 0;
+        for (j = i; j < nf; j++) {
+            const int32_t *B = S + BLK(a, fc[j]);
+            const int32_t x = u[3 * j], y = u[3 * j + 1], z = u[3 * j + 2];
+            s0 += (int64_t)B[0] * x;
+            s0 += (int64_t)B[1] * y;
+            s0 += (int64_t)B[2] * z;
+            s1 += (int64_t)B[3] * x;
+            s1 += (int64_t)B[4] * y;
+            s1 += (int64_t)B[5] * z;
+            s2 += (int64_t)B[6] * x;
+            s2 += (int64_t)B[7] * y;
+            s2 += (int64_t)B[8] * z;
+        }
+        l[3 * i] = s0;
+        l[3 * i + 1] = s1;
+        l[3 * i + 2] = s2;
+    }
+    /* pass 2: L_j += sum_{i < j} B(a_i, a_j)^T u_i */
+    for (j = 1; j < nf; j++) {
+        const uint32_t b = fc[j];
+        int64_t s0 = l[3 * j], s1 = l[3 * j + 1], s2 = l[3 * j + 2];
+        for (i = 0; i < j; i++) {
+            const int32_t *B = S + BLK(fc[i], b);
+            const int32_t x = u[3 * i], y = u[3 * i + 1], z = u[3 * i + 2];
+            s0 += (int64_t)B[0] * x;
+            s1 += (int64_t)B[1] * x;
+            s2 += (int64_t)B[2] * x;
+            s0 += (int64_t)B[3] * y;
+            s1 += (int64_t)B[4] * y;
+            s2 += (int64_t)B[5] * y;
+            s0 += (int64_t)B[6] * z;
+            s1 += (int64_t)B[7] * z;
+            s2 += (int64_t)B[8] * z;
+        }
+        l[3 * j] = s0;
+        l[3 * j + 1] = s1;
+        l[3 * j + 2] = s2;
+    }
+}
 
 #if defined(__OPTIMIZE__)
 /* Optimized builds: the two passes as small Thumb-2 assembly loops, LDM for
@@ -29,7 +77,8 @@
  * pointer and cannot give the asm its registers: the C loops below. */
 SN_INLINE int64_t join64(int32_t hi, uint32_t lo) { return (int64_t)hi * 4294967296LL + (int64_t)lo; }
 
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+/* all 8 corners: every row's blocks contiguous */
+static void cell_mul_full(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
     const int32_t *S = (const int32_t *)(const void *)K;
     int a, b;
     /* pass 1: L_a = sum_{b >= a} B_ab u_b; the blocks of row a are contiguous.
@@ -104,58 +153,20 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
         l[3 * b + 1] += join64(h1, l1);
         l[3 * b + 2] += join64(h2, l2);
     }
-    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
-}
-
-#else /* -O0: the same two passes in C */
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
-    const int32_t *S = (const int32_t *)(const void *)K;
-    int a, b;
-    /* pass 1: L_a = sum_{b >= a} B_ab u_b; the blocks of row a are contiguous */
-    for (a = 0; a < 8; a++) {
-        const int32_t *B = S + BLK(a, a);
-        int64_t s0 = 0, s1 = 0, s2 = 0;
-        for (b = a; b < 8; b++, B += 9) {
-            const int32_t x = u[3 * b], y = u[3 * b + 1], z = u[3 * b + 2];
-            s0 += (int64_t)B[0] * x;
-            s0 += (int64_t)B[1] * y;
-            s0 += (int64_t)B[2] * z;
-            s1 += (int64_t)B[3] * x;
-            s1 += (int64_t)B[4] * y;
-            s1 += (int64_t)B[5] * z;
-            s2 += (int64_t)B[6] * x;
-            s2 += (int64_t)B[7] * y;
-            s2 += (int64_t)B[8] * z;
-        }
-        l[3 * a] = s0;
-        l[3 * a + 1] = s1;
-        l[3 * a + 2] = s2;
-    }
-    /* pass 2: L_b += sum_{a < b} B_ab^T u_a (block (a,b) at BLK(a,b)) */
-    for (b = 1; b < 8; b++) {
-        const int32_t *B = S + BLK(0, b);
-        int64_t s0 = l[3 * b], s1 = l[3 * b + 1], s2 = l[3 * b + 2];
-        for (a = 0; a < b; a++) {
-            const int32_t x = u[3 * a], y = u[3 * a + 1], z = u[3 * a + 2];
-            s0 += (int64_t)B[0] * x;
-            s1 += (int64_t)B[1] * x;
-            s2 += (int64_t)B[2] * x;
-            s0 += (int64_t)B[3] * y;
-            s1 += (int64_t)B[4] * y;
-            s2 += (int64_t)B[5] * y;
-            s0 += (int64_t)B[6] * z;
-            s1 += (int64_t)B[7] * z;
-            s2 += (int64_t)B[8] * z;
-            B += 9 * (7 - a); /* block (a+1, b): row a holds 8-a blocks, skip to column b of row a+1 */
-        }
-        l[3 * b] = s0;
-        l[3 * b + 1] = s1;
-        l[3 * b + 2] = s2;
-    }
-    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
 }
 
 #endif /* __OPTIMIZE__ */
+
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    uint32_t i;
+#if defined(__OPTIMIZE__)
+    if (nf == 8) cell_mul_full(K, u, l);
+    else
+#endif
+        cell_mul_list((const int32_t *)(const void *)K, fc, nf, u, l);
+    for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
+}
+
 
 const char *sn_kernels_name(void) { return "m4"; }
 
