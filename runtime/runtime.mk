@@ -109,17 +109,17 @@ TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_c
              $(BUILD)/tests/test_runtime_fuzz_range
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
-$(BUILD)/bench/sn_bench: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FIXED)
+$(BUILD)/bench/sn_bench: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FLOAT)
+$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FLOAT) -lm
 # many instances sharing one blob (issue 15 item 5): runtime/bench/herd.c
-$(BUILD)/bench/sn_herd: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FIXED)
+$(BUILD)/bench/sn_herd: runtime/bench/herd.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(SN_INC) -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/bench/sn_herd_float: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FLOAT)
+$(BUILD)/bench/sn_herd_float: runtime/bench/herd.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -o $@ $< $(SN_LIB_FLOAT) -lm
 bench: $(BUILD)/bench/sn_herd $(BUILD)/bench/sn_herd_float

@@ -21,62 +21,14 @@
 #include <time.h>
 
 #include "sinew.h"
+#include "bench_common.h" /* FLAV, LEN, DEG, bench_load, bench_cmp_d, bench_pose */
 #include "sn_format.h"
 #include "sn_kernels.h" /* sn_kernels_name: the library's SIMD path */
-
-#if defined(SN_FLOAT)
-#define FLAV "float"
-#define LEN(x) ((float)(x))
-#define DEG(x) ((float)(x))
-#else
-#define FLAV "fixed"
-#define LEN(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#define DEG(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#endif
-
-static unsigned char *load(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    unsigned char *p;
-    long n;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    p = (unsigned char *)malloc((size_t)n + 8); /* malloc: 16-byte aligned */
-    if (p && fread(p, 1, (size_t)n, f) != (size_t)n) { free(p); p = NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return p;
-}
 
 static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Pose for frame k (60 Hz): per joint a swing of up to 25 degrees. */
-static void pose(const sn_blob *blob, uint32_t nJ, int k, sn_quat *local, sn_xform *out) {
-    uint32_t j;
-    double t = k / 60.0;
-    sn_vec3 root;
-    for (j = 0; j < nJ; j++) {
-        sn_vec3 ax;
-        double ph = 0.7 * j, per = 0.8 + 0.13 * (j % 5);
-        ax.x = LEN(cos(1.3 * j));
-        ax.y = LEN(0.5);
-        ax.z = LEN(sin(1.3 * j));
-        local[j] = sn_quat_axis_angle(ax, DEG((j == 0 ? 8.0 : 25.0) * sin(2 * 3.14159265358979 * t / per + ph)));
-    }
-    root.x = LEN(0.4 * t);
-    root.y = LEN(0.05 * sin(2 * 3.14159265358979 * t * 2));
-    root.z = LEN(0.0);
-    sn_pose_from_local(blob, local, &root, out);
 }
 
 /* Arithmetic of one sn_step, in scalar multiply-adds, counted from the code
@@ -107,7 +59,7 @@ static uint32_t rd32(const unsigned char *p) {
 
 static int bench_blob(const char *path, int only_steps) {
     size_t size, need;
-    unsigned char *bytes = load(path, &size);
+    unsigned char *bytes = bench_load(path, &size);
     const sn_blob *blob;
     sn_blob_info info;
     sn_instance *inst;
@@ -130,7 +82,7 @@ static int bench_blob(const char *path, int only_steps) {
             (void)sn_blob_validate(bytes, size, &blob);
             tv[k] = now() - t0;
         }
-        qsort(tv, 21, sizeof tv[0], cmp_d);
+        qsort(tv, 21, sizeof tv[0], bench_cmp_d);
         printf("  figure: %s sn_blob_validate: median %.0f us for %lu bytes (%.1f ns/byte)\n", FLAV, 1e6 * tv[10],
                (unsigned long)size, 1e9 * tv[10] / (double)size);
     }
@@ -143,7 +95,7 @@ static int bench_blob(const char *path, int only_steps) {
     if (!mem || !local || !xf || !surf || !ts) return 2;
     if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
     if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
-        pose(blob, info.joints, 7, local, xf);
+        bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         for (k = 0; k < only_steps; k++) sn_step(inst);
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
@@ -159,14 +111,14 @@ static int bench_blob(const char *path, int only_steps) {
     }
     for (k = 0; k < warm + n; k++) {
         double t0;
-        pose(blob, info.joints, k, local, xf);
+        bench_pose(blob, info.joints, k / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         t0 = now();
         sn_step(inst);
         if (k >= warm) ts[k - warm] = now() - t0;
     }
     for (k = 0; k < n; k++) sum += ts[k];
-    qsort(ts, (size_t)n, sizeof *ts, cmp_d);
+    qsort(ts, (size_t)n, sizeof *ts, bench_cmp_d);
     {
         double t0 = now();
         int rep = 50;
