@@ -33,22 +33,23 @@ static double now(void) {
 
 /* Arithmetic of one sn_step, in scalar multiply-adds, counted from the code
  * of runtime/src/sn_solve.c (format 2.0, per-cell stiffness) and the blob's
- * counts (nC cells, fc free cell corners, nnz mass blocks, nnzFF of them
- * free-free):
- *   cell product   576 = 8 diagonal + 2 x 28 off-diagonal 3x3 blocks
+ * counts (nC cells, fc free cell corners, fc2 the sum over cells of the
+ * square of their free corners, nnz mass blocks, nnzFF of them free-free):
+ *   cell product   576 = 8 diagonal + 2 x 28 off-diagonal 3x3 blocks (rhs);
+ *                  9 f^2 over a cell's f free corners (matvec, format 6.0)
  *   rhs            nC (16*9 + 2*576 + 24) + 9 fc  + mass 3 nF + 3 nnz + 3 nnzFF
  *                  + gravity 9 nF + kinetic energy 6 nF + w 3 nV
  *   skeleton       9 (nV - nF)
- *   matvec         nC 576 + 18 fc + mass 3 nF + 6 nnzFF + combine 6 nF
+ *   matvec         9 fc2 + 18 fc + mass 3 nF + 6 nnzFF + combine 6 nF
  *   CG start       matvec + precondition 27 nF + 1 dot 3 nF
  *   CG iteration   matvec + 27 nF + 2 dots + 2 axpys + direction 3 nF
  *   health         9 nF (skinned positions) + 3 nF
  * A "block multiply-add" is one 3x3 block times a 3-vector = 9 multiply-adds.
  * Not counted: the frames (nJ quaternion->matrix, one slerp per blended
  * vertex or cell) and the O(n) adds/clamps/shifts. */
-static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint32_t nnz, uint32_t nnzff,
+static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint32_t fc2, uint32_t nnz, uint32_t nnzff,
                         uint32_t iters) {
-    double mv = 576.0 * nC + 18.0 * fc + 3.0 * nF + 6.0 * nnzff + 6.0 * nF;
+    double mv = 9.0 * fc2 + 18.0 * fc + 3.0 * nF + 6.0 * nnzff + 6.0 * nF;
     double rhs = nC * (144.0 + 1152.0 + 24.0) + 9.0 * fc + 3.0 * nF + 3.0 * nnz + 3.0 * nnzff + 15.0 * nF + 3.0 * nV;
     return rhs + 9.0 * (nV - nF) + mv + 30.0 * nF + (double)iters * (mv + 27.0 * nF + 21.0 * nF) + 12.0 * nF;
 }
@@ -68,7 +69,7 @@ static int bench_blob(const char *path, int only_steps) {
     sn_xform *xf;
     sn_vec3 *surf;
     sn_status st;
-    uint32_t nnzff = 0, e, blended = 0, i, fc = 0;
+    uint32_t nnzff = 0, e, blended = 0, i, fc = 0, fc2 = 0;
     int k, warm = 30, n = 400;
     double *ts, sum = 0, macs;
     if (!bytes) { fprintf(stderr, "sn_bench: cannot read %s\n", path); return 1; }
@@ -107,7 +108,12 @@ static int bench_blob(const char *path, int only_steps) {
         for (e = 0; e < info.offdiag_blocks; e++) nnzff += (uint32_t)(cols[2 * e] | (cols[2 * e + 1] << 8)) < info.free_vertices;
         const unsigned char *cl = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_CELLS);
         for (i = 0; i < info.vertices; i++) blended += fr[4 * i] != fr[4 * i + 1] && (fr[4 * i + 2] | fr[4 * i + 3]);
-        for (i = 0; i < 8 * info.cells; i++) fc += (uint32_t)(cl[2 * i] | (cl[2 * i + 1] << 8)) < info.free_vertices;
+        for (e = 0; e < info.cells; e++) {
+            uint32_t f = 0;
+            for (i = 8 * e; i < 8 * e + 8; i++) f += (uint32_t)(cl[2 * i] | (cl[2 * i + 1] << 8)) < info.free_vertices;
+            fc += f;
+            fc2 += f * f;
+        }
     }
     for (k = 0; k < warm + n; k++) {
         double t0;
@@ -123,7 +129,7 @@ static int bench_blob(const char *path, int only_steps) {
         double t0 = now();
         int rep = 50;
         for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
-        macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, info.offdiag_blocks, nnzff,
+        macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, fc2, info.offdiag_blocks, nnzff,
                          info.cg_iters_default);
         printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
                "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u; kernels %s\n",

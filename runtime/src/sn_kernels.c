@@ -6,18 +6,28 @@
 
 #if defined(SN_KERNELS_SCALAR)
 
+/* block (a,b), a <= b, as 9 entries (float: the stored reals; fixed: sn_k_blk) */
+SN_INLINE void blk_get(const unsigned char *K, uint32_t a, uint32_t b, sn_q B[9]) {
+#if defined(SN_FLOAT)
+    const unsigned char *p = K + (size_t)SN_K_BLK(a, b) * RB;
+    uint32_t k;
+    for (k = 0; k < 9; k++) B[k] = rd_real(p, k);
+#else
+    sn_k_blk(K, a, b, B);
+#endif
+}
 /* Overflow freedom without clamps (fixed): entries |e| <= 2^27 (validator),
  * operands |x| <= 2^28 (every sn_q is clamped), so one block row is < 3*2^55. */
-SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
-    l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
-    l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
-    l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
+SN_INLINE void blk_row(sn_acc l[3], const sn_q B[9], const sn_q e[3]) {
+    l[0] += sn_mul(B[0], e[0]) + sn_mul(B[1], e[1]) + sn_mul(B[2], e[2]);
+    l[1] += sn_mul(B[3], e[0]) + sn_mul(B[4], e[1]) + sn_mul(B[5], e[2]);
+    l[2] += sn_mul(B[6], e[0]) + sn_mul(B[7], e[1]) + sn_mul(B[8], e[2]);
 }
 /* acc += B^T e (scatter of the transposed block) */
-SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    acc[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) + sn_mul(rd_real(b, 6), e[2]);
-    acc[1] += sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 7), e[2]);
-    acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
+SN_INLINE void blk_mac_t(sn_acc acc[3], const sn_q B[9], const sn_q e[3]) {
+    acc[0] += sn_mul(B[0], e[0]) + sn_mul(B[3], e[1]) + sn_mul(B[6], e[2]);
+    acc[1] += sn_mul(B[1], e[0]) + sn_mul(B[4], e[1]) + sn_mul(B[7], e[2]);
+    acc[2] += sn_mul(B[2], e[0]) + sn_mul(B[5], e[1]) + sn_mul(B[8], e[2]);
 }
 
 /* The order of the partial sums is the full product's (rows ascending;
@@ -25,12 +35,14 @@ SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3])
  * own row), so the float flavour's bits do not depend on the list. */
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     uint32_t i, j;
+    sn_q B[9];
     for (i = 0; i < 3 * nf; i++) l[i] = 0;
     for (i = 0; i < nf; i++) {
         uint32_t a = fc[i];
-        blk_row(l + 3 * i, K + (size_t)SN_K_BLK(a, a) * RB, u + 3 * i); /* diagonal block (a,a), stored in full */
+        blk_get(K, a, a, B);
+        blk_row(l + 3 * i, B, u + 3 * i); /* diagonal block (a,a) */
         for (j = i + 1; j < nf; j++) {
-            const unsigned char *B = K + (size_t)SN_K_BLK(a, fc[j]) * RB;
+            blk_get(K, a, fc[j], B);
             blk_row(l + 3 * i, B, u + 3 * j);
             blk_mac_t(l + 3 * j, B, u + 3 * i);
         }

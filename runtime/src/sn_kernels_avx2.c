@@ -2,7 +2,7 @@
  * encoded) kernels of sn_kernels.h, fixed flavour.
  *
  * cell_mul: one 3x3 block as 4 int64 lanes (the 4th unused) per column or
- * row: two overlapping unaligned loads (B0..B7, B1..B8), VPERMD puts a
+ * row: the block decoded into two int32 vectors (B0..B7, B1..B8; blk_ld), VPERMD puts a
  * column or row in the even int32 slots, VPMULDQ multiplies the signed low
  * halves exactly into int64 lanes (the odd slots are ignored), VPADDQ
  * accumulates. Block (a,b): L_a += B col_c * u_b[c], L_b += B row_r * u_a[r]
@@ -16,6 +16,30 @@
 
 #define LD(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
 #define MUL(v, idx, s) _mm256_mul_epi32(_mm256_permutevar8x32_epi32((v), (idx)), (s))
+
+/* Block (a,b), a <= b, of a fixed CELLK record (sn_format.h) as int32 lanes
+ * v0 = B0..B7 and v1 = B1..B8, the entries of sn_k_blk: a diagonal block
+ * from its 6 symmetric int32 (one load of 8: the 2 past them are the next
+ * block's or the first mantissas, inside the record), an off-diagonal one as
+ * VPMOVSXWD of 8 mantissas and the 9th, shifted left by e (m 2^e < 2^27:
+ * exact in int32). */
+SN_INLINE void blk_ld(const unsigned char *K, uint32_t a, uint32_t b, __m256i *v0, __m256i *v1) {
+    if (a == b) {
+        const __m256i d = LD(K + SN_CELLK_DIAG + 24u * a); /* xx yy zz xy xz yz . . */
+        *v0 = _mm256_permutevar8x32_epi32(d, _mm256_setr_epi32(0, 3, 4, 3, 1, 5, 4, 5));
+        *v1 = _mm256_permutevar8x32_epi32(d, _mm256_setr_epi32(3, 4, 3, 1, 5, 4, 5, 2));
+    } else {
+        const uint32_t o = SN_CELLK_OFFIDX(a, b);
+        const unsigned char *p = K + SN_CELLK_OFF + 18u * o;
+        const int e = K[SN_CELLK_EXP + o];
+        const __m256i m = _mm256_sll_epi32(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)p)),
+                                           _mm_cvtsi32_si128(e));
+        const int32_t b8 = sn_k_rd_i16(p + 16) * ((int32_t)1 << e);
+        *v0 = m;
+        *v1 = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(m, _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 7)),
+                                 _mm256_set1_epi32(b8), 0x80);
+    }
+}
 
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     /* the 4th lane of each index vector reads B0 (a harmless product, never stored) */
@@ -31,17 +55,15 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
         const uint32_t a = fc[i];
         const __m256i ua0 = _mm256_set1_epi32(u[3 * i]), ua1 = _mm256_set1_epi32(u[3 * i + 1]);
         const __m256i ua2 = _mm256_set1_epi32(u[3 * i + 2]);
-        const unsigned char *B = K + 4 * SN_K_BLK(a, a);
-        __m256i v0 = LD(B), v1 = LD(B + 4), la;
-        /* diagonal block (a,a), stored in full: L_a += B u_a */
+        __m256i v0, v1, la;
+        blk_ld(K, a, a, &v0, &v1);
+        /* diagonal block (a,a): L_a += B u_a */
         la = _mm256_add_epi64(L[i], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
                                                       MUL(v1, ic1, ua2)));
         for (j = i + 1; j < nf; j++) {
             const __m256i ub0 = _mm256_set1_epi32(u[3 * j]), ub1 = _mm256_set1_epi32(u[3 * j + 1]);
             const __m256i ub2 = _mm256_set1_epi32(u[3 * j + 2]);
-            B = K + 4 * SN_K_BLK(a, fc[j]);
-            v0 = LD(B);
-            v1 = LD(B + 4);
+            blk_ld(K, a, fc[j], &v0, &v1);
             la = _mm256_add_epi64(la, _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ub0), MUL(v0, ic1, ub1)),
                                                         MUL(v1, ic1, ub2)));
             L[j] = _mm256_add_epi64(L[j], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),

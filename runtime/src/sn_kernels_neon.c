@@ -9,18 +9,15 @@
  *   L_a.z  += (B6,B7) . (u_b.x, u_b.y) + B8 u_b.z
  *   L_b.xy += (B0,B1) u_a.x + (B3,B4) u_a.y + (B6,B7) u_a.z   (B^T u_a)
  *   L_b.z  += (B2,B5) . (u_a.x, u_a.y) + B8 u_a.z
- * Exact int32 x int32 -> int64 products (SMLAL), the same sums as the
- * scalar reference in another order (sn_kernels.h, NUMERICS.md). The blob
- * is little-endian and so are these targets (the build refuses otherwise). */
+ * B is the block decoded to int32 (sn_k_blk: int16 mantissa times 2^e, or
+ * the diagonal's 6 int32). Exact int32 x int32 -> int64 products (SMLAL),
+ * the same sums as the scalar reference in another order (sn_kernels.h,
+ * NUMERICS.md). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_NEON)
 #include <arm_neon.h>
-
-#if !SN_HOST_LE
-#error "sn_kernels_neon.c reads blob reals as native int32: little-endian only (build with SIMD=scalar)"
-#endif
 
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     int64x2_t xy[8], zz[8];
@@ -33,11 +30,14 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     }
     for (i = 0; i < nf; i++) {
         const uint32_t a = fc[i];
-        const int32_t *B = (const int32_t *)(const void *)(K + 4 * SN_K_BLK(a, a));
+        int32_t B[9], Bb[9]; /* the blocks decoded (sn_k_blk) */
         const int32_t ua0 = u[3 * i], ua1 = u[3 * i + 1], ua2 = u[3 * i + 2];
         const int32x2_t ua01 = vld1_s32(u + 3 * i);
-        int32x2x3_t c = vld3_s32(B);
-        int32x2_t r2 = vld1_s32(B + 6);
+        int32x2x3_t c;
+        int32x2_t r2;
+        sn_k_blk(K, a, a, B);
+        c = vld3_s32(B);
+        r2 = vld1_s32(B + 6);
         int64x2_t axy = xy[i], az = zz[i];
         int64_t az1 = z1[i];
         /* diagonal block (a,a), stored in full: L_a += B u_a */
@@ -47,9 +47,9 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
         az = vmlal_s32(az, r2, ua01);
         az1 += (int64_t)B[8] * ua2;
         for (j = i + 1; j < nf; j++) {
-            const int32_t *Bb = (const int32_t *)(const void *)(K + 4 * SN_K_BLK(a, fc[j]));
             const int32x2_t ub01 = vld1_s32(u + 3 * j);
             const int32_t ub2 = u[3 * j + 2];
+            sn_k_blk(K, a, fc[j], Bb);
             c = vld3_s32(Bb);
             r2 = vld1_s32(Bb + 6);
             axy = vmlal_n_s32(axy, c.val[0], vget_lane_s32(ub01, 0));

@@ -82,7 +82,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
     uint32_t e, k, c, nF = v->nF;
     uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
     acc_zero(acc, 3 * nF);
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
@@ -226,7 +226,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     uint32_t e, i, k, c, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         sn_q u[24];
