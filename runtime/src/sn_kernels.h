@@ -45,10 +45,16 @@
 #else
 #define SN_K_CELL_BYTES SN_CELLK_FIXED_BYTES
 
-/* little-endian int16 */
+/* little-endian int16 (a two's complement reinterpretation, as sn_rd_i32) */
 SN_INLINE int32_t sn_k_rd_i16(const unsigned char *p) {
+#if SN_HOST_LE
+    int16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
     int32_t x = (int32_t)sn_rd_u16(p);
     return x - ((x & 0x8000) << 1);
+#endif
 }
 /* Fixed flavour: block (a,b), a <= b, of a cell's CELLK record as 9 int32
  * entries (Q frac_S): a diagonal block from its 6 symmetric int32, an
@@ -68,7 +74,7 @@ SN_INLINE void sn_k_blk(const unsigned char *K, uint32_t a, uint32_t b, int32_t 
         const unsigned char *m = K + SN_CELLK_OFF + 18u * o;
         const int32_t sc = (int32_t)1 << K[SN_CELLK_EXP + o];
         uint32_t k;
-        for (k = 0; k < 9; k++) B[k] = sn_k_rd_i16(m + 2 * k) * sc;
+        for (k = 0; k < 9; k++) B[k] = sn_k_rd_i16(m + 2 * k) * sc; /* m 2^e, |.| < 2^27 */
     }
 }
 #endif
@@ -82,6 +88,11 @@ SN_INLINE void sn_k_blk(const unsigned char *K, uint32_t a, uint32_t b, int32_t 
  * +-0 terms added to the same partial sums in the same order change no bit).
  * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
+
+/* l1 = S^_e u1 and l2 = S^_e u2 over all 8 corners (the right-hand side's
+ * two products), each block decoded once; the same sums as two calls of
+ * sn_k_cell_mul with the 8 corners listed. */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]);
 
 #if !defined(SN_FLOAT)
 /* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a

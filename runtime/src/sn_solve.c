@@ -78,7 +78,6 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
     const unsigned char *rest = v->sec[SN_SEC_REST];
     const sn_q *cR = CARR(h, o_cR, sn_q), *pos = CARR(h, o_pos, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7}; /* the energy needs every corner's row */
     uint32_t e, k, c, nF = v->nF;
     uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
     acc_zero(acc, 3 * nF);
@@ -102,8 +101,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul(K, all8, 8, d, ld);
-        sn_k_cell_mul(K, all8, 8, uu, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu);
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
