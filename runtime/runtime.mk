@@ -53,7 +53,7 @@ $(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
 # ---- runtime tests: each built fixed and float (suffix _float) ----
 SN_TCFLAGS = -std=c99 -Wall -Wextra -Wpedantic -Werror $(CFLAGS) $(SN_INC) -Iruntime/src -Itests
 SN_TEST_HDRS = $(SN_HDRS) tests/sn_test.h tests/fuzz/sn_tblob.h
-SN_TESTS = math blob rig
+SN_TESTS = math blob rig kernels
 
 define SN_TEST_RULE
 $(BUILD)/tests/test_runtime_$(1): tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
