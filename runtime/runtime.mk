@@ -123,5 +123,6 @@ $(BUILD)/bench/sn_herd_float: runtime/bench/herd.c runtime/bench/bench_common.h 
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -o $@ $< $(SN_LIB_FLOAT) -lm
 bench: $(BUILD)/bench/sn_herd $(BUILD)/bench/sn_herd_float
-bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
+bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
+       $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob $(BUILD)/sinew-bake
 	BUILD=$(BUILD) SIMD=$(SIMD) sh runtime/bench/bench.sh $(BUILD)
