@@ -54,10 +54,10 @@ for flav in fixed float; do
     "$bin" "$blob" ${HERD_SIZES:-1 10 100} || rc=1
 done
 # ---- the figure table (issue 15 "Goals"; README's figure table comes from it) ----
-v() { [ -s "$tmp/$1" ] && tr '\n' ' ' < "$tmp/$1" | sed 's/ *$//' || echo "-"; }
+v() { if [ -s "$tmp/$1" ]; then head -n 1 "$tmp/$1"; else echo "-"; fi; }
 m4() { # asset -> Cortex-M4 instructions per step from the bench-baremetal log
     f=$BUILD/baremetal/bench_$1.log
-    if [ -f "$f" ]; then sed -n 's/^insns_per_step: //p' "$f"; else echo "- (make bench-baremetal: cow and limb only)"; fi
+    if [ -f "$f" ]; then sed -n 's/^insns_per_step: //p' "$f"; else echo "-"; fi
 }
 mem() { [ -s "$tmp/m_$1_$2" ] && awk -v k="$3" '{print $k}' "$tmp/m_$1_$2" || echo "-"; }
 echo "== figures (one run; kernels: see the 'kernels' field above; µs are medians of 400 steps on a shared machine)"
@@ -68,9 +68,10 @@ row "desktop fixed step, median µs" $(for a in $ASSETS; do v "t_${a}_fixed"; do
 row "desktop float step, median µs" $(for a in $ASSETS; do v "t_${a}_float"; done)
 row "callgrind fixed instructions per step" $(for a in $ASSETS; do v "c_${a}_fixed"; done)
 row "callgrind float instructions per step" $(for a in $ASSETS; do v "c_${a}_float"; done)
-row "Cortex-M4 instructions per step (fixed)" $(for a in $ASSETS; do m4 "$a" | tr ' ' '_'; done)
+row "Cortex-M4 instructions per step (fixed)" $(for a in $ASSETS; do m4 "$a"; done)
 row "instance bytes (fixed)" $(for a in $ASSETS; do mem "$a" fixed 2; done)
 row "blob bytes (fixed)" $(for a in $ASSETS; do mem "$a" fixed 1; done)
 row "blob bytes (fixed, --no-triangles)" $(for a in $ASSETS; do v "nt_$a"; done)
 row "blob bytes (float)" $(for a in $ASSETS; do mem "$a" float 1; done)
+echo "(Cortex-M4: the images of make bench-baremetal, cow and limb; '-' where none ran)"
 exit $rc
