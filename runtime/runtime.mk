@@ -53,7 +53,7 @@ $(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
 # ---- runtime tests: each built fixed and float (suffix _float) ----
 SN_TCFLAGS = -std=c99 -Wall -Wextra -Wpedantic -Werror $(CFLAGS) $(SN_INC) -Iruntime/src -Itests
 SN_TEST_HDRS = $(SN_HDRS) tests/sn_test.h tests/fuzz/sn_tblob.h
-SN_TESTS = math blob rig
+SN_TESTS = math blob rig kernels
 
 define SN_TEST_RULE
 $(BUILD)/tests/test_runtime_$(1): tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
@@ -109,19 +109,20 @@ TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_c
              $(BUILD)/tests/test_runtime_fuzz_range
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
-$(BUILD)/bench/sn_bench: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FIXED)
+$(BUILD)/bench/sn_bench: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c $(SN_HDRS) $(SN_LIB_FLOAT)
+$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FLOAT) -lm
 # many instances sharing one blob (issue 15 item 5): runtime/bench/herd.c
-$(BUILD)/bench/sn_herd: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FIXED)
+$(BUILD)/bench/sn_herd: runtime/bench/herd.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(SN_INC) -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/bench/sn_herd_float: runtime/bench/herd.c $(SN_HDRS) $(SN_LIB_FLOAT)
+$(BUILD)/bench/sn_herd_float: runtime/bench/herd.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -o $@ $< $(SN_LIB_FLOAT) -lm
 bench: $(BUILD)/bench/sn_herd $(BUILD)/bench/sn_herd_float
-bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
+bench: $(BUILD)/bench/sn_bench $(BUILD)/bench/sn_bench_float $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob \
+       $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob $(BUILD)/sinew-bake
 	BUILD=$(BUILD) SIMD=$(SIMD) sh runtime/bench/bench.sh $(BUILD)

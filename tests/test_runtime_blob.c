@@ -108,7 +108,7 @@ static void test_header(void) {
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
     CASE(SN_ERR_VERSION, "major 7", tb_u16(b + SN_H_VER_MAJOR, 7));
-    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout, dense crease rows: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout, dense crease rows, int32 CELLK: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
     CASE(SN_ERR_VERSION, "major 4 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 4 (format 4.0, no constraint section: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
@@ -267,7 +267,7 @@ static void test_header(void) {
          tb_u32(TAB(SN_SEC_TRIS, 2), 0x80000000u); tb_u32(b + SN_H_N_TRIANGLES, 0x80000000u));
     CASE(SN_ERR_SECTION, "elem_size", tb_u32(TAB(SN_SEC_REST, 3), 16));
     CASE(SN_ERR_SECTION, "size != count*elem", tb_u32(TAB(SN_SEC_MOFF, 1), nnz * 4 - 4));
-    CASE(SN_ERR_SECTION, "CELLK size != count*elem", tb_u32(TAB(SN_SEC_CELLK, 1), TB_NC * SN_ELEM_CELLK(4) - 4));
+    CASE(SN_ERR_SECTION, "CELLK size != count*elem", tb_u32(TAB(SN_SEC_CELLK, 1), TB_NC * SN_ELEM_CELLK(SN_FLAVOUR, 4) - 4));
     CASE(SN_ERR_SECTION, "CELLK elem_size of a 1.0 SOFF block", tb_u32(TAB(SN_SEC_CELLK, 3), 36));
     CASE(SN_ERR_SECTION, "CFRAMES count != nC", tb_u32(TAB(SN_SEC_CFRAMES, 2), TB_NC - 1));
     CASE(SN_ERR_SECTION, "CELLK count != nC", tb_u32(TAB(SN_SEC_CELLK, 2), TB_NC + 1));
@@ -344,11 +344,27 @@ static void test_contents(void) {
     CASE(SN_ERR_VALUE, "MLUMP > 2^27", put_over(SEC(SN_SEC_MLUMP) + 4 * 7, 1 << 27, 0));
     CASE(SN_ERR_VALUE, "MOFF < -2^27", put_over(SEC(SN_SEC_MOFF) + 4 * (nnz - 1), -(1 << 27), 0));
     /* cell stiffness: |e| <= 2^27 everywhere in CELLK, float finite */
+#if defined(SN_FLOAT)
     CASE(SN_ERR_VALUE, "CELLK first entry > 2^27", put_over(SEC(SN_SEC_CELLK), 1 << 27, 0));
     CASE(SN_ERR_VALUE, "CELLK last entry < -2^27", put_over(SEC(SN_SEC_CELLK) + 4 * (TB_NC * 324 - 1), -(1 << 27), 0));
     CASE(SN_ERR_VALUE, "CELLK cell 1 block (3,5) > 2^27", put_over(SEC(SN_SEC_CELLK) + 4 * (324 + 9 * 23 + 4), 1 << 27, 0)); /* blocks of row 3 start at 21 */
     CASE(SN_OK, "CELLK entries = +-2^27", put_at(SEC(SN_SEC_CELLK), 1 << 27, 0);
          put_at(SEC(SN_SEC_CELLK) + 4 * (TB_NC * 324 - 1), -(1 << 27), 0));
+#else
+    /* format 6.0: diagonal int32 |d| <= 2^27; off-diagonal int16 m != -2^15, exponent <= 12 */
+#define CK(c) (SEC(SN_SEC_CELLK) + SN_CELLK_FIXED_BYTES * (c))
+    CASE(SN_ERR_VALUE, "CELLK first diagonal entry > 2^27", put_over(CK(0) + SN_CELLK_DIAG, 1 << 27, 0));
+    CASE(SN_ERR_VALUE, "CELLK last diagonal entry < -2^27", put_over(CK(TB_NC - 1) + SN_CELLK_DIAG + 4 * 47, -(1 << 27), 0));
+    CASE(SN_OK, "CELLK diagonal entries = +-2^27", put_at(CK(0) + SN_CELLK_DIAG, 1 << 27, 0);
+         put_at(CK(TB_NC - 1) + SN_CELLK_DIAG + 4 * 47, -(1 << 27), 0));
+    CASE(SN_ERR_VALUE, "CELLK mantissa -2^15", tb_u16(CK(0) + SN_CELLK_OFF, 0x8000u));
+    CASE(SN_ERR_VALUE, "CELLK cell 1 block (3,5) last mantissa -2^15", tb_u16(CK(1) + SN_CELLK_OFF + 18 * SN_CELLK_OFFIDX(3, 5) + 16, 0x8000u));
+    CASE(SN_OK, "CELLK mantissas +-(2^15 - 1), exponent 12", tb_u16(CK(0) + SN_CELLK_OFF, 0x7FFFu);
+         tb_u16(CK(TB_NC - 1) + SN_CELLK_OFF + 2 * (28 * 9 - 1), 0x8001u); CK(0)[SN_CELLK_EXP] = 12; CK(TB_NC - 1)[SN_CELLK_EXP + 27] = 12);
+    CASE(SN_ERR_VALUE, "CELLK exponent 13", CK(0)[SN_CELLK_EXP] = 13);
+    CASE(SN_ERR_VALUE, "CELLK last exponent 255", CK(TB_NC - 1)[SN_CELLK_EXP + 27] = 255);
+#undef CK
+#endif
     /* cell frames: bones < nJ, w <= 32768 */
     CASE(SN_ERR_INDEX, "CFRAMES bone1 >= nJ", SEC(SN_SEC_CFRAMES)[0] = TB_NJ);
     CASE(SN_ERR_INDEX, "CFRAMES bone2 >= nJ", SEC(SN_SEC_CFRAMES)[4 * (TB_NC - 1) + 1] = 255);

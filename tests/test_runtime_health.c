@@ -118,14 +118,23 @@ static double elastic_rest_energy(const ch_t *c, const sn_vec3 *lat) {
             for (bb = a; bb < 8; bb++, n++)
                 for (i = 0; i < 3; i++)
                     for (j = 0; j < 3; j++) {
-                        uint32_t raw = rd32(K + ((size_t)e * 324 + (size_t)(9 * n + 3 * i + j)) * rs);
 #if defined(SN_FLOAT)
+                        uint32_t raw = rd32(K + ((size_t)e * 324 + (size_t)(9 * n + 3 * i + j)) * rs);
                         float fk;
                         double k;
                         memcpy(&fk, &raw, 4);
                         k = fk;
-#else
-                        double k = ldexp((double)(int32_t)raw, -frac_S);
+#else   /* format 6.0 CELLK: diagonal int32 xx yy zz xy xz yz, off-diagonal int16 m 2^e */
+                        const unsigned char *ck = K + (size_t)e * SN_CELLK_FIXED_BYTES;
+                        double k;
+                        if (a == bb) {
+                            static const int s6[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2};
+                            k = ldexp((double)(int32_t)rd32(ck + SN_CELLK_DIAG + 24 * a + 4 * s6[3 * i + j]), -frac_S);
+                        } else {
+                            uint32_t o = SN_CELLK_OFFIDX(a, bb);
+                            const unsigned char *m = ck + SN_CELLK_OFF + 18 * o + 2 * (3 * i + j);
+                            k = ldexp((double)(int16_t)(uint16_t)(m[0] | (m[1] << 8)), ck[SN_CELLK_EXP + o] - frac_S);
+                        }
 #endif
                         y[3 * a + i] += k * d[3 * bb + j];
                         if (bb != a) y[3 * bb + j] += k * d[3 * a + i];
@@ -186,15 +195,23 @@ int main(int argc, char **argv) {
         uint32_t i, n, rs = bytes[SN_H_REAL_SIZE];
         memcpy(bad, bytes, size);
         K = bad + rd32(bad + SN_H_SECTIONS + 16 * SN_SEC_CELLK);
-        n = rd32(bad + SN_H_SECTIONS + 16 * SN_SEC_CELLK + 4) / rs;
-        for (i = 0; i < n; i++) {
-            unsigned char *p = (unsigned char *)K + (size_t)i * rs;
 #if defined(SN_FLOAT)
-            p[3] ^= 0x80u; /* sign bit */
-#else
-            wr32(p, (uint32_t)(-(int32_t)rd32(p)));
-#endif
+        n = rd32(bad + SN_H_SECTIONS + 16 * SN_SEC_CELLK + 4) / rs;
+        for (i = 0; i < n; i++) ((unsigned char *)K)[(size_t)i * rs + 3] ^= 0x80u; /* sign bit */
+#else   /* format 6.0: negate the diagonal int32 and the int16 mantissas (never -2^15) */
+        n = rd32(bad + SN_H_SECTIONS + 16 * SN_SEC_CELLK + 8); /* cells */
+        (void)rs;
+        for (i = 0; i < n; i++) {
+            unsigned char *ck = (unsigned char *)K + (size_t)i * SN_CELLK_FIXED_BYTES;
+            uint32_t k;
+            for (k = 0; k < 48; k++) wr32(ck + SN_CELLK_DIAG + 4 * k, (uint32_t)(-(int32_t)rd32(ck + SN_CELLK_DIAG + 4 * k)));
+            for (k = 0; k < 28 * 9; k++) {
+                unsigned char *m = ck + SN_CELLK_OFF + 2 * k;
+                uint16_t v = (uint16_t)(0u - (unsigned)(m[0] | (m[1] << 8)));
+                m[0] = (unsigned char)v; m[1] = (unsigned char)(v >> 8);
+            }
         }
+#endif
         wr32(bad + SN_H_CRC32, snref_crc32(bad + 16, size - 16));
         T_CHECK(open_ch(&c, bad, size) == 0, "negated-stiffness blob validates");
         for (s = 0; s < 300; s++) { set_pose(&c, -1, ax, 0); sn_step(c.inst); }

@@ -56,25 +56,42 @@ static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
 /* Cell e's stiffness S^_e = h^2 S_e / m0, quantized for the flavour into
  * out (36 upper blocks a <= b, 9 entries each, block (a,b)[3i+j] =
- * S^_e[3a+i][3b+j]; format 2.0 CELLK). Fixed flavour: off-diagonal blocks are
- * rounded on their own, and each diagonal block is set so that the integer
- * block row sums equal the rounded exact ones (zero for the translation null
- * space): rounding every entry alone breaks that null space, which moved a
- * slender beam's static tip by 1.4% (tests/reference/README.md, finding 2);
- * then symmetrized (<= 1 LSB). Returns 0, or -1 if an entry does not fit. */
-static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavour, int frac, double out[36 * 9])
+ * S^_e[3a+i][3b+j]). Fixed flavour (format 6.0 CELLK, sn_format.h): each
+ * off-diagonal block is rounded on its own to an int16 mantissa times 2^e,
+ * e the smallest exponent (0..12) whose mantissas fit |m| <= 2^15 - 1 (into
+ * exps[], by the block's index among the 28); each diagonal block (int32)
+ * is set so that the integer block row sums equal the rounded exact ones
+ * (zero for the translation null space): rounding every entry alone breaks
+ * that null space, which moved a slender beam's static tip by 1.4%
+ * (tests/reference/README.md, finding 2); then symmetrized (<= 1 LSB).
+ * out holds the integer entries m 2^e / the diagonal's. Returns 0, or -1 if
+ * an entry does not fit. */
+static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavour, int frac, double out[36 * 9],
+                       int exps[28])
 {
     const double *Se = o->Se + (size_t)ci * 576;
     double sc = h * h / m0;
-    int a, b, i, j, n = 0;
+    int a, b, i, j, n = 0, no = 0;
     for (a = 0; a < 8; a++)
         for (b = a; b < 8; b++, n++)
             for (i = 0; i < 3; i++)
                 for (j = 0; j < 3; j++) {
                     double x = sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
-                    out[9 * n + 3 * i + j] = flavour == SB_FIXED ? rnd(ldexp(x, frac)) : x;
+                    out[9 * n + 3 * i + j] = flavour == SB_FIXED ? ldexp(x, frac) : x;
                 }
     if (flavour != SB_FIXED) return 0;
+    for (a = 0, n = 0; a < 8; a++)
+        for (b = a; b < 8; b++, n++) {
+            double mx = 0;
+            int k, e = 0;
+            if (b == a) continue;
+            for (k = 0; k < 9; k++) mx = fmax(mx, fabs(out[9 * n + k]));
+            while (e < SN_CELLK_EXP_MAX && rnd(ldexp(mx, -e)) > (double)SN_CELLK_M_MAX) e++;
+            if (!(mx <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
+            for (k = 0; k < 9; k++) /* at e = 12 an entry within 2^11 of 2^27 takes the largest mantissa */
+                out[9 * n + k] = ldexp(fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(out[9 * n + k], -e)))), e);
+            exps[no++] = e;
+        }
     for (a = 0; a < 8; a++) {
         double exact[9] = {0}, D[9];
         int k, na = 0;
@@ -274,7 +291,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     cnt[SN_SEC_MOFF] = (uint32_t)nnz;         esz[SN_SEC_MOFF] = SN_ELEM_MOFF(rs);
     cnt[SN_SEC_CELLS] = (uint32_t)o->nc;      esz[SN_SEC_CELLS] = SN_ELEM_CELLS;
     cnt[SN_SEC_CFRAMES] = (uint32_t)o->nc;    esz[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
-    cnt[SN_SEC_CELLK] = (uint32_t)o->nc;      esz[SN_SEC_CELLK] = SN_ELEM_CELLK(rs);
+    cnt[SN_SEC_CELLK] = (uint32_t)o->nc;      esz[SN_SEC_CELLK] = SN_ELEM_CELLK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
     cnt[SN_SEC_LIMIT] = (uint32_t)nlim;       esz[SN_SEC_LIMIT] = SN_ELEM_LIMIT(rs);
     cnt[SN_SEC_EMBED] = (uint32_t)o->ns;      esz[SN_SEC_EMBED] = SN_ELEM_EMBED;
     cnt[SN_SEC_TRIS] = (uint32_t)o->nt;       esz[SN_SEC_TRIS] = SN_ELEM_TRIS;
@@ -435,17 +452,33 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)nF, (uint32_t)nnz);
     for (i = 0; i < o->nc; i++) {
         double blk[36 * 9];
+        int exps[28];
         size_t at = off[SN_SEC_CFRAMES] + 4 * (size_t)i;
         for (k = 0; k < 8; k++) put_u16(&w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
         put_u8(&w, at, (unsigned)o->cfb1[i]);
         put_u8(&w, at + 1, (unsigned)o->cfb2[i]);
         put_u16(&w, at + 2, (unsigned)rnd(o->cfw[i] * 32768.0));
-        if (cell_blocks(o, i, h, m0, flavour, b->frac_S, blk) != 0) w.err = 1;
-        for (k = 0; k < 36 * 9; k++) {
-            size_t kat = off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs;
-            if (flavour == SB_FIXED) put_u32(&w, kat, (uint32_t)(int32_t)blk[k]);
-            else put_real(&w, kat, blk[k], 0);
-        }
+        if (cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w.err = 1;
+        if (flavour == SB_FIXED) { /* int32 diagonal (6 symmetric), int16 mantissas, exponents */
+            size_t c0 = off[SN_SEC_CELLK] + (size_t)i * SN_CELLK_FIXED_BYTES;
+            int a, bb, n = 0, no = 0;
+            for (a = 0; a < 8; a++)
+                for (bb = a; bb < 8; bb++, n++) {
+                    if (bb == a) {
+                        for (k = 0; k < 6; k++)
+                            put_u32(&w, c0 + SN_CELLK_DIAG + 24 * (size_t)a + 4 * (size_t)k,
+                                    (uint32_t)(int32_t)blk[9 * n + 3 * sym6[k][0] + sym6[k][1]]);
+                    } else {
+                        for (k = 0; k < 9; k++)
+                            put_u16(&w, c0 + SN_CELLK_OFF + 18 * (size_t)no + 2 * (size_t)k,
+                                    (unsigned)(uint16_t)(int16_t)ldexp(blk[9 * n + k], -exps[no]));
+                        put_u8(&w, c0 + SN_CELLK_EXP + (size_t)no, (unsigned)exps[no]);
+                        no++;
+                    }
+                }
+        } else
+            for (k = 0; k < 36 * 9; k++)
+                put_real(&w, off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs, blk[k], 0);
     }
     {   /* beyond 64 internal units the state clamps anyway (NUMERICS.md): say so once */
         int beyond = 0;

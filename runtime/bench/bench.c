@@ -21,33 +21,9 @@
 #include <time.h>
 
 #include "sinew.h"
+#include "bench_common.h" /* FLAV, LEN, DEG, bench_load, bench_cmp_d, bench_pose */
 #include "sn_format.h"
 #include "sn_kernels.h" /* sn_kernels_name: the library's SIMD path */
-
-#if defined(SN_FLOAT)
-#define FLAV "float"
-#define LEN(x) ((float)(x))
-#define DEG(x) ((float)(x))
-#else
-#define FLAV "fixed"
-#define LEN(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#define DEG(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#endif
-
-static unsigned char *load(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    unsigned char *p;
-    long n;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    p = (unsigned char *)malloc((size_t)n + 8); /* malloc: 16-byte aligned */
-    if (p && fread(p, 1, (size_t)n, f) != (size_t)n) { free(p); p = NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return p;
-}
 
 static double now(void) {
     struct timespec t;
@@ -55,48 +31,25 @@ static double now(void) {
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Pose for frame k (60 Hz): per joint a swing of up to 25 degrees. */
-static void pose(const sn_blob *blob, uint32_t nJ, int k, sn_quat *local, sn_xform *out) {
-    uint32_t j;
-    double t = k / 60.0;
-    sn_vec3 root;
-    for (j = 0; j < nJ; j++) {
-        sn_vec3 ax;
-        double ph = 0.7 * j, per = 0.8 + 0.13 * (j % 5);
-        ax.x = LEN(cos(1.3 * j));
-        ax.y = LEN(0.5);
-        ax.z = LEN(sin(1.3 * j));
-        local[j] = sn_quat_axis_angle(ax, DEG((j == 0 ? 8.0 : 25.0) * sin(2 * 3.14159265358979 * t / per + ph)));
-    }
-    root.x = LEN(0.4 * t);
-    root.y = LEN(0.05 * sin(2 * 3.14159265358979 * t * 2));
-    root.z = LEN(0.0);
-    sn_pose_from_local(blob, local, &root, out);
-}
-
 /* Arithmetic of one sn_step, in scalar multiply-adds, counted from the code
  * of runtime/src/sn_solve.c (format 2.0, per-cell stiffness) and the blob's
- * counts (nC cells, fc free cell corners, nnz mass blocks, nnzFF of them
- * free-free):
- *   cell product   576 = 8 diagonal + 2 x 28 off-diagonal 3x3 blocks
+ * counts (nC cells, fc free cell corners, fc2 the sum over cells of the
+ * square of their free corners, nnz mass blocks, nnzFF of them free-free):
+ *   cell product   576 = 8 diagonal + 2 x 28 off-diagonal 3x3 blocks (rhs);
+ *                  9 f^2 over a cell's f free corners (matvec, format 6.0)
  *   rhs            nC (16*9 + 2*576 + 24) + 9 fc  + mass 3 nF + 3 nnz + 3 nnzFF
  *                  + gravity 9 nF + kinetic energy 6 nF + w 3 nV
  *   skeleton       9 (nV - nF)
- *   matvec         nC 576 + 18 fc + mass 3 nF + 6 nnzFF + combine 6 nF
+ *   matvec         9 fc2 + 18 fc + mass 3 nF + 6 nnzFF + combine 6 nF
  *   CG start       matvec + precondition 27 nF + 1 dot 3 nF
  *   CG iteration   matvec + 27 nF + 2 dots + 2 axpys + direction 3 nF
  *   health         9 nF (skinned positions) + 3 nF
  * A "block multiply-add" is one 3x3 block times a 3-vector = 9 multiply-adds.
  * Not counted: the frames (nJ quaternion->matrix, one slerp per blended
  * vertex or cell) and the O(n) adds/clamps/shifts. */
-static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint32_t nnz, uint32_t nnzff,
+static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint32_t fc2, uint32_t nnz, uint32_t nnzff,
                         uint32_t iters) {
-    double mv = 576.0 * nC + 18.0 * fc + 3.0 * nF + 6.0 * nnzff + 6.0 * nF;
+    double mv = 9.0 * fc2 + 18.0 * fc + 3.0 * nF + 6.0 * nnzff + 6.0 * nF;
     double rhs = nC * (144.0 + 1152.0 + 24.0) + 9.0 * fc + 3.0 * nF + 3.0 * nnz + 3.0 * nnzff + 15.0 * nF + 3.0 * nV;
     return rhs + 9.0 * (nV - nF) + mv + 30.0 * nF + (double)iters * (mv + 27.0 * nF + 21.0 * nF) + 12.0 * nF;
 }
@@ -107,7 +60,7 @@ static uint32_t rd32(const unsigned char *p) {
 
 static int bench_blob(const char *path, int only_steps) {
     size_t size, need;
-    unsigned char *bytes = load(path, &size);
+    unsigned char *bytes = bench_load(path, &size);
     const sn_blob *blob;
     sn_blob_info info;
     sn_instance *inst;
@@ -116,7 +69,7 @@ static int bench_blob(const char *path, int only_steps) {
     sn_xform *xf;
     sn_vec3 *surf;
     sn_status st;
-    uint32_t nnzff = 0, e, blended = 0, i, fc = 0;
+    uint32_t nnzff = 0, e, blended = 0, i, fc = 0, fc2 = 0;
     int k, warm = 30, n = 400;
     double *ts, sum = 0, macs;
     if (!bytes) { fprintf(stderr, "sn_bench: cannot read %s\n", path); return 1; }
@@ -130,7 +83,7 @@ static int bench_blob(const char *path, int only_steps) {
             (void)sn_blob_validate(bytes, size, &blob);
             tv[k] = now() - t0;
         }
-        qsort(tv, 21, sizeof tv[0], cmp_d);
+        qsort(tv, 21, sizeof tv[0], bench_cmp_d);
         printf("  figure: %s sn_blob_validate: median %.0f us for %lu bytes (%.1f ns/byte)\n", FLAV, 1e6 * tv[10],
                (unsigned long)size, 1e9 * tv[10] / (double)size);
     }
@@ -143,7 +96,7 @@ static int bench_blob(const char *path, int only_steps) {
     if (!mem || !local || !xf || !surf || !ts) return 2;
     if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
     if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
-        pose(blob, info.joints, 7, local, xf);
+        bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         for (k = 0; k < only_steps; k++) sn_step(inst);
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
@@ -155,23 +108,28 @@ static int bench_blob(const char *path, int only_steps) {
         for (e = 0; e < info.offdiag_blocks; e++) nnzff += (uint32_t)(cols[2 * e] | (cols[2 * e + 1] << 8)) < info.free_vertices;
         const unsigned char *cl = bytes + rd32(bytes + SN_H_SECTIONS + 16 * SN_SEC_CELLS);
         for (i = 0; i < info.vertices; i++) blended += fr[4 * i] != fr[4 * i + 1] && (fr[4 * i + 2] | fr[4 * i + 3]);
-        for (i = 0; i < 8 * info.cells; i++) fc += (uint32_t)(cl[2 * i] | (cl[2 * i + 1] << 8)) < info.free_vertices;
+        for (e = 0; e < info.cells; e++) {
+            uint32_t f = 0;
+            for (i = 8 * e; i < 8 * e + 8; i++) f += (uint32_t)(cl[2 * i] | (cl[2 * i + 1] << 8)) < info.free_vertices;
+            fc += f;
+            fc2 += f * f;
+        }
     }
     for (k = 0; k < warm + n; k++) {
         double t0;
-        pose(blob, info.joints, k, local, xf);
+        bench_pose(blob, info.joints, k / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         t0 = now();
         sn_step(inst);
         if (k >= warm) ts[k - warm] = now() - t0;
     }
     for (k = 0; k < n; k++) sum += ts[k];
-    qsort(ts, (size_t)n, sizeof *ts, cmp_d);
+    qsort(ts, (size_t)n, sizeof *ts, bench_cmp_d);
     {
         double t0 = now();
         int rep = 50;
         for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
-        macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, info.offdiag_blocks, nnzff,
+        macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, fc2, info.offdiag_blocks, nnzff,
                          info.cg_iters_default);
         printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
                "tris %u, off-diagonal blocks %u (free-free %u), blended vertices %u, CG iterations %u; kernels %s\n",

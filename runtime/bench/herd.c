@@ -23,31 +23,7 @@
 #include <unistd.h>
 
 #include "sinew.h"
-
-#if defined(SN_FLOAT)
-#define FLAV "float"
-#define LEN(x) ((float)(x))
-#define DEG(x) ((float)(x))
-#else
-#define FLAV "fixed"
-#define LEN(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#define DEG(x) ((int32_t)floor((x) * 65536.0 + 0.5))
-#endif
-
-static unsigned char *load(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    unsigned char *p;
-    long n;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    p = (unsigned char *)malloc((size_t)n + 8);
-    if (p && fread(p, 1, (size_t)n, f) != (size_t)n) { free(p); p = NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return p;
-}
+#include "bench_common.h" /* FLAV, LEN, DEG, bench_load, bench_cmp_d, bench_pose */
 
 /* thread CPU time: on a shared machine a round of 100 cows spans many
  * scheduler slices, and wall time would charge the other processes' slices
@@ -61,29 +37,6 @@ static double now(void) {
     clock_gettime(CLOCK_MONOTONIC, &t);
 #endif
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* the pose sequence of bench.c at time t (seconds) */
-static void pose(const sn_blob *blob, uint32_t nJ, double t, sn_quat *local, sn_xform *out) {
-    uint32_t j;
-    sn_vec3 root;
-    for (j = 0; j < nJ; j++) {
-        sn_vec3 ax;
-        double ph = 0.7 * j, per = 0.8 + 0.13 * (j % 5);
-        ax.x = LEN(cos(1.3 * j));
-        ax.y = LEN(0.5);
-        ax.z = LEN(sin(1.3 * j));
-        local[j] = sn_quat_axis_angle(ax, DEG((j == 0 ? 8.0 : 25.0) * sin(2 * 3.14159265358979 * t / per + ph)));
-    }
-    root.x = LEN(0.4 * t);
-    root.y = LEN(0.05 * sin(2 * 3.14159265358979 * t * 2));
-    root.z = LEN(0.0);
-    sn_pose_from_local(blob, local, &root, out);
 }
 
 /* data cache sizes (glibc sysconf; 0 where unknown) */
@@ -118,7 +71,7 @@ static int herd(const sn_blob *blob, const sn_blob_info *info, size_t blob_bytes
     for (r = 0; r < budget_rounds; r++) {
         double t0;
         for (c = 0; c < n; c++) /* each cow its own phase: 0.37 s apart */
-            pose(blob, info->joints, r / 60.0 + 0.37 * c, local, xf + (size_t)c * info->joints);
+            bench_pose(blob, info->joints, r / 60.0 + 0.37 * c, local, xf + (size_t)c * info->joints);
         t0 = now();
         for (c = 0; c < n; c++) {
             sn_set_pose(inst[c], xf + (size_t)c * info->joints, info->joints);
@@ -126,7 +79,7 @@ static int herd(const sn_blob *blob, const sn_blob_info *info, size_t blob_bytes
         }
         ts[r] = (now() - t0) / n;
     }
-    qsort(ts + warm, (size_t)rounds, sizeof *ts, cmp_d);
+    qsort(ts + warm, (size_t)rounds, sizeof *ts, bench_cmp_d);
     med = ts[warm + rounds / 2];
     if (n == 1 || *base <= 0) *base = med;
     for (c = 0; c < n; c++) hx ^= (unsigned long long)sn_state_hash(inst[c]) * (unsigned long long)(2 * c + 1);
@@ -149,7 +102,7 @@ int main(int argc, char **argv) {
     double base = 0;
     static const int def[3] = {1, 10, 100};
     if (argc < 2) { fprintf(stderr, "usage: sn_herd blob [--rounds R] [N ...]\n"); return 2; }
-    if (!(bytes = load(argv[1], &size))) { fprintf(stderr, "sn_herd: cannot read %s\n", argv[1]); return 1; }
+    if (!(bytes = bench_load(argv[1], &size))) { fprintf(stderr, "sn_herd: cannot read %s\n", argv[1]); return 1; }
     if (sn_blob_validate(bytes, size, &blob) != SN_OK) { fprintf(stderr, "sn_herd: %s: invalid blob\n", argv[1]); return 1; }
     sn_blob_get_info(blob, &info);
     printf("  herd: %s (%s), instance %lu B, blob %lu B; data caches:", argv[1], FLAV,

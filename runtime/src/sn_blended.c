@@ -120,7 +120,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
     uint32_t e, k, c, i, nF = v->nF;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < 3 * nF; i++) acc[i] = 0;
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         uint32_t a0 = sn_rd_u16(cl);
         sn_q w0[3];
@@ -142,8 +142,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul(K, d, ld);
-        sn_k_cell_mul(K, uu, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3];
@@ -173,23 +172,26 @@ static void region_matvec(sn_ihdr *h, const sn_q *R, const blend_mem *m, const s
     uint32_t e, i, k, c, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < 3 * nF; i++) acc[i] = 0;
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         sn_q u[24];
         sn_acc l[24];
+        uint8_t fc[8];
+        uint32_t vi[8], nf = 0;
         if (!m->cm[e]) continue;
-        for (k = 0; k < 8; k++) {
+        for (k = 0; k < 8; k++) { /* the corners with an unknown of Q^r: d is 0 at the others (sn_solve.c's free-corner product) */
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            if (a < nF && m->vm[a]) sn_rot_t(R, d + 3 * a, u + 3 * k, sat);
-            else u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0;
-        }
-        sn_k_cell_mul(K, u, l);
-        for (k = 0; k < 8; k++) {
-            uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3];
-            int sh;
             if (a >= nF || !m->vm[a]) continue;
-            sh = v->frac_S - SN_KREL(kk[a]);
+            sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
+        }
+        if (nf == 0) continue;
+        sn_k_cell_mul(K, fc, nf, u, l);
+        for (k = 0; k < nf; k++) {
+            uint32_t a = vi[k];
+            sn_q t[3];
+            int sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
             rot_acc(acc + 3 * a, R, t);
         }

@@ -258,7 +258,20 @@ static sn_status sn_check_contents(const sn_view *v) {
         SN_CHK(f[0] < v->nJ && f[1] < v->nJ, SN_ERR_INDEX);
         SN_CHK(sn_rd_u16(f + 2) <= 32768u, SN_ERR_VALUE);
     }
+#if defined(SN_FLOAT)
     SN_CHK(sn_reals_ok(v->sec[SN_SEC_CELLK], SN_CELL_BLOCKS * 9 * v->nC, E, 0), SN_ERR_VALUE);
+#else
+    /* fixed CELLK (format 6.0): diagonal int32 |d| <= 2^27; off-diagonal
+     * int16 mantissas |m| <= 2^15 - 1 with exponents e <= 12, so every entry
+     * m 2^e < 2^27: the bound the cell-row proof uses (NUMERICS.md) */
+    s = v->sec[SN_SEC_CELLK];
+    for (i = 0; i < v->nC; i++) {
+        const unsigned char *c = s + (size_t)i * SN_CELLK_FIXED_BYTES;
+        SN_CHK(sn_reals_ok(c + SN_CELLK_DIAG, 8 * 6, E, 0), SN_ERR_VALUE);
+        for (k = 0; k < 28 * 9; k++) SN_CHK(sn_rd_u16(c + SN_CELLK_OFF + 2 * k) != 0x8000u, SN_ERR_VALUE);
+        for (k = 0; k < 28; k++) SN_CHK(c[SN_CELLK_EXP + k] <= SN_CELLK_EXP_MAX, SN_ERR_VALUE);
+    }
+#endif
     /* limits: 0 <= L <= 2^28 (Q22: 64 internal units, the state clamp) */
     s = v->sec[SN_SEC_LIMIT];
     for (i = 0; i < v->nL; i++)
@@ -431,7 +444,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(SN_REAL_BYTES),
             SN_ELEM_PRECOND(SN_REAL_BYTES), SN_ELEM_MLUMP(SN_REAL_BYTES), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(SN_REAL_BYTES), SN_ELEM_CELLS, SN_ELEM_CFRAMES,
-            SN_ELEM_CELLK(SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS,
+            SN_ELEM_CELLK(SN_FLAVOUR, SN_REAL_BYTES), SN_ELEM_LIMIT(SN_REAL_BYTES), SN_ELEM_EMBED, SN_ELEM_TRIS,
             SN_ELEM_CONTROLS(SN_REAL_BYTES), SN_ELEM_RIGS, SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES),
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),

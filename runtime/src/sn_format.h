@@ -99,8 +99,11 @@ enum {
     SN_SEC_MOFF,         /* nnz x R     M^_ij (Q frac_M) */
     SN_SEC_CELLS,        /* nC  x u16[8] corner vertices, corner k at (k&1, k>>1&1, k>>2&1) of the cell box; distinct */
     SN_SEC_CFRAMES,      /* nC  x {u8 bone1, u8 bone2, u16 w Q15}: cell frame R_e = slerp(R_b1, R_b2, w) (seed 003 end of 3.3) */
-    SN_SEC_CELLK,        /* nC  x 36 x R[9]: the cell's stiffness S^_e, upper blocks (a <= b) in order (0,0) (0,1) .. (0,7) (1,1) .. (7,7),
-                            block (a,b)[3i+j] = S^_e[3a+i][3b+j] (Q frac_S); S^_e,ba = S^_e,ab^T */
+    SN_SEC_CELLK,        /* nC  x the cell's stiffness S^_e, block (a,b)[3i+j] = S^_e[3a+i][3b+j], S^_e,ba = S^_e,ab^T.
+                            float flavours: 36 x R[9], upper blocks (a <= b) in order (0,0) (0,1) .. (0,7) (1,1) .. (7,7).
+                            fixed (format 6.0, SN_CELLK_FIXED_BYTES): i32 diag[8][6] (blocks (a,a), symmetric xx yy zz xy
+                            xz yz, Q frac_S, |.| <= 2^27), i16 m[28][9] (blocks (a,b), a < b, in order (0,1) .. (0,7)
+                            (1,2) .. (6,7), |m| <= 2^15 - 1), u8 e[28] (their exponents, <= 12): entry = m 2^e (Q frac_S) */
     SN_SEC_LIMIT,        /* nF x R, or count 0 (no limits): largest distance of free vertex i from its skinned position, internal units (Q22), 0 = none */
     SN_SEC_EMBED,        /* nS  x {u16 cell, u16 t[3] Q15 (0..32768)} trilinear coordinates in the cell */
     SN_SEC_TRIS,         /* nT  x u16[3] surface vertex indices, counter-clockwise seen from outside */
@@ -176,7 +179,18 @@ enum {
 #define SN_ELEM_MOFF(R)    (R)
 #define SN_ELEM_CELLS       16
 #define SN_ELEM_CFRAMES      4
-#define SN_ELEM_CELLK(R)   (36 * 9 * (R))
+/* CELLK: the fixed flavour stores int16 mantissas with a per-block exponent
+ * for the 28 off-diagonal blocks and the 8 diagonal blocks as 6 int32 (the
+ * null-space rule's exact row sums, runtime/NUMERICS.md "Stiffness storage") */
+#define SN_ELEM_CELLK(flavour, R) ((flavour) == SN_FLAVOUR_FIXED ? SN_CELLK_FIXED_BYTES : 36 * 9 * (R))
+#define SN_CELLK_FIXED_BYTES 724    /* 8 x 6 x 4 + 28 x 9 x 2 + 28 */
+#define SN_CELLK_DIAG 0             /* fixed: i32 diag[8][6] */
+#define SN_CELLK_OFF 192            /* fixed: i16 m[28][9] */
+#define SN_CELLK_EXP 696            /* fixed: u8 e[28] */
+#define SN_CELLK_EXP_MAX 12         /* m 2^e <= (2^15 - 1) 2^12 < 2^27, the entry bound */
+#define SN_CELLK_M_MAX 32767
+/* index of off-diagonal block (a,b), a < b: row r holds the 7 - r blocks (r,r+1)..(r,7) */
+#define SN_CELLK_OFFIDX(a, b) ((uint32_t)(a) * 7u - ((uint32_t)(a) * ((uint32_t)(a) - 1u)) / 2u + (uint32_t)(b) - (uint32_t)(a) - 1u)
 #define SN_ELEM_LIMIT(R)   (R)
 #define SN_CELL_BLOCKS      36
 #define SN_ELEM_EMBED       8

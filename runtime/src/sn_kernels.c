@@ -4,38 +4,78 @@
 #include "sn_kernels.h"
 #include "sn_instance.h"
 
-#if defined(SN_KERNELS_SCALAR)
-
+/* Block (a,b), a <= b: float, a pointer to its 9 stored reals; fixed, the 9
+ * decoded int32 entries (sn_k_blk). ENT(B, k) reads entry k. */
+#if defined(SN_FLOAT)
+typedef const unsigned char *blk_t;
+#define BLK_GET(K, a, b, B) ((B) = (K) + (size_t)SN_K_BLK(a, b) * RB)
+#define ENT(B, k) rd_real(B, k)
+#else
+typedef sn_q blk_t[9];
+#define BLK_GET(K, a, b, B) sn_k_blk(K, a, b, B)
+#define ENT(B, k) ((B)[k])
+#endif
 /* Overflow freedom without clamps (fixed): entries |e| <= 2^27 (validator),
  * operands |x| <= 2^28 (every sn_q is clamped), so one block row is < 3*2^55. */
-SN_INLINE void blk_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
-    l[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 1), e[1]) + sn_mul(rd_real(b, 2), e[2]);
-    l[1] += sn_mul(rd_real(b, 3), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 5), e[2]);
-    l[2] += sn_mul(rd_real(b, 6), e[0]) + sn_mul(rd_real(b, 7), e[1]) + sn_mul(rd_real(b, 8), e[2]);
-}
+#define BLK_ROW(l, B, e) do { \
+    (l)[0] += sn_mul(ENT(B, 0), (e)[0]) + sn_mul(ENT(B, 1), (e)[1]) + sn_mul(ENT(B, 2), (e)[2]); \
+    (l)[1] += sn_mul(ENT(B, 3), (e)[0]) + sn_mul(ENT(B, 4), (e)[1]) + sn_mul(ENT(B, 5), (e)[2]); \
+    (l)[2] += sn_mul(ENT(B, 6), (e)[0]) + sn_mul(ENT(B, 7), (e)[1]) + sn_mul(ENT(B, 8), (e)[2]); \
+} while (0)
 /* acc += B^T e (scatter of the transposed block) */
-SN_INLINE void blk_mac_t(sn_acc acc[3], const unsigned char *b, const sn_q e[3]) {
-    acc[0] += sn_mul(rd_real(b, 0), e[0]) + sn_mul(rd_real(b, 3), e[1]) + sn_mul(rd_real(b, 6), e[2]);
-    acc[1] += sn_mul(rd_real(b, 1), e[0]) + sn_mul(rd_real(b, 4), e[1]) + sn_mul(rd_real(b, 7), e[2]);
-    acc[2] += sn_mul(rd_real(b, 2), e[0]) + sn_mul(rd_real(b, 5), e[1]) + sn_mul(rd_real(b, 8), e[2]);
-}
+#define BLK_MAC_T(acc, B, e) do { \
+    (acc)[0] += sn_mul(ENT(B, 0), (e)[0]) + sn_mul(ENT(B, 3), (e)[1]) + sn_mul(ENT(B, 6), (e)[2]); \
+    (acc)[1] += sn_mul(ENT(B, 1), (e)[0]) + sn_mul(ENT(B, 4), (e)[1]) + sn_mul(ENT(B, 7), (e)[2]); \
+    (acc)[2] += sn_mul(ENT(B, 2), (e)[0]) + sn_mul(ENT(B, 5), (e)[1]) + sn_mul(ENT(B, 8), (e)[2]); \
+} while (0)
 
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
-    uint32_t a, b;
-    for (a = 0; a < 24; a++) l[a] = 0;
-    for (a = 0; a < 8; a++) {
-        blk_row(l + 3 * a, K, u + 3 * a); /* diagonal block (a,a), stored in full */
-        K += 9 * RB;
-        for (b = a + 1; b < 8; b++, K += 9 * RB) {
-            blk_row(l + 3 * a, K, u + 3 * b);
-            blk_mac_t(l + 3 * b, K, u + 3 * a);
+#if defined(SN_KERNELS_SCALAR)
+/* The order of the partial sums is the full product's (rows ascending;
+ * corner b's row takes the transposed blocks of the rows above it, then its
+ * own row), so the float flavour's bits do not depend on the list. */
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    uint32_t i, j;
+    blk_t B;
+    for (i = 0; i < 3 * nf; i++) l[i] = 0;
+    for (i = 0; i < nf; i++) {
+        uint32_t a = fc[i];
+        BLK_GET(K, a, a, B);
+        BLK_ROW(l + 3 * i, B, u + 3 * i); /* diagonal block (a,a) */
+        for (j = i + 1; j < nf; j++) {
+            BLK_GET(K, a, fc[j], B);
+            BLK_ROW(l + 3 * i, B, u + 3 * j);
+            BLK_MAC_T(l + 3 * j, B, u + 3 * i);
         }
     }
-    for (a = 0; a < 24; a++) SN_RANGE(SN_WITHIN(l[a], 60), "cell row beyond 24 * 2^55", l[a]);
+    for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
 }
 
 const char *sn_kernels_name(void) { return "scalar"; }
 #endif /* SN_KERNELS_SCALAR */
+
+#if defined(SN_KERNELS_SCALAR) || defined(SN_KERNELS_M4)
+/* Both right-hand-side products, one decode per block; each output's
+ * partial sums in sn_k_cell_mul's order (the M4 compiles this C to SMLAL). */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]) {
+    uint32_t a, b;
+    blk_t B;
+    for (a = 0; a < 24; a++) l1[a] = l2[a] = 0;
+    for (a = 0; a < 8; a++) {
+        BLK_GET(K, a, a, B);
+        BLK_ROW(l1 + 3 * a, B, u1 + 3 * a);
+        BLK_ROW(l2 + 3 * a, B, u2 + 3 * a);
+        for (b = a + 1; b < 8; b++) {
+            BLK_GET(K, a, b, B);
+            BLK_ROW(l1 + 3 * a, B, u1 + 3 * b);
+            BLK_MAC_T(l1 + 3 * b, B, u1 + 3 * a);
+            BLK_ROW(l2 + 3 * a, B, u2 + 3 * b);
+            BLK_MAC_T(l2 + 3 * b, B, u2 + 3 * a);
+        }
+    }
+    for (a = 0; a < 24; a++)
+        SN_RANGE(SN_WITHIN(l1[a], 60) && SN_WITHIN(l2[a], 60), "cell row beyond 24 * 2^55", l1[a]);
+}
+#endif
 
 #if !defined(SN_FLOAT) && !defined(SN_KERNELS_AVX2) && !defined(SN_KERNELS_NEON)
 /* The bound uses the OR of the magnitudes (same bit length as their

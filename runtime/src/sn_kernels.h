@@ -34,11 +34,65 @@
 #define SN_KERNELS_SCALAR 1
 #endif
 
-/* l = S^_e u for one cell: K the cell's 36 stored upper 3x3 blocks
- * (row-major, little-endian reals, order (0,0),(0,1)..(0,7),(1,1)..(7,7)),
- * used as (a,b) and (b,a); u 8 corner 3-vectors; l 8 corner sums.
+/* Offset (in reals) of stored upper block (a,b), a <= b, of a float
+ * flavour cell's 36: row r holds the 8 - r blocks (r,r)..(r,7). */
+#define SN_K_BLK(a, b) \
+    (9u * ((uint32_t)(a) * 8u - ((uint32_t)(a) * ((uint32_t)(a) - 1u)) / 2u + ((uint32_t)(b) - (uint32_t)(a))))
+
+/* Bytes of one cell's CELLK record in this flavour (sn_format.h). */
+#if defined(SN_FLOAT)
+#define SN_K_CELL_BYTES SN_ELEM_CELLK(SN_FLAVOUR_FLOAT32, SN_REAL_BYTES)
+#else
+#define SN_K_CELL_BYTES SN_CELLK_FIXED_BYTES
+
+/* little-endian int16 (a two's complement reinterpretation, as sn_rd_i32) */
+SN_INLINE int32_t sn_k_rd_i16(const unsigned char *p) {
+#if SN_HOST_LE
+    int16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    int32_t x = (int32_t)sn_rd_u16(p);
+    return x - ((x & 0x8000) << 1);
+#endif
+}
+/* Fixed flavour: block (a,b), a <= b, of a cell's CELLK record as 9 int32
+ * entries (Q frac_S): a diagonal block from its 6 symmetric int32, an
+ * off-diagonal one as m 2^e (|m| <= 2^15 - 1, e <= 12: |entry| < 2^27,
+ * exact; the validator's bounds). Every kernel multiplies these integers. */
+SN_INLINE void sn_k_blk(const unsigned char *K, uint32_t a, uint32_t b, int32_t B[9]) {
+    if (a == b) {
+        const unsigned char *d = K + SN_CELLK_DIAG + 24u * a;
+        B[0] = sn_rd_i32(d);
+        B[4] = sn_rd_i32(d + 4);
+        B[8] = sn_rd_i32(d + 8);
+        B[1] = B[3] = sn_rd_i32(d + 12);
+        B[2] = B[6] = sn_rd_i32(d + 16);
+        B[5] = B[7] = sn_rd_i32(d + 20);
+    } else {
+        const uint32_t o = SN_CELLK_OFFIDX(a, b);
+        const unsigned char *m = K + SN_CELLK_OFF + 18u * o;
+        const int32_t sc = (int32_t)1 << K[SN_CELLK_EXP + o];
+        uint32_t k;
+        for (k = 0; k < 9; k++) B[k] = sn_k_rd_i16(m + 2 * k) * sc; /* m 2^e, |.| < 2^27 */
+    }
+}
+#endif
+
+/* l = S^_e u over a cell's listed corners: K the cell's CELLK record (the
+ * blocks (a,b) used as (a,b) and (b,a)); fc[0..nf-1] the corners, strictly
+ * ascending (nf <= 8); u and l hold nf compacted corner 3-vectors (u_i
+ * belongs to corner fc[i]). The mat-vec lists only free corners: the others'
+ * operand is zero and their rows are dropped, so the 9 nf^2 multiply-adds
+ * give the same sums as the full 24x24 product (fixed: exact zeros; float:
+ * +-0 terms added to the same partial sums in the same order change no bit).
  * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]);
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
+
+/* l1 = S^_e u1 and l2 = S^_e u2 over all 8 corners (the right-hand side's
+ * two products), each block decoded once; the same sums as two calls of
+ * sn_k_cell_mul with the 8 corners listed. */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]);
 
 #if !defined(SN_FLOAT)
 /* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a

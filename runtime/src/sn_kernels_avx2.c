@@ -2,7 +2,7 @@
  * encoded) kernels of sn_kernels.h, fixed flavour.
  *
  * cell_mul: one 3x3 block as 4 int64 lanes (the 4th unused) per column or
- * row: two overlapping unaligned loads (B0..B7, B1..B8), VPERMD puts a
+ * row: the block decoded into two int32 vectors (B0..B7, B1..B8; blk_ld), VPERMD puts a
  * column or row in the even int32 slots, VPMULDQ multiplies the signed low
  * halves exactly into int64 lanes (the odd slots are ignored), VPADDQ
  * accumulates. Block (a,b): L_a += B col_c * u_b[c], L_b += B row_r * u_a[r]
@@ -17,7 +17,31 @@
 #define LD(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
 #define MUL(v, idx, s) _mm256_mul_epi32(_mm256_permutevar8x32_epi32((v), (idx)), (s))
 
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+/* Block (a,b), a <= b, of a fixed CELLK record (sn_format.h) as int32 lanes
+ * v0 = B0..B7 and v1 = B1..B8, the entries of sn_k_blk: a diagonal block
+ * from its 6 symmetric int32 (one load of 8: the 2 past them are the next
+ * block's or the first mantissas, inside the record), an off-diagonal one as
+ * VPMOVSXWD of 8 mantissas and the 9th, shifted left by e (m 2^e < 2^27:
+ * exact in int32). */
+SN_INLINE void blk_ld(const unsigned char *K, uint32_t a, uint32_t b, __m256i *v0, __m256i *v1) {
+    if (a == b) {
+        const __m256i d = LD(K + SN_CELLK_DIAG + 24u * a); /* xx yy zz xy xz yz . . */
+        *v0 = _mm256_permutevar8x32_epi32(d, _mm256_setr_epi32(0, 3, 4, 3, 1, 5, 4, 5));
+        *v1 = _mm256_permutevar8x32_epi32(d, _mm256_setr_epi32(3, 4, 3, 1, 5, 4, 5, 2));
+    } else {
+        const uint32_t o = SN_CELLK_OFFIDX(a, b);
+        const unsigned char *p = K + SN_CELLK_OFF + 18u * o;
+        const int e = K[SN_CELLK_EXP + o];
+        const __m256i m = _mm256_sll_epi32(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)p)),
+                                           _mm_cvtsi32_si128(e));
+        const int32_t b8 = sn_k_rd_i16(p + 16) * ((int32_t)1 << e);
+        *v0 = m;
+        *v1 = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(m, _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 7)),
+                                 _mm256_set1_epi32(b8), 0x80);
+    }
+}
+
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     /* the 4th lane of each index vector reads B0 (a harmless product, never stored) */
     const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0); /* col 0 from B0..B7 */
     const __m256i ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0); /* col 1 from B0..B7, col 2 from B1..B8 */
@@ -25,37 +49,45 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
     const __m256i ir1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0); /* row 1 from B0..B7 */
     const __m256i ir2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0); /* row 2 from B1..B8 */
     __m256i L[8];
-    int a, b;
-    for (a = 0; a < 8; a++) L[a] = _mm256_setzero_si256();
-    for (a = 0; a < 8; a++) {
-        const __m256i ua0 = _mm256_set1_epi32(u[3 * a]), ua1 = _mm256_set1_epi32(u[3 * a + 1]);
-        const __m256i ua2 = _mm256_set1_epi32(u[3 * a + 2]);
-        __m256i v0 = LD(K), v1 = LD(K + 4), la;
-        /* diagonal block (a,a), stored in full: L_a += B u_a */
-        la = _mm256_add_epi64(L[a], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) L[i] = _mm256_setzero_si256();
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        const __m256i ua0 = _mm256_set1_epi32(u[3 * i]), ua1 = _mm256_set1_epi32(u[3 * i + 1]);
+        const __m256i ua2 = _mm256_set1_epi32(u[3 * i + 2]);
+        __m256i v0, v1, la;
+        blk_ld(K, a, a, &v0, &v1);
+        /* diagonal block (a,a): L_a += B u_a */
+        la = _mm256_add_epi64(L[i], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ua0), MUL(v0, ic1, ua1)),
                                                       MUL(v1, ic1, ua2)));
-        K += 9 * 4;
-        for (b = a + 1; b < 8; b++, K += 9 * 4) {
-            const __m256i ub0 = _mm256_set1_epi32(u[3 * b]), ub1 = _mm256_set1_epi32(u[3 * b + 1]);
-            const __m256i ub2 = _mm256_set1_epi32(u[3 * b + 2]);
-            v0 = LD(K);
-            v1 = LD(K + 4);
+        for (j = i + 1; j < nf; j++) {
+            const __m256i ub0 = _mm256_set1_epi32(u[3 * j]), ub1 = _mm256_set1_epi32(u[3 * j + 1]);
+            const __m256i ub2 = _mm256_set1_epi32(u[3 * j + 2]);
+            blk_ld(K, a, fc[j], &v0, &v1);
             la = _mm256_add_epi64(la, _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, ub0), MUL(v0, ic1, ub1)),
                                                         MUL(v1, ic1, ub2)));
-            L[b] = _mm256_add_epi64(L[b], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),
+            L[j] = _mm256_add_epi64(L[j], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ua0), MUL(v0, ir1, ua1)),
                                                             MUL(v1, ir2, ua2)));
         }
-        L[a] = la;
+        L[i] = la;
     }
-    for (a = 0; a < 8; a++) {
+    for (i = 0; i < nf; i++) {
         int64_t t[4];
-        _mm256_storeu_si256((__m256i *)(void *)t, L[a]);
-        l[3 * a] = t[0];
-        l[3 * a + 1] = t[1];
-        l[3 * a + 2] = t[2];
+        _mm256_storeu_si256((__m256i *)(void *)t, L[i]);
+        l[3 * i] = t[0];
+        l[3 * i + 1] = t[1];
+        l[3 * i + 2] = t[2];
         SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60),
                  "cell row beyond 24 * 2^55", t[0]);
     }
+}
+
+/* the right-hand side's two products: two calls (the block decode is a few
+ * vector instructions here) */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]) {
+    static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    sn_k_cell_mul(K, all8, 8, u1, l1);
+    sn_k_cell_mul(K, all8, 8, u2, l2);
 }
 
 /* Block-floating dot product: magnitudes ORed 8 lanes at a time (VPABSD of

@@ -9,47 +9,47 @@
  *   L_a.z  += (B6,B7) . (u_b.x, u_b.y) + B8 u_b.z
  *   L_b.xy += (B0,B1) u_a.x + (B3,B4) u_a.y + (B6,B7) u_a.z   (B^T u_a)
  *   L_b.z  += (B2,B5) . (u_a.x, u_a.y) + B8 u_a.z
- * Exact int32 x int32 -> int64 products (SMLAL), the same sums as the
- * scalar reference in another order (sn_kernels.h, NUMERICS.md). The blob
- * is little-endian and so are these targets (the build refuses otherwise). */
+ * B is the block decoded to int32 (sn_k_blk: int16 mantissa times 2^e, or
+ * the diagonal's 6 int32). Exact int32 x int32 -> int64 products (SMLAL),
+ * the same sums as the scalar reference in another order (sn_kernels.h,
+ * NUMERICS.md). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_NEON)
 #include <arm_neon.h>
 
-#if !SN_HOST_LE
-#error "sn_kernels_neon.c reads blob reals as native int32: little-endian only (build with SIMD=scalar)"
-#endif
-
-void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     int64x2_t xy[8], zz[8];
     int64_t z1[8];
-    int a, b;
-    for (a = 0; a < 8; a++) {
-        xy[a] = vdupq_n_s64(0);
-        zz[a] = vdupq_n_s64(0);
-        z1[a] = 0;
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) {
+        xy[i] = vdupq_n_s64(0);
+        zz[i] = vdupq_n_s64(0);
+        z1[i] = 0;
     }
-    for (a = 0; a < 8; a++) {
-        const int32_t *B = (const int32_t *)(const void *)K;
-        const int32_t ua0 = u[3 * a], ua1 = u[3 * a + 1], ua2 = u[3 * a + 2];
-        const int32x2_t ua01 = vld1_s32(u + 3 * a);
-        int32x2x3_t c = vld3_s32(B);
-        int32x2_t r2 = vld1_s32(B + 6);
-        int64x2_t axy = xy[a], az = zz[a];
-        int64_t az1 = z1[a];
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        int32_t B[9], Bb[9]; /* the blocks decoded (sn_k_blk) */
+        const int32_t ua0 = u[3 * i], ua1 = u[3 * i + 1], ua2 = u[3 * i + 2];
+        const int32x2_t ua01 = vld1_s32(u + 3 * i);
+        int32x2x3_t c;
+        int32x2_t r2;
+        sn_k_blk(K, a, a, B);
+        c = vld3_s32(B);
+        r2 = vld1_s32(B + 6);
+        int64x2_t axy = xy[i], az = zz[i];
+        int64_t az1 = z1[i];
         /* diagonal block (a,a), stored in full: L_a += B u_a */
         axy = vmlal_n_s32(axy, c.val[0], ua0);
         axy = vmlal_n_s32(axy, c.val[1], ua1);
         axy = vmlal_n_s32(axy, c.val[2], ua2);
         az = vmlal_s32(az, r2, ua01);
         az1 += (int64_t)B[8] * ua2;
-        K += 9 * 4;
-        for (b = a + 1; b < 8; b++, K += 9 * 4) {
-            const int32_t *Bb = (const int32_t *)(const void *)K;
-            const int32x2_t ub01 = vld1_s32(u + 3 * b);
-            const int32_t ub2 = u[3 * b + 2];
+        for (j = i + 1; j < nf; j++) {
+            const int32x2_t ub01 = vld1_s32(u + 3 * j);
+            const int32_t ub2 = u[3 * j + 2];
+            sn_k_blk(K, a, fc[j], Bb);
             c = vld3_s32(Bb);
             r2 = vld1_s32(Bb + 6);
             axy = vmlal_n_s32(axy, c.val[0], vget_lane_s32(ub01, 0));
@@ -57,23 +57,31 @@ void sn_k_cell_mul(const unsigned char *K, const sn_q u[24], sn_acc l[24]) {
             axy = vmlal_n_s32(axy, c.val[2], ub2);
             az = vmlal_s32(az, r2, ub01);
             az1 += (int64_t)Bb[8] * ub2;
-            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb), ua0);
-            xy[b] = vmlal_n_s32(xy[b], vld1_s32(Bb + 3), ua1);
-            xy[b] = vmlal_n_s32(xy[b], r2, ua2);
-            zz[b] = vmlal_s32(zz[b], c.val[2], ua01);
-            z1[b] += (int64_t)Bb[8] * ua2;
+            xy[j] = vmlal_n_s32(xy[j], vld1_s32(Bb), ua0);
+            xy[j] = vmlal_n_s32(xy[j], vld1_s32(Bb + 3), ua1);
+            xy[j] = vmlal_n_s32(xy[j], r2, ua2);
+            zz[j] = vmlal_s32(zz[j], c.val[2], ua01);
+            z1[j] += (int64_t)Bb[8] * ua2;
         }
-        xy[a] = axy;
-        zz[a] = az;
-        z1[a] = az1;
+        xy[i] = axy;
+        zz[i] = az;
+        z1[i] = az1;
     }
-    for (a = 0; a < 8; a++) {
-        l[3 * a] = vgetq_lane_s64(xy[a], 0);
-        l[3 * a + 1] = vgetq_lane_s64(xy[a], 1);
-        l[3 * a + 2] = vgetq_lane_s64(zz[a], 0) + vgetq_lane_s64(zz[a], 1) + z1[a];
-        SN_RANGE(SN_WITHIN(l[3 * a], 60) && SN_WITHIN(l[3 * a + 1], 60) && SN_WITHIN(l[3 * a + 2], 60),
-                 "cell row beyond 24 * 2^55", l[3 * a + 2]);
+    for (i = 0; i < nf; i++) {
+        l[3 * i] = vgetq_lane_s64(xy[i], 0);
+        l[3 * i + 1] = vgetq_lane_s64(xy[i], 1);
+        l[3 * i + 2] = vgetq_lane_s64(zz[i], 0) + vgetq_lane_s64(zz[i], 1) + z1[i];
+        SN_RANGE(SN_WITHIN(l[3 * i], 60) && SN_WITHIN(l[3 * i + 1], 60) && SN_WITHIN(l[3 * i + 2], 60),
+                 "cell row beyond 24 * 2^55", l[3 * i + 2]);
     }
+}
+
+/* the right-hand side's two products: two calls (the block decode is a few
+ * vector instructions here) */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]) {
+    static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    sn_k_cell_mul(K, all8, 8, u1, l1);
+    sn_k_cell_mul(K, all8, 8, u2, l2);
 }
 
 /* Block-floating dot product: magnitudes ORed 4 lanes at a time (VABS of a

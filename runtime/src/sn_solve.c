@@ -90,7 +90,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
     uint32_t e, k, c, nF = v->nF;
     uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
     acc_zero(acc, 3 * nF);
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
@@ -111,8 +111,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul(K, d, ld);
-        sn_k_cell_mul(K, uu, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu);
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
@@ -227,7 +226,11 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
 }
 
 
-/* q = A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d  (free rows) */
+/* q = A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d  (free rows).
+ * The cell product runs over the cell's free corners only (9 f^2 multiply-adds
+ * for f free corners instead of 576): a skeleton corner's operand is zero
+ * and its rows are dropped, so the sums are the full product's. The list is
+ * read from the blob's corner indices (fixed per blob: constant cost). */
 static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
@@ -237,23 +240,26 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     uint32_t e, i, k, c, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
-    for (e = 0; e < v->nC; e++, K += SN_ELEM_CELLK(RB)) {
+    for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         sn_q u[24];
         sn_acc l[24];
+        uint8_t fc[8];
+        uint32_t vi[8], nf = 0;
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            if (a < nF) sn_rot_t(R, d + 3 * a, u + 3 * k, sat);
-            else u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0; /* skeleton: no unknown */
+            if (a >= nF) continue; /* skeleton: no unknown */
+            sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
         }
-        sn_k_cell_mul(K, u, l);
-        for (k = 0; k < 8; k++) {
-            uint32_t a = sn_rd_u16(cl + 2 * k);
+        if (nf == 0) continue;
+        sn_k_cell_mul(K, fc, nf, u, l);
+        for (k = 0; k < nf; k++) {
+            uint32_t a = vi[k];
             sn_q t[3];
-            int sh;
-            if (a >= nF) continue;
-            sh = v->frac_S - SN_KREL(kk[a]);
+            int sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
             rot_acc(acc + 3 * a, R, t);
         }

@@ -336,11 +336,35 @@ static void set_max(unsigned char *p, uint32_t n, int pattern) {
     }
 }
 static uint32_t sec_n(const unsigned char *b, int k) { return rd32(b + SN_H_SECTIONS + 16 * k + 4) / 4; }
+/* CELLK at the validator's bounds: float, every real +-2^27 as set_max;
+ * fixed (format 6.0), the diagonal int32 at +-2^27 and every off-diagonal
+ * entry at +-(2^15 - 1) 2^12 (the largest mantissa, the largest exponent);
+ * pattern 3: every entry negative */
+static void cellk_max(unsigned char *b, int pattern) {
+    unsigned char *p = b + tb_sec(b, SN_SEC_CELLK);
+#if defined(SN_FLOAT)
+    uint32_t i, n = sec_n(b, SN_SEC_CELLK);
+    if (pattern < 3) set_max(p, n, pattern);
+    else for (i = 0; i < n; i++) tb_real(p + 4 * (size_t)i, -134217728.0, 0);
+#else
+    uint32_t c, i, x = 54321u, nC = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLK + 8);
+    for (c = 0; c < nC; c++) {
+        unsigned char *ck = p + (size_t)c * SN_CELLK_FIXED_BYTES;
+        if (pattern < 3) set_max(ck + SN_CELLK_DIAG, 48, pattern);
+        else for (i = 0; i < 48; i++) tb_u32(ck + SN_CELLK_DIAG + 4 * i, 0xF8000000u);
+        for (i = 0; i < 28 * 9; i++) {
+            int neg = pattern == 3 ? 1 : pattern == 1 ? (int)(i & 1u) : pattern == 2 ? (int)((x = x * 1103515245u + 12345u) >> 31) : 0;
+            tb_u16(ck + SN_CELLK_OFF + 2 * i, neg ? 0x8001u : 0x7FFFu);
+        }
+        for (i = 0; i < 28; i++) ck[SN_CELLK_EXP + i] = SN_CELLK_EXP_MAX;
+    }
+#endif
+}
 
 static size_t craft_cellk(int pattern, int frac) {
     unsigned char *b = g_craft.b;
     uint32_t total = tb_build(b, sizeof g_craft.b, 0);
-    set_max(b + tb_sec(b, SN_SEC_CELLK), sec_n(b, SN_SEC_CELLK), pattern);
+    cellk_max(b, pattern);
     b[SN_H_FRAC_S] = (unsigned char)frac;
     tb_u16(b + SN_H_CG_DEFAULT, 256);
     tb_u16(b + SN_H_CG_MAX, 256);
@@ -358,7 +382,9 @@ static size_t craft_all_max(void) {
     uint32_t total = tb_build(b, sizeof g_craft.b, 0);
     static const int secs[5] = {SN_SEC_MDIAG, SN_SEC_PRECOND, SN_SEC_MLUMP, SN_SEC_MOFF, SN_SEC_CELLK};
     int k;
-    for (k = 0; k < 5; k++) set_max(b + tb_sec(b, secs[k]), sec_n(b, secs[k]), k & 1 ? 2 : 1);
+    for (k = 0; k < 5; k++)
+        if (secs[k] == SN_SEC_CELLK) cellk_max(b, 1);
+        else set_max(b + tb_sec(b, secs[k]), sec_n(b, secs[k]), k & 1 ? 2 : 1);
     b[SN_H_FRAC_S] = b[SN_H_FRAC_M] = b[SN_H_FRAC_P] = 0;
     tb_real(b + SN_H_REALS + 4 * SN_R_A1, 16.0, SN_Q_COEF);
     tb_real(b + SN_H_REALS + 4 * SN_R_B1, 16.0, SN_Q_COEF);
@@ -531,6 +557,7 @@ static unsigned char *secp(unsigned char *b, int k) { return b + tb_sec(b, k); }
 /* every real of section k at +-2^27 by sign pattern (0 all +, 1 alternating, 2 random, 3 all -) */
 static void sec_max(unsigned char *b, int k, int pattern) {
     uint32_t i, n = sec_n(b, k);
+    if (k == SN_SEC_CELLK) { cellk_max(b, pattern); return; }
     if (pattern < 3) { set_max(secp(b, k), n, pattern); return; }
     for (i = 0; i < n; i++) put(secp(b, k) + 4 * i, -(int32_t)0x08000000, -E27);
 }

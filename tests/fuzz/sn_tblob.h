@@ -90,6 +90,39 @@ static void tb_real(unsigned char *p, double v, int q) {
 #endif
 }
 
+/* one cell's CELLK record from its 24x24 stiffness K (Q TB_FRAC): float,
+ * 36 upper blocks of reals; fixed (format 6.0), diagonal blocks as 6
+ * symmetric int32, off-diagonal ones as int16 mantissas with the smallest
+ * exponent that fits (sn_format.h) */
+static void tb_cellk(unsigned char *ck, double K[24][24]) {
+    int a, bb, d, e = 0;
+#if defined(SN_FLOAT)
+    for (a = 0; a < 8; a++)
+        for (bb = a; bb < 8; bb++, e++)
+            for (d = 0; d < 9; d++) tb_real(ck + (9 * e + d) * 4, K[3 * a + d / 3][3 * bb + d % 3], TB_FRAC);
+#else
+    static const int s6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    (void)e;
+    for (a = 0; a < 8; a++)
+        for (d = 0; d < 6; d++)
+            tb_real(ck + SN_CELLK_DIAG + 24 * a + 4 * d, K[3 * a + s6[d][0]][3 * a + s6[d][1]], TB_FRAC);
+    for (a = 0; a < 8; a++)
+        for (bb = a + 1; bb < 8; bb++) {
+            uint32_t o = SN_CELLK_OFFIDX(a, bb);
+            double mx = 0;
+            int x = 0;
+            for (d = 0; d < 9; d++) mx = fmax(mx, fabs(ldexp(K[3 * a + d / 3][3 * bb + d % 3], TB_FRAC)));
+            while (x < SN_CELLK_EXP_MAX && floor(ldexp(mx, -x) + 0.5) > SN_CELLK_M_MAX) x++;
+            ck[SN_CELLK_EXP + o] = (unsigned char)x;
+            for (d = 0; d < 9; d++) {
+                double m = floor(ldexp(K[3 * a + d / 3][3 * bb + d % 3], TB_FRAC - x) + 0.5);
+                m = fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, m));
+                tb_u16(ck + SN_CELLK_OFF + 18 * o + 2 * (uint32_t)d, (uint32_t)(uint16_t)(int16_t)m);
+            }
+        }
+#endif
+}
+
 static uint32_t tb_crc32(const unsigned char *p, uint32_t n) {
     uint32_t c = 0xFFFFFFFFu, i;
     int k;
@@ -120,7 +153,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     const double a1 = 1.0 / 60.0, b1 = 0.06, k = 0.05, cell = 0.5, h = 1.0 / 60.0;
     int corner[TB_NC][8];
     uint32_t off, cnt[SN_SEC_COUNT], elem[SN_SEC_COUNT], secoff[SN_SEC_COUNT];
-    int c, i, j, a, bb, d, e, sec, nnz = 0;
+    int c, i, j, a, bb, d, sec, nnz = 0;
     memset(b, 0, cap);
     memset(M, 0, sizeof M);
     memset(K, 0, sizeof K);
@@ -173,7 +206,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_MOFF] = (uint32_t)nnz; elem[SN_SEC_MOFF] = (uint32_t)SN_ELEM_MOFF(R);
     cnt[SN_SEC_CELLS] = TB_NC;        elem[SN_SEC_CELLS] = SN_ELEM_CELLS;
     cnt[SN_SEC_CFRAMES] = TB_NC;      elem[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
-    cnt[SN_SEC_CELLK] = TB_NC;        elem[SN_SEC_CELLK] = (uint32_t)SN_ELEM_CELLK(R);
+    cnt[SN_SEC_CELLK] = TB_NC;        elem[SN_SEC_CELLK] = (uint32_t)SN_ELEM_CELLK(SN_FLAVOUR, R);
     cnt[SN_SEC_LIMIT] = TB_NF;        elem[SN_SEC_LIMIT] = (uint32_t)SN_ELEM_LIMIT(R);
     cnt[SN_SEC_EMBED] = TB_NS;        elem[SN_SEC_EMBED] = SN_ELEM_EMBED;
     cnt[SN_SEC_TRIS] = TB_NT;         elem[SN_SEC_TRIS] = SN_ELEM_TRIS;
@@ -250,15 +283,12 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     }
     for (c = 0; c < TB_NC; c++) {
         unsigned char *f = b + secoff[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * c;
-        unsigned char *ck = b + secoff[SN_SEC_CELLK] + (uint32_t)SN_ELEM_CELLK(R) * (uint32_t)c;
+        unsigned char *ck = b + secoff[SN_SEC_CELLK] + (uint32_t)SN_ELEM_CELLK(SN_FLAVOUR, R) * (uint32_t)c;
         for (a = 0; a < 8; a++) tb_u16(b + secoff[SN_SEC_CELLS] + 16 * c + 2 * a, (uint32_t)corner[c][a]);
         f[0] = 0;
         f[1] = 1;
         tb_u16(f + 2, (uint32_t)((c + 0.5) * cell * 32768.0 + 0.5)); /* cell centre x */
-        e = 0;
-        for (a = 0; a < 8; a++)
-            for (bb = a; bb < 8; bb++, e++)
-                for (d = 0; d < 9; d++) tb_real(ck + (9 * e + d) * R, K[c][3 * a + d / 3][3 * bb + d % 3], TB_FRAC);
+        tb_cellk(ck, K[c]);
     }
     {
         static const uint16_t emb[TB_NS][4] = {

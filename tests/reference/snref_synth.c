@@ -252,7 +252,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_MOFF] = nnz; el[SN_SEC_MOFF] = SN_ELEM_MOFF(R);
         cnt[SN_SEC_CELLS] = nC; el[SN_SEC_CELLS] = SN_ELEM_CELLS;
         cnt[SN_SEC_CFRAMES] = nC; el[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
-        cnt[SN_SEC_CELLK] = nC; el[SN_SEC_CELLK] = SN_ELEM_CELLK(R);
+        cnt[SN_SEC_CELLK] = nC; el[SN_SEC_CELLK] = SN_ELEM_CELLK(SN_FLAVOUR_FLOAT32, R);
         cnt[SN_SEC_LIMIT] = bx->limit > 0 ? nF : 0; el[SN_SEC_LIMIT] = SN_ELEM_LIMIT(R);
         cnt[SN_SEC_EMBED] = nV; el[SN_SEC_EMBED] = SN_ELEM_EMBED;   /* surface = every lattice vertex */
         cnt[SN_SEC_TRIS] = 0; el[SN_SEC_TRIS] = SN_ELEM_TRIS;
@@ -371,7 +371,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         {
             unsigned cx, cy, cz, a, c = 0;
             for (cz = 0; cz < bx->nz; cz++) for (cy = 0; cy < bx->ny; cy++) for (cx = 0; cx < bx->nx; cx++, c++) {
-                size_t cf = off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * c, ck = off[SN_SEC_CELLK] + SN_ELEM_CELLK(R) * c;
+                size_t cf = off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * c, ck = off[SN_SEC_CELLK] + SN_ELEM_CELLK(SN_FLAVOUR_FLOAT32, R) * c;
                 unsigned b2, blk = 0, q;
                 for (a = 0; a < 8; a++)
                     w_u16(&w, off[SN_SEC_CELLS] + 16 * c + 2 * a,

@@ -297,7 +297,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SEC_CNT(SN_SEC_LEVEL_BLOB), SEC_CNT(SN_SEC_LEVEL_UP), SEC_CNT(SN_SEC_LEVEL_DOWN) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
-            SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(R),
+            SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(m->flavour, R),
             SN_ELEM_LIMIT(R), SN_ELEM_EMBED, SN_ELEM_TRIS, SN_ELEM_CONTROLS(R), SN_ELEM_RIGS,
             SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R), SN_ELEM_SHARES(R), SN_ELEM_VSHARE,
             SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R), SN_ELEM_CONSTRAINTS,
@@ -371,7 +371,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
     for (i = 0; i < m->nnz; i++) m->moff[i] = rd_real(&r, d + sec_off[SN_SEC_MOFF] + i * R, (int)m->frac_M);
     for (i = 0; i < m->nC; i++) {
         const unsigned char *cf = d + sec_off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * i;
-        const unsigned char *ck = d + sec_off[SN_SEC_CELLK] + (size_t)SN_ELEM_CELLK(R) * i;
+        const unsigned char *ck = d + sec_off[SN_SEC_CELLK] + (size_t)SN_ELEM_CELLK(m->flavour, R) * i;
         double *K = m->cellk + (size_t)576 * i;
         unsigned a, b, blk = 0, q;
         for (a = 0; a < 8; a++) {
@@ -385,7 +385,18 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         for (a = 0; a < 8; a++)
             for (b = a; b < 8; b++, blk++)
                 for (q = 0; q < 9; q++) {
-                    double x = rd_real(&r, ck + (9 * blk + q) * R, (int)m->frac_S);
+                    double x;
+                    if (m->flavour != SN_FLAVOUR_FIXED) x = rd_real(&r, ck + (9 * blk + q) * R, (int)m->frac_S);
+                    else if (a == b) { /* format 6.0 fixed CELLK: diagonal int32 xx yy zz xy xz yz */
+                        static const unsigned s6[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2};
+                        x = rd_real(&r, ck + SN_CELLK_DIAG + 24 * a + 4 * s6[q], (int)m->frac_S);
+                    } else { /* off-diagonal int16 mantissa times 2^e */
+                        unsigned o = SN_CELLK_OFFIDX(a, b), e = ck[SN_CELLK_EXP + o];
+                        int mm = (int)rd_u16(ck + SN_CELLK_OFF + 18 * o + 2 * q);
+                        if (mm >= 32768) mm -= 65536;
+                        if (e > SN_CELLK_EXP_MAX || mm < -SN_CELLK_M_MAX) FAIL("cell %u block (%u,%u) mantissa/exponent", i, a, b);
+                        x = ldexp((double)mm, (int)e - (int)m->frac_S);
+                    }
                     K[24 * (3 * a + q / 3) + 3 * b + q % 3] = x;
                     K[24 * (3 * b + q % 3) + 3 * a + q / 3] = x;
                 }

@@ -1,0 +1,146 @@
+/* test_runtime_kernels.c -- the cell product kernels of this build's path
+ * (runtime/src/sn_kernels.h: scalar, AVX2, NEON or M4) against an
+ * independent reference written from BLOB.md's CELLK layout, not from
+ * sn_format.h's offsets or the runtime's decoder:
+ *   fixed: random format-6.0 records (int32 symmetric diagonal blocks up to
+ *   +-2^27, int16 mantissas up to +-(2^15 - 1) with exponents 0..12, some
+ *   records entirely at the bounds), operands up to +-2^28; the reference
+ *   expands the record into the full 24x24 matrix of integers (in double:
+ *   every entry < 2^27, exact) and sums the products exactly in 128-bit
+ *   halves. Tolerance 0: the kernel's sums are exact integer sums.
+ *   float: random float32 records; reference in double; tolerance 24 terms
+ *   x |entry| |operand| x 2^-23 (float accumulation of 24 products).
+ * Free-corner lists: the mat-vec's product over a random subset of corners
+ * equals the full product's rows with zero operands elsewhere (fixed:
+ * exactly; float: bit for bit), and sn_k_cell_mul2 equals two calls. */
+#include <stdint.h>
+#include <string.h>
+#include "sn_test.h"
+#include "sn_kernels.h"
+
+static uint32_t rng = 12345u;
+static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
+static int32_t rnd_in(int32_t lim) { return (int32_t)((int64_t)(rnd32() % (2u * (uint32_t)lim + 1u)) - lim); }
+
+static void put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+
+#if defined(SN_FLOAT)
+#define REC 1296
+/* random record, full matrix in S */
+static void make_rec(unsigned char *K, double S[24][24], int extreme) {
+    int a, b, i, j, n = 0;
+    for (a = 0; a < 8; a++)
+        for (b = a; b < 8; b++, n++)
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) {
+                    float f = extreme ? (rnd32() & 1 ? 1.0e3f : -1.0e3f) : (float)rnd_in(1 << 20) / 1024.0f;
+                    uint32_t u;
+                    memcpy(&u, &f, 4);
+                    put32(K + 4 * (9 * n + 3 * i + j), u);
+                    S[3 * a + i][3 * b + j] = f; /* a diagonal block is used as stored (in full) */
+                    if (b != a) S[3 * b + j][3 * a + i] = f;
+                }
+}
+#else
+#define REC 724
+/* BLOB.md format 6.0: i32 diag[8][6] (xx yy zz xy xz yz) at 0, i16 m[28][9]
+ * at 192, u8 e[28] at 696; off-diagonal block (a,b) number 7a - a(a-1)/2 + b - a - 1 */
+static void make_rec(unsigned char *K, double S[24][24], int extreme) {
+    static const int s6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    int a, b, i, k, o = 0;
+    for (a = 0; a < 8; a++)
+        for (k = 0; k < 6; k++) {
+            int32_t v = extreme ? (rnd32() & 1 ? (1 << 27) : -(1 << 27)) : rnd_in(1 << 27);
+            put32(K + 24 * a + 4 * k, (uint32_t)v);
+            S[3 * a + s6[k][0]][3 * a + s6[k][1]] = S[3 * a + s6[k][1]][3 * a + s6[k][0]] = v;
+        }
+    for (a = 0; a < 8; a++)
+        for (b = a + 1; b < 8; b++, o++) {
+            int e = extreme ? 12 : (int)(rnd32() % 13u);
+            K[696 + o] = (unsigned char)e;
+            for (i = 0; i < 9; i++) {
+                int32_t m = extreme ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                K[192 + 18 * o + 2 * i] = (unsigned char)u;
+                K[192 + 18 * o + 2 * i + 1] = (unsigned char)(u >> 8);
+                S[3 * a + i / 3][3 * b + i % 3] = S[3 * b + i % 3][3 * a + i / 3] = ldexp((double)m, e);
+            }
+        }
+}
+#endif
+
+/* reference row r of S u; fixed: exact, the operand split into a high
+ * part (>> 13) and a low one so that every product and partial sum is an
+ * integer below 2^53 (exact in double) */
+static int row_ok(double S[24][24], const sn_q *u, int r, sn_acc got) {
+#if defined(SN_FLOAT)
+    double ref = 0, mag = 0;
+    int c;
+    for (c = 0; c < 24; c++) { ref += S[r][c] * (double)u[c]; mag += fabs(S[r][c] * (double)u[c]); }
+    return fabs((double)got - ref) <= 24.0 * mag * ldexp(1.0, -23) + 1e-30;
+#else
+    /* products |S u| < 2^55: sum the high and low 26-bit halves of u separately (each partial sum < 2^53 exact) */
+    double hi = 0, lo = 0;
+    int c;
+    int64_t ref;
+    for (c = 0; c < 24; c++) {
+        int64_t uu = u[c], uh = uu >= 0 ? uu >> 13 : -((-uu) >> 13), ul = uu - uh * 8192;
+        hi += S[r][c] * (double)uh; /* < 2^27 * 2^15 * 24 < 2^47 */
+        lo += S[r][c] * (double)ul; /* < 2^27 * 2^13 * 24 < 2^45 */
+    }
+    ref = (int64_t)hi * 8192 + (int64_t)lo;
+    return ref == got;
+#endif
+}
+
+int main(void) {
+    static unsigned char K[REC];
+    double S[24][24];
+    int t, bad_full = 0, bad_list = 0, bad_two = 0, lists = 0;
+    printf("cell product kernels (%s flavour, path %s)\n", SN_FLAVOUR ? "float" : "fixed", sn_kernels_name());
+    rng = (uint32_t)T_SEED();
+    for (t = 0; t < 4000; t++) {
+        static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+        sn_q u[24], u2[24], uc[24], uz[24];
+        sn_acc l[24], l2[24], lm1[24], lm2[24], lc[24], lz[24];
+        uint8_t fc[8];
+        uint32_t nf = 0, k, c, mask = rnd32() & 0xFFu;
+        int extreme = t % 16 == 0, r;
+        make_rec(K, S, extreme);
+        for (k = 0; k < 24; k++) {
+#if defined(SN_FLOAT)
+            u[k] = (float)rnd_in(1 << 20) / 256.0f;
+            u2[k] = (float)rnd_in(1 << 20) / 256.0f;
+#else
+            u[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            u2[k] = rnd_in(1 << 28);
+#endif
+        }
+        sn_k_cell_mul(K, all8, 8, u, l);
+        for (r = 0; r < 24; r++) bad_full += !row_ok(S, u, r, l[r]);
+        /* two products at once = two calls */
+        sn_k_cell_mul2(K, u, u2, lm1, lm2);
+        sn_k_cell_mul(K, all8, 8, u2, l2);
+        bad_two += memcmp(lm1, l, sizeof l) != 0 || memcmp(lm2, l2, sizeof l2) != 0;
+        /* listed corners = the full product with zero operands at the others */
+        for (k = 0; k < 8; k++) {
+            if (mask >> k & 1u) {
+                fc[nf] = (uint8_t)k;
+                for (c = 0; c < 3; c++) uc[3 * nf + c] = uz[3 * k + c] = u[3 * k + c];
+                nf++;
+            } else
+                for (c = 0; c < 3; c++) uz[3 * k + c] = 0;
+        }
+        if (nf == 0) continue;
+        lists++;
+        sn_k_cell_mul(K, fc, nf, uc, lc);
+        sn_k_cell_mul(K, all8, 8, uz, lz);
+        for (k = 0; k < nf; k++)
+            for (c = 0; c < 3; c++) bad_list += memcmp(&lc[3 * k + c], &lz[3 * fc[k] + c], sizeof lc[0]) != 0;
+    }
+    T_CHECK(bad_full == 0, "%d of 96000 rows of the full product off the reference", bad_full);
+    T_CHECK(bad_two == 0, "sn_k_cell_mul2 differs from two calls in %d of 4000 cells", bad_two);
+    T_CHECK(bad_list == 0, "free-corner product differs from the zero-padded full product in %d rows (%d lists)", bad_list, lists);
+    T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
+    return T_END();
+}
