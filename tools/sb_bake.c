@@ -9,7 +9,7 @@ static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "F
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
-                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR"};
+                                             "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR", "ICHOL"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 5.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 6.0).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -15,7 +15,7 @@
 #define SN_MAGIC1 'N'
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
-#define SN_FORMAT_MAJOR 5
+#define SN_FORMAT_MAJOR 6
 #define SN_FORMAT_MINOR 0
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
@@ -150,6 +150,12 @@ enum {
                             unused tail entries SN_CREASE_NONE; every entry < nS */
     SN_SEC_CREASE_TNBR,  /* nS * nbr_t x u16: row s = the triangles touching a vertex of VNBR row s, increasing, unused tail
                             entries SN_CREASE_NONE; every entry < nT */
+    /* ---- IC(0) preconditioner (issue 15 item 3, runtime/SOLVER_STUDY.md §1), format 6.0; count 0 or nFF ---- */
+    SN_SEC_ICHOL,        /* nFF x {i16 m[9], u8 frac, u8 0}: the unit upper factor U = (I + L^)^T - I of the rest-frame
+                            A0 = (1+a1) M^ + (1+b1) sum_e S^_e ~ (I + L^) D (I + L^)^T, block U_ji = L^_ij^T (row j < column i),
+                            entry [3a+b] = m[3a+b] 2^-frac, |m| <= 2^15-1, frac <= SN_ICHOL_FRAC_MAX; one element per
+                            free-free entry of the mass pattern (COLS j < nF), in ROWPTR/COLS order, skeleton columns skipped;
+                            nFF = those entries' count. With ICHOL, PRECOND holds D^-1 (same format); count 0: block Jacobi */
     SN_SEC_COUNT
 };
 
@@ -186,6 +192,8 @@ enum {
 #define SN_ELEM_CREASE_PAIRS 4
 #define SN_ELEM_CREASE_VNBR  2
 #define SN_ELEM_CREASE_TNBR  2
+#define SN_ELEM_ICHOL       20   /* every flavour: int16 mantissas, one exponent per block */
+#define SN_ICHOL_FRAC_MAX   47   /* forward sweep shift frac + k_j - k_i <= 62 (k <= 15) */
 
 /* self-collision near creases (seed 003 §3.4; sn_crease.c, NUMERICS.md "Self-collision") */
 #define SN_CREASE_MAX_LIST   256u   /* collision list C entries (eq. 8) */
@@ -286,7 +294,7 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * writers (the host tool, the tests' blob writers). The runtime's layout
  * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
  * the header to equal it, and test_runtime_blob checks this macro against it. */
-#define SN_INSTANCE_HDR_BYTES 768u /* the instance header before the arrays */
+#define SN_INSTANCE_HDR_BYTES 784u /* the instance header before the arrays (format 6.0: + the ICHOL section pointer) */
 /* nFrc: force slots (header MAX_FORCES); segB: the extra state bytes before
  * the constraint state: the segment state, the sum over meshes of
  * SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts), plus the

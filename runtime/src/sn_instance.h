@@ -157,6 +157,7 @@ int64_t int_to_pub64(const sn_ihdr *h, sn_q v);
 void sn_frames(sn_ihdr *h, uint32_t *sat);          /* 1-2: joints, origin, vertex and cell frames */
 void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, first-pose placement */
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
+void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat); /* 6: z = C r, block Jacobi or IC(0) (sn_precond.c) */
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
 void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat); /* free vertex i carried rigidly by its frame (R x_rest + c; sn_health.c) */
 void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */
