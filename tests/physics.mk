@@ -272,3 +272,13 @@ ichol-counts: $(BUILD)/tests/ichol_count $(EX)/cow.blob $(EX)/limb.blob $(EX)/be
 	$(BUILD)/tests/ichol_count $(EX)/cow_jacobi.blob $(EX)/cow.blob 10 tools/examples/cow/trot.clip tools/examples/cow/head_turn.clip
 	$(BUILD)/tests/ichol_count $(EX)/limb_jacobi.blob $(EX)/limb.blob 16 tools/examples/limb/flex.clip
 	$(BUILD)/tests/ichol_count $(EX)/beast_jacobi.blob $(EX)/beast.blob 10 tools/examples/beast/walk.clip tools/examples/beast/head_turn.clip
+
+# The IC(0) apply against a double solve with the same factor (issue 15 item 3):
+# runtime internals (sn_precond) and the reference's decoded ICHOL.
+$(BUILD)/tests/test_runtime_precond: tests/test_runtime_precond.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED) $(EX)/cow.blob $(EX)/beast.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_precond_float: tests/test_runtime_precond.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(EX)/cow_float.blob $(EX)/beast_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_precond $(BUILD)/tests/test_runtime_precond_float
