@@ -1,6 +1,6 @@
 /* test_physics_runtime.c -- the runtime (this build's flavour) against the
  * double-precision reference over 600 steps of a deterministic cow animation
- * (and the limb): max surface-vertex error relative to the maximum elastic
+ * (and the limb, and the beast walking): max surface-vertex error relative to the maximum elastic
  * displacement (deformed surface minus the surface of the rigidly framed
  * lattice, R_i x_i + c_i). Separates
  *   arithmetic:   runtime vs reference on the same blob, same CG iterations;
@@ -173,5 +173,6 @@ int main(void) {
     printf("runtime vs double reference (%s)\n", PU_FLAVOUR_NAME);
     asset("cow", pu_cow_pose, goal);
     asset("limb", pu_limb_pose, goal);
+    asset("beast", pu_beast_pose, goal);
     return T_END();
 }
