@@ -13,14 +13,22 @@
  * Fixed point: y_i is a force, Q(19 + k_i); a block's 3-term row
  * (<= 3 (2^15 - 1) 2^28 < 2^44.6) is rounded once into the target vertex's
  * format (shift frac + k_j - k_i in [-15, 62]; below 0 it is scaled up by
- * at most 2^15, < 2^59.6) and added saturating (counted). w, z' are Q22
- * like today's z; the backward block rows round by frac into Q22 each. */
+ * at most 2^15 and clamped, counted), summed in int64 with the vertex's other
+ * rows (the instance's accumulators, scratch here) and clamped once (counted)
+ * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
+ * round by frac into Q22 each, summed in int64, clamped once per vertex. */
 #include "sn_instance.h"
 
-/* int16 from two little-endian bytes, without an implementation-defined conversion */
+/* int16 from two little-endian bytes, without an implementation-defined
+ * conversion (little-endian hosts: one load; int16_t is two's complement) */
 SN_INLINE int32_t rd_i16(const unsigned char *p) {
-    uint32_t u = sn_rd_u16(p);
-    return (int32_t)u - (int32_t)((u & 0x8000u) << 1);
+#if SN_HOST_LE
+    int16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    return (int32_t)(sn_rd_u16(p) ^ 0x8000u) - 32768;
+#endif
 }
 
 /* Block U (entries as sn_q: fixed the mantissa, float the value) and its frac. */
@@ -37,25 +45,38 @@ SN_INLINE int ic_block(const unsigned char *b, sn_q U[9]) {
     return b[18];
 }
 
-/* value of a block row product at shift s (s < 0: scaled up by 2^-s <= 2^15) */
-SN_INLINE sn_q ic_round(sn_acc p, int s, uint32_t *sat) {
-#if !defined(SN_FLOAT)
-    if (s < 0) { p *= (int64_t)1 << -s; s = 0; }
+/* A block row product p (|p| < 2^44.6) at shift s: rounded (s >= 0: < 2^44.6,
+ * no clamp needed) or, s < 0, scaled up by 2^-s <= 2^15 and clamped to the
+ * state range (counted). Float: p. */
+SN_INLINE sn_acc ic_round(sn_acc p, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s; (void)sat;
+    return p;
+#else
+    if (s >= 0) return sn_rshr64(p, s);
+    return sn_out(p * ((int64_t)1 << -s), 0, sat);
 #endif
-    return sn_out(p, s, sat);
 }
 
 /* y = (I + L^)^-1 y in place: for j ascending, y_i -= U_ji^T y_j (i > j).
- * Returns the ICHOL count (the blocks it read). */
-static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, uint32_t *sat) {
+ * The rounded block rows bound for y_i are summed in acc (int64: at most
+ * SN_MAX_ROW_BLOCKS of them, each < 2^44.6 or clamped to 2^28: < 2^49.3) and
+ * y_i is formed, clamped once, when the sweep reaches i. Returns the ICHOL
+ * count (the blocks it read). */
+static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc *acc, uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
-    uint32_t j, e, n = 0, c, nF = v->nF;
+    uint32_t j, e, n = 0, nF = v->nF;
+    for (j = 0; j < 3 * nF; j++) acc[j] = 0;
     for (j = 0; j < nF; j++) {
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
-        const sn_q *yj = y + 3 * j;
+        sn_q *yj = y + 3 * j;
+        yj[0] = sn_out((sn_acc)yj[0] - acc[3 * j], 0, sat);
+        yj[1] = sn_out((sn_acc)yj[1] - acc[3 * j + 1], 0, sat);
+        yj[2] = sn_out((sn_acc)yj[2] - acc[3 * j + 2], 0, sat);
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
+            sn_acc *ai = acc + 3 * i;
             sn_q U[9];
             int s;
             if (i >= nF) break; /* skeleton columns: not in ICHOL */
@@ -63,34 +84,39 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, uint32_
 #if !defined(SN_FLOAT)
             s += (int)kk[j] - (int)kk[i]; /* Q(19 + k_j + frac) -> Q(19 + k_i) */
 #endif
-            for (c = 0; c < 3; c++) {
-                sn_acc p = sn_mul(U[c], yj[0]) + sn_mul(U[3 + c], yj[1]) + sn_mul(U[6 + c], yj[2]);
-                y[3 * i + c] = sn_add(y[3 * i + c], ic_round(-p, s, sat), sat);
-            }
+            ai[0] += ic_round(sn_mul(U[0], yj[0]) + sn_mul(U[3], yj[1]) + sn_mul(U[6], yj[2]), s, sat);
+            ai[1] += ic_round(sn_mul(U[1], yj[0]) + sn_mul(U[4], yj[1]) + sn_mul(U[7], yj[2]), s, sat);
+            ai[2] += ic_round(sn_mul(U[2], yj[0]) + sn_mul(U[5], yj[1]) + sn_mul(U[8], yj[2]), s, sat);
         }
     }
     (void)kk;
     return n;
 }
 
-/* z = (I + L^)^-T z in place: for j descending, z_j -= sum_i U_ji z_i (Q22) */
+/* z = (I + L^)^-T z in place: for j descending, z_j -= sum_i U_ji z_i (Q22;
+ * each block row rounded by frac, < 2^44.6; their sum < 2^49.3) */
 static void ic_backward(const sn_view *v, uint32_t n, sn_q *z, uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
-    uint32_t j = v->nF, e, c, nF = v->nF;
+    uint32_t j = v->nF, e, nF = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4), f = b;
-        sn_acc l[3] = {0, 0, 0};
+        sn_acc l0 = 0, l1 = 0, l2 = 0;
+        const unsigned char *blk;
         while (f < end && sn_rd_u16(cols + 2 * f) < nF) f++; /* free columns first */
         n -= f - b;
-        for (e = b; e < f; e++) {
+        blk = L + (size_t)n * SN_ELEM_ICHOL;
+        for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
             const sn_q *zi = z + 3 * sn_rd_u16(cols + 2 * e);
             sn_q U[9];
-            int s = ic_block(L + (size_t)(n + e - b) * SN_ELEM_ICHOL, U);
-            for (c = 0; c < 3; c++) /* <= 26 blocks of |.| <= 2^28: < 2^33 */
-                l[c] += ic_round(sn_mul(U[3 * c], zi[0]) + sn_mul(U[3 * c + 1], zi[1]) + sn_mul(U[3 * c + 2], zi[2]), s, sat);
+            int s = ic_block(blk, U);
+            l0 += ic_round(sn_mul(U[0], zi[0]) + sn_mul(U[1], zi[1]) + sn_mul(U[2], zi[2]), s, sat);
+            l1 += ic_round(sn_mul(U[3], zi[0]) + sn_mul(U[4], zi[1]) + sn_mul(U[5], zi[2]), s, sat);
+            l2 += ic_round(sn_mul(U[6], zi[0]) + sn_mul(U[7], zi[1]) + sn_mul(U[8], zi[2]), s, sat);
         }
-        for (c = 0; c < 3; c++) z[3 * j + c] = sn_out((sn_acc)z[3 * j + c] - l[c], 0, sat);
+        z[3 * j] = sn_out((sn_acc)z[3 * j] - l0, 0, sat);
+        z[3 * j + 1] = sn_out((sn_acc)z[3 * j + 1] - l1, 0, sat);
+        z[3 * j + 2] = sn_out((sn_acc)z[3 * j + 2] - l2, 0, sat);
     }
 }
 
@@ -126,7 +152,7 @@ void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
         return;
     }
     for (i = 0; i < v->nF; i++) sn_rot_t(R + 9 * i, r + 3 * i, z + 3 * i, sat);
-    n = ic_forward(v, kk, z, sat);
+    n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
         sn_acc a[3];
         int sh = v->frac_P + SN_KREL(kk[i]);
