@@ -261,3 +261,34 @@ $(PHYS_EX)/cow_c8.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
 $(PHYS_EX)/cow_c8_float.blob: $(PHYS_EX)/cow_c8/cow.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 TEST_DEPS += $(PHYS_EX)/cow_c8.blob $(PHYS_EX)/cow_c8_float.blob $(EX)/beast.blob $(EX)/beast_float.blob
+
+# IC(0) iteration counts (issue 15 item 3, tools/DESCRIPTION.md "Preconditioner"):
+# the whole-clip criterion of runtime/SOLVER_STUDY.md §1 on the examples'
+# ICHOL blobs against block Jacobi at today's counts (cow 10, limb 16, beast
+# 10; the same descriptions baked with 'precond jacobi'). Not part of make test.
+$(BUILD)/tests/ichol_count: tests/ichol_count.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
+define JACOBI_BLOB_RULE
+$(EX)/$(1)_jacobi.blob: tools/examples/$(1)/$(1).sinew $(BAKE)
+	@mkdir -p $(EX)/$(1)_jacobi
+	sed 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/$(1)/\1|' $$< > $(EX)/$(1)_jacobi/$(1).sinew
+	echo "precond jacobi" >> $(EX)/$(1)_jacobi/$(1).sinew
+	$(BAKE) $(EX)/$(1)_jacobi/$(1).sinew -o $$@ --quiet
+endef
+$(foreach a,cow limb beast,$(eval $(call JACOBI_BLOB_RULE,$(a))))
+.PHONY: ichol-counts
+ichol-counts: $(BUILD)/tests/ichol_count $(EX)/cow.blob $(EX)/limb.blob $(EX)/beast.blob $(EX)/cow_jacobi.blob $(EX)/limb_jacobi.blob $(EX)/beast_jacobi.blob
+	$(BUILD)/tests/ichol_count $(EX)/cow_jacobi.blob $(EX)/cow.blob 10 tools/examples/cow/trot.clip tools/examples/cow/head_turn.clip
+	$(BUILD)/tests/ichol_count $(EX)/limb_jacobi.blob $(EX)/limb.blob 16 tools/examples/limb/flex.clip
+	$(BUILD)/tests/ichol_count $(EX)/beast_jacobi.blob $(EX)/beast.blob 10 tools/examples/beast/walk.clip tools/examples/beast/head_turn.clip
+
+# The IC(0) apply against a double solve with the same factor (issue 15 item 3):
+# runtime internals (sn_precond) and the reference's decoded ICHOL.
+$(BUILD)/tests/test_runtime_precond: tests/test_runtime_precond.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED) $(EX)/cow.blob $(EX)/beast.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_precond_float: tests/test_runtime_precond.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(EX)/cow_float.blob $(EX)/beast_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_precond $(BUILD)/tests/test_runtime_precond_float

@@ -108,7 +108,7 @@ static void test_header(void) {
     CASE(SN_ERR_VERSION, "major 1 (format 1.0)", tb_u16(b + SN_H_VER_MAJOR, 1));
     CASE(SN_ERR_VERSION, "major 2 (format 2.0, no rig sections)", tb_u16(b + SN_H_VER_MAJOR, 2));
     CASE(SN_ERR_VERSION, "major 7", tb_u16(b + SN_H_VER_MAJOR, 7));
-    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout, dense crease rows, int32 CELLK: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
+    CASE(SN_ERR_VERSION, "major 5 (format 5.0, no level sections, larger instance layout, dense crease rows, int32 CELLK, no ICHOL: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 5));
     CASE(SN_ERR_VERSION, "major 4 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
     CASE(SN_ERR_VERSION, "major 3 (re-bake)", tb_u16(b + SN_H_VER_MAJOR, 3));
     CASE(SN_ERR_VERSION, "major 4 (format 4.0, no constraint section: re-bake)", tb_u16(b + SN_H_VER_MAJOR, 4));
@@ -627,6 +627,48 @@ static void test_steps(void) {
     }
 }
 
+/* ICHOL (format 6.0, sn_tblob.h tb_add_ichol): the validator's bounds
+ * (NUMERICS.md "Preconditioner"): count 0 or the free-free mass entries,
+ * mantissas != -2^15, frac <= SN_ICHOL_FRAC_MAX, pad byte 0; an accepted
+ * blob steps without saturations. */
+#define ICASE(want, what, code) do { \
+    unsigned char *b = iw.b; \
+    memcpy(b, ib.b, CAP); \
+    { code; } \
+    tb_fix_crc(b); \
+    expect(what, run(b, itot), want); \
+} while (0)
+static void test_ichol(void) {
+    static union { uint64_t a; unsigned char b[CAP]; } ib, iw;
+    static union { uint64_t a; unsigned char m[8192]; } mem;
+    uint32_t itot, n, k, nnz;
+    const sn_blob *blob;
+    sn_instance *inst;
+    sn_stats st;
+    int s;
+    tb_build(ib.b, CAP, 0);
+    itot = tb_add_ichol(ib.b, CAP, 14);
+    n = tb_rd32(ib.b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL + 8);
+    nnz = tb_rd32(ib.b + SN_H_N_OFFDIAG);
+    T_CHECK(itot > 0 && n > 0 && n < nnz, "test blob with ICHOL: %u blocks of %u mass entries", n, nnz);
+    ICASE(SN_OK, "ICHOL valid", (void)b);
+    ICASE(SN_OK, "ICHOL mantissas +-(2^15-1), frac 0 and 47", for (k = 0; k < 9 * n; k++) tb_u16(SEC(SN_SEC_ICHOL) + 20 * (k / 9) + 2 * (k % 9), (k & 1) ? 0x7FFFu : 0x8001u);
+          SEC(SN_SEC_ICHOL)[18] = 0; SEC(SN_SEC_ICHOL)[20 * (n - 1) + 18] = SN_ICHOL_FRAC_MAX);
+    ICASE(SN_ERR_VALUE, "ICHOL mantissa -2^15", tb_u16(SEC(SN_SEC_ICHOL) + 20 * (n - 1) + 16, 0x8000u));
+    ICASE(SN_ERR_VALUE, "ICHOL frac 48", SEC(SN_SEC_ICHOL)[20 * (n / 2) + 18] = SN_ICHOL_FRAC_MAX + 1);
+    ICASE(SN_ERR_VALUE, "ICHOL frac 255", SEC(SN_SEC_ICHOL)[18] = 255);
+    ICASE(SN_ERR_VALUE, "ICHOL pad byte", SEC(SN_SEC_ICHOL)[20 * (n - 1) + 19] = 1);
+    ICASE(SN_ERR_SECTION, "ICHOL one block short", tb_u32(TAB(SN_SEC_ICHOL, 2), n - 1); tb_u32(TAB(SN_SEC_ICHOL, 1), 20 * (n - 1));
+          memset(SEC(SN_SEC_ICHOL) + 20 * (n - 1), 0, 20));
+    ICASE(SN_ERR_SECTION, "ICHOL count nnz + 1", tb_u32(TAB(SN_SEC_ICHOL, 2), nnz + 1); tb_u32(TAB(SN_SEC_ICHOL, 1), 20 * (nnz + 1)));
+    ICASE(SN_ERR_SECTION, "ICHOL element 36 bytes", tb_u32(TAB(SN_SEC_ICHOL, 3), 36); tb_u32(TAB(SN_SEC_ICHOL, 1), 36 * n));
+    if (sn_blob_validate(ib.b, itot, &blob) != SN_OK) return;
+    expect("init (ICHOL)", sn_instance_init(mem.m, sizeof mem.m, blob, &inst), SN_OK);
+    for (s = 0; s < 10; s++) sn_step(inst);
+    sn_get_stats(inst, &st);
+    T_CHECK(st.steps == 10 && st.saturations == 0, "ICHOL test blob: %u steps, %u saturations", st.steps, st.saturations);
+}
+
 /* The writers' macro equals the runtime's layout (the one source of the
  * instance size) over counts spanning every term. */
 static void test_instance_size_formula(void) {
@@ -659,6 +701,7 @@ int main(void) {
     test_accessors(-3);
     test_rest_rounding();
     test_steps();
+    test_ichol();
     test_instance_size_formula();
     return T_END();
 }

@@ -169,6 +169,7 @@ typedef struct sb_desc {
     sb_pin *pins; int npin;
     double alpha, beta, h;
     int cg_def, cg_max;
+    int precond;            /* 'precond ichol|jacobi': SB_PRECOND_* */
     double g[3];
     double kappa, twist_r;  /* retired ('twist' is an error now): always 0 */
     int element;            /* SB_ELEM_*: stiffness element (sb_integrate.c) */
@@ -258,6 +259,7 @@ typedef struct sb_model {
     /* description copy of physics */
     double h, alpha, beta, g[3], unit;
     int cg_def, cg_max;
+    int precond;            /* SB_PRECOND_*: the blob's preconditioner (ICHOL section or none) */
     double bbox_diag;
     double min_jac;         /* smallest Jacobian determinant in kept cells / cell volume (1 = undistorted) */
     int n_uncondensed;      /* incompatible element: cells left trilinear (bubble stiffness not positive definite) */
@@ -444,10 +446,27 @@ typedef struct sb_blob {
     unsigned char *bytes; size_t size;
     uint32_t sec_off[40], sec_size[40];   /* >= SN_SEC_COUNT */
     int len_shift, frac_S, frac_M, frac_P;
+    int ichol_n;            /* ICHOL blocks (0: block Jacobi) */
+    double ichol_max;       /* largest |U entry| */
     double m0;
     int *rig_frac;          /* per rig (fixed flavour): fractional bits of its RIG_FORCES; else 0 */
 } sb_blob;
 int sb_blob_make(const sb_model *o, int flavour, sb_blob *b);
+
+/* IC(0) preconditioner (sb_ichol.c): A0 = (1+a1) M/m0 + (1+b1) h^2 S/m0 over
+ * free vertices ~ (I + L^) D (I + L^)^T on the mass pattern. */
+#define SB_PRECOND_ICHOL 0
+#define SB_PRECOND_JACOBI 1
+typedef struct sb_ichol_t {
+    int n;          /* blocks: the free-free upper entries of the pattern, row order */
+    double *U;      /* n x 9: U_ji = L^_ij^T, row-major */
+    double *Dinv;   /* nF x 9: D_i^-1 */
+    double maxU;    /* largest |entry| of U */
+    int shifted;    /* pivots shifted at a breakdown */
+} sb_ichol_t;
+int sb_ichol(const sb_model *o, double m0, double a1, double b1, sb_ichol_t *f);
+int sb_ichol_quant(const double *U, int bits, int m[9], int *frac);
+void sb_ichol_free(sb_ichol_t *f);
 void sb_blob_free(sb_blob *b);
 int sb_write_file(const char *path, const unsigned char *p, size_t n);  /* temp + rename */
 int sb_write_c_array(const char *path, const char *symbol, const unsigned char *p, size_t n);

@@ -11,7 +11,7 @@ static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "F
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
                                              "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
-                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN"};
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL"};
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {

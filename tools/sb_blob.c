@@ -222,6 +222,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     const int nF = o->nf, nV = o->nv, nJ = o->nj;
     int i, j, k, e, nnz = 0, rs = flavour == SB_DOUBLE ? 8 : 4, s;
     double m0 = 0, maxS = 0, maxM = 0, maxP = 0, maxx = 0, h = o->h, a1, b1, U, *P, *lump;
+    sb_ichol_t ic = {0, NULL, NULL, 0, 0};
     const double *root = o->joints[0].pos;
     uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total;
     wr_t w;
@@ -271,6 +272,17 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             }
         inv3sym((const double (*)[3])A, R);
         for (k = 0; k < 6; k++) { P[6 * i + k] = R[sym6[k][0]][sym6[k][1]]; maxP = fmax(maxP, fabs(P[6 * i + k])); }
+    }
+    if (o->precond == SB_PRECOND_ICHOL) { /* PRECOND holds the IC(0) pivots D^-1 (sb_ichol.c) */
+        if (sb_ichol(o, m0, a1, b1, &ic) != 0) { free(P); free(lump); return -1; }
+        maxP = 0;
+        for (i = 0; i < nF; i++)
+            for (k = 0; k < 6; k++) {
+                P[6 * i + k] = 0.5 * (ic.Dinv[9 * i + 3 * sym6[k][0] + sym6[k][1]] + ic.Dinv[9 * i + 3 * sym6[k][1] + sym6[k][0]]);
+                maxP = fmax(maxP, fabs(P[6 * i + k]));
+            }
+        b->ichol_n = ic.n;
+        b->ichol_max = ic.maxU;
     }
     if (flavour == SB_FIXED) {
         b->frac_S = pick_frac(maxS); b->frac_M = pick_frac(maxM); b->frac_P = pick_frac(maxP);
@@ -339,6 +351,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     cnt[SN_SEC_LEVEL_BLOB] = o->lod_size;                      esz[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;
     cnt[SN_SEC_LEVEL_UP] = o->lod_size ? o->lod_nv1 : 0u;      esz[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_LEVEL_DOWN] = o->lod_size ? (uint32_t)nV : 0u;  esz[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
+    cnt[SN_SEC_ICHOL] = (uint32_t)ic.n;           esz[SN_SEC_ICHOL] = SN_ELEM_ICHOL;
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -450,6 +463,22 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         }
     }
     put_u32(&w, off[SN_SEC_ROWPTR] + 4 * (size_t)nF, (uint32_t)nnz);
+    {   /* ICHOL: int16 mantissas, one frac per block, in every flavour (SB_ICHOL_BITS: fewer mantissa bits, a measurement aid) */
+        const char *eb = getenv("SB_ICHOL_BITS");
+        int bits = eb ? atoi(eb) : 15;
+        if (bits < 2 || bits > 15) bits = 15;
+        for (k = 0; k < ic.n; k++) {
+            int mm[9], fr, r;
+            size_t at = off[SN_SEC_ICHOL] + (size_t)k * SN_ELEM_ICHOL;
+            if (sb_ichol_quant(ic.U + 9 * (size_t)k, bits, mm, &fr) != 0) {
+                sb_ichol_free(&ic); free(P); free(lump); sb_blob_free(b);
+                return sb_fail("IC(0) preconditioner: a factor entry beyond 2^15 (largest %g): bake with 'precond jacobi'", ic.maxU);
+            }
+            for (r = 0; r < 9; r++) put_u16(&w, at + 2 * (size_t)r, (unsigned)(mm[r] & 0xFFFF));
+            put_u8(&w, at + 18, (unsigned)fr);
+        }
+        sb_ichol_free(&ic);
+    }
     for (i = 0; i < o->nc; i++) {
         double blk[36 * 9];
         int exps[28];

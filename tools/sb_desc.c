@@ -464,6 +464,11 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
     } else if (!strcmp(kw, "iterations")) {
         if (nargs(c, 2) || inum(c, 1, 1, 256, &d->cg_def) || inum(c, 2, 1, 256, &d->cg_max)) return -1;
         if (d->cg_max < d->cg_def) return sb_fail("%s:%d: max iterations below the default", c->path, c->line);
+    } else if (!strcmp(kw, "precond")) {
+        if (nargs(c, 1)) return -1;
+        if (!strcmp(c->tok[1], "ichol")) d->precond = SB_PRECOND_ICHOL;
+        else if (!strcmp(c->tok[1], "jacobi")) d->precond = SB_PRECOND_JACOBI;
+        else return sb_fail("%s:%d: precond '%s': one of ichol (incomplete Cholesky, the default) or jacobi (block Jacobi)", c->path, c->line, c->tok[1]);
     } else if (!strcmp(kw, "gravity")) {
         if (nargs(c, 3)) return -1;
         for (k = 0; k < 3; k++) {

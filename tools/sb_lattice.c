@@ -365,7 +365,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
 
     memset(o, 0, sizeof *o);
     o->quiet = quiet;
-    o->unit = d->unit; o->h = d->h; o->alpha = d->alpha; o->beta = d->beta; o->cg_def = d->cg_def; o->cg_max = d->cg_max;
+    o->unit = d->unit; o->h = d->h; o->alpha = d->alpha; o->beta = d->beta; o->cg_def = d->cg_def; o->cg_max = d->cg_max; o->precond = d->precond;
     o->rest_modelled = d->rest_modelled;
     o->mesh_volume = sb_mesh_volume(m) * d->unit * d->unit * d->unit;
     for (k = 0; k < 3; k++) o->g[k] = d->g[k];

@@ -289,6 +289,24 @@ static sn_status sn_check_contents(const sn_view *v) {
     return sn_check_rigs(v);
 }
 
+/* IC(0) factor (NUMERICS.md "Preconditioner"), COLS already checked: 0 or
+ * one block per free-free mass entry; |m| <= 2^15 - 1 and frac <=
+ * SN_ICHOL_FRAC_MAX, so a sweep's block row is < 3 (2^15 - 1) 2^28 < 2^44.6
+ * and its shift frac + k_j - k_i lies in [-15, 62]: scaled up by at most
+ * 2^15 (< 2^59.6) or rounded down, always a valid sn_out argument. */
+static sn_status sn_check_ichol(const sn_view *v, uint32_t nic) {
+    const unsigned char *s = v->sec[SN_SEC_ICHOL], *cols = v->sec[SN_SEC_COLS];
+    uint32_t i, k, nff = 0;
+    for (i = 0; i < v->nnz; i++) nff += sn_rd_u16(cols + 2 * (size_t)i) < v->nF;
+    SN_CHK(nic == 0 || nic == nff, SN_ERR_SECTION);
+    for (i = 0; i < nic; i++) {
+        const unsigned char *b = s + (size_t)i * SN_ELEM_ICHOL;
+        for (k = 0; k < 9; k++) SN_CHK(sn_rd_u16(b + 2 * k) != 0x8000u, SN_ERR_VALUE);
+        SN_CHK(b[18] <= SN_ICHOL_FRAC_MAX && b[19] == 0, SN_ERR_VALUE);
+    }
+    return SN_OK;
+}
+
 /* One blob's own checks (a finer level's nested blob goes through the same:
  * sn_blob_validate calls this for the blob, then for its LEVEL_BLOB). */
 static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
@@ -374,6 +392,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     cnt[SN_SEC_LIMIT] = 0; /* 0 or nF: taken from the table below */
     cnt[SN_SEC_EMBED] = v.nS;
     cnt[SN_SEC_TRIS] = v.nT;
+    cnt[SN_SEC_ICHOL] = 0; /* 0 or nFF: taken from the table below */
     /* rig sections: counts from the table, bounded (cost per step, u16/u32 indices) */
     {
         const unsigned char *t = p + SN_H_SECTIONS + 8;
@@ -449,13 +468,15 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(SN_REAL_BYTES), SN_ELEM_SHARES(SN_REAL_BYTES),
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
-            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP};
+            SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP,
+            SN_ELEM_ICHOL};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
             uint32_t off = sn_rd_u32(e), sz = sn_rd_u32(e + 4);
             if ((k == SN_SEC_LIMIT || k == SN_SEC_VSHARE) && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
             if (k == SN_SEC_CONSTRAINTS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record */
+            if (k == SN_SEC_ICHOL && sn_rd_u32(e + 8) <= v.nnz) cnt[k] = sn_rd_u32(e + 8); /* 0 or nFF: checked with COLS */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -472,6 +493,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
 
     sn_view_sections(&v);
     st = sn_check_contents(&v);
+    if (st != SN_OK) return st;
+    st = sn_check_ichol(&v, cnt[SN_SEC_ICHOL]);
     if (st != SN_OK) return st;
     st = sn_check_forces(&v);
     if (st != SN_OK) return st;
@@ -545,7 +568,7 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
     v->nD = v->crB = 0;
-    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_nq = 0;
+    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_nq = v->ic = v->ic_pad = 0;
     v->cr_depth = v->cr_push = 0;
     v->nCon = v->nCol = v->nCt = v->nRows = v->conB = 0;
 }
@@ -561,6 +584,7 @@ static void sn_view_sections(sn_view *v) {
     v->nRE = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_RIG_VERTS * SN_SECTION_ENTRY + 8);
     v->nP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SHARES * SN_SECTION_ENTRY + 8);
     v->nVP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_VSHARE * SN_SECTION_ENTRY + 8);
+    v->ic = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_ICHOL * SN_SECTION_ENTRY + 8) != 0;
     v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
     v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
     v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);

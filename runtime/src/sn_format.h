@@ -163,6 +163,12 @@ enum {
                             joints, surface, controls, segment meshes, crease and constraint sections equal this blob's */
     SN_SEC_LEVEL_UP,     /* nV(level 1) x {u16 cell, u16 t[3] Q15}: each level-1 lattice vertex in a cell of this (level 0) lattice */
     SN_SEC_LEVEL_DOWN,   /* nV(level 0) x {u16 cell, u16 t[3] Q15}: each level-0 lattice vertex in a cell of the level-1 lattice */
+    /* ---- IC(0) preconditioner (issue 15 item 3, runtime/SOLVER_STUDY.md §1), format 6.0; count 0 or nFF ---- */
+    SN_SEC_ICHOL,        /* nFF x {i16 m[9], u8 frac, u8 0}: the unit upper factor U = (I + L^)^T - I of the rest-frame
+                            A0 = (1+a1) M^ + (1+b1) sum_e S^_e ~ (I + L^) D (I + L^)^T, block U_ji = L^_ij^T (row j < column i),
+                            entry [3a+b] = m[3a+b] 2^-frac, |m| <= 2^15-1, frac <= SN_ICHOL_FRAC_MAX; one element per
+                            free-free entry of the mass pattern (COLS j < nF), in ROWPTR/COLS order, skeleton columns skipped;
+                            nFF = those entries' count. With ICHOL, PRECOND holds D^-1 (same format); count 0: block Jacobi */
     SN_SEC_COUNT
 };
 
@@ -212,6 +218,8 @@ enum {
 #define SN_ELEM_CREASE_TNBR  2
 #define SN_ELEM_LEVEL_BLOB   1
 #define SN_ELEM_LEVEL_MAP    8
+#define SN_ELEM_ICHOL       20   /* every flavour: int16 mantissas, one exponent per block */
+#define SN_ICHOL_FRAC_MAX   47   /* forward sweep shift frac + k_j - k_i <= 62 (k <= 15) */
 
 /* self-collision near creases (seed 003 §3.4; sn_crease.c, NUMERICS.md "Self-collision") */
 #define SN_CREASE_MAX_LIST   256u   /* collision list C entries (eq. 8) */
@@ -314,7 +322,7 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * writers (the host tool, the tests' blob writers). The runtime's layout
  * (sn_instance.c, sn_instance_bytes) is the source; the validator requires
  * the header to equal it, and test_runtime_blob checks this macro against it. */
-#define SN_INSTANCE_HDR_BYTES 816u /* the instance header before the arrays (format 6.0: 768 before; the three level sections and the level of detail) */
+#define SN_INSTANCE_HDR_BYTES 832u /* the instance header before the arrays (format 6.0: 768 before; the level of detail, the four level and ICHOL section pointers) */
 /* nFrc: force slots (header MAX_FORCES); segB: the extra state bytes before
  * the constraint state: the segment state, the sum over meshes of
  * SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts), plus the

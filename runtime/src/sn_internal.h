@@ -215,7 +215,8 @@ typedef struct sn_view {
     uint32_t nM, nSN, nSA, segB; /* segment meshes, nodes, attachments; segment state bytes */
     uint32_t nD, crB;          /* crease: seed pairs, state bytes (SN_CREASE_STATE_BYTES, 0 without) */
     uint16_t nCR, cr_list, cr_active, cr_nv, cr_nt, cr_nq; /* crease: CREASE count (0 or 1), max list, max active,
-                                                              VNBR / TNBR row widths, neighbourhood rows (0 without) (16-bit: the view sits in the 816-byte instance header) */
+                                                              VNBR / TNBR row widths, neighbourhood rows (0 without) */
+    uint16_t ic, ic_pad;       /* 1 with an ICHOL section; 0 (16-bit: the view sits in the instance header) */
     sn_q cr_depth, cr_push;    /* crease: deepest detected penetration, push-out cap per step (Q22) */
     uint32_t nCon, nCol, nCt, nRows, conB; /* max constraints, colliders, contacts; rows per step; constraint state bytes */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;

@@ -1,7 +1,7 @@
 /* sn_solve.c -- steps 4-7: the right-hand side with the per-cell warped
  * elastic force (element energy, NUMERICS.md step 4), the mat-vec
- * A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d, the rotated block-Jacobi
- * preconditioner, and PCG with a fixed iteration count (seed 000 §4.2).
+ * A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d, and PCG (preconditioner:
+ * sn_precond.c) with a fixed iteration count (seed 000 §4.2).
  *
  * Overflow freedom (fixed): a cell product row sums 8 blocks of 3 products,
  * < 24 * 2^55 = 2^59.6, rounded to an int32 force (clamped) before it is
@@ -13,14 +13,6 @@
 #include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
 #include "sn_blended.h" /* sn_rhs and the CG arithmetic, shared with the blended mode */
 
-/* l += D e, D symmetric stored xx yy zz xy xz yz */
-SN_INLINE void sym_row(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
-    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
-    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
-    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
-    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
-    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
-}
 SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[0] += sn_mul(m, e[0]);
     l[1] += sn_mul(m, e[1]);
@@ -277,26 +269,6 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
         }
 }
 
-/* z_i = R_i P_i R_i^T r_i  (rest-frame block Jacobi, rotated) */
-static void precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
-    const sn_view *v = &h->v;
-    const sn_q *R = CARR(h, o_R, sn_q);
-    const unsigned char *P = v->sec[SN_SEC_PRECOND];
-    const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t i;
-    for (i = 0; i < v->nF; i++) {
-        sn_q t[3], s[3];
-        sn_acc a[3] = {0, 0, 0};
-        int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
-        sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
-        sym_row(a, P + (size_t)i * 6 * RB, t);
-        s[0] = sn_out(a[0], sh, sat);
-        s[1] = sn_out(a[1], sh, sat);
-        s[2] = sn_out(a[2], sh, sat);
-        sn_rot(R + 9 * i, s, z + 3 * i, sat);
-    }
-}
-
 /* ---- CG scalars ---- */
 #if defined(SN_FLOAT)
 typedef struct { float m; } sn_dotv;
@@ -384,7 +356,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     matvec(h, x, q, sat);
     for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
     if (rows) sn_rows_filter(h, r, 1, sat);
-    precond(h, r, z, sat);
+    sn_precond(h, r, z, sat); /* sn_precond.c */
     if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
     rz = dot(r, z, kk, n3);
@@ -398,7 +370,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
         if (rows) sn_rows_filter(h, r, 1, sat);
-        precond(h, r, z, sat);
+        sn_precond(h, r, z, sat); /* sn_precond.c */
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz, &clamps);

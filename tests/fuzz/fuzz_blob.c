@@ -436,6 +436,35 @@ static size_t craft_limits_tiny(void) {
     return total;
 }
 
+/* ICHOL (format 6.0) at its bounds: every mantissa +-(2^15 - 1) (alternating
+ * or random signs), frac 0 (the largest factor, 32767, and shifts down to
+ * -15: products scaled up by 2^15) or 47 (the largest shift, 62 with the
+ * k_i spread), odd free vertices' PRECOND at 2^27 (k 15) and even ones at
+ * 1 LSB (k 0), 256 CG iterations: the sweeps must saturate, never overflow. */
+static size_t craft_ichol(int frac, int pattern) {
+    unsigned char *b = g_craft.b;
+    uint32_t total, k, n, off, x = 777u;
+    tb_build(b, sizeof g_craft.b, 0);
+    total = tb_add_ichol(b, sizeof g_craft.b, frac);
+    n = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL + 8);
+    off = tb_sec(b, SN_SEC_ICHOL);
+    for (k = 0; k < 9 * n; k++) {
+        int neg = pattern ? (int)((x = x * 1103515245u + 12345u) >> 31) : (int)(k & 1u);
+        tb_u16(b + off + 20 * (k / 9) + 2 * (k % 9), neg ? 0x8001u : 0x7FFFu);
+    }
+    for (k = 0; k < TB_NF; k++) {
+        uint32_t d;
+        for (d = 0; d < 6; d++)
+            tb_real(b + tb_sec(b, SN_SEC_PRECOND) + 4 * (6 * k + d), (k & 1) ? 134217728.0 : d < 3 ? 1.0 : 0.0, 0);
+    }
+    tb_u16(b + SN_H_CG_DEFAULT, 256);
+    tb_u16(b + SN_H_CG_MAX, 256);
+    tb_fix_crc(b);
+    return total;
+}
+static size_t craft_ichol_q0(void) { return craft_ichol(0, 0); }
+static size_t craft_ichol_q47(void) { return craft_ichol(SN_ICHOL_FRAC_MAX, 1); }
+
 /* expect: 0 nothing, 1 the state must reach the clamp (saturations > 0), 2 limits must clamp */
 static int run_crafted(const char *name, size_t (*make)(void), int posetype, int steps, int expect) {
     pid_t pid;
@@ -521,6 +550,8 @@ static int crafted_all(void) {
     fails += run_crafted("rig forces, etas, gammas and axes at their bounds, controls at their type's extremes",
                          craft_rig_max, 1, 20, 1);
     fails += run_crafted("crease contact: a vertex 0.25 behind the opposite triangle, list 1, active 1", craft_crease, 0, 10, 3);
+    fails += run_crafted("ICHOL mantissas +-(2^15-1) alternating, frac 0, PRECOND k 0/15, 256 CG iterations, far pose", craft_ichol_q0, 1, 40, 1);
+    fails += run_crafted("ICHOL mantissas +-(2^15-1) random, frac 47 (shift 62), PRECOND k 0/15", craft_ichol_q47, 1, 40, 0);
     return fails;
 }
 
@@ -872,6 +903,19 @@ static void e_all(unsigned char *b, int hi) {
     coords(b, hi ? 24 : -24, hi, 0, 1);
 }
 
+/* ICHOL appended (tb_add_ichol): lo frac 0, hi frac 47, mantissas
+ * +-(2^15 - 1) alternating, with the k_i spread; the new total in g_edit_total */
+static uint32_t g_edit_total;
+static void e_ichol(unsigned char *b, int hi) {
+    uint32_t k, n, off;
+    kspread(b);
+    all_cg(b);
+    g_edit_total = tb_add_ichol(b, sizeof g_craft.b, hi ? SN_ICHOL_FRAC_MAX : 0);
+    n = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL + 8);
+    off = tb_sec(b, SN_SEC_ICHOL);
+    for (k = 0; k < 9 * n; k++) tb_u16(b + off + 20 * (k / 9) + 2 * (k % 9), (k & 1) ? 0x8001u : 0x7FFFu);
+}
+
 typedef struct {
     const char *field, *lo, *hi; /* row label; what min and max mean (fixed / float) */
     void (*edit)(unsigned char *b, int hi);
@@ -916,6 +960,7 @@ static const mx_row g_rows[] = {
     {"joint coords, len_shift -+24", "-2^27, ls -24", "+2^12, ls 24", e_joint_ls, 0},
     {"crease depth, push, exclude (a contact)", "1 LSB, 0, 1 LSB", "2^26, 2^26, 2^28", e_crease_depth, 0},
     {"crease list, active (a contact)", "1, 1", "256, 64", e_crease_list, 0},
+    {"ICHOL mantissas +-(2^15-1), k 0/15", "frac 0", "frac 47", e_ichol, 0},
     {"everything at once", "all min", "all max", e_all, 0},
 };
 #define N_ROWS ((int)(sizeof g_rows / sizeof g_rows[0]))
@@ -925,9 +970,10 @@ static int g_mx_hi;
 static size_t craft_matrix(void) {
     unsigned char *b = g_craft.b;
     uint32_t total = tb_build(b, sizeof g_craft.b, 0);
+    g_edit_total = 0;
     g_mx_row->edit(b, g_mx_hi);
     tb_fix_crc(b);
-    return total;
+    return g_edit_total ? g_edit_total : total;
 }
 
 typedef struct {

@@ -228,6 +228,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_LEVEL_BLOB] = 0;       elem[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;   /* format 6.0: no finer level */
     cnt[SN_SEC_LEVEL_UP] = 0;         elem[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_LEVEL_DOWN] = 0;       elem[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
+    cnt[SN_SEC_ICHOL] = 0;            elem[SN_SEC_ICHOL] = SN_ELEM_ICHOL; /* block Jacobi; tb_add_ichol adds it */
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -435,6 +436,32 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_real(b + SN_H_REALS + SN_R_FORCE * R, 1.0 / 1024.0, TB_FRAC_F); /* 2^30 at Q40 */
     tb_fix_crc(b);
     return off;
+}
+
+/* Append an ICHOL section (format 6.0, the last section) to a tb_build
+ * blob of capacity cap: one block per free-free mass entry with mantissas
+ * (7919 (n + k) mod 2001) - 1000 times 2^-frac (|U| <= 0.06 at frac 14),
+ * frac = the argument; PRECOND stays (its blocks act as the pivots D^-1: any
+ * U with SPD D^-1 gives an SPD preconditioner). Returns the new total size
+ * (CRC recomputed), or 0 if it does not fit. */
+static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
+    unsigned char *e = b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL;
+    const unsigned char *cols = b + tb_sec(b, SN_SEC_COLS);
+    uint32_t nnz = tb_rd32(b + SN_H_N_OFFDIAG), nF = tb_rd32(b + SN_H_N_FREE), off = tb_rd32(e), i, n = 0, k, total;
+    for (i = 0; i < nnz; i++) n += (uint32_t)(cols[2 * i] | cols[2 * i + 1] << 8) < nF;
+    total = (off + n * SN_ELEM_ICHOL + 7u) & ~7u;
+    if (total > cap) return 0;
+    memset(b + off, 0, total - off);
+    for (i = 0; i < n; i++) {
+        unsigned char *q = b + off + i * SN_ELEM_ICHOL;
+        for (k = 0; k < 9; k++) tb_u16(q + 2 * k, (uint32_t)((int32_t)((7919u * (i + k)) % 2001u) - 1000) & 0xFFFFu);
+        q[18] = (unsigned char)frac;
+    }
+    tb_u32(e + 4, n * SN_ELEM_ICHOL);
+    tb_u32(e + 8, n);
+    tb_u32(b + SN_H_TOTAL_SIZE, total);
+    tb_fix_crc(b);
+    return total;
 }
 
 /* Make the LIMIT section empty (count 0, size 0, bytes zeroed: a valid blob

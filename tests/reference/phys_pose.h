@@ -97,6 +97,30 @@ static inline void pu_cow_pose(const sn_blob *b, unsigned nJ, unsigned k, double
     sn_pose_from_local(b, local, &off, out);
 }
 
+/* Beast (upright humanoid, tools/examples/beast): walking in place along +z,
+ * legs and arms swinging, elbows and knees bending, head turning. */
+static inline void pu_beast_pose(const sn_blob *b, unsigned nJ, unsigned k, double h, sn_xform *out) {
+    sn_quat local[256];
+    sn_vec3 off;
+    double t = k * h, w = 2 * PU_PI * 0.9 * t;
+    unsigned j;
+    for (j = 0; j < nJ; j++) local[j] = pu_qident();
+    pu_set_local(b, local, "head", pu_axis_angle(0, 1, 0, 35 * sin(2 * PU_PI * 0.5 * t)));
+    pu_set_local(b, local, "neck", pu_axis_angle(1, 0, 0, 10 * sin(2 * PU_PI * 0.7 * t)));
+    pu_set_local(b, local, "hip_l", pu_axis_angle(1, 0, 0, 25 * sin(w)));
+    pu_set_local(b, local, "hip_r", pu_axis_angle(1, 0, 0, -25 * sin(w)));
+    pu_set_local(b, local, "knee_l", pu_axis_angle(1, 0, 0, 20 * (1 - cos(w))));
+    pu_set_local(b, local, "knee_r", pu_axis_angle(1, 0, 0, 20 * (1 + cos(w))));
+    pu_set_local(b, local, "shoulder_l", pu_axis_angle(1, 0, 0, -20 * sin(w)));
+    pu_set_local(b, local, "shoulder_r", pu_axis_angle(1, 0, 0, 20 * sin(w)));
+    pu_set_local(b, local, "elbow_l", pu_axis_angle(1, 0, 0, -15 * (1 - cos(w))));
+    pu_set_local(b, local, "elbow_r", pu_axis_angle(1, 0, 0, -15 * (1 + cos(w))));
+    off.x = pu_rlen(0);
+    off.y = pu_rlen(3 * sin(2 * w));   /* bounce */
+    off.z = pu_rlen(40 * t);           /* walk forward */
+    sn_pose_from_local(b, local, &off, out);
+}
+
 /* Limb: elbow bending 0..90 degrees and back, shoulder twisting and lifting. */
 static inline void pu_limb_pose(const sn_blob *b, unsigned nJ, unsigned k, double h, sn_xform *out) {
     sn_quat local[256];

@@ -294,7 +294,8 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_RIG_VERTS), SEC_CNT(SN_SEC_SHARES), m->nF,
             SEC_CNT(SN_SEC_SEGMESH), SEC_CNT(SN_SEC_SEGNODES), SEC_CNT(SN_SEC_SEGATTACH), 1u,
             SEC_CNT(SN_SEC_CREASE), SEC_CNT(SN_SEC_CREASE_PAIRS), SEC_CNT(SN_SEC_CREASE_VNBR), SEC_CNT(SN_SEC_CREASE_TNBR),
-            SEC_CNT(SN_SEC_LEVEL_BLOB), SEC_CNT(SN_SEC_LEVEL_UP), SEC_CNT(SN_SEC_LEVEL_DOWN) };
+            SEC_CNT(SN_SEC_LEVEL_BLOB), SEC_CNT(SN_SEC_LEVEL_UP), SEC_CNT(SN_SEC_LEVEL_DOWN),
+            SEC_CNT(SN_SEC_ICHOL) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(m->flavour, R),
@@ -302,9 +303,9 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R), SN_ELEM_SHARES(R), SN_ELEM_VSHARE,
             SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R), SN_ELEM_CONSTRAINTS,
             SN_ELEM_CREASE(R), SN_ELEM_CREASE_PAIRS, SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR,
-            SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP };
+            SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP, SN_ELEM_ICHOL };
 #undef SEC_CNT
-        typedef char sec_count_check[SN_SEC_COUNT == 34 ? 1 : -1];   /* format 6.0: update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
+        typedef char sec_count_check[SN_SEC_COUNT == 35 ? 1 : -1];   /* format 6.0: update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
         (void)sizeof(sec_count_check);
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
@@ -315,6 +316,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
                      (unsigned)cnt, (unsigned)el);
             sec_off[i] = off;
             if (i == SN_SEC_LIMIT) m->nlimit = cnt;
+            if (i == SN_SEC_ICHOL) m->nIC = cnt;
         }
         m->nK = expect_cnt[SN_SEC_CONTROLS]; m->nR = expect_cnt[SN_SEC_RIGS];
         m->nRS = expect_cnt[SN_SEC_RIG_SAMPLES]; m->nRE = expect_cnt[SN_SEC_RIG_VERTS];
@@ -369,6 +371,20 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
         }
     }
     for (i = 0; i < m->nnz; i++) m->moff[i] = rd_real(&r, d + sec_off[SN_SEC_MOFF] + i * R, (int)m->frac_M);
+    if (m->nIC) { /* IC(0) blocks: int16 mantissas times 2^-frac in every flavour (sn_format.h) */
+        unsigned nff = 0, k;
+        for (i = 0; i < m->nnz; i++) nff += m->cols[i] < m->nF;
+        if (m->nIC != nff) FAIL("ICHOL count %u, free-free mass entries %u", m->nIC, nff);
+        ALLOC(m->ichol, 9 * (size_t)m->nIC);
+        for (i = 0; i < m->nIC; i++) {
+            const unsigned char *b = d + sec_off[SN_SEC_ICHOL] + (size_t)SN_ELEM_ICHOL * i;
+            if (b[18] > SN_ICHOL_FRAC_MAX || b[19]) FAIL("ICHOL block %u frac %u", i, b[18]);
+            for (k = 0; k < 9; k++) {
+                unsigned u = rd_u16(b + 2 * k);
+                m->ichol[9 * (size_t)i + k] = ldexp((double)((int)u - (int)((u & 0x8000u) << 1)), -(int)b[18]);
+            }
+        }
+    }
     for (i = 0; i < m->nC; i++) {
         const unsigned char *cf = d + sec_off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * i;
         const unsigned char *ck = d + sec_off[SN_SEC_CELLK] + (size_t)SN_ELEM_CELLK(m->flavour, R) * i;
@@ -444,7 +460,7 @@ int snref_load_file(snref_model *m, const char *path, char *err, size_t errn) {
 
 void snref_free(snref_model *m) {
     free(m->jparent); free(m->jrest); free(m->jname); free(m->rest); free(m->fb1); free(m->fb2); free(m->fw);
-    free(m->mdiag); free(m->precond); free(m->mlump); free(m->rowptr); free(m->cols); free(m->moff);
+    free(m->mdiag); free(m->precond); free(m->ichol); free(m->mlump); free(m->rowptr); free(m->cols); free(m->moff);
     free(m->cells); free(m->cb1); free(m->cb2); free(m->cw); free(m->cellk); free(m->limit); free(m->sdiag);
     free(m->adjp); free(m->adj); free(m->ecell); free(m->et); free(m->tris);
     free(m->kname); free(m->kkind); free(m->kjoint); free(m->kaxis); free(m->kvalue0);
@@ -838,9 +854,43 @@ static const double *precond_blocks(snref_state *s) {
     return P;
 }
 
-/* z_i = R_i P_i R_i^T r_i (step 6: the vertex frame) */
+/* IC(0): z = R (I + L^)^-T D^-1 (I + L^)^-1 R^T r, ICHOL's U_ji = L^_ij^T
+ * in the mass pattern's free-free upper entries (runtime/src/sn_precond.c) */
+static void ichol_apply(const snref_state *s, const double *r, double *z) {
+    const snref_model *m = s->m;
+    unsigned i, j, e, n, c, nF = m->nF;
+    for (i = 0; i < nF; i++) matT_vec(s->R + 9 * i, r + 3 * i, z + 3 * i);
+    for (j = 0, n = 0; j < nF; j++) /* forward: y_i -= U_ji^T y_j */
+        for (e = m->rowptr[j]; e < m->rowptr[j + 1] && m->cols[e] < nF; e++, n++) {
+            const double *U = m->ichol + 9 * (size_t)n;
+            i = m->cols[e];
+            for (c = 0; c < 3; c++) z[3 * i + c] -= U[c] * z[3 * j] + U[3 + c] * z[3 * j + 1] + U[6 + c] * z[3 * j + 2];
+        }
+    for (i = 0; i < nF; i++) {
+        double t[3] = { z[3 * i], z[3 * i + 1], z[3 * i + 2] };
+        mat_vec(m->precond + 9 * i, t, z + 3 * i);
+    }
+    for (j = nF; j-- > 0;) { /* backward: z_j -= sum_i U_ji z_i */
+        unsigned f = m->rowptr[j];
+        while (f < m->rowptr[j + 1] && m->cols[f] < nF) f++;
+        n -= f - m->rowptr[j];
+        for (e = m->rowptr[j]; e < f; e++) {
+            const double *U = m->ichol + 9 * (size_t)(n + e - m->rowptr[j]);
+            i = m->cols[e];
+            for (c = 0; c < 3; c++) z[3 * j + c] -= U[3 * c] * z[3 * i] + U[3 * c + 1] * z[3 * i + 1] + U[3 * c + 2] * z[3 * i + 2];
+        }
+    }
+    for (i = 0; i < nF; i++) {
+        double t[3] = { z[3 * i], z[3 * i + 1], z[3 * i + 2] };
+        mat_vec(s->R + 9 * i, t, z + 3 * i);
+    }
+}
+
+/* z_i = R_i P_i R_i^T r_i (step 6: the vertex frame); the IC(0) of an ICHOL
+ * blob instead when P is the blob's own (no rescaled h or damping) */
 static void precond_apply(const snref_state *s, const double *P, const double *r, double *z) {
     unsigned i;
+    if (s->m->nIC && P == s->m->precond) { ichol_apply(s, r, z); return; }
     for (i = 0; i < s->m->nF; i++) {
         double a[3], b[3];
         matT_vec(s->R + 9 * i, r + 3 * i, a);

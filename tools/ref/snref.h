@@ -44,7 +44,9 @@ typedef struct snref_model {
     int *fb1, *fb2;       /* nV vertex frame bones */
     double *fw;           /* nV vertex frame weight */
     double *mdiag;        /* nF */
-    double *precond;      /* nF*9 full symmetric block */
+    double *precond;      /* nF*9 full symmetric block: A0_ii^-1, or with ICHOL the IC(0) pivots D_i^-1 */
+    unsigned nIC;         /* ICHOL blocks (0: block Jacobi) */
+    double *ichol;        /* nIC*9: U_ji = L^_ij^T (free-free upper mass entries, row order), row-major */
     double *mlump;        /* nF */
     unsigned *rowptr;     /* nF+1 (mass pattern) */
     unsigned *cols;       /* nnz */

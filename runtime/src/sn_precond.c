@@ -1,0 +1,169 @@
+/* sn_precond.c -- step 6, the PCG preconditioner z = C r (NUMERICS.md
+ * "Preconditioner"). Without an ICHOL section: rotated block Jacobi,
+ * z_i = R_i P_i R_i^T r_i (PRECOND = the inverse diagonal blocks of A0).
+ * With it: the rest-frame IC(0) of A0 = (1+a1) M^ + (1+b1) sum_e S^_e as a
+ * block LDL^T, A0 ~ (I + L^) D (I + L^)^T, rotated per vertex
+ * (runtime/SOLVER_STUDY.md §1):
+ *   t = R^T r;  y = (I + L^)^-1 t  (forward, by columns);  w = D^-1 y;
+ *   z' = (I + L^)^-T w  (backward, by rows);  z = R z'.
+ * ICHOL stores U_ji = L^_ij^T (j < i) row-wise in the mass pattern's
+ * ROWPTR/COLS order (free columns come first in a row: skeleton ones are
+ * skipped), entries m 2^-frac with an int16 mantissa and one frac per block.
+ *
+ * Fixed point: y_i is a force, Q(19 + k_i); a block's 3-term row
+ * (<= 3 (2^15 - 1) 2^28 < 2^44.6) is rounded once into the target vertex's
+ * format (shift frac + k_j - k_i in [-15, 62]; below 0 it is scaled up by
+ * at most 2^15 and clamped, counted), summed in int64 with the vertex's other
+ * rows (the instance's accumulators, scratch here) and clamped once (counted)
+ * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
+ * round by frac into Q22 each, summed in int64, clamped once per vertex. */
+#include "sn_instance.h"
+
+/* int16 from two little-endian bytes, without an implementation-defined
+ * conversion (little-endian hosts: one load; int16_t is two's complement) */
+SN_INLINE int32_t rd_i16(const unsigned char *p) {
+#if SN_HOST_LE
+    int16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    return (int32_t)(sn_rd_u16(p) ^ 0x8000u) - 32768;
+#endif
+}
+
+/* Block U (entries as sn_q: fixed the mantissa, float the value) and its frac. */
+SN_INLINE int ic_block(const unsigned char *b, sn_q U[9]) {
+    int k;
+#if defined(SN_FLOAT)
+    uint32_t u = (uint32_t)(127 - b[18]) << 23; /* 2^-frac, frac <= 47: a normal float */
+    float s;
+    memcpy(&s, &u, 4);
+    for (k = 0; k < 9; k++) U[k] = (float)rd_i16(b + 2 * k) * s;
+#else
+    for (k = 0; k < 9; k++) U[k] = rd_i16(b + 2 * k);
+#endif
+    return b[18];
+}
+
+/* A block row product p (|p| < 2^44.6) at shift s: rounded (s >= 0: < 2^44.6,
+ * no clamp needed) or, s < 0, scaled up by 2^-s <= 2^15 and clamped to the
+ * state range (counted). Float: p. */
+SN_INLINE sn_acc ic_round(sn_acc p, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s; (void)sat;
+    return p;
+#else
+    if (s >= 0) return sn_rshr64(p, s);
+    return sn_out(p * ((int64_t)1 << -s), 0, sat);
+#endif
+}
+
+/* y = (I + L^)^-1 y in place: for j ascending, y_i -= U_ji^T y_j (i > j).
+ * The rounded block rows bound for y_i are summed in acc (int64: at most
+ * SN_MAX_ROW_BLOCKS of them, each < 2^44.6 or clamped to 2^28: < 2^49.3) and
+ * y_i is formed, clamped once, when the sweep reaches i. Returns the ICHOL
+ * count (the blocks it read). */
+static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc *acc, uint32_t *sat) {
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL];
+    uint32_t j, e, n = 0, nF = v->nF;
+    for (j = 0; j < 3 * nF; j++) acc[j] = 0;
+    for (j = 0; j < nF; j++) {
+        uint32_t end = sn_rd_u32(rp + 4 * j + 4);
+        sn_q *yj = y + 3 * j;
+        yj[0] = sn_out((sn_acc)yj[0] - acc[3 * j], 0, sat);
+        yj[1] = sn_out((sn_acc)yj[1] - acc[3 * j + 1], 0, sat);
+        yj[2] = sn_out((sn_acc)yj[2] - acc[3 * j + 2], 0, sat);
+        for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
+            uint32_t i = sn_rd_u16(cols + 2 * e);
+            sn_acc *ai = acc + 3 * i;
+            sn_q U[9];
+            int s;
+            if (i >= nF) break; /* skeleton columns: not in ICHOL */
+            s = ic_block(L + (size_t)n * SN_ELEM_ICHOL, U);
+#if !defined(SN_FLOAT)
+            s += (int)kk[j] - (int)kk[i]; /* Q(19 + k_j + frac) -> Q(19 + k_i) */
+#endif
+            ai[0] += ic_round(sn_mul(U[0], yj[0]) + sn_mul(U[3], yj[1]) + sn_mul(U[6], yj[2]), s, sat);
+            ai[1] += ic_round(sn_mul(U[1], yj[0]) + sn_mul(U[4], yj[1]) + sn_mul(U[7], yj[2]), s, sat);
+            ai[2] += ic_round(sn_mul(U[2], yj[0]) + sn_mul(U[5], yj[1]) + sn_mul(U[8], yj[2]), s, sat);
+        }
+    }
+    (void)kk;
+    return n;
+}
+
+/* z = (I + L^)^-T z in place: for j descending, z_j -= sum_i U_ji z_i (Q22;
+ * each block row rounded by frac, < 2^44.6; their sum < 2^49.3) */
+static void ic_backward(const sn_view *v, uint32_t n, sn_q *z, uint32_t *sat) {
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL];
+    uint32_t j = v->nF, e, nF = v->nF;
+    while (j-- > 0) {
+        uint32_t b = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4), f = b;
+        sn_acc l0 = 0, l1 = 0, l2 = 0;
+        const unsigned char *blk;
+        while (f < end && sn_rd_u16(cols + 2 * f) < nF) f++; /* free columns first */
+        n -= f - b;
+        blk = L + (size_t)n * SN_ELEM_ICHOL;
+        for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
+            const sn_q *zi = z + 3 * sn_rd_u16(cols + 2 * e);
+            sn_q U[9];
+            int s = ic_block(blk, U);
+            l0 += ic_round(sn_mul(U[0], zi[0]) + sn_mul(U[1], zi[1]) + sn_mul(U[2], zi[2]), s, sat);
+            l1 += ic_round(sn_mul(U[3], zi[0]) + sn_mul(U[4], zi[1]) + sn_mul(U[5], zi[2]), s, sat);
+            l2 += ic_round(sn_mul(U[6], zi[0]) + sn_mul(U[7], zi[1]) + sn_mul(U[8], zi[2]), s, sat);
+        }
+        z[3 * j] = sn_out((sn_acc)z[3 * j] - l0, 0, sat);
+        z[3 * j + 1] = sn_out((sn_acc)z[3 * j + 1] - l1, 0, sat);
+        z[3 * j + 2] = sn_out((sn_acc)z[3 * j + 2] - l2, 0, sat);
+    }
+}
+
+/* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
+ * block Jacobi of format 5 did: float keeps its signed zeros) */
+SN_INLINE void sym_mul(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
+    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    l[0] = l[1] = l[2] = 0;
+    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
+    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
+    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
+}
+
+void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *R = CARR(h, o_R, sn_q);
+    const unsigned char *P = v->sec[SN_SEC_PRECOND];
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t i, n;
+    if (!v->ic) { /* block Jacobi: z_i = R_i P_i R_i^T r_i */
+        for (i = 0; i < v->nF; i++) {
+            sn_q t[3], s[3];
+            sn_acc a[3];
+            int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
+            sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
+            sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
+            s[0] = sn_out(a[0], sh, sat);
+            s[1] = sn_out(a[1], sh, sat);
+            s[2] = sn_out(a[2], sh, sat);
+            sn_rot(R + 9 * i, s, z + 3 * i, sat);
+        }
+        return;
+    }
+    for (i = 0; i < v->nF; i++) sn_rot_t(R + 9 * i, r + 3 * i, z + 3 * i, sat);
+    n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
+    for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
+        sn_acc a[3];
+        int sh = v->frac_P + SN_KREL(kk[i]);
+        sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, z + 3 * i);
+        z[3 * i] = sn_out(a[0], sh, sat);
+        z[3 * i + 1] = sn_out(a[1], sh, sat);
+        z[3 * i + 2] = sn_out(a[2], sh, sat);
+    }
+    ic_backward(v, n, z, sat);
+    for (i = 0; i < v->nF; i++) {
+        sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
+        sn_rot(R + 9 * i, t, z + 3 * i, sat);
+    }
+}
