@@ -8,6 +8,7 @@
 # scalar, armhf NEON (qemu user mode), the Cortex-M4 DSP kernels. Float
 # flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
 # and sinew-play-float).
+# The crease and level-of-detail scenarios run on every hosted platform too.
 # Every platform must also give the hash committed in tests/expected_hashes.txt
 # (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
@@ -195,6 +196,29 @@ for fl in "" _float; do
     else bad "crease sinew-play$fl: run failed"; tail -n 5 "$L/run_crease_play$fl.log" | sed 's/^/    /'; fi
 done
 
+# ---- level of detail (issue 13, runtime/LEVELS.md): the cow baked with
+# 'levels 2', the trot with the level switched up, down and up, on every
+# hosted platform; sinew-play's hash is tests/expected_hashes.txt's lod_* ----
+LOD_SW=250:1,500:0,750:1
+lodfixed=""; lodfloat=""
+pmake "$BUILD/level/cow_lod.blob" "$BUILD/level/cow_lod_float.blob" > "$L/build_lod.log" 2>&1 || \
+    { bad "lod: blobs failed to bake"; tail -n 5 "$L/build_lod.log"; }
+while read -r name target runner; do
+    case $name in cortex-*|"") continue ;; esac
+    [ -f "$L/rc_$name" ] && [ -x "$target" ] || continue
+    case $name in float-*) b=$BUILD/level/cow_lod_float.blob ;; *) b=$BUILD/level/cow_lod.blob ;; esac
+    case $runner in -) c="$target $b --steps $STEPS $clip_arg --lod $LOD_SW" ;; *) c="$runner $target $b --steps $STEPS $clip_arg --lod $LOD_SW" ;; esac
+    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
+    if timeout 600 $c < /dev/null > "$L/run_lod_$name.log" 2>&1 && h=$(hash_of "$L/run_lod_$name.log") && [ -n "$h" ]; then
+        echo "determinism: lod $name $h"
+        case $name in float-*) lodfloat="$lodfloat$name $h
+" ;; *) lodfixed="$lodfixed$name $h
+" ;; esac
+    else bad "lod $name: run failed"; tail -n 5 "$L/run_lod_$name.log" | sed 's/^/    /'; fi
+done <<EOF2
+$plats
+EOF2
+
 # desktop player (fixed): sinew-play on the blob file of the same bake
 if pmake "$BUILD/sinew-play" "$BUILD/examples/cow.blob" > "$L/build_play.log" 2>&1; then
     if run_log "$L/run_play.log" 600 "$BUILD/sinew-play" "$BUILD/examples/cow.blob" $clip_arg \
@@ -253,6 +277,8 @@ agree "fixed flavour, blended mode" "$fixedb" 2
 agree "float flavour, blended mode" "$floatb" 2
 agree "crease, fixed flavour" "$crfixed" 2
 agree "crease, float flavour" "$crfloat" 2
+agree "level of detail, fixed flavour" "$lodfixed" 2
+agree "level of detail, float flavour" "$lodfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -274,6 +300,8 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "float flavour, blended mode" "$floatb" float-blended
     expect_hash "crease, fixed flavour" "$crfixed" crease_fixed
     expect_hash "crease, float flavour" "$crfloat" crease_float
+    expect_hash "level of detail, fixed flavour" "$lodfixed" lod_fixed
+    expect_hash "level of detail, float flavour" "$lodfloat" lod_float
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi
