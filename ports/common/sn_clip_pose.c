@@ -18,6 +18,13 @@ static void put(char *err, size_t cap, size_t *len, const char *s) {
     for (; *s; s++) if (*len + 1 < cap) err[(*len)++] = *s;
     if (cap) err[*len] = 0;
 }
+static void put_uint(char *err, size_t cap, size_t *len, uint32_t v) {
+    char d[12];
+    int n = 11;
+    d[11] = 0;
+    do { d[--n] = (char)('0' + v % 10u); v /= 10u; } while (v);
+    put(err, cap, len, d + n);
+}
 
 int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
     sn_blob_info info;
@@ -60,7 +67,7 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
         }
         if (ch->kind == SN_CLIP_COLLIDER) {
             if (clip->n_colliders > info.max_colliders) {
-                put(err, errlen, &len, info.max_colliders ? "the clip has more collider channels than the blob's max_colliders (description: 'colliders N CONTACTS'; one name can carry colliders one after another)"
+                put(err, errlen, &len, info.max_colliders ? "the clip has more collider channels than the blob's max_colliders (description: 'colliders N CONTACTS'; reuse a name for colliders one after another)"
                                                           : "the clip has colliders but the blob bakes none (description: 'colliders N CONTACTS')");
                 return 1;
             }
@@ -69,7 +76,7 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
         if (ch->kind == SN_CLIP_PIN) {   /* vertices must exist */
             uint32_t k;
             if (clip->n_pins > info.max_constraints) {
-                put(err, errlen, &len, info.max_constraints ? "the clip has more pin channels than the blob's max_constraints (description: 'constraints N'; one name can pin points one after another)"
+                put(err, errlen, &len, info.max_constraints ? "the clip has more pin channels than the blob's max_constraints (description: 'constraints N'; reuse a name for pins one after another)"
                                                             : "the clip has pins but the blob bakes no constraints (description: 'constraints N')");
                 return 1;
             }
@@ -80,8 +87,12 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
                 if ((f & SN_CLIP_PIN_LATTICE) ? v >= info.free_vertices : v >= info.surface_vertices) {
                     put(err, errlen, &len, "clip pin '");
                     put(err, errlen, &len, ch->name);
-                    put(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? "' names a lattice vertex beyond the blob's free lattice vertices"
-                                                                     : "' names a surface vertex beyond the blob's");
+                    put(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? "' names lattice vertex " : "' names surface vertex ");
+                    put_uint(err, errlen, &len, v);
+                    put(err, errlen, &len, ", but the blob has ");
+                    put_uint(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? info.free_vertices : info.surface_vertices);
+                    put(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? " free lattice vertices (sinew-bake lists the lattice)"
+                                                                     : " surface vertices (those of the mesh it was baked from)");
                     return 1;
                 }
             }
