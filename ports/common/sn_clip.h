@@ -206,7 +206,8 @@ uint32_t sn_clip_colliders(const sn_clip *clip, const sn_blob *blob, uint32_t st
 /// key's target is where the point is (sn_get_surface / sn_get_lattice of
 /// inst) at the first call the key is in force, kept in hold[] (one entry per
 /// channel, SN_CLIP_MAX_CHANNELS, zeroed by the caller before the first
-/// step). Writes at most max to out in channel order; returns how many.
+/// step; inst NULL or a vertex it refuses: the origin). Writes at most max
+/// to out in channel order; returns how many.
 uint32_t sn_clip_constraints(const sn_clip *clip, const sn_blob *blob, uint32_t step,
                              const sn_instance *inst, sn_clip_hold *hold,
                              sn_constraint *out, uint32_t max);

@@ -192,6 +192,7 @@ void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
         const sn_clip_key *a, *b;
         int32_t u;
         if (!ch->count || ch->kind == SN_CLIP_CONTROL || ch->joint < 0 || (uint32_t)ch->joint >= info.joints) continue;
+        if (ch->kind == SN_CLIP_COLLIDER || ch->kind == SN_CLIP_PIN) continue;   /* not pose channels */
         segment(clip, ch, t, &a, &b, &u);
         if (ch->kind == SN_CLIP_MOVE) {
             root->x = from_q16(lerp_q16(a->v[0], b->v[0], u));
@@ -342,8 +343,8 @@ uint32_t sn_clip_constraints(const sn_clip *clip, const sn_blob *blob, uint32_t 
         if (f & SN_CLIP_PIN_HOLD) {
             if (hold[c].key_plus1 != idx + 1u) {   /* the key came into force: where the point is now */
                 hold[c].key_plus1 = idx + 1u;
-                if ((f & SN_CLIP_PIN_LATTICE ? sn_get_lattice(inst, &hold[c].at, v, 1)
-                                             : sn_get_surface(inst, &hold[c].at, v, 1)) != SN_OK)
+                if (!inst || (f & SN_CLIP_PIN_LATTICE ? sn_get_lattice(inst, &hold[c].at, v, 1)
+                                                      : sn_get_surface(inst, &hold[c].at, v, 1)) != SN_OK)
                     memset(&hold[c].at, 0, sizeof hold[c].at);
             }
             o->target = hold[c].at;
