@@ -6,7 +6,7 @@
  * straight into Q16.16 and all time arithmetic is integer, so the fixed
  * flavour gives bit-identical poses on every platform.
  *
- *   sn_clip clip;                    // caller storage (~23 KB with defaults)
+ *   sn_clip clip;                    // caller storage (~25 KB with defaults)
  *   char err[SN_CLIP_ERR_LEN];
  *   if (sn_clip_parse(&clip, text, len, err, sizeof err)) fail(err);
  *   if (sn_clip_bind(&clip, blob, err, sizeof err)) fail(err);
