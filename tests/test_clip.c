@@ -290,7 +290,8 @@ int main(void) {
     bad(H "rot head 1 0 1 0 5\nrot tail 0.5 0 1 0 5\nrot head 1 0 1 0 6\n", 5, "strictly increase");
     bad(H "move 1 0 0 0\nmove 0.5 0 0 0\n", 4, "strictly increase");
     bad(H "rot a_joint_name_that_is_much_too_long 0 0 1 0 5\n", 3, "longer than 31 bytes");
-    bad(H "rot a 0 0 1 0 5 # fine\nrot a 1 0 1 0 5 6 7 8 9 10\n", 4, "too many fields");
+    bad(H "rot a 0 0 1 0 5 # fine\nrot a 1 0 1 0 5 6 7 8 9 10 11 12 13 14 15 16 17 18\n", 4, "too many fields");
+    bad(H "rot a 1 0 1 0 5 6 7 8 9 10\n", 3, "usage: rot");
     bad(H "rot a 0 0 1 0 99999\n", 3, "number out of range");
     /* control lines */
     bad(H "control breath 0\n", 3, "usage: control <name> <time> <value>");
@@ -304,7 +305,7 @@ int main(void) {
     bad(H "control breath 1 1\nrot breath 0 0 1 0 5\ncontrol breath 1 0\n", 5, "strictly increase");
     bad(H "control a_control_name_that_is_much_too_long 0 1\n", 3, "longer than 31 bytes");
     bad("sinew-clip 1\ncontrol breath 0 1\nduration 1\n", 2, "'duration' must come before");
-    bad(H "controls breath 0 1\n", 3, "unknown keyword (expected duration, loop, rot, move, control, impulse)");
+    bad(H "controls breath 0 1\n", 3, "unknown keyword (expected duration, loop, rot, move, control, impulse, collider, pin)");
     /* impulse lines: impulse <time> <surface vertex> <jx> <jy> <jz> [profile] */
     bad(H "impulse 0 3 0 1\n", 3, "usage: impulse");
     bad(H "impulse 0 3 0 1 0 0 9\n", 3, "usage: impulse");
@@ -321,6 +322,131 @@ int main(void) {
                 clip.chan[0].kind == SN_CLIP_IMPULSE && !strcmp(clip.chan[0].name, "-1") && clip.chan[0].count == 2 &&
                 !strcmp(clip.chan[1].name, "2") && clip.keys[clip.chan[1].first].v[3] == 7 &&
                 clip.keys[clip.chan[1].first].v[2] == 3 * 65536, "impulse channels per profile: %s", err);
+    }
+
+    /* collider lines: collider <name> <time> plane|sphere|capsule <numbers> [vel vx vy vz] [mu f] | off */
+    {
+        static const char ok[] = H
+            "collider ground 0 plane 0 -1.25 0 0 1 0 mu 0.5\n"
+            "collider ball 0.5 sphere 1 2 3 0.75 vel 0 -2 0.5\n"
+            "collider arm 0 capsule 0 0 0 1 1 1 0.25 mu 1 vel 1 0 0\n"      /* options in either order */
+            "collider ball 1 off\n"
+            "collider ball 1.5 sphere 0 0 0 0\n"                              /* radius 0: a point */
+            "collider ground 2 off   # until the end\n";
+        const sn_clip_shape *sh;
+        T_CHECK(sn_clip_parse(&clip, ok, sizeof ok - 1, err, sizeof err) == 0, "collider lines: %s", err);
+        T_CHECK(clip.n_channels == 3 && clip.n_colliders == 3 && clip.n_pins == 0 && clip.n_shapes == 4 &&
+                clip.chan[0].kind == SN_CLIP_COLLIDER && !strcmp(clip.chan[0].name, "ground") && clip.chan[0].count == 2 &&
+                !strcmp(clip.chan[1].name, "ball") && clip.chan[1].count == 3 && !strcmp(clip.chan[2].name, "arm"),
+                "collider channels: %u channels, %u colliders, %u shapes", clip.n_channels, clip.n_colliders, clip.n_shapes);
+        T_CHECK(clip.keys[clip.chan[0].first].v[0] == 0 && clip.keys[clip.chan[0].first + 1].v[0] == -1 &&
+                clip.keys[clip.chan[0].first + 1].t == 2 * 65536 && clip.keys[clip.chan[1].first + 1].v[0] == -1 &&
+                clip.keys[clip.chan[1].first + 2].v[0] == 3, "collider keys: shape indices and off");
+        sh = &clip.shapes[0];
+        T_CHECK(sh->kind == SN_COLLIDER_PLANE && sh->a[1] == -81920 && sh->b[1] == 65536 && sh->mu == 32768 &&
+                !sh->vel[0] && !sh->vel[1], "plane shape");
+        sh = &clip.shapes[1];
+        T_CHECK(sh->kind == SN_COLLIDER_SPHERE && sh->a[0] == 65536 && sh->a[2] == 3 * 65536 && sh->radius == 49152 &&
+                sh->vel[1] == -2 * 65536 && sh->vel[2] == 32768 && !sh->mu, "sphere shape");
+        sh = &clip.shapes[2];
+        T_CHECK(sh->kind == SN_COLLIDER_CAPSULE && sh->b[0] == 65536 && sh->b[2] == 65536 && sh->radius == 16384 &&
+                sh->vel[0] == 65536 && sh->mu == 65536, "capsule shape");
+    }
+    bad(H "collider g 0\n", 3, "usage: collider <name> <time> plane|sphere|capsule");
+    bad(H "collider g soon plane 0 0 0 0 1 0\n", 3, "key time is not a number: 'soon'");
+    bad(H "collider g 0 box 0 0 0 1\n", 3, "collider shape must be plane, sphere, capsule or off, found 'box'");
+    bad(H "collider g 0 plane 0 0 0 0 1\n", 3, "usage: collider <name> <time> plane <px>");
+    bad(H "collider g 0 sphere 0 0 0\n", 3, "usage: collider <name> <time> sphere <cx>");
+    bad(H "collider g 0 capsule 0 0 0 1 1 1\n", 3, "usage: collider <name> <time> capsule <ax>");
+    bad(H "collider g 0 plane 0 y 0 0 1 0\n", 3, "collider coordinate is not a number: 'y'");
+    bad(H "collider g 0 plane 0 0 0 0 up 0\n", 3, "plane normal is not a number: 'up'");
+    bad(H "collider g 0 plane 0 0 0 0 0 0\n", 3, "plane normal is zero");
+    bad(H "collider g 0 sphere 0 0 0 big\n", 3, "radius is not a number: 'big'");
+    bad(H "collider g 0 sphere 0 0 0 -1\n", 3, "radius must be >= 0: '-1'");
+    bad(H "collider g 0 capsule 0 0 0 1 1 1 -0.5\n", 3, "radius must be >= 0");
+    bad(H "collider g 0 sphere 0 0 0 1 vel 1 2\n", 3, "usage: vel <vx> <vy> <vz>");
+    bad(H "collider g 0 sphere 0 0 0 1 vel 1 2 fast\n", 3, "velocity is not a number: 'fast'");
+    bad(H "collider g 0 sphere 0 0 0 1 vel 1 2 3 vel 1 2 3\n", 3, "'vel' given twice");
+    bad(H "collider g 0 sphere 0 0 0 1 mu\n", 3, "usage: mu");
+    bad(H "collider g 0 sphere 0 0 0 1 mu -0.1\n", 3, "friction coefficient must be >= 0: '-0.1'");
+    bad(H "collider g 0 sphere 0 0 0 1 mu x\n", 3, "friction coefficient is not a number: 'x'");
+    bad(H "collider g 0 sphere 0 0 0 1 mu 1 mu 1\n", 3, "'mu' given twice");
+    bad(H "collider g 0 sphere 0 0 0 1 spin 3\n", 3, "expected 'vel <vx> <vy> <vz>' or 'mu <f>' after the collider's numbers, found 'spin'");
+    bad(H "collider g 0 off 1\n", 3, "nothing after 'off'");
+    bad(H "collider g -1 off\n", 3, "key time is negative");
+    bad(H "collider g 3 off\n", 3, "after the clip duration");
+    bad(H "collider g 1 off\ncollider g 1 sphere 0 0 0 1\n", 4, "strictly increase");
+    bad(H "collider a_collider_name_that_is_much_too_long 0 off\n", 3, "collider name longer than 31 bytes");
+    bad("sinew-clip 1\ncollider g 0 off\nduration 1\n", 2, "'duration' must come before");
+    bad(H "collider g 0 sphere 0 0 0 40000\n", 3, "number out of range");
+    /* shape limit: SN_CLIP_MAX_SHAPES placements parse, one more does not; 'off' takes none */
+    {
+        static char big[16384];
+        size_t n = (size_t)sprintf(big, "sinew-clip 1\nduration 1000\n");
+        for (i = 0; i < SN_CLIP_MAX_SHAPES; i++) n += (size_t)sprintf(big + n, "collider c %d sphere 0 0 0 1\ncollider c %d.5 off\n", i, i);
+        T_CHECK(sn_clip_parse(&clip, big, n, err, sizeof err) == 0 && clip.n_shapes == SN_CLIP_MAX_SHAPES &&
+                clip.n_colliders == 1 && clip.chan[0].count == 2 * SN_CLIP_MAX_SHAPES, "full shapes: %s", err);
+        n += (size_t)sprintf(big + n, "collider c %d sphere 0 0 0 1\n", SN_CLIP_MAX_SHAPES);
+        T_CHECK(sn_clip_parse(&clip, big, n, err, sizeof err) == 1 && strstr(err, "too many collider placements (limit SN_CLIP_MAX_SHAPES)") &&
+                clip.error_line == 2 * SN_CLIP_MAX_SHAPES + 3, "one shape too many: line %u %s", clip.error_line, err);
+        n = (size_t)sprintf(big, "sinew-clip 1\nduration 1\n");
+        for (i = 0; i <= SN_CLIP_MAX_CHANNELS; i++) n += (size_t)sprintf(big + n, "%s c%d 0 off\n", i & 1 ? "pin" : "collider", i);
+        T_CHECK(sn_clip_parse(&clip, big, n, err, sizeof err) == 1 && strstr(err, "too many channels") &&
+                clip.error_line == SN_CLIP_MAX_CHANNELS + 3, "one collider/pin channel too many: %s", err);
+    }
+    /* the longest line: a capsule with vel and mu is 17 fields */
+    {
+        static const char ok[] = H "collider c 0 capsule 0 0 0 1 1 1 0.5 vel 0 0 1 mu 0.25\n";
+        T_CHECK(sn_clip_parse(&clip, ok, sizeof ok - 1, err, sizeof err) == 0 && clip.n_shapes == 1, "17-field capsule: %s", err);
+    }
+    bad(H "collider c 0 capsule 0 0 0 1 1 1 0.5 vel 0 0 1 mu 0.25 x\n", 3, "too many fields");
+
+    /* pin lines: pin <name> <time> surface|lattice <vertex> hold|<x> <y> <z> [axes xyz] | off */
+    {
+        static const char ok[] = H
+            "pin hoof 0 surface 120 hold\n"
+            "pin hoof 1 surface 120 0.5 -1 2 axes y\n"
+            "pin hoof 1.5 surface 120 0.5 0 2 axes y\n"
+            "pin hoof 2 off\n"
+            "pin core 0.25 lattice 7 1 2 3 axes zx\n";
+        const sn_clip_key *k;
+        T_CHECK(sn_clip_parse(&clip, ok, sizeof ok - 1, err, sizeof err) == 0 && clip.n_pins == 2 && clip.n_colliders == 0 &&
+                clip.n_channels == 2 && clip.chan[0].kind == SN_CLIP_PIN && clip.chan[0].count == 4 &&
+                !strcmp(clip.chan[1].name, "core"), "pin lines: %s", err);
+        k = &clip.keys[clip.chan[0].first];
+        T_CHECK(k[0].v[3] == (120 | SN_CLIP_PIN_HOLD | (int32_t)(SN_AXIS_ALL << SN_CLIP_PIN_AXES_SHIFT)) &&
+                k[1].v[3] == (120 | (int32_t)(SN_AXIS_Y << SN_CLIP_PIN_AXES_SHIFT)) && k[1].v[0] == 32768 &&
+                k[1].v[1] == -65536 && k[1].v[2] == 2 * 65536 && k[2].v[3] == k[1].v[3] && k[3].v[3] == SN_CLIP_PIN_OFF,
+                "pin keys: %x %x %x %x", (unsigned)k[0].v[3], (unsigned)k[1].v[3], (unsigned)k[2].v[3], (unsigned)k[3].v[3]);
+        k = &clip.keys[clip.chan[1].first];
+        T_CHECK(k[0].v[3] == (7 | SN_CLIP_PIN_LATTICE | (int32_t)((SN_AXIS_X | SN_AXIS_Z) << SN_CLIP_PIN_AXES_SHIFT)) &&
+                k[0].t == 16384, "lattice pin key %x", (unsigned)k[0].v[3]);
+    }
+    bad(H "pin p 0\n", 3, "usage: pin <name> <time> surface|lattice");
+    bad(H "pin p 0 bone 3 hold\n", 3, "pin point must be surface, lattice or off, found 'bone'");
+    bad(H "pin p 0 surface 3\n", 3, "usage: pin <name> <time> surface|lattice <vertex>");
+    bad(H "pin p 0 surface 3 1 2\n", 3, "usage: pin <name> <time> surface|lattice <vertex>");
+    bad(H "pin p 0 surface v3 hold\n", 3, "vertex is not a number: 'v3'");
+    bad(H "pin p 0 surface 3.5 hold\n", 3, "vertex must be a whole number >= 0: '3.5'");
+    bad(H "pin p 0 lattice -3 hold\n", 3, "vertex must be a whole number >= 0");
+    bad(H "pin p 0 surface 3 1 two 3\n", 3, "pin target is not a number: 'two'");
+    bad(H "pin p 0 surface 3 hold yz\n", 3, "expected 'axes <xyz>' (or nothing) after the pin's target, found 'yz'");
+    bad(H "pin p 0 surface 3 1 2 3 axes\n", 3, "expected 'axes <xyz>'");
+    bad(H "pin p 0 surface 3 1 2 3 axes y z\n", 3, "expected 'axes <xyz>'");
+    bad(H "pin p 0 surface 3 hold axes yy\n", 3, "axes must be x, y and/or z, each at most once");
+    bad(H "pin p 0 surface 3 hold axes w\n", 3, "axes must be x, y and/or z");
+    bad(H "pin p 0 off now\n", 3, "nothing after 'off'");
+    bad(H "pin p -0.5 off\n", 3, "key time is negative");
+    bad(H "pin p 2.5 surface 1 hold\n", 3, "after the clip duration");
+    bad(H "pin p 1 surface 1 hold\npin q 0 off\npin p 0.5 off\n", 5, "strictly increase");
+    bad(H "pin a_pin_name_that_is_much_too_long_yes 0 off\n", 3, "pin name longer than 31 bytes");
+    bad("sinew-clip 1\npin p 0 off\nduration 1\n", 2, "'duration' must come before");
+    bad(H "pin p 0 surface 40000 hold\n", 3, "number out of range");
+    /* pins and colliders share the channel pool with everything else and their
+       names live apart from joints and controls */
+    {
+        static const char ok[] = H "rot head 0 0 1 0 5\ncontrol head 0 1\ncollider head 0 off\npin head 0 off\n";
+        T_CHECK(sn_clip_parse(&clip, ok, sizeof ok - 1, err, sizeof err) == 0 && clip.n_channels == 4, "same name, four kinds: %s", err);
     }
     bad(H "control breath 0 1e3\n", 3, "control value is not a number: '1e3'");
     {

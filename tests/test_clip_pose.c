@@ -206,6 +206,75 @@ int main(void) {
                 "bind refuses a surface vertex the blob lacks: %s", err);
         free(mem);
     }
+
+    /* colliders and pins: placements at the step's start, targets at its end */
+    {
+        void *mem = malloc(sn_instance_size(blob) + 8);
+        sn_instance *inst;
+        sn_collider cl[4];
+        sn_constraint cs[4];
+        static sn_clip_hold hold[SN_CLIP_MAX_CHANNELS];
+        sn_vec3 p3;
+        uint32_t nc, seen_ball = 0, seen_lerp = 0, seen_none = 0;
+#ifdef SN_FLOAT
+#define QD(x) ((double)(x))
+#else
+#define QD(x) ((double)(x) / 65536.0)
+#endif
+        h = sn_clip_timestep_q16(blob);
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 2\nloop yes\n"
+            "collider g 0 plane 0 -3.39 0 0 1 0 mu 0.5\ncollider b 0.5 sphere 1 -2.5 0 1 vel 0 0.5 0\ncollider b 1 off\n"
+            "pin p 0 surface 3 hold axes y\npin p 0.5 surface 3 1 2 3\npin p 1.5 surface 3 2 4 -1\npin p 1.75 off\n");
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 0,
+                "collider/pin clip: %s", err);
+        T_CHECK(sn_instance_init(mem, sn_instance_size(blob), blob, &inst) == SN_OK, "instance");
+        memset(hold, 0, sizeof hold);
+        nc = sn_clip_colliders(&clip, blob, 1, cl, 4);
+        T_CHECK(nc == 1 && cl[0].kind == SN_COLLIDER_PLANE && fabs(QD(cl[0].a.y) + 3.39) < 1e-5 && QD(cl[0].b.y) == 1 &&
+                QD(cl[0].friction) == 0.5 && QD(cl[0].radius) == 0, "step 1: the ground only (%u)", nc);
+        T_CHECK(sn_clip_colliders(&clip, blob, 1, cl, 0) == 0, "max 0");
+        sn_get_surface(inst, &p3, 3, 1);
+        nc = sn_clip_constraints(&clip, blob, 1, inst, hold, cs, 4);
+        T_CHECK(nc == 1 && cs[0].at == SN_AT_SURFACE && cs[0].vertex == 3 && cs[0].axes == SN_AXIS_Y &&
+                cs[0].target.x == p3.x && cs[0].target.y == p3.y && cs[0].target.z == p3.z, "step 1: pin held where vertex 3 is");
+        for (k = 1; k <= (uint32_t)(2 * 65536 / h); k++) {
+            int32_t t0 = sn_clip_time(&clip, h, k - 1), t1 = sn_clip_time(&clip, h, k);
+            nc = sn_clip_colliders(&clip, blob, k, cl, 4);
+            if (t0 >= 32768 && t0 < 65536) {
+                /* -2.5 + 0.5 (t0 - 0.5 s), rounded once in Q16.16 */
+                double y = (-163840 + floor(32768.0 * (t0 - 32768) / 65536.0 + 0.5)) / 65536.0;
+                T_CHECK(nc == 2 && cl[1].kind == SN_COLLIDER_SPHERE && fabs(QD(cl[1].a.y) - y) < 1e-6 && QD(cl[1].a.x) == 1 &&
+                        QD(cl[1].velocity.y) == 0.5 && QD(cl[1].radius) == 1, "step %u: sphere at y %.6f, want %.6f", k, QD(cl[1].a.y), y);
+                seen_ball++;
+            } else T_CHECK(nc == 1, "step %u (t %d): %u colliders, want the ground only", k, t0, nc);
+            nc = sn_clip_constraints(&clip, blob, k, inst, hold, cs, 4);
+            if (t1 >= 32768 && t1 < 98304) {
+                double u = (t1 - 32768) / 65536.0;
+                T_CHECK(nc == 1 && cs[0].axes == SN_AXIS_ALL && fabs(QD(cs[0].target.x) - (1 + u)) < 2e-5 &&
+                        fabs(QD(cs[0].target.y) - (2 + 2 * u)) < 2e-5 && fabs(QD(cs[0].target.z) - (3 - 4 * u)) < 2e-5,
+                        "step %u: target (%.5f %.5f %.5f) interpolated", k, QD(cs[0].target.x), QD(cs[0].target.y), QD(cs[0].target.z));
+                seen_lerp++;
+            } else if (t1 >= 98304 && t1 < 114688) {
+                T_CHECK(nc == 1 && QD(cs[0].target.x) == 2 && QD(cs[0].target.y) == 4 && QD(cs[0].target.z) == -1, "step %u: last target held", k);
+            } else if (t1 >= 114688) {
+                T_CHECK(nc == 0, "step %u: pin off (%u)", k, nc);
+                seen_none++;
+            }
+        }
+        T_CHECK(seen_ball > 10 && seen_lerp > 20 && seen_none > 5, "windows seen: ball %u, lerp %u, off %u", seen_ball, seen_lerp, seen_none);
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\npin p 0 lattice %u hold\n", info.free_vertices);
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 1 &&
+                strstr(err, "names lattice vertex") && strstr(err, "free lattice vertices"), "bind refuses a lattice vertex the blob lacks: %s", err);
+        len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 1\npin p 0 lattice %u hold\n", info.free_vertices - 1);
+        T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 0, "last free lattice vertex: %s", err);
+        sn_get_lattice(inst, &p3, info.free_vertices - 1, 1);
+        memset(hold, 0, sizeof hold);
+        nc = sn_clip_constraints(&clip, blob, 1, inst, hold, cs, 4);
+        T_CHECK(nc == 1 && cs[0].at == SN_AT_LATTICE && cs[0].target.x == p3.x && cs[0].target.y == p3.y, "lattice pin held");
+        T_CHECK(sn_set_constraints(inst, cs, nc) == SN_OK, "the runtime takes it");
+        free(mem);
+#undef QD
+    }
     free(bytes);
     return T_END();
 }

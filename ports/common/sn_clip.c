@@ -123,7 +123,7 @@ static int long_turn(const sn_clip_key *a, const sn_clip_key *b, int64_t *apart,
 }
 
 /* ---- tokens of one line ---- */
-#define MAX_TOK 8
+#define MAX_TOK 17   /* the longest line: a capsule collider with vel and mu */
 typedef struct { const char *p[MAX_TOK]; size_t n[MAX_TOK]; int count; } toks;
 
 /* Splits at blanks, stops at '#'. Returns the token count, MAX_TOK+1 if too many. */
@@ -315,7 +315,114 @@ static int parse_line(pstate *ps, const char *s, size_t n) {
         if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
         return add_key(ps, ci, &key, t.p[1], t.n[1]);
     }
-    return fail(ps, "unknown keyword (expected duration, loop, rot, move, control, impulse):", t.p[0], t.n[0]);
+
+    if (tok_is(&t, 0, "collider")) {
+        /* collider <name> <time> plane|sphere|capsule <numbers> [vel <vx> <vy> <vz>] [mu <f>]
+           collider <name> <time> off */
+        int ci, k, nf, i;
+        sn_clip_key key;
+        sn_clip_shape sh;
+        memset(&key, 0, sizeof key);
+        memset(&sh, 0, sizeof sh);
+        if (!ps->have_duration) return fail(ps, "'duration' must come before the first key", 0, 0);
+        if (nt < 4) return fail(ps, "usage: collider <name> <time> plane|sphere|capsule <numbers> [vel <vx> <vy> <vz>] [mu <f>], or collider <name> <time> off", 0, 0);
+        if (t.n[1] > SN_CLIP_NAME_MAX) return fail(ps, "collider name longer than 31 bytes:", t.p[1], t.n[1]);
+        if (num(ps, &t, 2, "key time is not a number:", &key.t)) return 1;
+        if (tok_is(&t, 3, "off")) {
+            if (nt != 4) return fail(ps, "usage: collider <name> <time> off (nothing after 'off')", 0, 0);
+            key.v[0] = -1;
+        } else {
+            if (tok_is(&t, 3, "plane")) { sh.kind = 0; nf = 6; }
+            else if (tok_is(&t, 3, "sphere")) { sh.kind = 1; nf = 4; }
+            else if (tok_is(&t, 3, "capsule")) { sh.kind = 2; nf = 7; }
+            else return fail(ps, "collider shape must be plane, sphere, capsule or off, found", t.p[3], t.n[3]);
+            if (nt < 4 + nf)
+                return fail(ps, sh.kind == 0 ? "usage: collider <name> <time> plane <px> <py> <pz> <nx> <ny> <nz> [vel <vx> <vy> <vz>] [mu <f>]"
+                              : sh.kind == 1 ? "usage: collider <name> <time> sphere <cx> <cy> <cz> <radius> [vel <vx> <vy> <vz>] [mu <f>]"
+                              : "usage: collider <name> <time> capsule <ax> <ay> <az> <bx> <by> <bz> <radius> [vel <vx> <vy> <vz>] [mu <f>]", 0, 0);
+            for (k = 0; k < 3; k++)
+                if (num(ps, &t, 4 + k, "collider coordinate is not a number:", &sh.a[k])) return 1;
+            if (sh.kind != 1)
+                for (k = 0; k < 3; k++)
+                    if (num(ps, &t, 7 + k, sh.kind == 0 ? "plane normal is not a number:" : "collider coordinate is not a number:", &sh.b[k])) return 1;
+            if (sh.kind == 0 && !sh.b[0] && !sh.b[1] && !sh.b[2]) return fail(ps, "plane normal is zero: give the outward normal, e.g. 0 1 0", 0, 0);
+            if (sh.kind != 0) {
+                i = sh.kind == 1 ? 7 : 10;
+                if (num(ps, &t, i, "radius is not a number:", &sh.radius)) return 1;
+                if (sh.radius < 0) return fail(ps, "radius must be >= 0:", t.p[i], t.n[i]);
+            }
+            for (i = 4 + nf; i < nt;) {   /* options, each at most once, in either order */
+                if (tok_is(&t, i, "vel")) {
+                    if (sh.reserved[0]) return fail(ps, "'vel' given twice", 0, 0);
+                    if (i + 4 > nt) return fail(ps, "usage: vel <vx> <vy> <vz> (mesh units per second)", 0, 0);
+                    for (k = 0; k < 3; k++)
+                        if (num(ps, &t, i + 1 + k, "velocity is not a number:", &sh.vel[k])) return 1;
+                    sh.reserved[0] = 1; i += 4;
+                } else if (tok_is(&t, i, "mu")) {
+                    if (sh.reserved[1]) return fail(ps, "'mu' given twice", 0, 0);
+                    if (i + 2 > nt) return fail(ps, "usage: mu <friction coefficient >= 0>", 0, 0);
+                    if (num(ps, &t, i + 1, "friction coefficient is not a number:", &sh.mu)) return 1;
+                    if (sh.mu < 0) return fail(ps, "friction coefficient must be >= 0:", t.p[i + 1], t.n[i + 1]);
+                    sh.reserved[1] = 1; i += 2;
+                } else return fail(ps, "expected 'vel <vx> <vy> <vz>' or 'mu <f>' after the collider's numbers, found", t.p[i], t.n[i]);
+            }
+            sh.reserved[0] = sh.reserved[1] = 0;
+            if (c->n_shapes >= SN_CLIP_MAX_SHAPES) return fail(ps, "too many collider placements (limit SN_CLIP_MAX_SHAPES)", 0, 0);
+            key.v[0] = c->n_shapes;
+        }
+        ci = channel(c, SN_CLIP_COLLIDER, t.p[1], t.n[1]);
+        if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
+        if (add_key(ps, ci, &key, t.p[2], t.n[2])) return 1;
+        if (key.v[0] >= 0) c->shapes[c->n_shapes++] = sh;   /* only once the key is in */
+        return 0;
+    }
+    if (tok_is(&t, 0, "pin")) {
+        /* pin <name> <time> surface|lattice <vertex> hold|<x> <y> <z> [axes <xyz>]
+           pin <name> <time> off */
+        int ci, k, i;
+        int32_t vq;
+        uint32_t axes = 0;
+        sn_clip_key key;
+        memset(&key, 0, sizeof key);
+        if (!ps->have_duration) return fail(ps, "'duration' must come before the first key", 0, 0);
+        if (nt < 4) return fail(ps, "usage: pin <name> <time> surface|lattice <vertex> hold|<x> <y> <z> [axes <xyz>], or pin <name> <time> off", 0, 0);
+        if (t.n[1] > SN_CLIP_NAME_MAX) return fail(ps, "pin name longer than 31 bytes:", t.p[1], t.n[1]);
+        if (num(ps, &t, 2, "key time is not a number:", &key.t)) return 1;
+        if (tok_is(&t, 3, "off")) {
+            if (nt != 4) return fail(ps, "usage: pin <name> <time> off (nothing after 'off')", 0, 0);
+            key.v[3] = SN_CLIP_PIN_OFF;
+        } else {
+            if (tok_is(&t, 3, "lattice")) key.v[3] = SN_CLIP_PIN_LATTICE;
+            else if (!tok_is(&t, 3, "surface")) return fail(ps, "pin point must be surface, lattice or off, found", t.p[3], t.n[3]);
+            if (nt < 6) return fail(ps, "usage: pin <name> <time> surface|lattice <vertex> hold|<x> <y> <z> [axes <xyz>]", 0, 0);
+            if (num(ps, &t, 4, "vertex is not a number:", &vq)) return 1;
+            if (vq < 0 || (vq & 0xFFFF) != 0) return fail(ps, "vertex must be a whole number >= 0:", t.p[4], t.n[4]);
+            key.v[3] |= vq >> 16;
+            if (tok_is(&t, 5, "hold")) { key.v[3] |= SN_CLIP_PIN_HOLD; i = 6; }
+            else {
+                if (nt < 8) return fail(ps, "usage: pin <name> <time> surface|lattice <vertex> hold|<x> <y> <z> [axes <xyz>]", 0, 0);
+                for (k = 0; k < 3; k++)
+                    if (num(ps, &t, 5 + k, "pin target is not a number:", &key.v[k])) return 1;
+                i = 8;
+            }
+            if (i < nt) {
+                size_t j;
+                if (!tok_is(&t, i, "axes") || i + 2 != nt)
+                    return fail(ps, "expected 'axes <xyz>' (or nothing) after the pin's target, found", t.p[i], t.n[i]);
+                for (j = 0; j < t.n[i + 1]; j++) {
+                    char ch = t.p[i + 1][j];
+                    uint32_t bit = ch == 'x' ? SN_AXIS_X : ch == 'y' ? SN_AXIS_Y : ch == 'z' ? SN_AXIS_Z : 0;
+                    if (!bit || (axes & bit)) return fail(ps, "axes must be x, y and/or z, each at most once, e.g. 'axes yz'; found", t.p[i + 1], t.n[i + 1]);
+                    axes |= bit;
+                }
+            } else axes = SN_AXIS_ALL;
+            key.v[3] |= (int32_t)(axes << SN_CLIP_PIN_AXES_SHIFT);
+        }
+        ci = channel(c, SN_CLIP_PIN, t.p[1], t.n[1]);
+        if (ci < 0) return fail(ps, "too many channels (limit SN_CLIP_MAX_CHANNELS)", 0, 0);
+        return add_key(ps, ci, &key, t.p[2], t.n[2]);
+    }
+    return fail(ps, "unknown keyword (expected duration, loop, rot, move, control, impulse, collider, pin):", t.p[0], t.n[0]);
 }
 
 int32_t sn_clip_control_at(const sn_clip *clip, uint32_t c, int32_t t) {
@@ -396,5 +503,9 @@ int sn_clip_parse(sn_clip *clip, const char *text, size_t len, char *err, size_t
     }
     if (!ps.have_header) return fail(&ps, "empty clip: missing the line 'sinew-clip 1'", 0, 0);
     if (!ps.have_duration) return fail(&ps, "missing 'duration <seconds>'", 0, 0);
+    for (i = 0; i < clip->n_channels; i++) {
+        if (clip->chan[i].kind == SN_CLIP_COLLIDER) clip->n_colliders++;
+        if (clip->chan[i].kind == SN_CLIP_PIN) clip->n_pins++;
+    }
     return 0;
 }

@@ -6,7 +6,7 @@
  * straight into Q16.16 and all time arithmetic is integer, so the fixed
  * flavour gives bit-identical poses on every platform.
  *
- *   sn_clip clip;                    // caller storage (~23 KB with defaults)
+ *   sn_clip clip;                    // caller storage (~25 KB with defaults)
  *   char err[SN_CLIP_ERR_LEN];
  *   if (sn_clip_parse(&clip, text, len, err, sizeof err)) fail(err);
  *   if (sn_clip_bind(&clip, blob, err, sizeof err)) fail(err);
@@ -41,17 +41,47 @@
 /// Most warnings kept in a parsed clip (more are only counted).
 #define SN_CLIP_MAX_WARNINGS 8
 #endif
+#ifndef SN_CLIP_MAX_SHAPES
+/// Most collider placements (collider lines other than 'off') in one clip.
+#define SN_CLIP_MAX_SHAPES 32
+#endif
 /// A good size for the error buffer (and for sn_clip_warning_str).
 #define SN_CLIP_ERR_LEN 256
 
 /// Channel kinds: a joint's rotation, the root translation, a rig control,
-/// impulses on the flesh (one channel per share profile, named by it).
-enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1, SN_CLIP_CONTROL = 2, SN_CLIP_IMPULSE = 3 };
+/// impulses on the flesh (one channel per share profile, named by it), a
+/// named collider, a named pin (position constraint).
+enum { SN_CLIP_ROT = 0, SN_CLIP_MOVE = 1, SN_CLIP_CONTROL = 2, SN_CLIP_IMPULSE = 3,
+       SN_CLIP_COLLIDER = 4, SN_CLIP_PIN = 5 };
+
+/// Pin keys (kind SN_CLIP_PIN): v[0..2] the target (Q16.16 mesh units; unused
+/// for HOLD and OFF), v[3] these bits: the vertex, the constrained axes
+/// (SN_AXIS_X/Y/Z << SN_CLIP_PIN_AXES_SHIFT), and the flags.
+#define SN_CLIP_PIN_VERTEX     0x00FFFFFF  ///< surface or free lattice vertex index
+#define SN_CLIP_PIN_AXES_SHIFT 24          ///< 3 bits of SN_AXIS_* (never 0 in a parsed key)
+#define SN_CLIP_PIN_LATTICE    (1 << 27)   ///< a free lattice vertex (else a surface vertex)
+#define SN_CLIP_PIN_HOLD       (1 << 28)   ///< target: where the point is when the key comes into force
+#define SN_CLIP_PIN_OFF        (1 << 29)   ///< the pin is released
+
+/// A collider placement (a collider key's v[0] indexes clip.shapes; -1: off).
+/// Q16.16 mesh units (velocity: per second); kind is an sn_collider_kind.
+typedef struct sn_clip_shape {
+    int32_t a[3], b[3], radius, vel[3], mu;
+    uint8_t kind, reserved[3];
+} sn_clip_shape;
+
+/// What sn_clip_constraints remembers per pin channel between steps (the
+/// target of a 'hold' key). Zero it before the first step and after sn_reset.
+typedef struct sn_clip_hold {
+    uint32_t key_plus1;   ///< 1 + the key whose position is held (0: none yet)
+    sn_vec3  at;          ///< the held position (world, mesh units)
+} sn_clip_hold;
 
 /// One key. Q16.16 throughout: t seconds; v = axis x,y,z + angle degrees
 /// (rotation), x,y,z mesh units (root translation, v[3] = 0), or the
 /// control's value in v[0] (control, v[1..3] = 0), or an impulse's
-/// newton-seconds in v[0..2] and its surface vertex in v[3] (impulse).
+/// newton-seconds in v[0..2] and its surface vertex in v[3] (impulse), or
+/// a shape index in v[0] (collider, -1: off), or a pin (SN_CLIP_PIN_*).
 typedef struct sn_clip_key { int32_t t; int32_t v[4]; } sn_clip_key;
 
 /// One channel: keys[first .. first+count) with strictly increasing t.
@@ -60,7 +90,7 @@ typedef struct sn_clip_channel {
     int32_t  joint;                      ///< after sn_clip_bind: joint index (ROT, MOVE: 0) or
                                          ///< control index (CONTROL; -1: not in the blob); else -1
     uint16_t first, count;
-    uint8_t  kind;                       ///< SN_CLIP_ROT, SN_CLIP_MOVE or SN_CLIP_CONTROL
+    uint8_t  kind;                       ///< SN_CLIP_ROT, _MOVE, _CONTROL, _IMPULSE, _COLLIDER or _PIN
 } sn_clip_channel;
 
 /// Two consecutive keys of a rotation channel more than 180 degrees apart as
@@ -81,11 +111,16 @@ typedef struct sn_clip {
     uint8_t  loop;            ///< 1: time wraps at duration; 0: holds the end
     uint8_t  bound;           ///< set by sn_clip_bind
     uint16_t n_channels, n_keys;
+    uint16_t n_shapes;        ///< collider placements in shapes[]
+    uint16_t n_colliders;     ///< collider channels (at most this many in force at once)
+    uint16_t n_pins;          ///< pin channels (at most this many constraints at once)
+    uint16_t reserved;
     uint32_t error_line;      ///< line of the last parse error (0: none / not line-specific)
     uint32_t n_warnings;      ///< warnings found (the first SN_CLIP_MAX_WARNINGS are in warn[])
     sn_clip_warning warn[SN_CLIP_MAX_WARNINGS];
     sn_clip_channel chan[SN_CLIP_MAX_CHANNELS];
     sn_clip_key     keys[SN_CLIP_MAX_KEYS];
+    sn_clip_shape   shapes[SN_CLIP_MAX_SHAPES];
 } sn_clip;
 
 /// Parse clip text (len bytes, need not be NUL-terminated) into *clip.
@@ -151,6 +186,31 @@ uint32_t sn_clip_controls(const sn_clip *clip, const sn_blob *blob, uint32_t ste
 /// surface vertex and profile (-1: the blob's for the flesh there). Returns
 /// the number the runtime accepted (a full step's slots refuse the rest).
 uint32_t sn_clip_impulses(const sn_clip *clip, const sn_blob *blob, uint32_t step, sn_instance *inst);
+
+/// Colliders in force in step k (the clip's 'collider' channels; CLIP.md
+/// "Colliders and pins"): each channel's last key at or before the step's
+/// start t = sn_clip_time(k-1), unless it is 'off'; none before a channel's
+/// first key. A placement keyed at t_key with velocity v is at p + v (t -
+/// t_key) (integer Q16.16, rounded half away from zero). Writes at most max
+/// to out in channel order (first appearance in the file); returns how many.
+/// Needs no instance: the caller appends them to its own and calls
+/// sn_set_colliders.
+uint32_t sn_clip_colliders(const sn_clip *clip, const sn_blob *blob, uint32_t step,
+                           sn_collider *out, uint32_t max);
+
+/// Position constraints in force in step k (the clip's 'pin' channels): each
+/// channel's last key at or before t = sn_clip_time(k) (the step's end, where
+/// the runtime puts the point), unless it is 'off'; between that key and the
+/// next one of the channel, both with targets and naming the same point and
+/// axes, the target is interpolated linearly (as control tracks). A 'hold'
+/// key's target is where the point is (sn_get_surface / sn_get_lattice of
+/// inst) at the first call the key is in force, kept in hold[] (one entry per
+/// channel, SN_CLIP_MAX_CHANNELS, zeroed by the caller before the first
+/// step; inst NULL or a vertex it refuses: the origin). Writes at most max
+/// to out in channel order; returns how many.
+uint32_t sn_clip_constraints(const sn_clip *clip, const sn_blob *blob, uint32_t step,
+                             const sn_instance *inst, sn_clip_hold *hold,
+                             sn_constraint *out, uint32_t max);
 
 /// Own decimal reader (exported for tests): optional sign, digits, optional
 /// '.' and digits; no exponent. Rounds to nearest Q16.16 (half away from

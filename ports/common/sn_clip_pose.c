@@ -18,6 +18,13 @@ static void put(char *err, size_t cap, size_t *len, const char *s) {
     for (; *s; s++) if (*len + 1 < cap) err[(*len)++] = *s;
     if (cap) err[*len] = 0;
 }
+static void put_uint(char *err, size_t cap, size_t *len, uint32_t v) {
+    char d[12];
+    int n = 11;
+    d[11] = 0;
+    do { d[--n] = (char)('0' + v % 10u); v /= 10u; } while (v);
+    put(err, cap, len, d + n);
+}
 
 int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
     sn_blob_info info;
@@ -56,6 +63,39 @@ int sn_clip_bind(sn_clip *clip, const sn_blob *blob, char *err, size_t errlen) {
                 return 1;
             }
             ch->joint = prof;
+            continue;
+        }
+        if (ch->kind == SN_CLIP_COLLIDER) {
+            if (clip->n_colliders > info.max_colliders) {
+                put(err, errlen, &len, info.max_colliders ? "the clip has more collider channels than the blob's max_colliders (description: 'colliders N CONTACTS'; reuse a name for colliders one after another)"
+                                                          : "the clip has colliders but the blob bakes none (description: 'colliders N CONTACTS')");
+                return 1;
+            }
+            continue;
+        }
+        if (ch->kind == SN_CLIP_PIN) {   /* vertices must exist */
+            uint32_t k;
+            if (clip->n_pins > info.max_constraints) {
+                put(err, errlen, &len, info.max_constraints ? "the clip has more pin channels than the blob's max_constraints (description: 'constraints N'; reuse a name for pins one after another)"
+                                                            : "the clip has pins but the blob bakes no constraints (description: 'constraints N')");
+                return 1;
+            }
+            for (k = ch->first; k < (uint32_t)ch->first + ch->count && k < SN_CLIP_MAX_KEYS; k++) {
+                int32_t f = clip->keys[k].v[3];
+                uint32_t v = (uint32_t)f & SN_CLIP_PIN_VERTEX;
+                if (f & SN_CLIP_PIN_OFF) continue;
+                if ((f & SN_CLIP_PIN_LATTICE) ? v >= info.free_vertices : v >= info.surface_vertices) {
+                    put(err, errlen, &len, "clip pin '");
+                    put(err, errlen, &len, ch->name);
+                    put(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? "' names lattice vertex " : "' names surface vertex ");
+                    put_uint(err, errlen, &len, v);
+                    put(err, errlen, &len, ", but the blob has ");
+                    put_uint(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? info.free_vertices : info.surface_vertices);
+                    put(err, errlen, &len, (f & SN_CLIP_PIN_LATTICE) ? " free lattice vertices (sinew-bake lists the lattice)"
+                                                                     : " surface vertices (those of the mesh it was baked from)");
+                    return 1;
+                }
+            }
             continue;
         }
         if (ch->kind == SN_CLIP_CONTROL) {   /* a control the blob lacks: ignored (joint -1) */
@@ -152,6 +192,7 @@ void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
         const sn_clip_key *a, *b;
         int32_t u;
         if (!ch->count || ch->kind == SN_CLIP_CONTROL || ch->joint < 0 || (uint32_t)ch->joint >= info.joints) continue;
+        if (ch->kind == SN_CLIP_COLLIDER || ch->kind == SN_CLIP_PIN) continue;   /* not pose channels */
         segment(clip, ch, t, &a, &b, &u);
         if (ch->kind == SN_CLIP_MOVE) {
             root->x = from_q16(lerp_q16(a->v[0], b->v[0], u));
@@ -218,6 +259,108 @@ uint32_t sn_clip_impulses(const sn_clip *clip, const sn_blob *blob, uint32_t ste
                 if (sn_apply_impulse(inst, &f) == SN_OK) n++;
             }
         }
+    }
+    return n;
+}
+
+/* ---- colliders and pins ---- */
+
+/* The channel's last key at or before t (NULL: before its first key). */
+static const sn_clip_key *key_at(const sn_clip *clip, const sn_clip_channel *ch, int32_t t, uint32_t *idx) {
+    uint32_t k, n = ch->count;
+    const sn_clip_key *found = NULL;
+    for (k = 0; k < n && (uint32_t)ch->first + k < SN_CLIP_MAX_KEYS && clip->keys[ch->first + k].t <= t; k++) {
+        found = &clip->keys[ch->first + k];
+        *idx = ch->first + k;
+    }
+    return found;
+}
+
+/* p + v dt, Q16.16 (dt Q16.16 s), rounded half away from zero. */
+static int32_t moved(int32_t p, int32_t v, int32_t dt) {
+    int64_t d = (int64_t)v * dt;
+    d = d >= 0 ? (d + 32768) / 65536 : -((-d + 32768) / 65536);
+    d += p;
+    return d > INT32_MAX ? INT32_MAX : d < INT32_MIN ? INT32_MIN : (int32_t)d;
+}
+
+uint32_t sn_clip_colliders(const sn_clip *clip, const sn_blob *blob, uint32_t step,
+                           sn_collider *out, uint32_t max) {
+    int32_t h = sn_clip_timestep_q16(blob), t;
+    uint32_t c, n = 0, idx = 0;
+    if (h <= 0) return 0;
+    t = sn_clip_time(clip, h, step ? step - 1u : 0u);
+    for (c = 0; c < clip->n_channels && c < SN_CLIP_MAX_CHANNELS && n < max; c++) {
+        const sn_clip_channel *ch = &clip->chan[c];
+        const sn_clip_key *k;
+        const sn_clip_shape *sh;
+        sn_collider *o;
+        int32_t dt;
+        int i;
+        if (ch->kind != SN_CLIP_COLLIDER || !(k = key_at(clip, ch, t, &idx))) continue;
+        if (k->v[0] < 0 || k->v[0] >= clip->n_shapes || k->v[0] >= SN_CLIP_MAX_SHAPES) continue;
+        sh = &clip->shapes[k->v[0]];
+        dt = t - k->t;
+        o = &out[n++];
+        memset(o, 0, sizeof *o);
+        o->kind = sh->kind;
+        o->a.x = from_q16(moved(sh->a[0], sh->vel[0], dt));
+        o->a.y = from_q16(moved(sh->a[1], sh->vel[1], dt));
+        o->a.z = from_q16(moved(sh->a[2], sh->vel[2], dt));
+        for (i = 0; i < 3; i++) {   /* plane: the normal does not move; capsule: the other end does */
+            int32_t b = sh->kind == SN_COLLIDER_CAPSULE ? moved(sh->b[i], sh->vel[i], dt) : sh->b[i];
+            if (i == 0) o->b.x = from_q16(b); else if (i == 1) o->b.y = from_q16(b); else o->b.z = from_q16(b);
+        }
+        o->radius = from_q16(sh->radius);
+        o->velocity.x = from_q16(sh->vel[0]); o->velocity.y = from_q16(sh->vel[1]); o->velocity.z = from_q16(sh->vel[2]);
+        o->friction = from_q16(sh->mu);
+    }
+    return n;
+}
+
+uint32_t sn_clip_constraints(const sn_clip *clip, const sn_blob *blob, uint32_t step,
+                             const sn_instance *inst, sn_clip_hold *hold,
+                             sn_constraint *out, uint32_t max) {
+    int32_t h = sn_clip_timestep_q16(blob), t;
+    uint32_t c, n = 0, idx = 0;
+    if (h <= 0) return 0;
+    t = sn_clip_time(clip, h, step);
+    for (c = 0; c < clip->n_channels && c < SN_CLIP_MAX_CHANNELS && n < max; c++) {
+        const sn_clip_channel *ch = &clip->chan[c];
+        const sn_clip_key *k;
+        sn_constraint *o;
+        int32_t f, tx[3];
+        uint32_t v;
+        if (ch->kind != SN_CLIP_PIN || !(k = key_at(clip, ch, t, &idx))) continue;
+        f = k->v[3];
+        if (f & SN_CLIP_PIN_OFF) continue;
+        v = (uint32_t)f & SN_CLIP_PIN_VERTEX;
+        o = &out[n++];
+        memset(o, 0, sizeof *o);
+        o->at = (f & SN_CLIP_PIN_LATTICE) ? SN_AT_LATTICE : SN_AT_SURFACE;
+        o->vertex = v;
+        o->axes = ((uint32_t)f >> SN_CLIP_PIN_AXES_SHIFT) & SN_AXIS_ALL;
+        if (f & SN_CLIP_PIN_HOLD) {
+            if (hold[c].key_plus1 != idx + 1u) {   /* the key came into force: where the point is now */
+                hold[c].key_plus1 = idx + 1u;
+                if (!inst || (f & SN_CLIP_PIN_LATTICE ? sn_get_lattice(inst, &hold[c].at, v, 1)
+                                                      : sn_get_surface(inst, &hold[c].at, v, 1)) != SN_OK)
+                    memset(&hold[c].at, 0, sizeof hold[c].at);
+            }
+            o->target = hold[c].at;
+            continue;
+        }
+        tx[0] = k->v[0]; tx[1] = k->v[1]; tx[2] = k->v[2];
+        if (idx + 1u < (uint32_t)ch->first + ch->count && idx + 1u < SN_CLIP_MAX_KEYS) {
+            const sn_clip_key *b = &clip->keys[idx + 1u];
+            if (!(b->v[3] & (SN_CLIP_PIN_OFF | SN_CLIP_PIN_HOLD)) && b->v[3] == f && b->t > k->t) {
+                int32_t u = (int32_t)(((int64_t)(t - k->t) << 30) / ((int64_t)b->t - k->t));
+                tx[0] = lerp_q16(k->v[0], b->v[0], u);
+                tx[1] = lerp_q16(k->v[1], b->v[1], u);
+                tx[2] = lerp_q16(k->v[2], b->v[2], u);
+            }
+        }
+        o->target.x = from_q16(tx[0]); o->target.y = from_q16(tx[1]); o->target.z = from_q16(tx[2]);
     }
     return n;
 }

@@ -887,6 +887,9 @@ int main(int argc, char **argv) {
     rs_image aframe;
     long out_stride = 1, apng_stride = 1;
     int have_clip = 0, rc = 1;
+    static sn_clip_hold clip_hold[SN_CLIP_MAX_CHANNELS];   /* 'pin ... hold' targets */
+    sn_constraint *flag_cs = NULL, *all_cs = NULL;         /* --pin/--belt, then the clip's pins */
+    uint32_t flag_nc = 0;
     sn_quat *local = NULL;
     sn_xform *xf = NULL, *rest_xf = NULL;
     double *times = NULL, *cpu = NULL, h_s;
@@ -1124,6 +1127,14 @@ int main(int argc, char **argv) {
         sn_constraint *cs;
         uint32_t nc = 0, cap = s.info.max_constraints, nb = 0;
         if (!cap) { fprintf(stderr, PROG ": --pin/--belt: %s bakes no constraints (description line 'constraints N')\n", o.blob_path); goto done; }
+        if (have_clip && clip.n_pins) {   /* the clip's pin channels come after the flags' */
+            if ((uint32_t)o.n_pin + clip.n_pins > cap) {
+                fprintf(stderr, PROG ": --pin and %s: %u pinned vertices and %u clip pin channel(s) exceed the blob's max_constraints %u\n",
+                        o.clip_path, (unsigned)o.n_pin, (unsigned)clip.n_pins, cap);
+                goto done;
+            }
+            cap -= clip.n_pins;   /* the belt takes what is left */
+        }
         cs = calloc(cap + 1, sizeof *cs);
         s.pins = calloc(cap + 1, sizeof *s.pins);
         if (!cs || !s.pins) { free(cs); die("out of memory"); goto done; }
@@ -1153,12 +1164,19 @@ int main(int argc, char **argv) {
         s.n_pins = nc;
         st = sn_set_constraints(inst, cs, nc);
         if (inst2) sn_set_constraints(inst2, cs, nc);
-        free(cs);
+        flag_cs = cs; flag_nc = nc;   /* kept: set again with the clip's pins each step */
         if (st != SN_OK) { fprintf(stderr, PROG ": sn_set_constraints: %s\n", sn_status_str(st)); goto done; }
     }
     if ((o.have_ground || o.n_sph) && !s.info.max_colliders) {
         fprintf(stderr, PROG ": --ground/--sphere: %s bakes no colliders (description line 'colliders N CONTACTS')\n", o.blob_path); goto done;
     }
+    if (have_clip && clip.n_colliders && (uint32_t)(o.have_ground + o.n_sph) + clip.n_colliders > s.info.max_colliders) {
+        fprintf(stderr, PROG ": --ground/--sphere and %s: %d flag collider(s) and %u clip collider channel(s) exceed the blob's max_colliders %u\n",
+                o.clip_path, o.have_ground + o.n_sph, (unsigned)clip.n_colliders, s.info.max_colliders);
+        goto done;
+    }
+    if (have_clip && clip.n_pins && !(all_cs = calloc((size_t)flag_nc + clip.n_pins + 1, sizeof *all_cs))) { die("out of memory"); goto done; }
+    memset(clip_hold, 0, sizeof clip_hold);
     s.n_sph = o.n_sph;
     pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits || o.apng;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
@@ -1282,8 +1300,9 @@ int main(int argc, char **argv) {
                 if (sn_apply_segment_impulse(inst, o.imp[i].mesh, o.imp[i].node, j) != SN_OK) { die("--seg-impulse: refused"); goto done; }
                 if (inst2) sn_apply_segment_impulse(inst2, o.imp[i].mesh, o.imp[i].node, j);
             }
-        if (o.have_ground || o.n_sph) {   /* the colliders at the start of step k (spheres moved since step 1) */
-            sn_collider cl[5];
+        if (o.have_ground || o.n_sph || (have_clip && clip.n_colliders)) {
+            /* the colliders at the start of step k (spheres moved since step 1): the flags', then the clip's */
+            sn_collider cl[5 + SN_CLIP_MAX_CHANNELS];
             int q, nq = 0;
             memset(cl, 0, sizeof cl);
             if (o.have_ground) { cl[0].kind = SN_COLLIDER_PLANE; cl[0].a.y = R(o.ground_y); cl[0].b.y = R(1.0); nq = 1; }
@@ -1299,8 +1318,16 @@ int main(int argc, char **argv) {
                 s.sph[q][2] = (float)(o.sph[q][2] + o.sph[q][6] * (double)k * h_s);
                 s.sph[q][3] = (float)o.sph[q][3];
             }
+            if (have_clip) nq += (int)sn_clip_colliders(&clip, s.blob, (uint32_t)k, cl + nq, SN_CLIP_MAX_CHANNELS);
             if (sn_set_colliders(inst, cl, (uint32_t)nq) != SN_OK) { die("sn_set_colliders: refused (the blob's max_colliders is %u)", s.info.max_colliders); goto done; }
             if (inst2) sn_set_colliders(inst2, cl, (uint32_t)nq);
+        }
+        if (all_cs) {   /* the clip's pins (targets at the end of step k) after --pin/--belt */
+            uint32_t nc = flag_nc;
+            if (flag_nc) memcpy(all_cs, flag_cs, flag_nc * sizeof *all_cs);
+            nc += sn_clip_constraints(&clip, s.blob, (uint32_t)k, inst, clip_hold, all_cs + nc, clip.n_pins);
+            if ((st = sn_set_constraints(inst, all_cs, nc)) != SN_OK) { die("sn_set_constraints (%s pins): %s", o.clip_path, sn_status_str(st)); goto done; }
+            if (inst2) sn_set_constraints(inst2, all_cs, nc);
         }
         for (i = 0; i < (uint32_t)o.n_lod; i++)   /* level switches before this step */
             if (o.lod_step[i] == k && sn_set_lod(inst, o.lod_level[i]) != SN_OK) { die("--lod %ld:%u: sn_set_lod refused (the blob has %u level(s): bake with 'levels 2')", k, o.lod_level[i], sn_lod_levels(s.blob)); goto done; }
@@ -1513,6 +1540,6 @@ done:
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges); free(s.pins);
     free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
-    free(fctl); free(bytes2); free(refpos); free(s.cr_list);
+    free(fctl); free(bytes2); free(refpos); free(s.cr_list); free(flag_cs); free(all_cs);
     return rc;
 }

@@ -78,6 +78,18 @@ static void sample(sn_clip *clip) {
         if (t > 0) sn_clip_sample(clip, g_blob, t - 1, local, &root);
         if (t < clip->duration) sn_clip_sample(clip, g_blob, t + 1, local, &root);
     }
+    {   /* collider and pin channels: placements and targets at every step above */
+        static sn_collider cl[SN_CLIP_MAX_CHANNELS];
+        static sn_constraint cs[SN_CLIP_MAX_CHANNELS];
+        static sn_clip_hold hold[SN_CLIP_MAX_CHANNELS];
+        memset(hold, 0, sizeof hold);
+        for (k = 0; k < sizeof steps / sizeof steps[0]; k++) {
+            uint32_t n = sn_clip_colliders(clip, g_blob, steps[k], cl, SN_CLIP_MAX_CHANNELS);
+            LF_REQUIRE(n <= clip->n_colliders, "%u colliders from %u channels", n, clip->n_colliders);
+            n = sn_clip_constraints(clip, g_blob, steps[k], NULL, hold, cs, SN_CLIP_MAX_CHANNELS);
+            LF_REQUIRE(n <= clip->n_pins, "%u constraints from %u channels", n, clip->n_pins);
+        }
+    }
     sn_clip_sample(clip, g_blob, -1, local, &root);
     sn_clip_sample(clip, g_blob, clip->duration, local, &root);
     sn_clip_sample(clip, g_blob, 0x7FFFFFFF, local, &root);

@@ -216,5 +216,41 @@ worst=$(paste -d' ' "$TMP/fx/frame_0060.obj" "$TMP/fl/frame_0060.obj" | awk '$1 
 echo "  figure: fixed vs float surface after 60 trot steps: max distance $worst mesh units"
 awk -v w="$worst" 'BEGIN { exit !(w != "" && w <= 0.002) }' && ok || bad "fixed vs float differ by $worst mesh units (> 2e-3)"
 
+# Clip colliders and pins (CLIP.md "Colliders and pins"): a clip's collider
+# and pin lines step exactly as the flags with the same values (the player
+# sets them through the same sn_set_colliders / sn_set_constraints, the
+# flags' first). Fixed flavour: clip Q16.16 and the flags' rounding agree
+# bit for bit; float: the static sphere (values exact in Q16.16) too.
+hg=$("$PLAY" "$BLOB" --clip tools/examples/cow/ground.clip --frames 72 --hash --quiet 2>/dev/null | grep '^hash: ')
+hf=$("$PLAY" "$BLOB" --clip tools/examples/cow/trot.clip --ground -3.39 --frames 72 --hash --quiet 2>/dev/null | grep '^hash: ')
+hn=$("$PLAY" "$BLOB" --clip tools/examples/cow/trot.clip --frames 72 --hash --quiet 2>/dev/null | grep '^hash: ')
+[ -n "$hg" ] && [ "$hg" = "$hf" ] && [ "$hg" != "$hn" ] && ok "ground.clip = trot.clip --ground -3.39 ($hg), differs without the ground ($hn)" ||
+    bad "ground.clip '$hg' vs --ground -3.39 '$hf' (no ground '$hn')"
+printf 'sinew-clip 1\nduration 2\ncollider ball 0 sphere 1 -2.5 0 1\n' > "$TMP/sph.clip"
+printf 'sinew-clip 1\nduration 2\ncollider ball 0 sphere 1 -2.5 0 1 vel 0 0.25 0\n' > "$TMP/sphv.clip"
+printf 'sinew-clip 1\nduration 2\ncollider ground 0 plane 0 -3.39 0 0 1 0\ncollider ball 0 sphere 1 -2.5 0 1\n' > "$TMP/both.clip"
+printf 'sinew-clip 1\nduration 2\npin a 0 surface 1000 hold\npin b 0 surface 1342 hold\n' > "$TMP/pin.clip"
+same() {   # same LABEL PLAYER BLOB "ARGS A" "ARGS B" [FRAMES]: equal hashes, and not the no-collider one
+    ha=$("$2" "$3" $4 --frames ${6:-60} --hash --quiet 2>/dev/null | grep '^hash: ')
+    hb=$("$2" "$3" $5 --frames ${6:-60} --hash --quiet 2>/dev/null | grep '^hash: ')
+    h0=$("$2" "$3" --frames ${6:-60} --hash --quiet 2>/dev/null | grep '^hash: ')
+    [ -n "$ha" ] && [ "$ha" = "$hb" ] && [ "$ha" != "$h0" ] && ok "$1: $4 = $5 ($ha)" || bad "$1: '$ha' vs '$hb' (none '$h0')"
+}
+same "sphere" "$PLAY" "$BLOB" "--clip $TMP/sph.clip" "--sphere 1,-2.5,0,1"
+same "moving sphere" "$PLAY" "$BLOB" "--clip $TMP/sphv.clip" "--sphere 1,-2.5,0,1@0,0.25,0"
+same "sphere, float" "$PLAYF" "$BLOBF" "--clip $TMP/sph.clip" "--sphere 1,-2.5,0,1"
+same "flags first, then the clip" "$PLAY" "$BLOB" "--clip $TMP/both.clip" "--clip $TMP/sph.clip --ground -3.39" 100
+same "pins held where they are" "$PLAY" "$BLOB" "--clip $TMP/pin.clip" "--pin 1000,1342" 30
+# errors: the blob's maxima (cow: colliders 4, constraints 32), flags and clip together
+printf 'sinew-clip 1\nduration 1\n' > "$TMP/many.clip"
+for n in 1 2 3 4 5; do echo "collider c$n 0 off" >> "$TMP/many.clip"; done
+expect 1 "many.clip does not fit .*cow.blob: the clip has more collider channels than the blob's max_colliders" "$PLAY" "$BLOB" --clip "$TMP/many.clip" --frames 1
+expect 1 "--ground/--sphere and .*sph.clip: 4 flag collider\(s\) and 1 clip collider channel\(s\) exceed the blob's max_colliders 4" \
+    "$PLAY" "$BLOB" --clip "$TMP/sph.clip" --ground 0 --sphere 0,0,0,1 --sphere 0,0,0,1 --sphere 0,0,0,1 --frames 1
+printf 'sinew-clip 1\nduration 1\npin p 0 surface 2903 hold\n' > "$TMP/far.clip"
+expect 1 "far.clip does not fit .*: clip pin 'p' names surface vertex 2903, but the blob has 2903 surface vertices" "$PLAY" "$BLOB" --clip "$TMP/far.clip" --frames 1
+printf 'sinew-clip 1\nduration 1\npin p 0 surface 12 1 2\n' > "$TMP/short.clip"
+expect 1 'short.clip: line 3: usage: pin <name> <time> surface\|lattice <vertex>' "$PLAY" "$BLOB" --clip "$TMP/short.clip" --frames 1
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
