@@ -189,6 +189,17 @@ int main(void) {
         len = (size_t)snprintf(text, sizeof text, "sinew-clip 1\nduration 2\nloop yes\nimpulse 0.5 3 0 10 0\nimpulse 1.95 4 1 0 0 0\n"
                                                   "impulse 2 5 0 0 -1 1\n");
         T_CHECK(sn_clip_parse(&clip, text, len, err, sizeof err) == 0 && sn_clip_bind(&clip, blob, err, sizeof err) == 0, "impulse clip: %s", err);
+        {   /* impulse channels are not pose channels: the pose stays the rest pose (an impulse's profile once
+             * posed the joint of that number) */
+            int rest = 1;
+            for (t = 0; t <= 2 * 65536; t += 4099) {
+                sn_clip_sample(&clip, blob, t, local, &root);
+                for (j = 0; j < info.joints; j++)
+                    rest &= local[j].x == 0 && local[j].y == 0 && local[j].z == 0 && local[j].w == local[0].w;
+                rest &= root.x == 0 && root.y == 0 && root.z == 0;
+            }
+            T_CHECK(rest, "a clip of impulses alone (one with profile 1) samples the rest pose at every time");
+        }
         T_CHECK(sn_instance_init(mem, sn_instance_size(blob), blob, &inst) == SN_OK, "instance");
         T_CHECK(sn_clip_impulses(&clip, blob, 0, inst) == 0, "no impulse at step 0");
         for (k = 1; k <= steps; k++) {

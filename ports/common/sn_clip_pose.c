@@ -192,7 +192,8 @@ void sn_clip_sample(const sn_clip *clip, const sn_blob *blob, int32_t t,
         const sn_clip_key *a, *b;
         int32_t u;
         if (!ch->count || ch->kind == SN_CLIP_CONTROL || ch->joint < 0 || (uint32_t)ch->joint >= info.joints) continue;
-        if (ch->kind == SN_CLIP_COLLIDER || ch->kind == SN_CLIP_PIN) continue;   /* not pose channels */
+        if (ch->kind == SN_CLIP_COLLIDER || ch->kind == SN_CLIP_PIN || ch->kind == SN_CLIP_IMPULSE)
+            continue;   /* not pose channels (an impulse channel's joint field holds its profile) */
         segment(clip, ch, t, &a, &b, &u);
         if (ch->kind == SN_CLIP_MOVE) {
             root->x = from_q16(lerp_q16(a->v[0], b->v[0], u));
