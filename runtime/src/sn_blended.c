@@ -229,29 +229,10 @@ static void region_matvec(sn_ihdr *h, const sn_q *R, const blend_mem *m, const s
         }
 }
 
-/* z_i = R^r P_i R^rT r_i on Q^r, 0 elsewhere (sn_solve.c's precond with the region's frame) */
+/* z = R^r C R^rT r on Q^r, 0 elsewhere: the warped solve's preconditioner
+ * (block Jacobi or IC(0), sn_precond.c) with the region's frame */
 static void region_precond(sn_ihdr *h, const sn_q *R, const blend_mem *m, const sn_q *r, sn_q *z, uint32_t *sat) {
-    const sn_view *v = &h->v;
-    const unsigned char *P = v->sec[SN_SEC_PRECOND];
-    const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t i, k;
-    for (i = 0; i < v->nF; i++) {
-        const unsigned char *b = P + (size_t)i * 6 * RB;
-        sn_q t[3], s[3];
-        sn_acc a[3] = {0, 0, 0};
-        int sh = v->frac_P + SN_KREL(kk[i]);
-        if (!m->vm[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
-        sn_rot_t(R, r + 3 * i, t, sat);
-        {   /* a = P t, P symmetric stored xx yy zz xy xz yz */
-            sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
-            sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
-            a[0] = sn_mul(xx, t[0]) + sn_mul(xy, t[1]) + sn_mul(xz, t[2]);
-            a[1] = sn_mul(xy, t[0]) + sn_mul(yy, t[1]) + sn_mul(yz, t[2]);
-            a[2] = sn_mul(xz, t[0]) + sn_mul(yz, t[1]) + sn_mul(zz, t[2]);
-        }
-        for (k = 0; k < 3; k++) s[k] = sn_out(a[k], sh, sat);
-        sn_rot(R, s, z + 3 * i, sat);
-    }
+    sn_precond_region(h, R, m->vm, r, z, sat);
 }
 
 void sn_blended_solve(sn_ihdr *h, uint32_t *sat) {

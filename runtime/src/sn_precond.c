@@ -131,9 +131,12 @@ SN_INLINE void sym_mul(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
     l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
 }
 
-void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
+/* z = C r with the frame of vertex i at R + rs i (rs 9: the vertex frames;
+ * rs 0: one frame for all, the blended mode's region) and, if mask, only the
+ * vertices with mask[i] != 0 (r taken as 0 elsewhere, z set to 0 there: the
+ * principal block of an SPD C, so still SPD on the region). */
+static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat) {
     const sn_view *v = &h->v;
-    const sn_q *R = CARR(h, o_R, sn_q);
     const unsigned char *P = v->sec[SN_SEC_PRECOND];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, n;
@@ -142,16 +145,20 @@ void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
             sn_q t[3], s[3];
             sn_acc a[3];
             int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
-            sn_rot_t(R + 9 * i, r + 3 * i, t, sat);
+            if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
+            sn_rot_t(R + rs * i, r + 3 * i, t, sat);
             sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
             s[0] = sn_out(a[0], sh, sat);
             s[1] = sn_out(a[1], sh, sat);
             s[2] = sn_out(a[2], sh, sat);
-            sn_rot(R + 9 * i, s, z + 3 * i, sat);
+            sn_rot(R + rs * i, s, z + 3 * i, sat);
         }
         return;
     }
-    for (i = 0; i < v->nF; i++) sn_rot_t(R + 9 * i, r + 3 * i, z + 3 * i, sat);
+    for (i = 0; i < v->nF; i++) {
+        if (mask && !mask[i]) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
+        else sn_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
+    }
     n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
         sn_acc a[3];
@@ -164,6 +171,15 @@ void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
     ic_backward(v, n, z, sat);
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
-        sn_rot(R + 9 * i, t, z + 3 * i, sat);
+        if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
+        sn_rot(R + rs * i, t, z + 3 * i, sat);
     }
+}
+
+void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
+    precond_core(h, CARR(h, o_R, sn_q), 9, NULL, r, z, sat);
+}
+
+void sn_precond_region(sn_ihdr *h, const sn_q *R, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat) {
+    precond_core(h, R, 0, mask, r, z, sat);
 }

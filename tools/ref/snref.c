@@ -856,10 +856,14 @@ static const double *precond_blocks(snref_state *s) {
 
 /* IC(0): z = R (I + L^)^-T D^-1 (I + L^)^-1 R^T r, ICHOL's U_ji = L^_ij^T
  * in the mass pattern's free-free upper entries (runtime/src/sn_precond.c) */
-static void ichol_apply(const snref_state *s, const double *r, double *z) {
-    const snref_model *m = s->m;
+/* frame of vertex i at R + rs i (rs 0: one frame, the blended region's);
+ * with mask, only the vertices mask[i] != 0 (r taken as 0, z set to 0 elsewhere) */
+static void ichol_apply_f(const snref_model *m, const double *R, size_t rs, const unsigned char *mask, const double *r, double *z) {
     unsigned i, j, e, n, c, nF = m->nF;
-    for (i = 0; i < nF; i++) matT_vec(s->R + 9 * i, r + 3 * i, z + 3 * i);
+    for (i = 0; i < nF; i++) {
+        if (mask && !mask[i]) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
+        else matT_vec(R + rs * i, r + 3 * i, z + 3 * i);
+    }
     for (j = 0, n = 0; j < nF; j++) /* forward: y_i -= U_ji^T y_j */
         for (e = m->rowptr[j]; e < m->rowptr[j + 1] && m->cols[e] < nF; e++, n++) {
             const double *U = m->ichol + 9 * (size_t)n;
@@ -882,9 +886,12 @@ static void ichol_apply(const snref_state *s, const double *r, double *z) {
     }
     for (i = 0; i < nF; i++) {
         double t[3] = { z[3 * i], z[3 * i + 1], z[3 * i + 2] };
-        mat_vec(s->R + 9 * i, t, z + 3 * i);
+        if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
+        mat_vec(R + rs * i, t, z + 3 * i);
     }
 }
+
+static void ichol_apply(const snref_state *s, const double *r, double *z) { ichol_apply_f(s->m, s->R, 9, NULL, r, z); }
 
 /* z_i = R_i P_i R_i^T r_i (step 6: the vertex frame); the IC(0) of an ICHOL
  * blob instead when P is the blob's own (no rescaled h or damping) */
@@ -1373,7 +1380,8 @@ static double region_pcg(snref_state *s, const blend_region *g, const double *b,
     const double *P = precond_blocks(s);
     double rz, bn = sqrt(dot(b, b, n)), res;
 #define REGION_PRE(rr, zz) \
-    for (i = 0; i < m->nF; i++) { \
+    if (m->nIC && P == m->precond) ichol_apply_f(m, g->R, 0, g->vm, rr, zz); /* the runtime's region IC(0) */ \
+    else for (i = 0; i < m->nF; i++) { \
         double a_[3], b_[3]; \
         if (!g->vm[i]) { zz[3 * i] = zz[3 * i + 1] = zz[3 * i + 2] = 0; continue; } \
         matT_vec(g->R, rr + 3 * i, a_); mat_vec(P + 9 * i, a_, b_); mat_vec(g->R, b_, zz + 3 * i); \
