@@ -99,12 +99,6 @@ static uint32_t region_setup(const sn_ihdr *h, uint32_t r, blend_mem *m) {
     return nu;
 }
 
-/* acc += R t */
-SN_INLINE void rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
-    acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);
-    acc[1] += sn_mul(R[3], t[0]) + sn_mul(R[4], t[1]) + sn_mul(R[5], t[2]);
-    acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
-}
 
 /* b = bc - sum_{e in K^r} R S^_e (d_e + R^T (w - w_a0)) on Q^r, 0 elsewhere:
  * sn_solve.c's cell_forces with every cell frame R = R^r (eq. 24). w (the
@@ -150,7 +144,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
             if (a >= nF) continue;
             sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c], sh, sat);
-            rot_acc(acc + 3 * a, R, t);
+            sn_rot_acc(acc + 3 * a, R, t);
         }
     }
     for (i = 0; i < 3 * nF; i++) {
@@ -193,7 +187,7 @@ static void region_matvec(sn_ihdr *h, const sn_q *R, const blend_mem *m, const s
             sn_q t[3];
             int sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-            rot_acc(acc + 3 * a, R, t);
+            sn_rot_acc(acc + 3 * a, R, t);
         }
     }
     for (i = 0; i < 3 * nF; i++) {

@@ -165,6 +165,12 @@ void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, fi
  * stored, the same bits frame_of computed (sn_pose.c). */
 void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]);
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
+/* acc += R t (t rotated back out of a cell frame, kept at full precision; sn_solve.c, sn_blended.c) */
+SN_INLINE void sn_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
+    acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);
+    acc[1] += sn_mul(R[3], t[0]) + sn_mul(R[4], t[1]) + sn_mul(R[5], t[2]);
+    acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
+}
 void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat); /* 6: z = C r, block Jacobi or IC(0) (sn_precond.c) */
 /* the same with one frame R for every vertex, restricted to mask[i] != 0 (SN_MODE_BLENDED's region, sn_blended.c) */
 void sn_precond_region(sn_ihdr *h, const sn_q *R, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat);

@@ -38,12 +38,6 @@ static void acc_zero(sn_acc *acc, uint32_t n3) {
 }
 
 
-/* acc += R t (t rotated back out of a cell frame, kept at full precision) */
-SN_INLINE void rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
-    acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);
-    acc[1] += sn_mul(R[3], t[0]) + sn_mul(R[4], t[1]) + sn_mul(R[5], t[2]);
-    acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
-}
 
 /* Saturating sum of non-negative energy terms (fixed: at 2^62). */
 SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
@@ -113,7 +107,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
             sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c], sh, sat);
-            rot_acc(acc + 3 * a, R, t);
+            sn_rot_acc(acc + 3 * a, R, t);
         }
     }
 }
@@ -253,7 +247,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
             sn_q t[3];
             int sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-            rot_acc(acc + 3 * a, R, t);
+            sn_rot_acc(acc + 3 * a, R, t);
         }
     }
     for (i = 0; i < 3 * nF; i++) {
