@@ -163,32 +163,12 @@ static void region_matvec(sn_ihdr *h, const sn_q *R, const blend_mem *m, const s
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
-    uint32_t e, i, k, c, nF = v->nF;
+    uint32_t e, i, k, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < 3 * nF; i++) acc[i] = 0;
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
-        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
-        sn_q u[24];
-        sn_acc l[24];
-        uint8_t fc[8];
-        uint32_t vi[8], nf = 0;
-        if (!m->cm[e]) continue;
-        for (k = 0; k < 8; k++) { /* the corners with an unknown of Q^r: d is 0 at the others (sn_solve.c's free-corner product) */
-            uint32_t a = sn_rd_u16(cl + 2 * k);
-            if (a >= nF || !m->vm[a]) continue;
-            sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
-            fc[nf] = (uint8_t)k;
-            vi[nf++] = a;
-        }
-        if (nf == 0) continue;
-        sn_k_cell_mul(K, fc, nf, u, l);
-        for (k = 0; k < nf; k++) {
-            uint32_t a = vi[k];
-            sn_q t[3];
-            int sh = v->frac_S - SN_KREL(kk[a]);
-            for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-            sn_rot_acc(acc + 3 * a, R, t);
-        }
+        /* the corners with an unknown of Q^r: d is 0 at the others */
+        if (m->cm[e]) sn_cell_stiff_acc(h, K, cells + (size_t)e * SN_ELEM_CELLS, R, m->vm, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);

@@ -9,6 +9,9 @@
 /* Step 5's right-hand side into b (free rows); elastic = 0 leaves out the
  * cell terms (elastic force, -K~ w) but still sets the energy (sn_solve.c). */
 void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat);
+/* acc += R S^_e R^T d for one cell (CELLK record K, CELLS record cl) over its free corners with mask[a] != 0 (sn_solve.c) */
+void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
+                       const sn_q *d, sn_acc *acc, uint32_t *sat);
 
 /* A CG dot product: fixed, m * 2^e in Q41 units (block floating point);
  * float, m (e = 0). */

@@ -212,6 +212,40 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
 }
 
 
+/* acc += R S^_e R^T d for one cell over its free corners only (skeleton
+ * corners carry no unknown: their terms are exact zeros; with mask, only the
+ * corners with mask[a] != 0, the blended mode's region): the free-corner
+ * product, 9 f^2 MA (NUMERICS.md "SIMD kernels"). */
+SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
+                          const sn_q *d, sn_acc *acc, uint32_t *sat) {
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t k, c, vi[8], nf = 0, nF = h->v.nF;
+    sn_q u[24];
+    sn_acc l[24];
+    uint8_t fc[8];
+    for (k = 0; k < 8; k++) {
+        uint32_t a = sn_rd_u16(cl + 2 * k);
+        if (a >= nF || (mask && !mask[a])) continue;
+        sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+        fc[nf] = (uint8_t)k;
+        vi[nf++] = a;
+    }
+    if (nf == 0) return;
+    sn_k_cell_mul(K, fc, nf, u, l);
+    for (k = 0; k < nf; k++) {
+        uint32_t a = vi[k];
+        sn_q t[3];
+        int sh = h->v.frac_S - SN_KREL(kk[a]);
+        for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
+        sn_rot_acc(acc + 3 * a, R, t);
+    }
+}
+
+void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
+                       const sn_q *d, sn_acc *acc, uint32_t *sat) {
+    cell_stiff(h, K, cl, R, mask, d, acc, sat);
+}
+
 /* q = A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d  (free rows).
  * The cell product runs over the cell's free corners only (9 f^2 multiply-adds
  * for f free corners instead of 576): a skeleton corner's operand is zero
@@ -223,32 +257,11 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     const sn_q *cR = CARR(h, o_cR, sn_q);
     sn_acc *acc = ARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t e, i, k, c, nF = v->nF;
+    uint32_t e, i, k, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
-        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
-        const sn_q *R = cR + 9 * e;
-        sn_q u[24];
-        sn_acc l[24];
-        uint8_t fc[8];
-        uint32_t vi[8], nf = 0;
-        for (k = 0; k < 8; k++) {
-            uint32_t a = sn_rd_u16(cl + 2 * k);
-            if (a >= nF) continue; /* skeleton: no unknown */
-            sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
-            fc[nf] = (uint8_t)k;
-            vi[nf++] = a;
-        }
-        if (nf == 0) continue;
-        sn_k_cell_mul(K, fc, nf, u, l);
-        for (k = 0; k < nf; k++) {
-            uint32_t a = vi[k];
-            sn_q t[3];
-            int sh = v->frac_S - SN_KREL(kk[a]);
-            for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-            sn_rot_acc(acc + 3 * a, R, t);
-        }
+        cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, NULL, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
