@@ -98,7 +98,7 @@ TEST_BINS += $(BUILD)/tests/test_runtime_range
 # shift, conversion and int64 sum bound asserted: sn_internal.h SN_RANGE)
 $(BUILD)/tests/test_runtime_fuzz_range: $(SN_FUZZ_DEPS) tests/fuzz/range_fail.c
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -DSN_FUZZ_PER_SECTION=100 -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -DSN_FUZZ_PER_SECTION=40 -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
 $(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
@@ -107,6 +107,14 @@ $(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
 	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float \
              $(BUILD)/tests/test_runtime_fuzz_range
+# the long campaign of the same hostile blobs (make test samples 100 random
+# flips per section, the range build 40): 2000 per section, every build
+FUZZ_BLOB_PER_SECTION ?= 2000
+.PHONY: fuzz-blobs
+fuzz-blobs: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_float $(BUILD)/tests/test_runtime_fuzz_range \
+            $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
+	for t in test_runtime_fuzz test_runtime_fuzz_float test_runtime_fuzz_range test_runtime_fuzz_ck; do \
+	    BUILD=$(BUILD) $(BUILD)/tests/$$t --per-section $(FUZZ_BLOB_PER_SECTION) || exit 1; done
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
 $(BUILD)/bench/sn_bench: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)

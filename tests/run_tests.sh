@@ -3,14 +3,26 @@
 # adds up their closing "N passed, N failed" lines and prints the total.
 # A suite that exits non-zero without failures, or prints no closing line,
 # counts as one failure.
-# The test programs only read what make built, so they run in TEST_JOBS
-# lanes at once (default 2: the CI machine's cores); the scripts, several of
-# which call make on the same build directory, run one after another.
+# Work is shared by TEST_JOBS lanes (default 2: the CI machine's cores)
+# through a queue: each lane takes the next unclaimed suite (an atomic
+# mkdir claims it), the slowest first, so no lane idles while another still
+# has a long list. The scripts that call make on the build directory
+# (SERIAL below) run one after another as a single queue item; the others
+# only read what make built. Reports print in a fixed order at the end.
 BUILD=${1:-build}
 export BUILD
 JOBS=${TEST_JOBS:-2}
 total_p=0; total_f=0; bad=""
 log_dir="$BUILD/test-logs"; mkdir -p "$log_dir"
+rm -rf "$log_dir/claims"; mkdir -p "$log_dir/claims"
+
+# scripts that run make on $BUILD (or build ports into it): never two at once
+SERIAL="test_determinism test_integration test_fuzz test_runtime_rules test_baremetal test_nofloat test_gltf"
+# the slowest suites (seconds on a 2-core machine), queued first
+SLOW="test_runtime_fuzz test_runtime_fuzz_float test_runtime_fuzz_range test_physics_runtime test_physics_runtime_float
+      test_physics_cantilever test_bake_sweep test_physics_vibration test_runtime_fuzz_ck test_nonlinear
+      test_physics_longrun test_physics_longrun_float test_physics_cantilever_float test_physics_blended
+      test_physics_blended_float test_physics_vibration_float test_physics_held test_physics_held_float"
 
 # run one suite: its log and a result line "passed failed seconds"
 run_one() {
@@ -29,6 +41,7 @@ run_one() {
 # print a finished suite's line (and its failures and figures), add it up
 report() {
     name=$1
+    if [ ! -f "$log_dir/$name.res" ]; then echo "0 1 0" > "$log_dir/$name.res"; echo "no result" >> "$log_dir/$name.log"; fi
     read -r p f secs < "$log_dir/$name.res"
     total_p=$((total_p + p)); total_f=$((total_f + f))
     status=ok; [ "$f" -eq 0 ] || { status=FAILED; bad="$bad $name"; }
@@ -36,30 +49,39 @@ report() {
     if [ "$f" -ne 0 ]; then sed 's/^/    | /' "$log_dir/$name.log" | grep -E 'FAIL|SKIP|rror|\| *[0-9]+ passed' | head -n 40; fi
     grep -E '^ *(figure|SKIPPED|determinism):' "$log_dir/$name.log" | sed 's/^ */    /'
 }
+is_in() { case " $(echo $2) " in *" $1 "*) return 0;; esac; return 1; }
 
-# test programs: lane i takes every JOBS-th program
-progs=""
+progs=""; scripts=""; serial=""; rest=""
 for t in "$BUILD"/tests/test_*; do
-    [ -x "$t" ] && progs="$progs $t"
+    [ -x "$t" ] && progs="$progs $(basename "$t")"
 done
+for s in tests/scripts/test_*.sh; do
+    [ -f "$s" ] || continue
+    n=$(basename "$s" .sh); scripts="$scripts $n"
+    if is_in "$n" "$SERIAL"; then serial="$serial $n"; else rest="$rest $n"; fi
+done
+# the queue: the serial chain, the slow programs, then everything else
+queue="@serial"
+for n in $SLOW; do is_in "$n" "$progs" && queue="$queue $n"; done
+for n in $progs $rest; do is_in "$n" "$queue" || queue="$queue $n"; done
+
+run_item() {
+    case "$1" in
+        @serial) for n in $serial; do run_one "$n" sh "tests/scripts/$n.sh"; done ;;
+        *) if [ -x "$BUILD/tests/$1" ]; then run_one "$1" "$BUILD/tests/$1"; else run_one "$1" sh "tests/scripts/$1.sh"; fi ;;
+    esac
+}
 lane=0
 while [ "$lane" -lt "$JOBS" ]; do
     (
-        i=0
-        for t in $progs; do
-            [ $((i % JOBS)) -eq "$lane" ] && run_one "$(basename "$t")" "$t"
-            i=$((i + 1))
+        for item in $queue; do
+            mkdir "$log_dir/claims/$item" 2>/dev/null && run_item "$item"
         done
     ) &
     lane=$((lane + 1))
 done
 wait
-for t in $progs; do report "$(basename "$t")"; done
-for s in tests/scripts/test_*.sh; do
-    [ -f "$s" ] || continue
-    run_one "$(basename "$s" .sh)" sh "$s"
-    report "$(basename "$s" .sh)"
-done
+for n in $progs $scripts; do report "$n"; done
 echo "logs: $log_dir/"
 [ -z "$bad" ] || echo "failed suites:$bad"
 echo "$total_p passed, $total_f failed"

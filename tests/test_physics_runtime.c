@@ -108,7 +108,9 @@ static void asset(const char *name, pose_fn pf, double goal) {
     nS = poser.info.surface_vertices;
     def = poser.info.cg_iters_default;
     for (i = 0; i < 4 && its[i] != def; i++) {}
-    if (i == 4) {   /* the asset's default count joins the table, in order */
+    if (!getenv("SN_ACCURACY_SWEEP")) { /* make test: the default count (every check); `make accuracy-sweep`: the table */
+        its[0] = def; nits = 1;
+    } else if (i == 4) {   /* the asset's default count joins the table, in order */
         unsigned j = 0;
         while (j < 4 && its[j] < def) j++;
         memmove(its + j + 1, its + j, (4 - j) * sizeof *its);
