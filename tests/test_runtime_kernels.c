@@ -17,6 +17,7 @@
 #include <string.h>
 #include "sn_test.h"
 #include "sn_kernels.h"
+#include "sn_kernels_ic.h"
 
 static uint32_t rng = 12345u;
 static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
@@ -93,6 +94,105 @@ static int row_ok(double S[24][24], const sn_q *u, int r, sn_acc got) {
 #endif
 }
 
+/* ---- IC(0) block products (sn_kernels_ic.h), against a reference written
+ * from BLOB.md's ICHOL element (int16 m[9] row-major, u8 frac, pad) in
+ * double: every product sum |p| < 3 2^43 is an exact double, and so are
+ * p 2^-s and p 2^-s + 1/2 (< 2^52), so floor(p 2^-s + 1/2) is the exact
+ * round-half-up. Fixed: tolerance 0 (the path's integers equal the
+ * reference and the portable _ref; clamps counted alike). Float: the path
+ * is the _ref; against double, 4 roundings (3 products, 3 adds into a) each
+ * <= 2^-24 of a partial sum bounded by |a0| + sum |U y|: 2^-21 of that. */
+static double ic_rnd(double p, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s; (void)sat;
+    return p;
+#else
+    double v = floor(ldexp(p, -s) + (s > 0 ? 0.5 : 0.0));
+    if (s >= 0) return v;
+    if (v > 268435456.0) { (*sat)++; return 268435456.0; }
+    if (v < -268435456.0) { (*sat)++; return -268435456.0; }
+    return v;
+#endif
+}
+static int ic_close(sn_acc got, double ref, double mag) {
+#if defined(SN_FLOAT)
+    return fabs((double)got - ref) <= ldexp(mag, -21) + 1e-30;
+#else
+    (void)mag;
+    return (double)got == ref; /* |ref| < 2^52 here: exact in double */
+#endif
+}
+static void test_ic(void) {
+    int t, bad_path = 0, bad_ref = 0, clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        unsigned char b[20];
+        double U[9], scale, refc[3], refr[3], magc[3], magr[3];
+        sn_q y[3];
+        sn_acc a0[3], ac[3], ar[3], lc[4], lr[4];
+        uint32_t sat_p = 0, sat_r = 0, sat_d = 0, satc_p = 0, satc_r = 0, satc_d = 0;
+        int k, r, c, extreme = t % 16 == 0;
+#if defined(SN_FLOAT)
+        int frac = (int)(rnd32() % 41u), s = frac;
+#else
+        int frac = (int)(rnd32() % 63u); /* the row's shift: frac, 0..62 (sn_rshr64's range) */
+        int s = t % 4 == 0 ? -(int)(rnd32() % 16u) : (int)(rnd32() % 63u); /* the column's: frac + k_j - k_i, -15..62 */
+#endif
+        scale = SN_FLAVOUR ? ldexp(1.0, -frac) : 1.0;
+        for (k = 0; k < 9; k++) {
+            int32_t m = extreme ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+            uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+            b[2 * k] = (unsigned char)u;
+            b[2 * k + 1] = (unsigned char)(u >> 8);
+            U[k] = ldexp((double)m, 0) * scale;
+        }
+        b[18] = (unsigned char)frac;
+        b[19] = (unsigned char)rnd32(); /* pad: never used */
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            y[k] = (float)rnd_in(1 << 20) / 256.0f;
+            a0[k] = (float)rnd_in(1 << 20);
+#else
+            y[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            if (s < 0 && !extreme) y[k] /= (int32_t)1 << (rnd32() % 24u); /* some scaled-up rows below the clamp */
+            a0[k] = (int64_t)rnd_in(1 << 30) * (1 << 19); /* |.| <= 2^49: the sweeps' accumulator bound */
+#endif
+            ac[k] = ar[k] = a0[k];
+            lc[k] = lr[k] = a0[k];
+        }
+        lc[3] = lr[3] = 0;
+        sn_k_ic_col(b, y, s, ac, &satc_p);
+        sn_k_ic_col_ref(b, y, s, ar, &satc_r);
+        sn_k_ic_row(b, y, lc, &sat_p);
+        sn_k_ic_row_ref(b, y, lr, &sat_r);
+        for (k = 0; k < 3; k++) {
+            double pc = 0, pr = 0;
+            magc[k] = magr[k] = fabs((double)a0[k]);
+            for (r = 0; r < 3; r++) {
+                pc += U[3 * r + k] * (double)y[r];
+                magc[k] += fabs(U[3 * r + k] * (double)y[r]);
+            }
+            for (c = 0; c < 3; c++) {
+                pr += U[3 * k + c] * (double)y[c];
+                magr[k] += fabs(U[3 * k + c] * (double)y[c]);
+            }
+            refc[k] = (double)a0[k] + ic_rnd(pc, s, &satc_d);
+            refr[k] = (double)a0[k] + ic_rnd(pr, frac, &sat_d);
+        }
+        for (k = 0; k < 3; k++) {
+            bad_path += memcmp(&ac[k], &ar[k], sizeof ac[k]) != 0 || memcmp(&lc[k], &lr[k], sizeof lc[k]) != 0;
+            bad_ref += !ic_close(ar[k], refc[k], magc[k]) || !ic_close(lr[k], refr[k], magr[k]);
+        }
+        bad_path += satc_p != satc_r || sat_p != sat_r;
+        bad_ref += satc_r != satc_d || sat_r != sat_d;
+        clamps += (int)satc_d;
+    }
+    T_CHECK(bad_path == 0, "IC(0) block products: %d differences between path %s and the portable reference", bad_path,
+            sn_kernels_name());
+    T_CHECK(bad_ref == 0, "IC(0) block products: %d rows or clamp counts off the double reference", bad_ref);
+    T_FIGURE("IC(0) block products: 20000 random blocks (every 16th at the bounds, column shifts -15..62), %d clamped rows",
+             clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -142,5 +242,6 @@ int main(void) {
     T_CHECK(bad_two == 0, "sn_k_cell_mul2 differs from two calls in %d of 4000 cells", bad_two);
     T_CHECK(bad_list == 0, "free-corner product differs from the zero-padded full product in %d rows (%d lists)", bad_list, lists);
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
+    test_ic();
     return T_END();
 }
