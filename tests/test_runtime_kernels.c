@@ -18,6 +18,7 @@
 #include "sn_test.h"
 #include "sn_kernels.h"
 #include "sn_kernels_ic.h"
+#include "sn_kernels_rot.h"
 
 static uint32_t rng = 12345u;
 static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
@@ -193,6 +194,94 @@ static void test_ic(void) {
              clamps);
 }
 
+/* ---- frame rotations (sn_kernels_rot.h) against the reference in double:
+ * fixed, R entries up to +-2^30 (Q30; any matrix, not only rotations, so
+ * the clamp is reached), v up to +-2^28: the sum x < 3 2^58 is split as
+ * in row_ok (v = 2^13 vh + vl, every partial sum < 2^53 exact) and rounded
+ * half up by floor division on the exact int64, then clamped to +-2^28 and
+ * counted. Tolerance 0 against both the double reference and sn_rot*
+ * (sn_internal.h). Float: the path is sn_rot*; against double, 3 products
+ * and 2 adds rounded: 2^-21 of sum |R v|. */
+static double rot_ref(const double *r, int stride, const sn_q *v, double *mag) {
+#if defined(SN_FLOAT)
+    int c;
+    double x = 0;
+    *mag = 0;
+    for (c = 0; c < 3; c++) { x += r[c * stride] * (double)v[c]; *mag += fabs(r[c * stride] * (double)v[c]); }
+    return x;
+#else
+    double hi = 0, lo = 0;
+    int64_t x, q;
+    int c;
+    *mag = 0;
+    for (c = 0; c < 3; c++) {
+        int64_t vv = v[c], vh = vv >= 0 ? vv >> 13 : -((-vv) >> 13), vl = vv - vh * 8192;
+        hi += r[c * stride] * (double)vh;
+        lo += r[c * stride] * (double)vl;
+    }
+    x = (int64_t)hi * 8192 + (int64_t)lo;
+    q = x >= 0 ? x / 1073741824 : -((-x + 1073741823) / 1073741824); /* floor(x / 2^30) */
+    if (x - q * 1073741824 >= 536870912) q++;                          /* round half up */
+    return (double)q;
+#endif
+}
+static void test_rot(void) {
+    int t, k, bad_path = 0, bad_ref = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        sn_q R[9], v[3], o1[3], o2[3], p1[3], p2[3];
+        sn_acc a1[3], a2[3];
+        double Rd[9], mag;
+        uint32_t s1 = 0, s2 = 0, sd = 0;
+        int extreme = t % 16 == 0;
+        for (k = 0; k < 9; k++) {
+#if defined(SN_FLOAT)
+            (void)extreme;
+            R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+#else
+            R[k] = extreme ? (rnd32() & 1 ? (1 << 30) : -(1 << 30)) : rnd_in(1 << 30);
+#endif
+            Rd[k] = (double)R[k];
+        }
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            v[k] = (float)rnd_in(1 << 20) / 1024.0f; /* below SN_FLIM / 3: no clamp */
+            a1[k] = a2[k] = (float)rnd_in(1 << 20);
+#else
+            v[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) * (1 << 20);
+#endif
+        }
+        sn_k_rot_t(R, v, o1, &s1);
+        sn_rot_t(R, v, o2, &s2);
+        sn_k_rot(R, v, p1, &s1);
+        sn_rot(R, v, p2, &s2);
+        sn_k_rot_acc(a1, R, v);
+        sn_rot_acc(a2, R, v);
+        bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        for (k = 0; k < 3; k++) {
+            double xt = rot_ref(Rd + k, 3, v, &mag), mt = mag, xr = rot_ref(Rd + 3 * k, 1, v, &mag), mr = mag;
+#if defined(SN_FLOAT)
+            bad_ref += fabs((double)o2[k] - xt) > ldexp(mt, -21) + 1e-30 || fabs((double)p2[k] - xr) > ldexp(mr, -21) + 1e-30;
+#else
+            double lim = 268435456.0;
+            (void)mt; (void)mr;
+            sd += (xt > lim || xt < -lim) + (xr > lim || xr < -lim);
+            xt = xt > lim ? lim : xt < -lim ? -lim : xt;
+            xr = xr > lim ? lim : xr < -lim ? -lim : xr;
+            bad_ref += (double)o2[k] != xt || (double)p2[k] != xr;
+#endif
+        }
+#if !defined(SN_FLOAT)
+        bad_ref += s2 != sd;
+#endif
+        clamps += sd;
+    }
+    T_CHECK(bad_path == 0, "frame rotations: %d differences between path %s and sn_rot*", bad_path, sn_kernels_name());
+    T_CHECK(bad_ref == 0, "frame rotations: %d results or clamp counts off the double reference", bad_ref);
+    T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -243,5 +332,6 @@ int main(void) {
     T_CHECK(bad_list == 0, "free-corner product differs from the zero-padded full product in %d rows (%d lists)", bad_list, lists);
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
     test_ic();
+    test_rot();
     return T_END();
 }

@@ -18,6 +18,7 @@
  * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
  * round by frac into Q22 each, summed in int64, clamped once per vertex. */
 #include "sn_instance.h"
+#include "sn_kernels_rot.h" /* the frame rotations */
 #include "sn_kernels_ic.h" /* the block products: portable reference or the build's SIMD path */
 
 
@@ -101,18 +102,18 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
             sn_acc a[3];
             int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
             if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
-            sn_rot_t(R + rs * i, r + 3 * i, t, sat);
+            sn_k_rot_t(R + rs * i, r + 3 * i, t, sat);
             sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
             s[0] = sn_out(a[0], sh, sat);
             s[1] = sn_out(a[1], sh, sat);
             s[2] = sn_out(a[2], sh, sat);
-            sn_rot(R + rs * i, s, z + 3 * i, sat);
+            sn_k_rot(R + rs * i, s, z + 3 * i, sat);
         }
         return;
     }
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i]) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
-        else sn_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
+        else sn_k_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
     }
     n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
@@ -127,7 +128,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
         if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
-        sn_rot(R + rs * i, t, z + 3 * i, sat);
+        sn_k_rot(R + rs * i, t, z + 3 * i, sat);
     }
 }
 
