@@ -282,6 +282,62 @@ static void test_rot(void) {
     T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", clamps);
 }
 
+/* ---- CG vector update (sn_kernels.h sn_k_axpy) against the formula
+ * written here: fixed, the exact int64 product s x rounded half up by
+ * floor division (|s x| <= 2^59), clamped to +-2^28 (counted), added to a
+ * and clamped again (counted); tolerance 0, lengths 0..40 (the SIMD tails)
+ * and both aliasings of the solver (out = a: axpy; out = x: d = z + beta d).
+ * Float: out = a + s x, 2 roundings: 2^-22 of |a| + |s x|. */
+static void test_axpy(void) {
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q a[40], x[40], o[40], s;
+        double ref[40], mag[40];
+        uint32_t n = rnd32() % 41u, i, sat = 0, sd = 0;
+        int sh = t % 3 == 0 ? (int)(rnd32() % 63u) : 28, alias = t % 3;
+#if defined(SN_FLOAT)
+        s = (float)rnd_in(1 << 20) / 1048576.0f; /* |a + s x| < SN_FLIM: no clamp */
+        (void)sh;
+#else
+        s = t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (sn_q)(((int64_t)rnd32() - 2147483648) / ((int64_t)1 << (rnd32() % 31u)));
+#endif
+        for (i = 0; i < n; i++) {
+#if defined(SN_FLOAT)
+            a[i] = (float)rnd_in(1 << 20) / 1024.0f;
+            x[i] = (float)rnd_in(1 << 20) / 1024.0f;
+            ref[i] = (double)a[i] + (double)s * (double)x[i];
+            mag[i] = fabs((double)a[i]) + fabs((double)s * (double)x[i]);
+#else
+            int64_t p, q, half = sh > 0 ? (int64_t)1 << (sh - 1) : 0, d = (int64_t)1 << sh;
+            a[i] = rnd_in(1 << 28);
+            x[i] = t % 16 == 1 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            p = (int64_t)s * x[i] + half;
+            q = p >= 0 ? p / d : -((-p + d - 1) / d); /* floor */
+            if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+            q += a[i];
+            if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+            ref[i] = (double)q;
+            mag[i] = 0;
+#endif
+        }
+        if (alias == 1) { memcpy(o, a, sizeof a); sn_k_axpy(o, o, s, x, n, sh, &sat); }
+        else if (alias == 2) { memcpy(o, x, sizeof x); sn_k_axpy(o, a, s, o, n, sh, &sat); }
+        else sn_k_axpy(o, a, s, x, n, sh, &sat);
+        for (i = 0; i < n; i++) {
+#if defined(SN_FLOAT)
+            bad += fabs((double)o[i] - ref[i]) > ldexp(mag[i], -22) + 1e-30;
+#else
+            bad += (double)o[i] != ref[i] + 0.0 * mag[i];
+#endif
+        }
+        bad += sat != sd;
+        clamps += sd;
+    }
+    T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
+    T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -333,5 +389,6 @@ int main(void) {
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
     test_ic();
     test_rot();
+    test_axpy();
     return T_END();
 }

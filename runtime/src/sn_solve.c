@@ -336,8 +336,7 @@ static int32_t ratio(sn_dotv num, sn_dotv den, uint32_t *clamps) {
 
 /* y += s * x (s in Q28 fixed) over n values */
 static void axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) {
-    uint32_t i;
-    for (i = 0; i < n; i++) y[i] = sn_add(y[i], sn_mulq(s, x[i], SN_Q_SCAL, sat), sat);
+    sn_k_axpy(y, y, s, x, n, SN_Q_SCAL, sat); /* sn_kernels.h: reference or SIMD */
 }
 
 
@@ -382,7 +381,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz, &clamps);
-        for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
+        sn_k_axpy(d, z, beta, d, n3, SN_Q_SCAL, sat); /* d = z + beta d */
         rz = rz1;
     }
     if (rows) { /* the CG's rounding off the rows again; the second pass, in finer units, takes the first's rounding */
@@ -421,6 +420,5 @@ sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) {
 }
 void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) { axpy(y, s, x, n, sat); }
 void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat) {
-    uint32_t i;
-    for (i = 0; i < n; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
+    sn_k_axpy(d, z, beta, d, n, SN_Q_SCAL, sat);
 }
