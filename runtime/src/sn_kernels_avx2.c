@@ -164,9 +164,8 @@ SN_INLINE __m256i clamp4(__m256i q, uint32_t *c) {
 }
 
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
-    const __m256i vs = _mm256_set1_epi64x(s);
-    const __m256i bias = _mm256_set1_epi64x(((int64_t)1 << 62) + (sh > 0 ? (int64_t)1 << (sh - 1) : 0));
-    const __m256i off = _mm256_set1_epi64x(((int64_t)1 << 62) >> sh);
+    const int64_t b = ((int64_t)1 << 62) + (sh > 0 ? (int64_t)1 << (sh - 1) : 0), f = ((int64_t)1 << 62) >> sh;
+    const __m256i vs = _mm256_set1_epi64x(s), bias = _mm256_set1_epi64x(b), off = _mm256_set1_epi64x(f);
     const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0);
     const __m128i cnt = _mm_cvtsi32_si128(sh);
     uint32_t i, c = 0;
