@@ -266,7 +266,7 @@ static void test_rot(void) {
 #else
             double lim = 268435456.0;
             (void)mt; (void)mr;
-            sd += (xt > lim || xt < -lim) + (xr > lim || xr < -lim);
+            sd += (uint32_t)((xt > lim || xt < -lim) + (xr > lim || xr < -lim));
             xt = xt > lim ? lim : xt < -lim ? -lim : xt;
             xr = xr > lim ? lim : xr < -lim ? -lim : xr;
             bad_ref += (double)o2[k] != xt || (double)p2[k] != xr;

@@ -12,8 +12,9 @@
  * slots, VPMULDQ multiplies exactly. The sum |x| < 3 2^58 is rounded without
  * a 64-bit arithmetic shift: x + 2^29 + 2^62 is >= 0 and < 2^63, its logical
  * shift by 30 minus 2^32 is floor((x + 2^29) / 2^30), sn_rshr64's value;
- * then the same clamp and count. Same integers as the reference (exact
- * products, one rounding per output). Other paths: the reference. */
+ * then the same clamp and count. NEON: below. Same integers as the
+ * reference (exact products, one rounding per output). Other paths: the
+ * reference. */
 #ifndef SN_KERNELS_ROT_H
 #define SN_KERNELS_ROT_H
 
@@ -66,6 +67,43 @@ SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
                            _mm256_add_epi64(_mm256_maskload_epi64((const long long *)(const void *)acc, m3), sn_k_rot_x(R, t)));
 }
 #undef SN_K_R8
+
+#elif defined(SN_KERNELS_NEON)
+#include <arm_neon.h>
+/* NEON (aarch64 and ARMv7): lanes 0-1 in an int64x2 by VMULL/VMLAL by
+ * scalar, lane 2 scalar. VRSHR #30 is the round half up of sn_rshr64; the
+ * result fits int32 (|x| < 3 2^58), so VMOVN, then the clamp and its count
+ * in int32 (ARMv7 NEON has no 64-bit compare). */
+SN_INLINE void sn_k_rot_out2(int64x2_t x01, int64_t x2, sn_q out[3], uint32_t *sat) {
+    const int32x2_t lim = vdup_n_s32(SN_LIM), nlim = vdup_n_s32(-SN_LIM);
+    const int32x2_t q = vmovn_s64(vrshrq_n_s64(x01, SN_Q_ROT));
+    const uint32x2_t over = vorr_u32(vcgt_s32(q, lim), vclt_s32(q, nlim));
+    *sat += (vget_lane_u32(over, 0) & 1u) + (vget_lane_u32(over, 1) & 1u);
+    vst1_s32(out, vmax_s32(vmin_s32(q, lim), nlim));
+    out[2] = sn_out(x2, SN_Q_ROT, sat);
+}
+/* out = R^T v: lanes (R0,R1) v0 + (R3,R4) v1 + (R6,R7) v2 */
+SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    int64x2_t x = vmull_n_s32(vld1_s32(R), v[0]);
+    x = vmlal_n_s32(x, vld1_s32(R + 3), v[1]);
+    x = vmlal_n_s32(x, vld1_s32(R + 6), v[2]);
+    sn_k_rot_out2(x, sn_mul(R[2], v[0]) + sn_mul(R[5], v[1]) + sn_mul(R[8], v[2]), out, sat);
+}
+/* R v: VLD3 de-interleaves (R0,R3) (R1,R4) (R2,R5); row 2 scalar */
+SN_INLINE int64x2_t sn_k_rot_x01(const sn_q R[9], const sn_q v[3]) {
+    const int32x2x3_t c = vld3_s32(R);
+    int64x2_t x = vmull_n_s32(c.val[0], v[0]);
+    x = vmlal_n_s32(x, c.val[1], v[1]);
+    return vmlal_n_s32(x, c.val[2], v[2]);
+}
+SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    const int64x2_t x = sn_k_rot_x01(R, v);
+    sn_k_rot_out2(x, sn_mul(R[6], v[0]) + sn_mul(R[7], v[1]) + sn_mul(R[8], v[2]), out, sat);
+}
+SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
+    vst1q_s64(acc, vaddq_s64(vld1q_s64(acc), sn_k_rot_x01(R, t)));
+    acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
+}
 
 #else
 #define sn_k_rot_t sn_rot_t
