@@ -54,11 +54,13 @@ $(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
 SN_TCFLAGS = -std=c99 -Wall -Wextra -Wpedantic -Werror $(CFLAGS) $(SN_INC) -Iruntime/src -Itests
 SN_TEST_HDRS = $(SN_HDRS) tests/sn_test.h tests/fuzz/sn_tblob.h
 SN_TESTS = math blob rig kernels
+# the kernels test includes inline kernels (sn_kernels_ic.h): built for the library's SIMD path
+SN_TCFLAGS_kernels = $(SN_SIMD_FLAGS)
 
 define SN_TEST_RULE
 $(BUILD)/tests/test_runtime_$(1): tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $$(@D)
-	$(CC) $(SN_TCFLAGS) -o $$@ $$< $(SN_LIB_FIXED) -lm
+	$(CC) $(SN_TCFLAGS) $(SN_TCFLAGS_$(1)) -o $$@ $$< $(SN_LIB_FIXED) -lm
 $(BUILD)/tests/test_runtime_$(1)_float: tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $$(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $$@ $$< $(SN_LIB_FLOAT) -lm

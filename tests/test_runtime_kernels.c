@@ -17,6 +17,8 @@
 #include <string.h>
 #include "sn_test.h"
 #include "sn_kernels.h"
+#include "sn_kernels_ic.h"
+#include "sn_kernels_rot.h"
 
 static uint32_t rng = 12345u;
 static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
@@ -93,6 +95,249 @@ static int row_ok(double S[24][24], const sn_q *u, int r, sn_acc got) {
 #endif
 }
 
+/* ---- IC(0) block products (sn_kernels_ic.h), against a reference written
+ * from BLOB.md's ICHOL element (int16 m[9] row-major, u8 frac, pad) in
+ * double: every product sum |p| < 3 2^43 is an exact double, and so are
+ * p 2^-s and p 2^-s + 1/2 (< 2^52), so floor(p 2^-s + 1/2) is the exact
+ * round-half-up. Fixed: tolerance 0 (the path's integers equal the
+ * reference and the portable _ref; clamps counted alike). Float: the path
+ * is the _ref; against double, 4 roundings (3 products, 3 adds into a) each
+ * <= 2^-24 of a partial sum bounded by |a0| + sum |U y|: 2^-21 of that. */
+static double ic_rnd(double p, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s; (void)sat;
+    return p;
+#else
+    double v = floor(ldexp(p, -s) + (s > 0 ? 0.5 : 0.0));
+    if (s >= 0) return v;
+    if (v > 268435456.0) { (*sat)++; return 268435456.0; }
+    if (v < -268435456.0) { (*sat)++; return -268435456.0; }
+    return v;
+#endif
+}
+static int ic_close(sn_acc got, double ref, double mag) {
+#if defined(SN_FLOAT)
+    return fabs((double)got - ref) <= ldexp(mag, -21) + 1e-30;
+#else
+    (void)mag;
+    return (double)got == ref; /* |ref| < 2^52 here: exact in double */
+#endif
+}
+static void test_ic(void) {
+    int t, bad_path = 0, bad_ref = 0, clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        unsigned char b[20];
+        double U[9], scale, refc[3], refr[3], magc[3], magr[3];
+        sn_q y[3];
+        sn_acc a0[3], ac[3], ar[3], lc[4], lr[4];
+        uint32_t sat_p = 0, sat_r = 0, sat_d = 0, satc_p = 0, satc_r = 0, satc_d = 0;
+        int k, r, c, extreme = t % 16 == 0;
+#if defined(SN_FLOAT)
+        int frac = (int)(rnd32() % 41u), s = frac;
+#else
+        int frac = (int)(rnd32() % 63u); /* the row's shift: frac, 0..62 (sn_rshr64's range) */
+        int s = t % 4 == 0 ? -(int)(rnd32() % 16u) : (int)(rnd32() % 63u); /* the column's: frac + k_j - k_i, -15..62 */
+#endif
+        scale = SN_FLAVOUR ? ldexp(1.0, -frac) : 1.0;
+        for (k = 0; k < 9; k++) {
+            int32_t m = extreme ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+            uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+            b[2 * k] = (unsigned char)u;
+            b[2 * k + 1] = (unsigned char)(u >> 8);
+            U[k] = ldexp((double)m, 0) * scale;
+        }
+        b[18] = (unsigned char)frac;
+        b[19] = (unsigned char)rnd32(); /* pad: never used */
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            y[k] = (float)rnd_in(1 << 20) / 256.0f;
+            a0[k] = (float)rnd_in(1 << 20);
+#else
+            y[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            if (s < 0 && !extreme) y[k] /= (int32_t)1 << (rnd32() % 24u); /* some scaled-up rows below the clamp */
+            a0[k] = (int64_t)rnd_in(1 << 30) * (1 << 19); /* |.| <= 2^49: the sweeps' accumulator bound */
+#endif
+            ac[k] = ar[k] = a0[k];
+            lc[k] = lr[k] = a0[k];
+        }
+        lc[3] = lr[3] = 0;
+        sn_k_ic_col(b, y, s, ac, &satc_p);
+        sn_k_ic_col_ref(b, y, s, ar, &satc_r);
+        sn_k_ic_row(b, y, lc, &sat_p);
+        sn_k_ic_row_ref(b, y, lr, &sat_r);
+        for (k = 0; k < 3; k++) {
+            double pc = 0, pr = 0;
+            magc[k] = magr[k] = fabs((double)a0[k]);
+            for (r = 0; r < 3; r++) {
+                pc += U[3 * r + k] * (double)y[r];
+                magc[k] += fabs(U[3 * r + k] * (double)y[r]);
+            }
+            for (c = 0; c < 3; c++) {
+                pr += U[3 * k + c] * (double)y[c];
+                magr[k] += fabs(U[3 * k + c] * (double)y[c]);
+            }
+            refc[k] = (double)a0[k] + ic_rnd(pc, s, &satc_d);
+            refr[k] = (double)a0[k] + ic_rnd(pr, frac, &sat_d);
+        }
+        for (k = 0; k < 3; k++) {
+            bad_path += memcmp(&ac[k], &ar[k], sizeof ac[k]) != 0 || memcmp(&lc[k], &lr[k], sizeof lc[k]) != 0;
+            bad_ref += !ic_close(ar[k], refc[k], magc[k]) || !ic_close(lr[k], refr[k], magr[k]);
+        }
+        bad_path += satc_p != satc_r || sat_p != sat_r;
+        bad_ref += satc_r != satc_d || sat_r != sat_d;
+        clamps += (int)satc_d;
+    }
+    T_CHECK(bad_path == 0, "IC(0) block products: %d differences between path %s and the portable reference", bad_path,
+            sn_kernels_name());
+    T_CHECK(bad_ref == 0, "IC(0) block products: %d rows or clamp counts off the double reference", bad_ref);
+    T_FIGURE("IC(0) block products: 20000 random blocks (every 16th at the bounds, column shifts -15..62), %d clamped rows",
+             clamps);
+}
+
+/* ---- frame rotations (sn_kernels_rot.h) against the reference in double:
+ * fixed, R entries up to +-2^30 (Q30; any matrix, not only rotations, so
+ * the clamp is reached), v up to +-2^28: the sum x < 3 2^58 is split as
+ * in row_ok (v = 2^13 vh + vl, every partial sum < 2^53 exact) and rounded
+ * half up by floor division on the exact int64, then clamped to +-2^28 and
+ * counted. Tolerance 0 against both the double reference and sn_rot*
+ * (sn_internal.h). Float: the path is sn_rot*; against double, 3 products
+ * and 2 adds rounded: 2^-21 of sum |R v|. */
+static double rot_ref(const double *r, int stride, const sn_q *v, double *mag) {
+#if defined(SN_FLOAT)
+    int c;
+    double x = 0;
+    *mag = 0;
+    for (c = 0; c < 3; c++) { x += r[c * stride] * (double)v[c]; *mag += fabs(r[c * stride] * (double)v[c]); }
+    return x;
+#else
+    double hi = 0, lo = 0;
+    int64_t x, q;
+    int c;
+    *mag = 0;
+    for (c = 0; c < 3; c++) {
+        int64_t vv = v[c], vh = vv >= 0 ? vv >> 13 : -((-vv) >> 13), vl = vv - vh * 8192;
+        hi += r[c * stride] * (double)vh;
+        lo += r[c * stride] * (double)vl;
+    }
+    x = (int64_t)hi * 8192 + (int64_t)lo;
+    q = x >= 0 ? x / 1073741824 : -((-x + 1073741823) / 1073741824); /* floor(x / 2^30) */
+    if (x - q * 1073741824 >= 536870912) q++;                          /* round half up */
+    return (double)q;
+#endif
+}
+static void test_rot(void) {
+    int t, k, bad_path = 0, bad_ref = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        sn_q R[9], v[3], o1[3], o2[3], p1[3], p2[3];
+        sn_acc a1[3], a2[3];
+        double Rd[9], mag;
+        uint32_t s1 = 0, s2 = 0, sd = 0;
+        int extreme = t % 16 == 0;
+        for (k = 0; k < 9; k++) {
+#if defined(SN_FLOAT)
+            (void)extreme;
+            R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+#else
+            R[k] = extreme ? (rnd32() & 1 ? (1 << 30) : -(1 << 30)) : rnd_in(1 << 30);
+#endif
+            Rd[k] = (double)R[k];
+        }
+        for (k = 0; k < 3; k++) {
+#if defined(SN_FLOAT)
+            v[k] = (float)rnd_in(1 << 20) / 1024.0f; /* below SN_FLIM / 3: no clamp */
+            a1[k] = a2[k] = (float)rnd_in(1 << 20);
+#else
+            v[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) * (1 << 20);
+#endif
+        }
+        sn_k_rot_t(R, v, o1, &s1);
+        sn_rot_t(R, v, o2, &s2);
+        sn_k_rot(R, v, p1, &s1);
+        sn_rot(R, v, p2, &s2);
+        sn_k_rot_acc(a1, R, v);
+        sn_rot_acc(a2, R, v);
+        bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        for (k = 0; k < 3; k++) {
+            double xt = rot_ref(Rd + k, 3, v, &mag), mt = mag, xr = rot_ref(Rd + 3 * k, 1, v, &mag), mr = mag;
+#if defined(SN_FLOAT)
+            bad_ref += fabs((double)o2[k] - xt) > ldexp(mt, -21) + 1e-30 || fabs((double)p2[k] - xr) > ldexp(mr, -21) + 1e-30;
+#else
+            double lim = 268435456.0;
+            (void)mt; (void)mr;
+            sd += (uint32_t)((xt > lim || xt < -lim) + (xr > lim || xr < -lim));
+            xt = xt > lim ? lim : xt < -lim ? -lim : xt;
+            xr = xr > lim ? lim : xr < -lim ? -lim : xr;
+            bad_ref += (double)o2[k] != xt || (double)p2[k] != xr;
+#endif
+        }
+#if !defined(SN_FLOAT)
+        bad_ref += s2 != sd;
+#endif
+        clamps += sd;
+    }
+    T_CHECK(bad_path == 0, "frame rotations: %d differences between path %s and sn_rot*", bad_path, sn_kernels_name());
+    T_CHECK(bad_ref == 0, "frame rotations: %d results or clamp counts off the double reference", bad_ref);
+    T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", clamps);
+}
+
+/* ---- CG vector update (sn_kernels.h sn_k_axpy) against the formula
+ * written here: fixed, the exact int64 product s x rounded half up by
+ * floor division (|s x| <= 2^59), clamped to +-2^28 (counted), added to a
+ * and clamped again (counted); tolerance 0, lengths 0..40 (the SIMD tails)
+ * and both aliasings of the solver (out = a: axpy; out = x: d = z + beta d).
+ * Float: out = a + s x, 2 roundings: 2^-22 of |a| + |s x|. */
+static void test_axpy(void) {
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q a[40], x[40], o[40], s;
+        double ref[40], mag[40];
+        uint32_t n = rnd32() % 41u, i, sat = 0, sd = 0;
+        int sh = t % 3 == 0 ? (int)(rnd32() % 63u) : 28, alias = t % 3;
+#if defined(SN_FLOAT)
+        s = (float)rnd_in(1 << 20) / 1048576.0f; /* |a + s x| < SN_FLIM: no clamp */
+        (void)sh;
+#else
+        s = t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (sn_q)(((int64_t)rnd32() - 2147483648) / ((int64_t)1 << (rnd32() % 31u)));
+#endif
+        for (i = 0; i < n; i++) {
+#if defined(SN_FLOAT)
+            a[i] = (float)rnd_in(1 << 20) / 1024.0f;
+            x[i] = (float)rnd_in(1 << 20) / 1024.0f;
+            ref[i] = (double)a[i] + (double)s * (double)x[i];
+            mag[i] = fabs((double)a[i]) + fabs((double)s * (double)x[i]);
+#else
+            int64_t p, q, half = sh > 0 ? (int64_t)1 << (sh - 1) : 0, d = (int64_t)1 << sh;
+            a[i] = rnd_in(1 << 28);
+            x[i] = t % 16 == 1 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
+            p = (int64_t)s * x[i] + half;
+            q = p >= 0 ? p / d : -((-p + d - 1) / d); /* floor */
+            if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+            q += a[i];
+            if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+            ref[i] = (double)q;
+            mag[i] = 0;
+#endif
+        }
+        if (alias == 1) { memcpy(o, a, sizeof a); sn_k_axpy(o, o, s, x, n, sh, &sat); }
+        else if (alias == 2) { memcpy(o, x, sizeof x); sn_k_axpy(o, a, s, o, n, sh, &sat); }
+        else sn_k_axpy(o, a, s, x, n, sh, &sat);
+        for (i = 0; i < n; i++) {
+#if defined(SN_FLOAT)
+            bad += fabs((double)o[i] - ref[i]) > ldexp(mag[i], -22) + 1e-30;
+#else
+            bad += (double)o[i] != ref[i] + 0.0 * mag[i];
+#endif
+        }
+        bad += sat != sd;
+        clamps += sd;
+    }
+    T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
+    T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -142,5 +387,8 @@ int main(void) {
     T_CHECK(bad_two == 0, "sn_k_cell_mul2 differs from two calls in %d of 4000 cells", bad_two);
     T_CHECK(bad_list == 0, "free-corner product differs from the zero-padded full product in %d rows (%d lists)", bad_list, lists);
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
+    test_ic();
+    test_rot();
+    test_axpy();
     return T_END();
 }

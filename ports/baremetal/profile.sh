@@ -6,6 +6,7 @@
 # after init (init, blob CRC included, shows up as sn_blob_validate).
 . ports/cross/port_lib.sh
 B=$BUILD/baremetal
+mkdir -p "$B"   # a fresh build directory has none yet
 pmake "$B/prof_cow.elf" > "$B/prof_build.log" 2>&1 || { tail -n 20 "$B/prof_build.log"; exit 1; }
 log=$B/prof_qemu.log
 # shellcheck disable=SC2086

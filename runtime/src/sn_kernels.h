@@ -103,6 +103,21 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e);
 #endif
 
+/* The CG's vector updates (sn_solve.c axpy, the direction update):
+ * out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat); out may be a or x
+ * (each entry is read before it is written). Fixed: |s x| <= 2^31 2^28,
+ * |a| <= SN_LIM (a state vector) and 0 <= sh <= 62, every product rounded
+ * and clamped alone (order-free);
+ * float: the reference on every path. */
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON)
+void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat);
+#else /* the reference, inline as the loops it replaced */
+SN_INLINE void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
+    uint32_t i;
+    for (i = 0; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
+}
+#endif
+
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */
 const char *sn_kernels_name(void);
 

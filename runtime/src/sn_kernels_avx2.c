@@ -150,6 +150,34 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
     return sum;
 }
 
+/* CG updates, 4 values per iteration: the product s x_i exact (VPMULDQ),
+ * rounded by sh with the bias trick of sn_kernels_ic.h (|s x| <= 2^59:
+ * s x + 2^(sh-1) + 2^62 is in [0, 2^63), its logical shift minus 2^62 >> sh
+ * is sn_rshr64's value), clamped and counted as sn_out, added to a_i in
+ * int64, clamped and counted again (sn_add); the tail in scalar. */
+SN_INLINE __m256i clamp4(__m256i q, uint32_t *c) {
+    const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
+    const __m256i hi = _mm256_cmpgt_epi64(q, lim), lo = _mm256_cmpgt_epi64(nlim, q);
+    const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
+    *c += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3));
+    return _mm256_blendv_epi8(_mm256_blendv_epi8(q, lim, hi), nlim, lo);
+}
+
+void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
+    const int64_t b = ((int64_t)1 << 62) + (sh > 0 ? (int64_t)1 << (sh - 1) : 0), f = ((int64_t)1 << 62) >> sh;
+    const __m256i vs = _mm256_set1_epi64x(s), bias = _mm256_set1_epi64x(b), off = _mm256_set1_epi64x(f);
+    const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0);
+    const __m128i cnt = _mm_cvtsi32_si128(sh);
+    uint32_t i, c = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        __m256i q = _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(_mm256_mul_epi32(LD4(x + i), vs), bias), cnt), off);
+        q = clamp4(_mm256_add_epi64(clamp4(q, &c), LD4(a + i)), &c);
+        _mm_storeu_si128((__m128i *)(void *)(out + i), _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(q, even)));
+    }
+    *sat += c;
+    for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
+}
+
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 const char *sn_kernels_name(void) { return "avx512"; }
 #else

@@ -125,6 +125,29 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
     return sum;
 }
 
+/* CG updates, 4 values per iteration: VMULL by s (exact), VRSHL by -sh
+ * (sn_rshr64's rounding), VQMOVN to int32 (a value beyond int32 saturates,
+ * still beyond SN_LIM: clamped and counted the same), the clamp and count
+ * in int32 lanes (a compare mask is -1: subtracting it counts), + a
+ * (|a|, |q| <= 2^28: no overflow), clamp and count again; tail scalar. */
+void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
+    const int64x2_t vsh = vdupq_n_s64(-(int64_t)sh);
+    const int32x4_t lim = vdupq_n_s32(SN_LIM), nlim = vdupq_n_s32(-SN_LIM);
+    uint32x4_t c = vdupq_n_u32(0);
+    uint32_t i;
+    for (i = 0; i + 4 <= n; i += 4) {
+        const int32x4_t xv = vld1q_s32(x + i);
+        int32x4_t q = vcombine_s32(vqmovn_s64(vrshlq_s64(vmull_n_s32(vget_low_s32(xv), s), vsh)),
+                                   vqmovn_s64(vrshlq_s64(vmull_n_s32(vget_high_s32(xv), s), vsh)));
+        c = vsubq_u32(c, vorrq_u32(vcgtq_s32(q, lim), vcltq_s32(q, nlim)));
+        q = vaddq_s32(vmaxq_s32(vminq_s32(q, lim), nlim), vld1q_s32(a + i));
+        c = vsubq_u32(c, vorrq_u32(vcgtq_s32(q, lim), vcltq_s32(q, nlim)));
+        vst1q_s32(out + i, vmaxq_s32(vminq_s32(q, lim), nlim));
+    }
+    *sat += vgetq_lane_u32(c, 0) + vgetq_lane_u32(c, 1) + vgetq_lane_u32(c, 2) + vgetq_lane_u32(c, 3);
+    for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
+}
+
 const char *sn_kernels_name(void) { return "neon"; }
 
 #else

@@ -18,45 +18,9 @@
  * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
  * round by frac into Q22 each, summed in int64, clamped once per vertex. */
 #include "sn_instance.h"
+#include "sn_kernels_rot.h" /* the frame rotations */
+#include "sn_kernels_ic.h" /* the block products: portable reference or the build's SIMD path */
 
-/* int16 from two little-endian bytes, without an implementation-defined
- * conversion (little-endian hosts: one load; int16_t is two's complement) */
-SN_INLINE int32_t rd_i16(const unsigned char *p) {
-#if SN_HOST_LE
-    int16_t v;
-    memcpy(&v, p, 2);
-    return v;
-#else
-    return (int32_t)(sn_rd_u16(p) ^ 0x8000u) - 32768;
-#endif
-}
-
-/* Block U (entries as sn_q: fixed the mantissa, float the value) and its frac. */
-SN_INLINE int ic_block(const unsigned char *b, sn_q U[9]) {
-    int k;
-#if defined(SN_FLOAT)
-    uint32_t u = (uint32_t)(127 - b[18]) << 23; /* 2^-frac, frac <= 47: a normal float */
-    float s;
-    memcpy(&s, &u, 4);
-    for (k = 0; k < 9; k++) U[k] = (float)rd_i16(b + 2 * k) * s;
-#else
-    for (k = 0; k < 9; k++) U[k] = rd_i16(b + 2 * k);
-#endif
-    return b[18];
-}
-
-/* A block row product p (|p| < 2^44.6) at shift s: rounded (s >= 0: < 2^44.6,
- * no clamp needed) or, s < 0, scaled up by 2^-s <= 2^15 and clamped to the
- * state range (counted). Float: p. */
-SN_INLINE sn_acc ic_round(sn_acc p, int s, uint32_t *sat) {
-#if defined(SN_FLOAT)
-    (void)s; (void)sat;
-    return p;
-#else
-    if (s >= 0) return sn_rshr64(p, s);
-    return sn_out(p * ((int64_t)1 << -s), 0, sat);
-#endif
-}
 
 /* y = (I + L^)^-1 y in place: for j ascending, y_i -= U_ji^T y_j (i > j).
  * The rounded block rows bound for y_i are summed in acc (int64: at most
@@ -76,17 +40,14 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
         yj[2] = sn_out((sn_acc)yj[2] - acc[3 * j + 2], 0, sat);
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
-            sn_acc *ai = acc + 3 * i;
-            sn_q U[9];
+            const unsigned char *blk = L + (size_t)n * SN_ELEM_ICHOL;
             int s;
             if (i >= nF) break; /* skeleton columns: not in ICHOL */
-            s = ic_block(L + (size_t)n * SN_ELEM_ICHOL, U);
+            s = blk[18];
 #if !defined(SN_FLOAT)
             s += (int)kk[j] - (int)kk[i]; /* Q(19 + k_j + frac) -> Q(19 + k_i) */
 #endif
-            ai[0] += ic_round(sn_mul(U[0], yj[0]) + sn_mul(U[3], yj[1]) + sn_mul(U[6], yj[2]), s, sat);
-            ai[1] += ic_round(sn_mul(U[1], yj[0]) + sn_mul(U[4], yj[1]) + sn_mul(U[7], yj[2]), s, sat);
-            ai[2] += ic_round(sn_mul(U[2], yj[0]) + sn_mul(U[5], yj[1]) + sn_mul(U[8], yj[2]), s, sat);
+            sn_k_ic_col(blk, yj, s, acc + 3 * i, sat); /* acc_i += round(U_ji^T y_j) */
         }
     }
     (void)kk;
@@ -101,22 +62,17 @@ static void ic_backward(const sn_view *v, uint32_t n, sn_q *z, uint32_t *sat) {
     uint32_t j = v->nF, e, nF = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4), f = b;
-        sn_acc l0 = 0, l1 = 0, l2 = 0;
+        sn_acc l[4] = {0, 0, 0, 0};
         const unsigned char *blk;
         while (f < end && sn_rd_u16(cols + 2 * f) < nF) f++; /* free columns first */
         n -= f - b;
         blk = L + (size_t)n * SN_ELEM_ICHOL;
         for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
-            const sn_q *zi = z + 3 * sn_rd_u16(cols + 2 * e);
-            sn_q U[9];
-            int s = ic_block(blk, U);
-            l0 += ic_round(sn_mul(U[0], zi[0]) + sn_mul(U[1], zi[1]) + sn_mul(U[2], zi[2]), s, sat);
-            l1 += ic_round(sn_mul(U[3], zi[0]) + sn_mul(U[4], zi[1]) + sn_mul(U[5], zi[2]), s, sat);
-            l2 += ic_round(sn_mul(U[6], zi[0]) + sn_mul(U[7], zi[1]) + sn_mul(U[8], zi[2]), s, sat);
+            sn_k_ic_row(blk, z + 3 * sn_rd_u16(cols + 2 * e), l, sat); /* l += round(U_ji z_i) */
         }
-        z[3 * j] = sn_out((sn_acc)z[3 * j] - l0, 0, sat);
-        z[3 * j + 1] = sn_out((sn_acc)z[3 * j + 1] - l1, 0, sat);
-        z[3 * j + 2] = sn_out((sn_acc)z[3 * j + 2] - l2, 0, sat);
+        z[3 * j] = sn_out((sn_acc)z[3 * j] - l[0], 0, sat);
+        z[3 * j + 1] = sn_out((sn_acc)z[3 * j + 1] - l[1], 0, sat);
+        z[3 * j + 2] = sn_out((sn_acc)z[3 * j + 2] - l[2], 0, sat);
     }
 }
 
@@ -146,18 +102,18 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
             sn_acc a[3];
             int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
             if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
-            sn_rot_t(R + rs * i, r + 3 * i, t, sat);
+            sn_k_rot_t(R + rs * i, r + 3 * i, t, sat);
             sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
             s[0] = sn_out(a[0], sh, sat);
             s[1] = sn_out(a[1], sh, sat);
             s[2] = sn_out(a[2], sh, sat);
-            sn_rot(R + rs * i, s, z + 3 * i, sat);
+            sn_k_rot(R + rs * i, s, z + 3 * i, sat);
         }
         return;
     }
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i]) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
-        else sn_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
+        else sn_k_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
     }
     n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
@@ -172,7 +128,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
         if (mask && !mask[i]) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
-        sn_rot(R + rs * i, t, z + 3 * i, sat);
+        sn_k_rot(R + rs * i, t, z + 3 * i, sat);
     }
 }
 

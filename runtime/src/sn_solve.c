@@ -12,6 +12,7 @@
 #include "sn_constraint.h"
 #include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
 #include "sn_blended.h" /* sn_rhs and the CG arithmetic, shared with the blended mode */
+#include "sn_kernels_rot.h" /* sn_k_rot_t, sn_k_rot, sn_k_rot_acc: the frame rotations, reference or SIMD */
 
 SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[0] += sn_mul(m, e[0]);
@@ -90,8 +91,8 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
                 t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
                 s[c] = sn_add(w_at(h, w, vel, a, c), -w0[c], sat);
             }
-            sn_rot_t(R, t, l, sat);
-            sn_rot_t(R, s, uu + 3 * k, sat);
+            sn_k_rot_t(R, t, l, sat);
+            sn_k_rot_t(R, s, uu + 3 * k, sat);
             for (c = 0; c < 3; c++) {
                 sn_q xr = sn_add(rd_real(rest, 3 * a + c), -rd_real(rest, 3 * a0 + c), sat);
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
@@ -107,7 +108,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
             sh = v->frac_S - SN_KREL(kk[a]);
             for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c], sh, sat);
-            sn_rot_acc(acc + 3 * a, R, t);
+            sn_k_rot_acc(acc + 3 * a, R, t);
         }
     }
 }
@@ -174,7 +175,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i), gi[3], gr[3];
         /* rest shape = modelled shape: cancel gravity as the vertex frame turns it */
-        sn_rot(R + 9 * i, v->grav, gr, sat);
+        sn_k_rot(R + 9 * i, v->grav, gr, sat);
         for (k = 0; k < 3; k++)
             gi[k] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[k], -gr[k], sat) : v->grav[k];
         for (k = 0; k < 3; k++) {
@@ -226,7 +227,7 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     for (k = 0; k < 8; k++) {
         uint32_t a = sn_rd_u16(cl + 2 * k);
         if (a >= nF || (mask && !mask[a])) continue;
-        sn_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+        sn_k_rot_t(R, d + 3 * a, u + 3 * nf, sat);
         fc[nf] = (uint8_t)k;
         vi[nf++] = a;
     }
@@ -237,7 +238,7 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
         sn_q t[3];
         int sh = h->v.frac_S - SN_KREL(kk[a]);
         for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-        sn_rot_acc(acc + 3 * a, R, t);
+        sn_k_rot_acc(acc + 3 * a, R, t);
     }
 }
 
@@ -335,8 +336,7 @@ static int32_t ratio(sn_dotv num, sn_dotv den, uint32_t *clamps) {
 
 /* y += s * x (s in Q28 fixed) over n values */
 static void axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) {
-    uint32_t i;
-    for (i = 0; i < n; i++) y[i] = sn_add(y[i], sn_mulq(s, x[i], SN_Q_SCAL, sat), sat);
+    sn_k_axpy(y, y, s, x, n, SN_Q_SCAL, sat); /* sn_kernels.h: reference or SIMD */
 }
 
 
@@ -381,7 +381,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz, &clamps);
-        for (i = 0; i < n3; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
+        sn_k_axpy(d, z, beta, d, n3, SN_Q_SCAL, sat); /* d = z + beta d */
         rz = rz1;
     }
     if (rows) { /* the CG's rounding off the rows again; the second pass, in finer units, takes the first's rounding */
@@ -420,6 +420,5 @@ sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) {
 }
 void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) { axpy(y, s, x, n, sat); }
 void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat) {
-    uint32_t i;
-    for (i = 0; i < n; i++) d[i] = sn_add(z[i], sn_mulq(beta, d[i], SN_Q_SCAL, sat), sat);
+    sn_k_axpy(d, z, beta, d, n, SN_Q_SCAL, sat);
 }

@@ -1,0 +1,170 @@
+/* sn_kernels_ic.h -- the IC(0) preconditioner's block products (sn_precond.c,
+ * NUMERICS.md "Preconditioner"): one 3x3 ICHOL block U (int16 mantissas,
+ * one frac per block; SN_ELEM_ICHOL bytes: m[9], frac, pad) times a
+ * 3-vector, each of the three rows rounded alone. Inline: they run once per
+ * stored block of each sweep, where a call would cost as much as the block.
+ *
+ *   sn_k_ic_col: a[c] += round(sum_r U[3r+c] y[r], s)   (U^T y, forward)
+ *   sn_k_ic_row: l[r] += round(sum_c U[3r+c] z[c], frac) (U z, backward)
+ *
+ * round(p, s): s >= 0 the round-half-up shift (sn_rshr64), s < 0 scaled up
+ * by 2^-s <= 2^15 and clamped (counted). Fixed: |U| < 2^15, |y| <= 2^28, so
+ * |p| < 3 2^43 < 2^44.6. The _ref versions are the portable reference (and
+ * the float flavour); the AVX2 and NEON versions return the same integers:
+ * the products are exact, each row is rounded alone with the same rule, and
+ * the sums into a and l are exact int64 sums (bounds: sn_precond.c). */
+#ifndef SN_KERNELS_IC_H
+#define SN_KERNELS_IC_H
+
+#include "sn_kernels.h"
+
+/* int16 from two little-endian bytes, without an implementation-defined
+ * conversion (little-endian hosts: one load; int16_t is two's complement) */
+SN_INLINE int32_t sn_k_ic_i16(const unsigned char *p) {
+#if SN_HOST_LE
+    int16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    return (int32_t)(sn_rd_u16(p) ^ 0x8000u) - 32768;
+#endif
+}
+
+/* Block U (entries as sn_q: fixed the mantissa, float the value) and its frac. */
+SN_INLINE int sn_k_ic_block(const unsigned char *b, sn_q U[9]) {
+    int k;
+#if defined(SN_FLOAT)
+    uint32_t u = (uint32_t)(127 - b[18]) << 23; /* 2^-frac, frac <= 47: a normal float */
+    float s;
+    memcpy(&s, &u, 4);
+    for (k = 0; k < 9; k++) U[k] = (float)sn_k_ic_i16(b + 2 * k) * s;
+#else
+    for (k = 0; k < 9; k++) U[k] = sn_k_ic_i16(b + 2 * k);
+#endif
+    return b[18];
+}
+
+/* A block row product p (|p| < 2^44.6) at shift s: rounded (s >= 0: < 2^44.6,
+ * no clamp needed) or, s < 0, scaled up by 2^-s <= 2^15 and clamped to the
+ * state range (counted). Float: p. */
+SN_INLINE sn_acc sn_k_ic_round(sn_acc p, int s, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)s; (void)sat;
+    return p;
+#else
+    if (s >= 0) return sn_rshr64(p, s);
+    return sn_out(p * ((int64_t)1 << -s), 0, sat);
+#endif
+}
+
+SN_INLINE void sn_k_ic_col_ref(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    sn_q U[9];
+    (void)sn_k_ic_block(b, U);
+    a[0] += sn_k_ic_round(sn_mul(U[0], y[0]) + sn_mul(U[3], y[1]) + sn_mul(U[6], y[2]), s, sat);
+    a[1] += sn_k_ic_round(sn_mul(U[1], y[0]) + sn_mul(U[4], y[1]) + sn_mul(U[7], y[2]), s, sat);
+    a[2] += sn_k_ic_round(sn_mul(U[2], y[0]) + sn_mul(U[5], y[1]) + sn_mul(U[8], y[2]), s, sat);
+}
+
+/* l has 4 entries (the 4th is the SIMD paths' scratch, never read). */
+SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+    sn_q U[9];
+    int s = sn_k_ic_block(b, U);
+    l[0] += sn_k_ic_round(sn_mul(U[0], z[0]) + sn_mul(U[1], z[1]) + sn_mul(U[2], z[2]), s, sat);
+    l[1] += sn_k_ic_round(sn_mul(U[3], z[0]) + sn_mul(U[4], z[1]) + sn_mul(U[5], z[2]), s, sat);
+    l[2] += sn_k_ic_round(sn_mul(U[6], z[0]) + sn_mul(U[7], z[1]) + sn_mul(U[8], z[2]), s, sat);
+}
+
+#if defined(SN_KERNELS_AVX2)
+#include <immintrin.h>
+/* 4 int64 lanes (the 4th unused). Round half up for 0 <= s <= 62 without an
+ * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
+ * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
+ * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s). */
+SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
+    const int64_t bias = ((int64_t)1 << 62) + (s > 0 ? (int64_t)1 << (s - 1) : 0);
+    return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_set1_epi64x(bias)), _mm_cvtsi32_si128(s)),
+                            _mm256_set1_epi64x(((int64_t)1 << 62) >> s));
+}
+#define SN_K_IC_W(p) _mm256_cvtepi16_epi64(_mm_loadl_epi64((const __m128i *)(const void *)(p)))
+
+/* columns of U as lanes: U0..U3, U3..U6, U6..U9 (8-byte loads, inside the
+ * 20-byte block); lane c = sum_r U[3r+c] y[r]. s < 0 (scale-up and clamp,
+ * a rare blob): the reference. */
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    const __m256i m3 = _mm256_setr_epi64x(-1, -1, -1, 0);
+    __m256i p;
+    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
+    p = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), _mm256_set1_epi64x(y[0])),
+                                          _mm256_mul_epi32(SN_K_IC_W(b + 6), _mm256_set1_epi64x(y[1]))),
+                         _mm256_mul_epi32(SN_K_IC_W(b + 12), _mm256_set1_epi64x(y[2])));
+    p = _mm256_add_epi64(_mm256_maskload_epi64((const long long *)(const void *)a, m3), sn_k_ic_rshr(p, s));
+    _mm256_maskstore_epi64((long long *)(void *)a, m3, p);
+}
+
+/* rows of U as lanes: (U0,U3,U6) (U1,U4,U7) from bytes 0..15, (U2,U5,U8)
+ * from bytes 4..19 by the same byte shuffle; frac = b[18] >= 0. */
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, 0, 1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
+    const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
+    __m256i p;
+    (void)sat;
+    p = _mm256_add_epi64(
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh0)), _mm256_set1_epi64x(z[0])),
+                         _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh1)), _mm256_set1_epi64x(z[1]))),
+        _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(w, sh0)), _mm256_set1_epi64x(z[2])));
+    p = _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)(const void *)l), sn_k_ic_rshr(p, b[18]));
+    _mm256_storeu_si256((__m256i *)(void *)l, p);
+}
+#undef SN_K_IC_W
+
+#elif defined(SN_KERNELS_NEON)
+#include <arm_neon.h>
+/* The block widened to int32 (VMOVL), then as in sn_kernels_neon.c: VLD3
+ * de-interleaves (U0,U3) (U1,U4) (U2,U5); lanes 0,1 by VMULL/VMLAL by
+ * scalar, the third row/column as a pair product plus one scalar. VRSHL by
+ * -s is the round-half-up shift of sn_rshr64 (no intermediate overflow). */
+SN_INLINE void sn_k_ic_u32(const unsigned char *b, int32_t U[9]) {
+    const int16x8_t v = vld1q_s16((const int16_t *)(const void *)b);
+    vst1q_s32(U, vmovl_s16(vget_low_s16(v)));
+    vst1q_s32(U + 4, vmovl_s16(vget_high_s16(v)));
+    U[8] = sn_k_ic_i16(b + 16);
+}
+
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    int32_t U[9];
+    int64x2_t p;
+    int64_t p2;
+    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
+    sn_k_ic_u32(b, U);
+    p = vmull_n_s32(vld1_s32(U), y[0]);
+    p = vmlal_n_s32(p, vld1_s32(U + 3), y[1]);
+    p = vmlal_n_s32(p, vld1_s32(U + 6), y[2]);
+    p2 = (int64_t)U[2] * y[0] + (int64_t)U[5] * y[1] + (int64_t)U[8] * y[2];
+    vst1q_s64(a, vaddq_s64(vld1q_s64(a), vrshlq_s64(p, vdupq_n_s64(-s))));
+    a[2] += sn_rshr64(p2, s);
+}
+
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+    int32_t U[9];
+    int32x2x3_t c;
+    int64x2_t p, q;
+    int s = b[18];
+    (void)sat;
+    sn_k_ic_u32(b, U);
+    c = vld3_s32(U);
+    p = vmull_n_s32(c.val[0], z[0]);
+    p = vmlal_n_s32(p, c.val[1], z[1]);
+    p = vmlal_n_s32(p, c.val[2], z[2]);
+    q = vmull_s32(vld1_s32(U + 6), vld1_s32(z));
+    vst1q_s64(l, vaddq_s64(vld1q_s64(l), vrshlq_s64(p, vdupq_n_s64(-s))));
+    l[2] += sn_rshr64(vgetq_lane_s64(q, 0) + vgetq_lane_s64(q, 1) + (int64_t)U[8] * z[2], s);
+}
+
+#else
+#define sn_k_ic_col sn_k_ic_col_ref
+#define sn_k_ic_row sn_k_ic_row_ref
+#endif
+
+#endif /* SN_KERNELS_IC_H */
