@@ -168,6 +168,9 @@ static sn_acc row_dot_raw(const sn_ihdr *h, const sn_row *r, const sn_q *y, int 
     return s; /* Q52 (velocity-like) / Q49 (force-like) */
 }
 
+sn_q sn_row_dot(const sn_ihdr *h, const sn_row *r, const sn_q *y, uint32_t *sat) {
+    return sn_out(row_dot_raw(h, r, y, 0, sat), 30, sat);
+}
 
 /* acc += c_j lambda at the row's free entries, exactly (fixed: Q52 for
  * velocity-like y, Q49 for force-like; saturating at 2^62, never reached:
