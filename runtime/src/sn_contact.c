@@ -309,7 +309,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 else if (sn_rows_push(h, &r)) h->contacts++;
                 else continue;
                 rx[j].spare = score;
-                rx[j].s = dn; /* the normal change asked before the yield: friction's pressure (scratch until the factorization) */
+                rx[j].s = dn > want ? dn : want; /* friction's pressure: the normal change asked before the yield, or the push-out depth (scratch until the factorization) */
             }
         }
     }
