@@ -770,13 +770,15 @@ static uint32_t dominant_corner(const pu_rt *r, uint32_t s, double *phi, double 
  * beyond its skinned place, so a sticking contact can drag the point by at
  * most cap = (sum of its free weights) * cell/2, and a steady drag with
  * mu = 1 is min(D, cap). Measured: the mean over the last 20 steps and the
- * chatter (largest - smallest over them). SN_FRICTION_STRICT=1 turns the
- * expectation (mean within 25% of min(D, cap), chatter at most cap/2) into
- * a check; it fails today (issue 12 item 3 open). */
+ * chatter (largest - smallest over them): the mean within 25% of
+ * min(D, cap) and the chatter at most cap/2 are goals (the cow meets both
+ * in both flavours; the beast's chatter too, its mean is a known miss:
+ * it drags 3.95 / 4.07 against 2.72, NUMERICS.md "Friction"). */
 typedef struct fr_case {
     const char *name, *blob;
     double c0[3], p[3], q[3], rad, depth, dist;
     int reset; /* the beast: reset after the probe step, the pose set every step */
+    double mean_bound; /* > 0: the mean is a known miss, |mean - want| / want at most this */
 } fr_case;
 static void friction_case(const fr_case *fc) {
     pu_rt r[2];
@@ -784,7 +786,7 @@ static void friction_case(const fr_case *fc) {
     double mean[2] = {0, 0}, lo[2] = {0, 0}, hi[2] = {0, 0}, x0[2] = {0, 0}, dev_max[2] = {0, 0}, vmax[2] = {0, 0};
     double phi = 0, wsum = 0, cell = 0;
     uint32_t contacts[2] = {0, 0}, sat[2] = {0, 0}, tang[2] = {0, 0}, tang_drop[2] = {0, 0};
-    int m, strict = getenv("SN_FRICTION_STRICT") != NULL;
+    int m;
     for (m = 0; m < 2; m++) {
         sn_collider c;
         sn_stats st;
@@ -872,11 +874,17 @@ static void friction_case(const fr_case *fc) {
             T_FIGURE("friction (%s) mu %d: drag over the last 20 steps mean %+.4g, range %+.4g .. %+.4g (chatter %.3g); dominant corner up to %.3g (%.2f cells) from its skinned place along the drag, "
                      "speed up to %.3g a step (the sphere: %.3g); tangent rows %u, dropped %u; contact rows in the last step %u",
                      fc->name, m, mean[m], lo[m], hi[m], hi[m] - lo[m], dev_max[m], dev_max[m] / cell, vmax[m], fc->dist / 60, tang[m], tang_drop[m], contacts[m]);
-        if (strict) {
-            T_CHECK(fabs(mean[1] - want) <= 0.25 * want, "%s: mu 1 drags the flesh min(D, cap) = %.3g within 25%% (%.4g)", fc->name, want, mean[1]);
-            T_CHECK(hi[1] - lo[1] <= cap / 2, "%s: mu 1: chatter over the last 20 steps at most cap/2 = %.3g (%.3g)", fc->name, cap / 2, hi[1] - lo[1]);
-        } else if (!(fabs(mean[1] - want) <= 0.25 * want) || !(hi[1] - lo[1] <= cap / 2))
-            T_FIGURE("friction (%s): expectation NOT met (issue 12 item 3 open; SN_FRICTION_STRICT=1 makes it a check)", fc->name);
+        /* the expectation (mean within 25% of min(D, cap): the cap is the
+         * bound's own figure, the corner's offset from its skinned place at
+         * the end of the press moves it by up to cap/4; chatter at most
+         * cap/2, a quarter of the bound's range over 20 steps) */
+        if (fc->mean_bound > 0)
+            PU_KNOWN_MISS(fabs(mean[1] - want) / want, 0.25, fc->mean_bound,
+                          "the tangent budget ratchets with the corner's offset at the start of each step (NUMERICS.md \"Friction\")",
+                          "%s: mu 1 drags the flesh %.4g, min(D, cap) = %.3g", fc->name, mean[1], want);
+        else
+            PU_GOAL(fabs(mean[1] - want) <= 0.25 * want, "%s: mu 1 drags the flesh min(D, cap) = %.3g within 25%% (%.4g)", fc->name, want, mean[1]);
+        PU_GOAL(hi[1] - lo[1] <= cap / 2, "%s: mu 1: chatter over the last 20 steps at most cap/2 = %.3g (%.3g)", fc->name, cap / 2, hi[1] - lo[1]);
     }
     T_CHECK(sat[0] == 0 && finite_state(&r[0]) && finite_state(&r[1]), "%s frictionless: no saturation (%u); both states finite", fc->name, sat[0]);
     /* fixed point: the slide rows of neighbouring cells can be nearly
@@ -890,8 +898,8 @@ static void friction_case(const fr_case *fc) {
 }
 static void test_friction(void) {
     /* the cow: r = 1 under the belly (x 1, lowest at y -1.55), pressed 0.3 up, dragged 0.4 along z */
-    static const fr_case cow = {"cow", "cow" PU_BLOB_SUFFIX, {1.0, -2.55, 0.0}, {0, 1, 0}, {0, 0, 1}, 1.0, 0.3, 0.4, 0};
-    fr_case beast = {"beast", "beast" PU_BLOB_SUFFIX, {0, 18, 0}, {0, 0, -1}, {1, 0, 0}, 15.0, 6.0, 8.0, 1};
+    static const fr_case cow = {"cow", "cow" PU_BLOB_SUFFIX, {1.0, -2.55, 0.0}, {0, 1, 0}, {0, 0, 1}, 1.0, 0.3, 0.4, 0, 0};
+    fr_case beast = {"beast", "beast" PU_BLOB_SUFFIX, {0, 18, 0}, {0, 0, -1}, {1, 0, 0}, 15.0, 6.0, 8.0, 1, 0.6};
     friction_case(&cow);
     {   /* the beast (cell 24): r = 15 at the belly's front (test_beast_sphere), pressed 6 along -z, dragged 8 along x */
         pu_rt r;
