@@ -783,7 +783,7 @@ typedef struct fr_case {
 static void friction_case(const fr_case *fc) {
     pu_rt r[2];
     sn_xform pose[64];
-    double mean[2] = {0, 0}, lo[2] = {0, 0}, hi[2] = {0, 0}, x0[2] = {0, 0}, dev_max[2] = {0, 0}, vmax[2] = {0, 0};
+    double mean[2] = {0, 0}, lo[2] = {0, 0}, hi[2] = {0, 0}, x0[2] = {0, 0}, dev_max[2] = {0, 0}, vmax[2] = {0, 0}, dev0[2] = {0, 0};
     double phi = 0, wsum = 0, cell = 0;
     uint32_t contacts[2] = {0, 0}, sat[2] = {0, 0}, tang[2] = {0, 0}, tang_drop[2] = {0, 0};
     int m;
@@ -830,6 +830,7 @@ static void friction_case(const fr_case *fc) {
                 }
                 dq = fc->q[0] * pt[0] + fc->q[1] * pt[1] + fc->q[2] * pt[2] - x0[m];
                 if (fabs(d) > dev_max[m]) dev_max[m] = fabs(d);
+                if (step == 60) dev0[m] = d;
                 if (fabs(vq) > vmax[m]) vmax[m] = fabs(vq);
                 tang[m] += fr.tang;
                 tang_drop[m] += fr.drop_tang;
@@ -871,9 +872,9 @@ static void friction_case(const fr_case *fc) {
         T_FIGURE("friction (%s): sphere r=%g pressed %g, dragged %g; the flesh at its tip (free weight %.3f, dominant corner %.3f; cell %.3g): "
                  "yield cap %.3g, expected drag with mu 1 min(%g, cap) = %.3g", fc->name, fc->rad, fc->depth, fc->dist, wsum, phi, cell, cap, fc->dist, want);
         for (m = 0; m < 2; m++)
-            T_FIGURE("friction (%s) mu %d: drag over the last 20 steps mean %+.4g, range %+.4g .. %+.4g (chatter %.3g); dominant corner up to %.3g (%.2f cells) from its skinned place along the drag, "
+            T_FIGURE("friction (%s) mu %d: drag over the last 20 steps mean %+.4g, range %+.4g .. %+.4g (chatter %.3g); dominant corner %+.3g cells from its skinned place along the drag when the drag starts, up to %.3g (%.2f cells), "
                      "speed up to %.3g a step (the sphere: %.3g); tangent rows %u, dropped %u; contact rows in the last step %u",
-                     fc->name, m, mean[m], lo[m], hi[m], hi[m] - lo[m], dev_max[m], dev_max[m] / cell, vmax[m], fc->dist / 60, tang[m], tang_drop[m], contacts[m]);
+                     fc->name, m, mean[m], lo[m], hi[m], hi[m] - lo[m], dev0[m] / cell, dev_max[m], dev_max[m] / cell, vmax[m], fc->dist / 60, tang[m], tang_drop[m], contacts[m]);
         /* the expectation (mean within 25% of min(D, cap): the cap is the
          * bound's own figure, the corner's offset from its skinned place at
          * the end of the press moves it by up to cap/4; chatter at most
