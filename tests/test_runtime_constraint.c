@@ -881,7 +881,7 @@ static void friction_case(const fr_case *fc) {
          * cap/2, a quarter of the bound's range over 20 steps) */
         if (fc->mean_bound > 0)
             PU_KNOWN_MISS(fabs(mean[1] - want) / want, 0.25, fc->mean_bound,
-                          "the tangent budget ratchets with the corner's offset at the start of each step (NUMERICS.md \"Friction\")",
+                          "the cap ignores the corner's offset when the drag starts; the bound holds a corner where a step starts (NUMERICS.md \"Friction\")",
                           "%s: mu 1 drags the flesh %.4g, min(D, cap) = %.3g", fc->name, mean[1], want);
         else
             PU_GOAL(fabs(mean[1] - want) <= 0.25 * want, "%s: mu 1 drags the flesh min(D, cap) = %.3g within 25%% (%.4g)", fc->name, want, mean[1]);

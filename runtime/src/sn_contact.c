@@ -15,16 +15,20 @@
  * for no more than a velocity change of cell/2 and an end point cell/2
  * beyond their skinned place along n (minimum-norm share), so a vertex the
  * skeleton drives through a collider is left behind, not fought.
- * One contact per (collider, lattice cell): the vertex with the smallest
- * g + n . (v_pred - v_c) (a second vertex of the cell would give a nearly
- * dependent row). Up to max_contacts per step, in surface-vertex order;
- * more are counted in contact_overflow.
+ * One contact per (collider, dominant free corner: the cell's free corner
+ * with the largest weight): the vertex with the smallest g + n . (v_pred -
+ * v_c) (rows of several contacts over one corner's three unknowns are
+ * nearly dependent and leave no room for friction). Up to max_contacts per
+ * step, in surface-vertex order; more are counted in contact_overflow.
+ * After the CG, sn_contact_yield keeps the bound on the combined solve.
  *
  * Friction (mu > 0; a velocity-level Coulomb rule decided before the
  * solve, NUMERICS.md): after every normal contact is collected, each
  * contact of a collider with mu > 0 compares its predicted tangential slip
  * relative to the solid, s = (v_pred - u) - n n.(v_pred - u), with mu times
- * the normal velocity change the contact imposes, dn = target - n.v_pred.
+ * the contact's pressure, the normal velocity change it asks before the
+ * yield bound or its push-out depth, whichever is larger (a contact the
+ * bones hold in stays pressed).
  * |s| <= mu dn: it sticks (two tangential rows: it moves with the solid);
  * else it slides, its slip reduced by mu dn (one row along s). Friction
  * rows share the contacts' baked rows (max_contacts), after the normal ones.
@@ -406,13 +410,16 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
 /* The yield bound kept by the combined solve (NUMERICS.md "Friction"):
  * ct_yield bounds each row as if it were alone; rows sharing a free corner
  * (normals 30-60 deg apart, tangent rows beside a neighbour's normal) move
- * it 1/sin(angle) times further. After the CG, every free corner of a kept
- * contact row ends at most B_a = max(cell/2, |pos_a - skin_a|) from its
- * skinned place (a ball: normals and tangents share one budget; never
- * further out than it already is): a corner beyond is moved back onto the
- * ball (x_a += delta) and each contact row's required value follows the
- * change of c_j^T x, so the rows hold as stated (the bones win). The fixes
- * after it keep the other rows. Cost: the contact rows' entries. */
+ * it 1/sin(angle) times further. After the CG, along each kept contact
+ * row's direction (normal or tangent), each free corner of the row ends at
+ * most B = max(cell/2, |dir . (pos_a - skin_a)|) from its skinned place: a
+ * slab, so the press along n does not use up the drag's budget, and never
+ * further out than the corner starts the step (a corner the bound holds
+ * stays held: releasing it is the relay). A corner beyond is moved back
+ * onto the slab (x_a -= excess dir) and each contact row's required value
+ * follows the change of c_j^T x, so the rows hold as stated (the bones
+ * win). The fixes after it keep the other rows. Cost: the contact rows'
+ * entries (at most SN_ROW_MAX_ENT each), two row products a row. */
 void sn_contact_yield(sn_ihdr *h, sn_q *x, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_row *rows = sn_rows(h);
