@@ -46,6 +46,11 @@ typedef char sn_con_fits_[sizeof(sn_con) <= SN_CON_BYTES ? 1 : -1];
  * would leave their range), and at least 2^-10 absolutely: L_jj >= 2^-5,
  * so 1/L_jj <= 2^5 (Q24 < 2^31) */
 #define SN_DROP_BITS 4
+/* crease pair rows (sn_crease.c): relative pivot above 1/6. Neighbouring
+ * pairs share cells; kept at 1/16 their G^-1 amplified the solve's
+ * rounding and the fold depth followed it (0.26-0.33 mesh units with a
+ * 13-15 bit block exponent; 0.215-0.231 at 1/6: NUMERICS.md) */
+#define CR_DROP_K 6
 #if defined(SN_FLOAT)
 #define G_TINY (1.0f / 256.0f)
 #define P_TINY (1.0f / 1024.0f)
@@ -168,6 +173,9 @@ static sn_acc row_dot_raw(const sn_ihdr *h, const sn_row *r, const sn_q *y, int 
     return s; /* Q52 (velocity-like) / Q49 (force-like) */
 }
 
+sn_q sn_row_dot(const sn_ihdr *h, const sn_row *r, const sn_q *y, uint32_t *sat) {
+    return sn_out(row_dot_raw(h, r, y, 0, sat), 30, sat);
+}
 
 /* acc += c_j lambda at the row's free entries, exactly (fixed: Q52 for
  * velocity-like y, Q49 for force-like; saturating at 2^62, never reached:
@@ -389,9 +397,9 @@ static uint32_t rows_factor(sn_ihdr *h, uint32_t *sat) {
         piv = gjj;
         for (l = 0; l < j; l++) piv -= sn_mul(L[LIDX(j, l)], L[LIDX(j, l)]);
 #if defined(SN_FLOAT)
-        if (!(gjj >= G_TINY) || !(piv > gjj * P_REL) || !(piv >= P_TINY)) {
+        if (!(gjj >= G_TINY) || !(piv * (SN_ROW_PRODUCER(rj->source) == SN_SRC_CREASE ? (float)CR_DROP_K : 1.0f / P_REL) > gjj) || !(piv >= P_TINY)) {
 #else
-        if (gjj < G_TINY || piv <= (gjj >> SN_DROP_BITS) || piv < P_TINY) {
+        if (gjj < G_TINY || piv * (SN_ROW_PRODUCER(rj->source) == SN_SRC_CREASE ? CR_DROP_K : (1 << SN_DROP_BITS)) <= gjj || piv < P_TINY) {
 #endif
             x[j].inv = 0;
             for (l = 0; l <= j; l++) L[LIDX(j, l)] = 0;

@@ -77,6 +77,12 @@ void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat);
  * rounding with 8 more fraction bits). */
 void sn_rows_fix(sn_ihdr *h, sn_q *x, uint32_t *sat);
 
+/* c^T y of one row over its free entries, velocity-like y (Q22). */
+sn_q sn_row_dot(const sn_ihdr *h, const sn_row *r, const sn_q *y, uint32_t *sat);
+/* After the CG (sn_contact.c): the free corners of the contact rows kept
+ * within their yield bound; the contact rows' required values follow. */
+void sn_contact_yield(sn_ihdr *h, sn_q *x, uint32_t *sat);
+
 /* The material point under a world point (sn_force.c): its cell and
  * trilinear coordinates (Q15). */
 void sn_locate(const sn_ihdr *h, const sn_vec3 *P, uint32_t *cell, uint16_t t[3]);

@@ -15,16 +15,20 @@
  * for no more than a velocity change of cell/2 and an end point cell/2
  * beyond their skinned place along n (minimum-norm share), so a vertex the
  * skeleton drives through a collider is left behind, not fought.
- * One contact per (collider, lattice cell): the vertex with the smallest
- * g + n . (v_pred - v_c) (a second vertex of the cell would give a nearly
- * dependent row). Up to max_contacts per step, in surface-vertex order;
- * more are counted in contact_overflow.
+ * One contact per (collider, dominant free corner: the cell's free corner
+ * with the largest weight): the vertex with the smallest g + n . (v_pred -
+ * v_c) (rows of several contacts over one corner's three unknowns are
+ * nearly dependent and leave no room for friction). Up to max_contacts per
+ * step, in surface-vertex order; more are counted in contact_overflow.
+ * After the CG, sn_contact_yield keeps the bound on the combined solve.
  *
  * Friction (mu > 0; a velocity-level Coulomb rule decided before the
  * solve, NUMERICS.md): after every normal contact is collected, each
  * contact of a collider with mu > 0 compares its predicted tangential slip
  * relative to the solid, s = (v_pred - u) - n n.(v_pred - u), with mu times
- * the normal velocity change the contact imposes, dn = target - n.v_pred.
+ * the contact's pressure, the normal velocity change it asks before the
+ * yield bound or its push-out depth, whichever is larger (a contact the
+ * bones hold in stays pressed).
  * |s| <= mu dn: it sticks (two tangential rows: it moves with the solid);
  * else it slides, its slip reduced by mu dn (one row along s). Friction
  * rows share the contacts' baked rows (max_contacts), after the normal ones.
@@ -183,6 +187,15 @@ static sn_q ct_yield(sn_ihdr *h, const uint32_t vx[8], const sn_q phi[8], const 
 #endif
 }
 
+/* the free corner with the largest weight (first on ties) */
+static uint32_t ct_dom(const uint16_t *vx16, const sn_q phi[8], uint32_t nF) {
+    uint32_t k, best = 0xFFFFu;
+    sn_q m = 0;
+    for (k = 0; k < 8; k++)
+        if (vx16[k] < nF && phi[k] > m) { m = phi[k]; best = vx16[k]; }
+    return best;
+}
+
 void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
@@ -210,7 +223,8 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3], vx[8];
+        uint32_t t[3], vx[8], dom;
+        uint16_t vx16[8];
         sn_q phi[8], P[3], Vp[3];
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
@@ -237,6 +251,8 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 sv[q] += sn_mul(phi[k], vq);
             }
         }
+        for (k = 0; k < 8; k++) vx16[k] = (uint16_t)vx[k];
+        dom = ct_dom(vx16, phi, v->nF);
         for (q = 0; q < 3; q++) {
             P[q] = sn_out(sp[q], 30, sat);
             Vp[q] = sn_out(sv[q], 30, sat);
@@ -272,9 +288,13 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                     h->con_clamps = sn_count(h->con_clamps, 1);
                 }
             }
-            /* one contact per (collider, cell): the row of this cell, if any */
+            /* one contact per (collider, dominant free corner): rows on one
+             * corner's three unknowns from several contacts are nearly
+             * dependent (their normals 30-60 deg apart) and leave no room for
+             * the contact's friction rows */
             for (j = first; j < h->n_rows; j++)
-                if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && rows[j].vtx[0] == vx[0]) break;
+                if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && rows[j].one_sided &&
+                    ct_dom(rows[j].vtx, rows[j].w, v->nF) == dom) break;
             if (j < h->n_rows && !(score < rx[j].spare)) continue;
             if (j == h->n_rows && h->contacts >= v->nCt) {
                 h->contact_overflow = sn_count(h->contact_overflow, 1);
@@ -293,6 +313,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 else if (sn_rows_push(h, &r)) h->contacts++;
                 else continue;
                 rx[j].spare = score;
+                rx[j].s = dn > want ? dn : want; /* friction's pressure: the normal change asked before the yield, or the push-out depth (scratch until the factorization) */
             }
         }
     }
@@ -353,6 +374,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
         }
         vn = sn_out(sn_mul(r.dir[0], vp[0]) + sn_mul(r.dir[1], vp[1]) + sn_mul(r.dir[2], vp[2]), 30, sat);
         dn = sn_add(r.target, -vn, sat); /* the normal velocity change the contact imposes */
+        if (CARR(h, o_rx, sn_rowx)[j].s > dn) dn = CARR(h, o_rx, sn_rowx)[j].s; /* or would ask without the yield (the pressure the bones take) */
         if (!(dn > 0)) continue;
         {
             sn_q rn = sn_out(sn_mul(r.dir[0], rel[0]) + sn_mul(r.dir[1], rel[1]) + sn_mul(r.dir[2], rel[2]), 30, sat);
@@ -383,6 +405,57 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
         } else /* slide: the slip along t1, reduced by mu dn */
             push_tangent(h, &r, t1, V[c], sn_add(slen, -limit, sat), sat);
     }
+}
+
+/* The yield bound kept by the combined solve (NUMERICS.md "Friction"):
+ * ct_yield bounds each row as if it were alone; rows sharing a free corner
+ * (normals 30-60 deg apart, tangent rows beside a neighbour's normal) move
+ * it 1/sin(angle) times further. After the CG, along each kept contact
+ * row's direction (normal or tangent), each free corner of the row ends at
+ * most B = max(cell/2, |dir . (pos_a - skin_a)|) from its skinned place: a
+ * slab, so the press along n does not use up the drag's budget, and never
+ * further out than the corner starts the step (a corner the bound holds
+ * stays held: releasing it is the relay). A corner beyond is moved back
+ * onto the slab (x_a -= excess dir) and each contact row's required value
+ * follows the change of c_j^T x, so the rows hold as stated (the bones
+ * win). The fixes after it keep the other rows. Cost: the contact rows'
+ * entries (at most SN_ROW_MAX_ENT each), two row products a row. */
+void sn_contact_yield(sn_ihdr *h, sn_q *x, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_row *rows = sn_rows(h);
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    sn_rowx *rx = ARR(h, o_rx, sn_rowx);
+    const sn_q half = (sn_q)(v->cell / 2);
+    uint32_t j, k, q, m = h->n_rows;
+#define CT_MINE(j) (SN_ROW_PRODUCER(rows[j].source) == SN_SRC_CONTACT && rx[j].inv != 0)
+    for (j = 0; j < m; j++) rx[j].s = CT_MINE(j) ? sn_row_dot(h, rows + j, x, sat) : 0;
+    for (j = 0; j < m; j++) {
+        if (!CT_MINE(j)) continue;
+        for (k = 0; k < rows[j].n; k++) {
+            uint32_t a = rows[j].vtx[k];
+            const sn_q *n = rows[j].dir;
+            sn_q sk[3], d0[3], d[3], e0, e, b;
+            if (a >= v->nF || rows[j].w[k] == 0) continue;
+            sn_skinned(h, a, sk, sat);
+            for (q = 0; q < 3; q++) {
+                d0[q] = sn_add(pos[3 * a + q], -sk[q], sat);
+                d[q] = sn_add(sn_add(d0[q], vel[3 * a + q], sat), x[3 * a + q], sat);
+            }
+            e0 = sn_out(sn_mul(n[0], d0[0]) + sn_mul(n[1], d0[1]) + sn_mul(n[2], d0[2]), 30, sat);
+            e = sn_out(sn_mul(n[0], d[0]) + sn_mul(n[1], d[1]) + sn_mul(n[2], d[2]), 30, sat);
+            if (e0 < 0) e0 = (sn_q)-e0;
+            b = e0 > half ? e0 : half;
+            if (e > b) e = sn_add(e, -b, sat);
+            else if (e < -b) e = sn_add(e, b, sat);
+            else continue;
+            for (q = 0; q < 3; q++) /* back onto the slab |dir . d| <= b */
+                x[3 * a + q] = sn_add(x[3 * a + q], -sn_mulq(n[q], e, 30, sat), sat);
+            h->con_clamps = sn_count(h->con_clamps, 1);
+        }
+    }
+    for (j = 0; j < m; j++)
+        if (CT_MINE(j)) rx[j].a = sn_add(rx[j].a, sn_add(sn_row_dot(h, rows + j, x, sat), -rx[j].s, sat), sat);
+#undef CT_MINE
 }
 
 /* ---- public API ---- */

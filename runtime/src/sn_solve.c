@@ -384,7 +384,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         sn_k_axpy(d, z, beta, d, n3, SN_Q_SCAL, sat); /* d = z + beta d */
         rz = rz1;
     }
-    if (rows) { /* the CG's rounding off the rows again; the second pass, in finer units, takes the first's rounding */
+    if (rows) { /* the contacts' corners within their yield bound (sn_contact.c); the CG's rounding off the rows
+                 * again; the second pass, in finer units, takes the first's rounding */
+        sn_contact_yield(h, x, sat);
         sn_rows_fix(h, x, sat);
         sn_rows_fix(h, x, sat);
     }
