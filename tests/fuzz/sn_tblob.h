@@ -229,6 +229,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_LEVEL_UP] = 0;         elem[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_LEVEL_DOWN] = 0;       elem[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_ICHOL] = 0;            elem[SN_SEC_ICHOL] = SN_ELEM_ICHOL; /* block Jacobi; tb_add_ichol adds it */
+    cnt[SN_SEC_ADAPT] = 0;            elem[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
