@@ -353,6 +353,11 @@ void sn_adapt_estimate(sn_ihdr *h, const uint8_t *mask, const sn_q *r, sn_q *z, 
     (void)zero;
 }
 
+uint32_t sn_adapt_iterations(const sn_ihdr *h) {
+    uint32_t it = h->iterations < SN_ADAPT_MIN_ITERATIONS ? SN_ADAPT_MIN_ITERATIONS : h->iterations;
+    return it > h->v.cg_max ? h->v.cg_max : it;
+}
+
 void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x) {
     uint32_t *key = ARR(h, o_acc, uint32_t), w;
     for (w = 0; w < sn_ad(h)->n; w++) key[w] = mask[w] ? 0u : key_of(x[3 * w]);

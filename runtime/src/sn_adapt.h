@@ -33,6 +33,15 @@ void sn_adapt_restrict(sn_ihdr *h, const uint8_t *mask, sn_q *v, uint32_t *sat);
  * them into acc, before x is expanded. */
 void sn_adapt_estimate(sn_ihdr *h, const uint8_t *mask, const sn_q *r, sn_q *z, sn_q *x, uint32_t *sat);
 void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x);
+/* CG iterations of a reduced solve: at least SN_ADAPT_MIN_ITERATIONS (within
+ * the blob's cg_max). The preconditioner is the lattice's IC(0) restricted to
+ * the active set, not the reduced operator's: a source row also carries its
+ * inactive vertices' stiffness and mass. Measured on the cow's violent swing
+ * (tests/test_runtime_adapt.c): at the blob's 4 iterations the reduced step
+ * diverges and a steady state flips vertices every step (the refine estimate
+ * rides on the unconverged residual); at 16 both are gone. */
+#define SN_ADAPT_MIN_ITERATIONS 16u
+uint32_t sn_adapt_iterations(const sn_ihdr *h);
 /* After the step's update and limits: details, selection, projection. */
 void sn_adapt_step(sn_ihdr *h, uint32_t *sat);
 /* The mask into the state hash (blobs with ADAPT only: other hashes unchanged). */

@@ -356,14 +356,15 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
-    uint32_t clamps = 0, rows;
-    const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: prescribed, dv = 0 */
+    uint32_t clamps = 0, rows, iters = h->iterations;
+    const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: their dv is the coarse field's */
 
     sn_rhs(h, r, 1, sat);
     /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
     rows = sn_constrain_begin(h, x, sat);
     if (rows) mask = NULL; /* rows may hold an inactive vertex: this step solves them all (sn_adapt.c projects after) */
     if (mask) sn_adapt_expand(h, mask, x, sat); /* the warm start in the reduced space */
+    if (mask) iters = sn_adapt_iterations(h); /* the reduced rows' preconditioner is the lattice's: more iterations */
     /* PCG, warm-started from the previous step's solution, fixed iterations;
      * with rows, residuals and preconditioned residuals are projected onto
      * the free directions (Baraff-Witkin filtered PCG) */
@@ -379,7 +380,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
     rz = dot(r, z, kk, n3);
-    for (it = 0; it < h->iterations; it++) {
+    for (it = 0; it < iters; it++) {
         sn_dotv dq, rz1;
         sn_q alpha, beta, nalpha;
         if (mask) { /* q = P^T A P d: d expanded for the product, then 0 again off the active set */
