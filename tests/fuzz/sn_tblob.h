@@ -439,7 +439,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     return off;
 }
 
-/* Append an ICHOL section (format 6.0, the last section) to a tb_build
+/* Append an ICHOL section (format 6.0; followed by the empty ADAPT of 6.1) to a tb_build
  * blob of capacity cap: one block per free-free mass entry with mantissas
  * (7919 (n + k) mod 2001) - 1000 times 2^-frac (|U| <= 0.06 at frac 14),
  * frac = the argument; PRECOND stays (its blocks act as the pivots D^-1: any
@@ -460,6 +460,7 @@ static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
     }
     tb_u32(e + 4, n * SN_ELEM_ICHOL);
     tb_u32(e + 8, n);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_ADAPT, total); /* format 6.1: the empty ADAPT section follows */
     tb_u32(b + SN_H_TOTAL_SIZE, total);
     tb_fix_crc(b);
     return total;
