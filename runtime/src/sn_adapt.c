@@ -395,12 +395,8 @@ void sn_adapt_step(sn_ihdr *h, uint32_t *sat) {
     if (sn_ad(h)->inactive) project(h, &t, ps, vs, sat);
 }
 
-uint64_t sn_adapt_hash(const sn_ihdr *h, uint64_t hsh, uint64_t (*fnv)(uint64_t, uint32_t)) {
-    const uint8_t *m;
-    uint32_t i;
-    if (!h->ad_bytes) return hsh;
-    m = mask_of(h);
-    for (i = 0; i < sn_ad(h)->n; i++) /* the inactive set (none: the plain level-1 hash) */
-        if (!m[i]) hsh = fnv(hsh, i);
-    return hsh;
+const uint8_t *sn_adapt_mask_bytes(const sn_ihdr *h, uint32_t *n) {
+    if (!h->ad_bytes) { *n = 0; return NULL; }
+    *n = sn_ad(h)->n;
+    return mask_of(h);
 }

@@ -44,7 +44,8 @@ void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x);
 uint32_t sn_adapt_iterations(const sn_ihdr *h);
 /* After the step's update and limits: details, selection, projection. */
 void sn_adapt_step(sn_ihdr *h, uint32_t *sat);
-/* The mask into the state hash (blobs with ADAPT only: other hashes unchanged). */
-uint64_t sn_adapt_hash(const sn_ihdr *h, uint64_t hsh, uint64_t (*fnv)(uint64_t, uint32_t));
+/* The mask for the state hash (*n bytes, 1: in the solve), NULL without ADAPT:
+ * sn_state_hash adds the inactive indices (none: the plain level-1 hash). */
+const uint8_t *sn_adapt_mask_bytes(const sn_ihdr *h, uint32_t *n);
 
 #endif /* SN_ADAPT_H */

@@ -345,6 +345,11 @@ uint64_t sn_state_hash(const sn_instance *inst) {
     for (i = 0; i < 3 * h->v.nF; i++) hsh = fnv_q(hsh, x[i]);
     for (i = 0; i < h->v.nK; i++) hsh = fnv_q(hsh, CARR(h, o_ctl, sn_q)[i]); /* control values (none: unchanged) */
     hsh = sn_segments_hash(h, hsh); /* no segment meshes: unchanged */
-    hsh = sn_adapt_hash(h, hsh, fnv_u32); /* no ADAPT section: unchanged */
+    {   /* adaptation: the inactive set (no ADAPT section, or everything in the solve: unchanged) */
+        uint32_t na;
+        const uint8_t *m = sn_adapt_mask_bytes(h, &na);
+        for (i = 0; i < na; i++)
+            if (!m[i]) hsh = fnv_u32(hsh, i);
+    }
     return sn_crease_hash(h, hsh);   /* no crease sections: unchanged */
 }
