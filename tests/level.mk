@@ -16,6 +16,28 @@ $(LEVEL_EX)/%_lod_float.blob: $(LEVEL_EX)/%/lod.sinew $(BAKE)
 .PRECIOUS: $(LEVEL_EX)/%/lod.sinew
 LEVEL_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_lod.blob $(LEVEL_EX)/$(c)_lod_float.blob)
 
+# Adaptation (runtime/src/sn_adapt.c, tests/test_runtime_adapt.c): the same
+# two-level blobs with 'adapt REFINE COARSEN MAX_ACTIVE' (level-0 cells); the
+# test patches the record for its other settings.
+ADAPT_LINE = adapt 0.03 0.01 250
+$(LEVEL_EX)/%/adapt.sinew: $(LEVEL_EX)/%/lod.sinew tests/level.mk
+	cp $< $@
+	echo '$(ADAPT_LINE)' >> $@
+$(LEVEL_EX)/%_adapt.blob: $(LEVEL_EX)/%/adapt.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_adapt_float.blob: $(LEVEL_EX)/%/adapt.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/adapt.sinew
+ADAPT_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_adapt.blob $(LEVEL_EX)/$(c)_adapt_float.blob)
+
+$(BUILD)/tests/adapt_runtime: tests/test_runtime_adapt.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(ADAPT_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/adapt_runtime_float: tests/test_runtime_adapt.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(ADAPT_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_DEPS += $(BUILD)/tests/adapt_runtime $(BUILD)/tests/adapt_runtime_float
+
 $(BUILD)/tests/level_runtime: tests/test_runtime_level.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(LEVEL_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm

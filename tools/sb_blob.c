@@ -352,6 +352,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     cnt[SN_SEC_LEVEL_UP] = o->lod_size ? o->lod_nv1 : 0u;      esz[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_LEVEL_DOWN] = o->lod_size ? (uint32_t)nV : 0u;  esz[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_ICHOL] = (uint32_t)ic.n;           esz[SN_SEC_ICHOL] = SN_ELEM_ICHOL;
+    cnt[SN_SEC_ADAPT] = o->lod_size && o->ad_on ? 1u : 0u;   esz[SN_SEC_ADAPT] = SN_ELEM_ADAPT(rs);
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -546,6 +547,13 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         put_u16(&w, off[SN_SEC_CONSTRAINTS] + 2, (unsigned)o->max_contacts);
     }
     if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s, m0) != 0) { sb_blob_free(b); return -1; }
+    if (cnt[SN_SEC_ADAPT]) {   /* ADAPT record (sn_adapt.c): A_max, refine, coarsen (internal units, Q22) */
+        size_t at = off[SN_SEC_ADAPT];
+        if (o->ad_refine / U * 4194304.0 > (double)SN_ADAPT_MAX) { sb_blob_free(b); return sb_fail("adapt refine %g mesh units out of range (0..%g)", o->ad_refine, U * 256); }
+        put_u16(&w, at, (unsigned)o->ad_max);
+        put_real(&w, at + 8, o->ad_refine / U, SN_Q_LEN);
+        put_real(&w, at + 8 + (size_t)rs, fmin(o->ad_coarsen, o->ad_refine) / U, SN_Q_LEN);
+    }
     if (o->crease) {   /* CREASE record, seed pairs, neighbourhood rows (SN_CREASE_NONE for -1) */
         size_t at = off[SN_SEC_CREASE];
         double dep = o->cr_depth / U, push = o->cr_push / U;

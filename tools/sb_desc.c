@@ -513,6 +513,15 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         if (!(n_ >= 1 && n_ <= 2 && n_ == floor(n_))) return sb_fail("%s:%d: levels: 1 (the lattice) or 2 (and the lattice subdivided once)", c->path, c->line);
         d->levels = (int)n_;
         d->levels_line = c->line;
+    } else if (!strcmp(kw, "adapt")) {   /* adaptation on level 1 (runtime/LEVELS.md §3): thresholds in level-0 cells */
+        double r_, c_, m_;
+        if (nargs(c, 3) || num(c, 1, &r_) || num(c, 2, &c_) || num(c, 3, &m_)) return -1;
+        if (!(r_ >= 0 && c_ >= 0 && c_ <= r_))
+            return sb_fail("%s:%d: adapt REFINE COARSEN MAX_ACTIVE: thresholds in level-0 cells, 0 <= COARSEN <= REFINE (got %g %g)", c->path, c->line, r_, c_);
+        if (!(m_ >= 0 && m_ <= 65535 && m_ == floor(m_)))
+            return sb_fail("%s:%d: adapt: MAX_ACTIVE must be a whole number in 0..65535 (at most level 1's free vertices)", c->path, c->line);
+        d->adapt_refine = r_; d->adapt_coarsen = c_; d->adapt_max = (int)m_;
+        d->adapt_line = c->line;
     } else if (!strcmp(kw, "forces")) {
         double n_;
         if (nargs(c, 1) || num(c, 1, &n_)) return -1;
@@ -796,6 +805,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     if (!seen[2]) return sb_fail("%s: missing 'cell SIZE'", path);
     if (d->nj == 0) return sb_fail("%s: no joints", path);
     if (d->nm == 0) return sb_fail("%s: no materials", path);
+    if (d->adapt_line && d->levels < 2) return sb_fail("%s:%d: adapt needs 'levels 2' (it adapts the finer level)", path, d->adapt_line);
     if (d->cr_active > d->cr_list) return sb_fail("%s:%d: crease active rows (%d) exceed the list size (%d)", path, d->cr_line, d->cr_active, d->cr_list);
     if (d->cr_depth > 0 && d->cr_push > d->cr_depth) return sb_fail("%s:%d: crease push (%g) exceeds depth (%g)", path, d->cr_line, d->cr_push, d->cr_depth);
     /* resolve parents (they may be declared after their children) */

@@ -592,8 +592,16 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
     o->lod_inst_bytes = inst_bytes(o, nF + nS, nF, nC);
     info->inst0 = inst_bytes(o, o->nv, o->nf, o->nc); info->inst1 = inst_bytes(&o2, o2.nv, o2.nf, o2.nc);
     info->inst = o->lod_inst_bytes;
+    if (d->adapt_line) {   /* adaptation of level 1 (sn_adapt.c): A_max within its free vertices, thresholds in level-0 cells */
+        if (o->nv > o2.nf) {
+            sb_fail("%s:%d: adapt: level 0's %d vertices exceed level 1's %d free vertices (the runtime's scratch)", d->path, d->adapt_line, o->nv, o2.nf);
+            goto done;
+        }
+        o->ad_on = 1; o->ad_max = d->adapt_max < o2.nf ? d->adapt_max : o2.nf; /* at most every free vertex */
+        o->ad_refine = d->adapt_refine * o->c; o->ad_coarsen = d->adapt_coarsen * o->c;
+    }
     rc = sb_blob_make(o, flavour, b);
-    o->lod_blob = NULL; o->lod_size = 0; o->lod_up = o->lod_down = NULL;
+    o->lod_blob = NULL; o->lod_size = 0; o->lod_up = o->lod_down = NULL; o->ad_on = 0;
     (void)quiet;
 done:
     o2.cr_pairs = NULL; o2.cr_vnbr = o2.cr_tnbr = NULL; o2.crease = 0;   /* borrowed */

@@ -60,6 +60,7 @@ static void usage(FILE *f) {
         "                     a belt around the body, at most the blob's max_constraints of them, evenly spread\n"
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --lod K:L[,K:L..]  level of detail L (0 coarse, 1 fine; sn_set_lod) from step K on (blob baked with 'levels 2')\n"
+        "  --adapt on|off     adaptation on level 1 (sn_set_adapt; blob baked with 'adapt'): on by default\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5 (= --mode unwarped)\n"
         "  --mode M           warped (default), unwarped, or blended: blended local linearization, seed 000 sec. 4.5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
@@ -520,6 +521,7 @@ typedef struct {
     uint32_t pin[64];
     /* --lod: level switches before steps */
     int n_lod;
+    int adapt_off;      /* --adapt off */
     long lod_step[16];
     unsigned lod_level[16];
 } options;
@@ -569,7 +571,7 @@ static int parse_args(int argc, char **argv, options *o) {
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
                                          "--seg-impulse", "--seg-floor", "--segments", "--ground", "--sphere", "--pin", "--belt",
-                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", "--mode", NULL};
+                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", "--mode", "--adapt", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -683,6 +685,9 @@ static int parse_args(int argc, char **argv, options *o) {
                 if (!*e2) break;
                 q = e2 + 1;
             }
+        } else if (!strcmp(a, "--adapt")) {
+            if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --adapt: want on or off, got '%s'\n", v); return 2; }
+            o->adapt_off = !strcmp(v, "off");
         } else if (!strcmp(a, "--segments")) {
             if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --segments: want on or off, got '%s'\n", v); return 2; }
             o->no_segments = !strcmp(v, "off");
@@ -892,8 +897,9 @@ int main(int argc, char **argv) {
     uint32_t flag_nc = 0;
     sn_quat *local = NULL;
     sn_xform *xf = NULL, *rest_xf = NULL;
-    double *times = NULL, *cpu = NULL, h_s;
-    long k, n_frames;
+    double *times = NULL, *cpu = NULL, h_s, ad_sum = 0;
+    long k, n_frames, ad_steps = 0;
+    uint32_t ad_max = 0;
     uint32_t i, t;
     rs_image sheet, panel, cmp;
     long sheet_at[SHEET_COLS * SHEET_ROWS];
@@ -1031,6 +1037,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, PROG ": sn_instance_init: %s\n", sn_status_str(st)); goto done;
     }
     if (o.iterations) sn_set_iterations(inst, (uint32_t)o.iterations);
+    if (o.adapt_off) sn_set_adapt(inst, 0);
     if (o.unwarped && (st = sn_set_mode(inst, (sn_mode)o.unwarped)) != SN_OK) {
         fprintf(stderr, PROG ": sn_set_mode: %s\n", sn_status_str(st)); goto done;
     }
@@ -1338,6 +1345,13 @@ int main(int argc, char **argv) {
         c1 = now_us(CLOCK_THREAD_CPUTIME_ID);
         times[k - 1] = t1 - t0;
         cpu[k - 1] = c1 - c0;
+        {   /* adaptation: active detail vertices per step (sn_stats) */
+            sn_stats as;
+            if (sn_get_stats(inst, &as) == SN_OK && as.adapt_on) {
+                ad_sum += as.adapt_active; ad_steps++;
+                if (as.adapt_active > ad_max) ad_max = as.adapt_active;
+            }
+        }
         if (inst2) {
             if ((o.compare && !o.rigs_off) || o.compare_hits)
                 controls_step(inst2, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held, !o.compare_hits);
@@ -1400,6 +1414,9 @@ int main(int argc, char **argv) {
                "thread CPU time: median %.1f us, p99 %.1f us\n",
                times[n_frames / 2], times[p99], times[n_frames - 1], n_frames,
                SN_FLAVOUR ? "float" : "fixed", stats.iterations, stats.saturations, cpu[n_frames / 2], cpu[p99]);
+        if (ad_steps)
+            printf("adapt: active detail vertices mean %.1f, max %u over %ld steps; refines %u, coarsens %u, overflow %u\n",
+                   ad_sum / (double)ad_steps, ad_max, ad_steps, stats.adapt_refines, stats.adapt_coarsens, stats.adapt_overflow);
         printf("health: saturations %u, bound steps %u, limit clamps %u (last step; %u steps with clamps), "
                "largest displacement %.4g cells, largest energy %.4g J (last %.4g J)\n",
                stats.saturations, stats.bound_steps, stats.limit_clamps, stats.limit_steps,

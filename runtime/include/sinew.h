@@ -291,6 +291,11 @@ typedef struct sn_stats {
     uint32_t constraint_clamps;  ///< row targets clamped since init/reset: a constraint to one lattice cell per step (a far or fast target is approached at that speed), a contact to its yield bound (runtime/NUMERICS.md "Contacts")
     uint32_t lod;                ///< level of detail in force (sn_set_lod): 0 the baked lattice, 1 the finer one
     uint32_t lattice_vertices;   ///< lattice vertices of that level (free and skeleton): sn_get_lattice's range
+    uint32_t adapt_on;           ///< 1 while adaptation runs (blob with 'adapt', level 1, sn_set_adapt on; runtime/LEVELS.md §3)
+    uint32_t adapt_active;       ///< level-1 detail vertices in the last step's solve (at most the blob's max_active)
+    uint32_t adapt_refines;      ///< detail vertices that joined the solve since init/reset (detail estimate >= refine)
+    uint32_t adapt_coarsens;     ///< detail vertices that left it since init/reset (detail < coarsen, or pushed out by larger ones)
+    uint32_t adapt_overflow;     ///< since init/reset, the sum over steps of the vertices wanting in beyond max_active (the largest details won)
 } sn_stats;
 /// Self-collision near creases (seed 003 §3.4): the surface vertices in the
 /// collision list after the last step's detection, in the order they entered
@@ -318,6 +323,16 @@ uint32_t sn_lod_levels(const sn_blob *blob);
 /// colliders stay. The level survives sn_reset. SN_OK (nothing happens if
 /// the level is in force), SN_ERR_ARG for a level the blob does not have.
 sn_status sn_set_lod(sn_instance *inst, uint32_t level);
+
+/// Adaptation (seed 000 §4.7; description 'adapt REFINE COARSEN MAX_ACTIVE',
+/// runtime/LEVELS.md §3): on level 1, only the detail vertices (those at no
+/// level-0 vertex) whose detail is large are simulated, at most the blob's
+/// max_active; the others follow the coarse (level-0) field exactly. On by
+/// default in a blob baked with 'adapt'; on = 0 simulates every vertex (plain
+/// level 1), on = 1 starts again from the first selection (the inactive
+/// vertices jump onto the coarse field). Survives sn_reset. SN_OK, or
+/// SN_ERR_ARG turning it on in a blob without adaptation data.
+sn_status sn_set_adapt(sn_instance *inst, int on);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
 /// (free positions, velocities, warm start, skeleton state, step count, control

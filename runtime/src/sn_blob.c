@@ -27,6 +27,7 @@
  * 0 < h <= 32768, reserved reals +0.0.
  */
 #include "sn_internal.h"
+#include "sn_adapt.h" /* sn_check_adapt, sn_adapt_bytes */
 
 static const unsigned char *sn_bytes(const sn_blob *b) {
     return (const unsigned char *)(const void *)b;
@@ -393,6 +394,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     cnt[SN_SEC_EMBED] = v.nS;
     cnt[SN_SEC_TRIS] = v.nT;
     cnt[SN_SEC_ICHOL] = 0; /* 0 or nFF: taken from the table below */
+    cnt[SN_SEC_ADAPT] = 0; /* 0 or 1: taken from the table below */
     /* rig sections: counts from the table, bounded (cost per step, u16/u32 indices) */
     {
         const unsigned char *t = p + SN_H_SECTIONS + 8;
@@ -469,7 +471,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
             SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP,
-            SN_ELEM_ICHOL};
+            SN_ELEM_ICHOL, SN_ELEM_ADAPT(SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -477,6 +479,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             if ((k == SN_SEC_LIMIT || k == SN_SEC_VSHARE) && sn_rd_u32(e + 8) == v.nF) cnt[k] = v.nF; /* optional */
             if (k == SN_SEC_CONSTRAINTS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record */
             if (k == SN_SEC_ICHOL && sn_rd_u32(e + 8) <= v.nnz) cnt[k] = sn_rd_u32(e + 8); /* 0 or nFF: checked with COLS */
+            if (k == SN_SEC_ADAPT && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record: checked with the pair (sn_adapt.c) */
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -521,6 +524,12 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
         if (st != SN_OK) return st;
         st = sn_check_levels(&v, &f);
         if (st != SN_OK) return st;
+        st = sn_check_adapt(&f, NULL); /* the nested level has none */
+        if (st != SN_OK) return st;
+        st = sn_check_adapt(&v, &f);
+        if (st != SN_OK) return st;
+    } else if (sn_level_sec_count(&v, SN_SEC_ADAPT) != 0) {
+        return SN_ERR_SECTION;
     } else if (sn_level_sec_count(&v, SN_SEC_LEVEL_UP) != 0 || sn_level_sec_count(&v, SN_SEC_LEVEL_DOWN) != 0) {
         return SN_ERR_SECTION;
     }
@@ -634,7 +643,7 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->offdiag_blocks = v.nnz;
     info->cg_iters_default = v.cg_default;
     info->cg_iters_max = v.cg_max;
-    info->instance_bytes = v.instance_bytes;
+    info->instance_bytes = v.instance_bytes + sn_adapt_bytes(&v); /* == sn_instance_size */
     info->blob_bytes = v.total;
     info->timestep = v.timestep;
     info->controls = v.nK;
@@ -729,6 +738,8 @@ sn_status sn_get_triangle(const sn_blob *blob, uint32_t t, uint32_t idx[3]) {
 }
 
 size_t sn_instance_size(const sn_blob *blob) {
+    sn_view v;
     if (!blob) return 0;
-    return (size_t)sn_rd_u32(sn_bytes(blob) + SN_H_INSTANCE_BYTES);
+    sn_view_init(&v, blob);
+    return (size_t)v.instance_bytes + sn_adapt_bytes(&v); /* adaptation's mask follows the layout (sn_adapt.c) */
 }

@@ -16,7 +16,7 @@
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
 #define SN_FORMAT_MAJOR 6
-#define SN_FORMAT_MINOR 0
+#define SN_FORMAT_MINOR 1
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
 #define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
@@ -169,6 +169,10 @@ enum {
                             entry [3a+b] = m[3a+b] 2^-frac, |m| <= 2^15-1, frac <= SN_ICHOL_FRAC_MAX; one element per
                             free-free entry of the mass pattern (COLS j < nF), in ROWPTR/COLS order, skeleton columns skipped;
                             nFF = those entries' count. With ICHOL, PRECOND holds D^-1 (same format); count 0: block Jacobi */
+    /* ---- adaptation (seed 000 §4.7, runtime/LEVELS.md §3), format 6.1; count 0, or 1 in a blob with LEVEL_BLOB ---- */
+    SN_SEC_ADAPT,        /* 0 or 1 x {u16 max_active (A_max, 0..nF of level 1), u16 0, u32 0, R refine, R coarsen (Q22 internal,
+                            0 <= coarsen <= refine <= SN_ADAPT_MAX)}: level 1's detail vertices (free, at no level-0 vertex) are
+                            active while their detail stays >= coarsen, join at >= refine, at most A_max of them (sn_adapt.c) */
     SN_SEC_COUNT
 };
 
@@ -218,6 +222,8 @@ enum {
 #define SN_ELEM_CREASE_TNBR  2
 #define SN_ELEM_LEVEL_BLOB   1
 #define SN_ELEM_LEVEL_MAP    8
+#define SN_ELEM_ADAPT(R)   (8 + 2 * (R))
+#define SN_ADAPT_MAX ((int32_t)1 << 30) /* Q22: 256 internal units, beyond any detail (|p| <= SN_LIM = 2^28) */
 #define SN_ELEM_ICHOL       20   /* every flavour: int16 mantissas, one exponent per block */
 #define SN_ICHOL_FRAC_MAX   47   /* forward sweep shift frac + k_j - k_i <= 62 (k <= 15) */
 

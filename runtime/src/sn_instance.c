@@ -3,6 +3,7 @@
  * size: the validator asks sn_instance_bytes for it, and writers' macro
  * SN_INSTANCE_BYTES (sn_format.h) is tested against it. */
 #include "sn_blended.h" /* sn_instance.h, SN_VIEW_BLENDED */
+#include "sn_adapt.h"
 
 /* hdr | acc nF*3 acc | per joint: wrench | force slots | segment state |
  * per joint: pose q4 t3, R9, T3 | per vertex: pos3 vel3 |
@@ -122,6 +123,7 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     if (mem_size >= sn_instance_size_mode(blob, SN_MODE_BLENDED)) h->v.flags |= SN_VIEW_BLENDED;
     h->iterations = h->v.cg_default;
     h->mode = SN_MODE_WARPED;
+    sn_adapt_init(h); /* the mask after the layout, before the blended arrays (sn_instance_size) */
 #if defined(SN_FLOAT)
     {
         int k;
@@ -221,6 +223,24 @@ sn_status sn_reset(sn_instance *inst) {
     sn_controls_reset(h);
     sn_segments_reset(h);
     sn_cons_reset(h);
+    if (h->ad_bytes) sn_ad(h)->refines = sn_ad(h)->coarsens = sn_ad(h)->overflow = 0;
+    {
+        uint32_t sat = 0; /* interpolation with convex weights: never clamps */
+        sn_adapt_begin(h, &sat);
+    }
+    return SN_OK;
+}
+
+sn_status sn_set_adapt(sn_instance *inst, int on) {
+    sn_ihdr *h;
+    uint32_t sat = 0;
+    SN_CHECK_INST(inst);
+    h = hdr_of(inst);
+    if (!h->ad_bytes) return on ? SN_ERR_ARG : SN_OK;
+    if ((uint32_t)(on != 0) == sn_ad(h)->on) return SN_OK;
+    sn_ad(h)->on = on != 0;
+    sn_adapt_begin(h, &sat);
+    h->saturations = sn_count(h->saturations, sat);
     return SN_OK;
 }
 
@@ -279,6 +299,14 @@ sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
     out->constraint_clamps = h->con_clamps;
     out->lod = h->lod;
     out->lattice_vertices = h->v.nV;
+    if (h->ad_bytes) {
+        const sn_adapt_state *a = sn_ad(h);
+        out->adapt_active = a->active;
+        out->adapt_refines = a->refines;
+        out->adapt_coarsens = a->coarsens;
+        out->adapt_overflow = a->overflow;
+        out->adapt_on = a->on && h->lod == 1u;
+    }
     return SN_OK;
 }
 
@@ -317,5 +345,11 @@ uint64_t sn_state_hash(const sn_instance *inst) {
     for (i = 0; i < 3 * h->v.nF; i++) hsh = fnv_q(hsh, x[i]);
     for (i = 0; i < h->v.nK; i++) hsh = fnv_q(hsh, CARR(h, o_ctl, sn_q)[i]); /* control values (none: unchanged) */
     hsh = sn_segments_hash(h, hsh); /* no segment meshes: unchanged */
+    {   /* adaptation: the inactive set (no ADAPT section, or everything in the solve: unchanged) */
+        uint32_t na;
+        const uint8_t *m = sn_adapt_mask_bytes(h, &na);
+        for (i = 0; i < na; i++)
+            if (!m[i]) hsh = fnv_u32(hsh, i);
+    }
     return sn_crease_hash(h, hsh);   /* no crease sections: unchanged */
 }

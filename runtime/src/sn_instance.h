@@ -64,7 +64,23 @@ typedef struct sn_ihdr {
     /* level of detail (sn_level.c): the blob given to init (v is the active level's view), the active level */
     const unsigned char *lod_base;
     uint32_t lod;
+    /* adaptation on level 1 (sn_adapt.c): its state (sn_adapt_state, then the mask) takes ad_bytes
+     * after the layout, at v.instance_bytes (0: the blob has no ADAPT record) */
+    uint32_t ad_bytes;
 } sn_ihdr;
+
+/* Adaptation's state, at v.instance_bytes (sn_adapt.c): the record's A_max and thresholds as ordered
+ * keys, the switch, the counts and events; the mask (ad_n bytes, 1: in the solve) follows. */
+typedef struct sn_adapt_state {
+    uint32_t n, max, refine, coarsen, on;
+    uint32_t active, inactive, refines, coarsens, overflow;
+    uint32_t keyed, pad; /* keyed: the last solve left the inactive vertices' estimates in acc */
+} sn_adapt_state;
+#define SN_ADAPT_STATE_BYTES 48u
+typedef char sn_adapt_state_fits_[sizeof(sn_adapt_state) == SN_ADAPT_STATE_BYTES ? 1 : -1];
+SN_INLINE sn_adapt_state *sn_ad(const sn_ihdr *h) {
+    return (sn_adapt_state *)(void *)((unsigned char *)(uintptr_t)h + h->v.instance_bytes);
+}
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
 
@@ -174,6 +190,8 @@ SN_INLINE void sn_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
 void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat); /* 6: z = C r, block Jacobi or IC(0) (sn_precond.c) */
 /* the same with one frame R for every vertex, restricted to mask[i] != 0 (SN_MODE_BLENDED's region, sn_blended.c) */
 void sn_precond_region(sn_ihdr *h, const sn_q *R, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat);
+/* with the vertex frames, restricted to mask[i] != 0 (inv 0) or mask[i] == 0 (inv 1): adaptation (sn_adapt.c) */
+void sn_precond_mask(sn_ihdr *h, const uint8_t *mask, int inv, const sn_q *r, sn_q *z, uint32_t *sat);
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
 void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat); /* free vertex i carried rigidly by its frame (R x_rest + c; sn_health.c) */
 void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */

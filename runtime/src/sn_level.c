@@ -10,6 +10,7 @@
  * dropped). A step then costs what the active level's counts say. */
 #include "sn_blended.h" /* SN_VIEW_BLENDED */
 #include "sn_instance.h"
+#include "sn_adapt.h"
 
 uint32_t sn_level_sec_count(const sn_view *v, int sec) {
     return sn_rd_u32(v->base + SN_H_SECTIONS + (size_t)sec * SN_SECTION_ENTRY + 8);
@@ -153,6 +154,7 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level) {
     sn_forces_clear(h);   /* pending forces name vertices of the old level */
     h->n_con = 0;         /* so may constraints (SN_AT_LATTICE, SN_AT_POINT): set them again */
     sn_frames_refresh(h, &sat); /* the new level's vertex and cell frames for the pose in force */
+    sn_adapt_begin(h, &sat);    /* level 1: the first active set, the others onto the coarse field (sn_adapt.c) */
     h->saturations = sn_count(h->saturations, sat);
     return SN_OK;
 }

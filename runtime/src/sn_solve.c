@@ -13,6 +13,7 @@
 #include "sn_kernels.h" /* sn_k_cell_mul, sn_k_dot: scalar reference or the build's SIMD/DSP path */
 #include "sn_blended.h" /* sn_rhs and the CG arithmetic, shared with the blended mode */
 #include "sn_kernels_rot.h" /* sn_k_rot_t, sn_k_rot, sn_k_rot_acc: the frame rotations, reference or SIMD */
+#include "sn_adapt.h"   /* the active set of level 1 (seed 000 §4.7) */
 
 SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[0] += sn_mul(m, e[0]);
@@ -189,8 +190,9 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
 }
 
 
-/* Symmetric mass pass over free-free blocks: acc = M^ y (y over free). */
-static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
+/* Symmetric mass pass over free-free blocks: acc = M^ y (y over free); with
+ * mask, over the rows and columns with mask != 0 (y is 0 at the others). */
+static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_acc *acc) {
     const sn_view *v = &h->v;
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
@@ -199,11 +201,13 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, sn_acc *acc) {
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_acc l[3] = {0, 0, 0};
+        if (mask && !mask[i]) continue;
         sca_row(l, rd_real(md, i), y + 3 * i);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m;
             if (j >= nF) break;
+            if (mask && !mask[j]) continue;
             m = rd_real(mo, e);
             sca_row(l, m, y + 3 * j);
             sca_mac(acc + 3 * j, m, y + 3 * i);
@@ -252,7 +256,7 @@ void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned 
  * for f free corners instead of 576): a skeleton corner's operand is zero
  * and its rows are dropped, so the sums are the full product's. The list is
  * read from the blob's corner indices (fixed per blob: constant cost). */
-static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
+static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
     const sn_q *cR = CARR(h, o_cR, sn_q);
@@ -262,13 +266,13 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) {
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
-        cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, NULL, d, acc, sat);
+        cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
         q[i] = sn_out(acc[i], SN_Q_ROT, sat);
     }
-    pass_M_ff(h, d, acc);
+    pass_M_ff(h, d, mask, acc);
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) {
             sn_q mk = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
@@ -352,37 +356,56 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
-    uint32_t clamps = 0, rows;
+    uint32_t clamps = 0, rows, iters = h->iterations;
+    const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: their dv is the coarse field's */
 
     sn_rhs(h, r, 1, sat);
     /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
     rows = sn_constrain_begin(h, x, sat);
+    if (rows) mask = NULL; /* rows may hold an inactive vertex: this step solves them all (sn_adapt.c projects after) */
+    if (mask) sn_adapt_expand(h, mask, x, sat); /* the warm start in the reduced space */
+    if (mask) iters = sn_adapt_iterations(h); /* the reduced rows' preconditioner is the lattice's: more iterations */
     /* PCG, warm-started from the previous step's solution, fixed iterations;
      * with rows, residuals and preconditioned residuals are projected onto
      * the free directions (Baraff-Witkin filtered PCG) */
-    matvec(h, x, q, sat);
+    matvec(h, x, q, NULL, sat);
     for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    if (mask) { /* refine estimates from the inactive rows, then r = P^T (b - A P x) */
+        sn_adapt_estimate(h, mask, r, q, x, sat);
+        sn_adapt_restrict(h, mask, r, sat);
+    }
     if (rows) sn_rows_filter(h, r, 1, sat);
-    sn_precond(h, r, z, sat); /* sn_precond.c */
+    if (mask) sn_precond_mask(h, mask, 0, r, z, sat); /* the active set's block: z = 0 at inactive rows */
+    else sn_precond(h, r, z, sat); /* sn_precond.c */
     if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
     rz = dot(r, z, kk, n3);
-    for (it = 0; it < h->iterations; it++) {
+    for (it = 0; it < iters; it++) {
         sn_dotv dq, rz1;
         sn_q alpha, beta, nalpha;
-        matvec(h, d, q, sat);
+        if (mask) { /* q = P^T A P d: d expanded for the product, then 0 again off the active set */
+            sn_adapt_expand(h, mask, d, sat);
+            matvec(h, d, q, NULL, sat);
+            for (i = 0; i < n3; i++) d[i] = mask[i / 3] ? d[i] : 0;
+            sn_adapt_restrict(h, mask, q, sat);
+        } else matvec(h, d, q, NULL, sat);
         dq = dot(q, d, kk, n3);
         alpha = ratio(rz, dq, &clamps);
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
         if (rows) sn_rows_filter(h, r, 1, sat);
-        sn_precond(h, r, z, sat); /* sn_precond.c */
+        if (mask) sn_precond_mask(h, mask, 0, r, z, sat);
+        else sn_precond(h, r, z, sat); /* sn_precond.c */
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = ratio(rz1, rz, &clamps);
         sn_k_axpy(d, z, beta, d, n3, SN_Q_SCAL, sat); /* d = z + beta d */
         rz = rz1;
+    }
+    if (mask) { /* the estimates out of x, then dv = P x: the inactive vertices move with the coarse field */
+        sn_adapt_keys(h, mask, x);
+        sn_adapt_expand(h, mask, x, sat);
     }
     if (rows) { /* the contacts' corners within their yield bound (sn_contact.c); the CG's rounding off the rows
                  * again; the second pass, in finer units, takes the first's rounding */

@@ -8,6 +8,7 @@
  * step is known before it runs.
  */
 #include "sn_blended.h"
+#include "sn_adapt.h"
 
 sn_status sn_step(sn_instance *inst) {
     sn_ihdr *h;
@@ -20,6 +21,7 @@ sn_status sn_step(sn_instance *inst) {
     if (h->mode == SN_MODE_BLENDED) sn_blended_solve(h, &sat); /* seed 000 §4.5 (sn_blended.c) */
     else sn_solve(h, &sat);
     sn_limits(h, &sat);
+    sn_adapt_step(h, &sat); /* level 1's active set for the next step (seed 000 §4.7, sn_adapt.c) */
     sn_segments_step(h, &sat);
     sn_forces_clear(h);
     sn_health(h, sat);

@@ -229,6 +229,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_LEVEL_UP] = 0;         elem[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_LEVEL_DOWN] = 0;       elem[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_ICHOL] = 0;            elem[SN_SEC_ICHOL] = SN_ELEM_ICHOL; /* block Jacobi; tb_add_ichol adds it */
+    cnt[SN_SEC_ADAPT] = 0;            elem[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -438,7 +439,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     return off;
 }
 
-/* Append an ICHOL section (format 6.0, the last section) to a tb_build
+/* Append an ICHOL section (format 6.0; followed by the empty ADAPT of 6.1) to a tb_build
  * blob of capacity cap: one block per free-free mass entry with mantissas
  * (7919 (n + k) mod 2001) - 1000 times 2^-frac (|U| <= 0.06 at frac 14),
  * frac = the argument; PRECOND stays (its blocks act as the pivots D^-1: any
@@ -459,6 +460,7 @@ static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
     }
     tb_u32(e + 4, n * SN_ELEM_ICHOL);
     tb_u32(e + 8, n);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_ADAPT, total); /* format 6.1: the empty ADAPT section follows */
     tb_u32(b + SN_H_TOTAL_SIZE, total);
     tb_fix_crc(b);
     return total;

@@ -278,6 +278,7 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_LEVEL_UP] = 0; el[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
         cnt[SN_SEC_LEVEL_DOWN] = 0; el[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
         cnt[SN_SEC_ICHOL] = 0; el[SN_SEC_ICHOL] = SN_ELEM_ICHOL;   /* format 6.0: block Jacobi */
+        cnt[SN_SEC_ADAPT] = 0; el[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;
