@@ -44,6 +44,11 @@ lodfixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/level/cow_lod_float.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 lodfloat=$(hash_of "$T")
 [ -n "$lodfixed" ] && [ -n "$lodfloat" ] || { echo "update_hashes: a player printed no level-of-detail hash"; exit 1; }
+"$BUILD/sinew-play" "$BUILD/level/cow_adapt.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+adfixed=$(hash_of "$T")
+"$BUILD/sinew-play-float" "$BUILD/level/cow_adapt_float.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+adfloat=$(hash_of "$T")
+[ -n "$adfixed" ] && [ -n "$adfloat" ] || { echo "update_hashes: a player printed no adaptation hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -76,5 +81,9 @@ crease_float $crfloat
 # checked by tests/scripts/test_level.sh.
 lod_fixed $lodfixed
 lod_float $lodfloat
+# The same on the cow baked with 'levels 2' and 'adapt 0.03 0.01 250' (adaptation
+# on level 1, runtime/LEVELS.md §3), checked by tests/scripts/test_level.sh.
+adapt_fixed $adfixed
+adapt_float $adfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"
