@@ -30,18 +30,18 @@ $(LEVEL_EX)/%_adapt_float.blob: $(LEVEL_EX)/%/adapt.sinew $(BAKE)
 .PRECIOUS: $(LEVEL_EX)/%/adapt.sinew
 ADAPT_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_adapt.blob $(LEVEL_EX)/$(c)_adapt_float.blob)
 
-$(BUILD)/tests/adapt_runtime: tests/test_runtime_adapt.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(ADAPT_BLOBS)
+$(BUILD)/tests/adapt_runtime: tests/test_runtime_adapt.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(ADAPT_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/tests/adapt_runtime_float: tests/test_runtime_adapt.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(ADAPT_BLOBS)
+$(BUILD)/tests/adapt_runtime_float: tests/test_runtime_adapt.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FLOAT) $(ADAPT_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/adapt_runtime $(BUILD)/tests/adapt_runtime_float
 
-$(BUILD)/tests/level_runtime: tests/test_runtime_level.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(LEVEL_BLOBS)
+$(BUILD)/tests/level_runtime: tests/test_runtime_level.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(LEVEL_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(LEVEL_BLOBS)
+$(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FLOAT) $(LEVEL_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(BUILD)/examples/cow.blob \
