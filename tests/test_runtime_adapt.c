@@ -361,6 +361,28 @@ int main(int argc, char **argv)
         T_CHECK(sn_state_hash(Bi.in) == h100, "%s: reset replays bit for bit (level 1 and adaptation survive reset)", name);
         free(snap); free(Bi.mem);
     } else T_CHECK(0, "%s: init", name);
+    {   /* the blended mode's arrays follow adaptation's state (sn_instance_size_mode): blended steps on level 1
+         * leave it alone and stay inside the memory (guard bytes after it); the fuzzer found them overlapping */
+        size_t bsz = sn_instance_size_mode(A.blob, SN_MODE_BLENDED), g;
+        unsigned char *mem = malloc(bsz + 64);
+        sn_instance *bi;
+        sn_stats s0_, s1_;
+        int guard = 1;
+        if (mem && sn_instance_init(mem, bsz, A.blob, &bi) == SN_OK && sn_set_lod(bi, 1) == SN_OK) {
+            memset(mem + bsz, 0xA5, 64);
+            for (k = 1; k <= 20; k++) { pose_at(A.blob, A.info.joints, k, xf); sn_set_pose(bi, xf, A.info.joints); sn_step(bi); }
+            sn_get_stats(bi, &s0_);
+            T_CHECK(sn_set_mode(bi, SN_MODE_BLENDED) == SN_OK, "%s: blended mode with its memory", name);
+            for (k = 21; k <= 25; k++) { pose_at(A.blob, A.info.joints, k, xf); sn_set_pose(bi, xf, A.info.joints); sn_step(bi); }
+            sn_get_stats(bi, &s1_);
+            for (g = 0; g < 64; g++) guard &= mem[bsz + g] == 0xA5;
+            T_CHECK(guard && s1_.adapt_refines == s0_.adapt_refines && s1_.adapt_coarsens == s0_.adapt_coarsens &&
+                        s1_.adapt_overflow == s0_.adapt_overflow,
+                    "%s: blended steps keep adaptation's state (refines %u -> %u, coarsens %u -> %u) and their memory (guard %s)",
+                    name, s0_.adapt_refines, s1_.adapt_refines, s0_.adapt_coarsens, s1_.adapt_coarsens, guard ? "intact" : "overwritten");
+        } else T_CHECK(0, "%s: blended instance", name);
+        free(mem);
+    }
     (void)l0; (void)s1;
     free(b0); free(b1); free(el); free(src); free(wt); free(xf); free(l0); free(l1); free(s0); free(s1); free(P.mem); free(A.mem);
     return T_END();

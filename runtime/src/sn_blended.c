@@ -30,7 +30,8 @@
 #include "sn_blended.h"
 #include "sn_kernels.h" /* sn_k_cell_mul: as sn_solve.c */
 
-/* The blended mode's arrays, after the sn_instance_size bytes (v.instance_bytes):
+/* The blended mode's arrays, after the sn_instance_size bytes (the layout's
+ * v.instance_bytes, then adaptation's state, ad_bytes; sn_instance_size_mode):
  * mg 3nF x 8 (merge accumulator) | bc, xr, z 3nF x 4 (common rhs, region
  * solution, preconditioned residual) | wr nF x u16 (W^r, Q15) | vm nF x u8
  * (unknowns of the region) | cm nC x u8 (cells of the region). */
@@ -56,7 +57,7 @@ size_t sn_instance_size_mode(const sn_blob *blob, sn_mode mode) {
 }
 
 static void mem_of(sn_ihdr *h, blend_mem *m) {
-    unsigned char *p = (unsigned char *)h + h->v.instance_bytes;
+    unsigned char *p = (unsigned char *)h + h->v.instance_bytes + h->ad_bytes; /* past adaptation's mask */
     uint32_t n3 = 3 * h->v.nF;
     m->mg = (sn_acc *)(void *)p;
     p += (size_t)n3 * 8u;
