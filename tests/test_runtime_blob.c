@@ -115,6 +115,7 @@ static void test_header(void) {
     CASE(SN_ERR_VERSION, "major 0", tb_u16(b + SN_H_VER_MAJOR, 0));
     CASE(SN_ERR_VERSION, "byte-swapped major", tb_u16(b + SN_H_VER_MAJOR, 0x0200));
     CASE(SN_ERR_VERSION, "minor 1", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR + 1));
+    CASE(SN_ERR_VERSION, "an older minor (6.0's section table is shorter)", tb_u16(b + SN_H_VER_MINOR, SN_FORMAT_MINOR - 1));
     CASE(SN_ERR_FLAVOUR, "other flavour", b[SN_H_FLAVOUR] = (unsigned char)(1 - SN_FLAVOUR));
     CASE(SN_ERR_FLAVOUR, "float64 flavour", b[SN_H_FLAVOUR] = 2);
     CASE(SN_ERR_FLAVOUR, "real size 8", b[SN_H_REAL_SIZE] = 8);

@@ -323,8 +323,10 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     if (p[0] != SN_MAGIC0 || p[1] != SN_MAGIC1 || p[2] != SN_MAGIC2 || p[3] != SN_MAGIC3)
         return SN_ERR_MAGIC;
     if (sn_rd_u32(p + SN_H_ENDIAN) == 0x04030201u) return SN_ERR_ENDIAN; /* byte-swapped */
+    /* the minor too must be this reader's: 6.1's section table is longer than
+     * 6.0's, so no older minor reads the same (and a flipped minor is refused) */
     if (sn_rd_u16(p + SN_H_VER_MAJOR) != SN_FORMAT_MAJOR ||
-        sn_rd_u16(p + SN_H_VER_MINOR) > SN_FORMAT_MINOR)
+        sn_rd_u16(p + SN_H_VER_MINOR) != SN_FORMAT_MINOR)
         return SN_ERR_VERSION;
     if (sn_rd_u32(p + SN_H_ENDIAN) != SN_ENDIAN_MARK) return SN_ERR_ENDIAN;
     if (p[SN_H_FLAVOUR] != SN_FLAVOUR || p[SN_H_REAL_SIZE] != SN_REAL_BYTES ||
