@@ -46,3 +46,13 @@ $(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) t
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(BUILD)/examples/cow.blob \
              $(BUILD)/examples/cow_float.blob $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob
+
+# The hostile-blob fuzzer over a blob with LEVEL_BLOB and ADAPT (both levels
+# stepped, adaptation on level 1, then blended): part of `make fuzz-blobs`,
+# not of make test (about 85 s of CPU per 100 flips a section on a two-level
+# limb; the cow's pair is larger).
+.PHONY: fuzz-adapt
+fuzz-adapt: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_float $(LEVEL_EX)/cow_adapt.blob $(LEVEL_EX)/cow_adapt_float.blob
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz $(LEVEL_EX)/cow_adapt.blob --per-section $(FUZZ_BLOB_PER_SECTION)
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz_float $(LEVEL_EX)/cow_adapt_float.blob --per-section $(FUZZ_BLOB_PER_SECTION)
+fuzz-blobs: fuzz-adapt
