@@ -110,13 +110,14 @@ $(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
 TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float \
              $(BUILD)/tests/test_runtime_fuzz_range
 # the long campaign of the same hostile blobs (make test samples 100 random
-# flips per section, the range build 40): 2000 per section, every build
+# flips per section, the range build 40, and every bit of each section's
+# first and last 4 bytes): 2000 per section and 16 bytes at each end, every build
 FUZZ_BLOB_PER_SECTION ?= 2000
 .PHONY: fuzz-blobs
 fuzz-blobs: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_float $(BUILD)/tests/test_runtime_fuzz_range \
             $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
 	for t in test_runtime_fuzz test_runtime_fuzz_float test_runtime_fuzz_range test_runtime_fuzz_ck; do \
-	    BUILD=$(BUILD) $(BUILD)/tests/$$t --per-section $(FUZZ_BLOB_PER_SECTION) || exit 1; done
+	    BUILD=$(BUILD) $(BUILD)/tests/$$t --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16 || exit 1; done
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
 $(BUILD)/bench/sn_bench: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)

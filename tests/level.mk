@@ -53,6 +53,6 @@ TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(B
 # limb; the cow's pair is larger).
 .PHONY: fuzz-adapt
 fuzz-adapt: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_float $(LEVEL_EX)/cow_adapt.blob $(LEVEL_EX)/cow_adapt_float.blob
-	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz $(LEVEL_EX)/cow_adapt.blob --per-section $(FUZZ_BLOB_PER_SECTION)
-	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz_float $(LEVEL_EX)/cow_adapt_float.blob --per-section $(FUZZ_BLOB_PER_SECTION)
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz $(LEVEL_EX)/cow_adapt.blob --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_fuzz_float $(LEVEL_EX)/cow_adapt_float.blob --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16
 fuzz-blobs: fuzz-adapt

@@ -25,14 +25,15 @@
  *                         (CRC-32 detects every single-bit error; bytes 0..15,
  *                         outside the CRC, are magic/version/endian/CRC).
  *
- * Usage: test_runtime_fuzz [blob] [--all] [--per-section N] [--seed S] [--crafted | --matrix]
+ * Usage: test_runtime_fuzz [blob] [--all] [--per-section N] [--edge E] [--seed S] [--crafted | --matrix]
  *   blob       default $BUILD/examples/cow.blob (fixed) or cow_float.blob
  *              (float); if missing, the hand-built test blob (sn_tblob.h)
  *   --all      every bit of the blob (slow for a 200 KB blob: ~1.5 M cases)
  *   --crafted  only the crafted cases; --matrix only the extreme-valid matrix and sweeps
  *   env SN_FUZZ_TRACE=1: name each case on stderr before it runs (finds the case behind a sanitizer abort)
  *   default    every bit of the header and section table, every bit of the
- *              first and last 16 bytes of each section, plus N (default
+ *              first and last E bytes of each section (SN_FUZZ_EDGE: 4;
+ *              `make fuzz-blobs` 16), plus N (default
  *              SN_FUZZ_PER_SECTION: 100; the range-checking build 40;
  *              `make fuzz-blobs` runs 2000)
  *              random bits inside each section; truncations: every size
@@ -1195,6 +1196,10 @@ static int matrix_all(void) {
 }
 
 /* Fuzz one blob (g_orig, g_size); returns the number of failed checks. */
+#ifndef SN_FUZZ_EDGE
+#define SN_FUZZ_EDGE 4
+#endif
+static size_t g_edge = SN_FUZZ_EDGE; /* bytes flipped bit by bit at each end of a section (--edge) */
 static int fuzz_one(const char *name, int all, unsigned long per_section) {
     size_t n;
     int i, k, fails = 0;
@@ -1232,8 +1237,8 @@ static int fuzz_one(const char *name, int all, unsigned long per_section) {
                                                                   : rd32(g_orig + SN_H_TOTAL_SIZE);
             unsigned long r;
             if (sz == 0) continue;
-            for (n = off; n < end && n < off + 16; n++) flip_byte(n);
-            for (n = end > off + 16 ? end - 16 : off + 16; n < end; n++) flip_byte(n);
+            for (n = off; n < end && n < off + g_edge; n++) flip_byte(n);
+            for (n = end > off + g_edge ? end - g_edge : off + g_edge; n < end; n++) flip_byte(n);
             for (n = end; n < gap_end && n < g_size; n++) flip_byte(n); /* padding */
             for (r = 0; r < per_section; r++) {
                 uint64_t x = rnd64();
@@ -1305,6 +1310,7 @@ int main(int argc, char **argv) {
             return i != 0;
         }
         else if (strcmp(argv[i], "--per-section") == 0 && i + 1 < argc) per_section = strtoul(argv[++i], NULL, 0);
+        else if (strcmp(argv[i], "--edge") == 0 && i + 1 < argc) g_edge = strtoul(argv[++i], NULL, 0);
         else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = strtoul(argv[++i], NULL, 0);
         else path = argv[i];
     }
