@@ -1,12 +1,16 @@
 /* level_util.h -- what the level tests share (test_runtime_level.c,
- * test_runtime_adapt.c): the flavour's real <-> double conversions and a blob
- * loader (with 8 spare bytes, so a short read never overruns). */
+ * test_runtime_adapt.c): the flavour's real <-> double conversions, a blob
+ * loader (with 8 spare bytes, so a short read never overruns), the blob's cell
+ * edge and the violent swing both drive. */
 #ifndef SN_LEVEL_UTIL_H
 #define SN_LEVEL_UTIL_H
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include "sinew.h"
+#include "sn_format.h"
 
 #if defined(SN_FLOAT)
 #define D(x) ((double)(x))
@@ -30,6 +34,36 @@ static unsigned char *load(const char *path, size_t *n)
     fclose(f);
     *n = (size_t)sz;
     return p;
+}
+
+/* the blob's cell edge in mesh units (header real SN_R_CELL: internal Q22, unit 2^len_shift) */
+static double cell_of(const unsigned char *b)
+{
+    int ls = b[SN_H_LEN_SHIFT] < 128 ? b[SN_H_LEN_SHIFT] : b[SN_H_LEN_SHIFT] - 256;
+    const unsigned char *r = b + SN_H_REALS + 4 * SN_R_CELL;
+    uint32_t u = (uint32_t)r[0] | (uint32_t)r[1] << 8 | (uint32_t)r[2] << 16 | (uint32_t)r[3] << 24;
+#if defined(SN_FLOAT)
+    float f;
+    memcpy(&f, &u, 4);
+    return ldexp((double)f, ls);
+#else
+    return ldexp((double)(int32_t)u, ls - 22);
+#endif
+}
+
+/* every non-root joint swings about a tilted axis, each with its own phase: motion everywhere */
+static void pose_at(const sn_blob *blob, uint32_t nj, int step, sn_xform *xf)
+{
+    sn_quat *local = malloc(sizeof *local * nj);
+    uint32_t j;
+    for (j = 0; j < nj; j++) {
+        sn_vec3 ax;
+        double a = j == 0 ? 0 : 25.0 * sin(2 * 3.14159265358979 * step / 50.0 + 0.7 * j);
+        ax.x = R(1.0); ax.y = R(0.3); ax.z = R(0.2 * (j % 3));
+        local[j] = sn_quat_axis_angle(ax, R(a));
+    }
+    sn_pose_from_local(blob, local, NULL, xf);
+    free(local);
 }
 
 #endif

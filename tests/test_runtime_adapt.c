@@ -26,35 +26,6 @@ static uint32_t rd32(const unsigned char *p) { return rd16(p) | rd16(p + 2) << 1
 static const unsigned char *sec_of(const unsigned char *b, int k) { return b + rd32(b + SN_H_SECTIONS + SN_SECTION_ENTRY * k); }
 static uint32_t cnt_of(const unsigned char *b, int k) { return rd32(b + SN_H_SECTIONS + SN_SECTION_ENTRY * k + 8); }
 
-/* the blob's cell edge in mesh units (header real SN_R_CELL: internal Q22, unit 2^len_shift) */
-static double cell_of(const unsigned char *b)
-{
-    int ls = b[SN_H_LEN_SHIFT] < 128 ? b[SN_H_LEN_SHIFT] : b[SN_H_LEN_SHIFT] - 256;
-    uint32_t u = rd32(b + SN_H_REALS + 4 * SN_R_CELL);
-#if defined(SN_FLOAT)
-    float f;
-    memcpy(&f, &u, 4);
-    return ldexp((double)f, ls);
-#else
-    return ldexp((double)(int32_t)u, ls - 22);
-#endif
-}
-
-/* every non-root joint swings about a tilted axis, each with its own phase (test_runtime_level.c's swing) */
-static void pose_at(const sn_blob *blob, uint32_t nj, int step, sn_xform *xf)
-{
-    sn_quat *local = malloc(sizeof *local * nj);
-    uint32_t j;
-    for (j = 0; j < nj; j++) {
-        sn_vec3 ax;
-        double a = j == 0 ? 0 : 25.0 * sin(2 * 3.14159265358979 * step / 50.0 + 0.7 * j);
-        ax.x = R(1.0); ax.y = R(0.3); ax.z = R(0.2 * (j % 3));
-        local[j] = sn_quat_axis_angle(ax, R(a));
-    }
-    sn_pose_from_local(blob, local, NULL, xf);
-    free(local);
-}
-
 /* A copy of the adapt blob with its record set to refine, coarsen (level-0 cells) and A_max;
  * raw: the stored words as given (for the validator cases). */
 static unsigned char *patched(const unsigned char *src, size_t n, double refine, double coarsen, uint32_t amax)
