@@ -4,18 +4,23 @@
 B=${BUILD:-build}
 L=$B/level
 p=0; f=0
+# run one test program, print its output, add its closing "N passed, N failed" line
+# (no line, or a non-zero exit without failures, counts as one failure)
+suite() {
+    title=$1; shift
+    out=$("$@" 2>&1); rc=$?
+    echo "== $title"
+    echo "$out"
+    line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
+    if [ -z "$line" ]; then f=$((f + 1)); return; fi
+    p=$((p + ${line%% passed*}))
+    ff=${line#*passed, }; ff=${ff%% failed*}
+    f=$((f + ff))
+    [ "$rc" -eq 0 ] || [ "$ff" -ne 0 ] || f=$((f + 1))
+}
 for fl in "" _float; do
     for c in cow beast; do
-        out=$("$B/tests/level_runtime$fl" "$B/examples/$c$fl.blob" "$L/${c}_lod$fl.blob" 2>&1)
-        rc=$?
-        echo "== level_runtime$fl $c"
-        echo "$out"
-        line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
-        if [ -z "$line" ]; then f=$((f + 1)); continue; fi
-        p=$((p + ${line%% passed*}))
-        ff=${line#*passed, }; ff=${ff%% failed*}
-        f=$((f + ff))
-        [ "$rc" -eq 0 ] || [ "$ff" -ne 0 ] || f=$((f + 1))
+        suite "level_runtime$fl $c" "$B/tests/level_runtime$fl" "$B/examples/$c$fl.blob" "$L/${c}_lod$fl.blob"
     done
 done
 # adaptation (tests/test_runtime_adapt.c, blobs from tests/level.mk): the cow at the blob's iterations
@@ -24,16 +29,7 @@ done
 for fl in "" _float; do
     for c in cow beast; do
         it=""; [ $c = beast ] && it=64
-        out=$("$B/tests/adapt_runtime$fl" "$L/${c}_lod$fl.blob" "$L/${c}_adapt$fl.blob" $it 2>&1)
-        rc=$?
-        echo "== adapt_runtime$fl $c $it"
-        echo "$out"
-        line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
-        if [ -z "$line" ]; then f=$((f + 1)); continue; fi
-        p=$((p + ${line%% passed*}))
-        ff=${line#*passed, }; ff=${ff%% failed*}
-        f=$((f + ff))
-        [ "$rc" -eq 0 ] || [ "$ff" -ne 0 ] || f=$((f + 1))
+        suite "adapt_runtime$fl $c $it" "$B/tests/adapt_runtime$fl" "$L/${c}_lod$fl.blob" "$L/${c}_adapt$fl.blob" $it
     done
 done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
