@@ -228,7 +228,7 @@ nonlinear-figures: $(BUILD)/tests/test_nonlinear
 # Preconditioner study (issue 15 item 3; NUMERICS.md "Preconditioners
 # measured"): double precision, the reference stepping the examples' clips,
 # every step's system solved by each candidate. Not part of make test.
-$(BUILD)/tests/precond_study: tests/precond_study.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+$(BUILD)/tests/precond_study: tests/precond_study.c tests/reference/ref_clips.h $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
 # The runtime-vs-reference table at 4, 8, 16, 32 iterations and each asset's
@@ -280,7 +280,7 @@ TEST_DEPS += $(PHYS_EX)/cow_c8.blob $(PHYS_EX)/cow_c8_float.blob $(EX)/beast.blo
 # the whole-clip criterion of runtime/SOLVER_STUDY.md §1 on the examples'
 # ICHOL blobs against block Jacobi at today's counts (cow 10, limb 16, beast
 # 10; the same descriptions baked with 'precond jacobi'). Not part of make test.
-$(BUILD)/tests/ichol_count: tests/ichol_count.c $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
+$(BUILD)/tests/ichol_count: tests/ichol_count.c tests/reference/ref_clips.h $(REF_SRC) $(PHYS_HDRS) ports/common/sn_clip.c ports/common/sn_clip_pose.c ports/common/sn_clip.h $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iports/common -o $@ $< $(REF_SRC) ports/common/sn_clip.c ports/common/sn_clip_pose.c $(SN_LIB_FIXED) -lm
 define JACOBI_BLOB_RULE
