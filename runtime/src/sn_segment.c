@@ -415,6 +415,7 @@ static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
 #endif
 }
 
+#define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */
 typedef struct seg_ctx {
     sn_ihdr *h;
     const seg_mesh *M;
@@ -423,6 +424,11 @@ typedef struct seg_ctx {
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
     sn_real gap;
+    /* the first SEG_TCACHE attachments' targets and their clamp counts:
+     * the joints and the flesh do not move during the segment step, so
+     * each target is computed once per step, not once per sweep and level */
+    sn_q T[SEG_TCACHE][3];
+    uint32_t Tsat[SEG_TCACHE];
 } seg_ctx;
 
 /* pair constraint between two endpoints of equal masses: d = P2 - P1,
@@ -529,21 +535,46 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
         sn_q T[3];
         if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
-        attach_target(C->h, rec, T, sat);
+        if (i < SEG_TCACHE) { /* the same target and clamp count as attach_target's */
+            for (k = 0; k < 3; k++) T[k] = C->T[i][k];
+            *sat += C->Tsat[i];
+        } else {
+            attach_target(C->h, rec, T, sat);
+        }
         k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
         for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
     }
-    for (color = 0; color < 2; color++)
-        for (q = 0; q < L->nn; q++) {
-            uint32_t r, c;
-            n = (L->kind == SN_SEG_CHAIN && dir) ? L->nn - 1u - q : q;
-            r = L->kind == SN_SEG_CHAIN ? 0 : n / L->side;
-            c = L->kind == SN_SEG_CHAIN ? n : n % L->side;
-            if (L->kind == SN_SEG_CHAIN ? color != 0 : ((r + c) & 1u) != (color ^ dir)) continue;
-            k = seg_node_ends(L, n, seg, sgn);
-            for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
-            if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+    if (L->kind == SN_SEG_CHAIN) {
+        /* interior node n joins segment n-1's end and segment n's start (one
+         * pair; the chain's two end nodes have one end each, none) */
+        for (q = 1; q + 1u < L->nn; q++) {
+            n = dir ? L->nn - 1u - q : q;
+            pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
+    } else if (L->side == 2u) { /* braced 2x2 level: seg_node_ends' brace */
+        for (color = 0; color < 2; color++)
+            for (n = 0; n < L->nn; n++) {
+                if (((n >> 1) + (n & 1u) + color + dir) & 1u) continue;
+                k = seg_node_ends(L, n, seg, sgn);
+                for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+                if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+            }
+    } else { /* rows and columns directly: the ends of seg_node_ends, same order */
+        uint32_t sd = L->side, nh = sd * (sd - 1u), r, c;
+        for (color = 0; color < 2; color++)
+            for (r = 0; r < sd; r++)
+                for (c = (r + color + dir) & 1u; c < sd; c += 2u) { /* (r + c) even on colour dir */
+                    uint32_t h = r * (sd - 1u) + c;
+                    n = r * sd + c;
+                    k = 0;
+                    if (c > 0) { seg[k] = h - 1u; sgn[k++] = 1; }
+                    if (r > 0) { seg[k] = nh + n - sd; sgn[k++] = 1; }
+                    if (c + 1u < sd) { seg[k] = h; sgn[k++] = -1; }
+                    if (r + 1u < sd) { seg[k] = nh + n; sgn[k++] = -1; }
+                    for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+                    if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+                }
+    }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
          * (node words: the restricted nodes until seg_node_means): a flat
@@ -758,6 +789,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
         for (i = 0; i < M.nodes; i++)
             for (k = 0; k < 3; k++) M.N[NODE_W * i + k] = sn_add(M.N[NODE_W * i + k], -shift[k], sat);
         ctx_init(&C, h, &M, sat);
+        for (i = 0; i < M.n_attach && i < SEG_TCACHE; i++) {
+            C.Tsat[i] = 0;
+            attach_target(h, h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M.first_attach + i) * ATT_REC, C.T[i], &C.Tsat[i]);
+        }
         if (M.levels > 1) seg_restrict(&M, sat); /* positions and impulse shares of the coarse levels */
         else {
             seg_level(&M, 0, &L);
