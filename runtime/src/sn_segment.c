@@ -308,9 +308,8 @@ SN_INLINE void rotate_u(sn_q u[3], const sn_q t[3]) {
  * again (the limiter may tilt it), so |u + e|^2 <= |u|^2 + 3/16; then one
  * Newton step towards unit length (newton_unit).
  * Fixed: kf = s rf r / 2^30 (|kf| <= 2^30) with r the half length's
- * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: |d_k|
- * <= 2^29 (differences of clamped Q22 values), d.u <= 2^59.8 in Q52 -> Q22
- * <= 2^29.8; |d_perp_k| <= 2^31 (int64); d_perp kf <= 2^61; e.u <= 3 2^58. */
+ * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: see
+ * move_seg; d_perp kf <= 2^59.6; e.u <= 2^58.8 in Q60. */
 SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
 #if defined(SN_FLOAT)
     return a;
@@ -328,36 +327,67 @@ SN_INLINE sn_acc rsh(sn_acc a, int s) {
 }
 SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
 
-/* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30
- * with the shift of r in *sh, see seg_move) */
-SN_INLINE sn_acc seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
+/* A value the bounds above keep within int32 (fixed; float: float), so on
+ * a 32-bit target a product of two is one 32x32->64 multiply (SMULL on a
+ * Cortex-M4, not a 64x64 one); on a 64-bit target int64 (no sign
+ * extensions). The same values either way: the same bits. */
+#if defined(SN_FLOAT)
+typedef float seg_n;
+#define MUL(a, b) ((a) * (b))
+#else
+#if UINTPTR_MAX > 0xFFFFFFFFu
+typedef int64_t seg_n;
+#else
+typedef int32_t seg_n;
+#endif
+#define MUL(a, b) ((int64_t)(a) * (b))
+#endif
+/* an int64 value into seg_n; the range-checking build asserts the int32 bound
+ * on every target (a 64-bit seg_n would hide a value a 32-bit one truncates) */
+#if defined(SN_FLOAT)
+#define NARROW(x) (x)
+#else
+#define NARROW(x) narrow(x)
+SN_INLINE seg_n narrow(int64_t x) {
+    SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
+    return (seg_n)x;
+}
+#endif
+
+/* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
+ * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
+SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
     sn_q r;
-    sn_acc kf;
+    seg_n kf;
     (void)seg_half(L, i, &r, sh);
-    kf = r30((sn_acc)rf * r);
+    kf = NARROW(r30(MUL(rf, r)));
     return s > 0 ? kf : -kf;
 }
 
-/* the move on one segment's words S, all in registers (see above) */
-SN_INLINE void move_seg(sn_q *S, sn_acc d0, sn_acc d1, sn_acc d2, sn_acc t0, sn_acc t1, sn_acc t2, sn_acc kf,
+/* the move on one segment's words S, all in registers (see above). Fixed,
+ * |u| <= 1 (+LSBs) kept by every write of u: |d_k| <= 2^28 (clamped to the
+ * state range), d.u -> Q22 <= sqrt(3) 2^28, d_perp_k <= 2^29.6, e_k <=
+ * 2^28, e.u <= sqrt(3) 2^28, x_k < 1.5 2^30 (u plus e's part across u,
+ * |.| <= |e|), f in [0.47, 1.01] 2^30: every factor within int32 (NARROW). */
+SN_INLINE void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
                         int sh, uint32_t *sat) {
-    sn_acc u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
-    du = r30(d0 * u0 + d1 * u1 + d2 * u2);
-    e0 = lim(rsh((d0 - r30(du * u0)) * kf, sh), ROT_MAX);
-    e1 = lim(rsh((d1 - r30(du * u1)) * kf, sh), ROT_MAX);
-    e2 = lim(rsh((d2 - r30(du * u2)) * kf, sh), ROT_MAX);
-    eu = r30(e0 * u0 + e1 * u1 + e2 * u2);
-    x0 = u0 + e0 - r30(eu * u0);
-    x1 = u1 + e1 - r30(eu * u1);
-    x2 = u2 + e2 - r30(eu * u2);
+    seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
+    du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
+    e0 = NARROW(lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
+    e1 = NARROW(lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
+    e2 = NARROW(lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
+    eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
+    x0 = NARROW(u0 + e0 - r30(MUL(eu, u0)));
+    x1 = NARROW(u1 + e1 - r30(MUL(eu, u1)));
+    x2 = NARROW(u2 + e2 - r30(MUL(eu, u2)));
 #if defined(SN_FLOAT)
     f = 1.5f - 0.5f * (x0 * x0 + x1 * x1 + x2 * x2);
 #else
-    f = sn_rshr64(((int64_t)3 << 60) - (x0 * x0 + x1 * x1 + x2 * x2), SN_Q_ROT + 1);
+    f = NARROW(sn_rshr64(((int64_t)3 << 60) - (MUL(x0, x0) + MUL(x1, x1) + MUL(x2, x2)), SN_Q_ROT + 1));
 #endif
-    S[3] = (sn_q)r30(x0 * f);
-    S[4] = (sn_q)r30(x1 * f);
-    S[5] = (sn_q)r30(x2 * f);
+    S[3] = (sn_q)r30(MUL(x0, f));
+    S[4] = (sn_q)r30(MUL(x1, f));
+    S[5] = (sn_q)r30(MUL(x2, f));
     S[0] = sn_add(S[0], (sn_q)t0, sat);
     S[1] = sn_add(S[1], (sn_q)t1, sat);
     S[2] = sn_add(S[2], (sn_q)t2, sat);
@@ -366,7 +396,7 @@ SN_INLINE void move_seg(sn_q *S, sn_acc d0, sn_acc d1, sn_acc d2, sn_acc t0, sn_
 static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
                      uint32_t *sat) {
     int sh;
-    sn_acc kf = seg_kf(L, i, s, rf, &sh);
+    seg_n kf = seg_kf(L, i, s, rf, &sh);
     move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
 }
 
@@ -385,13 +415,20 @@ static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
 #endif
 }
 
+#define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */
 typedef struct seg_ctx {
     sn_ihdr *h;
     const seg_mesh *M;
     sn_q gh, rf1, rf2;  /* gamma/2, 1-gamma, (1-gamma)/2 */
+    seg_n kf0;          /* level 0's turn factor rf2/half (seg_kf), set by sweep */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
     sn_real gap;
+    /* the first SEG_TCACHE attachments' targets and their clamp counts:
+     * the joints and the flesh do not move during the segment step, so
+     * each target is computed once per step, not once per sweep and level */
+    sn_q T[SEG_TCACHE][3];
+    uint32_t Tsat[SEG_TCACHE];
 } seg_ctx;
 
 /* pair constraint between two endpoints of equal masses: d = P2 - P1,
@@ -400,26 +437,34 @@ typedef struct seg_ctx {
  * perpendicular part */
 static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
                  uint32_t *sat) {
-    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3], r;
-    sn_acc ha, hb, ka, kb, t[3];
+    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
+    seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
     int sha, shb;
     unsigned k;
-    ha = seg_half(L, a, &r, &sha);
-    hb = seg_half(L, b, &r, &shb);
+    if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
+        ha = hb = L->half;
+        sha = shb = L->sh;
+        ka = kb = C->kf0;
+    } else {
+        ha = A[12]; hb = B[12];
+        sha = (int)A[14]; shb = (int)B[14];
+        ka = NARROW(r30(MUL(C->rf2, A[13])));
+        kb = NARROW(r30(MUL(C->rf2, B[13])));
+    }
     ha = sa > 0 ? ha : -ha;
     hb = sb > 0 ? hb : -hb;
     /* endpoints G +- half u (|.| < 2^30) and their difference, clamped */
     for (k = 0; k < 3; k++) {
-        d[k] = sn_out((B[k] + r30(B[3 + k] * hb)) - (A[k] + r30(A[3 + k] * ha)), 0, &ls);
-        t[k] = r30((sn_acc)d[k] * C->gh); /* gamma d / 2: |.| <= 2^27 */
+        d[k] = sn_out((B[k] + r30(MUL(B[3 + k], hb))) - (A[k] + r30(MUL(A[3 + k], ha))), 0, &ls);
+        t[k] = NARROW(r30(MUL(d[k], C->gh))); /* gamma d / 2: |.| <= 2^27 */
     }
     if (measure) {
         sn_real g = gap_of(d, L);
         C->gap = g > C->gap ? g : C->gap;
     } else {
-        ka = seg_kf(L, a, sa, C->rf2, &sha);
-        kb = seg_kf(L, b, sb, C->rf2, &shb);
+        ka = sa > 0 ? ka : -ka;
+        kb = sb > 0 ? kb : -kb;
         move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
         move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
     }
@@ -481,26 +526,55 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
     uint32_t n, seg[5], i, q;
     int sgn[5];
     unsigned color, j, k;
+    {
+        int sh;
+        C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
+    }
     for (i = 0; i < M->n_attach; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
         sn_q T[3];
         if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
-        attach_target(C->h, rec, T, sat);
+        if (i < SEG_TCACHE) { /* the same target and clamp count as attach_target's */
+            for (k = 0; k < 3; k++) T[k] = C->T[i][k];
+            *sat += C->Tsat[i];
+        } else {
+            attach_target(C->h, rec, T, sat);
+        }
         k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
         for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
     }
-    for (color = 0; color < 2; color++)
-        for (q = 0; q < L->nn; q++) {
-            uint32_t r, c;
-            n = (L->kind == SN_SEG_CHAIN && dir) ? L->nn - 1u - q : q;
-            r = L->kind == SN_SEG_CHAIN ? 0 : n / L->side;
-            c = L->kind == SN_SEG_CHAIN ? n : n % L->side;
-            if (L->kind == SN_SEG_CHAIN ? color != 0 : ((r + c) & 1u) != (color ^ dir)) continue;
-            k = seg_node_ends(L, n, seg, sgn);
-            for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
-            if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+    if (L->kind == SN_SEG_CHAIN) {
+        /* interior node n joins segment n-1's end and segment n's start (one
+         * pair; the chain's two end nodes have one end each, none) */
+        for (q = 1; q + 1u < L->nn; q++) {
+            n = dir ? L->nn - 1u - q : q;
+            pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
+    } else if (L->side == 2u) { /* braced 2x2 level: seg_node_ends' brace */
+        for (color = 0; color < 2; color++)
+            for (n = 0; n < L->nn; n++) {
+                if (((n >> 1) + (n & 1u) + color + dir) & 1u) continue;
+                k = seg_node_ends(L, n, seg, sgn);
+                for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+                if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+            }
+    } else { /* rows and columns directly: the ends of seg_node_ends, same order */
+        uint32_t sd = L->side, nh = sd * (sd - 1u), r, c;
+        for (color = 0; color < 2; color++)
+            for (r = 0; r < sd; r++)
+                for (c = (r + color + dir) & 1u; c < sd; c += 2u) { /* (r + c) even on colour dir */
+                    uint32_t h = r * (sd - 1u) + c;
+                    n = r * sd + c;
+                    k = 0;
+                    if (c > 0) { seg[k] = h - 1u; sgn[k++] = 1; }
+                    if (r > 0) { seg[k] = nh + n - sd; sgn[k++] = 1; }
+                    if (c + 1u < sd) { seg[k] = h; sgn[k++] = -1; }
+                    if (r + 1u < sd) { seg[k] = nh + n; sgn[k++] = -1; }
+                    for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+                    if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+                }
+    }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
          * (node words: the restricted nodes until seg_node_means): a flat
@@ -715,6 +789,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
         for (i = 0; i < M.nodes; i++)
             for (k = 0; k < 3; k++) M.N[NODE_W * i + k] = sn_add(M.N[NODE_W * i + k], -shift[k], sat);
         ctx_init(&C, h, &M, sat);
+        for (i = 0; i < M.n_attach && i < SEG_TCACHE; i++) {
+            C.Tsat[i] = 0;
+            attach_target(h, h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M.first_attach + i) * ATT_REC, C.T[i], &C.Tsat[i]);
+        }
         if (M.levels > 1) seg_restrict(&M, sat); /* positions and impulse shares of the coarse levels */
         else {
             seg_level(&M, 0, &L);
