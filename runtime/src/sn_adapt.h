@@ -40,7 +40,9 @@ void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x);
  * (tests/test_runtime_adapt.c): at the blob's 4 iterations the reduced step
  * diverges and a steady state flips vertices every step (the refine estimate
  * rides on the unconverged residual); at 16 both are gone. */
+#ifndef SN_ADAPT_MIN_ITERATIONS
 #define SN_ADAPT_MIN_ITERATIONS 16u
+#endif
 uint32_t sn_adapt_iterations(const sn_ihdr *h);
 /* After the step's update and limits: details, selection, projection. */
 void sn_adapt_step(sn_ihdr *h, uint32_t *sat);

@@ -236,14 +236,15 @@ void sn_blended_solve(sn_ihdr *h, uint32_t *sat) {
         for (it = 0; it < h->iterations; it++) {
             sn_cgdot dq, rz1;
             sn_q alpha, beta;
+            int flat = sn_cg_flat(rz, n3); /* at the rounding floor: x and r stay (sn_solve.c) */
             region_matvec(h, R, &m, d, q, sat);
             dq = sn_cg_dot(q, d, kk, n3);
-            alpha = sn_cg_ratio(rz, dq, &clamps);
+            alpha = flat ? 0 : sn_cg_ratio(rz, dq, &clamps);
             sn_cg_axpy(m.xr, alpha, d, n3, sat);
             sn_cg_axpy(r, (sn_q)-alpha, q, n3, sat);
             region_precond(h, R, &m, r, m.z, sat);
             rz1 = sn_cg_dot(r, m.z, kk, n3);
-            beta = sn_cg_ratio(rz1, rz, &clamps);
+            beta = flat ? 0 : sn_cg_ratio(rz1, rz, &clamps);
             sn_cg_dir(d, m.z, beta, n3, sat);
             rz = rz1;
         }

@@ -19,6 +19,9 @@ typedef struct { sn_acc m; int e; } sn_cgdot;
 sn_cgdot sn_cg_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n);
 /* num/den as a CG step (fixed Q28), 0 when either is <= 0; clamps counted. */
 sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps);
+/* 1 when r.z is at the CG's rounding floor (sn_solve.c at_floor): that
+ * iteration takes alpha = beta = 0 */
+int sn_cg_flat(sn_cgdot rz, uint32_t n);
 /* y += s x;  d = z + beta d  (s, beta from sn_cg_ratio) */
 void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat);
 void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat);

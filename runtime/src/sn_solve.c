@@ -338,6 +338,28 @@ static int32_t ratio(sn_dotv num, sn_dotv den, uint32_t *clamps) {
 }
 #endif
 
+/* The CG's rounding floor: r.z at or below SN_CG_FLOOR units of Q41 (a
+ * Q19 force LSB times a Q22 velocity LSB) per unknown is noise. From there
+ * on alpha = rz/dq and beta = rz'/rz are ratios of rounding errors: beta
+ * sits at 1, d = z + d grows by the noise every iteration and x drifts
+ * along it (cow, 32 iterations: 1.7e-2 off the reference, 16x the error at
+ * 8). So a step at the floor takes alpha = beta = 0 for its remaining
+ * iterations: x and r stay, and so does the floor. The iterations still
+ * run: the cost stays the baked count's. Float: 0 only when r.z <= 0. */
+#if defined(SN_FLOAT)
+static int at_floor(sn_dotv rz, uint32_t n) { (void)n; return rz.m <= 0.0f; }
+#else
+#ifndef SN_CG_FLOOR
+#define SN_CG_FLOOR 1
+#endif
+static int at_floor(sn_dotv rz, uint32_t n) {
+    /* rz = m 2^e with m > 0, e >= 0 (sn_k_dot); SN_CG_FLOOR n fits 64 bits */
+    if (rz.m <= 0) return 1;
+    if (rz.e >= 40) return 0;
+    return (uint64_t)rz.m <= (((uint64_t)SN_CG_FLOOR * n) >> rz.e);
+}
+#endif
+
 /* y += s * x (s in Q28 fixed) over n values */
 static void axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) {
     sn_k_axpy(y, y, s, x, n, SN_Q_SCAL, sat); /* sn_kernels.h: reference or SIMD */
@@ -383,6 +405,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     for (it = 0; it < iters; it++) {
         sn_dotv dq, rz1;
         sn_q alpha, beta, nalpha;
+        int flat;
         if (mask) { /* q = P^T A P d: d expanded for the product, then 0 again off the active set */
             sn_adapt_expand(h, mask, d, sat);
             matvec(h, d, q, NULL, sat);
@@ -390,7 +413,8 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
             sn_adapt_restrict(h, mask, q, sat);
         } else matvec(h, d, q, NULL, sat);
         dq = dot(q, d, kk, n3);
-        alpha = ratio(rz, dq, &clamps);
+        flat = at_floor(rz, n3);
+        alpha = flat ? 0 : ratio(rz, dq, &clamps);
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
@@ -399,7 +423,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         else sn_precond(h, r, z, sat); /* sn_precond.c */
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
-        beta = ratio(rz1, rz, &clamps);
+        beta = flat ? 0 : ratio(rz1, rz, &clamps);
         sn_k_axpy(d, z, beta, d, n3, SN_Q_SCAL, sat); /* d = z + beta d */
         rz = rz1;
     }
@@ -442,6 +466,14 @@ sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) {
     b.e = den.e;
 #endif
     return ratio(a, b, clamps);
+}
+int sn_cg_flat(sn_cgdot rz, uint32_t n) {
+    sn_dotv a;
+    a.m = rz.m;
+#if !defined(SN_FLOAT)
+    a.e = rz.e;
+#endif
+    return at_floor(a, n);
 }
 void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) { axpy(y, s, x, n, sat); }
 void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat) {
