@@ -40,6 +40,9 @@
  *   each frame: sn_pose_from_local(...) or your own bone transforms,
  *               sn_set_pose(inst, xforms, n_joints); sn_step(inst);
  *               sn_get_surface(inst, out, 0, n_surface);
+ * Many instances on a thread: sn_instance_init_shared with
+ * sn_instance_state_size(blob) bytes each, stepped by sn_step_with with one
+ * workspace of sn_workspace_size(blob, mode) bytes (see "Shared workspace").
  */
 #ifndef SINEW_H
 #define SINEW_H
@@ -96,7 +99,7 @@ typedef struct sn_xform { sn_quat rot; sn_vec3 pos; } sn_xform;
     X(SN_ERR_SECTION,   "blob section offset/size/count inconsistent or out of bounds") \
     X(SN_ERR_INDEX,     "an index stored in the blob is out of range") \
     X(SN_ERR_VALUE,     "a number stored in the blob is out of its allowed range") \
-    X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size()") \
+    X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size() (workspace: sn_workspace_size())") \
     X(SN_ERR_ARG,       "argument out of range") \
     X(SN_ERR_INSTANCE,  "instance memory does not hold an initialised instance") \
     X(SN_ERR_FULL,      "every slot the blob provides for this step is taken")
@@ -119,8 +122,9 @@ typedef struct sn_blob sn_blob;
 /// An instance: all mutable simulation state, living in caller memory.
 /// The handle equals the memory pointer given to sn_instance_init(). The memory
 /// holds no pointers into itself, so a byte copy (memcpy) of sn_instance_size()
-/// bytes to another 8-byte aligned buffer is a snapshot that can be stepped or
-/// copied back (rollback, replay). It does point at its blob.
+/// bytes (sn_instance_state_size() for an sn_instance_init_shared instance) to
+/// another 8-byte aligned buffer is a snapshot that can be stepped or copied
+/// back (rollback, replay). It does point at its blob.
 typedef struct sn_instance sn_instance;
 
 /// Counts and settings of a blob.
