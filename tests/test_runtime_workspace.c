@@ -181,6 +181,12 @@ static int run_phases(drv *d, const int *phases, int np, uint32_t steps, uint64_
             T_CHECK(sn_set_lod(d->det.inst, 1) == SN_OK, "sn_set_lod 1 (adapt)");
             T_CHECK(sn_set_adapt(d->det.inst, 1) == SN_OK, "sn_set_adapt 1");
             drv_steps(d, steps / 4);
+            {   /* adaptation really ran: part of level 1 out of the solve (its projection uses d and q) */
+                sn_stats st;
+                sn_get_stats(d->det.inst, &st);
+                T_CHECK(st.adapt_on && st.adapt_refines + st.adapt_coarsens > 0, "adaptation ran (refines %u, coarsens %u)",
+                        st.adapt_refines, st.adapt_coarsens);
+            }
             (void)sn_reset(d->det.inst);
             drv_steps(d, steps / 4);
             T_CHECK(sn_set_adapt(d->det.inst, 0) == SN_OK, "sn_set_adapt 0");
