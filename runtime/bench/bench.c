@@ -139,6 +139,9 @@ static int bench_blob(const char *path, int only_steps) {
         printf("  figure: %s step time: median %.1f us, min %.1f us, mean %.1f us, p90 %.1f us (%d steps); "
                "get_surface %.1f us\n", FLAV, 1e6 * ts[n / 2], 1e6 * ts[0], 1e6 * sum / n, 1e6 * ts[n * 9 / 10], n,
                1e6 * (now() - t0) / rep);
+        printf("  figure: %s memory: instance %u B with its own scratch, or %u B persistent state + a %u B workspace "
+               "shared by every instance a thread steps (sn_instance_init_shared, sn_step_with)\n", FLAV, (unsigned)need,
+               (unsigned)sn_instance_state_size(blob), (unsigned)sn_workspace_size(blob, SN_MODE_WARPED));
         printf("  figure: %s arithmetic per step: %.0f multiply-adds = %.0f block multiply-adds (3x3 block x 3-vector)\n",
                FLAV, macs, macs / 9.0);
         printf("  macs: %.0f\n", macs / 9.0);

@@ -22,6 +22,7 @@ for flav in fixed float; do
     macs=$(sed -n 's/^  macs: //p' "$tmp/out")
     sed -n "s/^  figure: $flav step time: median \([0-9.]*\) us.*/\1/p" "$tmp/out" > "$tmp/t_${a}_$flav"
     sed -n 's/^  blob .*: \([0-9]*\) B blob, \([0-9]*\) B instance.*/\1 \2/p' "$tmp/out" > "$tmp/m_${a}_$flav"
+    sed -n 's/^  figure: .* memory: .* or \([0-9]*\) B persistent state + a \([0-9]*\) B workspace.*/\1 \2/p' "$tmp/out" > "$tmp/w_${a}_$flav"
     if command -v valgrind > /dev/null 2>&1; then
         for n in 0 "$STEPS"; do
             valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.$n" "$bin" --steps "$n" "$blob" \
@@ -70,6 +71,9 @@ row "callgrind fixed instructions per step" $(for a in $ASSETS; do v "c_${a}_fix
 row "callgrind float instructions per step" $(for a in $ASSETS; do v "c_${a}_float"; done)
 row "Cortex-M4 instructions per step (fixed)" $(for a in $ASSETS; do m4 "$a"; done)
 row "instance bytes (fixed)" $(for a in $ASSETS; do mem "$a" fixed 2; done)
+wmem() { [ -s "$tmp/w_$1_$2" ] && awk -v k="$3" '{print $k}' "$tmp/w_$1_$2" || echo "-"; }
+row "instance bytes, shared workspace: persistent state per instance (fixed)" $(for a in $ASSETS; do wmem "$a" fixed 1; done)
+row "workspace bytes, one per thread (fixed)" $(for a in $ASSETS; do wmem "$a" fixed 2; done)
 row "blob bytes (fixed)" $(for a in $ASSETS; do mem "$a" fixed 1; done)
 row "blob bytes (fixed, --no-triangles)" $(for a in $ASSETS; do v "nt_$a"; done)
 row "blob bytes (float)" $(for a in $ASSETS; do mem "$a" float 1; done)

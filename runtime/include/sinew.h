@@ -40,6 +40,9 @@
  *   each frame: sn_pose_from_local(...) or your own bone transforms,
  *               sn_set_pose(inst, xforms, n_joints); sn_step(inst);
  *               sn_get_surface(inst, out, 0, n_surface);
+ * Many instances on a thread: sn_instance_init_shared with
+ * sn_instance_state_size(blob) bytes each, stepped by sn_step_with with one
+ * workspace of sn_workspace_size(blob, mode) bytes (see "Shared workspace").
  */
 #ifndef SINEW_H
 #define SINEW_H
@@ -96,7 +99,7 @@ typedef struct sn_xform { sn_quat rot; sn_vec3 pos; } sn_xform;
     X(SN_ERR_SECTION,   "blob section offset/size/count inconsistent or out of bounds") \
     X(SN_ERR_INDEX,     "an index stored in the blob is out of range") \
     X(SN_ERR_VALUE,     "a number stored in the blob is out of its allowed range") \
-    X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size()") \
+    X(SN_ERR_MEMORY,    "instance memory is smaller than sn_instance_size() (workspace: sn_workspace_size())") \
     X(SN_ERR_ARG,       "argument out of range") \
     X(SN_ERR_INSTANCE,  "instance memory does not hold an initialised instance") \
     X(SN_ERR_FULL,      "every slot the blob provides for this step is taken")
@@ -119,8 +122,9 @@ typedef struct sn_blob sn_blob;
 /// An instance: all mutable simulation state, living in caller memory.
 /// The handle equals the memory pointer given to sn_instance_init(). The memory
 /// holds no pointers into itself, so a byte copy (memcpy) of sn_instance_size()
-/// bytes to another 8-byte aligned buffer is a snapshot that can be stepped or
-/// copied back (rollback, replay). It does point at its blob.
+/// bytes (sn_instance_state_size() for an sn_instance_init_shared instance) to
+/// another 8-byte aligned buffer is a snapshot that can be stepped or copied
+/// back (rollback, replay). It does point at its blob.
 typedef struct sn_instance sn_instance;
 
 /// Counts and settings of a blob.
@@ -218,7 +222,9 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local,
 
 /// Advance one timestep h with the current pose. Cost is fixed by the blob and
 /// the iteration count: no data-dependent loop exits. SN_ERR_NULL or
-/// SN_ERR_INSTANCE (nothing happens) if inst is not an initialised instance.
+/// SN_ERR_INSTANCE (nothing happens) if inst is not an initialised instance;
+/// SN_ERR_MEMORY (nothing happens) for an sn_instance_init_shared instance,
+/// which steps with sn_step_with.
 sn_status sn_step(sn_instance *inst);
 
 /// Override the CG iteration count (1..cg_iters_max); 0 restores the blob default.
@@ -242,6 +248,53 @@ sn_status sn_set_mode(sn_instance *inst, sn_mode mode);
 /// vectors, scratch only). Pass it as mem_size to sn_instance_init; a byte copy
 /// of such an instance needs this many bytes too. 0 if blob is NULL.
 size_t sn_instance_size_mode(const sn_blob *blob, sn_mode mode);
+
+/* ---- Shared workspace: many instances, one copy of the step's scratch ----
+ * Part of an instance is scratch: written before it is read within every
+ * step (CG vectors, the step's constraint rows and their packed Cholesky
+ * factor, the blended mode's vectors). An instance made by
+ * sn_instance_init_shared holds only its persistent state; each
+ * sn_step_with borrows the scratch from a workspace the caller passes.
+ * One workspace per thread serves every instance that thread steps, one
+ * after another, of any blob it is large enough for (the largest
+ * sn_workspace_size). The instance stores no pointer to the workspace, so a
+ * byte copy of its sn_instance_state_size() bytes is a snapshot as before,
+ * and the workspace's contents between steps mean nothing (tests fill it
+ * with garbage before every step). Every other call (getters, setters,
+ * sn_reset, sn_teleport, sn_set_lod, sn_set_adapt, hash, stats) works on
+ * the state alone, as for sn_instance_init's instances.
+ *
+ *   size_t ws = sn_workspace_size(blob, SN_MODE_WARPED);  // per thread
+ *   size_t st = sn_instance_state_size(blob);             // per instance
+ *   sn_instance_init_shared(mem[i], st, blob, &cow[i]);
+ *   for (i...) { sn_set_pose(cow[i], ...); sn_step_with(cow[i], work, ws); }
+ */
+
+/// Bytes of persistent state of one sn_instance_init_shared instance of this
+/// blob: what survives between steps (positions, velocities, warm start,
+/// frames, pose tracking, controls, forces, segment and crease state,
+/// constraint settings, adaptation, counters). 0 if blob is NULL.
+size_t sn_instance_state_size(const sn_blob *blob);
+
+/// Bytes of workspace sn_step_with needs for this blob in this mode (the
+/// blended mode needs more). Its memory is 8-byte aligned. 0 if blob is NULL.
+size_t sn_workspace_size(const sn_blob *blob, sn_mode mode);
+
+/// sn_instance_init for an instance without its own scratch: mem_size >=
+/// sn_instance_state_size(blob), mem 8-byte aligned; same errors. It steps
+/// with sn_step_with (sn_step refuses it); SN_MODE_BLENDED needs no larger
+/// state, only sn_workspace_size(blob, SN_MODE_BLENDED) at each step.
+sn_status sn_instance_init_shared(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out);
+
+/// sn_step using workspace (bytes long, 8-byte aligned) for the step's scratch:
+/// the same state, bit for bit, as sn_step on an sn_instance_init instance.
+/// The workspace may be shared by any number of instances stepped one at a
+/// time (one per thread); its contents before and after the call are
+/// irrelevant. SN_ERR_NULL for a NULL workspace, SN_ERR_ALIGN if misaligned,
+/// SN_ERR_MEMORY if bytes < sn_workspace_size(blob, mode in force): nothing
+/// happens then. An sn_instance_init instance ignores workspace and steps
+/// with its own scratch (sn_step).
+sn_status sn_step_with(sn_instance *inst, void *workspace, size_t bytes);
 
 /// Deformed lattice vertex positions (mesh units, world), vertices [first, first+count).
 /// Vertex order is the blob's: free vertices first, then skeleton vertices.

@@ -359,7 +359,7 @@ uint32_t sn_adapt_iterations(const sn_ihdr *h) {
 }
 
 void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x) {
-    uint32_t *key = ARR(h, o_acc, uint32_t), w;
+    uint32_t *key = WARR(h, o_acc, uint32_t), w;
     for (w = 0; w < sn_ad(h)->n; w++) key[w] = mask[w] ? 0u : key_of(x[3 * w]);
     sn_ad(h)->keyed = 1;
 }
@@ -375,7 +375,7 @@ void sn_adapt_step(sn_ihdr *h, uint32_t *sat) {
     top_view(h, &t);
     up = t.sec[SN_SEC_LEVEL_UP]; cells = t.sec[SN_SEC_CELLS];
     m = mask_of(h);
-    key = ARR(h, o_acc, uint32_t); /* 24 nF bytes: the preconditioner's scratch is done with first */
+    key = WARR(h, o_acc, uint32_t); /* 24 nF bytes: the preconditioner's scratch is done with first */
     ps = ARR(h, o_d, sn_q); vs = ARR(h, o_q, sn_q);
     pos = CARR(h, o_pos, sn_q);
     /* inactive rows: the estimate the solve left in acc (sn_adapt_keys), or none (a step with rows) */

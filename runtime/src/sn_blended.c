@@ -57,7 +57,7 @@ size_t sn_instance_size_mode(const sn_blob *blob, sn_mode mode) {
 }
 
 static void mem_of(sn_ihdr *h, blend_mem *m) {
-    unsigned char *p = (unsigned char *)h + h->v.instance_bytes + h->ad_bytes; /* past adaptation's mask */
+    unsigned char *p = sn_ws(h) + sn_blend_offset(h); /* scratch: in the instance past adaptation's mask, or the workspace's */
     uint32_t n3 = 3 * h->v.nF;
     m->mg = (sn_acc *)(void *)p;
     p += (size_t)n3 * 8u;
@@ -111,7 +111,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
     const unsigned char *rest = v->sec[SN_SEC_REST];
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     uint32_t e, k, c, i, nF = v->nF;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < 3 * nF; i++) acc[i] = 0;
@@ -163,7 +163,7 @@ static void region_matvec(sn_ihdr *h, const sn_q *R, const blend_mem *m, const s
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     uint32_t e, i, k, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     for (i = 0; i < 3 * nF; i++) acc[i] = 0;
@@ -214,7 +214,7 @@ void sn_blended_solve(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *jR = CARR(h, o_jR, sn_q);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q), *q = ARR(h, o_q, sn_q);
+    sn_q *x = ARR(h, o_x, sn_q), *r = WARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q), *q = ARR(h, o_q, sn_q);
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q);
     uint32_t reg, i, it, n3 = 3 * v->nF, clamps = 0;
     blend_mem m;

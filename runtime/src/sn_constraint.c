@@ -95,11 +95,11 @@ sn_status sn_check_constraints(sn_view *v) {
 }
 
 /* ---- layout and reset ---- */
-void sn_cons_layout(sn_ihdr *h, uint32_t off) {
+void sn_cons_layout(sn_ihdr *h, uint32_t off, uint32_t row) {
     const sn_view *v = &h->v;
     h->o_con = off;
     h->o_col = h->o_con + v->nCon * SN_CON_BYTES;
-    h->o_row = h->o_col + v->nCol * SN_COL_BYTES;
+    h->o_row = row; /* scratch (from h->ws): right after the colliders in the instance's own layout */
     h->o_rx = h->o_row + v->nRows * SN_ROW_BYTES;
     h->o_L = h->o_rx + v->nRows * SN_ROWAUX_BYTES;
 }
@@ -198,7 +198,7 @@ static void row_acc(const sn_ihdr *h, const sn_row *r, sn_q lam, sn_acc *acc, ui
 }
 /* acc = 0 at the rows' free entries (the mat-vec leaves its sums there) */
 static void rows_zero_acc(const sn_ihdr *h, sn_acc *acc) {
-    const sn_row *r = CARR(h, o_row, sn_row);
+    const sn_row *r = CWARR(h, o_row, sn_row);
     uint32_t j, k, nF = h->v.nF;
     for (j = 0; j < h->n_rows; j++)
         for (k = 0; k < r[j].n; k++)
@@ -209,8 +209,8 @@ static void rows_zero_acc(const sn_ihdr *h, sn_acc *acc) {
  * (lambda_true = lambda 2^e): the shift is 30 - e (velocity-like) or
  * 30 - k_a - e (force-like), >= 0 for e <= 15. */
 static void rows_apply_acc(const sn_ihdr *h, sn_acc *acc, sn_q *y, int force_like, int e, uint32_t *sat) {
-    const sn_row *r = CARR(h, o_row, sn_row);
-    const sn_rowx *x = CARR(h, o_rx, sn_rowx);
+    const sn_row *r = CWARR(h, o_row, sn_row);
+    const sn_rowx *x = CWARR(h, o_rx, sn_rowx);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t j, k, c, nF = h->v.nF;
     for (j = 0; j < h->n_rows; j++) {
@@ -251,8 +251,8 @@ SN_INLINE sn_q gs_store(sn_acc acc, sn_q inv, uint32_t *sat) {
 
 /* Solve G lam = s in place (aux[].s), over the kept rows: L u = s, L^T lam = u. */
 static void gram_solve(sn_ihdr *h, uint32_t *sat) {
-    const sn_q *L = CARR(h, o_L, sn_q);
-    sn_rowx *x = ARR(h, o_rx, sn_rowx);
+    const sn_q *L = CWARR(h, o_L, sn_q);
+    sn_rowx *x = WARR(h, o_rx, sn_rowx);
     uint32_t j, l, m = h->n_rows;
     for (j = 0; j < m; j++) { /* forward: L u = s */
         sn_acc acc;
@@ -298,8 +298,8 @@ static int block_exp(uint64_t o) {
 
 void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat) {
     const sn_row *r = sn_rows(h);
-    sn_rowx *x = ARR(h, o_rx, sn_rowx);
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_rowx *x = WARR(h, o_rx, sn_rowx);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     uint32_t j, m = h->n_rows;
     uint64_t o = 0;
     int e;
@@ -316,8 +316,8 @@ void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat) {
 
 void sn_rows_fix(sn_ihdr *h, sn_q *y, uint32_t *sat) {
     const sn_row *r = sn_rows(h);
-    sn_rowx *x = ARR(h, o_rx, sn_rowx);
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_rowx *x = WARR(h, o_rx, sn_rowx);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     uint32_t j, m = h->n_rows;
     uint64_t o = 0;
     int e;
@@ -346,9 +346,9 @@ void sn_rows_fix(sn_ihdr *h, sn_q *y, uint32_t *sat) {
 static uint32_t rows_factor(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_row *r = sn_rows(h);
-    sn_rowx *x = ARR(h, o_rx, sn_rowx);
-    sn_q *L = ARR(h, o_L, sn_q);
-    sn_acc *sc = ARR(h, o_acc, sn_acc);
+    sn_rowx *x = WARR(h, o_rx, sn_rowx);
+    sn_q *L = WARR(h, o_L, sn_q);
+    sn_acc *sc = WARR(h, o_acc, sn_acc);
     const sn_q *vel = CARR(h, o_vel, sn_q);
     uint32_t j, l, k, kept = 0, m = h->n_rows, nF = v->nF;
     uint32_t c;

@@ -57,7 +57,7 @@ typedef char sn_rowx_fits_[sizeof(sn_rowx) <= SN_ROWAUX_BYTES ? 1 : -1];
  * exceeds 2 (the bound the projection's sums rely on). */
 int sn_rows_push(sn_ihdr *h, const sn_row *r);
 /* The rows pushed so far this step (valid between collection and the end of the solve). */
-SN_INLINE sn_row *sn_rows(sn_ihdr *h) { return ARR(h, o_row, sn_row); }
+SN_INLINE sn_row *sn_rows(sn_ihdr *h) { return WARR(h, o_row, sn_row); }
 
 /* ---- the producers (called by sn_rows_collect, in order) ---- */
 void sn_user_rows(sn_ihdr *h, uint32_t *sat);     /* sn_constraint.c */

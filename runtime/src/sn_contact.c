@@ -200,7 +200,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    sn_rowx *rx = ARR(h, o_rx, sn_rowx);
+    sn_rowx *rx = WARR(h, o_rx, sn_rowx);
     sn_row *rows = sn_rows(h);
     sn_q A[SN_MAX_COLLIDERS][3], B[SN_MAX_COLLIDERS][3], R[SN_MAX_COLLIDERS], V[SN_MAX_COLLIDERS][3];
     sn_q cap = (sn_q)(v->cell / 8);
@@ -374,7 +374,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
         }
         vn = sn_out(sn_mul(r.dir[0], vp[0]) + sn_mul(r.dir[1], vp[1]) + sn_mul(r.dir[2], vp[2]), 30, sat);
         dn = sn_add(r.target, -vn, sat); /* the normal velocity change the contact imposes */
-        if (CARR(h, o_rx, sn_rowx)[j].s > dn) dn = CARR(h, o_rx, sn_rowx)[j].s; /* or would ask without the yield (the pressure the bones take) */
+        if (CWARR(h, o_rx, sn_rowx)[j].s > dn) dn = CWARR(h, o_rx, sn_rowx)[j].s; /* or would ask without the yield (the pressure the bones take) */
         if (!(dn > 0)) continue;
         {
             sn_q rn = sn_out(sn_mul(r.dir[0], rel[0]) + sn_mul(r.dir[1], rel[1]) + sn_mul(r.dir[2], rel[2]), 30, sat);
@@ -424,7 +424,7 @@ void sn_contact_yield(sn_ihdr *h, sn_q *x, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_row *rows = sn_rows(h);
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    sn_rowx *rx = ARR(h, o_rx, sn_rowx);
+    sn_rowx *rx = WARR(h, o_rx, sn_rowx);
     const sn_q half = (sn_q)(v->cell / 2);
     uint32_t j, k, q, m = h->n_rows;
 #define CT_MINE(j) (SN_ROW_PRODUCER(rows[j].source) == SN_SRC_CONTACT && rx[j].inv != 0)

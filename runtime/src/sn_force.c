@@ -230,7 +230,7 @@ static int coarse(sn_ihdr *h, sn_q *b, int k, sn_q s, const sn_q x[3], const sn_
     const sn_q *pos = CARR(h, o_pos, sn_q);
     const unsigned char *rest = v->sec[SN_SEC_REST], *ml = v->sec[SN_SEC_MLUMP];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    float *w = (float *)(void *)ARR(h, o_acc, sn_acc);
+    float *w = (float *)(void *)WARR(h, o_acc, sn_acc);
     float R = v->cell * (float)(1 << k), inv = 1.0f / R, W = 0.0f, c[3] = {0, 0, 0}, I[6] = {0, 0, 0, 0, 0, 0};
     float rp[3], cr[3], A[6], det, tr, beta[3];
     uint32_t a, d;
@@ -295,7 +295,7 @@ static int coarse(sn_ihdr *h, sn_q *b, int k, sn_q s, const sn_q x[3], const sn_
     const sn_q *pos = CARR(h, o_pos, sn_q);
     const unsigned char *rest = v->sec[SN_SEC_REST], *ml = v->sec[SN_SEC_MLUMP];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    int64_t *w = ARR(h, o_acc, sn_acc);
+    int64_t *w = WARR(h, o_acc, sn_acc);
     int64_t R = (int64_t)v->cell << k, INV, W = 0, Ws, inv, sum = 0, c[3], I[6] = {0, 0, 0, 0, 0, 0};
     int64_t Iq[6], A[6], det, tr, rp[3], cr[3], beta[3], accc[3] = {0, 0, 0};
     int S = 14 + bitlen64((uint64_t)R), sh, bl;

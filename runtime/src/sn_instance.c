@@ -50,16 +50,89 @@ uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, u
     return layout_offsets(nV, nF, nJ, nC, nK, nFrc, segB, crB, conB, off);
 }
 
-static void layout(sn_ihdr *h) {
-    uint32_t off[SN_LAYOUT_ARRAYS], nV, nF, nC;
-    sn_level_counts(&h->v, &nV, &nF, &nC); /* the largest level (sn_level.c): one layout for every level */
-    (void)layout_offsets(nV, nF, h->v.nJ, nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
+/* sn_instance_init_shared's layout: the same arrays, the scratch ones
+ * (acc, r, rows, row state, factor: written before read in every step) moved
+ * to the workspace sn_step_with passes. State: hdr | workspace address | wrench frc seg | pq pt
+ * jR jT | pos vel | R x | d q | cR ctl crease k | (8-aligned) records
+ * colliders | (8-aligned) adaptation's state and mask. Workspace: acc | r |
+ * rows | row state | factor | (8-aligned) the blended mode's arrays.
+ * d and q stay in the state: sn_set_lod and adaptation's sn_adapt_begin
+ * (sn_reset, sn_set_adapt) use them between steps. Offsets into off[] in the
+ * order of SN_LAYOUT_ARRAYS (off[19]: the records; *row: the rows in the
+ * workspace); returns the state bytes before adaptation's, *ws the workspace
+ * bytes before the blended mode's. */
+static uint32_t shared_offsets(const sn_view *v, uint32_t off[SN_LAYOUT_ARRAYS], uint32_t *row, uint32_t *ws) {
+    uint32_t nV, nF, nC, nDS, o = SN_HDR_BYTES + SN_WS_SLOT_BYTES, i; /* the workspace's address (sn_ws) */
+    uint32_t bytes[SN_LAYOUT_ARRAYS];
+    sn_level_counts(v, &nV, &nF, &nC); /* the largest level, as layout() */
+    nDS = nV - nF > nF ? nV - nF : nF;
+    bytes[0] = 0; bytes[12] = 0;      /* acc, r: in the workspace */
+    bytes[1] = v->nJ * SN_WRENCH_BYTES; bytes[2] = v->nFrc * SN_FORCE_SLOT_BYTES; bytes[3] = v->segB;
+    bytes[4] = v->nJ * 16u; bytes[5] = v->nJ * 12u; bytes[6] = v->nJ * 36u; bytes[7] = v->nJ * 12u;
+    bytes[8] = nV * 12u; bytes[9] = nV * 12u; bytes[10] = nF * 36u; bytes[11] = nF * 12u;
+    bytes[13] = nDS * 12u; bytes[14] = nF * 12u;
+    bytes[15] = nC * 36u; bytes[16] = v->nK * 4u; bytes[17] = v->crB; bytes[18] = nF;
+    bytes[19] = v->nCon * SN_CON_BYTES + v->nCol * SN_COL_BYTES;
+    for (i = 1; i < SN_LAYOUT_ARRAYS; i++) {
+        if (i == 12) continue;
+        if (i == SN_LAYOUT_ARRAYS - 1) o = (o + 7u) & ~7u;
+        off[i] = o;
+        o += bytes[i];
+    }
+    off[0] = 0;               /* acc first: 8-byte accumulators at the workspace's 8-aligned start */
+    off[12] = nF * 24u;
+    *row = off[12] + nF * 12u;
+    *ws = (*row + v->nRows * (SN_ROW_BYTES + SN_ROWAUX_BYTES) + 4u * (v->nRows * (v->nRows + 1u) / 2u) + 7u) & ~7u;
+    return (o + 7u) & ~7u;
+}
+
+static void set_offsets(sn_ihdr *h, const uint32_t off[SN_LAYOUT_ARRAYS], uint32_t row) {
     h->o_acc = off[0]; h->o_wr = off[1]; h->o_frc = off[2]; h->o_seg = off[3];
     h->o_pq = off[4]; h->o_pt = off[5]; h->o_jR = off[6]; h->o_jT = off[7];
     h->o_pos = off[8]; h->o_vel = off[9]; h->o_R = off[10]; h->o_x = off[11]; h->o_r = off[12];
     h->o_d = off[13]; h->o_ds = off[13]; h->o_q = off[14];
     h->o_cR = off[15]; h->o_ctl = off[16]; h->o_crs = off[17]; h->o_k = off[18];
-    sn_cons_layout(h, off[19]);
+    sn_cons_layout(h, off[19], row);
+}
+
+/* The instance's own layout (sn_instance_init: scratch inside, at the offsets
+ * of the format's SN_INSTANCE_BYTES), or the shared one (v.flags SN_VIEW_SHARED:
+ * v.instance_bytes becomes the state's end, where adaptation's state goes). */
+static void layout(sn_ihdr *h) {
+    uint32_t off[SN_LAYOUT_ARRAYS], nV, nF, nC, row, ws;
+    if (h->v.flags & SN_VIEW_SHARED) {
+        h->v.instance_bytes = shared_offsets(&h->v, off, &row, &ws);
+        set_offsets(h, off, row);
+        return;
+    }
+    sn_level_counts(&h->v, &nV, &nF, &nC); /* the largest level (sn_level.c): one layout for every level */
+    (void)layout_offsets(nV, nF, h->v.nJ, nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
+    set_offsets(h, off, off[19] + h->v.nCon * SN_CON_BYTES + h->v.nCol * SN_COL_BYTES);
+}
+
+size_t sn_instance_state_size(const sn_blob *blob) {
+    sn_view v;
+    uint32_t off[SN_LAYOUT_ARRAYS], row, ws;
+    if (!blob) return 0;
+    sn_view_init(&v, blob);
+    return (size_t)shared_offsets(&v, off, &row, &ws) + sn_adapt_bytes(&v);
+}
+
+size_t sn_workspace_size(const sn_blob *blob, sn_mode mode) {
+    sn_view v;
+    uint32_t off[SN_LAYOUT_ARRAYS], row, ws, nV, nF, nC;
+    if (!blob) return 0;
+    sn_view_init(&v, blob);
+    (void)shared_offsets(&v, off, &row, &ws);
+    if (mode != SN_MODE_BLENDED) return ws;
+    sn_level_counts(&v, &nV, &nF, &nC);
+    return (size_t)ws + sn_blended_bytes(nF, nC);
+}
+
+uint32_t sn_blend_offset(const sn_ihdr *h) {
+    if (h->v.flags & SN_VIEW_SHARED) /* after the factor (shared_offsets' *ws) */
+        return (h->o_L + 4u * (h->v.nRows * (h->v.nRows + 1u) / 2u) + 7u) & ~7u;
+    return h->v.instance_bytes + h->ad_bytes; /* past adaptation's mask (sn_instance_size_mode) */
 }
 
 #if !defined(SN_FLOAT)
@@ -84,11 +157,12 @@ int64_t int_to_pub64(const sn_ihdr *h, sn_q v) {
 #endif
 
 /* Structural limits the unclamped sums rely on (NUMERICS.md, overflow
- * freedom), counted in the accumulator array (24 bytes per free vertex):
+ * freedom), counted in the positions' and velocities' arrays (24 bytes per
+ * vertex, rewritten by sn_reset; acc may be in a workspace):
  * each free vertex is the column of at most SN_MAX_ROW_BLOCKS mass rows and a
  * corner of at most SN_MAX_VERTEX_CELLS cells. */
 static int structure_ok(sn_ihdr *h) {
-    uint16_t *cnt = ARR(h, o_acc, uint16_t);
+    uint16_t *cnt = ARR(h, o_pos, uint16_t);
     const unsigned char *cols = h->v.sec[SN_SEC_COLS], *cells = h->v.sec[SN_SEC_CELLS];
     uint32_t e, nF = h->v.nF;
     memset(cnt, 0, 2u * nF * sizeof *cnt);
@@ -103,24 +177,30 @@ static int structure_ok(sn_ihdr *h) {
     return 1;
 }
 
-sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out) {
+static sn_status init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out, int shared) {
     sn_ihdr *h;
     if (!mem || !blob || !out) return SN_ERR_NULL;
     if (((uintptr_t)mem & 7u) != 0) return SN_ERR_ALIGN;
-    if (mem_size < sn_instance_size(blob)) return SN_ERR_MEMORY;
+    if (mem_size < (shared ? sn_instance_state_size(blob) : sn_instance_size(blob))) return SN_ERR_MEMORY;
     memset(mem, 0, sizeof(sn_ihdr));
     h = (sn_ihdr *)mem;
     sn_view_init(&h->v, blob);
+    if (shared) h->v.flags |= SN_VIEW_SHARED;
     layout(h);
     h->lod_base = h->v.base;
     if (sn_level_sec_count(&h->v, SN_SEC_LEVEL_BLOB) != 0) { /* the finer level's structure too, then level 0 */
         sn_level_view(h->lod_base, 1, &h->v);
         if (!structure_ok(h)) return SN_ERR_INDEX;
         sn_view_init(&h->v, blob);
+        if (shared) {
+            h->v.flags |= SN_VIEW_SHARED;
+            layout(h); /* v.instance_bytes again: the state's end */
+        }
     }
     if (!structure_ok(h)) return SN_ERR_INDEX;
     h->magic = SN_INST_MAGIC;
-    if (mem_size >= sn_instance_size_mode(blob, SN_MODE_BLENDED)) h->v.flags |= SN_VIEW_BLENDED;
+    /* blended mode: its arrays are in the instance (sized by sn_instance_size_mode), or in every workspace */
+    if (shared || mem_size >= sn_instance_size_mode(blob, SN_MODE_BLENDED)) h->v.flags |= SN_VIEW_BLENDED;
     h->iterations = h->v.cg_default;
     h->mode = SN_MODE_WARPED;
     sn_adapt_init(h); /* the mask after the layout, before the blended arrays (sn_instance_size) */
@@ -137,6 +217,14 @@ sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_i
     *out = (sn_instance *)mem;
     (void)sn_reset(*out);
     return SN_OK;
+}
+
+sn_status sn_instance_init(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out) {
+    return init(mem, mem_size, blob, out, 0);
+}
+
+sn_status sn_instance_init_shared(void *mem, size_t mem_size, const sn_blob *blob, sn_instance **out) {
+    return init(mem, mem_size, blob, out, 1);
 }
 
 void sn_k_table(sn_ihdr *h) {

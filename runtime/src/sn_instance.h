@@ -86,6 +86,25 @@ typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
 
 #define ARR(h, off, T) ((T *)(void *)((unsigned char *)(h) + (h)->off))
 #define CARR(h, off, T) ((const T *)(const void *)((const unsigned char *)(h) + (h)->off))
+/* v.flags: sn_instance_init_shared's instance: its scratch lives in the workspace each
+ * sn_step_with passes, whose address the state keeps right after the header for the
+ * step's duration (NULL between steps: the header has no room for it); v.instance_bytes
+ * is then the offset of adaptation's state */
+#define SN_VIEW_SHARED 0x40000000u
+#define SN_WS_SLOT SN_HDR_BYTES /* the workspace pointer's bytes in a shared instance */
+#define SN_WS_SLOT_BYTES 8u
+/* Base of the scratch arrays (o_acc, o_r, o_row, o_rx, o_L, the blended mode's):
+ * the instance itself, or the step's workspace. Valid only inside a step
+ * (written before read there: tests/test_runtime_workspace.c). */
+SN_INLINE unsigned char *sn_ws(const sn_ihdr *h) {
+    unsigned char *self = (unsigned char *)(uintptr_t)h;
+    unsigned char *ws;
+    if (!(h->v.flags & SN_VIEW_SHARED)) return self;
+    memcpy(&ws, self + SN_WS_SLOT, sizeof ws);
+    return ws;
+}
+#define WARR(h, off, T) ((T *)(void *)(sn_ws(h) + (h)->off))
+#define CWARR(h, off, T) ((const T *)(const void *)(sn_ws(h) + (h)->off))
 
 /* Force-like values of free vertex i are Q(SN_Q_FORCE + k_i), k_i in
  * [0, SN_KMAX] (see sn_instance_init): the stiffest vertex gets Q19, three
@@ -208,7 +227,8 @@ uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 void sn_crease_step(sn_ihdr *h, uint32_t *sat);    /* 3b: crease list C: detect, drop, n_a, rows (sn_crease.c) */
 uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh); /* list C into the FNV-1a hash (unchanged without CREASE) */
-void sn_cons_layout(sn_ihdr *h, uint32_t off);      /* constraint arrays from offset off (sn_constraint.c) */
+void sn_cons_layout(sn_ihdr *h, uint32_t off, uint32_t row); /* records, colliders from off; rows, row state, factor from row (of h->ws; sn_constraint.c) */
+uint32_t sn_blend_offset(const sn_ihdr *h);         /* the blended mode's arrays, from h->ws (sn_instance.c) */
 void sn_cons_reset(sn_ihdr *h);                     /* no constraints, colliders or rows; counters 0 */
 
 /* ---- level of detail (sn_level.c) ---- */

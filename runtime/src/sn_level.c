@@ -147,7 +147,7 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level) {
     /* the instance keeps its size and its blended memory (sn_blended.c sits
      * after the top blob's instance_bytes, sized for the larger level) */
     dst.instance_bytes = h->v.instance_bytes;
-    dst.flags |= h->v.flags & SN_VIEW_BLENDED;
+    dst.flags |= h->v.flags & (SN_VIEW_BLENDED | SN_VIEW_SHARED);
     h->v = dst;
     h->lod = level;
     sn_k_table(h);

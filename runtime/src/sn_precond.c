@@ -115,7 +115,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
         if (mask && !mask[i] == !inv) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
         else sn_k_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
     }
-    n = ic_forward(v, kk, z, ARR(h, o_acc, sn_acc), sat);
+    n = ic_forward(v, kk, z, WARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
         sn_acc a[3];
         int sh = v->frac_P + SN_KREL(kk[i]);

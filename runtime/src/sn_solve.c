@@ -126,7 +126,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     const sn_q *R = CARR(h, o_R, sn_q), *vel = CARR(h, o_vel, sn_q);
     const sn_q *ds = CARR(h, o_ds, sn_q); /* in d's storage: d is not live yet */
     sn_q *u = ARR(h, o_q, sn_q); /* w, in q's storage: q and z are live only in the PCG */
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF, nV = v->nV, esat = 0;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
@@ -260,7 +260,7 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
     const sn_q *cR = CARR(h, o_cR, sn_q);
-    sn_acc *acc = ARR(h, o_acc, sn_acc);
+    sn_acc *acc = WARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t e, i, k, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
@@ -371,7 +371,7 @@ static void axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) {
 void sn_solve(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     uint32_t it, i, n3 = 3 * v->nF;
-    sn_q *x = ARR(h, o_x, sn_q), *r = ARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
+    sn_q *x = ARR(h, o_x, sn_q), *r = WARR(h, o_r, sn_q), *d = ARR(h, o_d, sn_q);
     /* z shares q's storage: q is dead from r -= alpha q to the next mat-vec,
      * z from d = z + beta d to the next preconditioner call */
     sn_q *q = ARR(h, o_q, sn_q), *z = q;

@@ -10,11 +10,8 @@
 #include "sn_blended.h"
 #include "sn_adapt.h"
 
-sn_status sn_step(sn_instance *inst) {
-    sn_ihdr *h;
+static void step(sn_ihdr *h) {
     uint32_t sat = 0;
-    SN_CHECK_INST(inst);
-    h = hdr_of(inst);
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
     sn_crease_step(h, &sat);
@@ -27,5 +24,40 @@ sn_status sn_step(sn_instance *inst) {
     sn_health(h, sat);
     h->saturations = sn_count(h->saturations, sat);
     h->steps = sn_count(h->steps, 1);
+}
+
+sn_status sn_step(sn_instance *inst) {
+    sn_ihdr *h;
+    SN_CHECK_INST(inst);
+    h = hdr_of(inst);
+    if (h->v.flags & SN_VIEW_SHARED) return SN_ERR_MEMORY; /* its scratch is the caller's: sn_step_with */
+    step(h); /* the scratch arrays inside the instance */
+    return SN_OK;
+}
+
+sn_status sn_step_with(sn_instance *inst, void *workspace, size_t bytes) {
+    sn_ihdr *h;
+    size_t need;
+    SN_CHECK_INST(inst);
+    h = hdr_of(inst);
+    if (!(h->v.flags & SN_VIEW_SHARED)) return sn_step(inst); /* sn_instance_init's: its own scratch */
+    if (!workspace) return SN_ERR_NULL;
+    if (((uintptr_t)workspace & 7u) != 0) return SN_ERR_ALIGN;
+    need = sn_blend_offset(h);
+    if (h->mode == SN_MODE_BLENDED) { /* sized for the larger level, as sn_workspace_size */
+        sn_view t;
+        uint32_t nV, nF, nC;
+        sn_view_init(&t, (const sn_blob *)(const void *)h->lod_base);
+        sn_level_counts(&t, &nV, &nF, &nC);
+        need += sn_blended_bytes(nF, nC);
+    }
+    if (bytes < need) return SN_ERR_MEMORY;
+    {   /* the workspace's address for the step's duration (sn_ws), then none:
+         * between calls the instance holds no pointer to memory it does not own */
+        unsigned char *ws = (unsigned char *)workspace, *none = NULL;
+        memcpy((unsigned char *)h + SN_WS_SLOT, &ws, sizeof ws);
+        step(h);
+        memcpy((unsigned char *)h + SN_WS_SLOT, &none, sizeof none);
+    }
     return SN_OK;
 }

@@ -81,6 +81,8 @@ static unsigned char *g_orig, *g_work;
 static size_t g_size, g_last_end; /* end of the last non-empty section */
 static void *g_mem;
 static size_t g_mem_size;
+static void *g_smem, *g_ws;       /* a shared instance's state and its workspace (exercise_shared) */
+static size_t g_smem_size, g_ws_size;
 static char g_case[128];
 static uint64_t g_rng;
 static int g_pose; /* 0: 25 degrees about one axis; 1: (1,1,1) onto -x, root far away;
@@ -108,6 +110,39 @@ static void on_death(void) { fprintf(stderr, "fuzz: sanitizer finding while runn
 
 static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static void *grow(void *p, size_t *have, size_t need) {
+    if (need <= *have) return p;
+    free(p);
+    p = malloc(need);
+    *have = need;
+    if (!p) { fprintf(stderr, "out of memory\n"); exit(2); }
+    return p;
+}
+
+/* The blob as an sn_instance_init_shared instance, stepped with a workspace
+ * (sn_step_with) in the warped and blended modes: the sizes derive from the
+ * same validated counts as sn_instance_size. Every fourth stepped case (cost). */
+static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const sn_xform *xf) {
+    sn_instance *si;
+    sn_status st;
+    size_t sb = sn_instance_state_size(blob), wb = sn_workspace_size(blob, SN_MODE_BLENDED);
+    if (sb == 0 || wb == 0 || sb + wb > (32u << 20)) return;
+    g_smem = grow(g_smem, &g_smem_size, sb);
+    g_ws = grow(g_ws, &g_ws_size, wb);
+    st = sn_instance_init_shared(g_smem, sb, blob, &si);
+    if (st != SN_OK) { printf("FAIL: init_shared refused a blob init accepted (%s): %s\n", g_case, sn_status_str(st)); exit(1); }
+    (void)sn_set_pose(si, xf, info->joints);
+    th_hostile_contacts(si, info->surface_vertices);
+    (void)sn_set_iterations(si, info->cg_iters_max < (uint32_t)g_iters ? info->cg_iters_max : (uint32_t)g_iters);
+    memset(g_ws, 0xA5, wb);
+    if (sn_step_with(si, g_ws, wb) != SN_OK) { printf("FAIL: sn_step_with refused (%s)\n", g_case); exit(1); }
+    if (sn_set_mode(si, SN_MODE_BLENDED) != SN_OK || sn_step_with(si, g_ws, wb) != SN_OK) {
+        printf("FAIL: blended sn_step_with refused with sn_workspace_size bytes (%s)\n", g_case);
+        exit(1);
+    }
+    (void)sn_state_hash(si);
 }
 
 /* Use an accepted blob the way a game would. */
@@ -217,6 +252,7 @@ static void exercise(const sn_blob *blob) {
     (void)sn_get_surface(inst, surf, 0, info.surface_vertices);
     if (info.triangles) (void)sn_get_normals(inst, surf, nrm);
     (void)sn_state_hash(inst);
+    if ((g.stepped & 3u) == 0) exercise_shared(blob, &info, xf);
     g.stepped++;
     free(local); free(xf); free(surf); free(nrm); free(lat);
 }
@@ -1351,7 +1387,7 @@ int main(int argc, char **argv) {
             printf("  SKIPPED: %s not found (make it with the host tool); fuzzed the hand-built blob only\n", path);
         }
     }
-    free(g_mem);
+    free(g_mem); free(g_smem); free(g_ws);
     printf("%d passed, %d failed\n", runs - (fails > runs ? runs : fails) + 1, fails);
     return fails != 0;
 }

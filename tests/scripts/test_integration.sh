@@ -11,7 +11,8 @@
 #               -Werror), the amalgamation as C++, and the RAII example
 #               tests/integration/cpp/sinew_example.cpp at -std=c++11 and c++17
 #   threads     tests/integration/threads/threads.c: 8 instances of one blob on
-#               8 pthreads = one after another; again under ThreadSanitizer
+#               8 pthreads = one after another = as shared instances on 2 threads
+#               with one workspace each; again under ThreadSanitizer
 #               (clang, over the runtime sources) with a racy positive control
 # Every consumer steps the cow $STEPS steps and prints its state hash: all
 # fixed-flavour hashes must equal the reference, float likewise. Also: the

@@ -5,6 +5,9 @@
  * Instance i follows the wiggle sequence shifted by 5*i steps, so every
  * instance has its own hash and cross-talk between instances would show.
  * Each thread also compares its hash every 10 steps with the sequential run.
+ * Then the same 8 motions as shared instances (sn_instance_init_shared):
+ * 2 threads, each stepping 4 of them in turn with its one workspace
+ * (sn_step_with), the engine's per-thread scratch: again the same hashes.
  * Prints "hash: <hex>" of instance 0 (phase 0: the consumers' hash) and
  * "threads: 8 instances agree" or a FAIL line; exit 0 only when all agree.
  * Built by tests/scripts/test_integration.sh with gcc, and with clang
@@ -34,6 +37,14 @@ typedef struct job {
     int failed;
 } job;
 
+/* a thread stepping several shared instances with its one workspace */
+typedef struct group {
+    job *jobs[N_INST];
+    int n;
+    void *ws;
+    size_t ws_size;
+} group;
+
 static pthread_barrier_t start_line;
 static int use_barrier;
 
@@ -54,8 +65,33 @@ static void *run(void *arg) {
     return NULL;
 }
 
+static void *run_group(void *arg) {
+    group *g = (group *)arg;
+    sn_instance *inst[N_INST];
+    uint32_t k;
+    int i;
+    pthread_barrier_wait(&start_line);
+    for (i = 0; i < g->n; i++)
+        if (sn_instance_init_shared(g->jobs[i]->mem, g->jobs[i]->mem_size, g->jobs[i]->blob, &inst[i]) != SN_OK) {
+            g->jobs[i]->failed = 1;
+            return NULL;
+        }
+    for (k = 0; k < g->jobs[0]->steps; k++)
+        for (i = 0; i < g->n; i++) {
+            job *jb = g->jobs[i];
+            sn_wiggle_pose(jb->blob, jb->joints, k, jb->phase, jb->local, jb->xf);
+            if (sn_set_pose(inst[i], jb->xf, jb->joints) != SN_OK) { jb->failed = 1; return NULL; }
+            if (sn_step_with(inst[i], g->ws, g->ws_size) != SN_OK) { jb->failed = 1; return NULL; }
+            if ((k + 1) % TRACE_EVERY == 0 && (k + 1) / TRACE_EVERY <= MAX_TRACE)
+                jb->trace[(k + 1) / TRACE_EVERY - 1] = sn_state_hash(inst[i]);
+        }
+    for (i = 0; i < g->n; i++) g->jobs[i]->hash = sn_state_hash(inst[i]);
+    return NULL;
+}
+
 int main(int argc, char **argv) {
-    static job seq[N_INST], par[N_INST];
+    static job seq[N_INST], par[N_INST], shr[N_INST];
+    static group grp[2];
     pthread_t tid[N_INST];
     const sn_blob *blob;
     sn_blob_info info;
@@ -98,6 +134,24 @@ int main(int argc, char **argv) {
         if (pthread_create(&tid[i], NULL, run, &par[i]) != 0) { fprintf(stderr, "threads: pthread_create failed\n"); return 2; }
     for (i = 0; i < N_INST; i++) pthread_join(tid[i], NULL);
     pthread_barrier_destroy(&start_line);
+    /* shared instances: 2 threads, 4 each, one workspace per thread */
+    if (pthread_barrier_init(&start_line, NULL, 2) != 0) return 2;
+    for (i = 0; i < N_INST; i++) {
+        shr[i] = seq[i];
+        shr[i].hash = 0; shr[i].failed = 0;
+        memset(shr[i].trace, 0, sizeof shr[i].trace);
+        shr[i].mem_size = sn_instance_state_size(blob);
+        shr[i].mem = malloc(shr[i].mem_size);
+        if (!shr[i].mem) return 2;
+        grp[i % 2].jobs[grp[i % 2].n++] = &shr[i];
+    }
+    for (i = 0; i < 2; i++) {
+        grp[i].ws_size = sn_workspace_size(blob, SN_MODE_WARPED);
+        if (!(grp[i].ws = malloc(grp[i].ws_size))) return 2;
+        if (pthread_create(&tid[i], NULL, run_group, &grp[i]) != 0) { fprintf(stderr, "threads: pthread_create failed\n"); return 2; }
+    }
+    for (i = 0; i < 2; i++) pthread_join(tid[i], NULL);
+    pthread_barrier_destroy(&start_line);
 
     ntr = steps / TRACE_EVERY < MAX_TRACE ? steps / TRACE_EVERY : MAX_TRACE;
     for (i = 0; i < N_INST; i++) {
@@ -109,13 +163,18 @@ int main(int argc, char **argv) {
         if (seq[i].hash != par[i].hash || memcmp(seq[i].trace, par[i].trace, ntr * sizeof seq[i].trace[0]) != 0) {
             printf("FAIL: instance %d: threaded run differs from the sequential one\n", i); bad = 1;
         }
+        if (shr[i].failed || shr[i].hash != seq[i].hash || memcmp(seq[i].trace, shr[i].trace, ntr * sizeof seq[i].trace[0]) != 0) {
+            printf("FAIL: instance %d: shared instance (2 threads, one workspace each) differs from the sequential one\n", i); bad = 1;
+        }
         if (i > 0 && seq[i].hash == seq[0].hash) distinct = 0;
     }
     if (!distinct) { printf("FAIL: instances with different motions gave equal hashes (the test would not see cross-talk)\n"); bad = 1; }
     sn_wiggle_hex(seq[0].hash, hex);
     printf("hash: %s\n", hex);
-    if (!bad) printf("threads: %d instances, %u steps each: threaded hashes = sequential hashes\n", N_INST, steps);
-    for (i = 0; i < N_INST; i++) { free(seq[i].mem); free(par[i].mem); }
+    if (!bad) printf("threads: %d instances, %u steps each: threaded hashes = sequential hashes = shared instances' "
+                     "(2 threads, one workspace each)\n", N_INST, steps);
+    for (i = 0; i < N_INST; i++) { free(seq[i].mem); free(par[i].mem); free(shr[i].mem); }
+    free(grp[0].ws); free(grp[1].ws);
     free(bytes);
     return bad;
 }
