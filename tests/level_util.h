@@ -11,6 +11,7 @@
 #include <string.h>
 #include "sinew.h"
 #include "sn_format.h"
+#include "sn_test.h"
 
 #if defined(SN_FLOAT)
 #define D(x) ((double)(x))
@@ -22,19 +23,7 @@
 #define FL "fixed"
 #endif
 
-static unsigned char *load(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *p;
-    long sz;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END); sz = ftell(f); fseek(f, 0, SEEK_SET);
-    p = malloc((size_t)sz + 8);
-    if (p && fread(p, 1, (size_t)sz, f) != (size_t)sz) { free(p); p = NULL; }
-    fclose(f);
-    *n = (size_t)sz;
-    return p;
-}
+static unsigned char *load(const char *path, size_t *n) { return (unsigned char *)t_read_file(path, n); }
 
 /* the blob's cell edge in mesh units (header real SN_R_CELL: internal Q22, unit 2^len_shift) */
 static double cell_of(const unsigned char *b)

@@ -34,5 +34,20 @@ static unsigned long t_seed(void) {
 }
 #define T_SEED() t_seed()
 
+/* A whole file in malloc'd memory (8 spare bytes), its size in *n; NULL if
+ * it cannot be read. */
+static inline void *t_read_file(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    char *p;
+    long sz;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END); sz = ftell(f); fseek(f, 0, SEEK_SET);
+    p = sz < 0 ? NULL : malloc((size_t)sz + 8);
+    if (p && fread(p, 1, (size_t)sz, f) != (size_t)sz) { free(p); p = NULL; }
+    fclose(f);
+    *n = sz < 0 ? 0 : (size_t)sz;
+    return p;
+}
+
 #define T_END() (printf("%d passed, %d failed\n", t_passed_, t_failed_), t_failed_ != 0)
 #endif

@@ -40,19 +40,6 @@
 #define GUARD 64u
 #define GUARD_BYTE 0xEEu
 
-static char *read_file(const char *path, size_t *n) {
-    FILE *f = fopen(path, "rb");
-    char *p;
-    long sz;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END); sz = ftell(f); fseek(f, 0, SEEK_SET);
-    p = malloc((size_t)sz + 8);
-    if (p && fread(p, 1, (size_t)sz, f) != (size_t)sz) { free(p); p = NULL; }
-    fclose(f);
-    *n = (size_t)sz;
-    return p;
-}
-
 static const char *build_dir(void) {
     const char *b = getenv("BUILD");
     return b && *b ? b : "build";
@@ -69,8 +56,8 @@ static int asset_load(asset *a, const char *blob_rel, const char *clip, const ch
     char p[512];
     snprintf(p, sizeof p, "%s/%s", build_dir(), blob_rel);
     a->name = name;
-    a->blob = read_file(p, &a->nb);
-    a->clip = read_file(clip, &a->nc);
+    a->blob = t_read_file(p, &a->nb);
+    a->clip = t_read_file(clip, &a->nc);
     if (!a->blob || !a->clip) { T_CHECK(0, "cannot read %s or %s (make them: tests/tests.mk)", p, clip); return -1; }
     return 0;
 }
