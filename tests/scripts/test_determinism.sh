@@ -32,8 +32,8 @@ clip_arg=""
 if [ -f "$COW_CLIP" ]; then clip_arg="--clip $COW_CLIP"; else echo "note: $COW_CLIP missing, built-in pose sequence"; fi
 
 # ---- which platforms can run here: "name target runner" (runner - = native) ----
-SLICE="cortex-m4-qemu mips-be-gcc-O2 armhf-gcc-O2-neon aarch64-gcc-O2 x86_64-gcc-O0
-       x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2"
+# the slice: DET_SLICE in ports/baremetal/baremetal.mk (make test-build builds it)
+SLICE=$(pmake print-det-slice)
 dropped=""
 sel() {  # name: in this run's set?
     [ "${DET_SET:-slice}" = full ] && return 0
