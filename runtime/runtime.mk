@@ -87,10 +87,28 @@ TEST_DEPS += $(BUILD)/tests/cost_probe
 # fuzzer with ASan + UBSan; _ck keeps the checksum (every flip must fail) ----
 SN_FUZZ_CFLAGS = -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
                  -fno-sanitize-recover=all $(SN_INC) -Iruntime/src -Itests/fuzz
-SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h tests/fuzz/sn_thostile.h $(SN_SRCS) $(SN_HDRS)
-$(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS)
+SN_FUZZ_DEPS = tests/fuzz/fuzz_blob.c tests/fuzz/sn_tblob.h tests/fuzz/sn_thostile.h $(SN_HDRS)
+# the runtime as objects per build (-j2 compiles them in parallel): fuzz and
+# fuzz_ck share all but sn_blob.c, the only source SN_VALIDATE_NO_CHECKSUM reaches
+SN_FUZZ_OBJ = $(BUILD)/fuzz-obj
+SN_FUZZ_DEFS_fixed =
+SN_FUZZ_DEFS_nock  = -DSN_VALIDATE_NO_CHECKSUM
+SN_FUZZ_DEFS_float = -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM
+SN_FUZZ_DEFS_range = -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK
+define SN_FUZZ_OBJ_RULE
+$(SN_FUZZ_OBJ)/$(1)/%.o: runtime/src/%.c $(SN_HDRS)
+	@mkdir -p $$(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) $(SN_FUZZ_DEFS_$(1)) -c $$< -o $$@
+endef
+$(foreach f,fixed nock float range,$(eval $(call SN_FUZZ_OBJ_RULE,$(f))))
+sn_fuzz_objs = $(patsubst runtime/src/%.c,$(SN_FUZZ_OBJ)/$(1)/%.o,$(SN_SRCS))
+SN_FUZZ_OBJS_ck    = $(call sn_fuzz_objs,fixed)
+SN_FUZZ_OBJS_nock  = $(filter-out %/sn_blob.o,$(SN_FUZZ_OBJS_ck)) $(SN_FUZZ_OBJ)/nock/sn_blob.o
+SN_FUZZ_OBJS_float = $(call sn_fuzz_objs,float)
+SN_FUZZ_OBJS_range = $(call sn_fuzz_objs,range)
+$(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS) $(SN_FUZZ_OBJS_nock)
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_FUZZ_OBJS_nock) -lm
 # the range-checking build's checks fire (no library: sn_internal.h inline code)
 $(BUILD)/tests/test_runtime_range: tests/test_runtime_range.c $(SN_TEST_HDRS)
 	@mkdir -p $(@D)
@@ -98,15 +116,15 @@ $(BUILD)/tests/test_runtime_range: tests/test_runtime_range.c $(SN_TEST_HDRS)
 TEST_BINS += $(BUILD)/tests/test_runtime_range
 # the same hostile blobs through the range-checking build (every derived
 # shift, conversion and int64 sum bound asserted: sn_internal.h SN_RANGE)
-$(BUILD)/tests/test_runtime_fuzz_range: $(SN_FUZZ_DEPS) tests/fuzz/range_fail.c
+$(BUILD)/tests/test_runtime_fuzz_range: $(SN_FUZZ_DEPS) tests/fuzz/range_fail.c $(SN_FUZZ_OBJS_range)
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -DSN_FUZZ_PER_SECTION=40 -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_SRCS) -lm
-$(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS)
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_RANGE_CHECK -DSN_FUZZ_PER_SECTION=40 -o $@ tests/fuzz/fuzz_blob.c tests/fuzz/range_fail.c $(SN_FUZZ_OBJS_range) -lm
+$(BUILD)/tests/test_runtime_fuzz_ck: $(SN_FUZZ_DEPS) $(SN_FUZZ_OBJS_ck)
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
-$(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS)
+	$(CC) $(SN_FUZZ_CFLAGS) -o $@ tests/fuzz/fuzz_blob.c $(SN_FUZZ_OBJS_ck) -lm
+$(BUILD)/tests/test_runtime_fuzz_float: $(SN_FUZZ_DEPS) $(SN_FUZZ_OBJS_float)
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_SRCS) -lm
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_FLOAT -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_FUZZ_OBJS_float) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/tests/test_runtime_fuzz_float \
              $(BUILD)/tests/test_runtime_fuzz_range
 # the long campaign of the same hostile blobs (make test samples 100 random

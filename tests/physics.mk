@@ -6,10 +6,8 @@ REF_HDR  = tools/ref/snref.h tests/reference/snref_synth.h runtime/src/sn_format
 REF_INC  = -Itools/ref
 # compiled once (the reference has no fixed/float variant: doubles only) and
 # linked into every physics test, instead of 40 compilations of 2,400 lines
-REF_SRC  = $(BUILD)/ref/snref.o $(BUILD)/ref/snref_synth.o
-$(BUILD)/ref/snref.o: tools/ref/snref.c $(REF_HDR)
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $(REF_INC) -c -o $@ $<
+# (snref.o: the host tool's object, tools/tools.mk, the same source and flags)
+REF_SRC  = $(BUILD)/tools/ref/snref.o $(BUILD)/ref/snref_synth.o
 $(BUILD)/ref/snref_synth.o: tests/reference/snref_synth.c $(REF_HDR)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(REF_INC) -c -o $@ $<

@@ -6,9 +6,10 @@
 # Work is shared by TEST_JOBS lanes (default 2: the CI machine's cores)
 # through a queue: each lane takes the next unclaimed suite (an atomic
 # mkdir claims it), the slowest first, so no lane idles while another still
-# has a long list. The scripts that call make on the build directory
-# (SERIAL below) run one after another as a single queue item; the others
-# only read what make built. Reports print in a fixed order at the end.
+# has a long list. `make test-build` builds everything the suites run (the
+# port scripts' cross drivers and images too), so their make calls only
+# check; a script that still builds into $BUILD belongs in SERIAL (one after
+# another as a single queue item). Reports print in a fixed order at the end.
 BUILD=${1:-build}
 export BUILD
 JOBS=${TEST_JOBS:-2}
@@ -16,11 +17,12 @@ total_p=0; total_f=0; bad=""
 log_dir="$BUILD/test-logs"; mkdir -p "$log_dir"
 rm -rf "$log_dir/claims"; mkdir -p "$log_dir/claims"
 
-# scripts that run make on $BUILD (or build ports into it): never two at once
-SERIAL="test_determinism test_integration test_fuzz test_runtime_rules test_baremetal test_nofloat test_gltf"
+# scripts that build into $BUILD: never two at once (none: test-build builds for them)
+SERIAL=""
 # the slowest suites (seconds on a 2-core machine), queued first
-SLOW="test_runtime_fuzz test_runtime_fuzz_float test_runtime_fuzz_range test_physics_runtime test_physics_runtime_float
-      test_physics_cantilever test_bake_sweep test_physics_vibration test_runtime_fuzz_ck test_nonlinear
+SLOW="test_integration test_determinism test_runtime_fuzz test_level test_runtime_fuzz_range test_runtime_fuzz_float
+      test_runtime_rules test_physics_cantilever test_fuzz test_physics_runtime test_physics_runtime_float
+      test_bake_sweep test_physics_vibration test_runtime_fuzz_ck test_nonlinear
       test_physics_longrun test_physics_longrun_float test_physics_cantilever_float test_physics_blended
       test_physics_blended_float test_physics_vibration_float test_physics_held test_physics_held_float"
 
@@ -60,9 +62,9 @@ for s in tests/scripts/test_*.sh; do
     n=$(basename "$s" .sh); scripts="$scripts $n"
     if is_in "$n" "$SERIAL"; then serial="$serial $n"; else rest="$rest $n"; fi
 done
-# the queue: the serial chain, the slow programs, then everything else
-queue="@serial"
-for n in $SLOW; do is_in "$n" "$progs" && queue="$queue $n"; done
+# the queue: the serial chain, the slow suites, then everything else
+queue=""; [ -z "$serial" ] || queue="@serial"
+for n in $SLOW; do is_in "$n" "$progs $rest" && queue="$queue $n"; done
 for n in $progs $rest; do is_in "$n" "$queue" || queue="$queue $n"; done
 
 run_item() {

@@ -119,6 +119,7 @@ DET_SRCS    = ports/cross/det_main.c $(PORT_COMMON) $(PORT_SN_SRCS)
 DET_CFLAGS  = $(PORT_WARN) -g $(PORT_INC)
 # $(1) name, $(2) compiler, $(3) flags
 define det_driver
+DET_CC_$(1) = $(firstword $(2))
 $(CROSS_DIR)/det_$(1): $(DET_SRCS) $(PORT_HDRS) $(COW_BLOB_C)
 	@mkdir -p $$(dir $$@)
 	$(2) $(DET_CFLAGS) $(3) -DSN_DET_BLOB=sinew_cow_blob -DSN_DET_BLOB_SIZE=sinew_cow_blob_size \
@@ -148,6 +149,7 @@ $(eval $(call det_driver,aarch64-clang-O2,clang --target=aarch64-linux-gnu,-O2 -
 # float flavour: desktop only, no FMA contraction so -O0/-O2 and gcc/clang
 # agree; the blob comes from the file (the target builds it too)
 define det_float
+DET_CC_$(1) = $(firstword $(2))
 $(CROSS_DIR)/det_$(1): $(DET_SRCS) $(PORT_HDRS) $(COW_FLOAT_BLOB)
 	@mkdir -p $$(dir $$@)
 	$(2) $(DET_CFLAGS) $(3) -DSN_FLOAT -ffp-contract=off -o $$@ $(DET_SRCS)
@@ -167,3 +169,20 @@ CROSS_HAVE = $(foreach d,x86_64-gcc-O2:gcc x86_64-clang-O2:clang i686-gcc-O2:i68
                $(if $(shell command -v $(word 2,$(subst :, ,$(d))) 2>/dev/null),$(CROSS_DIR)/det_$(word 1,$(subst :, ,$(d)))))
 ports-cross: $(CROSS_HAVE)
 ports: ports-baremetal ports-cross
+
+# ---- what make test's port scripts run, built by test-build (-j2 beside
+# everything else) so that the scripts only run: the determinism slice
+# (tests/scripts/test_determinism.sh reads DET_SLICE: one build per axis),
+# the Cortex-M4 images of test_baremetal.sh and the objects of test_nofloat.sh.
+# A driver whose compiler is missing is left out here; the script reports it.
+DET_SLICE = cortex-m4-qemu mips-be-gcc-O2 armhf-gcc-O2-neon aarch64-gcc-O2 x86_64-gcc-O0 \
+            x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2
+.PHONY: print-det-slice
+print-det-slice:
+	@echo $(DET_SLICE)
+TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
+               $(if $(shell command -v $(DET_CC_$(d)) 2>/dev/null),$(CROSS_DIR)/det_$(d)))
+ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
+TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf \
+             $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(PORT_SN_SRCS))
+endif

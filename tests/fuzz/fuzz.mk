@@ -104,15 +104,17 @@ fuzz-seeds: $(LF_SEEDS)
 
 # make test: the short run (tests/scripts/test_fuzz.sh) needs the harnesses
 # and their seeds; without clang the script reports SKIPPED (a failure under CI).
+# Prerequisites of test-build, not of test: `make test` itself runs without
+# -j, so its own prerequisites would be built one at a time.
 ifneq ($(FUZZ_HAVE),)
-test: fuzz-bins
+test-build: fuzz-bins
 endif
 
 # blob_patch: sets a header real and fixes the CRC (tests/scripts/test_player_timestep.sh)
 $(BUILD)/tests/blob_patch: tests/fuzz/blob_patch.c runtime/src/sn_format.h tools/sb_util.c tools/sb.h
 	@mkdir -p $(@D)
 	$(CC) -std=c99 -Wall -Wextra -Werror $(CFLAGS) -Iruntime/src -Itools -o $@ $< tools/sb_util.c -lm
-test: $(BUILD)/tests/blob_patch
+test-build: $(BUILD)/tests/blob_patch
 
 # ---- expected state hashes (tests/expected_hashes.txt, checked by
 # tests/scripts/test_determinism.sh): rewrite them on purpose after a change

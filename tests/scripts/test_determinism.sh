@@ -32,8 +32,8 @@ clip_arg=""
 if [ -f "$COW_CLIP" ]; then clip_arg="--clip $COW_CLIP"; else echo "note: $COW_CLIP missing, built-in pose sequence"; fi
 
 # ---- which platforms can run here: "name target runner" (runner - = native) ----
-SLICE="cortex-m4-qemu mips-be-gcc-O2 armhf-gcc-O2-neon aarch64-gcc-O2 x86_64-gcc-O0
-       x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2"
+# the slice: DET_SLICE in ports/baremetal/baremetal.mk (make test-build builds it)
+SLICE=$(pmake print-det-slice)
 dropped=""
 sel() {  # name: in this run's set?
     [ "${DET_SET:-slice}" = full ] && return 0
@@ -113,8 +113,24 @@ cmd_for() {  # name target runner -> command line
         *) echo "$3 $2 --steps $STEPS $clip_arg" ;;
     esac
 }
+# launch RCFILE LOG CMD...: run CMD in the background, output to LOG, "rc
+# seconds" to RCFILE; at most 2 at once (2 cores): polls for a finished one.
+# Every run below (cow, crease, level of detail, players) shares this pool.
 pids=""; n_run=0
+launch() {
+    _rf=$1; _lg=$2; shift 2
+    ( t0=$(date +%s); timeout 600 "$@" < /dev/null > "$_lg" 2>&1; echo "$? $(( $(date +%s) - t0 ))" > "$_rf" ) &
+    pids="$pids $!"; n_run=$((n_run + 1))
+    while [ "$n_run" -ge 2 ]; do
+        live=""; n_run=0
+        for _p in $pids; do if kill -0 "$_p" 2>/dev/null; then live="$live $_p"; n_run=$((n_run + 1)); fi; done
+        pids=$live
+        [ "$n_run" -ge 2 ] && sleep 1
+    done
+}
+rc_ok() { [ -f "$1" ] && [ "$(cut -d' ' -f1 "$1")" = 0 ]; }  # RCFILE: the run exited 0
 start=$(date +%s)
+built=""
 while read -r name target runner; do
     [ -n "$name" ] || continue
     # -q: a failed build may leave an old binary behind; only an up-to-date one runs
@@ -122,21 +138,51 @@ while read -r name target runner; do
         bad "$name: build failed (see $L/build.log)"; grep -E 'error|Error' "$L/build.log" | head -n 5
         continue
     fi
+    built="$built $name"
     c=$(cmd_for "$name" "$target" "$runner")
     # i686: native on an x86-64 kernel with IA-32 support, else qemu-i386
     case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
-    ( t0=$(date +%s); timeout 600 $c < /dev/null > "$L/run_$name.log" 2>&1; echo "$? $(( $(date +%s) - t0 ))" > "$L/rc_$name" ) &
-    pids="$pids $!"; n_run=$((n_run + 1))
-    # at most 2 at once (2 cores): poll for a finished one
-    while [ "$n_run" -ge 2 ]; do
-        live=""; n_run=0
-        for p in $pids; do if kill -0 "$p" 2>/dev/null; then live="$live $p"; n_run=$((n_run + 1)); fi; done
-        pids=$live
-        [ "$n_run" -ge 2 ] && sleep 1
-    done
+    launch "$L/rc_$name" "$L/run_$name.log" $c
 done <<EOF2
 $plats
 EOF2
+
+# ---- crease collision active (seed 003 §3.4): the limb with its elbow
+# crease (limb_crease.blob) folding to 120 degrees and back
+# (tools/examples/limb/crease.clip), CR_STEPS steps, on every hosted platform
+# (the Cortex-M4 image links the cow only) and sinew-play ----
+CR_STEPS=400
+CR_CLIP=tools/examples/limb/crease.clip
+pmake "$BUILD/examples/limb_crease.blob" "$BUILD/examples/limb_crease_float.blob" > "$L/build_crease.log" 2>&1 || \
+    { bad "crease: blobs failed to bake"; tail -n 5 "$L/build_crease.log"; }
+# ---- level of detail (issue 13, runtime/LEVELS.md): the cow baked with
+# 'levels 2', the trot with the level switched up, down and up, on every
+# hosted platform; sinew-play's hash is tests/expected_hashes.txt's lod_* ----
+LOD_SW=250:1,500:0,750:1
+pmake "$BUILD/level/cow_lod.blob" "$BUILD/level/cow_lod_float.blob" > "$L/build_lod.log" 2>&1 || \
+    { bad "lod: blobs failed to bake"; tail -n 5 "$L/build_lod.log"; }
+while read -r name target runner; do
+    case $name in cortex-*|"") continue ;; esac
+    case " $built " in *" $name "*) ;; *) continue ;; esac
+    case $name in float-*) b=$BUILD/examples/limb_crease_float.blob; bl=$BUILD/level/cow_lod_float.blob ;;
+                        *) b=$BUILD/examples/limb_crease.blob; bl=$BUILD/level/cow_lod.blob ;; esac
+    r=""; [ "$runner" = - ] || r=$runner
+    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || r=qemu-i386 ;; esac
+    launch "$L/rc_crease_$name" "$L/run_crease_$name.log" $r "$target" "$b" --steps $CR_STEPS --clip $CR_CLIP
+    launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $STEPS $clip_arg --lod $LOD_SW
+done <<EOF2
+$plats
+EOF2
+# the desktop players: the crease and the cow (fixed: the blob file of the
+# same bake; float: against the float drivers)
+for fl in "" _float; do
+    p=$BUILD/sinew-play; [ -n "$fl" ] && p=$BUILD/sinew-play-float   # the float player's name has a dash, the blob's an underscore
+    if pmake "$p" "$BUILD/examples/cow$fl.blob" > "$L/build_play$fl.log" 2>&1; then
+        launch "$L/rc_crease_play$fl" "$L/run_crease_play$fl.log" "$p" "$BUILD/examples/limb_crease$fl.blob" \
+            --clip "$CR_CLIP" --frames "$CR_STEPS" --hash --quiet
+        launch "$L/rc_play$fl" "$L/run_play$fl.log" "$p" "$BUILD/examples/cow$fl.blob" $clip_arg --frames "$STEPS" --hash --quiet
+    else bad "$(basename "$p"): build failed"; tail -n 10 "$L/build_play$fl.log"; fi
+done
 wait
 echo "note: runs took $(( $(date +%s) - start ))s wall"
 
@@ -163,83 +209,41 @@ done <<EOF2
 $plats
 EOF2
 
-# ---- crease collision active (seed 003 §3.4): the limb with its elbow
-# crease (limb_crease.blob) folding to 120 degrees and back
-# (tools/examples/limb/crease.clip), CR_STEPS steps, on every hosted platform
-# (the Cortex-M4 image links the cow only) and sinew-play ----
-CR_STEPS=400
-CR_CLIP=tools/examples/limb/crease.clip
-crfixed=""; crfloat=""
-pmake "$BUILD/examples/limb_crease.blob" "$BUILD/examples/limb_crease_float.blob" > "$L/build_crease.log" 2>&1 || \
-    { bad "crease: blobs failed to bake"; tail -n 5 "$L/build_crease.log"; }
+# the crease and level-of-detail runs: "fixed"/"float" lists per scenario
+crfixed=""; crfloat=""; lodfixed=""; lodfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
-    [ -f "$L/rc_$name" ] && [ -x "$target" ] || continue
-    case $name in float-*) b=$BUILD/examples/limb_crease_float.blob ;; *) b=$BUILD/examples/limb_crease.blob ;; esac
-    case $runner in -) c="$target $b --steps $CR_STEPS --clip $CR_CLIP" ;; *) c="$runner $target $b --steps $CR_STEPS --clip $CR_CLIP" ;; esac
-    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
-    if timeout 600 $c < /dev/null > "$L/run_crease_$name.log" 2>&1 && h=$(hash_of "$L/run_crease_$name.log") && [ -n "$h" ]; then
-        echo "determinism: crease $name $h"
-        case $name in float-*) crfloat="$crfloat$name $h
-" ;; *) crfixed="$crfixed$name $h
-" ;; esac
-    else bad "crease $name: run failed"; tail -n 5 "$L/run_crease_$name.log" | sed 's/^/    /'; fi
+    case " $built " in *" $name "*) ;; *) continue ;; esac
+    for sc in crease lod; do
+        if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
+            echo "determinism: $sc $name $h"
+            case $sc-$name in
+                crease-float-*) crfloat="$crfloat$name $h
+" ;;            crease-*) crfixed="$crfixed$name $h
+" ;;            lod-float-*) lodfloat="$lodfloat$name $h
+" ;;            *) lodfixed="$lodfixed$name $h
+" ;;        esac
+        else bad "$sc $name: run failed"; tail -n 5 "$L/run_${sc}_$name.log" | sed 's/^/    /'; fi
+    done
 done <<EOF2
 $plats
 EOF2
 for fl in "" _float; do
-    p=$BUILD/sinew-play; [ -n "$fl" ] && p=$BUILD/sinew-play-float   # the float player's name has a dash, the blob's an underscore
-    if pmake "$p" > "$L/build_crease_play$fl.log" 2>&1 && run_log "$L/run_crease_play$fl.log" 600 "$p" "$BUILD/examples/limb_crease$fl.blob" \
-            --clip "$CR_CLIP" --frames "$CR_STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_crease_play$fl.log")" ]; then
-        h=$(hash_of "$L/run_crease_play$fl.log"); echo "determinism: crease $(basename "$p") $h"
+    [ -f "$L/rc_play$fl" ] || continue   # build failed: reported above
+    p=sinew-play; [ -n "$fl" ] && p=sinew-play-float
+    if rc_ok "$L/rc_crease_play$fl" && h=$(hash_of "$L/run_crease_play$fl.log") && [ -n "$h" ]; then
+        echo "determinism: crease $p $h"
         if [ -z "$fl" ]; then crfixed="${crfixed}sinew-play $h
 "; else crfloat="${crfloat}sinew-play-float $h
 "; fi
-    else bad "crease sinew-play$fl: run failed"; tail -n 5 "$L/run_crease_play$fl.log" | sed 's/^/    /'; fi
+    else bad "crease $p: run failed"; tail -n 5 "$L/run_crease_play$fl.log" | sed 's/^/    /'; fi
+    if rc_ok "$L/rc_play$fl" && h=$(hash_of "$L/run_play$fl.log") && [ -n "$h" ]; then
+        echo "determinism: $p $h"
+        if [ -z "$fl" ]; then fixed="${fixed}sinew-play $h
+"; else float="${float}sinew-play-float $h
+"; fi
+    else bad "$p: run failed"; tail -n 5 "$L/run_play$fl.log" | sed 's/^/    /'; fi
 done
-
-# ---- level of detail (issue 13, runtime/LEVELS.md): the cow baked with
-# 'levels 2', the trot with the level switched up, down and up, on every
-# hosted platform; sinew-play's hash is tests/expected_hashes.txt's lod_* ----
-LOD_SW=250:1,500:0,750:1
-lodfixed=""; lodfloat=""
-pmake "$BUILD/level/cow_lod.blob" "$BUILD/level/cow_lod_float.blob" > "$L/build_lod.log" 2>&1 || \
-    { bad "lod: blobs failed to bake"; tail -n 5 "$L/build_lod.log"; }
-while read -r name target runner; do
-    case $name in cortex-*|"") continue ;; esac
-    [ -f "$L/rc_$name" ] && [ -x "$target" ] || continue
-    case $name in float-*) b=$BUILD/level/cow_lod_float.blob ;; *) b=$BUILD/level/cow_lod.blob ;; esac
-    case $runner in -) c="$target $b --steps $STEPS $clip_arg --lod $LOD_SW" ;; *) c="$runner $target $b --steps $STEPS $clip_arg --lod $LOD_SW" ;; esac
-    case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || c="qemu-i386 $c" ;; esac
-    if timeout 600 $c < /dev/null > "$L/run_lod_$name.log" 2>&1 && h=$(hash_of "$L/run_lod_$name.log") && [ -n "$h" ]; then
-        echo "determinism: lod $name $h"
-        case $name in float-*) lodfloat="$lodfloat$name $h
-" ;; *) lodfixed="$lodfixed$name $h
-" ;; esac
-    else bad "lod $name: run failed"; tail -n 5 "$L/run_lod_$name.log" | sed 's/^/    /'; fi
-done <<EOF2
-$plats
-EOF2
-
-# desktop player (fixed): sinew-play on the blob file of the same bake
-if pmake "$BUILD/sinew-play" "$BUILD/examples/cow.blob" > "$L/build_play.log" 2>&1; then
-    if run_log "$L/run_play.log" 600 "$BUILD/sinew-play" "$BUILD/examples/cow.blob" $clip_arg \
-            --frames "$STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_play.log")" ]; then
-        h=$(hash_of "$L/run_play.log"); echo "determinism: sinew-play $h"
-        fixed="${fixed}sinew-play $h
-"
-    else bad "sinew-play: run failed"; tail -n 5 "$L/run_play.log" | sed 's/^/    /'; fi
-else bad "sinew-play: build failed"; tail -n 10 "$L/build_play.log"; fi
-
-# desktop player (float) against the float drivers
-if pmake "$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" > "$L/build_play_float.log" 2>&1; then
-    if run_log "$L/run_play_float.log" 600 "$BUILD/sinew-play-float" "$BUILD/examples/cow_float.blob" $clip_arg \
-            --frames "$STEPS" --hash --quiet < /dev/null && [ -n "$(hash_of "$L/run_play_float.log")" ]; then
-        h=$(hash_of "$L/run_play_float.log"); echo "determinism: sinew-play-float $h"
-        float="${float}sinew-play-float $h
-"
-    else bad "sinew-play-float: run failed"; tail -n 5 "$L/run_play_float.log" | sed 's/^/    /'; fi
-else bad "sinew-play-float: build failed"; tail -n 10 "$L/build_play_float.log"; fi
 
 agree() {  # label list min
     n=$(printf '%s' "$2" | grep -c .)

@@ -33,7 +33,8 @@ compile_all() { # $1 compiler, $2 tag, $3 extra flags
         else bad "$1 $3: $s is not warning-clean:"; sed 's/^/    /' "$tmp/$2.log" | head -n 20; fi
     done
 }
-compile_all gcc gcc-fixed ""
+# gcc fixed also writes the -O2 stack-usage call graph (.ci) for the figure in 4.
+compile_all gcc gcc-fixed "-fcallgraph-info=su"
 compile_all gcc gcc-float "-DSN_FLOAT"
 if command -v clang > /dev/null 2>&1; then
     compile_all clang clang-fixed ""
@@ -58,14 +59,12 @@ for tag in gcc-fixed gcc-float clang-fixed clang-float; do
 done
 
 # ---- 4. no recursion (call graph at -O0) ----
-mkdir -p "$tmp/cg" "$tmp/su"
+mkdir -p "$tmp/cg"
 cg_ok=1
 for s in $SRCS; do
     b=$(basename "$s" .c)
     ( cd "$tmp/cg" && gcc -std=c99 -O0 -fcallgraph-info "-I$OLDPWD/runtime/include" -c "$OLDPWD/$s" -o "$b.o" ) \
         > "$tmp/cg.log" 2>&1 || { cg_ok=0; bad "gcc -fcallgraph-info failed on $s (gcc >= 12 needed)"; cat "$tmp/cg.log"; }
-    ( cd "$tmp/su" && gcc -std=c99 -O2 -fcallgraph-info=su "-I$OLDPWD/runtime/include" -c "$OLDPWD/$s" -o "$b.o" ) \
-        > /dev/null 2>&1
 done
 if [ "$cg_ok" = 1 ]; then
     # edges "caller callee"; node labels tell indirect calls ("__indirect_call")
@@ -86,7 +85,7 @@ if [ "$cg_ok" = 1 ]; then
     if [ -z "$cyc" ]; then ok; echo "  call graph: $(wc -l < "$tmp/edges") call edges, acyclic (no recursion)"
     else bad "recursion: these functions lie on (or call into) a call cycle:" $cyc; fi
     # worst-case stack (gcc -O2, bytes) of each public entry point: deepest path of frame sizes
-    cat "$tmp/su"/*.ci > "$tmp/su.all"
+    cat "$tmp/gcc-fixed"/*.ci > "$tmp/su.all"
     awk '
         /^node:/ {
             t = $0; sub(/.*title: "/, "", t); sub(/".*/, "", t)
