@@ -6,12 +6,15 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char *sec_name[SN_SEC_COUNT] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
+static const char *sec_name[] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDIAG", "PRECOND", "MLUMP",
                                              "ROWPTR", "COLS", "MOFF", "CELLS", "CFRAMES", "CELLK", "LIMIT", "EMBED", "TRIS",
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
                                              "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
-                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL"};
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT"};
+/* one name per section: a new section without its name fails to compile
+ * (format 6.1's ADAPT printed as "(null)", a NULL through %s) */
+typedef char sb_sec_name_count_[sizeof sec_name / sizeof sec_name[0] == SN_SEC_COUNT ? 1 : -1];
 
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b)
 {
