@@ -349,6 +349,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
     const sn_q *vel = CARR(h, o_vel, sn_q);
+    const sn_rowx *rx = CWARR(h, o_rx, sn_rowx);
     uint32_t j, k, q;
     for (j = first; j < end; j++) {
         sn_row r = sn_rows(h)[j];
@@ -374,7 +375,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
         }
         vn = sn_out(sn_mul(r.dir[0], vp[0]) + sn_mul(r.dir[1], vp[1]) + sn_mul(r.dir[2], vp[2]), 30, sat);
         dn = sn_add(r.target, -vn, sat); /* the normal velocity change the contact imposes */
-        if (CWARR(h, o_rx, sn_rowx)[j].s > dn) dn = CWARR(h, o_rx, sn_rowx)[j].s; /* or would ask without the yield (the pressure the bones take) */
+        if (rx[j].s > dn) dn = rx[j].s; /* or would ask without the yield (the pressure the bones take) */
         if (!(dn > 0)) continue;
         {
             sn_q rn = sn_out(sn_mul(r.dir[0], rel[0]) + sn_mul(r.dir[1], rel[1]) + sn_mul(r.dir[2], rel[2]), 30, sat);
