@@ -106,20 +106,28 @@ void seg_nodes(const seg_lvl *L, uint32_t i, uint32_t *a, uint32_t *b) {
     else { *a = 1; *b = 2; }
 }
 
+/* sheet node (r, c) of side s in ring order: left (end), up (end), right
+ * (start), down (start); no brace */
+SN_INLINE unsigned sheet_ends(uint32_t s, uint32_t r, uint32_t c, uint32_t seg[5], int sgn[5]) {
+    uint32_t h = r * (s - 1u) + c, n = r * s + c, nh = s * (s - 1u);
+    unsigned k = 0;
+    if (c > 0) { seg[k] = h - 1u; sgn[k++] = 1; }
+    if (r > 0) { seg[k] = nh + n - s; sgn[k++] = 1; }
+    if (c + 1u < s) { seg[k] = h; sgn[k++] = -1; }
+    if (r + 1u < s) { seg[k] = nh + n; sgn[k++] = -1; }
+    return k;
+}
+
 /* in ring order: left (end), up (end), right (start), down (start), brace */
 unsigned seg_node_ends(const seg_lvl *L, uint32_t n, uint32_t seg[5], int sgn[5]) {
     unsigned k = 0;
-    uint32_t s = L->side, r, c, nh;
+    uint32_t s = L->side, nh = s * (s - 1u);
     if (L->kind == SN_SEG_CHAIN) {
         if (n > 0) { seg[k] = n - 1u; sgn[k++] = 1; }
         if (n + 1u < s) { seg[k] = n; sgn[k++] = -1; }
         return k;
     }
-    r = n / s; c = n % s; nh = s * (s - 1u);
-    if (c > 0) { seg[k] = r * (s - 1u) + c - 1u; sgn[k++] = 1; }
-    if (r > 0) { seg[k] = nh + n - s; sgn[k++] = 1; }
-    if (c + 1u < s) { seg[k] = r * (s - 1u) + c; sgn[k++] = -1; }
-    if (r + 1u < s) { seg[k] = nh + n; sgn[k++] = -1; }
+    k = sheet_ends(s, n / s, n % s, seg, sgn);
     if (s == 2u) { seg[k] = 2u * nh + (n == 0 || n == 3 ? 0u : 1u); sgn[k++] = (n == 0 || n == 1) ? -1 : 1; }
     return k;
 }
@@ -521,6 +529,15 @@ static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
  * sweeps; the brace crossing of a 2x2 level; the floor last. At a node with
  * k ends the pairs are (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3,
  * (e_k-1, e0): a ring. */
+/* the pairs around one sheet node's ring of k ends: each end with the next,
+ * and the last with the first when the ring closes (k >= 3) */
+SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int measure,
+                    uint32_t *sat) {
+    unsigned j;
+    for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+    if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+}
+
 static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const seg_mesh *M = C->M;
     uint32_t n, seg[5], i, q;
@@ -556,23 +573,15 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
             for (n = 0; n < L->nn; n++) {
                 if (((n >> 1) + (n & 1u) + color + dir) & 1u) continue;
                 k = seg_node_ends(L, n, seg, sgn);
-                for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
-                if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+                ring(C, L, seg, sgn, k, measure, sat);
             }
-    } else { /* rows and columns directly: the ends of seg_node_ends, same order */
-        uint32_t sd = L->side, nh = sd * (sd - 1u), r, c;
+    } else { /* rows and columns directly (no division per node), same order */
+        uint32_t sd = L->side, r, c;
         for (color = 0; color < 2; color++)
             for (r = 0; r < sd; r++)
                 for (c = (r + color + dir) & 1u; c < sd; c += 2u) { /* (r + c) even on colour dir */
-                    uint32_t h = r * (sd - 1u) + c;
-                    n = r * sd + c;
-                    k = 0;
-                    if (c > 0) { seg[k] = h - 1u; sgn[k++] = 1; }
-                    if (r > 0) { seg[k] = nh + n - sd; sgn[k++] = 1; }
-                    if (c + 1u < sd) { seg[k] = h; sgn[k++] = -1; }
-                    if (r + 1u < sd) { seg[k] = nh + n; sgn[k++] = -1; }
-                    for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
-                    if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+                    k = sheet_ends(sd, r, c, seg, sgn);
+                    ring(C, L, seg, sgn, k, measure, sat);
                 }
     }
     if (is_brace(L, 4) && !measure) {
