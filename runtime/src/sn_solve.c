@@ -457,24 +457,16 @@ sn_cgdot sn_cg_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) 
 #endif
     return o;
 }
-sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) {
-    sn_dotv a, b;
-    a.m = num.m;
-    b.m = den.m;
+static sn_dotv dotv_of(sn_cgdot d) { /* the blended mode's dot product as this file's */
+    sn_dotv o;
+    o.m = d.m;
 #if !defined(SN_FLOAT)
-    a.e = num.e;
-    b.e = den.e;
+    o.e = d.e;
 #endif
-    return ratio(a, b, clamps);
+    return o;
 }
-int sn_cg_flat(sn_cgdot rz, uint32_t n) {
-    sn_dotv a;
-    a.m = rz.m;
-#if !defined(SN_FLOAT)
-    a.e = rz.e;
-#endif
-    return at_floor(a, n);
-}
+sn_q sn_cg_ratio(sn_cgdot num, sn_cgdot den, uint32_t *clamps) { return ratio(dotv_of(num), dotv_of(den), clamps); }
+int sn_cg_flat(sn_cgdot rz, uint32_t n) { return at_floor(dotv_of(rz), n); }
 void sn_cg_axpy(sn_q *y, sn_q s, const sn_q *x, uint32_t n, uint32_t *sat) { axpy(y, s, x, n, sat); }
 void sn_cg_dir(sn_q *d, const sn_q *z, sn_q beta, uint32_t n, uint32_t *sat) {
     sn_k_axpy(d, z, beta, d, n, SN_Q_SCAL, sat);
