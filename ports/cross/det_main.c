@@ -1,7 +1,11 @@
 /* det_main.c -- headless determinism driver, built by every compiler and
  * cross compiler of tests/scripts/test_determinism.sh.
  *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]
+ *            [--shared] [--main-only]
  * --lod: sn_set_lod(L) before step K (a blob baked with 'levels 2', runtime/LEVELS.md).
+ * --shared: a shared instance stepped by sn_step_with on a separate workspace
+ * (sinew.h "Shared workspace"); its hash must equal the own-scratch one.
+ * --main-only: leave out the contact and blended scenarios after the run.
  * Without BLOB it uses the array linked in with -DSN_DET_BLOB=sym
  * -DSN_DET_BLOB_SIZE=sym (the host tool's C-array output), copied to
  * malloc memory because the runtime wants 8-byte alignment.
@@ -42,8 +46,9 @@ int main(int argc, char **argv) {
     size_t blob_n = 0, clip_n = 0, mem_n;
     unsigned long steps = 1000, trace = 0, k, lod_k[16];
     unsigned lod_l[16];
-    void *mem;
-    int i, n_lod = 0, j;
+    void *mem, *ws = NULL;
+    size_t ws_n = 0;
+    int i, n_lod = 0, j, shared = 0, main_only = 0;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--clip") && i + 1 < argc) clip_path = argv[++i];
         else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = strtoul(argv[++i], NULL, 10);
@@ -62,8 +67,10 @@ int main(int argc, char **argv) {
                 q = e + 1;
             }
         }
+        else if (!strcmp(argv[i], "--shared")) shared = 1;
+        else if (!strcmp(argv[i], "--main-only")) main_only = 1;
         else if (argv[i][0] != '-' && !blob_path) blob_path = argv[i];
-        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]\n"); return 2; }
+        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]] [--shared] [--main-only]\n"); return 2; }
     }
     if (blob_path) {
         blob = slurp(blob_path, &blob_n);
@@ -87,12 +94,19 @@ int main(int argc, char **argv) {
         const sn_blob *b;
         sn_status s = sn_blob_validate(blob, blob_n, &b);
         if (s != SN_OK) { fprintf(stderr, "det_main: %s: %s\n", blob_path, sn_status_str(s)); return 1; }
-        mem_n = sn_instance_size_mode(b, SN_MODE_BLENDED); /* also the blended scenario's */
+        if (shared) { /* the blended scenario's workspace is the larger */
+            size_t w0 = sn_workspace_size(b, SN_MODE_WARPED), w1 = sn_workspace_size(b, SN_MODE_BLENDED);
+            mem_n = sn_instance_state_size(b);
+            ws_n = w0 > w1 ? w0 : w1;
+        } else mem_n = sn_instance_size_mode(b, SN_MODE_BLENDED); /* also the blended scenario's */
     }
     mem = malloc(mem_n);
-    if (!mem) { fprintf(stderr, "det_main: out of memory\n"); return 2; }
-    if (sn_det_init(&det, blob, blob_n, clip_text, clip_n, clip_text ? &clip : NULL,
-                    mem, mem_n, err, sizeof err)) {
+    if (shared) ws = malloc(ws_n ? ws_n : 1);
+    if (!mem || (shared && !ws)) { fprintf(stderr, "det_main: out of memory\n"); return 2; }
+    if (shared ? sn_det_init_shared(&det, blob, blob_n, clip_text, clip_n, clip_text ? &clip : NULL,
+                                    mem, mem_n, ws, ws_n, err, sizeof err)
+               : sn_det_init(&det, blob, blob_n, clip_text, clip_n, clip_text ? &clip : NULL,
+                             mem, mem_n, err, sizeof err)) {
         fprintf(stderr, "det_main: %s\n", err); return 1;
     }
     for (k = 0; k < steps; k++) {
@@ -105,6 +119,7 @@ int main(int argc, char **argv) {
             printf("step %lu %s\n", k + 1, hex);
         }
     }
+    if (det.refused) { fprintf(stderr, "det_main: sn_step_with refused %u steps\n", (unsigned)det.refused); return 1; }
     sn_det_hex64(sn_state_hash(det.inst), hex);
     printf("hash: %s\n", hex);
     {
@@ -112,7 +127,7 @@ int main(int argc, char **argv) {
         sn_get_stats(det.inst, &st);
         printf("steps: %" PRIu32 " saturations: %" PRIu32 "\n", st.steps, st.saturations);
     }
-    if (sn_det_contact(&det)) { /* the constrained scenario: every platform checks it too */
+    if (!main_only && sn_det_contact(&det)) { /* the constrained scenario: every platform checks it too */
         sn_stats st;
         sn_det_hex64(sn_det_run(&det, SN_DET_CONTACT_STEPS), hex);
         printf("hash-contact: %s\n", hex);
@@ -120,13 +135,13 @@ int main(int argc, char **argv) {
         printf("contact steps: %" PRIu32 " rows: %" PRIu32 " contacts: %" PRIu32 " drops: %" PRIu32 " saturations: %" PRIu32 "\n",
                st.steps, st.constraint_rows, st.contacts, st.constraint_drops, st.saturations);
     }
-    if (sn_det_blended(&det)) { /* blended local linearization (seed 000 §4.5): every platform checks it too */
+    if (!main_only && sn_det_blended(&det)) { /* blended local linearization (seed 000 §4.5): every platform checks it too */
         sn_stats st;
         sn_det_hex64(sn_det_run(&det, SN_DET_BLENDED_STEPS), hex);
         printf("hash-blended: %s\n", hex);
         sn_get_stats(det.inst, &st);
         printf("blended steps: %" PRIu32 " saturations: %" PRIu32 "\n", st.steps, st.saturations);
     }
-    free(mem); free(blob); free(clip_text);
+    free(ws); free(mem); free(blob); free(clip_text);
     return 0;
 }

@@ -16,21 +16,26 @@ static void put(char *err, size_t cap, size_t *len, const char *s) {
     if (cap) err[*len] = 0;
 }
 
-int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
-                const char *clip_text, size_t clip_len, sn_clip *clip,
-                void *mem, size_t mem_size, char *err, size_t errlen) {
+static int det_init(sn_det *d, const void *blob, size_t blob_size,
+                    const char *clip_text, size_t clip_len, sn_clip *clip,
+                    void *mem, size_t mem_size, void *ws, size_t ws_size,
+                    char *err, size_t errlen) {
     sn_blob_info info;
     sn_status s;
     size_t len = 0;
     if (errlen) err[0] = 0;
     d->clip = NULL;
     d->k = 0;
+    d->ws = ws;
+    d->ws_size = ws_size;
+    d->refused = 0;
     s = sn_blob_validate(blob, blob_size, &d->blob);
     if (s != SN_OK) { put(err, errlen, &len, "blob: "); put(err, errlen, &len, sn_status_str(s)); return 1; }
     sn_blob_get_info(d->blob, &info);
     d->n_joints = info.joints;
     if (info.joints > SN_DET_MAX_JOINTS) { put(err, errlen, &len, "too many joints"); return 1; }
-    s = sn_instance_init(mem, mem_size, d->blob, &d->inst);
+    s = ws ? sn_instance_init_shared(mem, mem_size, d->blob, &d->inst)
+           : sn_instance_init(mem, mem_size, d->blob, &d->inst);
     if (s != SN_OK) { put(err, errlen, &len, "instance: "); put(err, errlen, &len, sn_status_str(s)); return 1; }
     if (clip_text) {
         if (sn_clip_parse(clip, clip_text, clip_len, err, errlen)) return 1;
@@ -38,6 +43,21 @@ int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
         d->clip = clip;
     }
     return 0;
+}
+
+int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
+                const char *clip_text, size_t clip_len, sn_clip *clip,
+                void *mem, size_t mem_size, char *err, size_t errlen) {
+    return det_init(d, blob, blob_size, clip_text, clip_len, clip, mem, mem_size, NULL, 0, err, errlen);
+}
+
+int sn_det_init_shared(sn_det *d, const void *blob, size_t blob_size,
+                       const char *clip_text, size_t clip_len, sn_clip *clip,
+                       void *mem, size_t mem_size, void *ws, size_t ws_size,
+                       char *err, size_t errlen) {
+    size_t len = 0;
+    if (!ws) { if (errlen) err[0] = 0; put(err, errlen, &len, "no workspace"); return 1; }
+    return det_init(d, blob, blob_size, clip_text, clip_len, clip, mem, mem_size, ws, ws_size, err, errlen);
 }
 
 /* Built-in sequence for assets without a clip: every non-root joint swings
@@ -71,7 +91,8 @@ void sn_det_pose(sn_det *d) {
 }
 
 void sn_det_step(sn_det *d) {
-    sn_step(d->inst);
+    if (d->ws) { if (sn_step_with(d->inst, d->ws, d->ws_size) != SN_OK) d->refused++; }
+    else sn_step(d->inst);
     d->k++;
 }
 

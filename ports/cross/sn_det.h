@@ -23,6 +23,9 @@ typedef struct sn_det {
     const sn_clip *clip;     ///< NULL: built-in pose sequence
     uint32_t n_joints;
     uint32_t k;              ///< next step
+    void *ws;                ///< shared workspace (sn_det_init_shared), else NULL
+    size_t ws_size;          ///< its bytes
+    uint32_t refused;        ///< steps sn_step_with refused (must stay 0)
     sn_quat local[SN_DET_MAX_JOINTS];
     sn_xform xf[SN_DET_MAX_JOINTS];
 } sn_det;
@@ -34,10 +37,19 @@ int sn_det_init(sn_det *d, const void *blob, size_t blob_size,
                 const char *clip_text, size_t clip_len, sn_clip *clip,
                 void *mem, size_t mem_size, char *err, size_t errlen);
 
+/// sn_det_init for a shared instance (sn_instance_init_shared: mem holds
+/// sn_instance_state_size bytes, ws sn_workspace_size bytes of the mode the
+/// scenarios need, 8-byte aligned): sn_det_step then calls sn_step_with, so
+/// every port checks that path's hash against the player's own-scratch one.
+int sn_det_init_shared(sn_det *d, const void *blob, size_t blob_size,
+                       const char *clip_text, size_t clip_len, sn_clip *clip,
+                       void *mem, size_t mem_size, void *ws, size_t ws_size,
+                       char *err, size_t errlen);
+
 /// Compute and set the pose for the next step (clip time (d->k + 1) * h).
 void sn_det_pose(sn_det *d);
 
-/// sn_step and advance d->k.
+/// sn_step (sn_step_with on a shared instance) and advance d->k.
 void sn_det_step(sn_det *d);
 
 /// n times pose + step; returns sn_state_hash.

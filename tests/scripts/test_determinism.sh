@@ -8,7 +8,8 @@
 # scalar, armhf NEON (qemu user mode), the Cortex-M4 DSP kernels. Float
 # flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
 # and sinew-play-float).
-# The crease and level-of-detail scenarios run on every hosted platform too.
+# The crease, level-of-detail and adaptation scenarios run on every hosted
+# platform too (adaptation as a shared instance: sn_step_with's workspace).
 # Every platform must also give the hash committed in tests/expected_hashes.txt
 # (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
@@ -161,15 +162,25 @@ pmake "$BUILD/examples/limb_crease.blob" "$BUILD/examples/limb_crease_float.blob
 LOD_SW=250:1,500:0,750:1
 pmake "$BUILD/level/cow_lod.blob" "$BUILD/level/cow_lod_float.blob" > "$L/build_lod.log" 2>&1 || \
     { bad "lod: blobs failed to bake"; tail -n 5 "$L/build_lod.log"; }
+# ---- adaptation (runtime/LEVELS.md §3): the same trot and switches on the cow
+# baked with 'adapt' (tests/level.mk), stepped as a shared instance with
+# sn_step_with on its own workspace: every port checks both against the
+# own-scratch player's hash (tests/expected_hashes.txt adapt_*) ----
+pmake "$BUILD/level/cow_adapt.blob" "$BUILD/level/cow_adapt_float.blob" > "$L/build_adapt.log" 2>&1 || \
+    { bad "adapt: blobs failed to bake"; tail -n 5 "$L/build_adapt.log"; }
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
-    case $name in float-*) b=$BUILD/examples/limb_crease_float.blob; bl=$BUILD/level/cow_lod_float.blob ;;
-                        *) b=$BUILD/examples/limb_crease.blob; bl=$BUILD/level/cow_lod.blob ;; esac
+    case $name in float-*) b=$BUILD/examples/limb_crease_float.blob; bl=$BUILD/level/cow_lod_float.blob
+                           ba=$BUILD/level/cow_adapt_float.blob ;;
+                        *) b=$BUILD/examples/limb_crease.blob; bl=$BUILD/level/cow_lod.blob
+                           ba=$BUILD/level/cow_adapt.blob ;; esac
     r=""; [ "$runner" = - ] || r=$runner
     case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || r=qemu-i386 ;; esac
     launch "$L/rc_crease_$name" "$L/run_crease_$name.log" $r "$target" "$b" --steps $CR_STEPS --clip $CR_CLIP
-    launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $STEPS $clip_arg --lod $LOD_SW
+    launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $STEPS $clip_arg --lod $LOD_SW --main-only
+    launch "$L/rc_adapt_$name" "$L/run_adapt_$name.log" $r "$target" "$ba" --steps $STEPS $clip_arg --lod $LOD_SW \
+        --main-only --shared
 done <<EOF2
 $plats
 EOF2
@@ -210,18 +221,20 @@ $plats
 EOF2
 
 # the crease and level-of-detail runs: "fixed"/"float" lists per scenario
-crfixed=""; crfloat=""; lodfixed=""; lodfloat=""
+crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
-    for sc in crease lod; do
+    for sc in crease lod adapt; do
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
             echo "determinism: $sc $name $h"
             case $sc-$name in
                 crease-float-*) crfloat="$crfloat$name $h
 " ;;            crease-*) crfixed="$crfixed$name $h
 " ;;            lod-float-*) lodfloat="$lodfloat$name $h
-" ;;            *) lodfixed="$lodfixed$name $h
+" ;;            lod-*) lodfixed="$lodfixed$name $h
+" ;;            adapt-float-*) adfloat="$adfloat$name $h
+" ;;            *) adfixed="$adfixed$name $h
 " ;;        esac
         else bad "$sc $name: run failed"; tail -n 5 "$L/run_${sc}_$name.log" | sed 's/^/    /'; fi
     done
@@ -285,6 +298,8 @@ agree "crease, fixed flavour" "$crfixed" 2
 agree "crease, float flavour" "$crfloat" 2
 agree "level of detail, fixed flavour" "$lodfixed" 2
 agree "level of detail, float flavour" "$lodfloat" 2
+agree "adaptation (shared workspace), fixed flavour" "$adfixed" 2
+agree "adaptation (shared workspace), float flavour" "$adfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -308,6 +323,8 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "crease, float flavour" "$crfloat" crease_float
     expect_hash "level of detail, fixed flavour" "$lodfixed" lod_fixed
     expect_hash "level of detail, float flavour" "$lodfloat" lod_float
+    expect_hash "adaptation (shared workspace), fixed flavour" "$adfixed" adapt_fixed
+    expect_hash "adaptation (shared workspace), float flavour" "$adfloat" adapt_float
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi
