@@ -59,11 +59,12 @@ fuzz-blobs: fuzz-adapt
 
 # The shared workspace (sn_instance_init_shared, sn_step_with; issue 15):
 # shared vs own scratch on the cow's trot (contact, blended), the crease limb,
-# the two-level and adaptation cows; poison, interleaving, guards, refusals.
+# the two-level and adaptation cows, the humanoid (trot, contact, blended); poison, interleaving, guards, refusals.
 WS_TSRC = ports/cross/sn_det.c ports/common/sn_clip.c ports/common/sn_clip_pose.c
 WS_TDEPS = $(WS_TSRC) ports/cross/sn_det.h ports/common/sn_clip.h $(SN_TEST_HDRS)
 WS_BLOBS = $(EX)/cow.blob $(EX)/cow_float.blob $(EX)/limb_crease.blob $(EX)/limb_crease_float.blob \
-           $(LEVEL_EX)/cow_lod.blob $(LEVEL_EX)/cow_lod_float.blob $(LEVEL_EX)/cow_adapt.blob $(LEVEL_EX)/cow_adapt_float.blob
+           $(LEVEL_EX)/cow_lod.blob $(LEVEL_EX)/cow_lod_float.blob $(LEVEL_EX)/cow_adapt.blob $(LEVEL_EX)/cow_adapt_float.blob \
+           $(EX)/beast.blob $(EX)/beast_float.blob
 $(BUILD)/tests/test_runtime_workspace: tests/test_runtime_workspace.c $(WS_TDEPS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -Iports/cross -Iports/common -o $@ $< $(WS_TSRC) $(SN_LIB_FIXED) -lm

@@ -318,10 +318,10 @@ static void figures(const asset *a) {
 }
 
 int main(void) {
-    asset cow, limb, lod, adapt;
+    asset cow, limb, lod, adapt, beast;
     size_t ws = 0;
     const sn_blob *b;
-    const asset *all[4];
+    const asset *all[5];
     int i;
     static const int cow_ph[] = {PH_TROT, PH_CONTACT, PH_BLENDED};
     static const int limb_ph[] = {PH_TROT};
@@ -331,10 +331,11 @@ int main(void) {
     if (asset_load(&cow, "examples/cow" SUF ".blob", "tools/examples/cow/trot.clip", "cow") ||
         asset_load(&limb, "examples/limb_crease" SUF ".blob", "tools/examples/limb/crease.clip", "limb_crease") ||
         asset_load(&lod, "level/cow_lod" SUF ".blob", "tools/examples/cow/trot.clip", "cow levels 2") ||
-        asset_load(&adapt, "level/cow_adapt" SUF ".blob", "tools/examples/cow/trot.clip", "cow adapt"))
+        asset_load(&adapt, "level/cow_adapt" SUF ".blob", "tools/examples/cow/trot.clip", "cow adapt") ||
+        asset_load(&beast, "examples/beast" SUF ".blob", "tools/examples/beast/walk.clip", "beast"))
         return T_END();
-    all[0] = &cow; all[1] = &limb; all[2] = &lod; all[3] = &adapt;
-    for (i = 0; i < 4; i++) { /* one workspace for all: the largest */
+    all[0] = &cow; all[1] = &limb; all[2] = &lod; all[3] = &adapt; all[4] = &beast;
+    for (i = 0; i < 5; i++) { /* one workspace for all: the largest */
         size_t w;
         if (sn_blob_validate(all[i]->blob, all[i]->nb, &b) != SN_OK) continue;
         w = sn_workspace_size(b, SN_MODE_BLENDED);
@@ -348,6 +349,7 @@ int main(void) {
     compare(&limb, limb_ph, 1, 200);
     compare(&lod, lod_ph, 3, 160);
     compare(&adapt, adapt_ph, 2, 160);
+    compare(&beast, cow_ph, 3, 160);   /* the humanoid: a character the scratch sizes were not tuned on */
     interleave(&cow, &limb);
     api(&cow);
     T_CHECK(guard_ok(g_ws, g_ws_bytes), "guard bytes after the workspace intact at the end");
