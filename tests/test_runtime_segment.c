@@ -468,16 +468,33 @@ static void test_api(void) {
     printf("  hash after 60 steps (%s): %016llx\n", FLAV, (unsigned long long)h1);
 }
 
+/* FNV-1a over 32-bit words, low byte first: the same on either byte order */
+static uint64_t fnv_words(uint64_t f, const void *p, size_t bytes) {
+    const unsigned char *c = (const unsigned char *)p;
+    size_t i;
+    for (i = 0; i + 4 <= bytes; i += 4) {
+        uint32_t w;
+        int b;
+        memcpy(&w, c + i, 4);
+        for (b = 0; b < 4; b++) { f ^= (w >> (8 * b)) & 0xffu; f *= 1099511628211ull; }
+    }
+    return f;
+}
+
 /* The sweeps' bits (issue 15: the sweep and constraint move restructured
  * for speed, the same arithmetic in the same order): a chain on a moving
  * joint, a 9x9 sheet on 4 levels (the braced 2x2 level) and a 5x5 sheet
  * with 6 attachments (beyond the 4 whose targets are kept per step), a
- * tilted floor, impulses small and large (clamps), 80 steps: the state hash
- * and clamp count equal the ones of the code before that round (commit
- * 0e93b43, this scenario built against it; fixed: 4b43483, the same sweeps
- * with the CG's rounding floor, which moves the lattice under the
- * attachments: 0x45fa9d0e35af76b3 without it), not values of the code
- * under test. Fixed: every platform; float: the desktop builds. */
+ * tilted floor, impulses small and large, 80 steps. Checked against the
+ * runtime of commit 1f3b7b0 (this scenario built against it), not values
+ * of the code under test: every mesh's nodes and segment transforms
+ * (hashed as 32-bit words), and the saturation count, which must be 0.
+ * 1f3b7b0 counted 180 (fixed): the angular velocity's designed 0.25 rad
+ * per step cap, reached by the large impulses and equal to the fixed state
+ * clamp, went through sn_add and was counted; float applied it later and
+ * counted nothing. The state hash, which folds in the count, is checked in
+ * float only (unchanged, 0x6cd3236acfcbc1ef). Fixed: every platform;
+ * float: the desktop builds. */
 static void test_sweep_bits(void) {
     tmesh t[3];
     sn_instance *inst;
@@ -488,12 +505,11 @@ static void test_sweep_bits(void) {
     int s, i, m;
     uint64_t h;
 #if defined(SN_FLOAT)
-    const uint64_t want_h = 0x6cd3236acfcbc1efull;
-    const uint32_t want_sat = 0;
+    const uint64_t want_h = 0x6cd3236acfcbc1efull, want_seg = 0x496fbc5700bd4c46ull;
 #else
-    const uint64_t want_h = 0x2e658aaf48c91efdull;
-    const uint32_t want_sat = 180;
+    const uint64_t want_seg = 0xbb51c84fb2debc7cull;
 #endif
+    uint64_t seg = 1469598103934665603ull;
     make_chain(9, 0.1, 1.0, 0, -1);
     t[0] = chain_mesh(9, 0.1, 24, 0.8, 0.97, 0);
     t[0].n_att = 1; t[0].att_node[0] = 0; t[0].att_kind[0] = SN_SEGATT_JOINT; t[0].att_target[0] = 1; t[0].att_p[0][0] = 1.0;
@@ -535,12 +551,29 @@ static void test_sweep_bits(void) {
         }
         sn_step(inst);
     }
+    for (m = 0; m < 3; m++) {
+        static sn_vec3 nodes[81];
+        static sn_xform xf[80];
+        uint32_t nn = m == 0 ? 9u : (m == 1 ? 81u : 25u), ns = m == 0 ? 8u : (m == 1 ? 144u : 40u);
+        T_CHECK(sn_get_segment_nodes(inst, (uint32_t)m, nodes, 0, nn) == SN_OK, "sweep bits: nodes of mesh %d", m);
+        seg = fnv_words(seg, nodes, sizeof(sn_vec3) * nn);
+        for (i = 0; i < (int)ns; i += 80) { /* the segments' transforms, 80 at a time */
+            uint32_t c = ns - (uint32_t)i < 80u ? ns - (uint32_t)i : 80u;
+            T_CHECK(sn_get_segment_xforms(inst, (uint32_t)m, xf, (uint32_t)i, c) == SN_OK, "sweep bits: xforms of mesh %d", m);
+            seg = fnv_words(seg, xf, sizeof(sn_xform) * c);
+        }
+    }
     h = sn_state_hash(inst);
     sn_get_stats(inst, &st);
-    printf("  sweep bits (%s): hash %016llx, saturations %lu\n", FLAV, (unsigned long long)h, (unsigned long)st.saturations);
-    T_CHECK(h == want_h && st.saturations == want_sat,
-            "%s sweeps bit-identical to the code before issue 15's segment round: hash %016llx, %lu clamps",
-            FLAV, (unsigned long long)h, (unsigned long)st.saturations);
+    printf("  sweep bits (%s): segments %016llx, state hash %016llx, saturations %lu\n", FLAV, (unsigned long long)seg,
+           (unsigned long long)h, (unsigned long)st.saturations);
+    T_CHECK(seg == want_seg, "%s sweeps bit-identical to commit 1f3b7b0: segments %016llx, want %016llx", FLAV,
+            (unsigned long long)seg, (unsigned long long)want_seg);
+    T_CHECK(st.saturations == 0, "%s sweep bits: %lu saturations (the rotation cap is not an overflow)", FLAV,
+            (unsigned long)st.saturations);
+#if defined(SN_FLOAT)
+    T_CHECK(h == want_h, "float sweeps: state hash %016llx, want %016llx", (unsigned long long)h, (unsigned long long)want_h);
+#endif
 }
 
 int main(void) {

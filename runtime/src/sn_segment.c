@@ -31,6 +31,9 @@
 #define ROT_MAX 0.25f
 #else
 #define ROT_MAX ((int32_t)1 << 28)
+/* dynamics() caps angular velocity sums at ROT_MAX where sn_add would clamp
+ * at SN_LIM: the same value only while the two are equal */
+typedef char sn_rot_max_is_state_lim_[ROT_MAX == SN_LIM ? 1 : -1];
 #endif
 
 /* ---------------- mesh records and topology ---------------- */
@@ -658,7 +661,15 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
             c[2] = sn_out(sn_mul_sub(S[3], fe[1], S[4], fe[0]), SN_Q_ROT, sat);
             for (k = 0; k < 3; k++) { /* 3 (u x f)/half, limited to 0.25 rad/step */
                 sn_q dw = lever(c[k], hl, rr, rs, THREE, 0);
+#if defined(SN_FLOAT)
                 S[9 + k] = sn_add(S[9 + k], sgn[j] > 0 ? dw : -dw, sat);
+#else
+                /* w is Q30 rad/step and ROT_MAX = SN_LIM: a sum beyond it is
+                 * the designed 0.25 rad/step cap (float applies it below), not
+                 * an overflow, so it is not counted in sat; same value */
+                int64_t w = (int64_t)S[9 + k] + (sgn[j] > 0 ? dw : -dw);
+                S[9 + k] = (sn_q)(w > ROT_MAX ? ROT_MAX : (w < -ROT_MAX ? -ROT_MAX : w));
+#endif
             }
         }
     }
