@@ -250,18 +250,21 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3], dom = SN_NO_DOM;
+        uint32_t t[3], dom = SN_NO_DOM, anyf = 0;
         uint16_t vx[8];
         sn_q phi[8], P[3], Vp[3];
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
+        for (k = 0; k < 8; k++) {
+            vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
+            anyf |= vx[k] < v->nF;
+        }
+        if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
         sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
-        for (k = 0; k < 8; k++) {
-            vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
+        for (k = 0; k < 8; k++)
             if (vx[k] < v->nF) fw += sn_mul(phi[k], phi[k]);
-        }
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
