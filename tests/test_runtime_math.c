@@ -14,6 +14,8 @@
  *   slerp      8 LSB   (CORDIC atan2 ~1, sin/cos ~1.5, ratio division ~1, final normalize 1.5,
  *                       inputs normalized first ~1.5)
  *   float      a few float ulps of 1: 1e-6 for the trigonometric ones, 4e-7 for the others.
+ *   trilinear  fixed: exact (wx wy wz / 2^15 rounded half up, computed here in double: < 2^53);
+ *              float: 2 roundings of 2^-24 relative (the scale by 2^-45 is exact)
  */
 #include <math.h>
 #include <stdint.h>
@@ -22,6 +24,8 @@
 #include "sn_test.h"
 #include "sinew.h"
 #include "sn_internal.h"
+
+void sn_trilinear(const uint32_t t[3], sn_q phi[8]); /* sn_embed.c (declared in sn_instance.h) */
 
 #if defined(SN_FLOAT)
 #define FLAV "float"
@@ -375,6 +379,40 @@ static void test_status(void) {
 
 /* sn_out keeps every state value in range: clamps counted; in float a NaN
  * becomes 0 (counted) and an infinity the clamp, so neither enters the state. */
+/* sn_trilinear (sn_embed.c): corner a at bits (x, y, z) weighs
+ * prod_i (bit_i ? t_i : 32768 - t_i) / 2^45, against that product in double
+ * (exact: < 2^53), on a grid with the ends and the middle of [0, 32768] */
+static void test_trilinear(void) {
+    static const uint32_t ends[] = {0u, 1u, 2u, 16383u, 16384u, 16385u, 32766u, 32767u, 32768u};
+    uint32_t t[3], i, j, k, a, n = 0, bad = 0;
+    double worst = 0;
+    for (i = 0; i < 9 + 40; i++)
+        for (j = 0; j < 9 + 40; j++)
+            for (k = 0; k < 9 + 40; k++) {
+                sn_q phi[8];
+                t[0] = i < 9 ? ends[i] : (i - 9) * 819u + 7u;
+                t[1] = j < 9 ? ends[j] : (j - 9) * 811u + 13u;
+                t[2] = k < 9 ? ends[k] : 32768u - (k - 9) * 797u;
+                sn_trilinear(t, phi);
+                for (a = 0; a < 8; a++) {
+                    double p = (double)((a & 1u) ? t[0] : 32768u - t[0]) * (double)((a & 2u) ? t[1] : 32768u - t[1]) *
+                               (double)((a & 4u) ? t[2] : 32768u - t[2]);
+#if defined(SN_FLOAT)
+                    double want = p / 35184372088832.0, err = fabs((double)phi[a] - want);
+                    if (err > 2.5 * 5.96e-8 * want) bad++;
+                    if (want > 0 && err / want > worst) worst = err / want;
+#else
+                    double want = floor(p / 32768.0 + 0.5), err = fabs((double)phi[a] - want);
+                    if (err != 0) bad++;
+                    if (err > worst) worst = err;
+#endif
+                    n++;
+                }
+            }
+    T_CHECK(bad == 0, "trilinear: %u of %u weights off the reference (worst %.3g)", bad, n, worst);
+    T_FIGURE("trilinear: %u weights, worst error %.3g (%s)", n, worst, FLAV);
+}
+
 static void test_out_guard(void) {
     uint32_t sat = 0;
 #if defined(SN_FLOAT)
@@ -399,5 +437,6 @@ int main(void) {
     test_slerp();
     test_status();
     test_out_guard();
+    test_trilinear();
     return T_END();
 }

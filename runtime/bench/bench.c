@@ -5,6 +5,12 @@
  *                              callgrind: instructions per step =
  *                              (N-step run - 0-step run) / N; the cost of a
  *                              step is fixed by the blob, not by the pose)
+ *   sn_bench --contact --steps N blob
+ *                              the same with the determinism driver's contact
+ *                              scenario (ports/cross/sn_det.c sn_det_contact:
+ *                              ground plane, rising sphere, four pins) set
+ *                              before the first step; its cost follows the
+ *                              active contacts, so compare equal N only
  *
  * Built against the shipping library (libsinew.a / libsinew_float.a).
  * The pose sequence: every joint swings about its own axis with its own
@@ -58,7 +64,40 @@ static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static int bench_blob(const char *path, int only_steps) {
+/* sn_det_contact's colliders and pins (ports/cross/sn_det.c), on a fresh instance */
+static void bench_contact(sn_instance *inst, const sn_blob_info *bi) {
+    sn_collider col[2];
+    sn_constraint con[4];
+    sn_vec3 p;
+    sn_real ylow = 0;
+    uint32_t s, i;
+    for (s = 0; s < bi->surface_vertices; s++) {
+        (void)sn_get_surface(inst, &p, s, 1);
+        if (s == 0 || p.y < ylow) ylow = p.y;
+    }
+    memset(col, 0, sizeof col);
+    col[0].kind = SN_COLLIDER_PLANE;
+    col[0].a.y = ylow + LEN(3277 / 65536.0);
+    col[0].b.y = LEN(1.0);
+    col[1].kind = SN_COLLIDER_SPHERE;
+    col[1].a.y = ylow - LEN(45875 / 65536.0);
+    col[1].radius = LEN(1.0);
+    col[1].velocity.y = LEN(19661 / 65536.0);
+    memset(con, 0, sizeof con);
+    for (i = 0; i < 4; i++) {
+        static const uint32_t pick[4] = {2126u, 2362u, 1732u, 2901u};
+        con[i].at = SN_AT_SURFACE;
+        con[i].vertex = pick[i] % bi->surface_vertices;
+        (void)sn_get_surface(inst, &p, con[i].vertex, 1);
+        con[i].target = p;
+        con[i].target.y = p.y + LEN(6554 / 65536.0);
+        con[i].axes = i == 3 ? SN_AXIS_Y : 0;
+    }
+    if (sn_set_colliders(inst, col, 2) != SN_OK || sn_set_constraints(inst, con, 4) != SN_OK)
+        fprintf(stderr, "sn_bench: --contact: colliders or constraints refused\n");
+}
+
+static int bench_blob(const char *path, int only_steps, int contact) {
     size_t size, need;
     unsigned char *bytes = bench_load(path, &size);
     const sn_blob *blob;
@@ -98,6 +137,7 @@ static int bench_blob(const char *path, int only_steps) {
     if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
         bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
+        if (contact) bench_contact(inst, &info);
         for (k = 0; k < only_steps; k++) sn_step(inst);
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
         return 0;
@@ -157,12 +197,13 @@ static int bench_blob(const char *path, int only_steps) {
 }
 
 int main(int argc, char **argv) {
-    int i, steps = -1, rc = 0, any = 0;
+    int i, steps = -1, rc = 0, any = 0, contact = 0;
     for (i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) { steps = atoi(argv[++i]); continue; }
-        rc |= bench_blob(argv[i], steps);
+        if (strcmp(argv[i], "--contact") == 0) { contact = 1; continue; }
+        rc |= bench_blob(argv[i], steps, contact);
         any = 1;
     }
-    if (!any) { fprintf(stderr, "usage: sn_bench [--steps N] blob...\n"); return 2; }
+    if (!any) { fprintf(stderr, "usage: sn_bench [--contact] [--steps N] blob...\n"); return 2; }
     return rc;
 }

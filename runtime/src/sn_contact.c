@@ -141,7 +141,7 @@ static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, co
     return 1;
 }
 
-static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat);
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat);
 
 /* The yield bound (NUMERICS.md "Contacts"): the most normal velocity change
  * a contact row may ask of its point so that no free corner of its cell
@@ -152,7 +152,8 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
  * room_a = min(cell/2, cell/2 - n.(p_a + v_a + g^ - skin_a)). Skeleton
  * corners are the bones' own: the row never moves them. Returns the bound
  * (<= 0: no room, no row). Q22; S2 Q60 (fixed). */
-static sn_q ct_yield(sn_ihdr *h, const uint32_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, uint32_t *sat) {
+static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, const sn_q *vp,
+                     uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
     const sn_q dv = (sn_q)(v->cell / 2), dmax = (sn_q)(v->cell / 2);
@@ -165,7 +166,8 @@ static sn_q ct_yield(sn_ihdr *h, const uint32_t vx[8], const sn_q phi[8], const 
         if (a >= v->nF || !(phi[k] > 0)) continue;
         sn_skinned(h, a, sk, sat);
         for (q = 0; q < 3; q++)
-            d += sn_mul(n[q], sn_add(sn_add(pos[3 * a + q], sn_add(vel[3 * a + q], v->grav[q], sat), sat), -sk[q], sat));
+            d += sn_mul(n[q], sn_add(sn_add(pos[3 * a + q], vp ? vp[3 * a + q] : sn_add(vel[3 * a + q], v->grav[q], sat), sat),
+                                     -sk[q], sat));
         dev = sn_out(d, 30, sat);
         room = sn_add(dmax, -dev, sat);
         if (room > dv) room = dv;
@@ -187,13 +189,34 @@ static sn_q ct_yield(sn_ihdr *h, const uint32_t vx[8], const sn_q phi[8], const 
 #endif
 }
 
-/* the free corner with the largest weight (first on ties) */
+/* the free corner with the largest weight (first on ties); SN_NO_DOM: not yet */
+#define SN_NO_DOM 0xFFFFFFFFu
 static uint32_t ct_dom(const uint16_t *vx16, const sn_q phi[8], uint32_t nF) {
     uint32_t k, best = 0xFFFFu;
     sn_q m = 0;
     for (k = 0; k < 8; k++)
         if (vx16[k] < nF && phi[k] > m) { m = phi[k]; best = vx16[k]; }
     return best;
+}
+
+/* The step's start point and predicted velocity of every lattice vertex,
+ * once a step instead of once per surface vertex using it as a corner (~8):
+ * free vertices' v + h^2 g into q's storage (nF rows), skeleton vertices'
+ * pos - v (where they were) into d's (nDS >= nV - nF rows); both are dead
+ * between sn_rhs and the PCG (sn_instance.c). Returns 1 when no sum
+ * saturated: the arrays then stand for the per-use sums, whose saturation
+ * counts were all 0; else 0 and the callers compute per use as before (the
+ * same counts; a state that far out is rare). */
+static int ct_predict(sn_ihdr *h, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    sn_q *vp = ARR(h, o_q, sn_q), *ps = ARR(h, o_d, sn_q);
+    uint32_t a, q, s0 = 0;
+    for (a = 0; a < 3 * v->nF; a += 3)
+        for (q = 0; q < 3; q++) vp[a + q] = sn_add(vel[a + q], v->grav[q], &s0);
+    for (; a < 3 * v->nV; a++) ps[a - 3 * v->nF] = sn_add(pos[a], -vel[a], &s0);
+    (void)sat;
+    return s0 == 0;
 }
 
 void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
@@ -204,8 +227,10 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     sn_row *rows = sn_rows(h);
     sn_q A[SN_MAX_COLLIDERS][3], B[SN_MAX_COLLIDERS][3], R[SN_MAX_COLLIDERS], V[SN_MAX_COLLIDERS][3];
     sn_q cap = (sn_q)(v->cell / 8);
+    const sn_q *pst = CARR(h, o_d, sn_q), *vpre; /* ct_predict's */
     uint32_t c, s, k, first = h->n_rows, ncol = h->n_col;
     uint32_t q;
+    int exact;
     if (ncol == 0) return;
     for (c = 0; c < ncol; c++) { /* the solids at the start of the step, internal units; velocity per step */
         const sn_col *cl = cols + c;
@@ -220,19 +245,26 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         }
         R[c] = ct_to_int(h, cl->radius, 0, sat);
     }
+    exact = ct_predict(h, sat);
+    vpre = exact ? CARR(h, o_q, sn_q) : NULL;
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3], vx[8], dom;
-        uint16_t vx16[8];
+        uint32_t t[3], dom = SN_NO_DOM, anyf = 0;
+        uint16_t vx[8];
         sn_q phi[8], P[3], Vp[3];
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
+        for (k = 0; k < 8; k++) {
+            vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
+            anyf |= vx[k] < v->nF;
+        }
+        if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
         sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
         for (k = 0; k < 8; k++)
-            if (sn_rd_u16(cell + 2 * k) < v->nF) fw += sn_mul(phi[k], phi[k]);
+            if (vx[k] < v->nF) fw += sn_mul(phi[k], phi[k]);
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
@@ -240,19 +272,24 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
-        for (k = 0; k < 8; k++) {
-            uint32_t a = sn_rd_u16(cell + 2 * k);
-            vx[k] = a;
-            for (q = 0; q < 3; q++) {
-                sn_q vq = vel[3 * a + q];
-                sn_q pq = a < v->nF ? pos[3 * a + q] : sn_add(pos[3 * a + q], -vq, sat);
-                if (a < v->nF) vq = sn_add(vq, v->grav[q], sat);
-                sp[q] += sn_mul(phi[k], pq);
-                sv[q] += sn_mul(phi[k], vq);
+        if (exact)
+            for (k = 0; k < 8; k++) {
+                const uint32_t a = vx[k];
+                const sn_q *pp = a < v->nF ? pos + 3 * a : pst + 3 * (a - v->nF), *vv = a < v->nF ? vpre + 3 * a : vel + 3 * a;
+                sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
+                sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
             }
-        }
-        for (k = 0; k < 8; k++) vx16[k] = (uint16_t)vx[k];
-        dom = ct_dom(vx16, phi, v->nF);
+        else
+            for (k = 0; k < 8; k++) {
+                uint32_t a = vx[k];
+                for (q = 0; q < 3; q++) {
+                    sn_q vq = vel[3 * a + q];
+                    sn_q pq = a < v->nF ? pos[3 * a + q] : sn_add(pos[3 * a + q], -vq, sat);
+                    if (a < v->nF) vq = sn_add(vq, v->grav[q], sat);
+                    sp[q] += sn_mul(phi[k], pq);
+                    sv[q] += sn_mul(phi[k], vq);
+                }
+            }
         for (q = 0; q < 3; q++) {
             P[q] = sn_out(sp[q], 30, sat);
             Vp[q] = sn_out(sv[q], 30, sat);
@@ -281,7 +318,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
             target = sn_add(vcn, want, sat);
             if (dn > 0) {
-                lim = ct_yield(h, vx, phi, n, fw, sat);
+                lim = ct_yield(h, vx, phi, n, fw, vpre, sat);
                 if (!(lim > 0)) continue; /* the free corners are already as far out as the bound lets them: no row */
                 if (dn > lim) {           /* yield: ask only what the free corners can give within the bound */
                     target = sn_add(sn_add(vcn, vr, sat), lim, sat);
@@ -292,9 +329,9 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
              * corner's three unknowns from several contacts are nearly
              * dependent (their normals 30-60 deg apart) and leave no room for
              * the contact's friction rows */
-            for (j = first; j < h->n_rows; j++)
-                if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && rows[j].one_sided &&
-                    ct_dom(rows[j].vtx, rows[j].w, v->nF) == dom) break;
+            if (dom == SN_NO_DOM) dom = ct_dom(vx, phi, v->nF); /* once a vertex, and only for a contact */
+            for (j = first; j < h->n_rows; j++) /* every row since first is a contact's (one-sided) */
+                if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && (uint32_t)rx[j].a == dom) break;
             if (j < h->n_rows && !(score < rx[j].spare)) continue;
             if (j == h->n_rows && h->contacts >= v->nCt) {
                 h->contact_overflow = sn_count(h->contact_overflow, 1);
@@ -304,7 +341,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 sn_row r;
                 memset(&r, 0, sizeof r);
                 r.n = 8;
-                for (k = 0; k < 8; k++) { r.vtx[k] = (uint16_t)vx[k]; r.w[k] = phi[k]; }
+                for (k = 0; k < 8; k++) { r.vtx[k] = vx[k]; r.w[k] = phi[k]; }
                 for (q = 0; q < 3; q++) r.dir[q] = n[q];
                 r.target = target;
                 r.one_sided = 1;
@@ -313,11 +350,12 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 else if (sn_rows_push(h, &r)) h->contacts++;
                 else continue;
                 rx[j].spare = score;
+                rx[j].a = (sn_q)dom; /* the row's dominant corner (collection scratch: rows_factor sets a) */
                 rx[j].s = dn > want ? dn : want; /* friction's pressure: the normal change asked before the yield, or the push-out depth (scratch until the factorization) */
             }
         }
     }
-    friction_rows(h, first, h->n_rows, (const sn_q (*)[3])V, sat);
+    friction_rows(h, first, h->n_rows, (const sn_q (*)[3])V, vpre, sat);
 }
 
 /* one tangential row of contact row r along t (Q30) with target t.u + extra */
@@ -345,7 +383,7 @@ static void cross30(const sn_q a[3], const sn_q b[3], sn_q o[3], uint32_t *sat) 
 }
 
 /* Friction rows for the normal contacts rows[first .. end) (see the top). */
-static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], uint32_t *sat) {
+static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
     const sn_q *vel = CARR(h, o_vel, sn_q);
@@ -366,7 +404,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
         for (k = 0; k < r.n; k++)
             for (q = 0; q < 3; q++) {
                 sn_q vq = vel[3 * r.vtx[k] + q];
-                if (r.vtx[k] < v->nF) vq = sn_add(vq, v->grav[q], sat);
+                if (r.vtx[k] < v->nF) vq = vpre ? vpre[3 * r.vtx[k] + q] : sn_add(vq, v->grav[q], sat);
                 sv[q] += sn_mul(r.w[k], vq);
             }
         for (q = 0; q < 3; q++) {

@@ -20,18 +20,24 @@ void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
 /* Trilinear weights phi_a (Q30 / float, summing to one) of a cell's 8
  * corners at coordinates t (Q15), corner a at bits (x, y, z). */
 void sn_trilinear(const uint32_t t[3], sn_q phi[8]) {
-    uint32_t a;
-    for (a = 0; a < 8; a++) {
-        uint32_t wx = (a & 1u) ? t[0] : 32768u - t[0];
-        uint32_t wy = (a & 2u) ? t[1] : 32768u - t[1];
-        uint32_t wz = (a & 4u) ? t[2] : 32768u - t[2];
+    /* the four x-y products once (each two corners' first factor, in the
+     * order of wx * wy * wz: the same values), written out (no index
+     * arithmetic); t <= 32768 (validated), so wx * wy <= 2^30 fits 32 bits */
+    const uint32_t x0 = 32768u - t[0], y0 = 32768u - t[1], z0 = 32768u - t[2];
 #if defined(SN_FLOAT)
-        phi[a] = (float)wx * (float)wy * (float)wz * (1.0f / 35184372088832.0f); /* 2^45 */
+    const float xy0 = (float)x0 * (float)y0, xy1 = (float)t[0] * (float)y0, xy2 = (float)x0 * (float)t[1],
+                xy3 = (float)t[0] * (float)t[1], fz0 = (float)z0, fz1 = (float)t[2];
+#define SN_TRI(xy, z) ((xy) * (z) * (1.0f / 35184372088832.0f)) /* 2^45 */
+    phi[0] = SN_TRI(xy0, fz0); phi[1] = SN_TRI(xy1, fz0); phi[2] = SN_TRI(xy2, fz0); phi[3] = SN_TRI(xy3, fz0);
+    phi[4] = SN_TRI(xy0, fz1); phi[5] = SN_TRI(xy1, fz1); phi[6] = SN_TRI(xy2, fz1); phi[7] = SN_TRI(xy3, fz1);
 #else
-        /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
-        phi[a] = (int32_t)(((uint64_t)wx * wy * wz + (1u << 14)) >> 15);
+    const uint32_t xy0 = x0 * y0, xy1 = t[0] * y0, xy2 = x0 * t[1], xy3 = t[0] * t[1], z1 = t[2];
+    /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
+#define SN_TRI(xy, z) ((int32_t)(((uint64_t)(xy) * (z) + (1u << 14)) >> 15))
+    phi[0] = SN_TRI(xy0, z0); phi[1] = SN_TRI(xy1, z0); phi[2] = SN_TRI(xy2, z0); phi[3] = SN_TRI(xy3, z0);
+    phi[4] = SN_TRI(xy0, z1); phi[5] = SN_TRI(xy1, z1); phi[6] = SN_TRI(xy2, z1); phi[7] = SN_TRI(xy3, z1);
 #endif
-    }
+#undef SN_TRI
 }
 
 /* Current position (internal) of surface vertex s: trilinear in its cell

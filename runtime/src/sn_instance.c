@@ -19,6 +19,8 @@
  * mat-vec, z (the preconditioned residual) from d = z + beta d to the next
  * preconditioner call, and w (rhs's velocity term, over free vertices;
  * cell_forces computes the skeleton part) outside the PCG: one storage.
+ * Between rhs and the PCG both are free: sn_contact_rows keeps its per-step
+ * predictions there (free vertices' in q, skeleton vertices' in d).
  * The 8-byte arrays come first (the header and each of them are multiples
  * of 8). Array offsets into off[] in the order of SN_LAYOUT_ARRAYS; returns
  * the total, rounded up to 8. Counts are validated (nV <= 65535 ...): no wrap. */

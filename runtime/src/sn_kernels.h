@@ -73,8 +73,10 @@ SN_INLINE void sn_k_blk(const unsigned char *K, uint32_t a, uint32_t b, int32_t 
         const uint32_t o = SN_CELLK_OFFIDX(a, b);
         const unsigned char *m = K + SN_CELLK_OFF + 18u * o;
         const int32_t sc = (int32_t)1 << K[SN_CELLK_EXP + o];
-        uint32_t k;
-        for (k = 0; k < 9; k++) B[k] = sn_k_rd_i16(m + 2 * k) * sc; /* m 2^e, |.| < 2^27 */
+        /* m 2^e, |.| < 2^27; written out (a loop of 9 costs a third more) */
+        B[0] = sn_k_rd_i16(m) * sc; B[1] = sn_k_rd_i16(m + 2) * sc; B[2] = sn_k_rd_i16(m + 4) * sc;
+        B[3] = sn_k_rd_i16(m + 6) * sc; B[4] = sn_k_rd_i16(m + 8) * sc; B[5] = sn_k_rd_i16(m + 10) * sc;
+        B[6] = sn_k_rd_i16(m + 12) * sc; B[7] = sn_k_rd_i16(m + 14) * sc; B[8] = sn_k_rd_i16(m + 16) * sc;
     }
 }
 #endif

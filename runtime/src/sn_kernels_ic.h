@@ -31,16 +31,19 @@ SN_INLINE int32_t sn_k_ic_i16(const unsigned char *p) {
 }
 
 /* Block U (entries as sn_q: fixed the mantissa, float the value) and its frac. */
+/* The 9 entries written out: the compilers kept a loop of 9 through memory. */
 SN_INLINE int sn_k_ic_block(const unsigned char *b, sn_q U[9]) {
-    int k;
 #if defined(SN_FLOAT)
     uint32_t u = (uint32_t)(127 - b[18]) << 23; /* 2^-frac, frac <= 47: a normal float */
     float s;
     memcpy(&s, &u, 4);
-    for (k = 0; k < 9; k++) U[k] = (float)sn_k_ic_i16(b + 2 * k) * s;
+#define SN_K_IC_E(k) U[k] = (float)sn_k_ic_i16(b + 2 * (k)) * s
 #else
-    for (k = 0; k < 9; k++) U[k] = sn_k_ic_i16(b + 2 * k);
+#define SN_K_IC_E(k) U[k] = sn_k_ic_i16(b + 2 * (k))
 #endif
+    SN_K_IC_E(0); SN_K_IC_E(1); SN_K_IC_E(2); SN_K_IC_E(3); SN_K_IC_E(4);
+    SN_K_IC_E(5); SN_K_IC_E(6); SN_K_IC_E(7); SN_K_IC_E(8);
+#undef SN_K_IC_E
     return b[18];
 }
 
