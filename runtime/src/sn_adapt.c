@@ -209,10 +209,12 @@ static void k_reduced(sn_ihdr *h, const sn_view *t) {
     }
 }
 
+/* fixed: the masses summed in units of 2^5 (each m < 2^31 -> < 2^26; a source takes itself and at
+ * most 26 inactive neighbours with sum phi <= 7: < 2^29, an int32); float: as they are */
 #if defined(SN_FLOAT)
-#define sn_rshr_q(x, s) (x)
+#define M_SH(x, s) (x)
 #else
-#define sn_rshr_q(x, s) sn_rshr64((x), (s))
+#define M_SH(x, s) ((sn_q)sn_rshr64((x), (s)))
 #endif
 /* The reduced operator's preconditioner scales (NUMERICS.md "Adaptation"). A
  * source row c of P^T A P carries its inactive vertices' functions: its lumped
@@ -223,30 +225,30 @@ static void k_reduced(sn_ihdr *h, const sn_view *t) {
  * within 10x of its start; divergence through the swing). Stiffness scales
  * with the same cut volume, so s_c = sqrt(m_c / (P^T m)_c) in (0, 1] and
  * z = S C S r (SPD) restores the diagonal's scale; s = 1 where no inactive
- * vertex folds in. Cost 8 per inactive-or-not vertex + nF square roots:
- * fixed by the blob, run whenever the mask is (k_reduced's places). */
+ * vertex folds in. Cost 8 per inactive vertex + nF square roots, bounded by
+ * the blob, run whenever the mask changes (k_reduced's places, also outside
+ * a step: no workspace scratch, the sums are kept in the scales' array). */
 static void scales(sn_ihdr *h, const sn_view *t) {
     const unsigned char *ml = h->v.sec[SN_SEC_MLUMP];
     const uint8_t *m = mask_of(h);
-    sn_q *sc = scales_of(h), phi[8];
+    sn_q *M = scales_of(h), phi[8]; /* first (P^T m)_c, then the scales in place */
     uint32_t w, a, c[8], n = sn_ad(h)->n, nF = h->v.nF;
-    sn_acc *M = WARR(h, o_acc, sn_acc); /* scratch: free between steps */
-    for (w = 0; w < n; w++) M[w] = rd_real(ml, w);
+    for (w = 0; w < n; w++) M[w] = M_SH(rd_real(ml, w), 5);
     for (w = 0; w < n; w++) {
         if (m[w]) continue;
         sources(h, t, w, c, phi);
-        for (a = 0; a < 8; a++) /* fixed: Q30 x m rounded to m's units (each <= m_w < 2^31; <= 27 terms at a source) */
-            if (c[a] < nF) M[c[a]] += (sn_acc)sn_rshr_q(sn_mul(phi[a], rd_real(ml, w)), SN_Q_ROT);
+        for (a = 0; a < 8; a++) /* Q30 x m rounded to M's units (sum bound above) */
+            if (c[a] < nF) M[c[a]] += M_SH(sn_mul(phi[a], rd_real(ml, w)), SN_Q_ROT + 5);
     }
     for (w = 0; w < n; w++) {
-        sn_q mw = rd_real(ml, w);
+        sn_q mw = M_SH(rd_real(ml, w), 5);
 #if defined(SN_FLOAT)
-        sc[w] = (mw > 0.0f && M[w] > mw) ? sn_frsqrt(M[w] / mw) : 1.0f; /* sqrt(m / M) */
+        M[w] = (mw > 0.0f && M[w] > mw) ? sn_frsqrt(M[w] / mw) : 1.0f; /* sqrt(m / M) */
 #else
-        if (mw > 0 && M[w] > mw) { /* q = m / M in Q30, s = sqrt(q 2^30) in Q30, <= 2^30 */
+        if (mw > 0 && M[w] > mw) { /* q = m / M in Q30, s = sqrt(q 2^30) in Q30, < 2^30 */
             uint64_t q = ((uint64_t)mw << 30) / (uint64_t)M[w];
-            sc[w] = (sn_q)sn_isqrt64(q << 30);
-        } else sc[w] = SN_ONE_ROT;
+            M[w] = (sn_q)sn_isqrt64(q << 30);
+        } else M[w] = SN_ONE_ROT;
 #endif
     }
 }
