@@ -24,7 +24,8 @@
  * Cost per step, fixed by the blob: one preconditioner application, the
  * sampling 8 (nV0 + nF1) weighted sums of 3 x 2 values, at most 33 nF1
  * compares for the selection; the solve is the plain one minus the inactive
- * corners. Storage: sn_adapt_state and the mask (nF1 bytes) after the
+ * corners. Storage: sn_adapt_state, the mask (nF1 bytes) and the
+ * preconditioner's scales (4 nF1 bytes, recomputed with the mask) after the
  * instance's layout (sn_instance_size counts them); the rest reuses the step's dead arrays: keys in acc,
  * samples in d and q (nV0 <= nF1, validated). */
 #include "sn_adapt.h"
@@ -56,10 +57,12 @@ uint32_t sn_adapt_bytes(const sn_view *top) {
     sn_view f;
     if (sn_level_sec_count(top, SN_SEC_ADAPT) == 0) return 0;
     sn_view_init(&f, (const sn_blob *)(const void *)top->sec[SN_SEC_LEVEL_BLOB]);
-    return (SN_ADAPT_STATE_BYTES + f.nF + 7u) & ~7u;
+    return (SN_ADAPT_STATE_BYTES + ((f.nF + 3u) & ~3u) + 4u * f.nF + 7u) & ~7u; /* state, mask, scales */
 }
 
 static uint8_t *mask_of(const sn_ihdr *h) { return (uint8_t *)(sn_ad(h) + 1); }
+/* the preconditioner's scales per level-1 free vertex, after the mask (4-aligned) */
+static sn_q *scales_of(const sn_ihdr *h) { return (sn_q *)(void *)(mask_of(h) + ((sn_ad(h)->n + 3u) & ~3u)); }
 
 /* an ordered 32-bit key of a non-negative length (fixed: the integer; float:
  * its bits, which order as the values do) */
@@ -206,6 +209,52 @@ static void k_reduced(sn_ihdr *h, const sn_view *t) {
     }
 }
 
+/* fixed: the masses summed in units of 2^5 (each m < 2^31 -> < 2^26; a source takes itself and at
+ * most 26 inactive neighbours with sum phi <= 7: < 2^29, an int32); float: as they are */
+#if defined(SN_FLOAT)
+#define M_SH(x, s) (x)
+#else
+#define M_SH(x, s) ((sn_q)sn_rshr64((x), (s)))
+#endif
+/* The reduced operator's preconditioner scales (NUMERICS.md "Adaptation"). A
+ * source row c of P^T A P carries its inactive vertices' functions: its lumped
+ * mass is (P^T m)_c = m_c + sum_w phi_wc m_w (MLUMP), where the masked IC(0)
+ * is the lattice's at m_c. On the beast a source at a cut cell has m_c
+ * hundreds of times below what it carries (diagonal ratio up to 760): the
+ * masked IC(0) oversteps there and the PCG stalls (16 iterations left rz
+ * within 10x of its start; divergence through the swing). Stiffness scales
+ * with the same cut volume, so s_c = sqrt(m_c / (P^T m)_c) in (0, 1] and
+ * z = S C S r (SPD) restores the diagonal's scale; s = 1 where no inactive
+ * vertex folds in. Cost 8 per inactive vertex + nF square roots, bounded by
+ * the blob, run whenever the mask changes (k_reduced's places, also outside
+ * a step: no workspace scratch, the sums are kept in the scales' array). */
+static void scales(sn_ihdr *h, const sn_view *t) {
+    const unsigned char *ml = h->v.sec[SN_SEC_MLUMP];
+    const uint8_t *m = mask_of(h);
+    sn_q *M = scales_of(h), phi[8]; /* first (P^T m)_c, then the scales in place */
+    uint32_t w, a, c[8], n = sn_ad(h)->n, nF = h->v.nF;
+    for (w = 0; w < n; w++) M[w] = M_SH(rd_real(ml, w), 5);
+    for (w = 0; w < n; w++) {
+        if (m[w]) continue;
+        sources(h, t, w, c, phi);
+        for (a = 0; a < 8; a++) /* Q30 x m rounded to M's units (sum bound above) */
+            if (c[a] < nF) M[c[a]] += M_SH(sn_mul(phi[a], rd_real(ml, w)), SN_Q_ROT + 5);
+    }
+    for (w = 0; w < n; w++) {
+        sn_q mw = M_SH(rd_real(ml, w), 5);
+#if defined(SN_FLOAT)
+        M[w] = (mw > 0.0f && M[w] > mw) ? sn_frsqrt(M[w] / mw) : 1.0f; /* sqrt(m / M) */
+#else
+        if (mw > 0 && M[w] > mw) { /* q = m / M in Q30, s = sqrt(q 2^30) in Q30, < 2^30 */
+            uint64_t q = ((uint64_t)mw << 30) / (uint64_t)M[w];
+            M[w] = (sn_q)sn_isqrt64(q << 30);
+        } else M[w] = SN_ONE_ROT;
+#endif
+    }
+}
+
+const sn_q *sn_adapt_scales(const sn_ihdr *h) { return scales_of(h); }
+
 static void choose(sn_ihdr *h, uint32_t *key, int fresh) {
     uint8_t *m = mask_of(h);
     uint32_t i, n = sn_ad(h)->n, want = 0, above, room, act = 0, T = 0;
@@ -282,6 +331,7 @@ void sn_adapt_begin(sn_ihdr *h, uint32_t *sat) {
     for (i = 0; i < sn_ad(h)->n; i++) m[i] = eligible(h, &t, i) ? 0u : 0x41u; /* 0x41: in the solve for good */
     choose(h, NULL, 1);
     k_reduced(h, &t);
+    scales(h, &t);
     if (sn_ad(h)->inactive) {
         sn_q *ps = ARR(h, o_d, sn_q), *vs = ARR(h, o_q, sn_q);
         sample(h, &t, CARR(h, o_pos, sn_q), ps, sat);
@@ -329,7 +379,7 @@ void sn_adapt_restrict(sn_ihdr *h, const uint8_t *mask, sn_q *v, uint32_t *sat) 
 void sn_adapt_estimate(sn_ihdr *h, const uint8_t *mask, const sn_q *r, sn_q *z, sn_q *x, uint32_t *sat) {
     static const sn_q zero[3] = {0, 0, 0};
     uint32_t w;
-    sn_precond_mask(h, mask, 1, r, z, sat);
+    sn_precond_mask(h, mask, 1, NULL, r, z, sat);
     for (w = 0; w < sn_ad(h)->n; w++) {
         if (mask[w]) continue;
 #if defined(SN_FLOAT)
@@ -392,6 +442,7 @@ void sn_adapt_step(sn_ihdr *h, uint32_t *sat) {
     }
     choose(h, key, 0);
     k_reduced(h, &t);
+    scales(h, &t);
     if (sn_ad(h)->inactive) project(h, &t, ps, vs, sat);
 }
 

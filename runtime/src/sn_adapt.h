@@ -35,15 +35,17 @@ void sn_adapt_estimate(sn_ihdr *h, const uint8_t *mask, const sn_q *r, sn_q *z, 
 void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x);
 /* CG iterations of a reduced solve: at least SN_ADAPT_MIN_ITERATIONS (within
  * the blob's cg_max). The preconditioner is the lattice's IC(0) restricted to
- * the active set, not the reduced operator's: a source row also carries its
- * inactive vertices' stiffness and mass. Measured on the cow's violent swing
- * (tests/test_runtime_adapt.c): at the blob's 4 iterations the reduced step
- * diverges and a steady state flips vertices every step (the refine estimate
- * rides on the unconverged residual); at 16 both are gone. */
+ * the active set and scaled per source row (sn_adapt_scales), not the
+ * reduced operator's own factor. With the scales no run of
+ * tests/test_runtime_adapt.c diverges at 4 or 8, but a held steady state
+ * flips vertices every step (the refine estimate rides on the unconverged
+ * residual): the cow at 4, the beast at 8; at 16 neither does. */
 #ifndef SN_ADAPT_MIN_ITERATIONS
 #define SN_ADAPT_MIN_ITERATIONS 16u
 #endif
 uint32_t sn_adapt_iterations(const sn_ihdr *h);
+/* The masked preconditioner's per-vertex scales (Q30, (0, 1]) for the current mask (sn_adapt.c). */
+const sn_q *sn_adapt_scales(const sn_ihdr *h);
 /* After the step's update and limits: details, selection, projection. */
 void sn_adapt_step(sn_ihdr *h, uint32_t *sat);
 /* The mask for the state hash (*n bytes, 1: in the solve), NULL without ADAPT:

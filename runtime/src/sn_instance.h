@@ -209,8 +209,9 @@ SN_INLINE void sn_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
 void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat); /* 6: z = C r, block Jacobi or IC(0) (sn_precond.c) */
 /* the same with one frame R for every vertex, restricted to mask[i] != 0 (SN_MODE_BLENDED's region, sn_blended.c) */
 void sn_precond_region(sn_ihdr *h, const sn_q *R, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat);
-/* with the vertex frames, restricted to mask[i] != 0 (inv 0) or mask[i] == 0 (inv 1): adaptation (sn_adapt.c) */
-void sn_precond_mask(sn_ihdr *h, const uint8_t *mask, int inv, const sn_q *r, sn_q *z, uint32_t *sat);
+/* with the vertex frames, restricted to mask[i] != 0 (inv 0) or mask[i] == 0 (inv 1): adaptation (sn_adapt.c);
+ * sc (or NULL): z = S C S r, S the per-vertex Q30 scales of the reduced operator (sn_adapt_scales) */
+void sn_precond_mask(sn_ihdr *h, const uint8_t *mask, int inv, const sn_q *sc, const sn_q *r, sn_q *z, uint32_t *sat);
 void sn_limits(sn_ihdr *h, uint32_t *sat);          /* 8 */
 void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat); /* free vertex i carried rigidly by its frame (R x_rest + c; sn_health.c) */
 void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += rig forces (sn_rig.c) */

@@ -87,11 +87,21 @@ SN_INLINE void sym_mul(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
     l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
 }
 
+/* t = s t, s a Q30 scale in (0, 1] (adaptation's source rows): no clamp */
+SN_INLINE void scale3(sn_q t[3], sn_q s, uint32_t *sat) {
+    t[0] = sn_out(sn_mul(s, t[0]), SN_Q_ROT, sat);
+    t[1] = sn_out(sn_mul(s, t[1]), SN_Q_ROT, sat);
+    t[2] = sn_out(sn_mul(s, t[2]), SN_Q_ROT, sat);
+}
+
 /* z = C r with the frame of vertex i at R + rs i (rs 9: the vertex frames;
  * rs 0: one frame for all, the blended mode's region) and, if mask, only the
  * vertices with mask[i] != 0 (inv: == 0) (r taken as 0 elsewhere, z set to 0
- * there: the principal block of an SPD C, so still SPD on the region). */
-static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *mask, int inv, const sn_q *r, sn_q *z, uint32_t *sat) {
+ * there: the principal block of an SPD C, so still SPD on the region). With
+ * sc, z = S C S r, S = diag(sc) per vertex (a scalar: it commutes with the
+ * frames): still SPD. */
+static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *mask, int inv, const sn_q *sc, const sn_q *r,
+                         sn_q *z, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *P = v->sec[SN_SEC_PRECOND];
     const uint8_t *kk = CARR(h, o_k, uint8_t);
@@ -103,17 +113,22 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
             int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
             if (mask && !mask[i] == !inv) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
             sn_k_rot_t(R + rs * i, r + 3 * i, t, sat);
+            if (sc) scale3(t, sc[i], sat);
             sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
             s[0] = sn_out(a[0], sh, sat);
             s[1] = sn_out(a[1], sh, sat);
             s[2] = sn_out(a[2], sh, sat);
+            if (sc) scale3(s, sc[i], sat);
             sn_k_rot(R + rs * i, s, z + 3 * i, sat);
         }
         return;
     }
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i] == !inv) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
-        else sn_k_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
+        else {
+            sn_k_rot_t(R + rs * i, r + 3 * i, z + 3 * i, sat);
+            if (sc) scale3(z + 3 * i, sc[i], sat);
+        }
     }
     n = ic_forward(v, kk, z, WARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
@@ -128,18 +143,19 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
         if (mask && !mask[i] == !inv) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
+        if (sc) scale3(t, sc[i], sat);
         sn_k_rot(R + rs * i, t, z + 3 * i, sat);
     }
 }
 
 void sn_precond(sn_ihdr *h, const sn_q *r, sn_q *z, uint32_t *sat) {
-    precond_core(h, CARR(h, o_R, sn_q), 9, NULL, 0, r, z, sat);
+    precond_core(h, CARR(h, o_R, sn_q), 9, NULL, 0, NULL, r, z, sat);
 }
 
 void sn_precond_region(sn_ihdr *h, const sn_q *R, const uint8_t *mask, const sn_q *r, sn_q *z, uint32_t *sat) {
-    precond_core(h, R, 0, mask, 0, r, z, sat);
+    precond_core(h, R, 0, mask, 0, NULL, r, z, sat);
 }
 
-void sn_precond_mask(sn_ihdr *h, const uint8_t *mask, int inv, const sn_q *r, sn_q *z, uint32_t *sat) {
-    precond_core(h, CARR(h, o_R, sn_q), 9, mask, inv, r, z, sat);
+void sn_precond_mask(sn_ihdr *h, const uint8_t *mask, int inv, const sn_q *sc, const sn_q *r, sn_q *z, uint32_t *sat) {
+    precond_core(h, CARR(h, o_R, sn_q), 9, mask, inv, sc, r, z, sat);
 }

@@ -397,7 +397,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         sn_adapt_restrict(h, mask, r, sat);
     }
     if (rows) sn_rows_filter(h, r, 1, sat);
-    if (mask) sn_precond_mask(h, mask, 0, r, z, sat); /* the active set's block: z = 0 at inactive rows */
+    if (mask) sn_precond_mask(h, mask, 0, sn_adapt_scales(h), r, z, sat); /* the active set's block, scaled: z = 0 at inactive rows */
     else sn_precond(h, r, z, sat); /* sn_precond.c */
     if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
@@ -419,7 +419,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         axpy(x, alpha, d, n3, sat);
         axpy(r, nalpha, q, n3, sat);
         if (rows) sn_rows_filter(h, r, 1, sat);
-        if (mask) sn_precond_mask(h, mask, 0, r, z, sat);
+        if (mask) sn_precond_mask(h, mask, 0, sn_adapt_scales(h), r, z, sat);
         else sn_precond(h, r, z, sat); /* sn_precond.c */
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
