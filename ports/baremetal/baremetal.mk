@@ -116,7 +116,9 @@ profile-baremetal:
 # ---- hosted determinism drivers (det_main) for every compiler/CPU ----
 CROSS_DIR   = $(BUILD)/cross
 DET_SRCS    = ports/cross/det_main.c $(PORT_COMMON) $(PORT_SN_SRCS)
-DET_CFLAGS  = $(PORT_WARN) -g $(PORT_INC)
+# no -g: the drivers are run, never debugged (-g is a fifth of their compile
+# time and changes no code; rebuild one with -g by hand to trace a mismatch)
+DET_CFLAGS  = $(PORT_WARN) $(PORT_INC)
 # $(1) name, $(2) compiler, $(3) flags
 define det_driver
 DET_CC_$(1) = $(firstword $(2))
