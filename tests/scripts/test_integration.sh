@@ -7,8 +7,10 @@
 #               make's libsinew{,_float}.a; `make install` + pkg-config;
 #               CMake add_subdirectory; CMake find_package after cmake --install
 #               into a temporary prefix; the amalgamation (make amalgamation)
-#   C++         runtime sources compiled as C++ (g++ -x c++ -Wall -Wextra
-#               -Werror), the amalgamation as C++, and the RAII example
+#   C++         runtime sources checked as C++ (g++ -x c++ -Wall -Wextra
+#               -Werror -fsyntax-only: the front end's errors and warnings,
+#               each source alone), the amalgamation compiled as C++ (code
+#               generated), and the RAII example
 #               tests/integration/cpp/sinew_example.cpp at -std=c++11 and c++17
 #   threads     tests/integration/threads/threads.c: 8 instances of one blob on
 #               8 pthreads = one after another = as shared instances on 2 threads
@@ -185,11 +187,11 @@ if [ $have_cxx = 1 ]; then
     for f in runtime/src/*.c; do
         for fl in "" -DSN_FLOAT; do
             n=$((n + 1))
-            $CXX -x c++ -std=c++11 $CXX_WARN $fl -Iruntime/include -c "$f" -o "$D/cxx.o" > "$L/cxx_src.log" 2>&1 ||
+            $CXX -x c++ -std=c++11 $CXX_WARN $fl -Iruntime/include -fsyntax-only "$f" > "$L/cxx_src.log" 2>&1 ||
                 { nbad=$((nbad + 1)); bad "runtime as C++: $f $fl"; sed 's/^/    /' "$L/cxx_src.log" | head -n 20; }
         done
     done
-    [ $nbad -eq 0 ] && ok "runtime as C++: $n compiles (every runtime/src/*.c, fixed and float, g++ -x c++ -std=c++11 $CXX_WARN)"
+    [ $nbad -eq 0 ] && ok "runtime as C++: $n compiles (every runtime/src/*.c, fixed and float, g++ -x c++ -std=c++11 $CXX_WARN -fsyntax-only)"
     if log cxx_amal $CXX -x c++ -std=c++17 $CXX_WARN -I"$AMAL" -c "$AMAL/sinew.c" -o "$D/amal_cxx.o" &&
        log cxx_amal_float $CXX -x c++ -std=c++17 $CXX_WARN -DSN_FLOAT -I"$AMAL" -c "$AMAL/sinew.c" -o "$D/amal_cxx_float.o"; then
         ok "amalgamation as C++17: fixed and float"

@@ -3,7 +3,7 @@
 # (-mfloat-abi=soft, so any float would need a helper call) defines or
 # references no soft-float helper (__aeabi_f*/d*, i2f/f2i..., libgcc
 # __addsf3...), no libm function and no VFP instruction. Positive control:
-# the float flavour of the same runtime objects does reference such helpers,
+# the float flavour of a runtime object (sn_math.c) does reference such helpers,
 # so the check can see them. Host too: the x86-64 fixed library has no SSE/x87
 # float arithmetic (integer SIMD is fine), the float library has.
 . ports/cross/port_lib.sh
@@ -37,7 +37,7 @@ else bad "fixed runtime objects reference:" $hits; fi
 
 # positive control: the float flavour must show up
 if pmake bm-float-objs > "$L/build_float.log" 2>&1; then
-    fobjs=$(for s in $(pmake print-port-sn-srcs); do echo "$BUILD/baremetal/obj-float/${s%.c}.o"; done)
+    fobjs=$(for s in $(pmake print-bm-float-control); do echo "$BUILD/baremetal/obj-float/${s%.c}.o"; done)
     n=$(arm-none-eabi-nm -u $fobjs 2>/dev/null | awk '{print $NF}' | grep -E "$FLOAT_RE" | sort -u | wc -l)
     if [ "$n" -gt 0 ]; then ok "control: float flavour references $n float helpers (the check sees them)"
     else bad "control: float flavour shows no float helper; the check is blind"; fi
