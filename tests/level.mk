@@ -37,6 +37,12 @@ $(BUILD)/tests/adapt_runtime_float: tests/test_runtime_adapt.c $(SN_TEST_HDRS) t
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/adapt_runtime $(BUILD)/tests/adapt_runtime_float
+# adaptation's scales on a hostile level map (every detail vertex in one cell,
+# masses at the limit): the ASan + UBSan runtime objects of the blob fuzzer
+$(BUILD)/tests/test_runtime_adapt_hostile: tests/fuzz/adapt_hostile.c $(SN_TEST_HDRS) $(SN_FUZZ_OBJS_nock) $(LEVEL_EX)/cow_adapt.blob
+	@mkdir -p $(@D)
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -Itests -o $@ $< $(SN_FUZZ_OBJS_nock) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_adapt_hostile
 
 $(BUILD)/tests/level_runtime: tests/test_runtime_level.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(LEVEL_BLOBS)
 	@mkdir -p $(@D)

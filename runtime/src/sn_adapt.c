@@ -209,12 +209,20 @@ static void k_reduced(sn_ihdr *h, const sn_view *t) {
     }
 }
 
-/* fixed: the masses summed in units of 2^5 (each m < 2^31 -> < 2^26; a source takes itself and at
- * most 26 inactive neighbours with sum phi <= 7: < 2^29, an int32); float: as they are */
+/* fixed: the masses summed in units of 2^5 (each |m| <= 2^27, validated -> 2^22; on a baked
+ * lattice a source takes itself and at most 26 inactive neighbours with sum phi <= 7: < 2^26).
+ * A hostile blob's LEVEL_UP may send every level-1 vertex to one cell (up to 2^16 terms, 2^38):
+ * the sum saturates at the int32 range there instead of overflowing; float: as they are
+ * (< 2^43, finite) */
 #if defined(SN_FLOAT)
 #define M_SH(x, s) (x)
+SN_INLINE sn_q m_add(sn_q a, sn_q b) { return a + b; }
 #else
 #define M_SH(x, s) ((sn_q)sn_rshr64((x), (s)))
+SN_INLINE sn_q m_add(sn_q a, sn_q b) {
+    int64_t t = (int64_t)a + b;
+    return (sn_q)(t > INT32_MAX ? INT32_MAX : (t < INT32_MIN ? INT32_MIN : t));
+}
 #endif
 /* The reduced operator's preconditioner scales (NUMERICS.md "Adaptation"). A
  * source row c of P^T A P carries its inactive vertices' functions: its lumped
@@ -238,7 +246,7 @@ static void scales(sn_ihdr *h, const sn_view *t) {
         if (m[w]) continue;
         sources(h, t, w, c, phi);
         for (a = 0; a < 8; a++) /* Q30 x m rounded to M's units (sum bound above) */
-            if (c[a] < nF) M[c[a]] += M_SH(sn_mul(phi[a], rd_real(ml, w)), SN_Q_ROT + 5);
+            if (c[a] < nF) M[c[a]] = m_add(M[c[a]], M_SH(sn_mul(phi[a], rd_real(ml, w)), SN_Q_ROT + 5));
     }
     for (w = 0; w < n; w++) {
         sn_q mw = M_SH(rd_real(ml, w), 5);
