@@ -141,6 +141,21 @@ static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, co
     return 1;
 }
 
+/* Vertex a's predicted velocity (free: v + h^2 g; skeleton: v) and start
+ * point (free: pos; skeleton: pos - v, where it was), component q: from
+ * ct_predict's arrays when they hold (vpre, pst not NULL), else summed here
+ * with the per-use clamp count. */
+SN_INLINE sn_q ct_vel(const sn_ihdr *h, const sn_q *vpre, uint32_t a, uint32_t q, uint32_t *sat) {
+    const sn_q *vel = CARR(h, o_vel, sn_q);
+    if (a >= h->v.nF) return vel[3 * a + q];
+    return vpre ? vpre[3 * a + q] : sn_add(vel[3 * a + q], h->v.grav[q], sat);
+}
+SN_INLINE sn_q ct_start(const sn_ihdr *h, const sn_q *pst, uint32_t a, uint32_t q, uint32_t *sat) {
+    const sn_q *pos = CARR(h, o_pos, sn_q);
+    if (a < h->v.nF) return pos[3 * a + q];
+    return pst ? pst[3 * (a - h->v.nF) + q] : sn_add(pos[3 * a + q], -CARR(h, o_vel, sn_q)[3 * a + q], sat);
+}
+
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat);
 
 /* The yield bound (NUMERICS.md "Contacts"): the most normal velocity change
@@ -155,7 +170,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
 static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, const sn_q *vp,
                      uint32_t *sat) {
     const sn_view *v = &h->v;
-    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    const sn_q *pos = CARR(h, o_pos, sn_q);
     const sn_q dv = (sn_q)(v->cell / 2), dmax = (sn_q)(v->cell / 2);
     sn_q m = SN_LIM_OR_BIG;
     uint32_t k, q;
@@ -166,8 +181,7 @@ static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const 
         if (a >= v->nF || !(phi[k] > 0)) continue;
         sn_skinned(h, a, sk, sat);
         for (q = 0; q < 3; q++)
-            d += sn_mul(n[q], sn_add(sn_add(pos[3 * a + q], vp ? vp[3 * a + q] : sn_add(vel[3 * a + q], v->grav[q], sat), sat),
-                                     -sk[q], sat));
+            d += sn_mul(n[q], sn_add(sn_add(pos[3 * a + q], ct_vel(h, vp, a, q, sat), sat), -sk[q], sat));
         dev = sn_out(d, 30, sat);
         room = sn_add(dmax, -dev, sat);
         if (room > dv) room = dv;
@@ -227,7 +241,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     sn_row *rows = sn_rows(h);
     sn_q A[SN_MAX_COLLIDERS][3], B[SN_MAX_COLLIDERS][3], R[SN_MAX_COLLIDERS], V[SN_MAX_COLLIDERS][3];
     sn_q cap = (sn_q)(v->cell / 8);
-    const sn_q *pst = CARR(h, o_d, sn_q), *vpre; /* ct_predict's */
+    const sn_q *pst, *vpre; /* ct_predict's (vpre NULL: not holding) */
     uint32_t c, s, k, first = h->n_rows, ncol = h->n_col;
     uint32_t q;
     int exact;
@@ -250,6 +264,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     exact = 0;
 #endif
     vpre = exact ? CARR(h, o_q, sn_q) : NULL;
+    pst = CARR(h, o_d, sn_q);
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
@@ -275,7 +290,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
-        if (exact)
+        if (exact) /* the hot loop: each corner's two rows read straight from the arrays */
             for (k = 0; k < 8; k++) {
                 const uint32_t a = vx[k];
                 const sn_q *pp = a < v->nF ? pos + 3 * a : pst + 3 * (a - v->nF), *vv = a < v->nF ? vpre + 3 * a : vel + 3 * a;
@@ -283,16 +298,11 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
             }
         else
-            for (k = 0; k < 8; k++) {
-                uint32_t a = vx[k];
+            for (k = 0; k < 8; k++)
                 for (q = 0; q < 3; q++) {
-                    sn_q vq = vel[3 * a + q];
-                    sn_q pq = a < v->nF ? pos[3 * a + q] : sn_add(pos[3 * a + q], -vq, sat);
-                    if (a < v->nF) vq = sn_add(vq, v->grav[q], sat);
-                    sp[q] += sn_mul(phi[k], pq);
-                    sv[q] += sn_mul(phi[k], vq);
+                    sp[q] += sn_mul(phi[k], ct_start(h, NULL, vx[k], q, sat));
+                    sv[q] += sn_mul(phi[k], ct_vel(h, NULL, vx[k], q, sat));
                 }
-            }
         for (q = 0; q < 3; q++) {
             P[q] = sn_out(sp[q], 30, sat);
             Vp[q] = sn_out(sv[q], 30, sat);
@@ -389,7 +399,6 @@ static void cross30(const sn_q a[3], const sn_q b[3], sn_q o[3], uint32_t *sat) 
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_col *cols = CARR(h, o_col, sn_col);
-    const sn_q *vel = CARR(h, o_vel, sn_q);
     const sn_rowx *rx = CWARR(h, o_rx, sn_rowx);
     uint32_t j, k, q;
     for (j = first; j < end; j++) {
@@ -405,11 +414,7 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
 #endif
         if (h->contacts + 1u > v->nCt) { h->contact_overflow = sn_count(h->contact_overflow, 1); continue; }
         for (k = 0; k < r.n; k++)
-            for (q = 0; q < 3; q++) {
-                sn_q vq = vel[3 * r.vtx[k] + q];
-                if (r.vtx[k] < v->nF) vq = vpre ? vpre[3 * r.vtx[k] + q] : sn_add(vq, v->grav[q], sat);
-                sv[q] += sn_mul(r.w[k], vq);
-            }
+            for (q = 0; q < 3; q++) sv[q] += sn_mul(r.w[k], ct_vel(h, vpre, r.vtx[k], q, sat));
         for (q = 0; q < 3; q++) {
             vp[q] = sn_out(sv[q], 30, sat);
             rel[q] = sn_add(vp[q], -V[c][q], sat);
