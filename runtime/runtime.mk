@@ -138,12 +138,15 @@ fuzz-blobs: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_fl
 	    BUILD=$(BUILD) $(BUILD)/tests/$$t --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16 || exit 1; done
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
-$(BUILD)/bench/sn_bench: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
+# (--contact: the determinism driver's contact scenario, ports/cross/sn_det.c)
+BENCH_DET = ports/cross/sn_det.c ports/common/sn_clip.c ports/common/sn_clip_pose.c
+BENCH_DEPS = runtime/bench/bench.c runtime/bench/bench_common.h $(BENCH_DET) ports/cross/sn_det.h ports/common/sn_clip.h $(SN_HDRS)
+$(BUILD)/bench/sn_bench: $(BENCH_DEPS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
-$(BUILD)/bench/sn_bench_float: runtime/bench/bench.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FLOAT)
+	$(CC) $(HOST_CFLAGS) $(SN_INC) -Iruntime/src -Iports/cross -Iports/common -o $@ $< $(BENCH_DET) $(SN_LIB_FIXED) -lm
+$(BUILD)/bench/sn_bench_float: $(BENCH_DEPS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -o $@ $< $(SN_LIB_FLOAT) -lm
+	$(CC) $(HOST_CFLAGS) -DSN_FLOAT $(SN_INC) -Iruntime/src -Iports/cross -Iports/common -o $@ $< $(BENCH_DET) $(SN_LIB_FLOAT) -lm
 # many instances sharing one blob (issue 15 item 5): runtime/bench/herd.c
 $(BUILD)/bench/sn_herd: runtime/bench/herd.c runtime/bench/bench_common.h $(SN_HDRS) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)

@@ -28,6 +28,7 @@
 
 #include "sinew.h"
 #include "bench_common.h" /* FLAV, LEN, DEG, bench_load, bench_cmp_d, bench_pose */
+#include "sn_det.h"          /* sn_det_contact: --contact */
 #include "sn_format.h"
 #include "sn_kernels.h" /* sn_kernels_name: the library's SIMD path */
 
@@ -62,39 +63,6 @@ static double step_macs(uint32_t nV, uint32_t nF, uint32_t nC, uint32_t fc, uint
 
 static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-/* sn_det_contact's colliders and pins (ports/cross/sn_det.c), on a fresh instance */
-static void bench_contact(sn_instance *inst, const sn_blob_info *bi) {
-    sn_collider col[2];
-    sn_constraint con[4];
-    sn_vec3 p;
-    sn_real ylow = 0;
-    uint32_t s, i;
-    for (s = 0; s < bi->surface_vertices; s++) {
-        (void)sn_get_surface(inst, &p, s, 1);
-        if (s == 0 || p.y < ylow) ylow = p.y;
-    }
-    memset(col, 0, sizeof col);
-    col[0].kind = SN_COLLIDER_PLANE;
-    col[0].a.y = ylow + LEN(3277 / 65536.0);
-    col[0].b.y = LEN(1.0);
-    col[1].kind = SN_COLLIDER_SPHERE;
-    col[1].a.y = ylow - LEN(45875 / 65536.0);
-    col[1].radius = LEN(1.0);
-    col[1].velocity.y = LEN(19661 / 65536.0);
-    memset(con, 0, sizeof con);
-    for (i = 0; i < 4; i++) {
-        static const uint32_t pick[4] = {2126u, 2362u, 1732u, 2901u};
-        con[i].at = SN_AT_SURFACE;
-        con[i].vertex = pick[i] % bi->surface_vertices;
-        (void)sn_get_surface(inst, &p, con[i].vertex, 1);
-        con[i].target = p;
-        con[i].target.y = p.y + LEN(6554 / 65536.0);
-        con[i].axes = i == 3 ? SN_AXIS_Y : 0;
-    }
-    if (sn_set_colliders(inst, col, 2) != SN_OK || sn_set_constraints(inst, con, 4) != SN_OK)
-        fprintf(stderr, "sn_bench: --contact: colliders or constraints refused\n");
 }
 
 static int bench_blob(const char *path, int only_steps, int contact) {
@@ -135,9 +103,15 @@ static int bench_blob(const char *path, int only_steps, int contact) {
     if (!mem || !local || !xf || !surf || !ts) return 2;
     if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
     if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
+        if (contact) { /* the determinism driver's scenario itself (back to rest, then its colliders and pins) */
+            sn_det d;
+            memset(&d, 0, sizeof d);
+            d.blob = blob;
+            d.inst = inst;
+            if (!sn_det_contact(&d)) fprintf(stderr, "sn_bench: --contact: %s has no room for the contact scenario\n", path);
+        }
         bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
-        if (contact) bench_contact(inst, &info);
         for (k = 0; k < only_steps; k++) sn_step(inst);
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
         return 0;
