@@ -193,6 +193,7 @@ typedef struct sb_desc {
     double cr_exclude;               /* mesh units; < 0: default (one cell): seed pairs closer than this in the rest pose are not collisions */
     int cr_line;                     /* line of 'crease_settings' (0: none) */
     int levels, levels_line;         /* 'levels N': 1, or 2 with the lattice subdivided once (sb_level.c) */
+    int lod_level;                   /* 0; 1 in the level-1 description sb_level_desc derives (rig files pick that level's fit) */
     int adapt_line, adapt_max;       /* 'adapt REFINE COARSEN MAX_ACTIVE' (with levels 2; 0: none): A_max */
     double adapt_refine, adapt_coarsen; /* level-0 cells */
 } sb_desc;

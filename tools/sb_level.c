@@ -547,27 +547,40 @@ static uint32_t inst_bytes(const sb_model *o, int nV, int nF, int nC)
                                  : 0u);
 }
 
+void sb_level_desc(const sb_desc *d, const sb_model *o, sb_desc *d2)
+{
+    int i;
+    *d2 = *d;   /* shallow: only cell, origin, blend and crease differ */
+    d2->cell = 0.5 * o->c;
+    d2->has_origin = 1;
+    for (i = 0; i < 3; i++) d2->origin[i] = o->gorg[i];   /* the coarse grid's corner: every coarse vertex is a fine one */
+    d2->blend = d->blend > 0 ? d->blend : d->cell;        /* the same frames */
+    d2->ncrease = 0;                                      /* the crease data is the surface's: shared */
+    d2->lod_level = 1;
+}
+
+int sb_level_model(const sb_desc *d, const sb_desc *d2, const sb_mesh *m, sb_model *o2)
+{
+    /* bones: given radii stay; automatic ones are re-derived at the finer cell (at least 1.25 cells, so a
+     * thin limb keeps free flesh: with the coarse radii, rigs on thin parts touch no free vertex) */
+    if (sb_build(d2, m, o2, 1) || sb_rig_build(d2, m, o2) || sb_force_build(d2, o2) || sb_segment_build(d2, m, o2)) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", sb_error());
+        return sb_fail("%s:%d: levels 2: the subdivided lattice (cell %g): %s", d->path, d->levels_line, d2->cell, msg);
+    }
+    return 0;
+}
+
 int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, int quiet, sb_blob *b, sb_lodinfo *info)
 {
-    sb_desc d2 = *d;   /* shallow: only cell, origin, blend and crease differ */
+    sb_desc d2;
     sb_model o2;
     sb_blob b0, b1;
     uint16_t *up = NULL, *down = NULL;
-    int i, rc = -1, nF, nS, nC;
+    int rc = -1, nF, nS, nC;
     memset(&o2, 0, sizeof o2); memset(&b0, 0, sizeof b0); memset(&b1, 0, sizeof b1);
-    d2.cell = 0.5 * o->c;
-    d2.has_origin = 1;
-    for (i = 0; i < 3; i++) d2.origin[i] = o->gorg[i];   /* the coarse grid's corner: every coarse vertex is a fine one */
-    d2.blend = d->blend > 0 ? d->blend : d->cell;       /* the same frames */
-    d2.ncrease = 0;                                      /* the crease data is the surface's: shared */
-    /* bones: given radii stay; automatic ones are re-derived at the finer cell (at least 1.25 cells, so a
-     * thin limb keeps free flesh: with the coarse radii, rigs on thin parts touch no free vertex) */
-    if (sb_build(&d2, m, &o2, 1) || sb_rig_build(&d2, m, &o2) || sb_force_build(&d2, &o2) || sb_segment_build(&d2, m, &o2)) {
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", sb_error());
-        sb_fail("%s:%d: levels 2: the subdivided lattice (cell %g): %s", d->path, d->levels_line, d2.cell, msg);
-        goto done;
-    }
+    sb_level_desc(d, o, &d2);
+    if (sb_level_model(d, &d2, m, &o2)) goto done;
     /* shared surface data */
     o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
     o2.cr_vnbr = o->cr_vnbr; o2.cr_tnbr = o->cr_tnbr; o2.cr_list = o->cr_list; o2.cr_active = o->cr_active;

@@ -82,6 +82,12 @@ typedef struct sb_lodinfo {
     int up_far, down_far;   /* vertices of one level outside every kept cell of the other (nearest cell, clamped) */
     uint32_t inst0, inst1, inst;   /* instance bytes of level 0 alone, level 1 alone, the two-level instance */
 } sb_lodinfo;
+/* The level-1 description of d (built as o): d shallow-copied (d2 shares d's arrays: free only one)
+ * with cell o->c / 2 on o's grid corner, o's frame blend width, no crease lines, lod_level 1. */
+void sb_level_desc(const sb_desc *d, const sb_model *o, sb_desc *d2);
+/* level 1's model from d2 (sb_level_desc of d) and m: lattice, rigs, forces, segment meshes
+ * (not the crease data: o's, shared by sb_level_bake). Errors name d's 'levels' line. 0 or -1. */
+int sb_level_model(const sb_desc *d, const sb_desc *d2, const sb_mesh *m, sb_model *o2);
 int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, int quiet, sb_blob *b, sb_lodinfo *info);
 
 #endif
