@@ -280,7 +280,7 @@ int main(void)
         memset(&o, 0, sizeof o);
         T_CHECK(sb_desc_load(COW, &d) == 0 && sb_mesh_load_obj(d.mesh_path, &mm) == 0, "cow");
         T_CHECK(sb_rigfile_read(tpath("test_rigfit_biceps.rig"), &rf) == 0, "read back");
-        T_CHECK(sb_rigfile_apply(&rf, "biceps.rig", &o, &mm, vert, Q, &n, &drop) == -1 && strstr(sb_error(), "fitted to another character"),
+        T_CHECK(sb_rigfile_apply(&rf, "biceps.rig", &o, &mm, 0, vert, Q, &n, &drop) == -1 && strstr(sb_error(), "fitted to another character"),
                 "wrong character refused: %s", sb_error());
         printf("  wrong character: %s\n", sb_error());
         sb_rigfile_free(&rf);

@@ -377,26 +377,39 @@ double sb_rig_tau(const sb_rigdef *r, double gamma);
 const char *sb_rig_tpl_name(int tpl);
 
 /* ---- rig files (sb_rigfile.c; tools/DESCRIPTION.md "Rig files") ----
- * A fitted generalized force field (seed 003 eq. 13) keyed by lattice rest positions. */
-typedef struct sb_rigfile {
-    int mesh_nv;            /* identity of the character: mesh vertex count and sb_mesh_crc */
-    uint32_t mesh_crc;
+ * A fitted generalized force field (seed 003 eq. 13) keyed by lattice rest positions:
+ * one fit per lattice (cell size), e.g. level 0 and level 1 of 'levels 2'. */
+#define SB_RIGFILE_FITS 4
+typedef struct sb_rigfit {
     double cell, origin[3]; /* lattice the keys lie on (mesh units) */
     int n;
     double *x;              /* n x 3 rest positions, mesh units */
     double *Q;              /* n x 3 forces at eta = 1, newtons, rest model axes */
+    int line;               /* the file's line of its 'cell' */
+} sb_rigfit;
+typedef struct sb_rigfile {
+    int mesh_nv;            /* identity of the character: mesh vertex count and sb_mesh_crc */
+    uint32_t mesh_crc;
+    int nfit;               /* 1 ('sinew-rig 1'), 1..SB_RIGFILE_FITS ('sinew-rig 2'), distinct cells */
+    sb_rigfit fit[SB_RIGFILE_FITS];
 } sb_rigfile;
 /* CRC-32 of the mesh's vertex coordinates as little-endian IEEE doubles */
 uint32_t sb_mesh_crc(const sb_mesh *m);
 int sb_rigfile_read(const char *path, sb_rigfile *rf);
 void sb_rigfile_free(sb_rigfile *rf);
+/* the fit whose cell is cell (within 1e-9 of it), NULL if none */
+const sb_rigfit *sb_rigfile_pick(const sb_rigfile *rf, double cell);
 /* write Q (o->nf x 3: per free vertex, newtons, rest model axes; zero rows left out) for
  * model o baked from mesh m; comment lines (may hold newlines) go after the first line */
 int sb_rigfile_write(const char *path, const sb_model *o, const sb_mesh *m, const double *Q, const char *comment);
-/* the file's forces on o's free vertices: vert (o->nf ints) and Q (o->nf x 3) get the nout
- * non-zero entries, increasing vertex order; ndrop: entries on no free vertex (skeleton or
- * outside the lattice). Errors: another mesh, another cell, keys off the grid, nothing left. */
-int sb_rigfile_apply(const sb_rigfile *rf, const char *path, const sb_model *o, const sb_mesh *m, int *vert, double *Q, int *nout, int *ndrop);
+/* the same for nfit models of one mesh (distinct cells: the levels of 'levels 2'), one fit
+ * each ('sinew-rig 2' when nfit > 1; nfit 1 writes what sb_rigfile_write does) */
+int sb_rigfile_write_fits(const char *path, int nfit, const sb_model *const *o, const sb_mesh *m, const double *const *Q, const char *comment);
+/* the file's fit for o's cell, on o's free vertices: vert (o->nf ints) and Q (o->nf x 3) get the
+ * nout non-zero entries, increasing vertex order; ndrop: entries on no free vertex (skeleton or
+ * outside the lattice). level: the level of detail o is (for the message when no fit matches).
+ * Errors: another mesh, no fit for this cell, keys off the grid, nothing left. */
+int sb_rigfile_apply(const sb_rigfile *rf, const char *path, const sb_model *o, const sb_mesh *m, int level, int *vert, double *Q, int *nout, int *ndrop);
 
 /* ---- external forces (sb_force.c) ---- */
 /* share profiles from the description's 'force' lines, per free vertex */
@@ -478,5 +491,9 @@ int sb_write_c_array(const char *path, const char *symbol, const unsigned char *
 
 /* ---- whole bake (sb_bake.c) ---- */
 int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_blob *b);
+/* level 1 of a 'levels 2' description alone, as sb_level_bake builds it (sb_level_desc,
+ * sb_level_model): o its model (rigs included), b its blob without crease data (the
+ * surface's, which the two-level blob shares from level 0). 0 or -1 (sb_error). */
+int sb_bake_level1(const char *desc_path, int flavour, sb_model *o, sb_blob *b);
 
 #endif /* SB_H */

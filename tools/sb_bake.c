@@ -116,3 +116,23 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
     sb_desc_free(&d);
     return 0;
 }
+
+int sb_bake_level1(const char *desc_path, int flavour, sb_model *o, sb_blob *b)
+{
+    sb_desc d, d2;
+    sb_mesh m;
+    sb_model o0;
+    int rc = -1;
+    memset(o, 0, sizeof *o); memset(b, 0, sizeof *b); memset(&m, 0, sizeof m); memset(&o0, 0, sizeof o0);
+    if (sb_desc_load(desc_path, &d)) { sb_desc_free(&d); return -1; }
+    if (d.levels < 2) { sb_desc_free(&d); return sb_fail("%s: no 'levels 2': the description has no level 1", desc_path); }
+    if (sb_desc_mesh(&d, &m, NULL)) goto done;
+    /* level 0's lattice fixes level 1's (cell, grid corner), exactly as sb_level_bake derives it */
+    if (sb_build(&d, &m, &o0, 1)) goto done;
+    sb_level_desc(&d, &o0, &d2);
+    if (sb_level_model(&d, &d2, &m, o) || sb_blob_make(o, flavour, b)) { sb_model_free(o); goto done; }
+    rc = 0;
+done:
+    sb_model_free(&o0); sb_mesh_free(&m); sb_desc_free(&d);
+    return rc;
+}

@@ -35,14 +35,20 @@ void sb_quat_rotvec(const double q0[4], double r[3])
     for (k = 0; k < 3; k++) r[k] = sn > 1e-300 ? q[k] / sn * th : 2 * q[k];
 }
 
-int sb_fit_open(sb_fit *F, const char *desc, int quiet)
+int sb_fit_open(sb_fit *F, const char *desc, int quiet) { return sb_fit_open_level(F, desc, 0, quiet); }
+
+int sb_fit_open_level(sb_fit *F, const char *desc, int level, int quiet)
 {
     char err[300];
     unsigned c;
     memset(F, 0, sizeof *F);
     snprintf(F->desc, sizeof F->desc, "%s", desc);
     F->quiet = quiet;
-    if (sb_bake_file(desc, SB_DOUBLE, 1, &F->o, &F->b)) { fprintf(stderr, "sinew-rig: error: %s\n", sb_error()); return -1; }
+    F->level = level;
+    if (level ? sb_bake_level1(desc, SB_DOUBLE, &F->o, &F->b) : sb_bake_file(desc, SB_DOUBLE, 1, &F->o, &F->b)) {
+        fprintf(stderr, "sinew-rig: error: %s%s\n", level ? "level 1: " : "", sb_error());
+        return -1;
+    }
     if (snref_load(&F->m, F->b.bytes, F->b.size, err, sizeof err)) { fprintf(stderr, "sinew-rig: reading the baked blob: %s\n", err); return -1; }
     if (snref_init(&F->s, &F->m)) { fprintf(stderr, "sinew-rig: out of memory\n"); return -1; }
     if (sb_desc_load(desc, &F->d) || sb_mesh_load_obj(F->d.mesh_path, &F->mesh)) {

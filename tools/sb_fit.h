@@ -26,6 +26,7 @@ typedef struct sb_fit {
     double *p0;             /* nV x 3: static equilibrium at the current pose (internal units) */
     double *surf0;          /* nS x 3: its surface, description coordinates */
     int quiet;
+    int level;              /* level of detail the bake is (sb_fit_open_level) */
     /* sb_fit_pose: the shape the feature points are read on: 0 the rigidly framed
      * ("skinned") lattice (default), 1 the static equilibrium at the pose with the
      * rigs times pose_rig_scale (one solve per evaluation, sag included) */
@@ -38,6 +39,9 @@ typedef struct sb_fit {
 
 /* bake desc (float64), load the reference model, read the mesh. 0, or -1 with a message on stderr */
 int sb_fit_open(sb_fit *F, const char *desc, int quiet);
+/* the same on one level of detail: 0 as sb_fit_open, 1 level 1 of a 'levels 2' description alone
+ * (sb_bake_level1: its own lattice and rigs; F->d stays the description as written) */
+int sb_fit_open_level(sb_fit *F, const char *desc, int level, int quiet);
 void sb_fit_close(sb_fit *F);
 /* pose the model (transforms per joint), factor A, solve the static equilibrium
  * with every rig at the current controls times rig_scale (0: rigs off) into p0/surf0. 0 or -1 */

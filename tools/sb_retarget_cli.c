@@ -27,7 +27,8 @@ static void usage(FILE *f, const char *prog)
             "J_i at every lattice vertex (eq. 16),\n"
             "and transfers the rigs' generalized force: Q_A -> q_A (static equilibrium at rest, eq. 10) ->\n"
             "J_i q_A,i -> B's lattice -> Q_B = K_B q_B. Writes Q_B as a rig file (tools/DESCRIPTION.md \"Rig\n"
-            "files\") that B's description includes with 'rig_file NAME FILE CONTROL'.\n"
+            "files\") that B's description includes with 'rig_file NAME FILE CONTROL'. One fit, on B's level-0\n"
+            "lattice: a B with 'levels 2' is refused (tools/DESCRIPTION.md \"Retargeting\", two levels).\n"
             "  --rig LIST        rigs of A, comma-separated, summed at eta = 1 (e.g. smile_l,smile_r)\n"
             "  -o OUT.rig        the rig of B (written to OUT.rig.tmp, then renamed)\n"
             "  --name NAME       the rig's name in the printed rig_file line (default: the first rig's name)\n"
@@ -204,6 +205,13 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
     opt.verbose = !quiet;
     if (sb_rt_char_load(pa, &A)) { fprintf(stderr, "%s: error: A: %s\n", prog, sb_error()); goto done; }
     if (sb_rt_char_load(pb, &B)) { fprintf(stderr, "%s: error: B: %s\n", prog, sb_error()); goto done; }
+    if (B.d.levels > 1) {   /* the transfer is to B's level-0 lattice: a one-fit file, which B's level 1 refuses */
+        fprintf(stderr, "%s: error: B: %s:%d: 'levels 2': retarget writes one fit, on B's level-0 lattice, and level 1 needs its own; retarget to B "
+                "without 'levels 2', then fit both levels to that rig's static shape (sinew-bake --static ... -o T.obj; sinew-rig fit-surface on B "
+                "with 'levels 2' --target T.obj; tools/DESCRIPTION.md \"Retargeting\")\n", prog, B.d.path, B.d.levels_line);
+        rc = 2;
+        goto done;
+    }
     if (!quiet)
         printf("retarget: A %s: %d surface vertices, lattice %d (%d free), %d joints; B %s: %d surface vertices, lattice %d (%d free), %d joints (%.2f s)\n",
                pa, A.m.nv, A.o.nv, A.o.nf, A.o.nj, pb, B.m.nv, B.o.nv, B.o.nf, B.o.nj, sb_now() - t0);

@@ -272,7 +272,7 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
             free(Qv);
             rg->vert = sb_alloc(sizeof(int) * (size_t)(o->nf ? o->nf : 1));
             rg->Q = sb_alloc(sizeof(double) * 3 * (size_t)(o->nf ? o->nf : 1));
-            if (sb_rigfile_read(rg->def.file, &rf) || sb_rigfile_apply(&rf, rg->def.file, o, m, rg->vert, rg->Q, &rg->n, &drop)) {
+            if (sb_rigfile_read(rg->def.file, &rf) || sb_rigfile_apply(&rf, rg->def.file, o, m, d->lod_level, rg->vert, rg->Q, &rg->n, &drop)) {
                 char msg[2048];
                 snprintf(msg, sizeof msg, "%s", sb_error());
                 sb_rigfile_free(&rf); free(need); free(F.slot); free(F.frac);
@@ -280,7 +280,8 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
             }
             if (drop)
                 fprintf(stderr, "sinew-bake: warning: %s:%d: rig '%s': %d of the %d forces of '%s' fall on no free lattice vertex "
-                        "(skeleton or outside this lattice) and are dropped\n", d->path, rg->def.line, rg->def.name, drop, rf.n, rg->def.file);
+                        "(skeleton or outside this lattice) and are dropped%s\n", d->path, rg->def.line, rg->def.name, drop,
+                        sb_rigfile_pick(&rf, o->c)->n, rg->def.file, d->lod_level ? " (level 1 of 'levels 2')" : "");
             for (i = 0; i < rg->n; i++) {
                 rg->qmax = fmax(rg->qmax, sqrt(dot3(rg->Q + 3 * i, rg->Q + 3 * i)));
                 for (k = 0; k < 3; k++) rg->total[k] += rg->Q[3 * i + k];

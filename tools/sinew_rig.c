@@ -62,6 +62,9 @@ static void usage(FILE *f)
         "      rigs of character A carried to character B (seed 003 4.4): a map of A's lattice onto B,\n"
         "      its Jacobians, the rig moved as a displacement; written as a rig file of B\n"
         "      (sinew-rig retarget --help)\n"
+        "Two levels: with 'levels 2' in DESC, fit-surface and export write a fit per level ('sinew-rig 2'\n"
+        "files: level 1's computed on level 1's own lattice; tools/DESCRIPTION.md 'Rig files'); retarget\n"
+        "refuses a B with 'levels 2'.\n"
         "Common options: --quiet (no progress or summary), --progress N (a progress line every N\n"
         "iterations, default 10), --help.\n"
         "Progress lines (stderr): LABEL: iter N  f COST  |pg|inf PROJECTED-GRADIENT. Exit status: 0, 1 (a\n"
@@ -332,22 +335,38 @@ static FILE *check_readable(const char *path, const char *what)
 
 static int cmd_export(const opts_t *o)
 {
-    sb_fit F;
-    int a, i, k, rc = 1;
-    double *Q;
+    sb_fit F[2];
+    int a[2], i, k, l, nl, rc = 1;
+    double *Q[2] = {NULL, NULL};
+    const sb_model *om[2];
+    const double *Qc[2];
     char note[1200];
     if (!o->export_rig || !o->out) { fprintf(stderr, PROG ": export DESC RIG -o OUT.rig\n"); return 2; }
-    if (sb_fit_open(&F, o->desc, 1)) return 1;
-    for (a = 0; a < F.o.nrig && strcmp(F.o.rig[a].def.name, o->export_rig); a++) {}
-    if (a == F.o.nrig) { fprintf(stderr, PROG ": the description has no rig '%s'\n", o->export_rig); sb_fit_close(&F); return 2; }
-    Q = calloc(3 * (size_t)F.o.nf + 3, sizeof *Q);
-    for (i = 0; i < F.o.rig[a].n; i++) for (k = 0; k < 3; k++) Q[3 * F.o.rig[a].vert[i] + k] = F.o.rig[a].Q[3 * i + k];
-    snprintf(note, sizeof note, "exported by sinew-rig from rig '%s' of %s (template %s, strength %g): forces at eta = 1", o->export_rig, o->desc,
-             sb_rig_tpl_name(F.o.rig[a].def.tpl), F.o.rig[a].def.s);
-    if (sb_rigfile_write(o->out, &F.o, &F.mesh, Q, note)) fprintf(stderr, PROG ": %s\n", sb_error());
-    else { rc = 0; if (!o->quiet) printf("sinew-rig: wrote %s (%d forces of rig '%s')\n", o->out, F.o.rig[a].n, o->export_rig); }
-    free(Q);
-    sb_fit_close(&F);
+    memset(F, 0, sizeof F);
+    if (sb_fit_open(&F[0], o->desc, 1)) return 1;
+    nl = F[0].d.levels > 1 ? 2 : 1;   /* 'levels 2': level 1's rig too, integrated on its own lattice */
+    if (nl > 1 && sb_fit_open_level(&F[1], o->desc, 1, 1)) { sb_fit_close(&F[0]); return 1; }
+    for (l = 0; l < nl; l++) {
+        for (a[l] = 0; a[l] < F[l].o.nrig && strcmp(F[l].o.rig[a[l]].def.name, o->export_rig); a[l]++) {}
+        if (a[l] == F[l].o.nrig) { fprintf(stderr, PROG ": the description has no rig '%s'\n", o->export_rig); rc = 2; goto done; }
+        Q[l] = calloc(3 * (size_t)F[l].o.nf + 3, sizeof *Q[l]);
+        for (i = 0; i < F[l].o.rig[a[l]].n; i++) for (k = 0; k < 3; k++) Q[l][3 * F[l].o.rig[a[l]].vert[i] + k] = F[l].o.rig[a[l]].Q[3 * i + k];
+        om[l] = &F[l].o; Qc[l] = Q[l];
+    }
+    snprintf(note, sizeof note, "exported by sinew-rig from rig '%s' of %s (template %s, strength %g): forces at eta = 1%s", o->export_rig, o->desc,
+             sb_rig_tpl_name(F[0].o.rig[a[0]].def.tpl), F[0].o.rig[a[0]].def.s, nl > 1 ? "\nlevels 2: a fit on each level's lattice (level 0, then level 1)" : "");
+    if (sb_rigfile_write_fits(o->out, nl, om, &F[0].mesh, Qc, note)) fprintf(stderr, PROG ": %s\n", sb_error());
+    else {
+        rc = 0;
+        if (!o->quiet && nl == 1) printf("sinew-rig: wrote %s (%d forces of rig '%s')\n", o->out, F[0].o.rig[a[0]].n, o->export_rig);
+        if (!o->quiet && nl > 1)
+            printf("sinew-rig: wrote %s (%d forces of rig '%s' on level 0, cell %g; %d on level 1, cell %g)\n", o->out, F[0].o.rig[a[0]].n, o->export_rig,
+                   F[0].o.c, F[1].o.rig[a[1]].n, F[1].o.c);
+    }
+done:
+    free(Q[0]); free(Q[1]);
+    sb_fit_close(&F[0]);
+    if (nl > 1) sb_fit_close(&F[1]);
     return rc;
 }
 
@@ -426,21 +445,56 @@ static int cmp_gamma(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* fit-surface on level 1 of 'levels 2' (F1 opened by sb_fit_open_level): the same target,
+ * pose (--pose re-read on level 1's model, else the fitted or rest rotations local), controls
+ * and omega on level 1's own lattice; eta1 (F1->o.nf x 3) the fit, a summary in sum. 0, 1, 2 */
+static int fit_level1(sb_fit *F1, const opts_t *o, const double *target, const double *local, sb_opt_opts oo, double *eta1, char *sum, size_t sumn)
+{
+    const snref_model *m = &F1->m;
+    snref_xform *pose = malloc(m->nJ * sizeof *pose);
+    double *base = malloc(3 * (size_t)m->nS * sizeof *base), *fit = malloc(3 * (size_t)m->nS * sizeof *fit), *best = malloc(3 * (size_t)m->nS * sizeof *best);
+    double root[3] = {0, 0, 0}, rms, mx, rrms, rmx, t0 = sb_now();
+    char what[4096];
+    sb_opt_result rr;
+    sb_surf_reach reach;
+    int rc = 2;
+    if (o->controls && set_controls(&F1->s, o->controls)) goto done;
+    if (o->pose) { if (sb_static_pose(&F1->s, o->pose, pose, NULL, what, sizeof what)) goto done; }
+    else sb_pose_from_local(m, local, root, pose);
+    rc = 1;
+    if (sb_fit_set_pose(F1, pose, o->rigs_off ? 0 : 1)) goto done;
+    memcpy(base, F1->surf0, 3 * (size_t)m->nS * sizeof *base);
+    oo.label = "fit-surface level 1";
+    if (sb_fit_surface(F1, target, o->omega, &oo, &rr, eta1, fit)) goto done;
+    residual(fit, target, base, m->nS, &rms, &mx, NULL);
+    if (sb_fit_surface_reach(F1, target, &oo, &reach, best)) goto done;
+    residual(fit, best, base, m->nS, &rrms, &rmx, NULL);
+    snprintf(sum, sumn, "level 1 (cell %g, %u free lattice vertices): residual rms %.3g%%, max %.3g%% of the target's displacement; "
+             "best reachable rms %.3g%%, max %.3g%%; the fit against it rms %.3g%%, max %.3g%%; %d iterations",
+             m->cell * m->unit, m->nF, 100 * rms, 100 * mx, 100 * reach.rms, 100 * reach.max, 100 * rrms, 100 * rmx, rr.iterations);
+    if (!o->quiet) printf("fit-surface: %s (%s), %.2f s\n", sum, rr.status <= 1 ? "converged" : rr.status == 2 ? "max-iter" : "line search failed", sb_now() - t0);
+    rc = 0;
+done:
+    free(pose); free(base); free(fit); free(best);
+    return rc;
+}
+
 static int cmd_fit_surface(const opts_t *o)
 {
-    sb_fit F;
+    sb_fit F, F1;
     const snref_model *m;
-    double *tg[SB_TAU_MAX], gam[SB_TAU_MAX], *local = NULL, *eta = NULL, *fit = NULL, *base = NULL, *rest = NULL, *best = NULL, secs_pose, t0, rms, mx, dmax;
+    double *tg[SB_TAU_MAX], gam[SB_TAU_MAX], *local = NULL, *eta = NULL, *eta1 = NULL, *fit = NULL, *base = NULL, *rest = NULL, *best = NULL, secs_pose, t0, rms, mx, dmax;
     double rrms = 0, rmx = 0;
     sb_surf_reach reach;
     double samples[2 * SB_TAU_MAX];
     snref_xform *pose = NULL;
-    char what[4096], tau[512], *comment = NULL;
+    char what[4096], tau[512], *comment = NULL, sum1[512] = "";
     int i, k, rc = 2, ctl, primary = 0, it_pose, ns = 0, have_g[SB_TAU_MAX];
     sb_opt_opts oo;
     sb_opt_result rr;
     size_t cl;
     memset(tg, 0, sizeof tg);
+    memset(&F1, 0, sizeof F1);
     if (!o->ntarget || !o->control || !o->out) { fprintf(stderr, PROG ": fit-surface DESC --target T.obj --control NAME -o OUT.rig (--help)\n"); return 2; }
     if (o->pose && o->features && 0) return 2;
     for (i = 0; i < o->ntarget; i++) {   /* TARGET[@GAMMA] */
@@ -529,7 +583,13 @@ static int cmd_fit_surface(const opts_t *o)
         printf("fit-surface: with the skeleton vertices free too (as if no bone carried any; the lattice's resolution): best rms %.3g%%, max %.3g%%\n",
                100 * reach.rms_all, 100 * reach.max_all);
     }
-    /* tau samples: (0, 0), the primary at 1, the others by least squares on the rig's shape */
+    if (F.d.levels > 1) {   /* 'levels 2': level 1's own fit on its own lattice (its rigs are not level 0's spread: runtime/LEVELS.md §2) */
+        if (sb_fit_open_level(&F1, o->desc, 1, 1)) goto done;
+        eta1 = calloc(3 * (size_t)F1.o.nf + 3, sizeof *eta1);
+        if ((rc = fit_level1(&F1, o, tg[primary], local, oo, eta1, sum1, sizeof sum1))) goto done;
+        rc = 1;
+    }
+    /* tau samples: (0, 0), the primary at 1, the others by least squares on the rig's shape (level 0's) */
     samples[ns * 2] = gam[primary]; samples[ns * 2 + 1] = 1; ns++;
     for (i = 0; i < o->ntarget; i++) {
         double num = 0, den = 0;
@@ -559,7 +619,7 @@ static int cmd_fit_surface(const opts_t *o)
         l2[0] = NULL; l2[1] = s2; l2[2] = s3; l2[3] = s4;
         if (picture(o->png, m, 4, S, R, sc, l1, l2, o->az, o->el)) goto done;
     }
-    cl = strlen(o->desc) + strlen(what) + 2048;
+    cl = strlen(o->desc) + strlen(what) + sizeof sum1 + 2048;
     comment = malloc(cl);
     {
         size_t n = 0;
@@ -570,12 +630,18 @@ static int cmd_fit_surface(const opts_t *o)
         n += (size_t)snprintf(comment + n, cl - n, "best reachable (free lattice vertices alone): rms %.3g%%, max %.3g%%; the fit against it: rms %.3g%%, max %.3g%%\n"
                               "best with the skeleton vertices free too: rms %.3g%%, max %.3g%%\n",
                               100 * reach.rms, 100 * reach.max, 100 * rrms, 100 * rmx, 100 * reach.rms_all, 100 * reach.max_all);
+        if (sum1[0]) n += (size_t)snprintf(comment + n, cl - n, "levels 2: a fit on each level's lattice (level 0 above, then level 1); %s\n", sum1);
         {   /* the file's own name (not its directory): the bytes depend on the inputs only */
             const char *b = strrchr(o->out, '/');
             snprintf(comment + n, cl - n, "use: rig_file %s %s %s tau %s", o->name ? o->name : o->control, b ? b + 1 : o->out, o->control, tau);
         }
     }
-    if (sb_rigfile_write(o->out, &F.o, &F.mesh, eta, comment)) { fprintf(stderr, PROG ": %s\n", sb_error()); if (o->png) remove(o->png); goto done; }
+    {
+        const sb_model *om[2];
+        const double *Qs[2];
+        om[0] = &F.o; om[1] = &F1.o; Qs[0] = eta; Qs[1] = eta1;
+        if (sb_rigfile_write_fits(o->out, eta1 ? 2 : 1, om, &F.mesh, Qs, comment)) { fprintf(stderr, PROG ": %s\n", sb_error()); if (o->png) remove(o->png); goto done; }
+    }
     rc = 0;
     if (!o->quiet) {
         printf("fit-surface: wrote %s%s%s\n", o->out, o->png ? " and " : "", o->png ? o->png : "");
@@ -583,8 +649,9 @@ static int cmd_fit_surface(const opts_t *o)
     }
 done:
     for (i = 0; i < o->ntarget; i++) free(tg[i]);
-    free(local); free(pose); free(eta); free(fit); free(base); free(rest); free(best); free(comment);
+    free(local); free(pose); free(eta); free(eta1); free(fit); free(base); free(rest); free(best); free(comment);
     sb_fit_close(&F);
+    if (F1.m.nV || F1.o.nv) sb_fit_close(&F1);
     return rc;
 }
 

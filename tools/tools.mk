@@ -56,6 +56,11 @@ $(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS
 	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -Itests -o $@ $< $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
 TEST_BINS += $(BUILD)/tests/test_rigfit
 TEST_DEPS += $(RIGTOOL)
+# rig files on level 1 of 'levels 2' (issue 13): the checker tests/scripts/test_rigfile_levels.sh runs
+$(BUILD)/tests/rig_level_check: tests/rig_level_check.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(STATIC_INC) -Itests -o $@ $< $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+TEST_DEPS += $(BUILD)/tests/rig_level_check
 
 # ---- baked examples ----
 EX = $(BUILD)/examples
