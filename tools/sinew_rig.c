@@ -655,6 +655,39 @@ done:
     return rc;
 }
 
+/* fit-points with 'levels 2': the strengths eta (the rigs' own geometry) evaluated on level 1's
+ * lattice at the same pose and controls (the bake integrates the fitted templates on each level
+ * itself, so there is no level-1 output: this reports what level 1 makes of them). 0, 1, 2 */
+static int points_level1(const sb_fit *F, const opts_t *o, const int *rigs, int nr, const int *vert, const double *tgt, int np, const double *eta)
+{
+    sb_fit F1;
+    snref_xform *pose;
+    double s0[64], cm, cm0 = F->m.cell * F->m.unit, c1, c1s, cl0;
+    char what[4096];
+    int a, rc = 2;
+    if (sb_fit_open_level(&F1, o->desc, 1, 1)) return 1;
+    pose = malloc(F1.m.nJ * sizeof *pose);
+    cm = F1.m.cell * F1.m.unit;
+    if (o->controls && set_controls(&F1.s, o->controls)) goto done;
+    if (sb_static_pose(&F1.s, o->pose ? o->pose : "rest", pose, NULL, what, sizeof what)) goto done;
+    if (o->controls && set_controls(&F1.s, o->controls)) goto done;
+    rc = 1;
+    if (sb_fit_set_pose(&F1, pose, 1.0)) goto done;
+    for (a = 0; a < nr; a++) s0[a] = F->o.rig[rigs[a]].def.s;
+    c1 = sb_fit_points_cost(&F1, rigs, nr, vert, tgt, np, 0, eta, NULL);
+    c1s = sb_fit_points_cost(&F1, rigs, nr, vert, tgt, np, 0, s0, NULL);
+    cl0 = sb_fit_points_cost((sb_fit *)F, rigs, nr, vert, tgt, np, 0, eta, NULL);
+    if (!isfinite(c1) || !isfinite(c1s) || !isfinite(cl0)) { fprintf(stderr, PROG ": fit-points: level 1: the evaluation failed\n"); goto done; }
+    if (!o->quiet)
+        printf("fit-points: rms point distance at the fitted strengths: level 0 %.4g mesh units, level 1 (cell %g) %.4g (%.4g at the description's strengths)\n",
+               sqrt(cl0) * cm0, cm, sqrt(c1) * cm, sqrt(c1s) * cm);
+    rc = 0;
+done:
+    free(pose);
+    sb_fit_close(&F1);
+    return rc;
+}
+
 static int cmd_fit_points(const opts_t *o)
 {
     sb_fit F;
@@ -745,6 +778,11 @@ static int cmd_fit_points(const opts_t *o)
         }
         if (!o->quiet) printf("fit-points: %d points, %d rigs%s, pose %s: cost %.6g -> %.6g (C_points: mean squared distance / cell^2), %d iterations, %d evaluations, %.3f s\n",
                               np, nr, o->geometry ? " (strengths and geometry)" : " (strengths)", what, c0, rr.f, rr.iterations, rr.evaluations, sb_now() - t0);
+    }
+    if (F.d.levels > 1) {   /* 'levels 2': what level 1 makes of the fitted strengths */
+        if (o->geometry) { if (!o->quiet) printf("fit-points: level 1 not evaluated with --geometry (the bake integrates the fitted templates on its lattice)\n"); }
+        else if ((rc = points_level1(&F, o, rigs, nr, vert, tgt, np, eta))) goto done;
+        rc = 1;
     }
     {   /* the description's rig lines with the fitted strengths */
         FILE *f = fopen(o->desc, "r");

@@ -63,6 +63,14 @@ a=$(grep -v '^#' "$T/fit1.rig" | sed -n '2,/^end$/p'); b=$(grep -v '^#' "$T/fit2
 { cat "$T/limb_fit2.sinew"; echo "rig_file biceps fit2.rig elbow_bend tau 0 0 90 1"; } > "$T/limb_rf2.sinew"
 expect 0 "rig +biceps +control elbow_bend +file" "$BAKE" "$T/limb_rf2.sinew" -o "$T/limb_rf2.blob"
 
+# fit-points on 'levels 2': the same rig lines as on one level, and level 1's point distance reported
+printf '139 %s\n' "$(awk '$1 == "v" { n++; if (n == 140) print $2, $3 + 0.1, $4 }' "$T/target.obj")" > "$T/points.txt"
+{ cat "$T/limb.sinew"; echo 'levels 2'; } > "$T/limb2.sinew"
+"$RIG" fit-points "$T/limb.sinew" --pose elbow:0,0,1,90 --points "$T/points.txt" --rigs biceps -o "$T/pts1.sinew" --quiet || bad "fit-points"
+expect 0 "rms point distance at the fitted strengths: level 0 [0-9.e-]+ mesh units, level 1 \(cell 0.5\) [0-9.e-]+" \
+    "$RIG" fit-points "$T/limb2.sinew" --pose elbow:0,0,1,90 --points "$T/points.txt" --rigs biceps -o "$T/pts2.sinew"
+cmp -s "$T/pts1.sinew" "$T/pts2.sinew" && ok "fit-points: the same rig lines with 'levels 2'" || bad "fit-points output differs with 'levels 2'"
+
 # malformed two-fit files: file:line, nothing written
 mk() { sed -n '1,/^end$/p' "$T/sl.rig"; }
 { mk; sed -n '/^cell 1.2$/,/^end$/p' "$T/sl.rig"; } > "$T/dup.rig"
