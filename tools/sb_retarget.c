@@ -1,6 +1,7 @@
 /* sb_retarget.c -- rig retargeting, seed 003 §4.4 (eq. 15-16). See sb_retarget.h
  * for the cost terms, the Jacobian estimate and the transfer chain. */
 #include "sb_retarget.h"
+#include "sb_level.h"
 #include "sb_lbfgsb.h"
 
 #include <math.h>
@@ -22,6 +23,26 @@ int sb_rt_char_load(const char *desc_path, sb_rt_char *c)
         sb_model_free(&c->o); sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c);
         return -1;
     }
+    c->loaded = 1;
+    return 0;
+}
+
+int sb_rt_char_load_level1(const char *desc_path, sb_rt_char *c)
+{
+    sb_desc d2;
+    sb_model o0;
+    memset(c, 0, sizeof *c);
+    memset(&o0, 0, sizeof o0);
+    if (sb_desc_load(desc_path, &c->d)) { sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
+    if (c->d.levels < 2) { sb_desc_free(&c->d); memset(c, 0, sizeof *c); return sb_fail("%s: no 'levels 2'", desc_path); }
+    if (sb_desc_mesh(&c->d, &c->m, NULL)) { sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
+    /* level 1 as the bake derives it from level 0's lattice; without B's own rigs (the transfer
+     * needs the lattice only, and a one-fit rig file of B has no level-1 fit yet) */
+    if (sb_build(&c->d, &c->m, &o0, 1)) { sb_model_free(&o0); sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
+    sb_level_desc(&c->d, &o0, &d2);
+    d2.nrig = 0;
+    sb_model_free(&o0);
+    if (sb_level_model(&c->d, &d2, &c->m, &c->o)) { sb_model_free(&c->o); sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
     c->loaded = 1;
     return 0;
 }
@@ -1198,14 +1219,21 @@ int sb_rt_transfer(const sb_retarget *rt, const double *QA, double *QB, double *
 
 /* ---------------- output ---------------- */
 
+int sb_rt_write_rig_levels(const char *path, int nlev, const sb_model *const *B, const sb_mesh *mB, const double *const *Q, const char *comment)
+{
+    int i, l;
+    for (l = 0; l < nlev; l++) {
+        double qmax = 0;
+        for (i = 0; i < 3 * B[l]->nf; i++) {
+            if (!isfinite(Q[l][i])) return sb_fail("retarget: the rig force%s is not finite: nothing written", l ? " on B's level 1" : "");
+            qmax = fmax(qmax, fabs(Q[l][i]));
+        }
+        if (!(qmax > 0)) return sb_fail("retarget: the rig force%s is zero: nothing written", l ? " on B's level 1" : "");
+    }
+    return sb_rigfile_write_fits(path, nlev, B, mB, Q, comment);
+}
+
 int sb_rt_write_rig(const char *path, const sb_model *B, const sb_mesh *mB, const double *Q, const char *comment)
 {
-    double qmax = 0;
-    int i;
-    for (i = 0; i < 3 * B->nf; i++) {
-        if (!isfinite(Q[i])) return sb_fail("retarget: the rig force is not finite: nothing written");
-        qmax = fmax(qmax, fabs(Q[i]));
-    }
-    if (!(qmax > 0)) return sb_fail("retarget: the rig force is zero: nothing written");
-    return sb_rigfile_write(path, B, mB, Q, comment);
+    return sb_rt_write_rig_levels(path, 1, &B, mB, &Q, comment);
 }

@@ -56,6 +56,8 @@ typedef struct sb_rt_char {
     int loaded;
 } sb_rt_char;
 int sb_rt_char_load(const char *desc_path, sb_rt_char *c);   /* 0 or -1 (sb_error) */
+/* level 1 of a 'levels 2' description (sb_level_desc / sb_level_model), without its rigs */
+int sb_rt_char_load_level1(const char *desc_path, sb_rt_char *c);
 void sb_rt_char_free(sb_rt_char *c);
 
 enum { SB_RT_CORR_AUTO = -1, SB_RT_CORR_CLOSEST = 0, SB_RT_CORR_VERTEX = 1 };
@@ -164,5 +166,7 @@ int sb_rt_transfer(const sb_retarget *rt, const double *QA, double *QB, double *
  * with 'rig_file NAME FILE CONTROL'. comment: lines written as '# ...'.
  * Refuses a zero or non-finite force. 0 or -1 (sb_error; nothing written). */
 int sb_rt_write_rig(const char *path, const sb_model *B, const sb_mesh *mB, const double *Q, const char *comment);
+/* the same with one fit per level of B (nlev 2: B[1], Q[1] its level 1, sb_rt_char_load_level1) */
+int sb_rt_write_rig_levels(const char *path, int nlev, const sb_model *const *B, const sb_mesh *mB, const double *const *Q, const char *comment);
 
 #endif /* SB_RETARGET_H */

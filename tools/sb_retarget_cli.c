@@ -27,8 +27,8 @@ static void usage(FILE *f, const char *prog)
             "J_i at every lattice vertex (eq. 16),\n"
             "and transfers the rigs' generalized force: Q_A -> q_A (static equilibrium at rest, eq. 10) ->\n"
             "J_i q_A,i -> B's lattice -> Q_B = K_B q_B. Writes Q_B as a rig file (tools/DESCRIPTION.md \"Rig\n"
-            "files\") that B's description includes with 'rig_file NAME FILE CONTROL'. One fit, on B's level-0\n"
-            "lattice: a B with 'levels 2' is refused (tools/DESCRIPTION.md \"Retargeting\", two levels).\n"
+            "files\") that B's description includes with 'rig_file NAME FILE CONTROL'. B with 'levels 2': a fit\n"
+            "per level (the same transfer onto level 1's own lattice; tools/DESCRIPTION.md \"Retargeting\").\n"
             "  --rig LIST        rigs of A, comma-separated, summed at eta = 1 (e.g. smile_l,smile_r)\n"
             "  -o OUT.rig        the rig of B (written to OUT.rig.tmp, then renamed)\n"
             "  --name NAME       the rig's name in the printed rig_file line (default: the first rig's name)\n"
@@ -148,6 +148,41 @@ static int parse_pos(const char *s, double *v)
     return *e || e == s || !isfinite(*v) || *v < 0 ? -1 : 0;
 }
 
+/* B's level 1 ('levels 2'): the same map and transfer of A's rig force QA onto level 1's own
+ * lattice (sb_rt_char_load_level1: built as the bake builds it), so that B's rig file carries
+ * a fit per level. QB1 (B1->o.nf x 3) out. 0 or -1 (the message printed) */
+static int level1_transfer(const char *prog, const char *pb, const sb_rt_char *A, const sb_rt_opts *opt0, const double *QA, double db0, int quiet,
+                           sb_rt_char *B1, double **QB1)
+{
+    sb_retarget rt1;
+    sb_rt_opts opt = *opt0;
+    sb_rt_transfer_stats st;
+    double *qB1 = NULL, *s0 = NULL, *s1 = NULL, res, db, t0 = sb_now();
+    int rc = -1;
+    memset(&rt1, 0, sizeof rt1);
+    opt.verbose = 0;
+    if (sb_rt_char_load_level1(pb, B1)) { fprintf(stderr, "%s: error: B level 1: %s\n", prog, sb_error()); return -1; }
+    *QB1 = calloc(3 * (size_t)B1->o.nf + 3, sizeof **QB1);
+    qB1 = calloc(3 * (size_t)B1->o.nv + 3, sizeof *qB1);
+    s0 = malloc(sizeof(double) * 3 * (size_t)(B1->o.ns + 1)); s1 = malloc(sizeof(double) * 3 * (size_t)(B1->o.ns + 1));
+    if (!*QB1 || !qB1 || !s0 || !s1) { fprintf(stderr, "%s: out of memory\n", prog); goto done; }
+    if (sb_rt_init(&rt1, &A->o, &A->m, &B1->o, &B1->m, &opt) || sb_rt_solve(&rt1) || sb_rt_jacobians(&rt1) || sb_rt_transfer(&rt1, QA, *QB1, NULL, qB1, &st)) {
+        fprintf(stderr, "%s: error: B level 1: %s\n", prog, sb_error());
+        goto done;
+    }
+    res = sb_rt_static(&B1->o, *QB1, qB1);
+    sb_rt_surface(&B1->o, NULL, s0); sb_rt_surface(&B1->o, qB1, s1); db = maxdisp(s0, s1, B1->o.ns);
+    if (!quiet)
+        printf("retarget: B level 1 (cell %g, lattice %d (%d free)): map surface rms %.4g max %.4g; the rig moves B's surface by up to %.4g mesh units "
+               "(level 0: %.4g); %d of its free vertices sampled, %d smoothed; static residual %.1e (%.2f s)\n",
+               B1->o.c, B1->o.nv, B1->o.nf, rt1.surf_rms, rt1.surf_max, db, db0, st.inside, st.outside, res, sb_now() - t0);
+    rc = 0;
+done:
+    free(qB1); free(s0); free(s1);
+    sb_rt_free(&rt1);
+    return rc;
+}
+
 int sb_retarget_cli(int argc, char **argv, const char *prog)
 {
     const char *pa = NULL, *pb = NULL, *rigs = NULL, *out = NULL, *name = NULL, *control = NULL, *png = NULL, *mapobj = NULL;
@@ -155,11 +190,11 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
     int has_boxa = 0, has_boxb = 0;
     int i, quiet = 0, rc = 1, ctl = -1;
     sb_rt_opts opt;
-    sb_rt_char A, B;
+    sb_rt_char A, B, B1;
     sb_retarget rt;
-    double *QA = NULL, *QB = NULL, *qA = NULL, *qB = NULL, t0 = sb_now();
+    double *QA = NULL, *QB = NULL, *qA = NULL, *qB = NULL, *QB1 = NULL, t0 = sb_now(), db0 = 0;
     sb_rt_defaults(&opt);
-    memset(&A, 0, sizeof A); memset(&B, 0, sizeof B); memset(&rt, 0, sizeof rt);
+    memset(&A, 0, sizeof A); memset(&B, 0, sizeof B); memset(&B1, 0, sizeof B1); memset(&rt, 0, sizeof rt);
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
@@ -205,13 +240,6 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
     opt.verbose = !quiet;
     if (sb_rt_char_load(pa, &A)) { fprintf(stderr, "%s: error: A: %s\n", prog, sb_error()); goto done; }
     if (sb_rt_char_load(pb, &B)) { fprintf(stderr, "%s: error: B: %s\n", prog, sb_error()); goto done; }
-    if (B.d.levels > 1) {   /* the transfer is to B's level-0 lattice: a one-fit file, which B's level 1 refuses */
-        fprintf(stderr, "%s: error: B: %s:%d: 'levels 2': retarget writes one fit, on B's level-0 lattice, and level 1 needs its own; retarget to B "
-                "without 'levels 2', then fit both levels to that rig's static shape (sinew-bake --static ... -o T.obj; sinew-rig fit-surface on B "
-                "with 'levels 2' --target T.obj; tools/DESCRIPTION.md \"Retargeting\")\n", prog, B.d.path, B.d.levels_line);
-        rc = 2;
-        goto done;
-    }
     if (!quiet)
         printf("retarget: A %s: %d surface vertices, lattice %d (%d free), %d joints; B %s: %d surface vertices, lattice %d (%d free), %d joints (%.2f s)\n",
                pa, A.m.nv, A.o.nv, A.o.nf, A.o.nj, pb, B.m.nv, B.o.nv, B.o.nf, B.o.nj, sb_now() - t0);
@@ -258,7 +286,7 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
             double *s1 = malloc(sizeof(double) * 3 * (size_t)(A.o.ns > B.o.ns ? A.o.ns : B.o.ns)), da, db;
             if (!s0 || !s1) { free(s0); free(s1); fprintf(stderr, "%s: out of memory\n", prog); goto done; }
             sb_rt_surface(&A.o, NULL, s0); sb_rt_surface(&A.o, qA, s1); da = maxdisp(s0, s1, A.o.ns);
-            sb_rt_surface(&B.o, NULL, s0); sb_rt_surface(&B.o, qB, s1); db = maxdisp(s0, s1, B.o.ns);
+            sb_rt_surface(&B.o, NULL, s0); sb_rt_surface(&B.o, qB, s1); db = maxdisp(s0, s1, B.o.ns); db0 = db;
             if (!quiet)
                 printf("retarget: the rig moves the surface by up to %.4g mesh units on A (%.3g%% of its size), %.4g on B (%.3g%%)\n", da,
                        100 * da / rt.LA, db, 100 * db / rt.L);
@@ -269,6 +297,7 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
                    "outside (closest mapped surface point); %d of B's %d free vertices sampled, %d smoothed; static residuals A %.1e, B %.1e\n",
                    st.qA_max, st.qB_max, st.surf_inside, st.surf_outside, st.inside, B.o.nf, st.outside, st.static_res, res);
     }
+    if (B.d.levels > 1 && level1_transfer(prog, pb, &A, &opt, QA, db0, quiet, &B1, &QB1)) goto done;   /* 'levels 2': a fit per level */
     /* outputs */
     {
         char head[4096];
@@ -279,7 +308,11 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
                  "map residuals (B mesh units): skeleton rms %.6g max %.6g, surface rms %.6g max %.6g; distortion %.6g",
                  rigs, pa, pb, name, control, opt.w_skel, opt.w_surf, rt.corr == SB_RT_CORR_VERTEX ? "vertex" : "closest-point", rt.rounds,
                  rt.skel_rms, rt.skel_max, rt.surf_rms, rt.surf_max, rt.c_dist);
-        if (sb_rt_write_rig(out, &B.o, &B.m, QB, head)) { fprintf(stderr, "%s: error: %s\n", prog, sb_error()); goto done; }
+        const sb_model *Bl[2];
+        const double *Ql[2];
+        Bl[0] = &B.o; Bl[1] = &B1.o; Ql[0] = QB; Ql[1] = QB1;
+        if (QB1) snprintf(head + strlen(head), sizeof head - strlen(head), "\nlevels 2: a fit on each of B's levels (level 0, then level 1: the same map onto its lattice)");
+        if (sb_rt_write_rig_levels(out, QB1 ? 2 : 1, Bl, &B.m, Ql, head)) { fprintf(stderr, "%s: error: %s\n", prog, sb_error()); goto done; }
     }
     if (mapobj) {
         FILE *f = fopen(mapobj, "w");
@@ -347,8 +380,8 @@ int sb_retarget_cli(int argc, char **argv, const char *prog)
                        sb_now() - t0);
     rc = 0;
 done:
-    free(QA); free(QB); free(qA); free(qB);
+    free(QA); free(QB); free(qA); free(qB); free(QB1);
     sb_rt_free(&rt);
-    sb_rt_char_free(&A); sb_rt_char_free(&B);
+    sb_rt_char_free(&A); sb_rt_char_free(&B); sb_rt_char_free(&B1);
     return rc;
 }

@@ -211,7 +211,7 @@ int sb_rigfile_apply(const sb_rigfile *rfile, const char *path, const sb_model *
             l += (size_t)snprintf(cells + l, sizeof cells - l, "%s%.9g (line %d)", i ? ", " : "", rfile->fit[i].cell, rfile->fit[i].line);
         if (level > 0)
             return sb_fail("rig file '%s' has fits for lattice cell %s, none for level %d of 'levels 2' (cell %.9g): refit it on the description "
-                           "with 'levels 2' (sinew-rig fit-surface, or sinew-rig export for a template rig: they write a fit per level)",
+                           "with 'levels 2' (sinew-rig fit-surface, export or retarget: they write a fit per level)",
                            path, cells, level, o->c);
         return sb_fail("rig file '%s' has fits for lattice cell %s, this description's lattice has cell %.9g: refit it", path, cells, o->c);
     }
