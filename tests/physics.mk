@@ -315,3 +315,16 @@ $(BUILD)/tests/test_runtime_precond_float: tests/test_runtime_precond.c $(REF_SR
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_precond $(BUILD)/tests/test_runtime_precond_float
+
+# make seg-study (issue 15): the segment meshes' gap through the cow's trot for
+# blobs given in SEG_BLOBS (default: the cow, fixed and float); tests/scripts/seg_study.sh
+# bakes the sweep-count variants.
+$(BUILD)/tests/seg_study: tests/seg_study.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/seg_study_float: tests/seg_study.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+.PHONY: seg-study
+seg-study: $(BUILD)/tests/seg_study $(BUILD)/tests/seg_study_float $(BUILD)/sinew-bake
+	BUILD=$(BUILD) sh tests/scripts/seg_study.sh

@@ -99,10 +99,10 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
              nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
     const uint32_t elem[36] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, flavour == 0 ? 724u : 324 * R, R, 8, 6,
-                               40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 16 + 9 * R, 3 * R, 8 + 3 * R, 8,
+                               40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 20 + 9 * R, 3 * R, 8 + 3 * R, 8,
                                12 + 3 * R, 4, 2, 2, 1, 8, 8, 20, 8 + 2 * R};
     uint32_t want[36], inst, segB = 0, conB = 0, crB = 0, crRows = 0;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 1, "%s: spec: magic SNWB, version 6.1", what);
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 2, "%s: spec: magic SNWB, version 6.2", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
@@ -166,11 +166,15 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         for (k = 0; k < nnz; k++) nff += u16(cols + 2 * k) < nF;
         want[34] = u32(b + 176 + 16 * 34 + 8) == 0 ? 0 : nff;
     }
-    {   /* SEGMESH: nodes and attachments are the running sums; state bytes 64 per segment + 24 per node, every level */
+    {   /* SEGMESH: nodes and attachments are the running sums; state bytes 64 per segment + 24 per node, every level;
+         * format 6.2's tail: coarse_sweeps 1..64 (= sweeps at one level), relax 32..63 with relax (1 - gamma) <= 32, u16 0 */
         uint32_t m, nodes = 0, att = 0;
         for (m = 0; m < want[23]; m++) {
-            const unsigned char *r = b + u32(b + 176 + 16 * 23) + (16 + 9 * R) * m;
+            const unsigned char *r = b + u32(b + 176 + 16 * 23) + (20 + 9 * R) * m, *x = r + 16 + 9 * R;
             uint32_t side = u16(r + 4), lv = r[1], l, segs = 0, nn = 0;
+            double gam = real_at(b, (uint32_t)(r + 16 - b), 1, 30);
+            T_CHECK(x[0] >= 1 && x[0] <= 64 && (lv > 1 || x[0] == r[2]) && x[1] >= 32 && x[1] <= 63 && x[1] * (1 - gam) <= 32 + 1e-9 &&
+                    u16(x + 2) == 0, "%s: spec: segment mesh %u: coarse_sweeps %u relax %u gamma %g", what, m, x[0], x[1], gam);
             T_CHECK(u32(r + 8) == nodes && u32(r + 12) == att, "%s: spec: segment mesh %u's first node/attachment are the running sums", what, m);
             if (r[0] == 0) { segs = side - 1; nn = side; }
             else for (l = 0; l < lv; l++) { uint32_t s_ = ((side - 1) >> l) + 1; segs += 2 * s_ * (s_ - 1) + (s_ == 2 ? 2 : 0); nn += s_ * s_; }

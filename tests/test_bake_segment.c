@@ -73,21 +73,25 @@ static int write_text(const char *name, const char *text, char *path, size_t pn)
 #define HEAD "mesh cube.obj\nunit 0.05\ncell 2\nsubdiv 2\n" \
              "joint root - 2 2 2\njoint tip mid 3.2 2 2\njoint mid root 2.6 2 2\nmaterial flesh 1e5 0.3 1000\n"
 static const char *DESC = HEAD
-    "chain tail nodes 9 from 4 4 4 to 4 8 4 mass 0.4 sweeps 12 gamma 0.7 damping 3 centre 0.25\n"
+    "chain tail nodes 9 from 4 4 4 to 4 8 4 mass 0.4 sweeps 12 gamma 0.7 damping 3 centre 0.25 relax 1.5\n"
     "attach tail first surface\n"
     "attach tail last joint tip\n"
     "chain off nodes 2 from 4.1 3.9 4.05 to 4.1 3.9 6.05 gravity off\n"
     "attach off first surface within 0.2\n"
-    "sheet cape side 5 corner 0 4 0 u 4 0 0 v 0 0 4 shares 0.5 0.3 0.2 mass 2\n"
+    "sheet cape side 5 corner 0 4 0 u 4 0 0 v 0 0 4 shares 0.5 0.3 0.2 mass 2 coarse_sweeps 3\n"
     "attach cape corners surface\n"
     "attach cape node 12 joint mid\n";
 
 /* what the description says, transcribed */
-typedef struct { int kind, side, levels, sweeps, gravity; double p0[3], u[3], v[3], mass, gamma, damping, centre, share[4]; } expect_mesh;
+typedef struct {
+    int kind, side, levels, sweeps, gravity;
+    double p0[3], u[3], v[3], mass, gamma, damping, centre, share[4];
+    int coarse_sweeps, relax; /* format 6.2: = sweeps unless given; 32 omega */
+} expect_mesh;
 static const expect_mesh EM[3] = {
-    {0, 9, 1, 12, 1, {4, 4, 4}, {0, 4, 0}, {0, 0, 0}, 0.4, 0.7, 3, 0.25, {1, 0, 0, 0}},
-    {0, 2, 1, 8, 0, {4.1, 3.9, 4.05}, {0, 0, 2}, {0, 0, 0}, 1, 0.5, 0.5, 0.5, {1, 0, 0, 0}},
-    {1, 5, 3, 8, 1, {0, 4, 0}, {4, 0, 0}, {0, 0, 4}, 2, 0.5, 0.5, 0.5, {0.5, 0.3, 0.2, 0}},
+    {0, 9, 1, 12, 1, {4, 4, 4}, {0, 4, 0}, {0, 0, 0}, 0.4, 0.7, 3, 0.25, {1, 0, 0, 0}, 12, 48},
+    {0, 2, 1, 8, 0, {4.1, 3.9, 4.05}, {0, 0, 2}, {0, 0, 0}, 1, 0.5, 0.5, 0.5, {1, 0, 0, 0}, 8, 32},
+    {1, 5, 3, 8, 1, {0, 4, 0}, {4, 0, 0}, {0, 0, 4}, 2, 0.5, 0.5, 0.5, {0.5, 0.3, 0.2, 0}, 3, 32},
 };
 /* attachments, node order: node, kind, joint name or NULL (surface) */
 typedef struct { int mesh, node, kind; const char *joint; } expect_att;
@@ -119,7 +123,7 @@ static void check_blob(const sb_blob *bl, int flavour, double h)
     double tl = flavour == 0 ? ldexp(1.0, -23) * 1.0001 : flavour == 1 ? 64 * ldexp(1.0, -24) : 1e-12;
     double tq = flavour == 0 ? ldexp(1.0, -31) * 1.0001 : flavour == 1 ? ldexp(1.0, -24) : 1e-15;   /* Q30 fraction */
     uint32_t fn = 0, fa = 0, segB = 0, jn = sec_cnt(b, SN_SEC_JOINTS);
-    T_CHECK(sec_cnt(b, SN_SEC_SEGMESH) == 3 && sec_esz(b, SN_SEC_SEGMESH) == 16u + 9u * (uint32_t)rs, "%s: SEGMESH 3 records of 16 + 9R bytes", fname);
+    T_CHECK(sec_cnt(b, SN_SEC_SEGMESH) == 3 && sec_esz(b, SN_SEC_SEGMESH) == 20u + 9u * (uint32_t)rs, "%s: SEGMESH 3 records of 20 + 9R bytes", fname);
     T_CHECK(sec_cnt(b, SN_SEC_SEGNODES) == 9 + 2 + 25 && sec_esz(b, SN_SEC_SEGNODES) == 3u * (uint32_t)rs, "%s: SEGNODES 36 x 3R", fname);
     T_CHECK(sec_cnt(b, SN_SEC_SEGATTACH) == (uint32_t)NEA && sec_esz(b, SN_SEC_SEGATTACH) == 8u + 3u * (uint32_t)rs, "%s: SEGATTACH %d x (8 + 3R)", fname, NEA);
     for (m = 0; m < 3; m++) {
@@ -142,6 +146,9 @@ static void check_blob(const sb_blob *bl, int flavour, double h)
         T_CHECK(r[0] == (e->kind ? SN_SEG_SHEET : SN_SEG_CHAIN) && r[1] == e->levels && r[2] == e->sweeps &&
                 r[3] == (e->gravity ? 0 : SN_SEGF_NO_GRAVITY) && u16(r + 4) == (unsigned)e->side && u16(r + 6) == (unsigned)na,
                 "%s mesh %d: kind %u levels %u sweeps %u flags %u side %u n_attach %u", fname, m, r[0], r[1], r[2], r[3], u16(r + 4), u16(r + 6));
+        T_CHECK(r[16 + 9 * rs] == e->coarse_sweeps && r[17 + 9 * rs] == e->relax && u16(r + 18 + 9 * rs) == 0,
+                "%s mesh %d: coarse_sweeps %u (want %d) relax %u (want %d), then u16 0", fname, m, r[16 + 9 * rs], e->coarse_sweeps,
+                r[17 + 9 * rs], e->relax);
         T_CHECK(u32(r + 8) == fn && u32(r + 12) == fa, "%s mesh %d: first_node %u first_attach %u (running sums %u %u)", fname, m, u32(r + 8), u32(r + 12), fn, fa);
         T_NEAR(real(b, r + 16, SN_Q_LEN), L / U, tl, "seg_len: rounding of the stored real");
         T_NEAR(real(b, r + 16 + rs, SN_Q_ROT), e->gamma, tq, "gamma Q30 rounding");
@@ -230,6 +237,14 @@ static void check_errors(void)
         {"chain t nodes 4 from 0 0 0 to 1 0 0 wobble 3", ":9: unknown chain option 'wobble'"},
         {"chain t nodes 4 from 0 0 0 to 1 0 0 mass", ":9: missing value after 'mass'"},
         {"chain t nodes 4 from 0 0 0 to 1 0 0 levels 2", ":9: 'levels' is for sheets"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 coarse_sweeps 2", ":9: 'coarse_sweeps' is for sheets"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 relax 0.9", ":9: relax (over-relaxation omega) must be in [1, 1.96875] (got 0.9)"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 relax 2", ":9: relax (over-relaxation omega) must be in [1, 1.96875] (got 2)"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 relax 1.7", ":9: relax 1.7 is not a multiple of 1/32 (the blob stores 32 omega): use 1.6875 or 1.71875"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 relax 1.5 gamma 0.25", ":9: chain 't': relax 1.5 with gamma 0.25 over-relaxes the turns: want relax (1 - gamma) <= 1 (relax <= 1.3125)"},
+        {"chain t nodes 4 from 0 0 0 to 1 0 0 relax", ":9: missing value after 'relax'"},
+        {"sheet s side 9 corner 0 0 0 u 1 0 0 v 0 1 0 coarse_sweeps 2", ":9: sheet 's': 'coarse_sweeps' needs levels >= 2"},
+        {"sheet s side 9 corner 0 0 0 u 1 0 0 v 0 1 0 levels 2 coarse_sweeps 65", ":9: '65' must be an integer in 1..64"},
         {"chain t nodes 4 from 0 0 0 to 1 0 0 shares 1", ":9: 'shares' is for sheets"},
         {"sheet s side 4 corner 0 0 0 u 1 0 0 v 0 1 0", ":9: sheet side 4 is not 2^n + 1"},
         {"sheet s side 9 corner 0 0 0 u 1 0 0 v 0 2 0", ":9: sheet 's': edges u and v have lengths 1 and 2"},

@@ -7,8 +7,8 @@
  *    sheet dropped on a floor, each with shares fine, equal, coarse
  *    (the demo runs of ports/desktop/demo.sh);
  *  - the gap left after the examples' sweeps (sn_stats seg_gap): the cow's
- *    asserted (< 1% of a segment through the trot, < 2% since init), the
- *    sheets' reported;
+ *    asserted (< 1% of a segment at step 72, < 2% since init, < 1.6% at
+ *    every step of [30, 240)), the sheets' reported;
  *  - sn_teleport carries the segment meshes rigidly with the root (a respawn
  *    30,000 units away, and one also turned 90 degrees, mid-trot): nodes
  *    after the jump = G (nodes before), and the run after it = G (an
@@ -21,32 +21,40 @@
 
 static const char *fl(void) { return PU_FLAVOUR_NAME; }
 
-/* the cow trotting K steps (phys_pose's trot): saturations and last gap */
-static void cow_trot(unsigned K) {
+/* the cow trotting K2 steps (phys_pose's trot): saturations, the gap at
+ * step K and since init, and the largest gap over steps [30, K2) */
+static void cow_trot(unsigned K, unsigned K2) {
     char path[512];
     pu_rt a;
     sn_xform x[256];
-    sn_stats st;
-    double h;
+    sn_stats st, sK;
+    double h, gmax = 0;
     unsigned k;
     pu_example(path, sizeof path, "cow" PU_BLOB_SUFFIX);
     if (pu_rt_open(&a, path)) { T_CHECK(0, "open %s", path); return; }
     h = SN_FLAVOUR ? (double)a.info.timestep : ldexp((double)a.info.timestep, -16);
-    for (k = 0; k < K; k++) {
+    memset(&sK, 0, sizeof sK);
+    for (k = 0; k < K2; k++) {
         pu_cow_pose(a.blob, a.info.joints, k, h, x);
         sn_set_pose(a.inst, x, a.info.joints);
         sn_step(a.inst);
+        sn_get_stats(a.inst, &st);
+        if (k + 1 == K) sK = st;
+        if (k >= 30) gmax = pu_len(st.seg_gap) > gmax ? pu_len(st.seg_gap) : gmax;
     }
-    sn_get_stats(a.inst, &st);
-    T_FIGURE("[%s] cow (tail + blanket) trot %u steps: saturations %u, gap %.4f%% (max since init %.4f%%) of a segment",
-             fl(), K, st.saturations, 100 * pu_len(st.seg_gap) / (SN_FLAVOUR ? 1 : 1), 100 * pu_len(st.seg_gap_max));
+    T_FIGURE("[%s] cow (tail + blanket) trot %u steps: saturations %u, gap %.4f%% (max since init %.4f%%) of a segment; "
+             "largest over steps [30, %u): %.4f%%", fl(), K, sK.saturations, 100 * pu_len(sK.seg_gap), 100 * pu_len(sK.seg_gap_max),
+             K2, 100 * gmax);
     T_CHECK(st.saturations == 0, "[%s] cow trot with segments: %u saturations", fl(), st.saturations);
-    /* the examples' sweeps (tail 64 at gamma 1, blanket 32 at gamma 0.5)
-     * leave ~0.6% of a segment through the trot, ~1.3% in the first steps
-     * (the blanket settling from flat); bounds with margin */
-    T_CHECK(pu_len(st.seg_gap) < 0.01, "[%s] cow trot: gap %.4f%% of a segment (bound 1%%)", fl(), 100 * pu_len(st.seg_gap));
-    T_CHECK(pu_len(st.seg_gap_max) < 0.02, "[%s] cow trot: largest gap since init %.4f%% of a segment (bound 2%%)", fl(),
-            100 * pu_len(st.seg_gap_max));
+    /* the examples' sweeps (tail 32 over-relaxed at omega 1.6875, gamma 1;
+     * blanket 24 fine + 2 coarse at gamma 0.5) leave ~0.6% of a segment at
+     * step 72, ~1.4% in the first steps (the blanket settling from flat) and
+     * at most 1.42% over [30, 240) (32 plain sweeps on both levels and 64 on
+     * the tail, before issue 15: 1.94%); bounds with margin */
+    T_CHECK(pu_len(sK.seg_gap) < 0.01, "[%s] cow trot: gap %.4f%% of a segment (bound 1%%)", fl(), 100 * pu_len(sK.seg_gap));
+    T_CHECK(pu_len(sK.seg_gap_max) < 0.02, "[%s] cow trot: largest gap since init %.4f%% of a segment (bound 2%%)", fl(),
+            100 * pu_len(sK.seg_gap_max));
+    T_CHECK(gmax < 0.016, "[%s] cow trot: largest gap over steps [30, %u) %.4f%% of a segment (bound 1.6%%)", fl(), K2, 100 * gmax);
     pu_rt_close(&a);
 }
 
@@ -149,7 +157,7 @@ int main(void) {
     int i;
     char fv[32];
     (void)T_SEED();
-    cow_trot(72);
+    cow_trot(72, 240);
     teleport(0);
     teleport(90);
     for (i = 0; i < 3; i++) {

@@ -151,8 +151,8 @@ int main(int argc, char **argv)
     b0 = load(argv[1], &n0); b1 = load(argv[2], &n1);
     if (!b0 || !b1) { T_CHECK(0, "cannot read %s / %s (make them: tests/level.mk)", argv[1], argv[2]); return T_END(); }
     if (!mk(&P, b0, n0) || !mk(&A, b1, n1)) { T_CHECK(0, "%s: validate, init, level 1", name); return T_END(); }
-    T_CHECK(cnt_of(b1, SN_SEC_ADAPT) == 1 && cnt_of(b0, SN_SEC_ADAPT) == 0 && rd16(b1 + SN_H_VER_MINOR) == 1,
-            "%s: the ADAPT record (format 6.1) in the adapt blob only", name);
+    T_CHECK(cnt_of(b1, SN_SEC_ADAPT) == 1 && cnt_of(b0, SN_SEC_ADAPT) == 0 && rd16(b1 + SN_H_VER_MINOR) >= 1,
+            "%s: the ADAPT record (format 6.1 and later) in the adapt blob only", name);
     cell = cell_of(b1);
     nf1 = rd32(sec_of(b1, SN_SEC_LEVEL_BLOB) + SN_H_N_FREE);
     nv1 = rd32(sec_of(b1, SN_SEC_LEVEL_BLOB) + SN_H_N_VERTICES);

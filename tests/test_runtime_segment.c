@@ -44,7 +44,7 @@ static union { uint64_t a; unsigned char m[1 << 18]; } g_mem;
 
 /* A mesh to write: kind, side, levels, sweeps, flags, params, nodes, attachments */
 typedef struct tmesh {
-    int kind, side, levels, sweeps, flags;
+    int kind, side, levels, sweeps, flags, coarse_sweeps, relax; /* 0: = sweeps, 32 (omega 1) */
     double len, gamma, keep, inv_mass, centre, share[4];
     const double *nodes;
     int n_att, att_node[8], att_kind[8], att_target[8];
@@ -98,6 +98,8 @@ static uint32_t with_meshes(unsigned char *b, const tmesh *ms, int nm) {
             tb_real(r + 28, t->inv_mass, 16);
             tb_real(r + 32, t->centre, 30);
             for (k = 0; k < 4; k++) tb_real(r + 36 + 4 * k, t->share[k], 30);
+            r[52] = (unsigned char)(t->coarse_sweeps ? t->coarse_sweeps : t->sweeps);
+            r[53] = (unsigned char)(t->relax ? t->relax : (int)SN_SEG_RELAX_ONE);
             for (i = 0; i < 3 * nn; i++) tb_real(nd + 4 * (3 * fn + (uint32_t)i), t->nodes[i], SN_Q_LEN);
             for (i = 0; i < t->n_att; i++) {
                 unsigned char *a = ap + elem[2] * (fa + (uint32_t)i);
@@ -159,23 +161,28 @@ static double grav_y(void) { return -9.81 / 3600.0; } /* the test blob's h^2 g, 
 
 /* chain of 8 hanging along +x (horizontal: it swings), node 0 pinned to the
  * tip joint, which moves sinusoidally in x; runtime vs reference */
-static void test_reference(void) {
+/* relax: the blob's over-relaxation byte (omega = relax/32, issue 15);
+ * returns the runtime's largest gap over the run (segment lengths) */
+static double test_reference(int relax) {
     const int n = 9, steps = 120;
     const double len = 0.1;
     tmesh t;
     sn_instance *inst;
     segref ref;
-    double g[3] = {0, 0, 0}, maxd = 0;
+    double g[3] = {0, 0, 0}, maxd = 0, gap = 0;
     sn_xform x[TB_NJ];
+    sn_stats st;
     int s, i, k;
     make_chain(n, len, 1.0, 1, 0);
     t = chain_mesh(n, len, 16, 0.8, 0.995, 0);
+    t.relax = relax;
     t.n_att = 1; t.att_node[0] = 0; t.att_kind[0] = SN_SEGATT_JOINT; t.att_target[0] = 1;
     t.att_p[0][0] = 1.0;
     inst = instance(g_work.b, with_meshes(g_work.b, &t, 1));
-    if (!inst) { T_CHECK(0, "reference chain blob"); return; }
+    if (!inst) { T_CHECK(0, "reference chain blob"); return 0; }
     g[1] = grav_y();
     segref_init(&ref, 0, n, chain_nodes, len, 0.8, 0.995, 4.0, 0.5, 16, g);
+    ref.omega = relax / 32.0;
     ref.n_att = 1; ref.att_node[0] = 0;
     memset(x, 0, sizeof x);
     for (s = 0; s < steps; s++) {
@@ -185,6 +192,8 @@ static void test_reference(void) {
         x[1].pos.x = PUB(a);
         sn_set_pose(inst, x, TB_NJ);
         sn_step(inst);
+        sn_get_stats(inst, &st);
+        gap = UNPUB(st.seg_gap) > gap ? UNPUB(st.seg_gap) : gap;
         ref.att_T[0][0] = 1.0 + a; ref.att_T[0][1] = 0; ref.att_T[0][2] = 0;
         segref_step(&ref);
         sn_get_segment_nodes(inst, 0, p, 0, (uint32_t)n);
@@ -195,14 +204,16 @@ static void test_reference(void) {
                 maxd = d > maxd ? d : maxd;
             }
     }
-    T_FIGURE("%s: chain 8 segs, 120 steps, moving joint: max |node - reference| = %.3g units (%.3g segment lengths), ref end (%.4f %.4f)",
-             FLAV, maxd, maxd / len, ref.N[n - 1][0], ref.N[n - 1][1]);
+    T_FIGURE("%s: chain 8 segs, 16 sweeps, omega %.4f, 120 steps, moving joint: max |node - reference| = %.3g units (%.3g segment "
+             "lengths), ref end (%.4f %.4f), largest gap %.4f%%", FLAV, ref.omega, maxd, maxd / len, ref.N[n - 1][0], ref.N[n - 1][1],
+             100 * gap);
     /* tolerance: fixed rounds every product to 2^-22 (2.4e-7) units and
      * every unit vector to ~2^-30; over 120 steps x 16 sweeps x ~4 roundings
      * per constraint the walk is ~sqrt(7700) * 2.4e-7 ~ 2e-5, amplified by
      * the iteration's sensitivity (< 10 for a damped chain): 1e-3 segment
      * lengths = 2e-4 units leaves margin; float's 2^-24 relative is similar */
-    T_CHECK(maxd < 2e-4, "%s chain vs reference: %.3g units", FLAV, maxd);
+    T_CHECK(maxd < 2e-4, "%s chain vs reference (omega %.4f): %.3g units", FLAV, ref.omega, maxd);
+    return gap;
 }
 
 /* free chain, no gravity, keep 1: linear momentum exact, angular close */
@@ -378,8 +389,13 @@ static void test_validator(void) {
         {"first_attach 1", 12, 4, 1}, {"seg_len 0", 16, 4, 0}, {"gamma 0", 20, 4, 0},
         {"gamma > 1", 20, 4, 0x40000001}, {"keep < 0", 24, 4, -1}, {"inv_mass 0", 28, 4, 0},
         {"centre > 1", 32, 4, 0x40000001}, {"share sum", 36, 4, 0x3FFFFFFF},
-        {"sheet side 4", 52 + 4, 2, 4}, {"sheet levels 3", 52 + 1, 1, 3}, {"sheet levels 0", 52 + 1, 1, 0},
-        {"sheet share beyond levels", 52 + 36 + 8, 4, 1},
+        {"sheet side 4", 56 + 4, 2, 4}, {"sheet levels 3", 56 + 1, 1, 3}, {"sheet levels 0", 56 + 1, 1, 0},
+        {"sheet share beyond levels", 56 + 36 + 8, 4, 1},
+        /* format 6.2's tail (the chain: sweeps 8, relax 48 = omega 1.5, gamma 0.5) */
+        {"coarse_sweeps 0", 52, 1, 0}, {"one-level coarse_sweeps != sweeps", 52, 1, 9}, {"relax 31 (omega < 1)", 53, 1, 31},
+        {"relax 64 (omega 2)", 53, 1, 64}, {"tail u16 not 0", 54, 2, 1},
+        {"omega (1 - gamma) > 1: gamma 0.25 at relax 1.5", 20, 4, 0x10000000},
+        {"sheet coarse_sweeps 65", 56 + 52, 1, 65},
     };
     unsigned i;
     T_CHECK(sn_blob_validate(g_blob.b, n, &blob) == SN_OK, "%s test blob with a chain and a sheet accepted", FLAV);
@@ -394,9 +410,9 @@ static void test_validator(void) {
         unsigned char *b = g_work.b;
         memcpy(b, g_blob.b, CAP);
 #if defined(SN_FLOAT)
-        if (bad[i].bytes == 4 && bad[i].off >= 16 && (bad[i].off - 16) % 52 != 0 && bad[i].off != 52 + 36 + 8) {
+        if (bad[i].bytes == 4 && bad[i].off >= 16 && (bad[i].off - 16) % 56 != 0 && bad[i].off != 56 + 36 + 8) {
             /* reals: the same values as floats */
-            double v = bad[i].off % 52 == 28 ? (double)bad[i].val / 65536.0 : (double)bad[i].val / 1073741824.0;
+            double v = bad[i].off % 56 == 28 ? (double)bad[i].val / 65536.0 : (double)bad[i].val / 1073741824.0;
             if (v > 1.0) v = 1.01;            /* 1 + 2^-30 rounds to 1.0f: a float-visible excess */
             if (bad[i].val == 0x3FFFFFFF) v = 0.99;
             tb_real(b + ms + bad[i].off, v, 0);
@@ -581,7 +597,12 @@ int main(void) {
     tb_build(g_blob.b, CAP, 0);
     test_validator();
     test_api();
-    test_reference();
+    {   /* over-relaxed sweeps (omega 1.6875, the cow's tail) follow the
+         * reference too, and leave a smaller gap than plain ones at the same
+         * count (successive over-relaxation of Gauss-Seidel) */
+        double g1 = test_reference((int)SN_SEG_RELAX_ONE), g2 = test_reference(54);
+        T_CHECK(g2 < g1, "%s: over-relaxed sweeps leave a smaller gap: %.4f%% vs %.4f%% plain", FLAV, 100 * g2, 100 * g1);
+    }
     test_momentum();
     test_gap();
     test_multilevel();

@@ -129,7 +129,9 @@ typedef struct sb_segdef {
     int levels;         /* sheet: 1..min(n+1, 4); chain 1 */
     double share[4];    /* force share per level, finest first, sum 1 */
     double mass;        /* kg, the whole mesh (finest level) */
-    int sweeps;         /* constraint sweeps per level per step */
+    int sweeps;         /* constraint sweeps per step on level 0 */
+    int coarse_sweeps;  /* on the coarser levels (sheets); 0: = sweeps */
+    int relax;          /* over-relaxation omega of the sweeps' corrections x 32: 32..63 */
     double gamma;       /* translation factor (seed 004 §3.2.2), (0, 1] */
     double damping;     /* 1/s: velocity kept per step = exp(-damping h) */
     double centre;      /* share of a node force applied at the segments' centres (seed 004 §3.1) */

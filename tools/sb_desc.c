@@ -175,16 +175,29 @@ static int seg_options(ctx_t *c, sb_segdef *g, int first)
             continue;
         }
         if (i + 1 >= c->nt) {
-            static const char *known[] = {"mass", "sweeps", "gamma", "damping", "centre", "gravity", "levels"};
-            for (k = 0; k < 7; k++) if (!strcmp(key, known[k])) return sb_fail("%s:%d: missing value after '%s'", c->path, c->line, key);
-            return sb_fail("%s:%d: unknown %s option '%s' (want mass, sweeps, gamma, damping, centre, gravity%s)", c->path, c->line,
-                           sheet ? "sheet" : "chain", key, sheet ? ", levels, shares" : "");
+            static const char *known[] = {"mass", "sweeps", "gamma", "damping", "centre", "gravity", "levels", "relax", "coarse_sweeps"};
+            for (k = 0; k < 9; k++) if (!strcmp(key, known[k])) return sb_fail("%s:%d: missing value after '%s'", c->path, c->line, key);
+            return sb_fail("%s:%d: unknown %s option '%s' (want mass, sweeps, relax, gamma, damping, centre, gravity%s)", c->path, c->line,
+                           sheet ? "sheet" : "chain", key, sheet ? ", levels, shares, coarse_sweeps" : "");
         }
         if (!strcmp(key, "mass")) {
             if (num(c, i + 1, &g->mass)) return -1;
             if (!(g->mass > 0 && g->mass <= 1e6)) return sb_fail("%s:%d: mass must be in (0, 1e6] kg (got %g)", c->path, c->line, g->mass);
         } else if (!strcmp(key, "sweeps")) {
             if (inum(c, i + 1, 1, 64, &g->sweeps)) return -1;
+        } else if (!strcmp(key, "coarse_sweeps")) {
+            if (!sheet) return sb_fail("%s:%d: 'coarse_sweeps' is for sheets (a chain has one level)", c->path, c->line);
+            if (inum(c, i + 1, 1, 64, &g->coarse_sweeps)) return -1;
+        } else if (!strcmp(key, "relax")) {
+            double w, k32;
+            if (num(c, i + 1, &w)) return -1;
+            if (!(w >= 1 && w <= 63.0 / 32))
+                return sb_fail("%s:%d: relax (over-relaxation omega) must be in [1, 1.96875] (got %g)", c->path, c->line, w);
+            k32 = floor(w * 32 + 0.5);
+            if (fabs(w * 32 - k32) > 1e-9)
+                return sb_fail("%s:%d: relax %g is not a multiple of 1/32 (the blob stores 32 omega): use %g or %g", c->path, c->line, w,
+                               floor(w * 32) / 32, ceil(w * 32) / 32);
+            g->relax = (int)k32;
         } else if (!strcmp(key, "gamma")) {
             if (num(c, i + 1, &g->gamma)) return -1;
             /* gamma = 0 only rotates: the constraints do not converge (seed 004 §3.2.2) */
@@ -203,11 +216,17 @@ static int seg_options(ctx_t *c, sb_segdef *g, int first)
             if (!sheet) return sb_fail("%s:%d: 'levels' is for sheets (a chain has one level)", c->path, c->line);
             if (inum(c, i + 1, 1, 4, &g->levels)) return -1;
         } else {
-            return sb_fail("%s:%d: unknown %s option '%s' (want mass, sweeps, gamma, damping, centre, gravity%s)", c->path, c->line,
-                           sheet ? "sheet" : "chain", key, sheet ? ", levels, shares" : "");
+            return sb_fail("%s:%d: unknown %s option '%s' (want mass, sweeps, relax, gamma, damping, centre, gravity%s)", c->path, c->line,
+                           sheet ? "sheet" : "chain", key, sheet ? ", levels, shares, coarse_sweeps" : "");
         }
         i += 2;
     }
+    /* omega (1 - gamma) <= 1: a turn closes at most all of the gap's
+     * perpendicular part, and the runtime's turn factors keep their int32
+     * bound (the validator's check, sn_segment_api.c) */
+    if (g->relax * (1 - g->gamma) > 32 + 1e-9)
+        return sb_fail("%s:%d: %s '%s': relax %g with gamma %g over-relaxes the turns: want relax (1 - gamma) <= 1 (relax <= %g)", c->path,
+                       c->line, sheet ? "sheet" : "chain", g->name, g->relax / 32.0, g->gamma, floor(32 / (1 - g->gamma)) / 32);
     if (sheet) {
         int n = 0, maxl;
         double sum = 0;
@@ -218,6 +237,8 @@ static int seg_options(ctx_t *c, sb_segdef *g, int first)
             return sb_fail("%s:%d: sheet '%s': %d levels, at most %d for side %d (= 2^%d + 1; levels <= min(n + 1, 4))", c->path, c->line, g->name, g->levels, maxl, g->side, n, n);
         if (nsh && nsh != g->levels)
             return sb_fail("%s:%d: sheet '%s': %d share(s) for %d level(s): give one per level, finest first", c->path, c->line, g->name, nsh, g->levels);
+        if (g->coarse_sweeps && g->levels == 1)
+            return sb_fail("%s:%d: sheet '%s': 'coarse_sweeps' needs levels >= 2 (one level takes 'sweeps')", c->path, c->line, g->name);
         if (!nsh) g->share[0] = 1;   /* all on the finest level: Gascuel's original method (seed 004 fig. 4.9) */
         for (k = 0; k < 4; k++) sum += g->share[k];
         if (fabs(sum - 1) > 1e-6) return sb_fail("%s:%d: sheet '%s': shares sum to %.9g, want 1", c->path, c->line, g->name, sum);
@@ -235,7 +256,7 @@ static int seg_line(ctx_t *c, sb_desc *d)
     static const char *usage[2] = {"'chain NAME nodes N from X Y Z to X Y Z [OPTIONS]'", "'sheet NAME side S corner X Y Z u X Y Z v X Y Z [OPTIONS]'"};
     memset(&g, 0, sizeof g);
     g.kind = sheet; g.line = c->line;
-    g.mass = 1; g.sweeps = 8; g.gamma = 0.5; g.damping = 0.5; g.centre = 0.5; g.gravity = 1;
+    g.mass = 1; g.sweeps = 8; g.relax = 32; g.gamma = 0.5; g.damping = 0.5; g.centre = 0.5; g.gravity = 1;
     if (c->nt < (sheet ? 16 : 12)) return sb_fail("%s:%d: missing value: %s", c->path, c->line, usage[sheet]);
     if (strlen(c->tok[1]) >= SB_NAME_MAX) return sb_fail("%s:%d: segment mesh names are at most %d characters", c->path, c->line, SB_NAME_MAX - 1);
     if (find_seg(d, c->tok[1]) >= 0) return sb_fail("%s:%d: segment mesh '%s' declared twice", c->path, c->line, c->tok[1]);

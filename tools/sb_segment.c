@@ -221,6 +221,10 @@ int sb_segment_blob_write(const sb_model *o, unsigned char *blob, const uint32_t
         bad |= put_real(r + 16 + 3 * (size_t)rs, flavour, inv, 16);
         bad |= put_real(r + 16 + 4 * (size_t)rs, flavour, g->centre, SN_Q_ROT);
         for (k = 0; k < 4; k++) bad |= put_real(r + 16 + (size_t)(5 + k) * (size_t)rs, flavour, sh[k], SN_Q_ROT);
+        /* format 6.2: coarse_sweeps (= sweeps unless given), relax, u16 0 */
+        r[16 + 9 * (size_t)rs] = (unsigned char)(g->coarse_sweeps ? g->coarse_sweeps : g->sweeps);
+        r[17 + 9 * (size_t)rs] = (unsigned char)g->relax;
+        put16(r + 18 + 9 * (size_t)rs, 0);
         if (flavour == SB_FIXED && !(rnd(ldexp(s->seg_len / U, SN_Q_LEN)) >= 1))
             return sb_fail("%s:%d: %s '%s': segments of %g mesh units are below the blob's length resolution", s->path, g->line, what, g->name, s->seg_len);
         for (j = 0; j < s->nodes; j++) {

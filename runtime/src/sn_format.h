@@ -16,7 +16,7 @@
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
 #define SN_FORMAT_MAJOR 6
-#define SN_FORMAT_MINOR 1
+#define SN_FORMAT_MINOR 2
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
 #define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
@@ -133,7 +133,10 @@ enum {
                             R gamma (translation factor, Q30, (0, 1]), R keep (velocity kept per step, Q30, [0, 1]),
                             R inv_mass (m0 / segment mass, Q16.16, > 0), R centre (share of a node force applied at the
                             segments' centres, seed 004 §3.2.2, Q30, [0, 1]), R share[4] (force share per level, finest
-                            first, Q30, sum 2^30)}; nM <= SN_SEG_MAX_MESHES.
+                            first, Q30, sum 2^30), u8 coarse_sweeps (levels l >= 1, 1..SN_SEG_MAX_SWEEPS),
+                            u8 relax (over-relaxation of the sweeps' corrections, omega = relax/32,
+                            SN_SEG_RELAX_ONE..SN_SEG_RELAX_MAX, omega (1 - gamma) <= 1), u16 0 (format 6.2)};
+                            nM <= SN_SEG_MAX_MESHES.
                             chain: side = nodes (2..SN_SEG_MAX_SIDE), levels 1; sheet: side = 2^n + 1 (3..SN_SEG_MAX_SHEET),
                             levels 1..min(n+1, 4). first_node / first_attach are running sums from 0 */
     SN_SEC_SEGNODES,     /* sum of nodes x R[3]: rest node positions, model space, Q22 (sheets row-major) */
@@ -212,7 +215,7 @@ enum {
 #define SN_ELEM_RIG_FORCES(R) (3 * (R))
 #define SN_ELEM_SHARES(R)   (SN_LEVELS * (R))
 #define SN_ELEM_VSHARE      1
-#define SN_ELEM_SEGMESH(R)  (16 + 9 * (R))
+#define SN_ELEM_SEGMESH(R)  (20 + 9 * (R))
 #define SN_ELEM_SEGNODES(R) (3 * (R))
 #define SN_ELEM_SEGATTACH(R) (8 + 3 * (R))
 #define SN_ELEM_CONSTRAINTS 8
@@ -262,6 +265,8 @@ enum {
 #define SN_SEG_MAX_SIDE 256u
 #define SN_SEG_MAX_SHEET 65u
 #define SN_SEG_MAX_SWEEPS 64u
+#define SN_SEG_RELAX_ONE 32u   /* relax byte of omega = 1 (plain Gauss-Seidel) */
+#define SN_SEG_RELAX_MAX 63u   /* omega < 2: SOR converges for omega in (0, 2) */
 #define SN_SEG_SEG_BYTES 64u      /* instance bytes per segment (state of every level) */
 #define SN_SEG_NODE_BYTES 24u     /* instance bytes per node (every level) */
 /* Segments and nodes of a mesh over all its levels (sheet level l has side

@@ -8,13 +8,17 @@
  * and impulses to the coarser levels; then from the coarsest level to the
  * finest: dynamics (damping, gravity and impulses by the level's share,
  * Euler-Cromer, seed 004 appendix A), a FIXED number of constraint sweeps
- * (no error-driven exit, unlike seed 004 fig. 3.8), velocities from the
- * displacements, prolongation to the next finer level.
+ * (no error-driven exit, unlike seed 004 fig. 3.8: `sweeps` on level 0,
+ * `coarse_sweeps` on the coarser ones), velocities from the displacements,
+ * prolongation to the next finer level. The sweeps' corrections may be
+ * over-relaxed by omega = relax/32 (SOR on Palazzi's projection; omega 1
+ * is seed 004 §3.2 as written; NUMERICS.md "Segment meshes").
  *
  * Cost per step, with S_l, N_l, E_l the segments, nodes and node-endpoint
  * pairs of level l (chain: E = N - 2; sheet interior node: 4 pairs in a
- * ring), A the attachments, F = 1 if a floor is set:
- *   sum_l [ c1 S_l + c2 N_l + sweeps (c3 E_l + c4 A + F c5 2 S_l) ] + c6 N_0 levels
+ * ring), A the attachments, F = 1 if a floor is set, W_l the sweeps of
+ * level l (sweeps, coarse_sweeps for l >= 1):
+ *   sum_l [ c1 S_l + c2 N_l + W_l (c3 E_l + c4 A + F c5 2 S_l) ] + c6 N_0 levels
  * with constants c_i independent of the data: every loop runs over counts
  * fixed by the blob and the settings; no loop exits on a value.
  */
@@ -46,6 +50,7 @@ void seg_mesh_get(const sn_ihdr *h, uint32_t m, seg_mesh *M) {
         M->kind = r[0]; M->levels = r[1]; M->sweeps = r[2]; M->flags = r[3];
         M->side = sn_rd_u16(r + 4); M->n_attach = sn_rd_u16(r + 6);
         M->first_node = sn_rd_u32(r + 8); M->first_attach = sn_rd_u32(r + 12);
+        M->coarse_sweeps = r[16 + 9 * SN_REAL_BYTES]; M->relax = r[17 + 9 * SN_REAL_BYTES];
         sn_seg_counts(M->kind, M->side, M->levels, &M->segs, &M->nodes);
         M->S = base;
         M->N = base + SEG_W * M->segs;
@@ -430,7 +435,11 @@ static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
 typedef struct seg_ctx {
     sn_ihdr *h;
     const seg_mesh *M;
-    sn_q gh, rf1, rf2;  /* gamma/2, 1-gamma, (1-gamma)/2 */
+    /* Palazzi's factors times the over-relaxation omega = relax/32 (1 when
+     * relax = 32: then these are exactly the plain factors, same bits) */
+    sn_q gh, rf1, rf2;  /* omega gamma/2, omega (1-gamma), omega (1-gamma)/2 */
+    sn_acc g1;          /* omega gamma (fixed Q30, < 2^31: int64) */
+    sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
     seg_n kf0;          /* level 0's turn factor rf2/half (seg_kf), set by sweep */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
@@ -468,7 +477,7 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     /* endpoints G +- half u (|.| < 2^30) and their difference, clamped */
     for (k = 0; k < 3; k++) {
         d[k] = sn_out((B[k] + r30(MUL(B[3 + k], hb))) - (A[k] + r30(MUL(A[3 + k], ha))), 0, &ls);
-        t[k] = NARROW(r30(MUL(d[k], C->gh))); /* gamma d / 2: |.| <= 2^27 */
+        t[k] = NARROW(r30(MUL(d[k], C->gh))); /* omega gamma d / 2: |.| < 2^28 */
     }
     if (measure) {
         sn_real g = gap_of(d, L);
@@ -490,7 +499,7 @@ static void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3
     seg_end(L, a, sa, P, sat);
     for (k = 0; k < 3; k++) {
         d[k] = sn_add(T[k], -P[k], sat);
-        t[k] = sn_mulq(d[k], C->M->gamma, SN_Q_ROT, sat);
+        t[k] = sn_out((sn_acc)d[k] * C->g1, SN_Q_ROT, sat); /* omega gamma d: |d| 2^31 < 2^60 */
     }
     if (measure) {
         sn_real g = gap_of(d, L);
@@ -597,7 +606,7 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
         for (k = 0; k < 3; k++) {
             sn_q d0 = sn_add(mean_k((sn_acc)N[NODE_W + k] + N[2 * NODE_W + k], 2, sat),
                              -mean_k((sn_acc)N[k] + N[3 * NODE_W + k], 2, sat), sat);
-            t = sn_mulq(sn_add(sn_add(B5[k], -B4[k], sat), -d0, sat), C->gh, SN_Q_ROT, sat);
+            t = sn_mulq(sn_add(sn_add(B5[k], -B4[k], sat), -d0, sat), C->gb, SN_Q_ROT, sat);
             B4[k] = sn_add(B4[k], t, sat);
             B5[k] = sn_add(B5[k], -t, sat);
         }
@@ -615,7 +624,7 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
                     d[k] = sn_mulq(C->fn[k], pen, SN_Q_ROT, sat);
                     t[k] = sn_mulq(d[k], M->gamma, SN_Q_ROT, sat);
                 }
-                seg_move(L, i, s, t, d, C->rf1, sat);
+                seg_move(L, i, s, t, d, C->rfu, sat);
             }
 }
 
@@ -722,12 +731,24 @@ static void ctx_init(seg_ctx *C, sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
     C->h = h;
     C->M = M;
 #if defined(SN_FLOAT)
-    C->gh = 0.5f * M->gamma;
-    C->rf1 = 1.0f - M->gamma;
-    C->rf2 = 0.5f * C->rf1;
+    {
+        float om = (float)M->relax / 32.0f;
+        C->gb = 0.5f * M->gamma;
+        C->rfu = 1.0f - M->gamma;
+        C->gh = C->gb * om;
+        C->rf1 = C->rfu * om;
+        C->rf2 = 0.5f * C->rf1;
+        C->g1 = M->gamma * om;
+    }
 #else
-    C->gh = M->gamma >> 1; /* gamma/2 rounded down: the pair's translation is t = d gamma/2 */
-    C->rf1 = ((int32_t)1 << 30) - M->gamma;
+    C->gb = M->gamma >> 1; /* gamma/2 rounded down: the pair's translation is t = d gamma/2 */
+    C->rfu = ((int32_t)1 << 30) - M->gamma;
+    /* relax <= 63, gamma <= 2^30: gamma relax < 2^36; the validator keeps
+     * omega (1 - gamma) <= 1, so rf1 <= 2^30 and the turn factors keep
+     * their bounds (seg_kf); omega gamma < 2^31 needs int64 (pin) */
+    C->g1 = ((int64_t)M->gamma * M->relax) >> 5;
+    C->gh = (sn_q)(((int64_t)M->gamma * M->relax) >> 6);
+    C->rf1 = (sn_q)(((int64_t)C->rfu * M->relax) >> 5);
     C->rf2 = C->rf1 >> 1;
 #endif
     (void)sat;
@@ -834,7 +855,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
 #endif
             }
             dynamics(&C, &L, im, sat);
-            for (s = 0; s < M.sweeps; s++) sweep(&C, &L, 0, s & 1u, sat);
+            /* level 0 takes `sweeps`, the coarser ones `coarse_sweeps`: a
+             * coarse level starts each step with its constraints met
+             * (restriction), its sweeps only pin it and follow its dynamics */
+            for (s = 0; s < (l ? M.coarse_sweeps : M.sweeps); s++) sweep(&C, &L, 0, s & 1u, sat);
             renormalize(&L); /* the Newton steps of the moves leave |u| within 2% of 1 */
             seg_node_means(&L, sat);
             if (l > 0) seg_prolong(&M, l, sat); /* reads this level's start (v, w words) */

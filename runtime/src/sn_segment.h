@@ -24,7 +24,7 @@
 
 /* One mesh, decoded from its (validated) record. */
 typedef struct seg_mesh {
-    unsigned kind, levels, sweeps, flags, side, n_attach;
+    unsigned kind, levels, sweeps, coarse_sweeps, relax, flags, side, n_attach;
     uint32_t first_node, first_attach, segs, nodes; /* segs, nodes: all levels */
     sn_q len, gamma, keep, inv_mass, centre, share[SN_SEG_MAX_LEVELS];
     sn_q *S, *N; /* state: segments, nodes of level 0 (coarser levels follow) */

@@ -59,6 +59,22 @@ sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
             !sn_real_ok(R + 12, 1, INT32_MAX, 16) ||              /* inv_mass (0, 32768) */
             !sn_real_ok(R + 16, 0, (int32_t)1 << 30, 30))         /* centre [0, 1] */
             return SN_ERR_VALUE;
+        {   /* format 6.2: coarse_sweeps (a one-level mesh: = sweeps), relax,
+             * u16 0. omega = relax/32 in [1, 2) (SOR converges below 2), and
+             * omega (1 - gamma) <= 1: the turn factors (sn_segment.c seg_kf,
+             * move_seg) keep their int32 bound, a turn closes at most all of
+             * the gap's perpendicular part */
+            const unsigned char *X = R + 9 * SN_REAL_BYTES;
+            unsigned cs = X[0], rx = X[1];
+            if (cs < 1 || cs > SN_SEG_MAX_SWEEPS || (levels == 1 && cs != sweeps) || rx < SN_SEG_RELAX_ONE ||
+                rx > SN_SEG_RELAX_MAX || sn_rd_u16(X + 2) != 0)
+                return SN_ERR_VALUE;
+#if defined(SN_FLOAT)
+            if ((1.0f - sn_rd_f32(R + 4)) * (float)rx > 32.0f) return SN_ERR_VALUE;
+#else
+            if ((((int64_t)1 << 30) - sn_rd_i32(R + 4)) * (int64_t)rx > ((int64_t)1 << 35)) return SN_ERR_VALUE;
+#endif
+        }
         for (k = 0; k < SN_SEG_MAX_LEVELS; k++) {
             const unsigned char *p = R + 20 + 4 * k;
             if (!sn_real_ok(p, 0, (int32_t)1 << 30, 30)) return SN_ERR_VALUE;

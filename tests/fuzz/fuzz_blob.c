@@ -960,6 +960,21 @@ static void e_ichol(unsigned char *b, int hi) {
     for (k = 0; k < 9 * n; k++) tb_u16(b + off + 20 * (k / 9) + 2 * (k % 9), (k & 1) ? 0x8001u : 0x7FFFu);
 }
 
+/* segment meshes (format 6.2): lo every mesh at relax 32 (omega 1) with gamma
+ * 1 LSB and 1 coarse sweep; hi relax 63 (omega 1.97) with gamma at the
+ * validator's bound omega (1 - gamma) <= 1 (fixed 2^30 - 2^35/63 rounded up,
+ * float 31/63 + 1e-6) and 64 sweeps on every level */
+static void e_seg_relax(unsigned char *b, int hi) {
+    unsigned char *r = secp(b, SN_SEC_SEGMESH);
+    uint32_t m, n = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_SEGMESH + 8), es = (uint32_t)SN_ELEM_SEGMESH(4);
+    for (m = 0; m < n; m++, r += es) {
+        put(r + 20, hi ? 528349152 : 1, hi ? 31.0 / 63.0 + 1e-6 : ldexp(1.0, -30));
+        r[2] = (unsigned char)(hi ? 64 : r[2]);
+        r[52] = (unsigned char)(hi ? 64 : (r[1] > 1 ? 1 : r[2])); /* coarse_sweeps: = sweeps at one level */
+        r[53] = (unsigned char)(hi ? 63 : 32);
+    }
+}
+
 typedef struct {
     const char *field, *lo, *hi; /* row label; what min and max mean (fixed / float) */
     void (*edit)(unsigned char *b, int hi);
@@ -1005,6 +1020,7 @@ static const mx_row g_rows[] = {
     {"crease depth, push, exclude (a contact)", "1 LSB, 0, 1 LSB", "2^26, 2^26, 2^28", e_crease_depth, 0},
     {"crease list, active (a contact)", "1, 1", "256, 64", e_crease_list, 0},
     {"ICHOL mantissas +-(2^15-1), k 0/15", "frac 0", "frac 47", e_ichol, 0},
+    {"segment relax, gamma, sweeps (format 6.2)", "relax 32, gamma 1 LSB", "relax 63, gamma at omega (1-gamma) = 1, 64 sweeps", e_seg_relax, 0},
     {"everything at once", "all min", "all max", e_all, 0},
 };
 #define N_ROWS ((int)(sizeof g_rows / sizeof g_rows[0]))

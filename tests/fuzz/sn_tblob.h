@@ -360,6 +360,8 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
             tb_real(r + 16 + 3 * R, 4.0, 16);
             tb_real(r + 16 + 4 * R, 0.5, SN_Q_ROT);
             for (j = 0; j < 4; j++) tb_real(r + 16 + (5 + j) * R, sh[i][j], SN_Q_ROT);
+            r[16 + 9 * R] = (unsigned char)(i ? 2u : hd[i][2]); /* coarse_sweeps (a one-level chain: = sweeps) */
+            r[17 + 9 * R] = (unsigned char)(i ? SN_SEG_RELAX_ONE : 48u); /* relax: the chain over-relaxed (omega 1.5) */
         }
         for (i = 0; i < 5; i++) { /* chain along -y from (1, 0, 0) */
             tb_real(nd + 3 * R * i, 2 * cell, SN_Q_LEN);

@@ -76,6 +76,7 @@ void segref_init(segref *r, int kind, int side, const double *nodes, double len,
     r->ns = kind ? 2 * side * (side - 1) : side - 1;
     r->len = len; r->gamma = gamma; r->keep = keep; r->inv_mass = inv_mass; r->centre = centre;
     r->sweeps = sweeps;
+    r->omega = 1;
     for (k = 0; k < 3; k++) r->grav[k] = grav[k];
     for (i = 0; i < r->nn; i++)
         for (k = 0; k < 3; k++) r->N[i][k] = nodes[3 * i + k];
@@ -98,9 +99,9 @@ static void sweep(segref *r, int measure, int dir) {
         for (j = 0; j < ne; j++) {
             double P[3], d[3], t[3];
             endp(r, seg[j], sg[j], P);
-            for (k = 0; k < 3; k++) { d[k] = r->att_T[i][k] - P[k]; t[k] = r->gamma * d[k]; }
+            for (k = 0; k < 3; k++) { d[k] = r->att_T[i][k] - P[k]; t[k] = r->omega * r->gamma * d[k]; }
             if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
-            move(r, seg[j], sg[j], t, d, 1 - r->gamma);
+            move(r, seg[j], sg[j], t, d, r->omega * (1 - r->gamma));
         }
     }
     for (color = 0; color < 2; color++)
@@ -116,11 +117,11 @@ static void sweep(segref *r, int measure, int dir) {
                 endp(r, a, sa, P1); endp(r, b, sb, P2);
                 for (k = 0; k < 3; k++) {
                     d[k] = P2[k] - P1[k]; nd[k] = -d[k];
-                    t[k] = 0.5 * r->gamma * d[k]; nt[k] = -t[k];
+                    t[k] = 0.5 * r->omega * r->gamma * d[k]; nt[k] = -t[k];
                 }
                 if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
-                move(r, a, sa, t, d, 0.5 * (1 - r->gamma));
-                move(r, b, sb, nt, nd, 0.5 * (1 - r->gamma));
+                move(r, a, sa, t, d, 0.5 * r->omega * (1 - r->gamma));
+                move(r, b, sb, nt, nd, 0.5 * r->omega * (1 - r->gamma));
             }
         }
     if (r->floor_on && !measure)

@@ -12,6 +12,7 @@
 typedef struct segref {
     int kind, side, ns, nn, sweeps, n_att;
     double len, gamma, keep, inv_mass, centre, grav[3];
+    double omega;                               /* over-relaxation of attachments and pairs (1 after init) */
     double G[SEGREF_MAXS][3], u[SEGREF_MAXS][3], v[SEGREF_MAXS][3], w[SEGREF_MAXS][3];
     double N[SEGREF_MAXN][3], J[SEGREF_MAXN][3]; /* node positions; impulses (dv of mass m0) */
     int att_node[SEGREF_MAXN];
