@@ -20,7 +20,7 @@ int main(int argc, char **argv) {
     f = fopen(argv[1], "rb");
     if (!f) { fprintf(stderr, "mem_bytes: %s: cannot open\n", argv[1]); return 1; }
     if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) <= 0 || fseek(f, 0, SEEK_SET) != 0) {
-        fprintf(stderr, "mem_bytes: %s: cannot size\n", argv[1]); fclose(f); return 1;
+        fprintf(stderr, "mem_bytes: %s: empty or cannot be sized\n", argv[1]); fclose(f); return 1;
     }
     buf = malloc((size_t)n);
     if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
