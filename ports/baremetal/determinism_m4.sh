@@ -23,7 +23,7 @@ for i in lod adapt; do   # both at once: 2 cores
 done
 wait
 for i in lod adapt; do
-    set -- $(cat "$B/determinism_m4_$i.rc"); rc=$1; secs=$2
+    read -r rc secs < "$B/determinism_m4_$i.rc"
     h=$(hash_of "$B/determinism_m4_$i.log")
     want=$(sed -n "s/^${i}_fixed \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
     if [ "$rc" -ne 0 ] || [ -z "$h" ]; then bad "cortex-m4 level_$i: rc $rc"; tail -n 5 "$B/determinism_m4_$i.log"; continue; fi
