@@ -3,6 +3,7 @@
 #   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
 #   make profile-baremetal  Cortex-M4 instructions per function (QEMU exec log)
 #   make determinism-m4  the full level-of-detail and adaptation runs on the M4 (QEMU, ~1 min)
+#   make bench-baremetal-level  their instructions per step on each level (qemu -icount, ~70 s)
 #   make deps             install the cross toolchains and QEMU (Debian, root)
 # Inputs from other fragments: SN_SRCS / SN_INC (runtime.mk), the host tool's
 # C-array blobs $(BUILD)/examples/<asset>_blob.c (tools.mk).
@@ -122,14 +123,14 @@ $(BM_DIR)/gen/%_mem.h: $(BUILD)/level/%.blob $(BM_DIR)/mem_bytes
 	$(BM_DIR)/mem_bytes $< > $@.tmp || { rm -f $@.tmp; exit 1; }
 	mv $@.tmp $@
 # $(1) image, $(2) blob (cow_lod, cow_adapt), $(3) steps, $(4) name of the
-# switch variable (det_main's K:L list), $(5) shared 0/1
+# switch variable (det_main's K:L list), $(5) shared 0/1, $(6) bench 0/1
 define bm_level_image
 $(BM_DIR)/obj/main_$(1).o: ports/baremetal/main_level.c $(PORT_HDRS) ports/baremetal/semihost.h \
         $(BM_DIR)/gen/$(2)_mem.h ports/baremetal/baremetal.mk
 	@mkdir -p $$(dir $$@)
 	$(BM_CC) $(BM_CFLAGS) -include $(BM_DIR)/gen/$(2)_mem.h -DSN_BM_BLOB=sinew_$(2)_blob \
 	    -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size -DSN_BM_STEPS=$(3) -DSN_BM_LOD=$(subst :,$(comma),$($(4))) \
-	    -DSN_BM_SHARED=$(5) -c $$< -o $$@
+	    -DSN_BM_SHARED=$(5) -DSN_BM_BENCH=$(if $(6),$(6),0) -c $$< -o $$@
 $(BM_DIR)/$(1).elf: $(BM_DIR)/obj/main_$(1).o $(BM_OBJS) $(BM_DIR)/obj/$(2)_blob.o \
         $(BM_DIR)/obj/cow_clip.o ports/baremetal/an386.ld
 	$(BM_CC) $(BM_LDFLAGS) -Wl,-Map,$$@.map -o $$@ $$(filter %.o,$$^)
@@ -138,7 +139,16 @@ $(eval $(call bm_level_image,level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0))
 $(eval $(call bm_level_image,level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1))
 $(eval $(call bm_level_image,level_lod_slice,cow_lod,$(BM_SLICE_STEPS),BM_SLICE_LOD,0))
 $(eval $(call bm_level_image,level_adapt_slice,cow_adapt,$(BM_SLICE_STEPS),BM_SLICE_LOD,1))
+# timed (make bench-baremetal-level): instructions per step on each level
+$(eval $(call bm_level_image,bench_level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0,1))
+$(eval $(call bm_level_image,bench_level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1,1))
+.PHONY: bench-baremetal-level
+bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf
+	for i in lod adapt; do echo "== level_$$i (1000 steps, switches $(BM_LEVEL_LOD), qemu -icount shift=0)"; \
+	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_$$i.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)' || exit 1; done
 BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice,$(BM_DIR)/$(i).elf)
+BM_QEMU_ICOUNT = qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+                 -semihosting-config enable=on,target=native -icount shift=0,sleep=off
 .PHONY: print-bm-level determinism-m4
 determinism-m4:   # the full runs alone, against tests/expected_hashes.txt
 	BUILD=$(BUILD) sh ports/baremetal/determinism_m4.sh

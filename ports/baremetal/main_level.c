@@ -9,6 +9,9 @@
  *   SN_BM_STEPS                  steps to play
  *   SN_BM_LOD                    switches K,L,K,L..: sn_set_lod(L) before step K
  *   SN_BM_SHARED                 1: shared instance stepped by sn_step_with
+ *   SN_BM_BENCH                  1: also time each step with CMSDK timer 0 and
+ *                                print instructions per step on each level;
+ *                                meaningful only under `-icount shift=0`
  *   SN_BM_INSTANCE_BYTES, SN_BM_STATE_BYTES, SN_BM_WS_BYTES
  *                                the blob's sizes (mem_bytes.c, on the host)
  * The clip is always linked (sn_bm_clip_text): the scenarios are the trot's.
@@ -30,6 +33,10 @@ extern const unsigned long SN_BM_BLOB_SIZE; /* as sinew-bake --c-array writes it
 extern const unsigned char sn_bm_clip_text[];
 extern const uint32_t sn_bm_clip_len;
 uint32_t sn_bm_stack_used(void);
+
+#ifndef SN_BM_BENCH
+#define SN_BM_BENCH 0
+#endif
 
 static const uint32_t lod_sw[] = { SN_BM_LOD };
 #define N_SW (sizeof lod_sw / sizeof lod_sw[0] / 2u)
@@ -59,6 +66,19 @@ static void put_kv(const char *k, uint64_t v) {
     sn_bm_puts(k); put_u64(v); sn_bm_puts("\n");
 }
 
+#if SN_BM_BENCH
+/* as main.c: ticks of a loop of exactly 2*n instructions (subs + bne), so
+ * that ticks convert to instructions without trusting the clock rate */
+static uint32_t timer_now(void) { return SN_CMSDK_TIMER0[SN_TIMER_VALUE]; }
+static uint32_t calibrate(uint32_t n) {
+    uint32_t t0, t1, r = n;
+    t0 = timer_now();
+    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(r) : : "cc");
+    t1 = timer_now();
+    return t0 - t1;
+}
+#endif
+
 static int fail(const char *what) {
     sn_bm_puts("FAIL: "); sn_bm_puts(what); sn_bm_puts("\n");
     return 1;
@@ -67,6 +87,18 @@ static int fail(const char *what) {
 int main(void) {
     char err[SN_CLIP_ERR_LEN * 2], hex[17];
     uint32_t k, j;
+#if SN_BM_BENCH
+    uint32_t lod = 0;   /* the level in force */
+    uint64_t ticks[2] = { 0, 0 };
+    uint32_t n_lvl[2] = { 0, 0 }, cal_ticks, overhead, t0;
+    SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 0;
+    SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;
+    SN_CMSDK_TIMER0[SN_TIMER_VALUE] = 0xFFFFFFFFu;
+    SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 1u;
+    cal_ticks = calibrate(2000000u);
+    t0 = timer_now(); overhead = t0 - timer_now();
+    if (cal_ticks == 0) return fail("timer does not run");
+#endif
     sn_stats st;
     const sn_blob *b;
     /* the host's sizes must be the target's: the figures below are exact */
@@ -93,12 +125,30 @@ int main(void) {
         for (j = 0; j < N_SW; j++)   /* before step k + 1, as det_main --lod */
             if (lod_sw[2u * j] == k + 1u) {
                 if (sn_set_lod(det.inst, lod_sw[2u * j + 1u]) != SN_OK) return fail("sn_set_lod refused");
+#if SN_BM_BENCH
+                lod = lod_sw[2u * j + 1u] ? 1u : 0u;
+#endif
                 (void)sn_get_stats(det.inst, &st);   /* the level's lattice: evidence the switch acted */
                 sn_bm_puts("switch: step "); put_u64(k + 1u); sn_bm_puts(" level "); put_u64(st.lod);
                 sn_bm_puts(" lattice_vertices "); put_u64(st.lattice_vertices); sn_bm_puts("\n");
             }
+#if SN_BM_BENCH
+        t0 = timer_now();
         sn_det_step(&det);
+        ticks[lod] += t0 - timer_now() - overhead;
+        n_lvl[lod]++;
+#else
+        sn_det_step(&det);
+#endif
     }
+#if SN_BM_BENCH   /* instructions = ticks * 4,000,000 / cal_ticks, per step */
+    for (j = 0; j < 2u; j++)
+        if (n_lvl[j]) {
+            sn_bm_puts(j ? "insns_per_step_level1: " : "insns_per_step_level0: ");
+            put_u64(ticks[j] * 4000000u / cal_ticks / n_lvl[j]);
+            sn_bm_puts(" (mean of "); put_u64(n_lvl[j]); sn_bm_puts(" steps)\n");
+        }
+#endif
     put_kv("refused: ", det.refused);
     (void)sn_get_stats(det.inst, &st);
     put_kv("steps: ", st.steps);
