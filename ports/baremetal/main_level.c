@@ -87,6 +87,8 @@ static int fail(const char *what) {
 int main(void) {
     char err[SN_CLIP_ERR_LEN * 2], hex[17];
     uint32_t k, j;
+    sn_stats st;
+    const sn_blob *b;
 #if SN_BM_BENCH
     uint32_t lod = 0;   /* the level in force */
     uint64_t ticks[2] = { 0, 0 };
@@ -99,8 +101,6 @@ int main(void) {
     t0 = timer_now(); overhead = t0 - timer_now();
     if (cal_ticks == 0) return fail("timer does not run");
 #endif
-    sn_stats st;
-    const sn_blob *b;
     /* the host's sizes must be the target's: the figures below are exact */
     if (sn_blob_validate(SN_BM_BLOB, SN_BM_BLOB_SIZE, &b) != SN_OK) return fail("blob does not validate");
     if (sn_instance_size(b) != SN_BM_INSTANCE_BYTES || sn_instance_state_size(b) != SN_BM_STATE_BYTES ||
