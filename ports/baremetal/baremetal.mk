@@ -2,6 +2,8 @@
 #   make ports            Cortex-M4 images (QEMU mps2-an386) + cross determinism drivers
 #   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
 #   make profile-baremetal  Cortex-M4 instructions per function (QEMU exec log)
+#   make determinism-m4  the full level-of-detail and adaptation runs on the M4 (QEMU, ~1 min)
+#   make bench-baremetal-level  their instructions per step on each level (qemu -icount, ~70 s)
 #   make deps             install the cross toolchains and QEMU (Debian, root)
 # Inputs from other fragments: SN_SRCS / SN_INC (runtime.mk), the host tool's
 # C-array blobs $(BUILD)/examples/<asset>_blob.c (tools.mk).
@@ -92,8 +94,70 @@ $(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
 $(eval $(call bm_image,bad_blob,bad,10,0,))
 
+# ---- the level-of-detail and adaptation scenarios on the M4 (issue 13,
+# main_level.c): det_main's --lod runs on tests/level.mk's two-level cow
+# (cow_lod, own scratch) and its 'adapt' bake (cow_adapt, shared instance).
+# The blobs are baked again as C arrays from tests/level.mk's descriptions
+# (as tools.mk does cow_blob.c; the baker is deterministic, and the full run's
+# hash is checked against tests/expected_hashes.txt, made from the .blob
+# files). Full: 1000 steps, test_determinism.sh's LOD_SW (make determinism,
+# make determinism-m4). Slice (make test): fewer steps, earlier switches, so
+# level 1 and adaptation act within a few seconds of QEMU.
+comma := ,
+BM_LEVEL_LOD   = 250:1,500:0,750:1
+BM_SLICE_STEPS = 60
+BM_SLICE_LOD   = 20:1,40:0,50:1
+$(BM_DIR)/gen/cow_%_blob.c: $(BUILD)/level/cow/%.sinew $(BAKE)
+	@mkdir -p $(dir $@)
+	$(BAKE) $< --c-array $@ --name sinew_cow_$*_blob --quiet
+.SECONDARY: $(BM_DIR)/gen/cow_lod_blob.c $(BM_DIR)/gen/cow_adapt_blob.c
+$(BM_DIR)/obj/cow_%_blob.o: $(BM_DIR)/gen/cow_%_blob.c
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+# the runtime's own sizes for the static buffers (host helper, host runtime)
+$(BM_DIR)/mem_bytes: ports/baremetal/mem_bytes.c runtime/include/sinew.h $(SN_LIB_FIXED)
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) $(SN_INC) -o $@ $< $(SN_LIB_FIXED)
+$(BM_DIR)/gen/%_mem.h: $(BUILD)/level/%.blob $(BM_DIR)/mem_bytes
+	@mkdir -p $(dir $@)
+	$(BM_DIR)/mem_bytes $< > $@.tmp || { rm -f $@.tmp; exit 1; }
+	mv $@.tmp $@
+# $(1) image, $(2) blob (cow_lod, cow_adapt), $(3) steps, $(4) name of the
+# switch variable (det_main's K:L list), $(5) shared 0/1, $(6) bench 0/1
+define bm_level_image
+$(BM_DIR)/obj/main_$(1).o: ports/baremetal/main_level.c $(PORT_HDRS) ports/baremetal/semihost.h \
+        $(BM_DIR)/gen/$(2)_mem.h ports/baremetal/baremetal.mk
+	@mkdir -p $$(dir $$@)
+	$(BM_CC) $(BM_CFLAGS) -include $(BM_DIR)/gen/$(2)_mem.h -DSN_BM_BLOB=sinew_$(2)_blob \
+	    -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size -DSN_BM_STEPS=$(3) -DSN_BM_LOD=$(subst :,$(comma),$($(4))) \
+	    -DSN_BM_SHARED=$(5) -DSN_BM_BENCH=$(if $(6),$(6),0) -c $$< -o $$@
+$(BM_DIR)/$(1).elf: $(BM_DIR)/obj/main_$(1).o $(BM_OBJS) $(BM_DIR)/obj/$(2)_blob.o \
+        $(BM_DIR)/obj/cow_clip.o ports/baremetal/an386.ld
+	$(BM_CC) $(BM_LDFLAGS) -Wl,-Map,$$@.map -o $$@ $$(filter %.o,$$^)
+endef
+$(eval $(call bm_level_image,level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0))
+$(eval $(call bm_level_image,level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1))
+$(eval $(call bm_level_image,level_lod_slice,cow_lod,$(BM_SLICE_STEPS),BM_SLICE_LOD,0))
+$(eval $(call bm_level_image,level_adapt_slice,cow_adapt,$(BM_SLICE_STEPS),BM_SLICE_LOD,1))
+# timed (make bench-baremetal-level): instructions per step on each level
+$(eval $(call bm_level_image,bench_level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0,1))
+$(eval $(call bm_level_image,bench_level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1,1))
+.PHONY: bench-baremetal-level
+bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf
+	for i in lod adapt; do echo "== level_$$i (1000 steps, switches $(BM_LEVEL_LOD), qemu -icount shift=0)"; \
+	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_$$i.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)' || exit 1; done
+BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice,$(BM_DIR)/$(i).elf)
+BM_QEMU_ICOUNT = qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+                 -semihosting-config enable=on,target=native -icount shift=0,sleep=off
+.PHONY: print-bm-level determinism-m4
+determinism-m4:   # the full runs alone, against tests/expected_hashes.txt
+	BUILD=$(BUILD) sh ports/baremetal/determinism_m4.sh
+.PHONY: print-bm-level
+print-bm-level:   # for test_determinism.sh: steps and switches of both runs
+	@echo $(BM_STEPS) $(BM_LEVEL_LOD) $(BM_SLICE_STEPS) $(BM_SLICE_LOD)
+
 BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bench_limb.elf
-ports-baremetal: $(BM_IMAGES)
+ports-baremetal: $(BM_IMAGES) $(BM_LEVEL_IMAGES)
 
 # test_nofloat.sh: the float flavour of a runtime object is its positive control
 # (one is enough to show the check sees soft-float helpers: sn_math.c, the
@@ -180,7 +244,8 @@ ports: ports-baremetal ports-cross
 # ---- what make test's port scripts run, built by test-build (-j2 beside
 # everything else) so that the scripts only run: the determinism slice
 # (tests/scripts/test_determinism.sh reads DET_SLICE: one build per axis),
-# the Cortex-M4 images of test_baremetal.sh and the objects of test_nofloat.sh.
+# the Cortex-M4 images of test_baremetal.sh and of test_determinism.sh's
+# level slice, and the objects of test_nofloat.sh.
 # A driver whose compiler is missing is left out here; the script reports it.
 DET_SLICE = cortex-m4-qemu mips-be-gcc-O2 armhf-gcc-O2-neon aarch64-gcc-O2 x86_64-gcc-O0 \
             x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2
@@ -191,5 +256,6 @@ TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
                $(if $(shell command -v $(DET_CC_$(d)) 2>/dev/null),$(CROSS_DIR)/det_$(d)))
 ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
 TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf \
+             $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf \
              $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
 endif

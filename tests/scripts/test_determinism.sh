@@ -9,7 +9,9 @@
 # flavour: its own desktop-only check (gcc/clang, -O0/-O2, -ffp-contract=off,
 # and sinew-play-float).
 # The crease, level-of-detail and adaptation scenarios run on every hosted
-# platform too (adaptation as a shared instance: sn_step_with's workspace).
+# platform too (adaptation as a shared instance: sn_step_with's workspace);
+# the level-of-detail and adaptation ones on the Cortex-M4 too (in full under
+# `make determinism`, a slice compared with x86-64 in `make test`).
 # Every platform must also give the hash committed in tests/expected_hashes.txt
 # (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
@@ -54,7 +56,19 @@ want() {  # name compiler runner
 if ! sel cortex-m4-qemu; then :
 elif ! have arm-none-eabi-gcc; then skip "cortex-m4: no arm-none-eabi-gcc (make deps)"
 elif ! have qemu-system-arm; then skip "cortex-m4: no qemu-system-arm (make deps)"
-else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; fi
+else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; m4=1; fi
+# the level-of-detail and adaptation scenarios on the Cortex-M4 (issue 13,
+# ports/baremetal/main_level.c, the cow_lod / cow_adapt C arrays): the full
+# 1000 steps in `make determinism` (QEMU: ~16 s lod + ~46 s adapt), checked
+# with every other platform and tests/expected_hashes.txt; in the slice a
+# short run with earlier switches (print-bm-level) whose hash must equal an
+# x86-64 det_main's of the same run, made here (a cross-platform identity).
+m4lvl=""
+if [ -n "${m4:-}" ] && [ -n "$clip_arg" ]; then
+    if [ "${DET_SET:-slice}" = full ]; then m4lvl="level_lod level_adapt"; else m4lvl="level_lod_slice level_adapt_slice"; fi
+elif [ -n "${m4:-}" ]; then skip "cortex-m4 level of detail: the images play $COW_CLIP, which is missing"; fi
+# shellcheck disable=SC2046
+set -- $(pmake print-bm-level); M4_STEPS=$1; M4_SW=$2; M4_SLICE_STEPS=$3; M4_SLICE_SW=$4
 want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
 # clang cross: needs the cross gcc for headers, crt files and libgcc
 if have clang; then want mips-be-clang-O2 mips-linux-gnu-gcc qemu-mips; else skip "mips-be-clang-O2: no clang"; fi
@@ -101,7 +115,7 @@ want float-clang-O2 clang -
 [ -z "$dropped" ] || echo "note: slice (make determinism runs every build); not built here:$dropped"
 
 # ---- build everything in one make -k -j2 ----
-targets=$(printf '%s' "$plats" | awk '{print $2}')
+targets="$(printf '%s' "$plats" | awk '{print $2}') $(for i in $m4lvl; do echo "$BUILD/baremetal/$i.elf"; done)"
 # shellcheck disable=SC2086
 pmake -k -j2 $targets > "$L/build.log" 2>&1 || true
 
@@ -131,6 +145,13 @@ launch() {
 }
 rc_ok() { [ -f "$1" ] && [ "$(cut -d' ' -f1 "$1")" = 0 ]; }  # RCFILE: the run exited 0
 start=$(date +%s)
+# the Cortex-M4 level runs first: the full adaptation run is the longest of all
+for i in $m4lvl; do
+    if pmake -q "$BUILD/baremetal/$i.elf" 2>/dev/null; then
+        # shellcheck disable=SC2086
+        launch "$L/rc_m4_$i" "$L/run_m4_$i.log" $BM_QEMU_RUN -kernel "$BUILD/baremetal/$i.elf"
+    else bad "cortex-m4 $i: build failed (see $L/build.log)"; grep -E 'error|Error' "$L/build.log" | head -n 5; fi
+done
 built=""
 while read -r name target runner; do
     [ -n "$name" ] || continue
@@ -188,6 +209,19 @@ while read -r name target runner; do
 done <<EOF2
 $plats
 EOF2
+# the x86-64 reference of the Cortex-M4 slice: det_main on the same steps and switches
+m4ref=""
+case $m4lvl in *_slice*)
+    for c in x86_64-gcc-O2 x86_64-clang-O2 x86_64-gcc-O2-avx2 x86_64-gcc-O0; do
+        case " $built " in *" $c "*) m4ref=$c; break ;; esac
+    done
+    if [ -n "$m4ref" ]; then
+        launch "$L/rc_m4ref_lod" "$L/run_m4ref_lod.log" "$D/det_$m4ref" "$BUILD/level/cow_lod.blob" \
+            --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only
+        launch "$L/rc_m4ref_adapt" "$L/run_m4ref_adapt.log" "$D/det_$m4ref" "$BUILD/level/cow_adapt.blob" \
+            --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only --shared
+    else bad "cortex-m4 level slice: no x86-64 det_main built to compare with"; fi ;;
+esac
 # the desktop players: the crease and the cow (fixed: the blob file of the
 # same bake; float: against the float drivers)
 for fl in "" _float; do
@@ -246,6 +280,27 @@ while read -r name target runner; do
 done <<EOF2
 $plats
 EOF2
+# the Cortex-M4 level runs: the image's own checks (bm_level_check), then
+# its hash joins the full run's lists, or must equal the x86-64 slice's
+case $m4lvl in level_lod*) [ "$M4_SW" = "$LOD_SW" ] || bad "cortex-m4: BM_LEVEL_LOD $M4_SW (baremetal.mk) is not LOD_SW $LOD_SW" ;; esac
+for i in $m4lvl; do
+    case $i in level_adapt*) sc=adapt; ad=1; ;; *) sc=lod; ad=0 ;; esac
+    case $i in *_slice) sw=$M4_SLICE_SW; n=$M4_SLICE_STEPS ;; *) sw=$M4_SW; n=$M4_STEPS ;; esac
+    [ -f "$L/rc_m4_$i" ] || continue   # build failed: reported above
+    if rc_ok "$L/rc_m4_$i" && h=$(hash_of "$L/run_m4_$i.log") && [ -n "$h" ]; then
+        echo "determinism: $sc cortex-m4-qemu $h ($n steps, switches $sw, $(cut -d' ' -f2 "$L/rc_m4_$i")s)"
+        bm_level_check "cortex-m4 $i" "$L/run_m4_$i.log" "$sw" "$ad"
+        case $i in
+            level_lod) lodfixed="${lodfixed}cortex-m4-qemu $h
+" ;;        level_adapt) adfixed="${adfixed}cortex-m4-qemu $h
+" ;;        *) if rc_ok "$L/rc_m4ref_$sc" && r=$(hash_of "$L/run_m4ref_$sc.log") && [ -n "$r" ]; then
+                   if [ "$h" = "$r" ]; then ok "cortex-m4 $i: hash $h = $m4ref det_main's ($n steps, switches $sw)"
+                   else bad "cortex-m4 $i: hash $h, $m4ref det_main $r ($n steps, switches $sw)"; fi
+               elif [ -n "$m4ref" ]; then bad "cortex-m4 $i: $m4ref det_main reference run failed"; tail -n 5 "$L/run_m4ref_$sc.log" | sed 's/^/    /'
+               fi ;;
+        esac
+    else bad "cortex-m4 $i: run failed (rc $(cut -d' ' -f1 "$L/rc_m4_$i" 2>/dev/null))"; tail -n 5 "$L/run_m4_$i.log" | sed 's/^/    /'; fi
+done
 for fl in "" _float; do
     [ -f "$L/rc_play$fl" ] || continue   # build failed: reported above
     p=sinew-play; [ -n "$fl" ] && p=sinew-play-float
