@@ -10,6 +10,8 @@
 # port scripts' cross drivers and images too), so their make calls only
 # check; a script that still builds into $BUILD belongs in SERIAL (one after
 # another as a single queue item). Reports print in a fixed order at the end.
+# $BUILD/test-logs/NAME.res: "passed failed wall-seconds cpu-seconds" (cpu: user+sys
+# of the suite and its children, from /usr/bin/time; "-" without it).
 BUILD=${1:-build}
 export BUILD
 JOBS=${TEST_JOBS:-2}
