@@ -10,6 +10,8 @@
 # port scripts' cross drivers and images too), so their make calls only
 # check; a script that still builds into $BUILD belongs in SERIAL (one after
 # another as a single queue item). Reports print in a fixed order at the end.
+# $BUILD/test-logs/NAME.res: "passed failed wall-seconds cpu-seconds" (cpu: user+sys
+# of the suite and its children, from /usr/bin/time; "-" without it).
 BUILD=${1:-build}
 export BUILD
 JOBS=${TEST_JOBS:-2}
@@ -30,24 +32,32 @@ SLOW="test_integration test_determinism test_runtime_fuzz test_level test_runtim
 run_one() {
     name=$1; shift
     start=$(date +%s)
-    "$@" > "$log_dir/$name.log" 2>&1
+    # CPU seconds (user+sys of the suite and everything it waited for) when
+    # /usr/bin/time is there: wall seconds mislead on a shared machine
+    if [ -x /usr/bin/time ]; then
+        /usr/bin/time -f '%U %S' -o "$log_dir/$name.cpu" "$@" > "$log_dir/$name.log" 2>&1
+    else
+        "$@" > "$log_dir/$name.log" 2>&1
+    fi
     rc=$?
     end=$(date +%s)
+    cpu=-
+    [ ! -s "$log_dir/$name.cpu" ] || cpu=$(tail -n 1 "$log_dir/$name.cpu" | awk '{ printf "%.1f", $1 + $2 }')
     line=$(grep -E '^([A-Za-z]+: )?[0-9]+ passed, [0-9]+ failed' "$log_dir/$name.log" | tail -n 1)
     p=$(echo "$line" | sed -E 's/^([A-Za-z]+: )?([0-9]+) passed, ([0-9]+) failed.*/\2/')
     f=$(echo "$line" | sed -E 's/^([A-Za-z]+: )?([0-9]+) passed, ([0-9]+) failed.*/\3/')
     [ -n "$line" ] || { p=0; f=1; }
     if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
-    echo "$p $f $((end - start))" > "$log_dir/$name.res"
+    echo "$p $f $((end - start)) $cpu" > "$log_dir/$name.res"
 }
 # print a finished suite's line (and its failures and figures), add it up
 report() {
     name=$1
     if [ ! -f "$log_dir/$name.res" ]; then echo "0 1 0" > "$log_dir/$name.res"; echo "no result" >> "$log_dir/$name.log"; fi
-    read -r p f secs < "$log_dir/$name.res"
+    read -r p f secs cpu < "$log_dir/$name.res"
     total_p=$((total_p + p)); total_f=$((total_f + f))
     status=ok; [ "$f" -eq 0 ] || { status=FAILED; bad="$bad $name"; }
-    printf '%-28s %5d passed %3d failed  %4ss  %s\n' "$name" "$p" "$f" "$secs" "$status"
+    printf '%-28s %5d passed %3d failed  %4ss %6s cpu-s  %s\n' "$name" "$p" "$f" "$secs" "${cpu:--}" "$status"
     if [ "$f" -ne 0 ]; then sed 's/^/    | /' "$log_dir/$name.log" | grep -E 'FAIL|SKIP|rror|\| *[0-9]+ passed' | head -n 40; fi
     grep -E '^ *(figure|SKIPPED|determinism):' "$log_dir/$name.log" | sed 's/^ */    /'
 }
@@ -84,7 +94,8 @@ while [ "$lane" -lt "$JOBS" ]; do
 done
 wait
 for n in $progs $scripts; do report "$n"; done
-echo "logs: $log_dir/"
+cpu_all=$(for n in $progs $scripts; do cat "$log_dir/$n.res"; done | awk '$4 != "-" { t += $4 } END { printf "%.0f", t }')
+echo "logs: $log_dir/ (suites' CPU: $cpu_all s)"
 [ -z "$bad" ] || echo "failed suites:$bad"
 echo "$total_p passed, $total_f failed"
 [ "$total_f" -eq 0 ]
