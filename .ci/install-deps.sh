@@ -15,10 +15,11 @@ set -euo pipefail
 # (llvm-symbolizer: readable sanitizer reports): tests/fuzz/fuzz.mk's libFuzzer
 # harnesses, which must run under CI (tests/scripts/test_fuzz.sh).
 # python3: tests/scripts/gltf_check.py, the independent GLB and APNG decoder.
+# time: /usr/bin/time, each suite's CPU seconds in tests/run_tests.sh's report.
 PKGS=(
     make gcc g++ binutils clang valgrind libclang-rt-14-dev llvm
     cmake pkg-config
-    python3
+    python3 time
     gcc-arm-none-eabi binutils-arm-none-eabi libnewlib-arm-none-eabi
     qemu-system-arm qemu-user
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross

@@ -32,6 +32,7 @@ SLOW="test_integration test_determinism test_runtime_fuzz test_level test_runtim
 run_one() {
     name=$1; shift
     start=$(date +%s)
+    rm -f "$log_dir/$name.cpu"
     # CPU seconds (user+sys of the suite and everything it waited for) when
     # /usr/bin/time is there: wall seconds mislead on a shared machine
     if [ -x /usr/bin/time ]; then
