@@ -137,7 +137,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul2(K, d, uu, ld, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu, 0xFFu); /* every row (lu is read at free corners: a mask would do) */
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3];
