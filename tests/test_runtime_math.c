@@ -366,6 +366,35 @@ static void test_slerp(void) {
     }
 }
 
+/* sn_qslerp_pair + sn_qslerp_at (sn_pose.c's per-pair cache) against one
+ * sn_qslerp / sn_qslerp_path call: the same bits for every t of one pair. */
+static void test_slerp_pair(void) {
+    int i, j, k, path, bad = 0;
+    for (i = 0; i < 20000; i++) {
+        double a[4], b[4];
+        sn_quat qa, qb;
+        sn_q A[4], B[4], o1[4], o2[4];
+        sn_slerp_pair p;
+        rnd_unit(a); rnd_unit(b);
+        if (i % 4 == 1) for (k = 0; k < 4; k++) b[k] = -b[k] * 0.999 + a[k] * 0.001 * (double)(i % 3);
+        if (i % 4 == 2) for (k = 0; k < 4; k++) b[k] = a[k];
+        qa = to_quat(a); qb = to_quat(b);
+        A[0] = qa.x; A[1] = qa.y; A[2] = qa.z; A[3] = qa.w;
+        B[0] = qb.x; B[1] = qb.y; B[2] = qb.z; B[3] = qb.w;
+        for (path = 0; path < 2; path++) {
+            sn_qslerp_pair(A, B, path, &p);
+            for (j = 0; j < 6; j++) {
+                sn_q t = j == 0 ? Q30(0.0) : j == 1 ? Q30(1.0) : Q30(rndu());
+                if (path) sn_qslerp_path(A, B, t, o1);
+                else sn_qslerp(A, B, t, o1);
+                sn_qslerp_at(A, B, &p, t, o2);
+                if (memcmp(o1, o2, sizeof o1) != 0 && bad++ < 5) T_CHECK(0, "slerp pair case %d path %d t %d differs", i, path, j);
+            }
+        }
+    }
+    T_CHECK(bad == 0, "slerp pair: %d of 240000 results differ from one call", bad);
+}
+
 static void test_status(void) {
     int i, j;
     for (i = 0; i < (int)SN_STATUS_COUNT; i++) {
@@ -435,6 +464,7 @@ int main(void) {
     test_mul();
     test_rotate();
     test_slerp();
+    test_slerp_pair();
     test_status();
     test_out_guard();
     test_trilinear();

@@ -121,11 +121,13 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
         sn_q w0[3];
         sn_q d[24], uu[24];
         sn_acc ld[24], lu[24];
+        uint32_t fr = 0; /* the free corners: the rows read below */
         if (!m->cm[e]) continue;
         for (c = 0; c < 3; c++) w0[c] = coef(vel[3 * a0 + c], a0 < nF ? ck : v->b1, sat);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3];
+            fr |= (uint32_t)(a < nF) << k;
             for (c = 0; c < 3; c++) {
                 t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
                 s[c] = sn_add(coef(vel[3 * a + c], a < nF ? ck : v->b1, sat), -w0[c], sat);
@@ -137,7 +139,7 @@ static void region_rhs(sn_ihdr *h, const sn_q *R, const blend_mem *m, sn_q *b, u
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul2(K, d, uu, ld, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3];

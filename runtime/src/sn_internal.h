@@ -192,6 +192,23 @@ void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
  * wound past 180 degrees keeps its way), unless a.b < -cos 30 degrees
  * (more than 300 degrees of rotation), where the shorter arc is taken. */
 void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
+/* sn_qslerp(_path) in two parts: the pair's (b's sign, v = b - (a.b) a,
+ * |v|, the angle; independent of t) and the slerp at t from it, the same
+ * bits as one call. key: the caller's (sn_pose.c's cache of bone pairs). */
+typedef struct sn_slerp_pair {
+#if defined(SN_FLOAT)
+    float v[4], s, th;
+    int same;
+#else
+    uint64_t s;  /* |v| rounded, Q30 */
+    int64_t th;  /* the angle, Q30 radians */
+    int32_t v[4];
+#endif
+    int flip;
+    uint32_t key;
+} sn_slerp_pair;
+void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p);
+void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]);
 /* Angle (public degrees: fixed Q16.16) of the rotation q about the unit
  * axis a (Q30 / float): the twist of a swing-twist decomposition,
  * 2 atan2(v.a, w) with q's sign chosen so w >= 0, in (-180, 180]. */

@@ -55,21 +55,24 @@ const char *sn_kernels_name(void) { return "scalar"; }
 
 #if defined(SN_KERNELS_SCALAR) || defined(SN_KERNELS_M4)
 /* Both right-hand-side products, one decode per block; each output's
- * partial sums in sn_k_cell_mul's order (the M4 compiles this C to SMLAL). */
-void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]) {
+ * partial sums in sn_k_cell_mul's order (the M4 compiles this C to SMLAL).
+ * l2's rows outside rows2 (skeleton corners) are skipped, left 0. */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
     uint32_t a, b;
     blk_t B;
     for (a = 0; a < 24; a++) l1[a] = l2[a] = 0;
     for (a = 0; a < 8; a++) {
+        const uint32_t ra = rows2 >> a & 1u;
         BLK_GET(K, a, a, B);
         BLK_ROW(l1 + 3 * a, B, u1 + 3 * a);
-        BLK_ROW(l2 + 3 * a, B, u2 + 3 * a);
+        if (ra) BLK_ROW(l2 + 3 * a, B, u2 + 3 * a);
         for (b = a + 1; b < 8; b++) {
             BLK_GET(K, a, b, B);
             BLK_ROW(l1 + 3 * a, B, u1 + 3 * b);
             BLK_MAC_T(l1 + 3 * b, B, u1 + 3 * a);
-            BLK_ROW(l2 + 3 * a, B, u2 + 3 * b);
-            BLK_MAC_T(l2 + 3 * b, B, u2 + 3 * a);
+            if (ra) BLK_ROW(l2 + 3 * a, B, u2 + 3 * b);
+            if (rows2 >> b & 1u) BLK_MAC_T(l2 + 3 * b, B, u2 + 3 * a);
         }
     }
     for (a = 0; a < 24; a++)

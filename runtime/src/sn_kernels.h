@@ -91,10 +91,13 @@ SN_INLINE void sn_k_blk(const unsigned char *K, uint32_t a, uint32_t b, int32_t 
  * Fixed: entries |K| <= 2^27, |u| <= 2^28, each product < 2^55, each l < 24 * 2^55. */
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
 
-/* l1 = S^_e u1 and l2 = S^_e u2 over all 8 corners (the right-hand side's
- * two products), each block decoded once; the same sums as two calls of
- * sn_k_cell_mul with the 8 corners listed. */
-void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]);
+/* l1 = S^_e u1 over all 8 corners and l2 = S^_e u2 at least at the corners
+ * k with bit k of rows2 set (the right-hand side's two products: the second
+ * is read only at free corners), each block decoded once; those rows are
+ * the sums of two calls of sn_k_cell_mul with the 8 corners listed, in the
+ * same order (float: the same bits). l2's other rows are unspecified. */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2);
 
 #if !defined(SN_FLOAT)
 /* Fixed flavour's block-floating dot product of the CG (sn_solve.c): a

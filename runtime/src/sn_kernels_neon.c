@@ -78,8 +78,10 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
 
 /* the right-hand side's two products: two calls (the block decode is a few
  * vector instructions here) */
-void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24]) {
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
     static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    (void)rows2; /* every row of l2 */
     sn_k_cell_mul(K, all8, 8, u1, l1);
     sn_k_cell_mul(K, all8, 8, u2, l2);
 }

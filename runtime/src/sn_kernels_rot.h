@@ -14,7 +14,7 @@
  * shift by 30 minus 2^32 is floor((x + 2^29) / 2^30), sn_rshr64's value;
  * then the same clamp and count. NEON: below. Same integers as the
  * reference (exact products, one rounding per output). Other paths: the
- * reference. */
+ * reference (the M4: narrowed to int32 before its clamp, below). */
 #ifndef SN_KERNELS_ROT_H
 #define SN_KERNELS_ROT_H
 
@@ -105,6 +105,29 @@ SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
     acc[2] += sn_mul(R[6], t[0]) + sn_mul(R[7], t[1]) + sn_mul(R[8], t[2]);
 }
 
+#elif defined(SN_KERNELS_M4)
+/* Cortex-M4: the rounded sum narrowed to int32 before the clamp, as the
+ * SIMD paths do (|x| < 3 2^58, so |x / 2^30| < 3 2^28: exact): 32-bit
+ * compares instead of 64-bit pairs (cow step -0.8%; on x86-64 the same C
+ * costs +0.4%, so other scalar paths keep the reference). */
+SN_INLINE sn_q sn_k_rot_out1(int64_t x, uint32_t *sat) {
+    int32_t v;
+    SN_RANGE(x < 3 * ((int64_t)1 << 58) && x > -3 * ((int64_t)1 << 58), "frame rotation sum beyond 3 2^58", x);
+    v = (int32_t)sn_rshr64(x, SN_Q_ROT);
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return v;
+}
+SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    int k;
+    for (k = 0; k < 3; k++) out[k] = sn_k_rot_out1(sn_mul(R[k], v[0]) + sn_mul(R[3 + k], v[1]) + sn_mul(R[6 + k], v[2]), sat);
+}
+SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    int k;
+    for (k = 0; k < 3; k++)
+        out[k] = sn_k_rot_out1(sn_mul(R[3 * k], v[0]) + sn_mul(R[3 * k + 1], v[1]) + sn_mul(R[3 * k + 2], v[2]), sat);
+}
+#define sn_k_rot_acc sn_rot_acc
 #else
 #define sn_k_rot_t sn_rot_t
 #define sn_k_rot sn_rot

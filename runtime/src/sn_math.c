@@ -234,8 +234,10 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
  * (a == b takes the full path, to within 1-2 LSB of a), so the cost of a
  * step does not depend on the pose.
  * Error for unit inputs: <= ~4 LSB per component (test: <= 8). */
-static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
-    int64_t A[4], B[4], v[4], o[4], d = 0, tt, th, ph, sp, cp, k;
+/* The part of the slerp that does not depend on t (sn_pose.c's frames reuse
+ * it per bone pair): b's sign, v = b - d a, |v| and theta. */
+void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p) {
+    int64_t A[4], B[4], v, d = 0, th;
     uint64_t n2 = 0, s;
     int i, flip;
     for (i = 0; i < 4; i++) {
@@ -247,34 +249,50 @@ static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, s
     if (d > SN_Q30) d = SN_Q30;
     if (d < -SN_Q30) d = -SN_Q30;
     flip = path ? d < -SN_COS30_Q30 : d < 0;
-    if (flip) {
-        for (i = 0; i < 4; i++) B[i] = -B[i];
-        d = -d;
-    }
-    tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
-    if (tt == 0 || tt == SN_Q30) { /* t is the blob's frame weight: not a pose-dependent branch */
-        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == SN_Q30 ? B[i] : A[i]);
-        return;
-    }
+    if (flip) d = -d;
     for (i = 0; i < 4; i++) {
-        v[i] = sn_clamp64(B[i] - sn_rshr64(A[i] * d, 30), (int64_t)INT32_MAX);
-        n2 += (uint64_t)(v[i] * v[i]); /* < 2^62 each */
+        v = sn_clamp64((flip ? -B[i] : B[i]) - sn_rshr64(A[i] * d, 30), (int64_t)INT32_MAX);
+        p->v[i] = (int32_t)v;
+        n2 += (uint64_t)(v * v); /* < 2^62 each */
     }
     s = sn_isqrt64(n2);
     if (n2 - s * s > s) s++;
     th = sn_atan2_pos((int64_t)s, d < 0 ? -d : d);
     if (d < 0) th = 2 * SN_PI_2_Q30 - th; /* path: the obtuse side, (pi/2, pi] */
-    ph = sn_rshr64(th * tt, 30); /* [0, pi] */
+    p->s = s;
+    p->th = th;
+    p->flip = flip;
+}
+/* The slerp at t from its pair part p (of these a and b). */
+void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]) {
+    int64_t A[4], o[4], tt, ph, sp, cp, k;
+    uint64_t s = p->s;
+    int i;
+    for (i = 0; i < 4; i++) A[i] = sn_clamp64(a[i], SN_Q30);
+    tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
+    if (tt == 0 || tt == SN_Q30) { /* t is the blob's frame weight: not a pose-dependent branch */
+        for (i = 0; i < 4; i++) {
+            int64_t B = sn_clamp64(b[i], SN_Q30);
+            out[i] = (int32_t)(tt == 0 ? A[i] : p->flip ? -B : B);
+        }
+        return;
+    }
+    ph = sn_rshr64(p->th * tt, 30); /* [0, pi] */
     if (ph > 3 * SN_PI_4_Q30) sn_sincos_red(ph - 2 * SN_PI_2_Q30, 2, &sp, &cp);
     else if (ph > SN_PI_4_Q30) sn_sincos_red(ph - SN_PI_2_Q30, 1, &sp, &cp);
     else sn_sincos_red(ph, 0, &sp, &cp);
     if (s == 0) k = tt;
     else k = (sp * SN_Q30 + (int64_t)(s >> 1)) / (int64_t)s;
     k = k < 0 ? 0 : (k > SN_Q30 ? SN_Q30 : k);
-    for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + v[i] * k, 30);
+    for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + (int64_t)p->v[i] * k, 30);
     if (!sn_unit(o, 4, out)) {
         for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
     }
+}
+static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
+    sn_slerp_pair p;
+    sn_qslerp_pair(a, b, path, &p);
+    sn_qslerp_at(a, b, &p, t, out);
 }
 void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
     sn_qslerp_core(a, b, t, 0, out);
@@ -462,8 +480,8 @@ static float sn_fatan2_pos(float y, float x) {
     return swap ? SN_FPI_2 - a : a;
 }
 
-static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
-    float B[4], v[4], o[4], d = 0.0f, n2 = 0.0f, s, th, ph, sp, cp, k;
+void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p) {
+    float d = 0.0f, n2 = 0.0f;
     int i, same = 1, flip;
     for (i = 0; i < 4; i++) {
         d += a[i] * b[i];
@@ -472,29 +490,39 @@ static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, s
     if (!(d <= 1.0f)) d = d > 1.0f ? 1.0f : 0.0f; /* also NaN -> 0 */
     if (d < -1.0f) d = -1.0f;
     flip = path ? d < -0.86602540378443865f : d < 0.0f;
-    for (i = 0; i < 4; i++) B[i] = flip ? -b[i] : b[i];
     if (flip) d = -d;
+    for (i = 0; i < 4; i++) {
+        p->v[i] = (flip ? -b[i] : b[i]) - a[i] * d;
+        n2 += p->v[i] * p->v[i];
+    }
+    p->s = n2 * sn_frsqrt(n2);
+    p->th = sn_fatan2_pos(p->s, sn_fabs(d));
+    if (d < 0.0f) p->th = 2.0f * SN_FPI_2 - p->th; /* path: the obtuse side */
+    p->flip = flip;
+    p->same = same;
+}
+void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]) {
+    float o[4], ph, sp, cp, k;
+    int i;
     if (!(t > 0.0f)) t = 0.0f; /* also NaN -> 0 */
     if (t > 1.0f) t = 1.0f;
-    if (same || t == 0.0f || t == 1.0f) {
-        for (i = 0; i < 4; i++) out[i] = t == 1.0f && !same ? B[i] : a[i];
+    if (p->same || t == 0.0f || t == 1.0f) {
+        for (i = 0; i < 4; i++) out[i] = t == 1.0f && !p->same ? (p->flip ? -b[i] : b[i]) : a[i];
         return;
     }
-    for (i = 0; i < 4; i++) {
-        v[i] = B[i] - a[i] * d;
-        n2 += v[i] * v[i];
-    }
-    s = n2 * sn_frsqrt(n2);
-    th = sn_fatan2_pos(s, sn_fabs(d));
-    if (d < 0.0f) th = 2.0f * SN_FPI_2 - th; /* path: the obtuse side */
-    ph = th * t;
+    ph = p->th * t;
     if (ph > 3.0f * SN_FPI_4) sn_fsincos_red(ph - 2.0f * SN_FPI_2, 2, &sp, &cp);
     else if (ph > SN_FPI_4) sn_fsincos_red(ph - SN_FPI_2, 1, &sp, &cp);
     else sn_fsincos_red(ph, 0, &sp, &cp);
-    k = s > 1e-20f ? sp / s : t;
+    k = p->s > 1e-20f ? sp / p->s : t;
     k = k < 0.0f ? 0.0f : (k > 1.0f ? 1.0f : k);
-    for (i = 0; i < 4; i++) o[i] = a[i] * cp + v[i] * k;
+    for (i = 0; i < 4; i++) o[i] = a[i] * cp + p->v[i] * k;
     if (!sn_funit(o, 4, out)) memcpy(out, a, 4 * sizeof(float));
+}
+static void sn_qslerp_core(const sn_q a[4], const sn_q b[4], sn_q t, int path, sn_q out[4]) {
+    sn_slerp_pair p;
+    sn_qslerp_pair(a, b, path, &p);
+    sn_qslerp_at(a, b, &p, t, out);
 }
 void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]) {
     sn_qslerp_core(a, b, t, 0, out);

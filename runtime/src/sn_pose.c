@@ -136,9 +136,17 @@ void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]) {
     origin_of(h, h->v.sec[SN_SEC_FRAMES] + 4 * (size_t)i, h->frame_mode, c);
 }
 
+/* Slots of joint_frames' cache of slerp pair parts (sn_qslerp_pair), direct
+ * mapped by bone pair: the entries of one pair share its angle, so most
+ * frames skip its square root and CORDIC (cow: 216 slerps a step, 30 pairs,
+ * ~150 hits). Which entries hit is fixed by the blob: the cost stays the
+ * blob's. */
+#define FRAME_SLOTS 16u
+
 /* Rotation of a vertex's or cell's frame from its (b1, b2, w) entry:
- * R = slerp_path(q_b1, q_b2, w) (seed 003 §3.3), the bone's jR when w = 0. */
-static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R) {
+ * R = slerp_path(q_b1, q_b2, w) (seed 003 §3.3), the bone's jR when w = 0.
+ * cache: FRAME_SLOTS pair parts of this pose (keys 0 when empty), or NULL. */
+static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp_pair *cache) {
     const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q);
     uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
     if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I */
@@ -152,7 +160,15 @@ static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R) {
 #else
         sn_q t = (sn_q)(w << (SN_Q_ROT - SN_Q_W));
 #endif
-        sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
+        if (cache) { /* key: the pair + 1 (never 0), in a slot by the pair */
+            const uint32_t key = (b1 << 8 | b2) + 1u;
+            sn_slerp_pair *p = cache + ((3u * b1 + b2) & (FRAME_SLOTS - 1u));
+            if (p->key != key) {
+                sn_qslerp_pair(pq + 4 * b1, pq + 4 * b2, 1, p);
+                p->key = key;
+            }
+            sn_qslerp_at(pq + 4 * b1, pq + 4 * b2, p, t, q);
+        } else sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
         sn_qtomat(q, R);
     }
 }
@@ -184,7 +200,9 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
     sn_q *jT = ARR(h, o_jT, sn_q), *R = ARR(h, o_R, sn_q);
     sn_q *cR = ARR(h, o_cR, sn_q), xroot[3], rx[3];
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
+    sn_slerp_pair cache[FRAME_SLOTS];
     uint32_t i, j, k;
+    for (k = 0; k < FRAME_SLOTS; k++) cache[k].key = 0;
     for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
     for (j = 0; j < v->nJ; j++) {
         sn_rot(jR + 9 * j, xroot, rx, sat);
@@ -198,9 +216,9 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
         }
     }
     for (i = 0; i < v->nF; i++) /* free vertices only: a skeleton vertex's frame is its bone's jR */
-        frame_of(h, fr + 4 * i, R + 9 * i);
+        frame_of(h, fr + 4 * i, R + 9 * i, cache);
     for (i = 0; i < v->nC; i++)
-        frame_of(h, cfr + 4 * i, cR + 9 * i);
+        frame_of(h, cfr + 4 * i, cR + 9 * i, cache);
     h->frame_mode = h->mode;
 }
 
@@ -351,7 +369,7 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
         sn_q Rn[9];
         if (h->mode == SN_MODE_UNWARPED) carry_vertex(h, i, jR, Rroot, &sat);
         else {
-            frame_of(h, fr + 4 * i, Rn);
+            frame_of(h, fr + 4 * i, Rn, NULL);
             carry_vertex(h, i, Rn, R + 9 * i, &sat);
         }
     }

@@ -84,10 +84,12 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         uint32_t a0 = sn_rd_u16(cl);
         sn_q d[24], uu[24], w0[3];
         sn_acc ld[24], lu[24], ec = 0;
+        uint32_t fr = 0; /* the free corners: lu's rows read below */
         for (c = 0; c < 3; c++) w0[c] = w_at(h, w, vel, a0, c);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3];
+            fr |= (uint32_t)(a < nF) << k;
             for (c = 0; c < 3; c++) {
                 t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
                 s[c] = sn_add(w_at(h, w, vel, a, c), -w0[c], sat);
@@ -99,7 +101,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
                 d[3 * k + c] = sn_add(l[c], -xr, sat);
             }
         }
-        sn_k_cell_mul2(K, d, uu, ld, lu);
+        sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
