@@ -46,31 +46,7 @@ static sn_clip clip;   /* ~23 KB: only in images that play a clip */
 #define CLIP_MEM NULL
 #endif
 
-static void put_u64(uint64_t v) {
-    char d[21];
-    int n = 20;
-    d[n] = 0;
-    do { d[--n] = (char)('0' + (int)(v % 10u)); v /= 10u; } while (v);
-    sn_bm_puts(&d[n]);
-}
-
-static void put_kv(const char *k, uint64_t v) {
-    sn_bm_puts(k); put_u64(v); sn_bm_puts("\n");
-}
-
 #if SN_BM_BENCH
-static uint32_t timer_now(void) { return SN_CMSDK_TIMER0[SN_TIMER_VALUE]; }
-
-/* Ticks of a loop of exactly 2*n instructions (subs + bne), so that ticks
- * convert to instructions without trusting the clock rate. */
-static uint32_t calibrate(uint32_t n, uint32_t *insns) {
-    uint32_t t0, t1, r = n;
-    t0 = timer_now();
-    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(r) : : "cc");
-    t1 = timer_now();
-    *insns = 2u * n;
-    return t0 - t1;
-}
 
 static uint32_t overhead;   /* ticks of two back-to-back timer reads */
 
@@ -78,11 +54,11 @@ static uint32_t overhead;   /* ticks of two back-to-back timer reads */
 static void time_steps(uint32_t n, uint64_t *pose_ticks, uint64_t *step_ticks) {
     uint32_t k;
     for (k = 0; k < n; k++) {
-        uint32_t t0 = timer_now(), t1, t2;
+        uint32_t t0 = sn_bm_timer_now(), t1, t2;
         sn_det_pose(&det);
-        t1 = timer_now();
+        t1 = sn_bm_timer_now();
         sn_det_step(&det);
-        t2 = timer_now();
+        t2 = sn_bm_timer_now();
         *pose_ticks += t0 - t1 - overhead;
         *step_ticks += t1 - t2 - overhead;
     }
@@ -108,20 +84,21 @@ int main(void) {
         sn_bm_puts("FAIL: "); sn_bm_puts(err); sn_bm_puts("\n");
         return 1;
     }
-    put_kv("instance_bytes: ", sn_instance_size(det.blob));
+    sn_bm_put_kv("instance_bytes: ", sn_instance_size(det.blob));
     sn_blob_get_info(det.blob, &bi);
-    put_kv("lattice_vertices: ", bi.vertices);
-    put_kv("free_vertices: ", bi.free_vertices);
-    put_kv("offdiag_blocks: ", bi.offdiag_blocks);
-    put_kv("cg_iterations: ", bi.cg_iters_default);
-    put_kv("clip: ", SN_BM_CLIP);
+    sn_bm_put_kv("lattice_vertices: ", bi.vertices);
+    sn_bm_put_kv("free_vertices: ", bi.free_vertices);
+    sn_bm_put_kv("offdiag_blocks: ", bi.offdiag_blocks);
+    sn_bm_put_kv("cg_iterations: ", bi.cg_iters_default);
+    sn_bm_put_kv("clip: ", SN_BM_CLIP);
 #if SN_BM_BENCH
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 0;
     SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;
     SN_CMSDK_TIMER0[SN_TIMER_VALUE] = 0xFFFFFFFFu;
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 1u;
-    cal_ticks = calibrate(2000000u, &cal_insns);
-    { uint32_t t_a = timer_now(); overhead = t_a - timer_now(); }
+    cal_ticks = sn_bm_calibrate(2000000u);
+    cal_insns = 2u * 2000000u;
+    { uint32_t t_a = sn_bm_timer_now(); overhead = t_a - sn_bm_timer_now(); }
     if (cal_ticks == 0) { sn_bm_puts("FAIL: timer does not run\n"); return 1; }
     time_steps(SN_BM_STEPS, &pose_ticks, &step_ticks);
     hash = sn_state_hash(det.inst);
@@ -135,25 +112,25 @@ int main(void) {
         (void)sn_set_iterations(det.inst, 0);
         a = step_ticks * cal_insns / cal_ticks / SN_BM_STEPS;
         b = more_ticks * cal_insns / cal_ticks / n_more;
-        put_kv("cg_iterations_more: ", more_iters);
-        put_kv("insns_per_step_more: ", b);
-        put_kv("insns_per_cg_iteration: ", (b - a) / (more_iters - bi.cg_iters_default));
+        sn_bm_put_kv("cg_iterations_more: ", more_iters);
+        sn_bm_put_kv("insns_per_step_more: ", b);
+        sn_bm_put_kv("insns_per_cg_iteration: ", (b - a) / (more_iters - bi.cg_iters_default));
     }
     /* instructions = ticks * cal_insns / cal_ticks, per step */
-    put_kv("bench_steps: ", SN_BM_STEPS);
-    put_kv("insns_per_step: ", (step_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
-    put_kv("insns_per_pose: ", (pose_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
-    put_kv("insns_per_tick_x1000: ", (uint64_t)cal_insns * 1000u / cal_ticks);
+    sn_bm_put_kv("bench_steps: ", SN_BM_STEPS);
+    sn_bm_put_kv("insns_per_step: ", (step_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
+    sn_bm_put_kv("insns_per_pose: ", (pose_ticks * cal_insns / cal_ticks) / SN_BM_STEPS);
+    sn_bm_put_kv("insns_per_tick_x1000: ", (uint64_t)cal_insns * 1000u / cal_ticks);
 #else
     hash = sn_det_run(&det, SN_BM_STEPS);
 #endif
     {
         sn_stats st;
         sn_get_stats(det.inst, &st);
-        put_kv("steps: ", st.steps);
-        put_kv("saturations: ", st.saturations);
+        sn_bm_put_kv("steps: ", st.steps);
+        sn_bm_put_kv("saturations: ", st.saturations);
     }
-    put_kv("stack_bytes: ", sn_bm_stack_used());
+    sn_bm_put_kv("stack_bytes: ", sn_bm_stack_used());
     sn_det_hex64(hash, hex);
     sn_bm_puts("hash: "); sn_bm_puts(hex); sn_bm_puts("\n");
     if (sn_det_contact(&det)) { /* the constrained scenario (issue 12) */

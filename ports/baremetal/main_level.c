@@ -54,30 +54,6 @@ static uint64_t ws_mem[(SN_BM_WS_BYTES + 7u) / 8u];
 static uint64_t state_mem[(SN_BM_INSTANCE_BYTES + 7u) / 8u];
 #endif
 
-static void put_u64(uint64_t v) {
-    char d[21];
-    int n = 20;
-    d[n] = 0;
-    do { d[--n] = (char)('0' + (int)(v % 10u)); v /= 10u; } while (v);
-    sn_bm_puts(&d[n]);
-}
-
-static void put_kv(const char *k, uint64_t v) {
-    sn_bm_puts(k); put_u64(v); sn_bm_puts("\n");
-}
-
-#if SN_BM_BENCH
-/* as main.c: ticks of a loop of exactly 2*n instructions (subs + bne), so
- * that ticks convert to instructions without trusting the clock rate */
-static uint32_t timer_now(void) { return SN_CMSDK_TIMER0[SN_TIMER_VALUE]; }
-static uint32_t calibrate(uint32_t n) {
-    uint32_t t0, t1, r = n;
-    t0 = timer_now();
-    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(r) : : "cc");
-    t1 = timer_now();
-    return t0 - t1;
-}
-#endif
 
 static int fail(const char *what) {
     sn_bm_puts("FAIL: "); sn_bm_puts(what); sn_bm_puts("\n");
@@ -97,8 +73,8 @@ int main(void) {
     SN_CMSDK_TIMER0[SN_TIMER_RELOAD] = 0xFFFFFFFFu;
     SN_CMSDK_TIMER0[SN_TIMER_VALUE] = 0xFFFFFFFFu;
     SN_CMSDK_TIMER0[SN_TIMER_CTRL] = 1u;
-    cal_ticks = calibrate(2000000u);
-    t0 = timer_now(); overhead = t0 - timer_now();
+    cal_ticks = sn_bm_calibrate(2000000u);
+    t0 = sn_bm_timer_now(); overhead = t0 - sn_bm_timer_now();
     if (cal_ticks == 0) return fail("timer does not run");
 #endif
     /* the host's sizes must be the target's: the figures below are exact */
@@ -110,16 +86,16 @@ int main(void) {
     if (sn_det_init_shared(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, (const char *)sn_bm_clip_text, sn_bm_clip_len,
                            &clip, state_mem, sizeof state_mem, ws_mem, sizeof ws_mem, err, sizeof err))
         return fail(err);
-    put_kv("state_bytes: ", SN_BM_STATE_BYTES);
-    put_kv("workspace_bytes: ", SN_BM_WS_BYTES);
+    sn_bm_put_kv("state_bytes: ", SN_BM_STATE_BYTES);
+    sn_bm_put_kv("workspace_bytes: ", SN_BM_WS_BYTES);
 #else
     if (sn_det_init(&det, SN_BM_BLOB, SN_BM_BLOB_SIZE, (const char *)sn_bm_clip_text, sn_bm_clip_len,
                     &clip, state_mem, sizeof state_mem, err, sizeof err))
         return fail(err);
 #endif
-    put_kv("instance_bytes: ", SN_BM_INSTANCE_BYTES);
-    put_kv("shared: ", SN_BM_SHARED);
-    put_kv("levels: ", sn_lod_levels(det.blob));
+    sn_bm_put_kv("instance_bytes: ", SN_BM_INSTANCE_BYTES);
+    sn_bm_put_kv("shared: ", SN_BM_SHARED);
+    sn_bm_put_kv("levels: ", sn_lod_levels(det.blob));
     for (k = 0; k < SN_BM_STEPS; k++) {
         sn_det_pose(&det);
         for (j = 0; j < N_SW; j++)   /* before step k + 1, as det_main --lod */
@@ -129,13 +105,13 @@ int main(void) {
                 lod = lod_sw[2u * j + 1u] ? 1u : 0u;
 #endif
                 (void)sn_get_stats(det.inst, &st);   /* the level's lattice: evidence the switch acted */
-                sn_bm_puts("switch: step "); put_u64(k + 1u); sn_bm_puts(" level "); put_u64(st.lod);
-                sn_bm_puts(" lattice_vertices "); put_u64(st.lattice_vertices); sn_bm_puts("\n");
+                sn_bm_puts("switch: step "); sn_bm_put_u64(k + 1u); sn_bm_puts(" level "); sn_bm_put_u64(st.lod);
+                sn_bm_puts(" lattice_vertices "); sn_bm_put_u64(st.lattice_vertices); sn_bm_puts("\n");
             }
 #if SN_BM_BENCH
-        t0 = timer_now();
+        t0 = sn_bm_timer_now();
         sn_det_step(&det);
-        ticks[lod] += t0 - timer_now() - overhead;
+        ticks[lod] += t0 - sn_bm_timer_now() - overhead;
         n_lvl[lod]++;
 #else
         sn_det_step(&det);
@@ -145,21 +121,21 @@ int main(void) {
     for (j = 0; j < 2u; j++)
         if (n_lvl[j]) {
             sn_bm_puts(j ? "insns_per_step_level1: " : "insns_per_step_level0: ");
-            put_u64(ticks[j] * 4000000u / cal_ticks / n_lvl[j]);
-            sn_bm_puts(" (mean of "); put_u64(n_lvl[j]); sn_bm_puts(" steps)\n");
+            sn_bm_put_u64(ticks[j] * 4000000u / cal_ticks / n_lvl[j]);
+            sn_bm_puts(" (mean of "); sn_bm_put_u64(n_lvl[j]); sn_bm_puts(" steps)\n");
         }
 #endif
-    put_kv("refused: ", det.refused);
+    sn_bm_put_kv("refused: ", det.refused);
     (void)sn_get_stats(det.inst, &st);
-    put_kv("steps: ", st.steps);
-    put_kv("saturations: ", st.saturations);
-    put_kv("lod: ", st.lod);
-    put_kv("lattice_vertices: ", st.lattice_vertices);
-    put_kv("adapt_on: ", st.adapt_on);
-    put_kv("adapt_active: ", st.adapt_active);
-    put_kv("adapt_refines: ", st.adapt_refines);
-    put_kv("adapt_coarsens: ", st.adapt_coarsens);
-    put_kv("stack_bytes: ", sn_bm_stack_used());
+    sn_bm_put_kv("steps: ", st.steps);
+    sn_bm_put_kv("saturations: ", st.saturations);
+    sn_bm_put_kv("lod: ", st.lod);
+    sn_bm_put_kv("lattice_vertices: ", st.lattice_vertices);
+    sn_bm_put_kv("adapt_on: ", st.adapt_on);
+    sn_bm_put_kv("adapt_active: ", st.adapt_active);
+    sn_bm_put_kv("adapt_refines: ", st.adapt_refines);
+    sn_bm_put_kv("adapt_coarsens: ", st.adapt_coarsens);
+    sn_bm_put_kv("stack_bytes: ", sn_bm_stack_used());
     sn_det_hex64(sn_state_hash(det.inst), hex);
     sn_bm_puts("hash: "); sn_bm_puts(hex); sn_bm_puts("\n");
     return det.refused ? fail("sn_step_with refused steps") : 0;

@@ -32,4 +32,28 @@ static inline void sn_bm_exit(uint32_t code) {
 #define SN_TIMER_VALUE 1
 #define SN_TIMER_RELOAD 2
 
+/* decimal output of an unsigned value, and "key<value>\n" lines */
+static inline void sn_bm_put_u64(uint64_t v) {
+    char d[21];
+    int n = 20;
+    d[n] = 0;
+    do { d[--n] = (char)('0' + (int)(v % 10u)); v /= 10u; } while (v);
+    sn_bm_puts(&d[n]);
+}
+static inline void sn_bm_put_kv(const char *k, uint64_t v) {
+    sn_bm_puts(k); sn_bm_put_u64(v); sn_bm_puts("\n");
+}
+
+static inline uint32_t sn_bm_timer_now(void) { return SN_CMSDK_TIMER0[SN_TIMER_VALUE]; }
+
+/* Ticks of a loop of exactly 2*n instructions (subs + bne), so that ticks
+ * convert to instructions without trusting the clock rate. */
+static inline uint32_t sn_bm_calibrate(uint32_t n) {
+    uint32_t t0, t1, r = n;
+    t0 = sn_bm_timer_now();
+    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(r) : : "cc");
+    t1 = sn_bm_timer_now();
+    return t0 - t1;
+}
+
 #endif /* SN_BM_SEMIHOST_H */
