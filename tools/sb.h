@@ -497,5 +497,8 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
  * sb_level_model): o its model (rigs included), b its blob without crease data (the
  * surface's, which the two-level blob shares from level 0). 0 or -1 (sb_error). */
 int sb_bake_level1(const char *desc_path, int flavour, sb_model *o, sb_blob *b);
+/* its description, mesh and model (rigs 0: without the description's rigs), for the
+ * caller to free; 0, or -1 (sb_error) with nothing left allocated */
+int sb_level1_load(const char *desc_path, int rigs, sb_desc *d, sb_mesh *m, sb_model *o);
 
 #endif /* SB_H */

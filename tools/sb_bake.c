@@ -117,22 +117,36 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
     return 0;
 }
 
+int sb_level1_load(const char *desc_path, int rigs, sb_desc *d, sb_mesh *m, sb_model *o)
+{
+    sb_desc d2;
+    sb_model o0;
+    memset(d, 0, sizeof *d); memset(m, 0, sizeof *m); memset(o, 0, sizeof *o); memset(&o0, 0, sizeof o0);
+    if (sb_desc_load(desc_path, d)) goto fail;
+    if (d->levels < 2) { sb_fail("%s: no 'levels 2': the description has no level 1", desc_path); goto fail; }
+    if (sb_desc_mesh(d, m, NULL)) goto fail;
+    /* level 0's lattice fixes level 1's (cell, grid corner), exactly as sb_level_bake derives it */
+    if (sb_build(d, m, &o0, 1)) goto fail;
+    sb_level_desc(d, &o0, &d2);
+    sb_model_free(&o0);
+    if (!rigs) d2.nrig = 0;
+    if (sb_level_model(d, &d2, m, o)) goto fail;
+    return 0;
+fail:
+    sb_model_free(&o0); sb_model_free(o); sb_mesh_free(m); sb_desc_free(d);
+    memset(d, 0, sizeof *d); memset(m, 0, sizeof *m); memset(o, 0, sizeof *o);
+    return -1;
+}
+
 int sb_bake_level1(const char *desc_path, int flavour, sb_model *o, sb_blob *b)
 {
-    sb_desc d, d2;
+    sb_desc d;
     sb_mesh m;
-    sb_model o0;
-    int rc = -1;
-    memset(o, 0, sizeof *o); memset(b, 0, sizeof *b); memset(&m, 0, sizeof m); memset(&o0, 0, sizeof o0);
-    if (sb_desc_load(desc_path, &d)) { sb_desc_free(&d); return -1; }
-    if (d.levels < 2) { sb_desc_free(&d); return sb_fail("%s: no 'levels 2': the description has no level 1", desc_path); }
-    if (sb_desc_mesh(&d, &m, NULL)) goto done;
-    /* level 0's lattice fixes level 1's (cell, grid corner), exactly as sb_level_bake derives it */
-    if (sb_build(&d, &m, &o0, 1)) goto done;
-    sb_level_desc(&d, &o0, &d2);
-    if (sb_level_model(&d, &d2, &m, o) || sb_blob_make(o, flavour, b)) { sb_model_free(o); goto done; }
-    rc = 0;
-done:
-    sb_model_free(&o0); sb_mesh_free(&m); sb_desc_free(&d);
-    return rc;
+    int rc;
+    memset(b, 0, sizeof *b);
+    if (sb_level1_load(desc_path, 1, &d, &m, o)) return -1;
+    rc = sb_blob_make(o, flavour, b);
+    if (rc) sb_model_free(o);
+    sb_mesh_free(&m); sb_desc_free(&d);
+    return rc ? -1 : 0;
 }

@@ -1,7 +1,6 @@
 /* sb_retarget.c -- rig retargeting, seed 003 §4.4 (eq. 15-16). See sb_retarget.h
  * for the cost terms, the Jacobian estimate and the transfer chain. */
 #include "sb_retarget.h"
-#include "sb_level.h"
 #include "sb_lbfgsb.h"
 
 #include <math.h>
@@ -29,20 +28,10 @@ int sb_rt_char_load(const char *desc_path, sb_rt_char *c)
 
 int sb_rt_char_load_level1(const char *desc_path, sb_rt_char *c)
 {
-    sb_desc d2;
-    sb_model o0;
     memset(c, 0, sizeof *c);
-    memset(&o0, 0, sizeof o0);
-    if (sb_desc_load(desc_path, &c->d)) { sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
-    if (c->d.levels < 2) { sb_desc_free(&c->d); memset(c, 0, sizeof *c); return sb_fail("%s: no 'levels 2'", desc_path); }
-    if (sb_desc_mesh(&c->d, &c->m, NULL)) { sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
-    /* level 1 as the bake derives it from level 0's lattice; without B's own rigs (the transfer
-     * needs the lattice only, and a one-fit rig file of B has no level-1 fit yet) */
-    if (sb_build(&c->d, &c->m, &o0, 1)) { sb_model_free(&o0); sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
-    sb_level_desc(&c->d, &o0, &d2);
-    d2.nrig = 0;
-    sb_model_free(&o0);
-    if (sb_level_model(&c->d, &d2, &c->m, &c->o)) { sb_model_free(&c->o); sb_mesh_free(&c->m); sb_desc_free(&c->d); memset(c, 0, sizeof *c); return -1; }
+    /* without B's own rigs: the transfer needs the lattice only, and a one-fit
+     * rig file of B has no level-1 fit yet */
+    if (sb_level1_load(desc_path, 0, &c->d, &c->m, &c->o)) return -1;
     c->loaded = 1;
     return 0;
 }
