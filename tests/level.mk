@@ -79,3 +79,18 @@ $(BUILD)/tests/test_runtime_workspace_float: tests/test_runtime_workspace.c $(WS
 	$(CC) $(SN_TCFLAGS) -Iports/cross -Iports/common -DSN_FLOAT -o $@ $< $(WS_TSRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_workspace $(BUILD)/tests/test_runtime_workspace_float
 TEST_DEPS += $(WS_BLOBS)
+
+# A true hierarchical solve, measured (runtime/LEVELS.md §3; tests/hier_study.c): double
+# precision, host only. `make hier-study` prints the tables; make test runs the Galerkin
+# identity of the hierarchical elements (--check-only, cow and beast, a few seconds).
+$(BUILD)/tests/hier_study: tests/hier_study.c tests/sn_test.h $(TOOLS_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -Itools -Itools/ref -Itests -o $@ $< $(TOOLS_LIB) -lm
+.PHONY: hier-study
+hier-study: $(BUILD)/tests/hier_study
+	$(BUILD)/tests/hier_study tools/examples/cow/cow.sinew
+	$(BUILD)/tests/hier_study tools/examples/beast/beast.sinew
+$(BUILD)/tests/test_bake_hier: tests/hier_study.c tests/sn_test.h $(TOOLS_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -DHIER_TEST -Itools -Itools/ref -Itests -o $@ $< $(TOOLS_LIB) -lm
+TEST_BINS += $(BUILD)/tests/test_bake_hier

@@ -333,6 +333,8 @@ void sb_cell_point(const sb_model *o, int ci, const double t[3], double p[3]);
 int sb_nearest_seg(const sb_model *o, const double p[3], double *dist);
 /* does a description region (joint indices in description order) contain p? */
 int sb_region_has(const sb_model *o, const sb_region *r, const double p[3]);
+/* frame bones and weight (as the model's cfb1/cfb2/cfw) at rest point p, mesh units */
+void sb_frame_point(const sb_desc *d, const sb_model *o, const double p[3], int *fb1, int *fb2, double *fw);
 /* integrals over the kept cells (sb_integrate.c); inbits: per grid cell, per quadrature point, inside flag */
 int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits);
 /* the same with inside fractions: per grid cell fidx = -1 (outside), -2 (inside) or k >= 0:

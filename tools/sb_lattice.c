@@ -245,6 +245,16 @@ static void skin_frame(const sb_desc *d, const sb_model *o, const double p[3], d
     *fw = a2 > 0 ? a2 / (a1 + a2) : 0;
 }
 
+/* The frame rule of sb_build step 10 at any rest point p (tools/sb_level.h, the
+ * hierarchical study's per-child frames): frame_at, or the skin's when 'frames skin'. */
+void sb_frame_point(const sb_desc *d, const sb_model *o, const double p[3], int *fb1, int *fb2, double *fw)
+{
+    double B = d->blend > 0 ? d->blend : d->cell, *jd = sb_alloc(sizeof(double) * (size_t)(o->nj > 1 ? o->nj : 1));
+    frame_at(d, o, p, B, jd, fb1, fb2, fw);
+    if (d->skin_frames && !frame_ruled(d, o, p)) skin_frame(d, o, p, jd, fb1, fb2, fw);
+    free(jd);
+}
+
 /* Flesh thickness of bone a: distance from the segment to the mesh surface, the
  * smallest over 9 samples of its middle half (0 where the segment leaves the mesh). */
 static double flesh_thickness(const sb_model *o, const sb_mesh *m, const sb_inside *in, int a)
