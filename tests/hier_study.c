@@ -13,7 +13,7 @@
  * 3. Per step: PCG iterations on the implicit-Euler step matrix (1+a1)M + (1+b1)h^2 K
  *    to a relative residual of 1e-4 with several preconditioners, and the 3x3-block
  *    multiply-adds of one mat-vec, against plain level 1 and level 0.
- * Usage: hier_study DESC.sinew [--check-only]; built with -DHIER_TEST it is make test's
+ * Usage: hier_study DESC.sinew [--check-only | --dynamics STEPS [POSE]]; built with -DHIER_TEST it is make test's
  * test_bake_hier (step 1 on the cow and the beast, the statics against snref on the cow). */
 #include "sb_level.h"
 #include "snref.h"
@@ -932,6 +932,194 @@ done:
     return worst;
 }
 
+/* out = Q^T (K' y) (withK, the frames of P) or Q^T (M y), y nodal (nv x 3) */
+static void qt_apply(const lproblem *P, const double *y, int withK, double *out)
+{
+    int c, a, b, k, l, e;
+    memset(out, 0, sizeof(double) * 3 * (size_t)P->nu);
+    for (c = 0; c < P->nc; c++) {
+        const int *cv = P->cells + 8 * c;
+        const double *R = P->Rc + 9 * c, *K = P->Se + 576 * (size_t)c;
+        double f[24], t[24];
+        if (withK) {   /* f = Rbd K Rbd^T y_c */
+            for (b = 0; b < 8; b++) for (k = 0; k < 3; k++) { double s = 0; for (l = 0; l < 3; l++) s += R[3 * l + k] * y[3 * cv[b] + l]; t[3 * b + k] = s; }
+            for (a = 0; a < 24; a++) { double s = 0; for (b = 0; b < 24; b++) s += K[24 * a + b] * t[b]; f[a] = s; }
+            for (a = 0; a < 8; a++) for (k = 0; k < 3; k++) { double s = 0; for (l = 0; l < 3; l++) s += R[3 * k + l] * f[3 * a + l]; t[3 * a + k] = s; }
+            memcpy(f, t, sizeof f);
+        } else
+            for (a = 0; a < 8; a++) for (k = 0; k < 3; k++) { double s = 0; for (b = 0; b < 8; b++) s += P->Me[64 * (size_t)c + 8 * a + b] * y[3 * cv[b] + k]; f[3 * a + k] = s; }
+        for (a = 0; a < 8; a++)
+            for (e = P->qptr[cv[a]]; e < P->qptr[cv[a] + 1]; e++)
+                for (k = 0; k < 3; k++) out[3 * P->qidx[e] + k] += P->qw[e] * f[3 * a + k];
+    }
+}
+
+/* ---- a sequence of steps (seed 000 §4.7 over time): the joint ramps to its angle in `ramp` steps and
+ * holds; linearly implicit Euler as NUMERICS step 5-6 in double, exact solves, the same integrator
+ * for every variant; the skeleton's motion enters through the mass coupling and the damping ---- */
+typedef struct { int kind; int amax; double refine, coarsen; const char *name; } dyn_variant;
+typedef struct {
+    lproblem P;
+    double *u, *w, *pn, *pfix_prev, *vfix_prev, *surf;
+    unsigned char *on;       /* hierarchical: unknown active */
+    int nco, *ufun;
+    double emax, erms_sum, eavg_max; long act_sum; int act_max, refines, coarsens;
+} dyn_state;
+
+static void dyn_build(study *S, dyn_state *D, int kind, double *Me0)
+{
+    const sb_hier *h = &S->h;
+    unsigned char *all = xalloc((size_t)h->nh);
+    memset(all, 1, (size_t)h->nh);
+    if (kind == 0) lp_nodal1(S, &D->P, 1);
+    else if (kind == 1) lp_level0(S, &D->P, Me0);
+    else { if (!D->ufun) D->ufun = xalloc(sizeof(int) * (size_t)h->nh); lp_hier(S, &D->P, all, 0, 1, D->ufun, NULL); }
+    free(all);
+}
+
+static void dynamic(study *S, const char *what, const pose_spec *target, int nsteps, int ramp)
+{
+    const sb_model *o = &S->o;
+    const sb_hier *h = &S->h;
+    dyn_variant V[] = {
+        {0, 0, 0, 0, "(a) level 1 nodal, child frames"},
+        {1, 0, 0, 0, "(c') baked level 0"},
+        {2, 0, 1e9, 0, "cut hierarchy, coarse only (k = 0)"},
+        {2, 100000, 0, 0, "cut hierarchy, every detail"},
+        {2, 25, 0.03, 0.01, "adaptive 0.03 0.01 A_max 25"},
+        {2, 50, 0.03, 0.01, "adaptive 0.03 0.01 A_max 50"},
+        {2, 50, 0.003, 0.001, "adaptive 0.003 0.001 A_max 50"},
+        {2, 100, 0.003, 0.001, "adaptive 0.003 0.001 A_max 100"},
+    };
+    int nv = (int)(sizeof V / sizeof V[0]), vi, n, i, k;
+    double a1 = o->h * o->alpha, b1 = o->beta / o->h, hh = o->h;
+    double *Me0 = xalloc(sizeof(double) * 64 * (size_t)o->nc), *sref = xalloc(sizeof(double) * 3 * (size_t)S->m.nv * (size_t)(nsteps + 1));
+    memcpy(Me0, S->L0->Me, sizeof(double) * 64 * (size_t)o->nc);
+    printf("\n%s, dynamics: %s ramped over %d steps, held to step %d (h = %.4g s, exact solves)\n", what, target->name, ramp, nsteps, hh);
+    printf("      %-34s %-24s %-16s %s\n", "variant", "surface vs (a): max / mean rms", "active mean/max", "refines / coarsens");
+    for (vi = 0; vi < nv; vi++) {
+        dyn_state D;
+        int lat = V[vi].kind != 1, NV;
+        memset(&D, 0, sizeof D);
+        D.emax = 0;
+        for (n = 0; n <= nsteps; n++) {
+            pose_spec ps = *target;
+            double frac = n >= ramp ? 1.0 : (double)n / ramp, *A, *rhs, *tmp, *tmp2, *vfix, *g, *H, *M;
+            int N, nact, *sel;
+            ps.r[0].deg = target->r[0].deg * frac;
+            set_pose(S, &ps);
+            if (D.P.Rc) lp_free(&D.P);
+            dyn_build(S, &D, V[vi].kind, Me0);
+            NV = D.P.nv;
+            N = 3 * D.P.nu;
+            if (n == 0) {   /* at rest: u = rest coefficients (positions; details 0), w = 0 */
+                D.u = xalloc(sizeof(double) * (size_t)N); D.w = xalloc(sizeof(double) * (size_t)N);
+                D.pn = xalloc(sizeof(double) * 3 * (size_t)NV); D.pfix_prev = xalloc(sizeof(double) * 3 * (size_t)NV);
+                D.vfix_prev = xalloc(sizeof(double) * 3 * (size_t)NV); D.surf = xalloc(sizeof(double) * 3 * (size_t)S->m.nv);
+                D.on = xalloc((size_t)(D.P.nu + 1));
+                for (i = 0; i < D.P.nu; i++) {
+                    int vert;
+                    if (V[vi].kind == 2) {
+                        int f = D.ufun[i];
+                        if (h->hlev[f] != 0) { D.on[i] = V[vi].amax >= 100000; continue; }
+                        D.on[i] = 1; D.nco = i + 1;
+                        for (k = 0; k < 3; k++) D.u[3 * i + k] = S->L0->x[3 * h->hvert[f] + k];
+                        continue;
+                    }
+                    D.on[i] = 1;
+                    for (vert = 0; vert < NV && !(D.P.qptr[vert + 1] > D.P.qptr[vert] && D.P.qidx[D.P.qptr[vert]] == i); vert++) {}
+                    for (k = 0; k < 3; k++) D.u[3 * i + k] = D.P.x[3 * vert + k];
+                }
+                memcpy(D.pfix_prev, D.P.pfix, sizeof(double) * 3 * (size_t)NV);
+                expand(&D.P, D.u, D.pn);
+            } else {
+                vfix = xalloc(sizeof(double) * 3 * (size_t)NV);
+                for (i = 0; i < 3 * NV; i++) vfix[i] = (D.P.pfix[i] - D.pfix_prev[i]) / hh;
+                /* g = Q^T (R K x - K' p_n): assemble with pfix := p_n */
+                memcpy(D.pfix_prev, D.P.pfix, sizeof(double) * 3 * (size_t)NV);
+                memcpy(D.P.pfix, D.pn, sizeof(double) * 3 * (size_t)NV);
+                H = xalloc(sizeof(double) * (size_t)N * N); M = xalloc(sizeof(double) * (size_t)N * N); g = xalloc(sizeof(double) * (size_t)N);
+                assemble(&D.P, H, g, M);
+                memcpy(D.P.pfix, D.pfix_prev, sizeof(double) * 3 * (size_t)NV);
+                A = xalloc(sizeof(double) * (size_t)N * N); rhs = xalloc(sizeof(double) * (size_t)N);
+                tmp = xalloc(sizeof(double) * (size_t)N); tmp2 = xalloc(sizeof(double) * 3 * (size_t)NV);
+                for (i = 0; i < N * N; i++) A[i] = (1 + a1) * M[i] + (1 + b1) * hh * hh * H[i];
+                for (i = 0; i < N; i++) { double s = 0; for (k = 0; k < N; k++) s += M[(size_t)i * N + k] * D.w[k]; rhs[i] = s + hh * g[i]; }
+                for (i = 0; i < 3 * NV; i++) tmp2[i] = vfix[i] - D.vfix_prev[i] + a1 * vfix[i];
+                qt_apply(&D.P, tmp2, 0, tmp);
+                for (i = 0; i < N; i++) rhs[i] -= tmp[i];
+                qt_apply(&D.P, vfix, 1, tmp);
+                for (i = 0; i < N; i++) rhs[i] -= (1 + b1) * hh * hh * tmp[i];
+                memcpy(D.vfix_prev, vfix, sizeof(double) * 3 * (size_t)NV);
+                /* adaptation (hierarchical variants with thresholds): incumbents above COARSEN stay, then the
+                 * inactive details whose estimate h |D_d^-1 r_d| (r = rhs - A w at the step's start) reaches
+                 * REFINE, largest first, up to A_max */
+                if (V[vi].kind == 2 && V[vi].amax < 100000) {
+                    int nd = D.P.nu - D.nco, seats = V[vi].amax, *cand = xalloc(sizeof(int) * (size_t)(nd + 1)), nc_ = 0;
+                    double *est = xalloc(sizeof(double) * (size_t)(nd + 1));
+                    for (i = D.nco; i < D.P.nu; i++) if (D.on[i]) {
+                        double m_ = fmax(fabs(D.u[3 * i]), fmax(fabs(D.u[3 * i + 1]), fabs(D.u[3 * i + 2]))) / o->c;
+                        if (m_ >= V[vi].coarsen && seats > 0) seats--;
+                        else { D.on[i] = 0; D.u[3 * i] = D.u[3 * i + 1] = D.u[3 * i + 2] = 0; D.w[3 * i] = D.w[3 * i + 1] = D.w[3 * i + 2] = 0; D.coarsens++; }
+                    }
+                    for (i = D.nco; i < D.P.nu; i++) if (!D.on[i]) {
+                        double r[3], Db[9], Di[9], z[3];
+                        int a_, b_;
+                        for (a_ = 0; a_ < 3; a_++) {
+                            double s = rhs[3 * i + a_];
+                            for (k = 0; k < N; k++) s -= A[(size_t)(3 * i + a_) * N + k] * D.w[k];
+                            r[a_] = s;
+                            for (b_ = 0; b_ < 3; b_++) Db[3 * a_ + b_] = A[(size_t)(3 * i + a_) * N + 3 * i + b_];
+                        }
+                        inv3(Db, Di);
+                        for (a_ = 0; a_ < 3; a_++) z[a_] = Di[3 * a_] * r[0] + Di[3 * a_ + 1] * r[1] + Di[3 * a_ + 2] * r[2];
+                        est[i - D.nco] = hh * sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]) / o->c;
+                        if (est[i - D.nco] >= V[vi].refine) cand[nc_++] = i;
+                    }
+                    for (i = 1; i < nc_; i++) { int t = cand[i], j = i; while (j > 0 && est[cand[j - 1] - D.nco] < est[t - D.nco]) { cand[j] = cand[j - 1]; j--; } cand[j] = t; }
+                    for (i = 0; i < nc_ && seats > 0; i++, seats--) { D.on[cand[i]] = 1; D.refines++; }
+                    free(cand); free(est);
+                }
+                /* solve on the active unknowns */
+                sel = xalloc(sizeof(int) * (size_t)(D.P.nu + 1));
+                for (i = 0, nact = 0; i < D.P.nu; i++) if (D.on[i]) sel[nact++] = i;
+                {
+                    double *Ak = xalloc(sizeof(double) * (size_t)(3 * nact) * (3 * nact)), *bk = xalloc(sizeof(double) * 3 * (size_t)nact), *wk = xalloc(sizeof(double) * 3 * (size_t)nact);
+                    subsys(A, rhs, N, sel, nact, Ak, bk);
+                    if (dense_solve(Ak, 3 * nact, bk, wk)) { T_CHECK(0, "%s: dynamics: step matrix not positive definite", what); }
+                    memset(D.w, 0, sizeof(double) * (size_t)N);
+                    for (i = 0; i < 3 * nact; i++) D.w[3 * sel[i / 3] + i % 3] = wk[i];
+                    free(Ak); free(bk); free(wk);
+                }
+                for (i = 0; i < N; i++) D.u[i] += hh * D.w[i];
+                if (V[vi].kind == 2) { int na = nact - D.nco; D.act_sum += na; if (na > D.act_max) D.act_max = na; }
+                expand(&D.P, D.u, D.pn);
+                free(sel); free(vfix); free(H); free(M); free(g); free(A); free(rhs); free(tmp); free(tmp2);
+            }
+            surface(S, lat, D.pn, D.surf);
+            if (vi == 0) memcpy(sref + 3 * (size_t)S->m.nv * n, D.surf, sizeof(double) * 3 * (size_t)S->m.nv);
+            else if (n > 0) {
+                double e1, r1;
+                surf_err(S, D.surf, sref + 3 * (size_t)S->m.nv * n, &e1, &r1);
+                D.emax = fmax(D.emax, e1); D.erms_sum += r1;
+            }
+        }
+        {
+            char c1[64], c2[32], c3[32];
+            if (vi == 0) snprintf(c1, sizeof c1, "(reference)");
+            else snprintf(c1, sizeof c1, "%.4f / %.4f", D.emax, D.erms_sum / nsteps);
+            if (V[vi].kind == 2) snprintf(c2, sizeof c2, "%.1f / %d", (double)D.act_sum / nsteps, D.act_max); else snprintf(c2, sizeof c2, "-");
+            if (V[vi].kind == 2 && V[vi].amax < 100000) snprintf(c3, sizeof c3, "%d / %d", D.refines, D.coarsens); else snprintf(c3, sizeof c3, "-");
+            printf("      %-34s %-24s %-16s %s\n", V[vi].name, c1, c2, c3);
+        }
+        lp_free(&D.P);
+        free(D.u); free(D.w); free(D.pn); free(D.pfix_prev); free(D.vfix_prev); free(D.surf); free(D.on); free(D.ufun);
+    }
+    free(Me0); free(sref);
+}
+
+static int dyn_steps = 0, dyn_pose = 0;   /* --dynamics N [POSE]: a sequence of N steps to pose POSE (0: none) */
+
 static void run(const char *desc, const pose_spec *poses, int npose, int check_only)
 {
     study S;
@@ -1040,7 +1228,7 @@ static void run(const char *desc, const pose_spec *poses, int npose, int check_o
         }
         goto out;
     }
-    for (ps = 0; ps < npose; ps++) {
+    for (ps = 0; ps < (dyn_steps > 0 ? 0 : npose); ps++) {
         lproblem Pa, P;
         double *pa = xalloc(sizeof(double) * 3 * (size_t)L->nv), *sa = xalloc(sizeof(double) * 3 * (size_t)S.m.nv),
                *sx = xalloc(sizeof(double) * 3 * (size_t)S.m.nv), *px = xalloc(sizeof(double) * 3 * (size_t)L->nv), emx, erm, moved = 0;
@@ -1083,6 +1271,7 @@ static void run(const char *desc, const pose_spec *poses, int npose, int check_o
         lp_free(&Pa);
         free(pa); free(sa); free(sx); free(px); free(act);
     }
+    if (npose > 0 && dyn_steps > 0) dynamic(&S, what, &poses[dyn_pose < npose ? dyn_pose : 0], dyn_steps, 12);
 out:
     free(S.Efun); free(S.Enf); free(S.Eshare); free(S.joint0); free(S.joint1); free(S.fun_of_v1);
     free(S.cf1b1); free(S.cf1b2); free(S.cf1w); free(S.vf1b1); free(S.vf1b2); free(S.vf1w); free(S.v1_of_v0); free(S.jq); free(S.jR); free(S.jt);
@@ -1108,6 +1297,7 @@ int main(int argc, char **argv)
 {
     const char *desc = argc > 1 ? argv[1] : "tools/examples/cow/cow.sinew";
     int check_only = argc > 2 && !strcmp(argv[2], "--check-only");
+    if (argc > 3 && !strcmp(argv[2], "--dynamics")) { dyn_steps = atoi(argv[3]); dyn_pose = argc > 4 ? atoi(argv[4]) : 0; }
     pose_spec poses[3];
     int np = 0;
     memset(poses, 0, sizeof poses);

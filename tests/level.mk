@@ -86,10 +86,16 @@ TEST_DEPS += $(WS_BLOBS)
 $(BUILD)/tests/hier_study: tests/hier_study.c tests/sn_test.h $(TOOLS_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -Itools -Itools/ref -Itests -o $@ $< $(TOOLS_LIB) -lm
-.PHONY: hier-study
+.PHONY: hier-study hier-study-dynamics
 hier-study: $(BUILD)/tests/hier_study
 	$(BUILD)/tests/hier_study tools/examples/cow/cow.sinew
 	$(BUILD)/tests/hier_study tools/examples/beast/beast.sinew
+# the same over 48 steps per pose (about 10 minutes of CPU: dense double solves of level 1 each step)
+hier-study-dynamics: $(BUILD)/tests/hier_study
+	$(BUILD)/tests/hier_study tools/examples/cow/cow.sinew --dynamics 48 0
+	$(BUILD)/tests/hier_study tools/examples/cow/cow.sinew --dynamics 48 1
+	$(BUILD)/tests/hier_study tools/examples/beast/beast.sinew --dynamics 48 0
+	$(BUILD)/tests/hier_study tools/examples/beast/beast.sinew --dynamics 48 1
 $(BUILD)/tests/test_bake_hier: tests/hier_study.c tests/sn_test.h $(TOOLS_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -DHIER_TEST -Itools -Itools/ref -Itests -o $@ $< $(TOOLS_LIB) -lm
