@@ -973,7 +973,7 @@ static void dyn_build(study *S, dyn_state *D, int kind, double *Me0)
     memset(all, 1, (size_t)h->nh);
     if (kind == 0) lp_nodal1(S, &D->P, 1);
     else if (kind == 1) lp_level0(S, &D->P, Me0);
-    else { if (!D->ufun) D->ufun = xalloc(sizeof(int) * (size_t)h->nh); lp_hier(S, &D->P, all, 0, 1, D->ufun, NULL); }
+    else { if (!D->ufun) D->ufun = xalloc(sizeof(int) * (size_t)h->nh); lp_hier(S, &D->P, all, kind == 3, 1, D->ufun, NULL); }
     free(all);
 }
 
@@ -986,6 +986,7 @@ static void dynamic(study *S, const char *what, const pose_spec *target, int nst
         {1, 0, 0, 0, "(c') baked level 0"},
         {2, 0, 1e9, 0, "cut hierarchy, coarse only (k = 0)"},
         {2, 100000, 0, 0, "cut hierarchy, every detail"},
+        {3, 100000, 0, 0, "cut, every detail, child frames"},
         {2, 25, 0.03, 0.01, "adaptive 0.03 0.01 A_max 25"},
         {2, 50, 0.03, 0.01, "adaptive 0.03 0.01 A_max 50"},
         {2, 50, 0.003, 0.001, "adaptive 0.003 0.001 A_max 50"},
@@ -1019,7 +1020,7 @@ static void dynamic(study *S, const char *what, const pose_spec *target, int nst
                 D.on = xalloc((size_t)(D.P.nu + 1));
                 for (i = 0; i < D.P.nu; i++) {
                     int vert;
-                    if (V[vi].kind == 2) {
+                    if (V[vi].kind >= 2) {
                         int f = D.ufun[i];
                         if (h->hlev[f] != 0) { D.on[i] = V[vi].amax >= 100000; continue; }
                         D.on[i] = 1; D.nco = i + 1;
@@ -1092,7 +1093,7 @@ static void dynamic(study *S, const char *what, const pose_spec *target, int nst
                     free(Ak); free(bk); free(wk);
                 }
                 for (i = 0; i < N; i++) D.u[i] += hh * D.w[i];
-                if (V[vi].kind == 2) { int na = nact - D.nco; D.act_sum += na; if (na > D.act_max) D.act_max = na; }
+                if (V[vi].kind >= 2) { int na = nact - D.nco; D.act_sum += na; if (na > D.act_max) D.act_max = na; }
                 expand(&D.P, D.u, D.pn);
                 free(sel); free(vfix); free(H); free(M); free(g); free(A); free(rhs); free(tmp); free(tmp2);
             }
@@ -1108,8 +1109,8 @@ static void dynamic(study *S, const char *what, const pose_spec *target, int nst
             char c1[64], c2[32], c3[32];
             if (vi == 0) snprintf(c1, sizeof c1, "(reference)");
             else snprintf(c1, sizeof c1, "%.4f / %.4f", D.emax, D.erms_sum / nsteps);
-            if (V[vi].kind == 2) snprintf(c2, sizeof c2, "%.1f / %d", (double)D.act_sum / nsteps, D.act_max); else snprintf(c2, sizeof c2, "-");
-            if (V[vi].kind == 2 && V[vi].amax < 100000) snprintf(c3, sizeof c3, "%d / %d", D.refines, D.coarsens); else snprintf(c3, sizeof c3, "-");
+            if (V[vi].kind >= 2) snprintf(c2, sizeof c2, "%.1f / %d", (double)D.act_sum / nsteps, D.act_max); else snprintf(c2, sizeof c2, "-");
+            if (V[vi].kind >= 2 && V[vi].amax < 100000) snprintf(c3, sizeof c3, "%d / %d", D.refines, D.coarsens); else snprintf(c3, sizeof c3, "-");
             printf("      %-34s %-24s %-16s %s\n", V[vi].name, c1, c2, c3);
         }
         lp_free(&D.P);
