@@ -440,7 +440,8 @@ typedef struct seg_ctx {
     sn_q gh, rf1, rf2;  /* omega gamma/2, omega (1-gamma), omega (1-gamma)/2 */
     sn_acc g1;          /* omega gamma (fixed Q30, < 2^31: int64) */
     sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
-    seg_n kf0;          /* level 0's turn factor rf2/half (seg_kf), set by sweep */
+    seg_n kf0, kf1;     /* level 0's turn factors rf2/half, rf1/half (seg_kf), set by sweep */
+    seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
     sn_real gap;
@@ -487,6 +488,57 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
         kb = sb > 0 ? kb : -kb;
         move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
         move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
+    }
+    *sat += ls;
+}
+
+/* The ends meeting at a sheet node (k >= 3) projected together towards
+ * their mean m (one Gauss-Seidel step on the node's constraint "all ends
+ * coincide", equal masses): end j takes D_j = m - P_j like an attachment
+ * to m, t = omega gamma D_j and a turn closing omega (1-gamma) of D_j's
+ * perpendicular part. At k = 2 this is pair() (D = d/2). A ring of k pairs
+ * costs 2k endpoints and 2k moves; this k and k, and each end reaches the
+ * node's mean in one projection instead of exchanging with its two ring
+ * neighbours in turn (NUMERICS.md "Segment meshes", node projection).
+ * Linear momentum exact: the last end's t is minus the sum of the others'.
+ * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
+ * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
+ * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
+SN_INLINE void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                    uint32_t *sat) {
+    seg_n P[5][3], kf[5];
+    int sh[5];
+    sn_acc sum[3] = {0, 0, 0}, tl[3] = {0, 0, 0};
+    sn_q m[3];
+    uint32_t ls = 0;
+    unsigned j, c;
+    for (j = 0; j < k; j++) {
+        const sn_q *S = L->S + SEG_W * seg[j];
+        seg_n h;
+        if (L->l == 0) {
+            h = L->half; sh[j] = L->sh; kf[j] = C->kf1;
+        } else {
+            h = S[12]; sh[j] = (int)S[14]; kf[j] = NARROW(r30(MUL(C->rf1, S[13])));
+        }
+        if (sgn[j] < 0) { h = -h; kf[j] = -kf[j]; }
+        for (c = 0; c < 3; c++) {
+            P[j][c] = NARROW(S[c] + r30(MUL(S[3 + c], h)));
+            sum[c] += P[j][c];
+        }
+    }
+    for (c = 0; c < 3; c++) m[c] = mean_k(sum[c], k, &ls);
+    for (j = 0; j < k; j++) {
+        seg_n d[3], t[3];
+        for (c = 0; c < 3; c++) {
+            d[c] = sn_out((sn_acc)m[c] - P[j][c], 0, &ls);
+            if (j + 1 < k) {
+                t[c] = NARROW(r30(MUL(d[c], C->g1n)));
+                tl[c] -= t[c];
+            } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
+                t[c] = NARROW(lim(tl[c], (sn_acc)2 * SN_LIM));
+            }
+        }
+        move_seg(L->S + SEG_W * seg[j], d[0], d[1], d[2], t[0], t[1], t[2], kf[j], sh[j], &ls);
     }
     *sat += ls;
 }
@@ -550,14 +602,25 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
 }
 
+/* a sheet node's ends: measured as ring pairs (the gap's definition);
+ * projected by star at k = 3 or 4 (a sheet node has 2 to 4 ends, a braced
+ * 2x2 level's 3: the constant k lets the compiler unroll), pair at k = 2 */
+SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                         int measure, uint32_t *sat) {
+    if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
+    else if (k == 4) star(C, L, seg, sgn, 4u, sat);
+    else star(C, L, seg, sgn, 3u, sat);
+}
+
 static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const seg_mesh *M = C->M;
     uint32_t n, seg[5], i, q;
     int sgn[5];
-    unsigned color, j, k;
+    unsigned j, k;
     {
         int sh;
         C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
+        C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
     }
     for (i = 0; i < M->n_attach; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
@@ -580,21 +643,15 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
             n = dir ? L->nn - 1u - q : q;
             pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
-    } else if (L->side == 2u) { /* braced 2x2 level: seg_node_ends' brace */
-        for (color = 0; color < 2; color++)
-            for (n = 0; n < L->nn; n++) {
-                if (((n >> 1) + (n & 1u) + color + dir) & 1u) continue;
-                k = seg_node_ends(L, n, seg, sgn);
-                ring(C, L, seg, sgn, k, measure, sat);
-            }
-    } else { /* rows and columns directly (no division per node), same order */
+    } else { /* sheet: row-major, reversed on odd sweeps (symmetric Gauss-Seidel) */
         uint32_t sd = L->side, r, c;
-        for (color = 0; color < 2; color++)
-            for (r = 0; r < sd; r++)
-                for (c = (r + color + dir) & 1u; c < sd; c += 2u) { /* (r + c) even on colour dir */
-                    k = sheet_ends(sd, r, c, seg, sgn);
-                    ring(C, L, seg, sgn, k, measure, sat);
-                }
+        for (r = 0; r < sd; r++)
+            for (c = 0; c < sd; c++) {
+                uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
+                if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
+                else k = sheet_ends(sd, rr, cc, seg, sgn);
+                node_proj(C, L, seg, sgn, k, measure, sat);
+            }
     }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
@@ -751,6 +808,7 @@ static void ctx_init(seg_ctx *C, sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
     C->rf1 = (sn_q)(((int64_t)C->rfu * M->relax) >> 5);
     C->rf2 = C->rf1 >> 1;
 #endif
+    C->g1n = NARROW(C->g1);
     (void)sat;
     C->floor_on = (int)h->floor_on;
     C->gap = 0;
