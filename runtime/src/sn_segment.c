@@ -385,7 +385,14 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
  * state range), d.u -> Q22 <= sqrt(3) 2^28, d_perp_k <= 2^29.6, e_k <=
  * 2^28, e.u <= sqrt(3) 2^28, x_k < 1.5 2^30 (u plus e's part across u,
  * |.| <= |e|), f in [0.47, 1.01] 2^30: every factor within int32 (NARROW). */
-SN_INLINE void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+/* the hot move inlined into its few callers (GCC/Clang would otherwise
+ * call it: about 20 instructions of call overhead on a ~130-instruction body) */
+#if defined(__GNUC__)
+#define SEG_HOT static inline __attribute__((always_inline))
+#else
+#define SEG_HOT static inline
+#endif
+SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
                         int sh, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
@@ -504,7 +511,7 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
  * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
  * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
  * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
-SN_INLINE void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                     uint32_t *sat) {
     seg_n P[5][3], kf[5];
     int sh[5];
