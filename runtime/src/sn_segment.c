@@ -269,16 +269,6 @@ SN_INLINE sn_q shr30(sn_acc a) {
 #endif
 }
 
-/* every segment's u of a level to unit length (exact: isqrt, one division) */
-static void renormalize(const seg_lvl *L) {
-    uint32_t i;
-    for (i = 0; i < L->ns; i++) {
-        sn_q *u = L->S + SEG_W * i + 3, x[3];
-        x[0] = u[0]; x[1] = u[1]; x[2] = u[2];
-        seg_unit(x, u);
-    }
-}
-
 /* One multiply-only Newton step towards unit length: u = x (3 - |x|^2)/2
  * (no square root, no division). For |x| = n the result has length
  * n (3 - n^2)/2 <= 1 (equality at n = 1): an error e = n^2 - 1 becomes
@@ -299,6 +289,23 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
     unsigned k;
     for (k = 0; k < 3; k++) u[k] = (sn_q)sn_rshr64(x[k] * f, SN_Q_ROT);
 #endif
+}
+
+/* every segment's u of a level to unit length: every write of u leaves
+ * |u| in [0.9876, 1] (newton_unit's bound, below), so three Newton steps
+ * reach the LSB (|u|^2 - 1: 2.5e-2 -> 4.6e-4 -> 1.6e-7 -> 2e-14, below
+ * Q30's 1e-9) without a square root or a division */
+static void renormalize(const seg_lvl *L) {
+    uint32_t i;
+    unsigned it, k;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *u = L->S + SEG_W * i + 3;
+        for (it = 0; it < 3; it++) {
+            sn_acc x[3];
+            for (k = 0; k < 3; k++) x[k] = u[k];
+            newton_unit(x, u);
+        }
+    }
 }
 
 /* u + theta x u (the dynamics' turn by w, |theta_k| <= ROT_MAX, limited by
@@ -423,17 +430,28 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
     move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
 }
 
-/* |d| in public Q16.16 segment lengths (or float) */
-static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
+/* The measuring pass keeps the largest |d|^2 and converts it once (gap_of):
+ * the conversion is monotonic, so the same value as the largest converted
+ * |d| (fixed), without a square root per pair. Fixed: |d_k| <= 2^29, < 2^60. */
 #if defined(SN_FLOAT)
-    float n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+typedef float seg_n2;
+#else
+typedef uint64_t seg_n2;
+#endif
+SN_INLINE seg_n2 norm2(const sn_q d[3]) {
+#if defined(SN_FLOAT)
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+#else
+    return (uint64_t)((int64_t)d[0] * d[0]) + (uint64_t)((int64_t)d[1] * d[1]) + (uint64_t)((int64_t)d[2] * d[2]);
+#endif
+}
+
+/* sqrt(n2) in public Q16.16 segment lengths (or float) */
+static sn_real gap_of(seg_n2 n2, const seg_lvl *L) {
+#if defined(SN_FLOAT)
     return n2 > 0.0f ? n2 * sn_frsqrt(n2) / (2.0f * L->half) : 0.0f;
 #else
-    uint64_t n2 = 0;
-    int64_t g;
-    unsigned k;
-    for (k = 0; k < 3; k++) n2 += (uint64_t)((int64_t)d[k] * d[k]); /* |d| <= 2^29: < 2^60 */
-    g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
+    int64_t g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
     return g > INT32_MAX ? INT32_MAX : (sn_real)g;
 #endif
 }
@@ -451,7 +469,7 @@ typedef struct seg_ctx {
     seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
-    sn_real gap;
+    seg_n2 gap2;        /* the measuring pass's largest |d|^2 */
     /* the first SEG_TCACHE attachments' targets and their clamp counts:
      * the joints and the flesh do not move during the segment step, so
      * each target is computed once per step, not once per sweep and level */
@@ -488,8 +506,8 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
         t[k] = NARROW(r30(MUL(d[k], C->gh))); /* omega gamma d / 2: |.| < 2^28 */
     }
     if (measure) {
-        sn_real g = gap_of(d, L);
-        C->gap = g > C->gap ? g : C->gap;
+        seg_n2 g = norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
     } else {
         ka = sa > 0 ? ka : -ka;
         kb = sb > 0 ? kb : -kb;
@@ -561,8 +579,8 @@ static void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3
         t[k] = sn_out((sn_acc)d[k] * C->g1, SN_Q_ROT, sat); /* omega gamma d: |d| 2^31 < 2^60 */
     }
     if (measure) {
-        sn_real g = gap_of(d, L);
-        C->gap = g > C->gap ? g : C->gap;
+        seg_n2 g = norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
         return;
     }
     seg_move(L, a, sa, t, d, C->rf1, sat);
@@ -818,7 +836,7 @@ static void ctx_init(seg_ctx *C, sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
     C->g1n = NARROW(C->g1);
     (void)sat;
     C->floor_on = (int)h->floor_on;
-    C->gap = 0;
+    C->gap2 = 0;
     C->foff = 0;
     for (k = 0; k < 3; k++) C->fn[k] = h->floor_n[k];
     if (h->floor_on) { /* n.(origin + p) >= off  <=>  n.p >= off - n.origin */
@@ -931,7 +949,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
         }
         seg_level(&M, 0, &L);
         sweep(&C, &L, 1, 0, sat); /* measure the gaps left (no displacement) */
-        gap = C.gap > gap ? C.gap : gap;
+        {
+            sn_real g = gap_of(C.gap2, &L);
+            gap = g > gap ? g : gap;
+        }
         clear_impulses(&M);
     }
     h->seg_placed = 1;
