@@ -481,13 +481,12 @@ typedef struct seg_ctx {
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
  * perpendicular part */
-static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
-                 uint32_t *sat) {
+SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                  uint32_t *sat) {
     sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
     int sha, shb;
-    unsigned k;
     if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
         ha = hb = L->half;
         sha = shb = L->sh;
@@ -500,11 +499,14 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     }
     ha = sa > 0 ? ha : -ha;
     hb = sb > 0 ? hb : -hb;
-    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped */
-    for (k = 0; k < 3; k++) {
-        d[k] = sn_out((B[k] + r30(MUL(B[3 + k], hb))) - (A[k] + r30(MUL(A[3 + k], ha))), 0, &ls);
-        t[k] = NARROW(r30(MUL(d[k], C->gh))); /* omega gamma d / 2: |.| < 2^28 */
-    }
+    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
+     * t = omega gamma d / 2: |.| < 2^28 (components written out) */
+    d[0] = sn_out((B[0] + r30(MUL(B[3], hb))) - (A[0] + r30(MUL(A[3], ha))), 0, &ls);
+    d[1] = sn_out((B[1] + r30(MUL(B[4], hb))) - (A[1] + r30(MUL(A[4], ha))), 0, &ls);
+    d[2] = sn_out((B[2] + r30(MUL(B[5], hb))) - (A[2] + r30(MUL(A[5], ha))), 0, &ls);
+    t[0] = NARROW(r30(MUL(d[0], C->gh)));
+    t[1] = NARROW(r30(MUL(d[1], C->gh)));
+    t[2] = NARROW(r30(MUL(d[2], C->gh)));
     if (measure) {
         seg_n2 g = norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
@@ -530,40 +532,37 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
  * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
  * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
 SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
-                    uint32_t *sat) {
-    seg_n P[5][3], kf[5];
+                  uint32_t *sat) {
+    seg_n P[5][3], kf[5], h0 = L->half, k0 = C->kf1;
     int sh[5];
-    sn_acc sum[3] = {0, 0, 0}, tl[3] = {0, 0, 0};
-    sn_q m[3];
+    sn_acc s0 = 0, s1 = 0, s2 = 0, l0 = 0, l1 = 0, l2 = 0;
+    sn_q m0, m1, m2;
     uint32_t ls = 0;
-    unsigned j, c;
-    for (j = 0; j < k; j++) {
+    unsigned j;
+    for (j = 0; j < k; j++) { /* components written out: compilers kept the loop */
         const sn_q *S = L->S + SEG_W * seg[j];
-        seg_n h;
-        if (L->l == 0) {
-            h = L->half; sh[j] = L->sh; kf[j] = C->kf1;
-        } else {
-            h = S[12]; sh[j] = (int)S[14]; kf[j] = NARROW(r30(MUL(C->rf1, S[13])));
-        }
-        if (sgn[j] < 0) { h = -h; kf[j] = -kf[j]; }
-        for (c = 0; c < 3; c++) {
-            P[j][c] = NARROW(S[c] + r30(MUL(S[3 + c], h)));
-            sum[c] += P[j][c];
-        }
+        seg_n h = h0, f = k0;
+        sh[j] = L->sh;
+        if (L->l != 0) { h = S[12]; sh[j] = (int)S[14]; f = NARROW(r30(MUL(C->rf1, S[13]))); }
+        if (sgn[j] < 0) { h = -h; f = -f; }
+        kf[j] = f;
+        P[j][0] = NARROW(S[0] + r30(MUL(S[3], h)));
+        P[j][1] = NARROW(S[1] + r30(MUL(S[4], h)));
+        P[j][2] = NARROW(S[2] + r30(MUL(S[5], h)));
+        s0 += P[j][0]; s1 += P[j][1]; s2 += P[j][2];
     }
-    for (c = 0; c < 3; c++) m[c] = mean_k(sum[c], k, &ls);
+    m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
     for (j = 0; j < k; j++) {
-        seg_n d[3], t[3];
-        for (c = 0; c < 3; c++) {
-            d[c] = sn_out((sn_acc)m[c] - P[j][c], 0, &ls);
-            if (j + 1 < k) {
-                t[c] = NARROW(r30(MUL(d[c], C->g1n)));
-                tl[c] -= t[c];
-            } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
-                t[c] = NARROW(lim(tl[c], (sn_acc)2 * SN_LIM));
-            }
+        seg_n d0 = sn_out((sn_acc)m0 - P[j][0], 0, &ls), d1 = sn_out((sn_acc)m1 - P[j][1], 0, &ls),
+              d2 = sn_out((sn_acc)m2 - P[j][2], 0, &ls), t0, t1, t2;
+        if (j + 1 < k) {
+            t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
+            l0 -= t0; l1 -= t1; l2 -= t2;
+        } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
+            t0 = NARROW(lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(lim(l1, (sn_acc)2 * SN_LIM));
+            t2 = NARROW(lim(l2, (sn_acc)2 * SN_LIM));
         }
-        move_seg(L->S + SEG_W * seg[j], d[0], d[1], d[2], t[0], t[1], t[2], kf[j], sh[j], &ls);
+        move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
     }
     *sat += ls;
 }
