@@ -569,20 +569,32 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
-static void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
-    sn_q P[3], d[3], t[3];
-    unsigned k;
-    seg_end(L, a, sa, P, sat);
-    for (k = 0; k < 3; k++) {
-        d[k] = sn_add(T[k], -P[k], sat);
-        t[k] = sn_out((sn_acc)d[k] * C->g1, SN_Q_ROT, sat); /* omega gamma d: |d| 2^31 < 2^60 */
-    }
+SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
+    /* seg_end, then d = T - P and t = omega gamma d (|d| 2^31 < 2^60), each
+     * clamped and counted, components written out (same values as before) */
+    sn_q *S = L->S + SEG_W * a, P0, P1, P2, d[3], t0, t1, t2, r;
+    int sh;
+    seg_n hl = seg_half(L, a, &r, &sh), kf;
+    sn_acc o0 = r30(MUL(S[3], hl)), o1 = r30(MUL(S[4], hl)), o2 = r30(MUL(S[5], hl));
+    uint32_t ls = 0;
+    P0 = sn_out(sa > 0 ? S[0] + o0 : S[0] - o0, 0, &ls);
+    P1 = sn_out(sa > 0 ? S[1] + o1 : S[1] - o1, 0, &ls);
+    P2 = sn_out(sa > 0 ? S[2] + o2 : S[2] - o2, 0, &ls);
+    d[0] = sn_add(T[0], -P0, &ls);
+    d[1] = sn_add(T[1], -P1, &ls);
+    d[2] = sn_add(T[2], -P2, &ls);
     if (measure) {
         seg_n2 g = norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
+        *sat += ls;
         return;
     }
-    seg_move(L, a, sa, t, d, C->rf1, sat);
+    t0 = sn_out((sn_acc)d[0] * C->g1, SN_Q_ROT, &ls);
+    t1 = sn_out((sn_acc)d[1] * C->g1, SN_Q_ROT, &ls);
+    t2 = sn_out((sn_acc)d[2] * C->g1, SN_Q_ROT, &ls);
+    kf = seg_kf(L, a, sa, C->rf1, &sh);
+    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
+    *sat += ls;
 }
 
 /* attachment target in the internal frame */
