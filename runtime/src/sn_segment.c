@@ -14,10 +14,10 @@
  * over-relaxed by omega = relax/32 (SOR on Palazzi's projection; omega 1
  * is seed 004 §3.2 as written; NUMERICS.md "Segment meshes").
  *
- * Cost per step, with S_l, N_l, E_l the segments, nodes and node-endpoint
- * pairs of level l (chain: E = N - 2; sheet interior node: 4 pairs in a
- * ring), A the attachments, F = 1 if a floor is set, W_l the sweeps of
- * level l (sweeps, coarse_sweeps for l >= 1):
+ * Cost per step, with S_l, N_l, E_l the segments, nodes and rod ends moved
+ * at the nodes of level l (a pair 2, a star k), A the attachments, F = 1
+ * if a floor is set, W_l the sweeps of level l (sweeps, coarse_sweeps for
+ * l >= 1):
  *   sum_l [ c1 S_l + c2 N_l + W_l (c3 E_l + c4 A + F c5 2 S_l) ] + c6 N_0 levels
  * with constants c_i independent of the data: every loop runs over counts
  * fixed by the blob and the settings; no loop exits on a value.
@@ -526,7 +526,7 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
  * perpendicular part. At k = 2 this is pair() (D = d/2). A ring of k pairs
  * costs 2k endpoints and 2k moves; this k and k, and each end reaches the
  * node's mean in one projection instead of exchanging with its two ring
- * neighbours in turn (NUMERICS.md "Segment meshes", node projection).
+ * neighbours in turn (NUMERICS.md "Segment meshes", Sweep).
  * Linear momentum exact: the last end's t is minus the sum of the others'.
  * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
  * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
@@ -624,13 +624,14 @@ static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
  * attachments first, so the pinned ends propagate through the same sweep;
  * then the nodes: a chain from node 0 up on even sweeps (dir 0) and back
  * down on odd ones (symmetric Gauss-Seidel: a chain held at either end
- * has one sweep in each pass running away from its holder); a sheet red
- * nodes ((r+c) even) then black ones, in the opposite colour order on odd
- * sweeps; the brace crossing of a 2x2 level; the floor last. At a node with
- * k ends the pairs are (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3,
- * (e_k-1, e0): a ring. */
+ * has one sweep in each pass running away from its holder); a sheet
+ * row-major, reversed on odd sweeps (symmetric too), each node of 3-4
+ * ends by star, a corner by its pair; the brace crossing of a 2x2 level;
+ * the floor last. The measuring pass measures at a node with k ends the
+ * pairs (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3, (e_k-1, e0): a ring. */
 /* the pairs around one sheet node's ring of k ends: each end with the next,
- * and the last with the first when the ring closes (k >= 3) */
+ * and the last with the first when the ring closes (k >= 3); moves only at
+ * k = 2 (one pair), measures any k */
 SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int measure,
                     uint32_t *sat) {
     unsigned j;
