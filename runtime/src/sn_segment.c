@@ -372,8 +372,16 @@ typedef int32_t seg_n;
 #else
 #define NARROW(x) narrow(x)
 SN_INLINE seg_n narrow(int64_t x) {
+    seg_n v;
     SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
-    return (seg_n)x;
+    v = (seg_n)x;
+#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
+    /* no code, the same value: GCC would otherwise multiply the 64-bit value
+     * v came from (known to fit) as 64 x 64 bits (UMULL and two MLA, seen on
+     * the Cortex-M4) instead of one SMULL */
+    __asm__("" : "+r"(v));
+#endif
+    return v;
 }
 #endif
 
@@ -402,6 +410,7 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
 SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
                         int sh, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
+    d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
     e0 = NARROW(lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
     e1 = NARROW(lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
@@ -553,8 +562,8 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     }
     m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
     for (j = 0; j < k; j++) {
-        seg_n d0 = sn_out((sn_acc)m0 - P[j][0], 0, &ls), d1 = sn_out((sn_acc)m1 - P[j][1], 0, &ls),
-              d2 = sn_out((sn_acc)m2 - P[j][2], 0, &ls), t0, t1, t2;
+        seg_n d0 = NARROW(sn_out((sn_acc)m0 - P[j][0], 0, &ls)), d1 = NARROW(sn_out((sn_acc)m1 - P[j][1], 0, &ls)),
+              d2 = NARROW(sn_out((sn_acc)m2 - P[j][2], 0, &ls)), t0, t1, t2;
         if (j + 1 < k) {
             t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
             l0 -= t0; l1 -= t1; l2 -= t2;
