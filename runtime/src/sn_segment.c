@@ -513,9 +513,9 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     d[0] = sn_out((B[0] + r30(MUL(B[3], hb))) - (A[0] + r30(MUL(A[3], ha))), 0, &ls);
     d[1] = sn_out((B[1] + r30(MUL(B[4], hb))) - (A[1] + r30(MUL(A[4], ha))), 0, &ls);
     d[2] = sn_out((B[2] + r30(MUL(B[5], hb))) - (A[2] + r30(MUL(A[5], ha))), 0, &ls);
-    t[0] = NARROW(r30(MUL(d[0], C->gh)));
-    t[1] = NARROW(r30(MUL(d[1], C->gh)));
-    t[2] = NARROW(r30(MUL(d[2], C->gh)));
+    t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
+    t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
+    t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
     if (measure) {
         seg_n2 g = norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
