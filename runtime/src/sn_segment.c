@@ -14,10 +14,10 @@
  * over-relaxed by omega = relax/32 (SOR on Palazzi's projection; omega 1
  * is seed 004 §3.2 as written; NUMERICS.md "Segment meshes").
  *
- * Cost per step, with S_l, N_l, E_l the segments, nodes and node-endpoint
- * pairs of level l (chain: E = N - 2; sheet interior node: 4 pairs in a
- * ring), A the attachments, F = 1 if a floor is set, W_l the sweeps of
- * level l (sweeps, coarse_sweeps for l >= 1):
+ * Cost per step, with S_l, N_l, E_l the segments, nodes and rod ends moved
+ * at the nodes of level l (a pair 2, a star k), A the attachments, F = 1
+ * if a floor is set, W_l the sweeps of level l (sweeps, coarse_sweeps for
+ * l >= 1):
  *   sum_l [ c1 S_l + c2 N_l + W_l (c3 E_l + c4 A + F c5 2 S_l) ] + c6 N_0 levels
  * with constants c_i independent of the data: every loop runs over counts
  * fixed by the blob and the settings; no loop exits on a value.
@@ -269,16 +269,6 @@ SN_INLINE sn_q shr30(sn_acc a) {
 #endif
 }
 
-/* every segment's u of a level to unit length (exact: isqrt, one division) */
-static void renormalize(const seg_lvl *L) {
-    uint32_t i;
-    for (i = 0; i < L->ns; i++) {
-        sn_q *u = L->S + SEG_W * i + 3, x[3];
-        x[0] = u[0]; x[1] = u[1]; x[2] = u[2];
-        seg_unit(x, u);
-    }
-}
-
 /* One multiply-only Newton step towards unit length: u = x (3 - |x|^2)/2
  * (no square root, no division). For |x| = n the result has length
  * n (3 - n^2)/2 <= 1 (equality at n = 1): an error e = n^2 - 1 becomes
@@ -299,6 +289,23 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
     unsigned k;
     for (k = 0; k < 3; k++) u[k] = (sn_q)sn_rshr64(x[k] * f, SN_Q_ROT);
 #endif
+}
+
+/* every segment's u of a level to unit length: every write of u leaves
+ * |u| in [0.9876, 1] (newton_unit's bound, below), so three Newton steps
+ * reach the LSB (|u|^2 - 1: 2.5e-2 -> 4.6e-4 -> 1.6e-7 -> 2e-14, below
+ * Q30's 1e-9) without a square root or a division */
+static void renormalize(const seg_lvl *L) {
+    uint32_t i;
+    unsigned it, k;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *u = L->S + SEG_W * i + 3;
+        for (it = 0; it < 3; it++) {
+            sn_acc x[3];
+            for (k = 0; k < 3; k++) x[k] = u[k];
+            newton_unit(x, u);
+        }
+    }
 }
 
 /* u + theta x u (the dynamics' turn by w, |theta_k| <= ROT_MAX, limited by
@@ -365,8 +372,16 @@ typedef int32_t seg_n;
 #else
 #define NARROW(x) narrow(x)
 SN_INLINE seg_n narrow(int64_t x) {
+    seg_n v;
     SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
-    return (seg_n)x;
+    v = (seg_n)x;
+#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
+    /* no code, the same value: GCC would otherwise multiply the 64-bit value
+     * v came from (known to fit) as 64 x 64 bits (UMULL and two MLA, seen on
+     * the Cortex-M4) instead of one SMULL */
+    __asm__("" : "+r"(v));
+#endif
+    return v;
 }
 #endif
 
@@ -385,9 +400,17 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
  * state range), d.u -> Q22 <= sqrt(3) 2^28, d_perp_k <= 2^29.6, e_k <=
  * 2^28, e.u <= sqrt(3) 2^28, x_k < 1.5 2^30 (u plus e's part across u,
  * |.| <= |e|), f in [0.47, 1.01] 2^30: every factor within int32 (NARROW). */
-SN_INLINE void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+/* the hot move inlined into its few callers (GCC/Clang would otherwise
+ * call it: about 20 instructions of call overhead on a ~130-instruction body) */
+#if defined(__GNUC__)
+#define SEG_HOT static inline __attribute__((always_inline))
+#else
+#define SEG_HOT static inline
+#endif
+SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
                         int sh, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
+    d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
     e0 = NARROW(lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
     e1 = NARROW(lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
@@ -416,17 +439,28 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
     move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
 }
 
-/* |d| in public Q16.16 segment lengths (or float) */
-static sn_real gap_of(const sn_q d[3], const seg_lvl *L) {
+/* The measuring pass keeps the largest |d|^2 and converts it once (gap_of):
+ * the conversion is monotonic, so the same value as the largest converted
+ * |d| (fixed), without a square root per pair. Fixed: |d_k| <= 2^29, < 2^60. */
 #if defined(SN_FLOAT)
-    float n2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+typedef float seg_n2;
+#else
+typedef uint64_t seg_n2;
+#endif
+SN_INLINE seg_n2 norm2(const sn_q d[3]) {
+#if defined(SN_FLOAT)
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+#else
+    return (uint64_t)((int64_t)d[0] * d[0]) + (uint64_t)((int64_t)d[1] * d[1]) + (uint64_t)((int64_t)d[2] * d[2]);
+#endif
+}
+
+/* sqrt(n2) in public Q16.16 segment lengths (or float) */
+static sn_real gap_of(seg_n2 n2, const seg_lvl *L) {
+#if defined(SN_FLOAT)
     return n2 > 0.0f ? n2 * sn_frsqrt(n2) / (2.0f * L->half) : 0.0f;
 #else
-    uint64_t n2 = 0;
-    int64_t g;
-    unsigned k;
-    for (k = 0; k < 3; k++) n2 += (uint64_t)((int64_t)d[k] * d[k]); /* |d| <= 2^29: < 2^60 */
-    g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
+    int64_t g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
     return g > INT32_MAX ? INT32_MAX : (sn_real)g;
 #endif
 }
@@ -440,10 +474,11 @@ typedef struct seg_ctx {
     sn_q gh, rf1, rf2;  /* omega gamma/2, omega (1-gamma), omega (1-gamma)/2 */
     sn_acc g1;          /* omega gamma (fixed Q30, < 2^31: int64) */
     sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
-    seg_n kf0;          /* level 0's turn factor rf2/half (seg_kf), set by sweep */
+    seg_n kf0, kf1;     /* level 0's turn factors rf2/half, rf1/half (seg_kf), set by sweep */
+    seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
-    sn_real gap;
+    seg_n2 gap2;        /* the measuring pass's largest |d|^2 */
     /* the first SEG_TCACHE attachments' targets and their clamp counts:
      * the joints and the flesh do not move during the segment step, so
      * each target is computed once per step, not once per sweep and level */
@@ -455,13 +490,12 @@ typedef struct seg_ctx {
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
  * perpendicular part */
-static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
-                 uint32_t *sat) {
+SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                  uint32_t *sat) {
     sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
     int sha, shb;
-    unsigned k;
     if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
         ha = hb = L->half;
         sha = shb = L->sh;
@@ -474,14 +508,17 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     }
     ha = sa > 0 ? ha : -ha;
     hb = sb > 0 ? hb : -hb;
-    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped */
-    for (k = 0; k < 3; k++) {
-        d[k] = sn_out((B[k] + r30(MUL(B[3 + k], hb))) - (A[k] + r30(MUL(A[3 + k], ha))), 0, &ls);
-        t[k] = NARROW(r30(MUL(d[k], C->gh))); /* omega gamma d / 2: |.| < 2^28 */
-    }
+    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
+     * t = omega gamma d / 2: |.| < 2^28 (components written out) */
+    d[0] = sn_out((B[0] + r30(MUL(B[3], hb))) - (A[0] + r30(MUL(A[3], ha))), 0, &ls);
+    d[1] = sn_out((B[1] + r30(MUL(B[4], hb))) - (A[1] + r30(MUL(A[4], ha))), 0, &ls);
+    d[2] = sn_out((B[2] + r30(MUL(B[5], hb))) - (A[2] + r30(MUL(A[5], ha))), 0, &ls);
+    t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
+    t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
+    t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
     if (measure) {
-        sn_real g = gap_of(d, L);
-        C->gap = g > C->gap ? g : C->gap;
+        seg_n2 g = norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
     } else {
         ka = sa > 0 ? ka : -ka;
         kb = sb > 0 ? kb : -kb;
@@ -491,22 +528,82 @@ static void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     *sat += ls;
 }
 
+/* The ends meeting at a sheet node (k >= 3) projected together towards
+ * their mean m (one Gauss-Seidel step on the node's constraint "all ends
+ * coincide", equal masses): end j takes D_j = m - P_j like an attachment
+ * to m, t = omega gamma D_j and a turn closing omega (1-gamma) of D_j's
+ * perpendicular part. At k = 2 this is pair() (D = d/2). A ring of k pairs
+ * costs 2k endpoints and 2k moves; this k and k, and each end reaches the
+ * node's mean in one projection instead of exchanging with its two ring
+ * neighbours in turn (NUMERICS.md "Segment meshes", Sweep).
+ * Linear momentum exact: the last end's t is minus the sum of the others'.
+ * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
+ * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
+ * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
+SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                  uint32_t *sat) {
+    seg_n P[5][3], kf[5], h0 = L->half, k0 = C->kf1;
+    int sh[5];
+    sn_acc s0 = 0, s1 = 0, s2 = 0, l0 = 0, l1 = 0, l2 = 0;
+    sn_q m0, m1, m2;
+    uint32_t ls = 0;
+    unsigned j;
+    for (j = 0; j < k; j++) { /* components written out: compilers kept the loop */
+        const sn_q *S = L->S + SEG_W * seg[j];
+        seg_n h = h0, f = k0;
+        sh[j] = L->sh;
+        if (L->l != 0) { h = S[12]; sh[j] = (int)S[14]; f = NARROW(r30(MUL(C->rf1, S[13]))); }
+        if (sgn[j] < 0) { h = -h; f = -f; }
+        kf[j] = f;
+        P[j][0] = NARROW(S[0] + r30(MUL(S[3], h)));
+        P[j][1] = NARROW(S[1] + r30(MUL(S[4], h)));
+        P[j][2] = NARROW(S[2] + r30(MUL(S[5], h)));
+        s0 += P[j][0]; s1 += P[j][1]; s2 += P[j][2];
+    }
+    m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
+    for (j = 0; j < k; j++) {
+        seg_n d0 = NARROW(sn_out((sn_acc)m0 - P[j][0], 0, &ls)), d1 = NARROW(sn_out((sn_acc)m1 - P[j][1], 0, &ls)),
+              d2 = NARROW(sn_out((sn_acc)m2 - P[j][2], 0, &ls)), t0, t1, t2;
+        if (j + 1 < k) {
+            t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
+            l0 -= t0; l1 -= t1; l2 -= t2;
+        } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
+            t0 = NARROW(lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(lim(l1, (sn_acc)2 * SN_LIM));
+            t2 = NARROW(lim(l2, (sn_acc)2 * SN_LIM));
+        }
+        move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
+    }
+    *sat += ls;
+}
+
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
-static void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
-    sn_q P[3], d[3], t[3];
-    unsigned k;
-    seg_end(L, a, sa, P, sat);
-    for (k = 0; k < 3; k++) {
-        d[k] = sn_add(T[k], -P[k], sat);
-        t[k] = sn_out((sn_acc)d[k] * C->g1, SN_Q_ROT, sat); /* omega gamma d: |d| 2^31 < 2^60 */
-    }
+SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
+    /* seg_end, then d = T - P and t = omega gamma d (|d| 2^31 < 2^60), each
+     * clamped and counted, components written out (same values as before) */
+    sn_q *S = L->S + SEG_W * a, P0, P1, P2, d[3], t0, t1, t2, r;
+    int sh;
+    seg_n hl = seg_half(L, a, &r, &sh), kf;
+    sn_acc o0 = r30(MUL(S[3], hl)), o1 = r30(MUL(S[4], hl)), o2 = r30(MUL(S[5], hl));
+    uint32_t ls = 0;
+    P0 = sn_out(sa > 0 ? S[0] + o0 : S[0] - o0, 0, &ls);
+    P1 = sn_out(sa > 0 ? S[1] + o1 : S[1] - o1, 0, &ls);
+    P2 = sn_out(sa > 0 ? S[2] + o2 : S[2] - o2, 0, &ls);
+    d[0] = sn_add(T[0], -P0, &ls);
+    d[1] = sn_add(T[1], -P1, &ls);
+    d[2] = sn_add(T[2], -P2, &ls);
     if (measure) {
-        sn_real g = gap_of(d, L);
-        C->gap = g > C->gap ? g : C->gap;
+        seg_n2 g = norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
+        *sat += ls;
         return;
     }
-    seg_move(L, a, sa, t, d, C->rf1, sat);
+    t0 = sn_out((sn_acc)d[0] * C->g1, SN_Q_ROT, &ls);
+    t1 = sn_out((sn_acc)d[1] * C->g1, SN_Q_ROT, &ls);
+    t2 = sn_out((sn_acc)d[2] * C->g1, SN_Q_ROT, &ls);
+    kf = seg_kf(L, a, sa, C->rf1, &sh);
+    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
+    *sat += ls;
 }
 
 /* attachment target in the internal frame */
@@ -536,13 +633,14 @@ static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
  * attachments first, so the pinned ends propagate through the same sweep;
  * then the nodes: a chain from node 0 up on even sweeps (dir 0) and back
  * down on odd ones (symmetric Gauss-Seidel: a chain held at either end
- * has one sweep in each pass running away from its holder); a sheet red
- * nodes ((r+c) even) then black ones, in the opposite colour order on odd
- * sweeps; the brace crossing of a 2x2 level; the floor last. At a node with
- * k ends the pairs are (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3,
- * (e_k-1, e0): a ring. */
+ * has one sweep in each pass running away from its holder); a sheet
+ * row-major, reversed on odd sweeps (symmetric too), each node of 3-4
+ * ends by star, a corner by its pair; the brace crossing of a 2x2 level;
+ * the floor last. The measuring pass measures at a node with k ends the
+ * pairs (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3, (e_k-1, e0): a ring. */
 /* the pairs around one sheet node's ring of k ends: each end with the next,
- * and the last with the first when the ring closes (k >= 3) */
+ * and the last with the first when the ring closes (k >= 3); moves only at
+ * k = 2 (one pair), measures any k */
 SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int measure,
                     uint32_t *sat) {
     unsigned j;
@@ -550,14 +648,25 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
 }
 
+/* a sheet node's ends: measured as ring pairs (the gap's definition);
+ * projected by star at k = 3 or 4 (a sheet node has 2 to 4 ends, a braced
+ * 2x2 level's 3: the constant k lets the compiler unroll), pair at k = 2 */
+SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                         int measure, uint32_t *sat) {
+    if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
+    else if (k == 4) star(C, L, seg, sgn, 4u, sat);
+    else star(C, L, seg, sgn, 3u, sat);
+}
+
 static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const seg_mesh *M = C->M;
     uint32_t n, seg[5], i, q;
     int sgn[5];
-    unsigned color, j, k;
+    unsigned j, k;
     {
         int sh;
         C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
+        C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
     }
     for (i = 0; i < M->n_attach; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
@@ -580,21 +689,15 @@ static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint3
             n = dir ? L->nn - 1u - q : q;
             pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
-    } else if (L->side == 2u) { /* braced 2x2 level: seg_node_ends' brace */
-        for (color = 0; color < 2; color++)
-            for (n = 0; n < L->nn; n++) {
-                if (((n >> 1) + (n & 1u) + color + dir) & 1u) continue;
-                k = seg_node_ends(L, n, seg, sgn);
-                ring(C, L, seg, sgn, k, measure, sat);
-            }
-    } else { /* rows and columns directly (no division per node), same order */
+    } else { /* sheet: row-major, reversed on odd sweeps (symmetric Gauss-Seidel) */
         uint32_t sd = L->side, r, c;
-        for (color = 0; color < 2; color++)
-            for (r = 0; r < sd; r++)
-                for (c = (r + color + dir) & 1u; c < sd; c += 2u) { /* (r + c) even on colour dir */
-                    k = sheet_ends(sd, r, c, seg, sgn);
-                    ring(C, L, seg, sgn, k, measure, sat);
-                }
+        for (r = 0; r < sd; r++)
+            for (c = 0; c < sd; c++) {
+                uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
+                if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
+                else k = sheet_ends(sd, rr, cc, seg, sgn);
+                node_proj(C, L, seg, sgn, k, measure, sat);
+            }
     }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
@@ -751,9 +854,10 @@ static void ctx_init(seg_ctx *C, sn_ihdr *h, const seg_mesh *M, uint32_t *sat) {
     C->rf1 = (sn_q)(((int64_t)C->rfu * M->relax) >> 5);
     C->rf2 = C->rf1 >> 1;
 #endif
+    C->g1n = NARROW(C->g1);
     (void)sat;
     C->floor_on = (int)h->floor_on;
-    C->gap = 0;
+    C->gap2 = 0;
     C->foff = 0;
     for (k = 0; k < 3; k++) C->fn[k] = h->floor_n[k];
     if (h->floor_on) { /* n.(origin + p) >= off  <=>  n.p >= off - n.origin */
@@ -866,7 +970,10 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
         }
         seg_level(&M, 0, &L);
         sweep(&C, &L, 1, 0, sat); /* measure the gaps left (no displacement) */
-        gap = C.gap > gap ? C.gap : gap;
+        {
+            sn_real g = gap_of(C.gap2, &L);
+            gap = g > gap ? g : gap;
+        }
         clear_impulses(&M);
     }
     h->seg_placed = 1;

@@ -91,9 +91,10 @@ void segref_init(segref *r, int kind, int side, const double *nodes, double len,
 }
 
 /* order (NUMERICS.md "Sweep"): attachments; chain nodes up (dir 0) or down
- * (dir 1); sheet red then black (dir 0) or black then red (dir 1) */
+ * (dir 1); sheet nodes row-major (dir 0) or reversed (dir 1), a node of 3 or
+ * 4 ends projected towards their mean (star), a corner's 2 ends as a pair */
 static void sweep(segref *r, int measure, int dir) {
-    int color, q, n, j, k, i, seg[4], sg[4], ne;
+    int q, n, j, k, i, seg[4], sg[4], ne;
     for (i = 0; i < r->n_att; i++) {
         ne = ends_of(r, r->att_node[i], seg, sg);
         for (j = 0; j < ne; j++) {
@@ -104,26 +105,39 @@ static void sweep(segref *r, int measure, int dir) {
             move(r, seg[j], sg[j], t, d, r->omega * (1 - r->gamma));
         }
     }
-    for (color = 0; color < 2; color++)
-        for (q = 0; q < r->nn; q++) {
-            int row, c;
-            n = (!r->kind && dir) ? r->nn - 1 - q : q;
-            row = r->kind ? n / r->side : 0; c = r->kind ? n % r->side : n;
-            if (r->kind ? ((row + c) & 1) != (color ^ dir) : color != 0) continue;
-            ne = ends_of(r, n, seg, sg);
-            for (j = 0; j < ne && (j + 1 < ne || ne >= 3); j++) {
-                int a = seg[j], sa = sg[j], b = seg[(j + 1) % ne], sb = sg[(j + 1) % ne];
-                double P1[3], P2[3], d[3], nd[3], t[3], nt[3];
-                endp(r, a, sa, P1); endp(r, b, sb, P2);
-                for (k = 0; k < 3; k++) {
-                    d[k] = P2[k] - P1[k]; nd[k] = -d[k];
-                    t[k] = 0.5 * r->omega * r->gamma * d[k]; nt[k] = -t[k];
-                }
-                if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
-                move(r, a, sa, t, d, 0.5 * r->omega * (1 - r->gamma));
-                move(r, b, sb, nt, nd, 0.5 * r->omega * (1 - r->gamma));
+    for (q = 0; q < r->nn; q++) {
+        /* chain: up (dir 0) or down; sheet: row-major, reversed on odd sweeps */
+        n = dir ? r->nn - 1 - q : q;
+        ne = ends_of(r, n, seg, sg);
+        if (r->kind && ne >= 3 && !measure) {
+            /* star: every end towards the ends' mean m, as an attachment to m:
+             * t = omega gamma (m - P_j), turn closing omega (1-gamma) of its
+             * perpendicular part (NUMERICS.md "Segment meshes", node projection) */
+            double P[4][3], m[3] = {0, 0, 0};
+            for (j = 0; j < ne; j++) {
+                endp(r, seg[j], sg[j], P[j]);
+                for (k = 0; k < 3; k++) m[k] += P[j][k] / ne;
             }
+            for (j = 0; j < ne; j++) {
+                double d[3], t[3];
+                for (k = 0; k < 3; k++) { d[k] = m[k] - P[j][k]; t[k] = r->omega * r->gamma * d[k]; }
+                move(r, seg[j], sg[j], t, d, r->omega * (1 - r->gamma));
+            }
+            continue;
         }
+        for (j = 0; j < ne && (j + 1 < ne || ne >= 3); j++) {
+            int a = seg[j], sa = sg[j], b = seg[(j + 1) % ne], sb = sg[(j + 1) % ne];
+            double P1[3], P2[3], d[3], nd[3], t[3], nt[3];
+            endp(r, a, sa, P1); endp(r, b, sb, P2);
+            for (k = 0; k < 3; k++) {
+                d[k] = P2[k] - P1[k]; nd[k] = -d[k];
+                t[k] = 0.5 * r->omega * r->gamma * d[k]; nt[k] = -t[k];
+            }
+            if (measure) { double g = norm(d) / r->len; r->gap = g > r->gap ? g : r->gap; continue; }
+            move(r, a, sa, t, d, 0.5 * r->omega * (1 - r->gamma));
+            move(r, b, sb, nt, nd, 0.5 * r->omega * (1 - r->gamma));
+        }
+    }
     if (r->floor_on && !measure)
         for (i = 0; i < r->ns; i++)
             for (j = 0; j < 2; j++) {

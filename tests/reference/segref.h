@@ -1,8 +1,9 @@
 /* segref.h -- double-precision reference of the runtime's segment meshes
  * (runtime/NUMERICS.md "Segment meshes (seed 004 ch. 3-4)"), single level:
  * chains and sheets, Palazzi's displacement constraints (seed 004 §3.2)
- * with the same order of operations as the runtime (dynamics, red/black
- * node sweeps with ring pairs, attachments, floor; velocities from the
+ * with the same order of operations as the runtime (dynamics, symmetric
+ * row-major node sweeps: star at sheet nodes of 3-4 ends, pairs elsewhere;
+ * attachments, floor; velocities from the
  * displacements), written independently from the NUMERICS.md text. Units:
  * internal lengths (the caller converts), velocities per step. */
 #ifndef SEGREF_H
