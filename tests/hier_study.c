@@ -626,32 +626,15 @@ static void subsys(const double *H, const double *g, int N, const int *sel, int 
 
 static const char *basis_name[2] = {"sb_level's hats", "coarse hats cut at level-1 skeleton vertices"};
 
-/* (d) for one basis (cut 0/1), parent frames: the estimate at the coarse solution, the A_max
- * sweep (surface vs (a) and vs the all-active solve), and with do_pcg the step's PCG table */
-static void adaptive(study *S, const char *what, int cut, const double *sa, int do_pcg, const lproblem *Pa)
+/* the estimate of (d): one block-Jacobi relaxation of each detail's equation at the coarse solution,
+ * |D_d^-1 r_d| in level-0 cells (est, nd = N/3 - nco of them), and ord the details largest first.
+ * Hb, gb: the all-active system, its first nco unknowns the coarse ones. 0, or -1 (coarse not PD) */
+static int rank_details(const study *S, const double *Hb, const double *gb, int N, int nco, double *est, int *ord)
 {
-    const sb_hier *h = &S->h;
-    const sb_model *o = &S->o;
-    const sb_lev *L = S->L1;
-    lproblem Pb;
-    unsigned char *act = xalloc((size_t)h->nh), *on = xalloc((size_t)h->nh);
-    int *ufun = xalloc(sizeof(int) * (size_t)h->nh), N, nco, nd, i, k, c, si, a2, b2;
-    int sweep[] = {0, 10, 25, 50, 100, 150, 200, 300, 100000};
-    double *Hb, *gb, *ub, *px = xalloc(sizeof(double) * 3 * (size_t)L->nv), *sx = xalloc(sizeof(double) * 3 * (size_t)S->m.nv),
-           *sb_ = xalloc(sizeof(double) * 3 * (size_t)S->m.nv), *uc, *est, *Hc, e1, r1, e2, r2;
-    int *ord;
-    memset(act, 1, (size_t)h->nh);
-    lp_hier(S, &Pb, act, 0, cut, ufun, NULL);
-    if (solve_lp(&Pb, px, &Hb, &gb, &ub)) { T_CHECK(0, "%s: hierarchical system not positive definite", what); return; }
-    surface(S, 1, px, sb_);
-    N = 3 * Pb.nu;
-    for (nco = 0; nco < Pb.nu && h->hlev[ufun[nco]] == 0; nco++) {}
-    nd = Pb.nu - nco;
-    /* the estimate: one block-Jacobi relaxation of each detail's equation at the coarse solution */
-    Hc = xalloc(sizeof(double) * (size_t)(3 * nco) * (3 * nco)); uc = xalloc(sizeof(double) * (size_t)N);
-    est = xalloc(sizeof(double) * (size_t)(nd + 1)); ord = xalloc(sizeof(int) * (size_t)(nd + 1));
+    int nd = N / 3 - nco, i, a2, b2;
+    double *Hc = xalloc(sizeof(double) * (size_t)(3 * nco) * (3 * nco)), *uc = xalloc(sizeof(double) * (size_t)N);
     for (a2 = 0; a2 < 3 * nco; a2++) memcpy(Hc + (size_t)a2 * 3 * nco, Hb + (size_t)a2 * N, sizeof(double) * 3 * (size_t)nco);
-    if (dense_solve(Hc, 3 * nco, gb, uc)) { T_CHECK(0, "%s: coarse system not positive definite", what); return; }
+    if (dense_solve(Hc, 3 * nco, gb, uc)) { free(Hc); free(uc); return -1; }
     for (i = 0; i < nd; i++) {
         int row = 3 * (nco + i);
         double r[3], D[9], Di[9], z[3];
@@ -663,10 +646,37 @@ static void adaptive(study *S, const char *what, int cut, const double *sa, int 
         }
         inv3(D, Di);
         for (a2 = 0; a2 < 3; a2++) z[a2] = Di[3 * a2] * r[0] + Di[3 * a2 + 1] * r[1] + Di[3 * a2 + 2] * r[2];
-        est[i] = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]) / o->c;
+        est[i] = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]) / S->o.c;
         ord[i] = i;
     }
     for (i = 1; i < nd; i++) { int t = ord[i], j = i; while (j > 0 && est[ord[j - 1]] < est[t]) { ord[j] = ord[j - 1]; j--; } ord[j] = t; }
+    free(Hc); free(uc);
+    return 0;
+}
+
+/* (d) for one basis (cut 0/1), parent frames: the estimate at the coarse solution, the A_max
+ * sweep (surface vs (a) and vs the all-active solve), and with do_pcg the step's PCG table */
+static void adaptive(study *S, const char *what, int cut, const double *sa, int do_pcg, const lproblem *Pa)
+{
+    const sb_hier *h = &S->h;
+    const sb_model *o = &S->o;
+    const sb_lev *L = S->L1;
+    lproblem Pb;
+    unsigned char *act = xalloc((size_t)h->nh), *on = xalloc((size_t)h->nh);
+    int *ufun = xalloc(sizeof(int) * (size_t)h->nh), N, nco, nd, i, k, c, si, a2;
+    int sweep[] = {0, 10, 25, 50, 100, 150, 200, 300, 100000};
+    double *Hb, *gb, *ub, *px = xalloc(sizeof(double) * 3 * (size_t)L->nv), *sx = xalloc(sizeof(double) * 3 * (size_t)S->m.nv),
+           *sb_ = xalloc(sizeof(double) * 3 * (size_t)S->m.nv), *est, e1, r1, e2, r2;
+    int *ord;
+    memset(act, 1, (size_t)h->nh);
+    lp_hier(S, &Pb, act, 0, cut, ufun, NULL);
+    if (solve_lp(&Pb, px, &Hb, &gb, &ub)) { T_CHECK(0, "%s: hierarchical system not positive definite", what); return; }
+    surface(S, 1, px, sb_);
+    N = 3 * Pb.nu;
+    for (nco = 0; nco < Pb.nu && h->hlev[ufun[nco]] == 0; nco++) {}
+    nd = Pb.nu - nco;
+    est = xalloc(sizeof(double) * (size_t)(nd + 1)); ord = xalloc(sizeof(int) * (size_t)(nd + 1));
+    if (rank_details(S, Hb, gb, N, nco, est, ord)) { T_CHECK(0, "%s: coarse system not positive definite", what); return; }
     {
         int n3 = 0, n1 = 0;
         for (i = 0; i < nd; i++) { n3 += est[i] > 0.03; n1 += est[i] > 0.01; }
@@ -867,7 +877,7 @@ static void adaptive(study *S, const char *what, int cut, const double *sa, int 
         free(Mb); free(A); free(bb); free(A0); free(Lfull); free(patfull);
     }
     (void)c;
-    free(Hb); free(gb); free(ub); free(Hc); free(uc); free(est); free(ord);
+    free(Hb); free(gb); free(ub); free(est); free(ord);
     lp_free(&Pb); free(act); free(on); free(ufun); free(px); free(sx); free(sb_);
 }
 
@@ -1119,6 +1129,58 @@ static void dynamic(study *S, const char *what, const pose_spec *target, int nst
     free(Me0); free(sref);
 }
 
+/* load DESC and build its two-level hierarchy (0, or -1 with a failed check) */
+static int study_load(study *S, const char *desc)
+{
+    memset(S, 0, sizeof *S);
+    if (sb_desc_load(desc, &S->d) || sb_mesh_load_obj(S->d.mesh_path, &S->m) || sb_build(&S->d, &S->m, &S->o, 1) || sb_level_build(&S->d, &S->m, &S->o, 1, &S->h))
+        { T_CHECK(0, "%s: %s", desc, sb_error()); return -1; }
+    S->L0 = &S->h.lev[0]; S->L1 = &S->h.lev[1];
+    return 0;
+}
+
+/* the skeleton of both levels, level 1's frames, the pose arrays (0, or -1 with a failed check) */
+static int study_prepare(study *S, const char *what)
+{
+    const sb_model *o = &S->o;
+    const sb_lev *L = S->L1;
+    const sb_hier *h = &S->h;
+    int n, c, f, k;
+    S->joint0 = xalloc(sizeof(int) * (size_t)o->nv);
+    for (n = 0; n < o->nv; n++) S->joint0[n] = o->gjoint[o->v_grid[n]];
+    S->joint1 = xalloc(sizeof(int) * (size_t)L->nv);
+    S->fun_of_v1 = xalloc(sizeof(int) * (size_t)L->nv);
+    for (f = 0; f < h->nh; f++) if (h->hlev[f] == 1) S->fun_of_v1[h->hvert[f]] = f;
+    for (n = 0; n < L->nv; n++) {
+        if (L->vold[n] >= 0) { S->joint1[n] = S->joint0[L->vold[n]]; S->fun_of_v1[n] = L->vold[n]; }
+        else if (!L->skel[n]) S->joint1[n] = -1;
+        else if (L->vbone[n] >= 0) S->joint1[n] = o->joints[o->seg_child[L->vbone[n]]].parent;
+        else { T_CHECK(0, "%s: pinned level-1 vertex: not handled by the study", what); return -1; }
+    }
+    S->cf1b1 = xalloc(sizeof(int) * (size_t)L->nc); S->cf1b2 = xalloc(sizeof(int) * (size_t)L->nc); S->cf1w = xalloc(sizeof(double) * (size_t)L->nc);
+    for (c = 0; c < L->nc; c++) {
+        double p[3];
+        for (k = 0; k < 3; k++) p[k] = L->x[3 * L->cells[8 * c] + k] + 0.5 * L->c;
+        sb_frame_point(&S->d, o, p, &S->cf1b1[c], &S->cf1b2[c], &S->cf1w[c]);
+    }
+    S->vf1b1 = xalloc(sizeof(int) * (size_t)L->nv); S->vf1b2 = xalloc(sizeof(int) * (size_t)L->nv); S->vf1w = xalloc(sizeof(double) * (size_t)L->nv);
+    S->v1_of_v0 = xalloc(sizeof(int) * (size_t)o->nv);
+    for (n = 0; n < L->nv; n++) {
+        if (L->vold[n] >= 0) S->v1_of_v0[L->vold[n]] = n;
+        if (S->joint1[n] >= 0) { S->vf1b1[n] = S->vf1b2[n] = S->joint1[n]; S->vf1w[n] = 0; }
+        else sb_frame_point(&S->d, o, L->x + 3 * n, &S->vf1b1[n], &S->vf1b2[n], &S->vf1w[n]);
+    }
+    S->jq = xalloc(sizeof(double) * 4 * (size_t)o->nj); S->jR = xalloc(sizeof(double) * 9 * (size_t)o->nj); S->jt = xalloc(sizeof(double) * 3 * (size_t)o->nj);
+    return 0;
+}
+
+static void study_free(study *S)
+{
+    free(S->Efun); free(S->Enf); free(S->Eshare); free(S->joint0); free(S->joint1); free(S->fun_of_v1);
+    free(S->cf1b1); free(S->cf1b2); free(S->cf1w); free(S->vf1b1); free(S->vf1b2); free(S->vf1w); free(S->v1_of_v0); free(S->jq); free(S->jR); free(S->jt);
+    sb_hier_free(&S->h); sb_model_free(&S->o); sb_mesh_free(&S->m); sb_desc_free(&S->d);
+}
+
 static int dyn_steps = 0, dyn_pose = 0;   /* --dynamics N [POSE]: a sequence of N steps to pose POSE (0: none) */
 
 static void run(const char *desc, const pose_spec *poses, int npose, int check_only)
@@ -1127,40 +1189,15 @@ static void run(const char *desc, const pose_spec *poses, int npose, int check_o
     sb_hier *h = &S.h;
     const sb_model *o;
     const sb_lev *L;
-    int i, n, c, f, k, ps;
+    int i, n, f, ps;
     char what[64];
-    memset(&S, 0, sizeof S);
-    if (sb_desc_load(desc, &S.d) || sb_mesh_load_obj(S.d.mesh_path, &S.m) || sb_build(&S.d, &S.m, &S.o, 1) || sb_level_build(&S.d, &S.m, &S.o, 1, h))
-        { T_CHECK(0, "%s: %s", desc, sb_error()); return; }
-    o = &S.o; S.L0 = &h->lev[0]; S.L1 = L = &h->lev[1];
+    if (study_load(&S, desc)) { study_free(&S); return; }
+    o = &S.o; L = S.L1;
     snprintf(what, sizeof what, "%s", strrchr(desc, '/') ? strrchr(desc, '/') + 1 : desc);
     S.Efun = xalloc(sizeof(int) * 27 * (size_t)o->nc); S.Enf = xalloc(sizeof(int) * (size_t)o->nc); S.Eshare = xalloc(729 * (size_t)o->nc);
     check_elements(&S, what);
 
-    S.joint0 = xalloc(sizeof(int) * (size_t)o->nv);
-    for (n = 0; n < o->nv; n++) S.joint0[n] = o->gjoint[o->v_grid[n]];
-    S.joint1 = xalloc(sizeof(int) * (size_t)L->nv);
-    S.fun_of_v1 = xalloc(sizeof(int) * (size_t)L->nv);
-    for (f = 0; f < h->nh; f++) if (h->hlev[f] == 1) S.fun_of_v1[h->hvert[f]] = f;
-    for (n = 0; n < L->nv; n++) {
-        if (L->vold[n] >= 0) { S.joint1[n] = S.joint0[L->vold[n]]; S.fun_of_v1[n] = L->vold[n]; }
-        else if (!L->skel[n]) S.joint1[n] = -1;
-        else if (L->vbone[n] >= 0) S.joint1[n] = o->joints[o->seg_child[L->vbone[n]]].parent;
-        else { T_CHECK(0, "%s: pinned level-1 vertex: not handled by the study", what); goto out; }
-    }
-    S.cf1b1 = xalloc(sizeof(int) * (size_t)L->nc); S.cf1b2 = xalloc(sizeof(int) * (size_t)L->nc); S.cf1w = xalloc(sizeof(double) * (size_t)L->nc);
-    for (c = 0; c < L->nc; c++) {
-        double p[3];
-        for (k = 0; k < 3; k++) p[k] = L->x[3 * L->cells[8 * c] + k] + 0.5 * L->c;
-        sb_frame_point(&S.d, o, p, &S.cf1b1[c], &S.cf1b2[c], &S.cf1w[c]);
-    }
-    S.vf1b1 = xalloc(sizeof(int) * (size_t)L->nv); S.vf1b2 = xalloc(sizeof(int) * (size_t)L->nv); S.vf1w = xalloc(sizeof(double) * (size_t)L->nv);
-    S.v1_of_v0 = xalloc(sizeof(int) * (size_t)o->nv);
-    for (n = 0; n < L->nv; n++) {
-        if (L->vold[n] >= 0) S.v1_of_v0[L->vold[n]] = n;
-        if (S.joint1[n] >= 0) { S.vf1b1[n] = S.vf1b2[n] = S.joint1[n]; S.vf1w[n] = 0; }
-        else sb_frame_point(&S.d, o, L->x + 3 * n, &S.vf1b1[n], &S.vf1b2[n], &S.vf1w[n]);
-    }
+    if (study_prepare(&S, what)) goto out;
     {   /* blob bytes of the cut basis' elements (CELLK-style fixed storage: a diagonal block 6 x i32,
          * an off-diagonal block 9 x i16 + an exponent byte) and of the function-space mass pattern (i32) */
         long nd_ = 0, no_ = 0, nm = 0, nl = 0;
@@ -1185,7 +1222,6 @@ static void run(const char *desc, const pose_spec *poses, int npose, int check_o
                what, nd_, no_, nd_ * 24 + no_ * 19, nl * 2, nm, nm * 4);
         free(st);
     }
-    S.jq = xalloc(sizeof(double) * 4 * (size_t)o->nj); S.jR = xalloc(sizeof(double) * 9 * (size_t)o->nj); S.jt = xalloc(sizeof(double) * 3 * (size_t)o->nj);
     {
         int nB = 0, nfree0 = 0, nfree1 = 0, nsk = 0;
         for (f = 0; f < h->nh; f++) nB += h->hlev[f] == 1 && h->in_b[f];
@@ -1274,9 +1310,7 @@ static void run(const char *desc, const pose_spec *poses, int npose, int check_o
     }
     if (npose > 0 && dyn_steps > 0) dynamic(&S, what, &poses[dyn_pose < npose ? dyn_pose : 0], dyn_steps, 12);
 out:
-    free(S.Efun); free(S.Enf); free(S.Eshare); free(S.joint0); free(S.joint1); free(S.fun_of_v1);
-    free(S.cf1b1); free(S.cf1b2); free(S.cf1w); free(S.vf1b1); free(S.vf1b2); free(S.vf1w); free(S.v1_of_v0); free(S.jq); free(S.jR); free(S.jt);
-    sb_hier_free(h); sb_model_free(&S.o); sb_mesh_free(&S.m); sb_desc_free(&S.d);
+    study_free(&S);
 }
 
 #ifdef HIER_TEST
@@ -1293,7 +1327,7 @@ int main(void)
     run("tools/examples/beast/beast.sinew", NULL, 0, 1);
     return T_END();
 }
-#else
+#elif !defined HIER_PICTURE   /* hier_picture.c includes this file for its solves */
 int main(int argc, char **argv)
 {
     const char *desc = argc > 1 ? argv[1] : "tools/examples/cow/cow.sinew";
