@@ -15,21 +15,6 @@ void sn_skinned(const sn_ihdr *h, uint32_t i, sn_q s[3], uint32_t *sat) {
     for (k = 0; k < 3; k++) s[k] = sn_add(rx[k], c[k], sat);
 }
 
-/* |d|^2 of a state difference (fixed: |d_k| <= 2^29, so < 2^59.6) */
-#if defined(SN_FLOAT)
-typedef float sn_len2;
-#else
-typedef uint64_t sn_len2;
-#endif
-static sn_len2 len2(const sn_q d[3]) {
-#if defined(SN_FLOAT)
-    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-#else
-    return (uint64_t)((int64_t)d[0] * d[0]) + (uint64_t)((int64_t)d[1] * d[1]) +
-           (uint64_t)((int64_t)d[2] * d[2]);
-#endif
-}
-
 void sn_limits(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *lim = v->sec[SN_SEC_LIMIT];
@@ -41,7 +26,7 @@ void sn_limits(sn_ihdr *h, uint32_t *sat) {
         if (!(L > 0)) continue;
         sn_skinned(h, i, s, sat);
         for (k = 0; k < 3; k++) d[k] = sn_add(pos[3 * i + k], -s[k], sat);
-        d2 = len2(d);
+        d2 = sn_norm2(d);
 #if defined(SN_FLOAT)
         if (d2 > L * L) {
             float f = L * sn_frsqrt(d2);
@@ -113,7 +98,7 @@ void sn_health(sn_ihdr *h, uint32_t step_clamps) {
         if (rd_real(ml, i) < mmin) continue;
         sn_skinned(h, i, s, &local);
         for (k = 0; k < 3; k++) d[k] = sn_add(pos[3 * i + k], -s[k], &local);
-        d2 = len2(d);
+        d2 = sn_norm2(d);
         m2 = d2 > m2 ? d2 : m2;
     }
 #if defined(SN_FLOAT)

@@ -67,6 +67,21 @@ typedef int64_t sn_acc;
 #define SN_REAL_BYTES 4
 #endif
 
+/* |d|^2 of a difference of state positions (fixed: |d_k| <= 2^29, so the sum
+ * < 2^59.6 in uint64; the health pass and the segment meshes' measure) */
+#if defined(SN_FLOAT)
+typedef float sn_len2;
+#else
+typedef uint64_t sn_len2;
+#endif
+SN_INLINE sn_len2 sn_norm2(const sn_q d[3]) {
+#if defined(SN_FLOAT)
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+#else
+    return (uint64_t)((int64_t)d[0] * d[0]) + (uint64_t)((int64_t)d[1] * d[1]) + (uint64_t)((int64_t)d[2] * d[2]);
+#endif
+}
+
 /* Limits (fixed): state values are clamped to +-SN_LIM (Q22: +-64 internal
  * units); SN_ACC_LIM bounds intermediate public-unit sums (NUMERICS.md,
  * overflow freedom). */

@@ -441,22 +441,10 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
 
 /* The measuring pass keeps the largest |d|^2 and converts it once (gap_of):
  * the conversion is monotonic, so the same value as the largest converted
- * |d| (fixed), without a square root per pair. Fixed: |d_k| <= 2^29, < 2^60. */
-#if defined(SN_FLOAT)
-typedef float seg_n2;
-#else
-typedef uint64_t seg_n2;
-#endif
-SN_INLINE seg_n2 norm2(const sn_q d[3]) {
-#if defined(SN_FLOAT)
-    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-#else
-    return (uint64_t)((int64_t)d[0] * d[0]) + (uint64_t)((int64_t)d[1] * d[1]) + (uint64_t)((int64_t)d[2] * d[2]);
-#endif
-}
+ * |d| (fixed), without a square root per pair (sn_norm2, sn_internal.h). */
 
 /* sqrt(n2) in public Q16.16 segment lengths (or float) */
-static sn_real gap_of(seg_n2 n2, const seg_lvl *L) {
+static sn_real gap_of(sn_len2 n2, const seg_lvl *L) {
 #if defined(SN_FLOAT)
     return n2 > 0.0f ? n2 * sn_frsqrt(n2) / (2.0f * L->half) : 0.0f;
 #else
@@ -478,7 +466,7 @@ typedef struct seg_ctx {
     seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
-    seg_n2 gap2;        /* the measuring pass's largest |d|^2 */
+    sn_len2 gap2;        /* the measuring pass's largest |d|^2 */
     /* the first SEG_TCACHE attachments' targets and their clamp counts:
      * the joints and the flesh do not move during the segment step, so
      * each target is computed once per step, not once per sweep and level */
@@ -517,7 +505,7 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
     t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
     if (measure) {
-        seg_n2 g = norm2(d);
+        sn_len2 g = sn_norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
     } else {
         ka = sa > 0 ? ka : -ka;
@@ -593,7 +581,7 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     d[1] = sn_add(T[1], -P1, &ls);
     d[2] = sn_add(T[2], -P2, &ls);
     if (measure) {
-        seg_n2 g = norm2(d);
+        sn_len2 g = sn_norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
         *sat += ls;
         return;
