@@ -118,7 +118,15 @@ static int sn_unit(const int64_t *c, int n, int32_t *out) {
     }
     N = sn_isqrt64(n2);
     if (n2 - N * N > N) N++;  /* round: sqrt(n2) > N + 1/2 */
-    r = (((uint64_t)1 << 62) + (N >> 1)) / N;  /* N in [2^30, 2^32] */
+    /* r = (2^62 + N/2) / N for N in [2^30, 2^32]: 2^32 at N = 2^30, 2^30 at
+     * N = 2^32, else below 2^32: a 64/32 division with N normalized (no
+     * library 64-bit divide on a 32-bit core), the same quotient */
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else {
+        int s = N < ((uint64_t)1 << 31) ? 1 : 0;
+        r = sn_div64n((((uint64_t)1 << 62) + (N >> 1)) << s, (uint32_t)(N << s));
+    }
     for (i = 0; i < n; i++) {
         uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32; /* a*r < 2^63 */
         out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
