@@ -132,6 +132,8 @@ static void test_isqrt(void) {
         if (!(r * r <= x && (r == 0xFFFFFFFFull || (r + 1) * (r + 1) > x))) {
             if (bad++ < 5) T_CHECK(0, "isqrt(%llu) = %llu", (unsigned long long)x, (unsigned long long)r);
         }
+        if (sn_isqrt64_digits(x) != r && bad++ < 5) /* the 32-bit targets' method, here too */
+            T_CHECK(0, "isqrt_digits(%llu) = %u", (unsigned long long)x, sn_isqrt64_digits(x));
     }
     T_CHECK(bad == 0, "isqrt: %d of %d inputs not the exact floor", bad, (int)i);
 }
@@ -154,14 +156,15 @@ static void test_div64n(void) {
         case 2: n = (rnd64() % d) * d + (d - 1u - (uint32_t)(rnd64() % 4)); break; /* remainder near d */
         default: n = ((rnd64() % d) << 32) | (rnd64() & 0xFFFF0000u); break;
         }
-        q = sn_div64n(n, d);
-        if ((uint64_t)q != n / d && bad++ < 5) T_CHECK(0, "div64n(%llu, %u) = %u", (unsigned long long)n, d, q);
+        q = sn_div64n_digits(n, d); /* the 32-bit targets' method, here too */
+        if (((uint64_t)q != n / d || sn_div64n(n, d) != q) && bad++ < 5)
+            T_CHECK(0, "div64n(%llu, %u) = %u", (unsigned long long)n, d, q);
     }
     for (i = 1; i <= (1 << 22); i++) { /* reciprocals: x over 2^22 and scaled to 2^30 */
         uint64_t x = (uint64_t)i << (i & 8 ? 8 : 0);
         int b = 0;
         while ((x >> b) != 0) b++;
-        if ((uint64_t)sn_div64n((uint64_t)1 << 61, (uint32_t)(x << (32 - b))) != ((uint64_t)1 << (29 + b)) / x &&
+        if ((uint64_t)sn_div64n_digits((uint64_t)1 << 61, (uint32_t)(x << (32 - b))) != ((uint64_t)1 << (29 + b)) / x &&
             bad++ < 5) T_CHECK(0, "div64n reciprocal of %llu", (unsigned long long)x);
     }
     T_CHECK(bad == 0, "div64n: %d quotients not exact", bad);
