@@ -132,9 +132,44 @@ static void test_isqrt(void) {
         if (!(r * r <= x && (r == 0xFFFFFFFFull || (r + 1) * (r + 1) > x))) {
             if (bad++ < 5) T_CHECK(0, "isqrt(%llu) = %llu", (unsigned long long)x, (unsigned long long)r);
         }
+        if (sn_isqrt64_digits(x) != r && bad++ < 5) /* the 32-bit targets' method, here too */
+            T_CHECK(0, "isqrt_digits(%llu) = %u", (unsigned long long)x, sn_isqrt64_digits(x));
     }
     T_CHECK(bad == 0, "isqrt: %d of %d inputs not the exact floor", bad, (int)i);
 }
+
+#if !defined(SN_FLOAT)
+/* sn_div64n against the compiler's 64-bit division (exact integers): edges of
+ * the divisor range [2^31, 2^32), remainders near d, quotients near 2^32, and
+ * every reciprocal the segment meshes take (2^61 / (x 2^(32 - bits x))). */
+static void test_div64n(void) {
+    int bad = 0, i;
+    for (i = 0; i < 2000000; i++) {
+        uint32_t d = (uint32_t)rnd64() | 0x80000000u, q;
+        uint64_t n, lim;
+        if (i % 5 == 1) d = 0x80000000u + (uint32_t)(rnd64() % 4);
+        if (i % 5 == 2) d = 0xFFFFFFFFu - (uint32_t)(rnd64() % 4);
+        lim = (uint64_t)d << 32; /* n < lim: the quotient fits 32 bits */
+        switch (i % 4) {
+        case 0: n = rnd64() % lim; break;
+        case 1: n = lim - 1u - rnd64() % 1024u; break;            /* quotient 2^32 - 1 */
+        case 2: n = (rnd64() % d) * d + (d - 1u - (uint32_t)(rnd64() % 4)); break; /* remainder near d */
+        default: n = ((rnd64() % d) << 32) | (rnd64() & 0xFFFF0000u); break;
+        }
+        q = sn_div64n_digits(n, d); /* the 32-bit targets' method, here too */
+        if (((uint64_t)q != n / d || sn_div64n(n, d) != q) && bad++ < 5)
+            T_CHECK(0, "div64n(%llu, %u) = %u", (unsigned long long)n, d, q);
+    }
+    for (i = 1; i <= (1 << 22); i++) { /* reciprocals: x over 2^22 and scaled to 2^30 */
+        uint64_t x = (uint64_t)i << (i & 8 ? 8 : 0);
+        int b = 0;
+        while ((x >> b) != 0) b++;
+        if ((uint64_t)sn_div64n_digits((uint64_t)1 << 61, (uint32_t)(x << (32 - b))) != ((uint64_t)1 << (29 + b)) / x &&
+            bad++ < 5) T_CHECK(0, "div64n reciprocal of %llu", (unsigned long long)x);
+    }
+    T_CHECK(bad == 0, "div64n: %d quotients not exact", bad);
+}
+#endif
 
 static void test_normalize(void) {
     double maxe = 0;
@@ -458,6 +493,9 @@ int main(void) {
     g_rng = 0x9E3779B97F4A7C15ull ^ (uint64_t)T_SEED();
     printf("  flavour: %s\n", FLAV);
     test_isqrt();
+#if !defined(SN_FLOAT)
+    test_div64n();
+#endif
     test_normalize();
     test_qtomat();
     test_axis_angle();

@@ -232,6 +232,36 @@ sn_real sn_twist_deg(const sn_q q[4], const sn_q a[3]);
 uint64_t sn_udiv64(uint64_t n, uint64_t D);
 /* Integer square root: floor(sqrt(x)). */
 uint32_t sn_isqrt64(uint64_t x);
+/* the same by two-bit digits in 32-bit words (sn_isqrt64 on a 32-bit target) */
+uint32_t sn_isqrt64_digits(uint64_t x);
+/* floor(n / d) for a normalized d in [2^31, 2^32) and n < d 2^32 (the
+ * quotient fits 32 bits): two 32/32 divisions on 16-bit digits with at most
+ * two corrections each (Knuth D; Warren, Hacker's Delight fig. 9-3 divlu),
+ * exact. A core with a 32-bit divider (Cortex-M4 UDIV) needs no library
+ * 64-bit divide; a 64-bit target divides natively (sn_div64n). */
+SN_INLINE uint32_t sn_div64n_digits(uint64_t n, uint32_t d) {
+    uint32_t u1 = (uint32_t)(n >> 32), n1 = (uint32_t)n >> 16, n0 = (uint32_t)n & 0xffffu;
+    uint32_t d1 = d >> 16, d0 = d & 0xffffu, q1, q0, r;
+    int i;
+    SN_RANGE(d >= 0x80000000u && u1 < d, "sn_div64n: divisor not normalized or quotient beyond 32 bits", n);
+    q1 = u1 / d1; r = u1 - q1 * d1;
+    for (i = 0; i < 2; i++) /* q1 too large by at most 2 */
+        if (r <= 0xffffu && (q1 > 0xffffu || q1 * d0 > ((r << 16) | n1))) { q1--; r += d1; }
+    u1 = (u1 << 16) + n1 - q1 * d; /* the remainder < d (mod 2^32 exact) */
+    q0 = u1 / d1; r = u1 - q0 * d1;
+    for (i = 0; i < 2; i++)
+        if (r <= 0xffffu && (q0 > 0xffffu || q0 * d0 > ((r << 16) | n0))) { q0--; r += d1; }
+    return (q1 << 16) + q0;
+}
+/* the same quotient: natively on a 64-bit target, by digits on a 32-bit one */
+SN_INLINE uint32_t sn_div64n(uint64_t n, uint32_t d) {
+#if UINTPTR_MAX > 0xFFFFFFFFu
+    SN_RANGE(d >= 0x80000000u && (n >> 32) < d, "sn_div64n: divisor not normalized or quotient beyond 32 bits", n);
+    return (uint32_t)(n / d);
+#else
+    return sn_div64n_digits(n, d);
+#endif
+}
 #if defined(SN_FLOAT)
 /* 1/sqrt(x) for x > 0 (no libm). */
 float sn_frsqrt(float x);

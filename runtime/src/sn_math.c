@@ -29,9 +29,41 @@ uint64_t sn_udiv64(uint64_t n, uint64_t D) {
     return q;
 }
 
-/* floor(sqrt(x)) for every uint64 x, exact. Bit-by-bit method, 32 fixed
- * iterations, shifts and subtractions only (same code in both flavours). */
+/* floor(sqrt(x)) for every uint64 x, exact, by two-bit digits (same code
+ * in both flavours, 32 fixed steps): after the top 2j bits X of x,
+ * y = floor(sqrt(X)) and r = X - y^2 <= 2y, so the remainder and the trial
+ * 4y + 1 stay below 2^32 for 30 steps (y < 2^29 before the 30th); only the
+ * last two take 64-bit words. A 32-bit core (Cortex-M4): 12 instructions a
+ * step against ~16 for the 64-bit loop below, which a 64-bit target keeps
+ * (~8 a step there against ~13). */
+uint32_t sn_isqrt64_digits(uint64_t x) {
+    uint32_t w = (uint32_t)(x >> 32), y = 0, r = 0, t;
+    uint64_t r2;
+    int i, j;
+    for (j = 0; j < 2; j++) {
+        for (i = j ? 14 : 16; i > 0; i--) {
+            r = (r << 2) | (w >> 30); /* the next two bits of x */
+            w <<= 2;
+            t = (y << 2) | 1u;
+            y <<= 1;
+            if (r >= t) { r -= t; y |= 1u; }
+        }
+        if (!j) w = (uint32_t)x;
+    }
+    r2 = r;
+    for (i = 0; i < 2; i++) {
+        uint64_t t2 = ((uint64_t)y << 2) | 1u;
+        r2 = (r2 << 2) | (w >> 30);
+        w <<= 2;
+        y <<= 1;
+        if (r2 >= t2) { r2 -= t2; y |= 1u; }
+    }
+    return y;
+}
+
+/* the same root by the bit-by-bit method in 64-bit words on a 64-bit target */
 uint32_t sn_isqrt64(uint64_t x) {
+#if UINTPTR_MAX > 0xFFFFFFFFu
     uint64_t rem = x, root = 0, bit = (uint64_t)1 << 62;
     int i;
     for (i = 0; i < 32; i++) {
@@ -45,6 +77,9 @@ uint32_t sn_isqrt64(uint64_t x) {
         bit >>= 2;
     }
     return (uint32_t)root;
+#else
+    return sn_isqrt64_digits(x);
+#endif
 }
 
 /* Messages from the one status list in sinew.h. A switch rather than a
@@ -118,7 +153,15 @@ static int sn_unit(const int64_t *c, int n, int32_t *out) {
     }
     N = sn_isqrt64(n2);
     if (n2 - N * N > N) N++;  /* round: sqrt(n2) > N + 1/2 */
-    r = (((uint64_t)1 << 62) + (N >> 1)) / N;  /* N in [2^30, 2^32] */
+    /* r = (2^62 + N/2) / N for N in [2^30, 2^32]: 2^32 at N = 2^30, 2^30 at
+     * N = 2^32, else below 2^32: a 64/32 division with N normalized (no
+     * library 64-bit divide on a 32-bit core), the same quotient */
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else {
+        int s = N < ((uint64_t)1 << 31) ? 1 : 0;
+        r = sn_div64n((((uint64_t)1 << 62) + (N >> 1)) << s, (uint32_t)(N << s));
+    }
     for (i = 0; i < n; i++) {
         uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32; /* a*r < 2^63 */
         out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;

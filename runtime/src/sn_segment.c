@@ -70,8 +70,10 @@ static void recip(sn_q x, sn_q *r, int *s) {
     *r = 1.0f / x;
     *s = 0;
 #else
+    /* 2^(29+b)/x = 2^61/(x 2^(32-b)) with the divisor normalized: a 64/32
+     * division (no library 64-bit divide on a 32-bit core), same quotient */
     int b = bitlen64((uint64_t)x);
-    *r = (sn_q)(((int64_t)1 << (29 + b)) / x);
+    *r = (sn_q)sn_div64n((uint64_t)1 << 61, (uint32_t)x << (32 - b));
     *s = b - 1;
 #endif
 }
@@ -97,10 +99,8 @@ void seg_level(const seg_mesh *M, unsigned l, seg_lvl *L) {
     /* (side-1) len <= 2^27 (validated) and 2^l <= side-1: no overflow */
     L->half = (sn_q)(((int64_t)M->len << l) >> 1);
     L->half = L->half < 1 ? 1 : L->half;
-    L->bhalf = (sn_q)sn_isqrt64(2u * (uint64_t)L->half * (uint64_t)L->half);
 #endif
     recip(L->half, &L->rh, &L->sh);
-    recip(L->bhalf, &L->rb, &L->sb);
 }
 
 /* sheet of side s: horizontal (r,c)-(r,c+1) first, r(s-1)+c; vertical

@@ -35,9 +35,12 @@ typedef struct seg_lvl {
     sn_q *S, *N;
     uint32_t ns, nn;   /* segments, nodes */
     unsigned kind, side, l;
-    sn_q half, bhalf;  /* half length of a segment / of a brace (Q22) */
-    sn_q rh, rb;       /* 1/half, 1/bhalf: fixed Q(29 + bits of half) reciprocals, float 1/x */
-    int sh, sb;        /* shifts of those reciprocals (fixed) */
+    sn_q half;         /* half length of a segment (Q22) */
+#if defined(SN_FLOAT)
+    sn_q bhalf;        /* of a brace: the length of a degenerate coarse brace */
+#endif
+    sn_q rh;           /* 1/half: fixed Q(29 + bits of half) reciprocal, float 1/x */
+    int sh;            /* shift of that reciprocal (fixed) */
 } seg_lvl;
 
 void seg_mesh_get(const sn_ihdr *h, uint32_t m, seg_mesh *M);
