@@ -159,6 +159,40 @@ static tmesh chain_mesh(int n, double len, int sweeps, double gamma, double keep
 
 static double grav_y(void) { return -9.81 / 3600.0; } /* the test blob's h^2 g, internal units */
 
+/* Runtime and reference side by side for `steps` steps while joint 1 moves
+ * x by 0.05 sin(0.1 s) and the reference's attachments follow from `base`:
+ * the largest |node - reference| (units) over the nn nodes; *gap the
+ * runtime's largest gap (segment lengths). */
+static double follow_reference(sn_instance *inst, segref *ref, const double (*base)[3], int steps, int nn, double *gap) {
+    sn_xform x[TB_NJ];
+    sn_stats st;
+    sn_vec3 p[25];
+    double maxd = 0;
+    int s, i, k;
+    if (nn > 25) nn = 25;
+    memset(x, 0, sizeof x);
+    for (s = 0; s < steps; s++) {
+        double a = 0.05 * sin(0.1 * s);
+        for (i = 0; i < TB_NJ; i++) x[i].rot.w = SN_FLOAT_OR(1.0f, (int32_t)1 << 30);
+        x[1].pos.x = PUB(a);
+        sn_set_pose(inst, x, TB_NJ);
+        sn_step(inst);
+        sn_get_stats(inst, &st);
+        *gap = UNPUB(st.seg_gap) > *gap ? UNPUB(st.seg_gap) : *gap;
+        for (i = 0; i < ref->n_att; i++)
+            for (k = 0; k < 3; k++) ref->att_T[i][k] = base[i][k] + (k == 0 ? a : 0);
+        segref_step(ref);
+        sn_get_segment_nodes(inst, 0, p, 0, (uint32_t)nn);
+        for (i = 0; i < nn; i++)
+            for (k = 0; k < 3; k++) {
+                double got = k == 0 ? UNPUB(p[i].x) : (k == 1 ? UNPUB(p[i].y) : UNPUB(p[i].z));
+                double d = fabs(got - ref->N[i][k]);
+                maxd = d > maxd ? d : maxd;
+            }
+    }
+    return maxd;
+}
+
 /* chain of 8 hanging along +x (horizontal: it swings), node 0 pinned to the
  * tip joint, which moves sinusoidally in x; runtime vs reference */
 /* relax: the blob's over-relaxation byte (omega = relax/32, issue 15);
@@ -169,10 +203,7 @@ static double test_reference(int relax) {
     tmesh t;
     sn_instance *inst;
     segref ref;
-    double g[3] = {0, 0, 0}, maxd = 0, gap = 0;
-    sn_xform x[TB_NJ];
-    sn_stats st;
-    int s, i, k;
+    double g[3] = {0, 0, 0}, maxd, gap = 0;
     make_chain(n, len, 1.0, 1, 0);
     t = chain_mesh(n, len, 16, 0.8, 0.995, 0);
     t.relax = relax;
@@ -184,25 +215,9 @@ static double test_reference(int relax) {
     segref_init(&ref, 0, n, chain_nodes, len, 0.8, 0.995, 4.0, 0.5, 16, g);
     ref.omega = relax / 32.0;
     ref.n_att = 1; ref.att_node[0] = 0;
-    memset(x, 0, sizeof x);
-    for (s = 0; s < steps; s++) {
-        double a = 0.05 * sin(0.1 * s);
-        sn_vec3 p[9];
-        for (i = 0; i < TB_NJ; i++) x[i].rot.w = SN_FLOAT_OR(1.0f, (int32_t)1 << 30);
-        x[1].pos.x = PUB(a);
-        sn_set_pose(inst, x, TB_NJ);
-        sn_step(inst);
-        sn_get_stats(inst, &st);
-        gap = UNPUB(st.seg_gap) > gap ? UNPUB(st.seg_gap) : gap;
-        ref.att_T[0][0] = 1.0 + a; ref.att_T[0][1] = 0; ref.att_T[0][2] = 0;
-        segref_step(&ref);
-        sn_get_segment_nodes(inst, 0, p, 0, (uint32_t)n);
-        for (i = 0; i < n; i++)
-            for (k = 0; k < 3; k++) {
-                double got = k == 0 ? UNPUB(p[i].x) : (k == 1 ? UNPUB(p[i].y) : UNPUB(p[i].z));
-                double d = fabs(got - ref.N[i][k]);
-                maxd = d > maxd ? d : maxd;
-            }
+    {
+        const double base[1][3] = {{1.0, 0, 0}};
+        maxd = follow_reference(inst, &ref, base, steps, n, &gap);
     }
     T_FIGURE("%s: chain 8 segs, 16 sweeps, omega %.4f, 120 steps, moving joint: max |node - reference| = %.3g units (%.3g segment "
              "lengths), ref end (%.4f %.4f), largest gap %.4f%%", FLAV, ref.omega, maxd, maxd / len, ref.N[n - 1][0], ref.N[n - 1][1],
@@ -226,10 +241,8 @@ static double test_reference_sheet(void) {
     tmesh t;
     sn_instance *inst;
     static segref ref;
-    double g[3] = {0, 0, 0}, maxd = 0, gap = 0;
-    sn_xform x[TB_NJ];
-    sn_stats st;
-    int s, i, k;
+    double g[3] = {0, 0, 0}, base[2][3], maxd, gap = 0;
+    int i, k;
     make_sheet(sd, len);
     memset(&t, 0, sizeof t);
     t.kind = SN_SEG_SHEET; t.side = sd; t.levels = 1; t.sweeps = sweeps; t.relax = relax;
@@ -247,27 +260,9 @@ static double test_reference_sheet(void) {
     segref_init(&ref, 1, sd, sheet_nodes, len, 0.6, 0.99, 4.0, 0.5, sweeps, g);
     ref.omega = relax / 32.0;
     ref.n_att = 2; ref.att_node[0] = 0; ref.att_node[1] = sd - 1;
-    memset(x, 0, sizeof x);
-    for (s = 0; s < steps; s++) {
-        double a = 0.05 * sin(0.1 * s);
-        sn_vec3 p[25];
-        for (i = 0; i < TB_NJ; i++) x[i].rot.w = SN_FLOAT_OR(1.0f, (int32_t)1 << 30);
-        x[1].pos.x = PUB(a);
-        sn_set_pose(inst, x, TB_NJ);
-        sn_step(inst);
-        sn_get_stats(inst, &st);
-        gap = UNPUB(st.seg_gap) > gap ? UNPUB(st.seg_gap) : gap;
-        for (i = 0; i < 2; i++)
-            for (k = 0; k < 3; k++) ref.att_T[i][k] = sheet_nodes[3 * ref.att_node[i] + k] + (k == 0 ? a : 0);
-        segref_step(&ref);
-        sn_get_segment_nodes(inst, 0, p, 0, (uint32_t)(sd * sd));
-        for (i = 0; i < sd * sd; i++)
-            for (k = 0; k < 3; k++) {
-                double got = k == 0 ? UNPUB(p[i].x) : (k == 1 ? UNPUB(p[i].y) : UNPUB(p[i].z));
-                double d = fabs(got - ref.N[i][k]);
-                maxd = d > maxd ? d : maxd;
-            }
-    }
+    for (i = 0; i < 2; i++)
+        for (k = 0; k < 3; k++) base[i][k] = sheet_nodes[3 * ref.att_node[i] + k];
+    maxd = follow_reference(inst, &ref, (const double (*)[3])base, steps, sd * sd, &gap);
     T_FIGURE("%s: sheet 5x5, 12 sweeps, omega %.4f, 120 steps draping from a moving joint: max |node - reference| = %.3g "
              "units (%.3g segment lengths), ref far corner (%.4f %.4f %.4f), largest gap %.4f%%", FLAV, ref.omega, maxd,
              maxd / len, ref.N[sd * sd - 1][0], ref.N[sd * sd - 1][1], ref.N[sd * sd - 1][2], 100 * gap);
