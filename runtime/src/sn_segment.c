@@ -162,16 +162,16 @@ SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *
     sn_q r;
     int sh;
     sn_q hl = seg_half(L, i, &r, &sh);
-    unsigned k;
-    for (k = 0; k < 3; k++) {
+    /* components written out: compilers kept the loop (it runs per end per sweep) */
 #if defined(SN_FLOAT)
-        sn_q o = S[3 + k] * hl;
-        P[k] = sn_out(s > 0 ? S[k] + o : S[k] - o, 0, sat);
+    sn_q o0 = S[3] * hl, o1 = S[4] * hl, o2 = S[5] * hl;
 #else
-        int64_t o = sn_rshr64((int64_t)S[3 + k] * hl, SN_Q_ROT);
-        P[k] = sn_out(s > 0 ? S[k] + o : S[k] - o, 0, sat);
+    int64_t o0 = sn_rshr64((int64_t)S[3] * hl, SN_Q_ROT), o1 = sn_rshr64((int64_t)S[4] * hl, SN_Q_ROT),
+            o2 = sn_rshr64((int64_t)S[5] * hl, SN_Q_ROT);
 #endif
-    }
+    P[0] = sn_out(s > 0 ? S[0] + o0 : S[0] - o0, 0, sat);
+    P[1] = sn_out(s > 0 ? S[1] + o1 : S[1] - o1, 0, sat);
+    P[2] = sn_out(s > 0 ? S[2] + o2 : S[2] - o2, 0, sat);
 }
 
 void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) { end_of(L, i, s, P, sat); }
@@ -567,19 +567,16 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
 SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
-    /* seg_end, then d = T - P and t = omega gamma d (|d| 2^31 < 2^60), each
-     * clamped and counted, components written out (same values as before) */
-    sn_q *S = L->S + SEG_W * a, P0, P1, P2, d[3], t0, t1, t2, r;
+    /* the end P, then d = T - P and t = omega gamma d (|d| 2^31 < 2^60),
+     * each clamped and counted */
+    sn_q *S = L->S + SEG_W * a, P[3], d[3], t0, t1, t2;
     int sh;
-    seg_n hl = seg_half(L, a, &r, &sh), kf;
-    sn_acc o0 = r30(MUL(S[3], hl)), o1 = r30(MUL(S[4], hl)), o2 = r30(MUL(S[5], hl));
+    seg_n kf;
     uint32_t ls = 0;
-    P0 = sn_out(sa > 0 ? S[0] + o0 : S[0] - o0, 0, &ls);
-    P1 = sn_out(sa > 0 ? S[1] + o1 : S[1] - o1, 0, &ls);
-    P2 = sn_out(sa > 0 ? S[2] + o2 : S[2] - o2, 0, &ls);
-    d[0] = sn_add(T[0], -P0, &ls);
-    d[1] = sn_add(T[1], -P1, &ls);
-    d[2] = sn_add(T[2], -P2, &ls);
+    end_of(L, a, sa, P, &ls);
+    d[0] = sn_add(T[0], -P[0], &ls);
+    d[1] = sn_add(T[1], -P[1], &ls);
+    d[2] = sn_add(T[2], -P[2], &ls);
     if (measure) {
         sn_len2 g = sn_norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
