@@ -226,11 +226,26 @@ static void surf_err(const study *S, const double *a, const double *b, double *m
 /* ---- the problems ---- */
 static void lp_free(lproblem *P) { free(P->Rc); free(P->qptr); free(P->qidx); free(P->qw); free(P->pfix); memset(P, 0, sizeof *P); }
 
+/* every free vertex its own unknown (weight 1), a skeleton vertex (joint[n]
+ * >= 0) moved with its joint: P's nodal rows and fixed positions */
+static void lp_nodal_rows(const study *S, lproblem *P, const int *joint, const double *x)
+{
+    int n, nu = 0, nv = P->nv;
+    P->qptr = xalloc(sizeof(int) * (size_t)(nv + 1)); P->qidx = xalloc(sizeof(int) * (size_t)nv); P->qw = xalloc(sizeof(double) * (size_t)nv);
+    P->pfix = xalloc(sizeof(double) * 3 * (size_t)nv);
+    for (n = 0; n < nv; n++) {
+        P->qptr[n] = nu;
+        if (joint[n] >= 0) joint_move(S, joint[n], x + 3 * n, P->pfix + 3 * n);
+        else { P->qidx[nu] = nu; P->qw[nu] = 1; nu++; }
+    }
+    P->qptr[nv] = nu; P->nu = nu;
+}
+
 /* (a): level 1 nodal, every free vertex an unknown, skeleton vertices with their joint; frames per child */
 static void lp_nodal1(const study *S, lproblem *P, int own_frames)
 {
     const sb_lev *L = S->L1;
-    int n, c, nu = 0;
+    int c;
     memset(P, 0, sizeof *P);
     P->nv = L->nv; P->nc = L->nc; P->cells = L->cells; P->Se = L->Se; P->Me = L->Me; P->x = L->x;
     P->Rc = xalloc(sizeof(double) * 9 * (size_t)L->nc);
@@ -239,14 +254,7 @@ static void lp_nodal1(const study *S, lproblem *P, int own_frames)
         if (own_frames) frame_mat(S, S->cf1b1[c], S->cf1b2[c], S->cf1w[c], P->Rc + 9 * c);
         else frame_mat(S, S->o.cfb1[pc], S->o.cfb2[pc], S->o.cfw[pc], P->Rc + 9 * c);
     }
-    P->qptr = xalloc(sizeof(int) * (size_t)(L->nv + 1)); P->qidx = xalloc(sizeof(int) * (size_t)L->nv); P->qw = xalloc(sizeof(double) * (size_t)L->nv);
-    P->pfix = xalloc(sizeof(double) * 3 * (size_t)L->nv);
-    for (n = 0; n < L->nv; n++) {
-        P->qptr[n] = nu;
-        if (S->joint1[n] >= 0) joint_move(S, S->joint1[n], L->x + 3 * n, P->pfix + 3 * n);
-        else { P->qidx[nu] = nu; P->qw[nu] = 1; nu++; }
-    }
-    P->qptr[L->nv] = nu; P->nu = nu;
+    lp_nodal_rows(S, P, S->joint1, L->x);
 }
 
 /* hierarchical: unknowns = free coarse hats + the details with act[f] (B only), P's rows;
@@ -293,19 +301,12 @@ static void lp_hier(const study *S, lproblem *P, const unsigned char *act, int o
 static void lp_level0(const study *S, lproblem *P, double *Me0)
 {
     const sb_model *o = &S->o;
-    int n, c, nu = 0;
+    int c;
     memset(P, 0, sizeof *P);
     P->nv = o->nv; P->nc = o->nc; P->cells = o->cells; P->Se = o->Se; P->Me = Me0; P->x = o->x;
     P->Rc = xalloc(sizeof(double) * 9 * (size_t)o->nc);
     for (c = 0; c < o->nc; c++) frame_mat(S, o->cfb1[c], o->cfb2[c], o->cfw[c], P->Rc + 9 * c);
-    P->qptr = xalloc(sizeof(int) * (size_t)(o->nv + 1)); P->qidx = xalloc(sizeof(int) * (size_t)o->nv); P->qw = xalloc(sizeof(double) * (size_t)o->nv);
-    P->pfix = xalloc(sizeof(double) * 3 * (size_t)o->nv);
-    for (n = 0; n < o->nv; n++) {
-        P->qptr[n] = nu;
-        if (S->joint0[n] >= 0) joint_move(S, S->joint0[n], o->x + 3 * n, P->pfix + 3 * n);
-        else { P->qidx[nu] = nu; P->qw[nu] = 1; nu++; }
-    }
-    P->qptr[o->nv] = nu; P->nu = nu;
+    lp_nodal_rows(S, P, S->joint0, o->x);
 }
 
 /* ---- step 1: the hierarchical element of each coarse cell against S_h, M_h ---- */
