@@ -1,7 +1,7 @@
 # ports/baremetal + ports/cross build fragment.
 #   make ports            Cortex-M4 images (QEMU mps2-an386) + cross determinism drivers
 #   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
-#   make profile-baremetal  Cortex-M4 instructions per function (QEMU exec log)
+#   make profile-m4       Cortex-M4 instructions per step per function (QEMU plugin)
 #   make determinism-m4  the full level-of-detail and adaptation runs on the M4 (QEMU, ~1 min)
 #   make bench-baremetal-level  their instructions per step on each level (qemu -icount, ~70 s)
 #   make deps             install the cross toolchains and QEMU (Debian, root)
@@ -88,7 +88,17 @@ $(eval $(call bm_image,sinew_cow,cow,$(BM_STEPS),0,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,bench_cow,cow,$(BM_BENCH_STEPS),1,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,sinew_limb,limb,$(BM_STEPS),0,$(LIMB_CLIP)))
 $(eval $(call bm_image,bench_limb,limb,$(BM_BENCH_STEPS),1,$(LIMB_CLIP)))
-$(eval $(call bm_image,prof_cow,cow,2,0,$(wildcard $(COW_CLIP))))
+# make profile-m4: the same image at two step counts; the per-address
+# difference over PROF_M4_STEPS steps is the per-step profile
+PROF_M4_STEPS ?= 2 10
+$(eval $(call bm_image,prof_cow_a,cow,$(word 1,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,prof_cow_b,cow,$(word 2,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,prof_limb_a,limb,$(word 1,$(PROF_M4_STEPS)),0,$(LIMB_CLIP)))
+$(eval $(call bm_image,prof_limb_b,limb,$(word 2,$(PROF_M4_STEPS)),0,$(LIMB_CLIP)))
+# the QEMU TCG plugin that counts instructions per address (host code)
+$(BM_DIR)/insn_plugin.so: ports/baremetal/insn_plugin.c
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O2 -Wall -Wextra -Werror -shared -fPIC -o $@ $<
 $(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
@@ -178,9 +188,13 @@ print-sn-libs:
 bench-baremetal:
 	BUILD=$(BUILD) sh ports/baremetal/bench.sh
 bench: bench-baremetal
-.PHONY: profile-baremetal
-profile-baremetal:
-	BUILD=$(BUILD) sh ports/baremetal/profile.sh
+.PHONY: profile-baremetal profile-m4 print-prof-m4-steps
+# Cortex-M4 instructions per step per function (QEMU TCG plugin, ~10 s);
+# PROF_M4_ASSET=limb for the limb, PROF_M4_LINES=N for the N hottest source lines
+profile-m4 profile-baremetal:
+	BUILD=$(BUILD) sh ports/baremetal/profile_m4.sh $(if $(PROF_M4_ASSET),$(PROF_M4_ASSET),cow) $(PROF_M4_LINES)
+print-prof-m4-steps:
+	@echo $(PROF_M4_STEPS)
 
 # ---- hosted determinism drivers (det_main) for every compiler/CPU ----
 CROSS_DIR   = $(BUILD)/cross
