@@ -279,7 +279,7 @@ static void test_rot(void) {
     }
     T_CHECK(bad_path == 0, "frame rotations: %d differences between path %s and sn_rot*", bad_path, sn_kernels_name());
     T_CHECK(bad_ref == 0, "frame rotations: %d results or clamp counts off the double reference", bad_ref);
-    T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", clamps);
+    T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", (unsigned)clamps);
 }
 
 /* ---- CG vector update (sn_kernels.h sn_k_axpy) against the formula
@@ -335,7 +335,7 @@ static void test_axpy(void) {
         clamps += sd;
     }
     T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
-    T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", clamps);
+    T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);
 }
 
 int main(void) {

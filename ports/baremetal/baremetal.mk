@@ -99,6 +99,17 @@ $(eval $(call bm_image,prof_limb_b,limb,$(word 2,$(PROF_M4_STEPS)),0,$(LIMB_CLIP
 $(BM_DIR)/insn_plugin.so: ports/baremetal/insn_plugin.c
 	@mkdir -p $(dir $@)
 	$(CC) -std=c99 -O2 -Wall -Wextra -Werror -shared -fPIC -o $@ $<
+# tests/test_runtime_kernels.c on the M4 itself (the DSP kernels against
+# the portable reference and the double references; test_baremetal.sh runs
+# it): newlib's semihosting printf (rdimon.specs), the images' startup
+$(BM_DIR)/obj/test_runtime_kernels.o: tests/test_runtime_kernels.c tests/sn_test.h $(PORT_HDRS)
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_ARCH) -std=c99 -O2 -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
+	    $(PORT_SN_INC) -Iruntime/src -Itests -Dmain=sn_test_main -c $< -o $@
+$(BM_DIR)/test_kernels.elf: $(BM_DIR)/obj/test_runtime_kernels.o $(BM_DIR)/obj/ports/baremetal/test_main.o \
+        $(BM_OBJS) ports/baremetal/an386.ld
+	$(BM_CC) $(BM_ARCH) -nostartfiles --specs=nano.specs --specs=rdimon.specs -u _printf_float \
+	    -T ports/baremetal/an386.ld -Wl,--gc-sections -Wl,--defsym,end=__bss_end -o $@ $(filter %.o,$^) -lm
 $(BM_DIR)/obj/bad_blob.o: ports/baremetal/bad_blob.c
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
@@ -269,7 +280,7 @@ print-det-slice:
 TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
                $(if $(shell command -v $(DET_CC_$(d)) 2>/dev/null),$(CROSS_DIR)/det_$(d)))
 ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
-TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf \
+TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf $(BM_DIR)/test_kernels.elf \
              $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf \
              $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
 endif

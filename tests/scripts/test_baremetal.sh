@@ -19,6 +19,16 @@ if pmake "$B/bad_blob.elf" > "$B/test_build_bad.log" 2>&1; then
     else bad "corrupt blob: rc $rc, log:"; cat "$B/test_bad.log"; fi
 else bad "build bad_blob.elf"; tail -n 20 "$B/test_build_bad.log"; fi
 
+# the kernels of sn_kernels.h on the M4 (tests/test_runtime_kernels.c built
+# for the image: DSP paths against the portable and double references)
+if pmake "$B/test_kernels.elf" > "$B/test_build_kernels.log" 2>&1; then
+    # shellcheck disable=SC2086
+    run_log "$B/test_kernels.log" 120 $BM_QEMU_RUN -kernel "$B/test_kernels.elf" < /dev/null; rc=$?
+    if [ "$rc" -eq 0 ] && grep -q 'path m4' "$B/test_kernels.log" && grep -q '^[1-9][0-9]* passed, 0 failed$' "$B/test_kernels.log"; then
+        ok "M4 kernels: $(tail -n 1 "$B/test_kernels.log") (test_runtime_kernels on the image)"
+    else bad "M4 kernels: rc $rc, log:"; tail -n 20 "$B/test_kernels.log"; fi
+else bad "build test_kernels.elf"; tail -n 20 "$B/test_build_kernels.log"; fi
+
 # good path: the small asset when the tool makes one, else the cow
 img=sinew_cow
 if pmake -n "$BUILD/examples/limb_blob.c" >/dev/null 2>&1; then img=sinew_limb; fi
