@@ -165,6 +165,43 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
     l[2] += sn_rshr64(vgetq_lane_s64(q, 0) + vgetq_lane_s64(q, 1) + (int64_t)U[8] * z[2], s);
 }
 
+#elif defined(SN_KERNELS_M4)
+/* Cortex-M4: each row's sum starts from the rounding term 2^(s-1) (the
+ * three SMLAL add onto it) and, for 0 < s < 32, the block's three rows
+ * share the shift split over the two words: lo >> s | hi << (32 - s) and
+ * hi >> s, the value of sn_rshr64 (the sum is exact, < 2^44.6 + 2^30, no
+ * overflow). Other s (s < 0 scales up and clamps): the reference. */
+SN_INLINE sn_acc sn_k_ic_sh(int64_t p, int s, int r) { /* p >> s, 0 < s < 32, r = 32 - s */
+    const uint32_t lo = (uint32_t)p;
+    const int32_t hi = (int32_t)(p >> 32);
+    return (int64_t)(hi >> s) * ((int64_t)1 << 32) + (int64_t)((lo >> s) | ((uint32_t)hi << r));
+}
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    const int64_t bias = (int64_t)((uint32_t)1 << ((s - 1) & 31));
+    const int r = 32 - s;
+    const int32_t y0 = y[0], y1 = y[1], y2 = y[2];
+    if (s <= 0 || s >= 32) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
+    a[0] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b) * y0 + (int64_t)sn_k_ic_i16(b + 6) * y1 +
+                       (int64_t)sn_k_ic_i16(b + 12) * y2, s, r);
+    a[1] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 2) * y0 + (int64_t)sn_k_ic_i16(b + 8) * y1 +
+                       (int64_t)sn_k_ic_i16(b + 14) * y2, s, r);
+    a[2] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 4) * y0 + (int64_t)sn_k_ic_i16(b + 10) * y1 +
+                       (int64_t)sn_k_ic_i16(b + 16) * y2, s, r);
+}
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+    const int s = b[18];
+    const int64_t bias = (int64_t)((uint32_t)1 << ((s - 1) & 31));
+    const int r = 32 - s;
+    const int32_t z0 = z[0], z1 = z[1], z2 = z[2];
+    if (s <= 0 || s >= 32) { sn_k_ic_row_ref(b, z, l, sat); return; }
+    l[0] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b) * z0 + (int64_t)sn_k_ic_i16(b + 2) * z1 +
+                       (int64_t)sn_k_ic_i16(b + 4) * z2, s, r);
+    l[1] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 6) * z0 + (int64_t)sn_k_ic_i16(b + 8) * z1 +
+                       (int64_t)sn_k_ic_i16(b + 10) * z2, s, r);
+    l[2] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 12) * z0 + (int64_t)sn_k_ic_i16(b + 14) * z1 +
+                       (int64_t)sn_k_ic_i16(b + 16) * z2, s, r);
+}
+
 #else
 #define sn_k_ic_col sn_k_ic_col_ref
 #define sn_k_ic_row sn_k_ic_row_ref
