@@ -338,6 +338,45 @@ static void test_axpy(void) {
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);
 }
 
+#if !defined(SN_FLOAT)
+/* ---- the rounding shift for run-time shifts (sn_rshr64_var: the Cortex-M
+ * split over two words, sn_rshr64 elsewhere) against floor((x + 2^(s-1)) /
+ * 2^s) by division, written here: random x with |x| up to 2^62 (the
+ * precondition x + 2^(s-1) < 2^63), s 0..62, and the edges around every
+ * multiple of 2^s near 0, +-2^31, +-2^32 and +-2^62. Tolerance 0. */
+static int64_t rshr_ref(int64_t x, int s) {
+    int64_t d, q, r;
+    if (s <= 0) return x;
+    /* floor(x / 2^s) plus the carry of the remainder r in [0, 2^s) */
+    d = (int64_t)1 << (s - 1);
+    q = x / (d * 2);
+    r = x % (d * 2);
+    if (r < 0) { r += d * 2; q -= 1; }
+    return q + (r + d >= d * 2 ? 1 : 0);
+}
+static void test_rshr(void) {
+    static const int64_t base[] = {0, (int64_t)1 << 31, (int64_t)1 << 32, (int64_t)1 << 61};
+    int t, s, k, bad = 0, n = 0;
+    for (t = 0; t < 200000; t++) {
+        int64_t x = (int64_t)((((uint64_t)rnd32() << 32) | rnd32()) >> (2 + rnd32() % 61u)); /* 0 <= x < 2^62 */
+        if (rnd32() & 1) x = -x;
+        s = (int)(rnd32() % 63u);
+        bad += sn_rshr64_var(x, s) != rshr_ref(x, s);
+        n++;
+    }
+    for (s = 0; s <= 62; s++)
+        for (k = 0; k < 4; k++) {
+            int64_t m = s > 0 ? (int64_t)1 << (s - 1) : 1, j;
+            for (j = -2; j <= 2; j++) {
+                int64_t c[4] = {base[k] + j, base[k] + m + j, -base[k] + j, -base[k] - m + j};
+                int i;
+                for (i = 0; i < 4; i++) { bad += sn_rshr64_var(c[i], s) != rshr_ref(c[i], s); n++; }
+            }
+        }
+    T_CHECK(bad == 0, "rounding shift: %d of %d results off floor((x + 2^(s-1)) / 2^s)", bad, n);
+}
+#endif
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -395,5 +434,8 @@ int main(void) {
     test_ic();
     test_rot();
     test_axpy();
+#if !defined(SN_FLOAT)
+    test_rshr();
+#endif
     return T_END();
 }

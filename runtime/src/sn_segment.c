@@ -345,7 +345,7 @@ SN_INLINE sn_acc rsh(sn_acc a, int s) {
     (void)s;
     return a;
 #else
-    return sn_rshr64(a, s);
+    return sn_rshr64_var(a, s);
 #endif
 }
 SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
