@@ -354,6 +354,37 @@ static int64_t rshr_ref(int64_t x, int s) {
     if (r < 0) { r += d * 2; q -= 1; }
     return q + (r + d >= d * 2 ? 1 : 0);
 }
+/* ---- the CG's block-floating dot product (sn_k_dot) against a reference
+ * written from its contract (sn_kernels.h): s = max(0, bitlen(OR|a|) +
+ * bitlen(OR|b|) + bitlen(n) - 62), each product a_k b_k rounded alone by
+ * rshr_ref at s + k_i, summed exactly. Random lengths 0..600 (whole
+ * vertices), values at scales 2^0..2^28 (every 8th vector at +-2^28),
+ * k_i 0..15. Tolerance 0: the result is an exact integer. */
+static int bitlen_ref(uint64_t x) { int n = 0; while (x) { n++; x /= 2; } return n; }
+static void test_dot(void) {
+    static sn_q a[600], b[600];
+    static uint8_t kk[200];
+    int t, bad = 0;
+    for (t = 0; t < 400; t++) {
+        uint32_t nv = rnd32() % 201u, n = 3 * nv, i, oa = 0, ob = 0;
+        int sa = (int)(rnd32() % 29u), sb = (int)(rnd32() % 29u), s, e = -1;
+        int64_t ref = 0, got;
+        for (i = 0; i < n; i++) {
+            a[i] = t % 8 == 0 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sa);
+            b[i] = t % 8 == 1 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sb);
+            oa |= (uint32_t)(a[i] < 0 ? -a[i] : a[i]);
+            ob |= (uint32_t)(b[i] < 0 ? -b[i] : b[i]);
+        }
+        for (i = 0; i < nv; i++) kk[i] = (uint8_t)(rnd32() % 16u);
+        s = bitlen_ref(oa) + bitlen_ref(ob) + bitlen_ref(n) - 62;
+        s = s < 0 ? 0 : s;
+        for (i = 0; i < n; i++) ref += rshr_ref((int64_t)a[i] * b[i], s + kk[i / 3]);
+        got = sn_k_dot(a, b, kk, n, &e);
+        bad += got != ref || e != s;
+    }
+    T_CHECK(bad == 0, "CG dot product (path %s): %d of 400 sums or exponents off the reference", sn_kernels_name(), bad);
+}
+
 static void test_rshr(void) {
     static const int64_t base[] = {0, (int64_t)1 << 31, (int64_t)1 << 32, (int64_t)1 << 61};
     int t, s, k, bad = 0, n = 0;
@@ -436,6 +467,7 @@ int main(void) {
     test_axpy();
 #if !defined(SN_FLOAT)
     test_rshr();
+    test_dot();
 #endif
     return T_END();
 }

@@ -80,7 +80,7 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
 }
 #endif
 
-#if !defined(SN_FLOAT) && !defined(SN_KERNELS_AVX2) && !defined(SN_KERNELS_NEON)
+#if !defined(SN_FLOAT) && !defined(SN_KERNELS_AVX2) && !defined(SN_KERNELS_NEON) && !defined(SN_KERNELS_M4)
 /* The bound uses the OR of the magnitudes (same bit length as their
  * maximum, no compares). */
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {

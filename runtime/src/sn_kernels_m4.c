@@ -8,6 +8,7 @@
  * The same exact products as the scalar reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
+#include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_M4)
 
@@ -62,6 +63,48 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
         l[3 * i + 2] = s2;
     }
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
+}
+
+/* The CG dot product (sn_kernels.c's reference): each product rounded alone,
+ * (a b + 2^(sh-1)) >> sh. Here the rounding term is the SMLAL's starting
+ * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),
+ * the shift is done on the two words: the same rounded terms (sn_rshr64_var's
+ * identity), summed in the same order. */
+int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
+    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
+    int s;
+    int64_t sum = 0;
+    for (i = 0; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    s = s < 0 ? 0 : s;
+    for (i = 0; i < nv; i++) {
+        const int sh = s + kk[i];
+        if (sh > 0 && sh < 32) {
+            const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
+            const int r = 32 - sh;
+            const sn_q *ai = a + 3 * i, *bi = b + 3 * i;
+            /* written out: GCC kept a loop of 3 (15 instructions a term) */
+#define SN_DOT_T(k)                                                                                       \
+    do {                                                                                                  \
+        const int64_t p = bias + (int64_t)ai[k] * bi[k];                                                  \
+        const uint32_t lo = (uint32_t)p;                                                                  \
+        const int32_t hi = (int32_t)(p >> 32);                                                            \
+        sum += (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | ((uint32_t)hi << r));   \
+    } while (0)
+            SN_DOT_T(0);
+            SN_DOT_T(1);
+            SN_DOT_T(2);
+#undef SN_DOT_T
+        } else {
+            const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+            for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
+        }
+    }
+    *e = s;
+    return sum;
 }
 
 const char *sn_kernels_name(void) { return "m4"; }
