@@ -114,7 +114,7 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
  * |a| <= SN_LIM (a state vector) and 0 <= sh <= 62, every product rounded
  * and clamped alone (order-free);
  * float: the reference on every path. */
-#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON)
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON) || defined(SN_KERNELS_M4)
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat);
 #else /* the reference, inline as the loops it replaced */
 SN_INLINE void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
