@@ -405,6 +405,20 @@ static void test_rshr(void) {
             }
         }
     T_CHECK(bad == 0, "rounding shift: %d of %d results off floor((x + 2^(s-1)) / 2^s)", bad, n);
+    /* sn_add over the whole int32 range (the Cortex-M's 32-bit sum with its
+     * overflow test) against the int64 sum clamped to +-2^28, with the count */
+    bad = 0;
+    for (t = 0; t < 200000; t++) {
+        const int32_t x = t % 4 == 0 ? (int32_t)((int64_t)rnd32() - 2147483648) /* any int32 */
+                                     : (int32_t)(rnd32() >> (1 + rnd32() % 31u)) * (rnd32() & 1 ? 1 : -1);
+        const int32_t y = t % 7 == 0 ? (x < 0 ? INT32_MIN : INT32_MAX)
+                                     : (int32_t)(rnd32() >> (1 + rnd32() % 31u)) * (rnd32() & 1 ? 1 : -1);
+        const int64_t w = (int64_t)x + y, c = w > (1 << 28) ? (1 << 28) : (w < -(1 << 28) ? -(1 << 28) : w);
+        uint32_t sat = 0;
+        const sn_q got = sn_add(x, y, &sat);
+        bad += got != c || sat != (uint32_t)(c != w);
+    }
+    T_CHECK(bad == 0, "saturating add: %d of 200000 sums or counts off the clamped int64 sum", bad);
 }
 #endif
 

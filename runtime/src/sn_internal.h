@@ -190,6 +190,15 @@ SN_INLINE sn_q sn_out(sn_acc a, int s, uint32_t *sat) {
 SN_INLINE sn_q sn_add(sn_q a, sn_q b, uint32_t *sat) {
 #if defined(SN_FLOAT)
     return sn_out(a + b, 0, sat);
+#elif defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__GNUC__)
+    /* Cortex-M: the sum in one 32-bit ADDS (an overflow means |a + b| >= 2^31
+     * with a's sign: beyond SN_LIM, clamped and counted as before) and
+     * 32-bit compares, instead of a 64-bit sum and 64-bit compares */
+    int32_t v;
+    if (__builtin_add_overflow(a, b, &v)) { (*sat)++; return a < 0 ? -SN_LIM : SN_LIM; }
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return v;
 #else
     return sn_out((int64_t)a + (int64_t)b, 0, sat);
 #endif
