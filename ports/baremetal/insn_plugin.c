@@ -59,7 +59,7 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb) {
     qemu_plugin_register_vcpu_tb_exec_inline(tb, QEMU_PLUGIN_INLINE_ADD_U64, &b->count, 1);
 }
 
-static void on_exit(qemu_plugin_id_t id, void *p) {
+static void write_counts(qemu_plugin_id_t id, void *p) {
     struct block *b;
     size_t i;
     FILE *f = fopen(out_path, "w");
@@ -85,6 +85,6 @@ EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const void *info, int argc, 
     }
     strcpy(out_path, argv[0] + 4);
     qemu_plugin_register_vcpu_tb_trans_cb(id, on_translate);
-    qemu_plugin_register_atexit_cb(id, on_exit, NULL);
+    qemu_plugin_register_atexit_cb(id, write_counts, NULL);
     return 0;
 }
