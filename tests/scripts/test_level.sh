@@ -30,6 +30,11 @@ for fl in "" _float; do
         suite "adapt_runtime$fl $c" "$B/tests/adapt_runtime$fl" "$L/${c}_lod$fl.blob" "$L/${c}_adapt$fl.blob"
     done
 done
+# the cut level (tests/test_runtime_cut.c): the study's held poses (runtime/LEVELS.md §3)
+for fl in "" _float; do
+    suite "cut_runtime$fl cow" "$B/tests/cut_runtime$fl" "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" neck y 90
+    suite "cut_runtime$fl beast" "$B/tests/cut_runtime$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob" elbow_l y 90
+done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
 for fl in fixed float; do
     if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_lod.blob; else P=$B/sinew-play-float; BL=$L/cow_lod_float.blob; fi
