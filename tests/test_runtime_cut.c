@@ -14,16 +14,20 @@
  *    level-1 vertex not on its skeleton, and the skeleton ones are moved by
  *    their bones on both); down drops level 1's free detail: no more than
  *    LOD's baked level 0 moves in the same run.
- * 3. No saturation, a finite state, the blended mode refused (steps warped). */
+ * 3. No saturation, a bounded displacement.
+ * 4. The validator's CELLX / CELLXK checks, each crafted change refused. */
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
+#include "fuzz/sn_tblob.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "level_util.h"
+
+static int b_flavour(const unsigned char *b) { return b[SN_H_FLAVOUR]; }
 
 static void dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, double *mx, double *rms)
 {
@@ -71,6 +75,7 @@ int main(int argc, char **argv)
     name = name ? name + 1 : argc > 1 ? argv[1] : "?";
     (void)t_seed;
     (void)pose_at;   /* level_util.h's swing: this test ramps one joint */
+    (void)tb_build;  /* sn_tblob.h: only its checksum helper is used here */
     if (argc < 6) { printf("usage: %s CUT.blob LOD.blob JOINT x|y|z DEG\n", argv[0]); return 2; }
     bc = load(argv[1], &nc); bl = load(argv[2], &nl);
     if (!bc || !bl) { T_CHECK(0, "cannot read %s / %s (make them: tests/level.mk)", argv[1], argv[2]); return T_END(); }
@@ -156,6 +161,43 @@ int main(int argc, char **argv)
     sn_get_stats(c0, &st);
     T_CHECK(st.saturations == 0 && D(st.disp_max) < 4.0, "%s: %u saturations, largest displacement %.3g cells", name, st.saturations,
             D(st.disp_max));
+    /* 4. the validator on CELLX / CELLXK (BLOB.md "Validation" 12c), the checksum fixed after each change */
+    {
+        unsigned char *h = malloc(nc + 8), *cx, *xk;
+        const sn_blob *bb;
+        uint32_t e, slot = 0, xsz = SN_ELEM_CELLXK(b_flavour(bc), 4);
+#define CX_CASE(want, what, change) do { \
+            memcpy(h, bc, nc); cx = h + tb_rd32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLX); \
+            xk = h + tb_rd32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLXK); (void)xk; \
+            change; tb_fix_crc(h); \
+            T_CHECK(sn_blob_validate(h, nc, &bb) == (want), "%s: %s: got %s, want %s", name, what, \
+                    sn_status_str(sn_blob_validate(h, nc, &bb)), sn_status_str(want)); } while (0)
+        for (e = 0; e < ic.cells; e++) if (bc[tb_rd32(bc + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLX) + e * SN_ELEM_CELLX + 38]) break;
+        {   /* the first set entry of cell e */
+            const unsigned char *r = bc + tb_rd32(bc + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLX) + e * SN_ELEM_CELLX;
+            while (slot < SN_CUT_MAXX && (r[2 * slot] | r[2 * slot + 1] << 8) == SN_CUT_NONE) slot++;
+        }
+        T_CHECK(e < ic.cells && slot < SN_CUT_MAXX, "%s: a cell with an extra", name);
+        CX_CASE(SN_OK, "unchanged", (void)0);
+        CX_CASE(SN_ERR_INDEX, "an extra below nF (a free vertex)", tb_u16(cx + e * SN_ELEM_CELLX + 2 * slot, ic.free_vertices - 1));
+        CX_CASE(SN_ERR_INDEX, "an extra at nV", tb_u16(cx + e * SN_ELEM_CELLX + 2 * slot, ic.vertices));
+        CX_CASE(SN_ERR_VALUE, "nx one short", cx[e * SN_ELEM_CELLX + 38]--);
+        CX_CASE(SN_ERR_VALUE, "pad byte", cx[e * SN_ELEM_CELLX + 39] = 1);
+        CX_CASE(SN_ERR_INDEX, "first off the running sum", cx[(ic.cells - 1) * SN_ELEM_CELLX + 40]++);
+        CX_CASE(SN_ERR_INDEX, "an entry dropped (the later cells' first off the sum)", (tb_u16(cx + e * SN_ELEM_CELLX + 2 * slot, SN_CUT_NONE),
+                                                                             cx[e * SN_ELEM_CELLX + 38]--));
+#if defined(SN_FLOAT)
+        CX_CASE(SN_ERR_VALUE, "a block entry 2^28", tb_u32(xk, 0x4D800000u));
+#else
+        CX_CASE(SN_ERR_VALUE, "a block exponent 13", xk[18] = 13);
+        CX_CASE(SN_ERR_VALUE, "a mantissa -2^15", tb_u16(xk, 0x8000u));
+        CX_CASE(SN_ERR_VALUE, "a block pad byte", xk[19] = 1);
+#endif
+        CX_CASE(SN_ERR_SECTION, "CELLX count 1", tb_u32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLX + 8, 1));
+        (void)xsz;
+#undef CX_CASE
+        free(h);
+    }
     free(m[0]); free(m[1]); free(m[2]); free(xf); free(sc); free(s0); free(s1); free(bc); free(bl);
     return T_END();
 }
