@@ -31,7 +31,17 @@ $(LEVEL_EX)/limb/cut.sinew: tools/examples/limb/limb.sinew tests/level.mk
 	@mkdir -p $(@D)
 	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' -e '/^constraints /d' -e '/^colliders /d' $< > $@
 	echo 'levels 2 cut' >> $@
+$(LEVEL_EX)/%_cut_double.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour double --quiet
 CUT_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_cut.blob $(LEVEL_EX)/$(c)_cut_float.blob)
+# the cut level settled against the double-precision static reference (tests/test_physics_cut.c)
+$(BUILD)/tests/test_physics_cut: tests/test_physics_cut.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED) $(CUT_BLOBS) $(LEVEL_EX)/cow_cut_double.blob $(LEVEL_EX)/beast_cut_double.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_physics_cut_float: tests/test_physics_cut.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(CUT_BLOBS) $(LEVEL_EX)/cow_cut_double.blob $(LEVEL_EX)/beast_cut_double.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_physics_cut $(BUILD)/tests/test_physics_cut_float
 $(BUILD)/tests/cut_runtime: tests/test_runtime_cut.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(CUT_BLOBS) $(LEVEL_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
