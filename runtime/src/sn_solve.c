@@ -107,6 +107,7 @@ static void cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const 
                 }
         }
     }
+    for (i = 0; i < 24; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
 }
 
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
