@@ -40,18 +40,20 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
     for (cc = 0; cc < o2->nc; cc++) {
         int q[3];
         half_coords(o, o2, o2->cells[8 * cc], q);
-        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= hn[0] - 1 || q[1] >= hn[1] - 1 || q[2] >= hn[2] - 1) { cut->nlost++; continue; }
+        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= hn[0] - 1 || q[1] >= hn[1] - 1 || q[2] >= hn[2] - 1) continue;
         hc[q[0] + hn[0] * (q[1] + hn[1] * q[2])] = cc;
         if (full < 0 || o2->cell_fill[cc] > o2->cell_fill[full]) full = cc;
     }
     /* the air element of a child level 1 did not keep (no interior worth a cell): the sb_integrate weight of
-     * outside points, air x the solid cube's (exact for one material: the condensed element scales with it) */
+     * outside points, air x the solid cube's (exact for one material: the condensed element scales with it;
+     * with material regions, the material of level 1's fullest cell) */
     if (full < 0 || !(o2->cell_fill[full] >= 1.0)) { sb_fail("the cut level: level 1 has no cell wholly inside"); goto done; }
     Sair = sb_alloc(sizeof(double) * 576); Mair = sb_alloc(sizeof(double) * 64);
     for (i = 0; i < 576; i++) Sair[i] = air * o2->Se[576 * (size_t)full + (size_t)i];
     for (i = 0; i < 64; i++) Mair[i] = air * o2->Me[64 * (size_t)full + (size_t)i];
     xid = sb_alloc(sizeof(int) * (size_t)o2->nv);
     for (i = 0; i < o2->nv; i++) xid[i] = -1;
+    cut->nlost = o2->nc;   /* less each kept level-1 cell a kept level-0 cell claims below */
     cut->xv = sb_alloc(sizeof(int) * (size_t)o2->nv);
     cut->cnx = sb_alloc(sizeof(int) * (size_t)o->nc);
     cut->cx = sb_alloc(sizeof(int) * SB_CUT_MAXX * (size_t)o->nc);
@@ -114,7 +116,7 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
                                 for (s2 = 0; s2 < 3; s2++)
                                     KE[(size_t)N3 * (size_t)(3 * la + r) + (size_t)(3 * lb + s2)] += w * Sc[24 * (3 * a + r) + 3 * b + s2];
                         }
-            if (cc < 0) cut->nair++;
+            if (cc < 0) cut->nair++; else cut->nlost--;   /* claimed by a kept level-0 cell */
         }
     }
     rc = 0;

@@ -20,7 +20,7 @@ typedef struct sb_cut {
     int nx;          /* extra prescribed vertices */
     int nfreed;      /* level-0 skeleton vertices free on level 1: unknowns of the cut level (sb_cut_apply) */
     int *v1;         /* per level-0 vertex: the level-1 vertex at its place, -1 */
-    int nlost;       /* kept level-1 cells outside level 0's grid (left out) */
+    int nlost;       /* kept level-1 cells in no kept level-0 cell (level 0 has no unknown there: left out) */
     int nair;        /* children of level-0 cells that level 1 did not keep: the air element (sb_integrate's outside weight) */
     int *xv;         /* per extra: its level-1 vertex */
     int *cnx;        /* per level-0 cell: its extras */

@@ -591,6 +591,7 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
         if (what) { sb_fail("%s:%d: levels 2 cut: %s are not supported on the cut level (remove them or 'cut')", d->path, d->levels_line, what); goto done; }
         if (sb_cut_build(o, &o2, d->air, &cut)) goto done;
         sb_cut_apply(d, o, &o2, &cut);
+        info->cut_nx = cut.nx; info->cut_freed = cut.nfreed; info->cut_air = cut.nair; info->cut_lost = cut.nlost;
     }
     /* shared surface data */
     o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
