@@ -16,6 +16,40 @@ $(LEVEL_EX)/%_lod_float.blob: $(LEVEL_EX)/%/lod.sinew $(BAKE)
 .PRECIOUS: $(LEVEL_EX)/%/lod.sinew
 LEVEL_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_lod.blob $(LEVEL_EX)/$(c)_lod_float.blob)
 
+# The cut level (runtime/LEVELS.md §2 "The cut level", tests/test_runtime_cut.c): the same
+# two-level descriptions with 'levels 2 cut', without the constraint and collider slots
+# (the cut level refuses them at bake time).
+$(LEVEL_EX)/%/cut.sinew: $(LEVEL_EX)/%/lod.sinew tests/level.mk
+	sed -e 's/^levels 2$$/levels 2 cut/' -e '/^constraints /d' -e '/^colliders /d' $< > $@
+$(LEVEL_EX)/%_cut.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_cut_float.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/cut.sinew
+# the limb's cut level: the fuzzers' seed (tests/fuzz/fuzz.mk) and a small blob for hostile runs
+$(LEVEL_EX)/limb/cut.sinew: tools/examples/limb/limb.sinew tests/level.mk
+	@mkdir -p $(@D)
+	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' -e '/^constraints /d' -e '/^colliders /d' $< > $@
+	echo 'levels 2 cut' >> $@
+$(LEVEL_EX)/%_cut_double.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour double --quiet
+CUT_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_cut.blob $(LEVEL_EX)/$(c)_cut_float.blob)
+# the cut level settled against the double-precision static reference (tests/test_physics_cut.c)
+$(BUILD)/tests/test_physics_cut: tests/test_physics_cut.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED) $(CUT_BLOBS) $(LEVEL_EX)/cow_cut_double.blob $(LEVEL_EX)/beast_cut_double.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_physics_cut_float: tests/test_physics_cut.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(CUT_BLOBS) $(LEVEL_EX)/cow_cut_double.blob $(LEVEL_EX)/beast_cut_double.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_physics_cut $(BUILD)/tests/test_physics_cut_float
+$(BUILD)/tests/cut_runtime: tests/test_runtime_cut.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(CUT_BLOBS) $(LEVEL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/cut_runtime_float: tests/test_runtime_cut.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FLOAT) $(CUT_BLOBS) $(LEVEL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_DEPS += $(BUILD)/tests/cut_runtime $(BUILD)/tests/cut_runtime_float
+
 # Adaptation (runtime/src/sn_adapt.c, tests/test_runtime_adapt.c): the same
 # two-level blobs with 'adapt REFINE COARSEN MAX_ACTIVE' (level-0 cells); the
 # test patches the record for its other settings.

@@ -195,6 +195,7 @@ typedef struct sb_desc {
     double cr_exclude;               /* mesh units; < 0: default (one cell): seed pairs closer than this in the rest pose are not collisions */
     int cr_line;                     /* line of 'crease_settings' (0: none) */
     int levels, levels_line;         /* 'levels N': 1, or 2 with the lattice subdivided once (sb_level.c) */
+    int levels_cut;                  /* 'levels 2 cut': level 0 is the cut level (sb_cut.c) */
     int lod_level;                   /* 0; 1 in the level-1 description sb_level_desc derives (rig files pick that level's fit) */
     int adapt_line, adapt_max;       /* 'adapt REFINE COARSEN MAX_ACTIVE' (with levels 2; 0: none): A_max */
     double adapt_refine, adapt_coarsen; /* level-0 cells */
@@ -317,6 +318,8 @@ typedef struct sb_model {
     uint32_t lod_size, lod_nv1;   /* bytes; the finer level's lattice vertices */
     const uint16_t *lod_up, *lod_down; /* lod_nv1 x 4, nv x 4: {cell, t[3] Q15} */
     uint32_t lod_inst_bytes;      /* instance bytes for the larger level */
+    const struct sb_cut *cut;     /* the cut level (sb_cut.c): CELLX/CELLXK written from it; extras at cut_nv0 + id */
+    int cut_nv0;
     int ad_on, ad_max;            /* adaptation (ADAPT record, with lod_size): A_max */
     double ad_refine, ad_coarsen; /* mesh units */
     int lshift_set, lshift;       /* lshift_set: the blob's length unit is at least 2^lshift (both levels share it) */

@@ -1,6 +1,7 @@
 /* sb_blob.c -- baked units (runtime/NUMERICS.md) and the byte layout
  * (runtime/src/sn_format.h, prose in runtime/BLOB.md). */
 #include "sb.h"
+#include "sb_cut.h"
 #include "../runtime/src/sn_format.h"
 #include <errno.h>
 #include <math.h>
@@ -66,12 +67,43 @@ static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
  * (tests/reference/README.md, finding 2); then symmetrized (<= 1 LSB).
  * out holds the integer entries m 2^e / the diagonal's. Returns 0, or -1 if
  * an entry does not fit. */
+/* The cut level's blocks [corner a x extra k] of cell ci (sb_cut.h), scaled as
+ * cell_blocks' and, fixed, rounded each to int16 mantissas times 2^e (xe[]):
+ * out[9 (8 k + a) + 3i + j]. Returns the extras, or -1 if an entry does not fit. */
+static int cut_blocks(const sb_model *o, int ci, double sc, int flavour, int frac, double *out, int *xe)
+{
+    const sb_cut *cut = o->cut;
+    const int N3 = 3 * SB_CUT_NL;
+    const double *KE;
+    int nx, k, a, i, j;
+    if (!cut) return 0;
+    nx = cut->cnx[ci];
+    KE = cut->K + (size_t)(N3 * N3) * (size_t)ci;
+    for (k = 0; k < nx; k++)
+        for (a = 0; a < 8; a++) {
+            double *B = out + 9 * (8 * k + a), mx = 0;
+            int e = 0;
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) {
+                    double x = sc * KE[(size_t)N3 * (size_t)(3 * a + i) + (size_t)(3 * (8 + k) + j)];
+                    B[3 * i + j] = flavour == SB_FIXED ? ldexp(x, frac) : x;
+                    mx = fmax(mx, fabs(B[3 * i + j]));
+                }
+            if (!(mx <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
+            if (flavour != SB_FIXED) continue;
+            while (e < SN_CELLK_EXP_MAX && rnd(ldexp(mx, -e)) > (double)SN_CELLK_M_MAX) e++;
+            for (i = 0; i < 9; i++) B[i] = ldexp(fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(B[i], -e)))), e);
+            xe[8 * k + a] = e;
+        }
+    return nx;
+}
+
 static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavour, int frac, double out[36 * 9],
                        int exps[28])
 {
     const double *Se = o->Se + (size_t)ci * 576;
-    double sc = h * h / m0;
-    int a, b, i, j, n = 0, no = 0;
+    double sc = h * h / m0, xb[8 * SB_CUT_MAXX * 9];
+    int a, b, i, j, n = 0, no = 0, nx = 0, xe[8 * SB_CUT_MAXX];
     for (a = 0; a < 8; a++)
         for (b = a; b < 8; b++, n++)
             for (i = 0; i < 3; i++)
@@ -92,14 +124,25 @@ static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavo
                 out[9 * n + k] = ldexp(fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(out[9 * n + k], -e)))), e);
             exps[no++] = e;
         }
+    if (o->cut && (nx = cut_blocks(o, ci, sc, SB_FIXED, frac, xb, xe)) < 0) return -1;
     for (a = 0; a < 8; a++) {
-        double exact[9] = {0}, D[9];
+        double exact[9] = {0}, D[9], xsum[9] = {0};
         int k, na = 0;
         for (k = 0; k < a; k++) na += 8 - k; /* index of block (a,a) */
         for (b = 0; b < 8; b++)
             for (i = 0; i < 3; i++)
                 for (j = 0; j < 3; j++) exact[3 * i + j] += sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
-        for (k = 0; k < 9; k++) D[k] = rnd(ldexp(exact[k], frac));
+        if (o->cut) { /* the cut element: its rows' null space runs over the extras too (their rounded blocks) */
+            const int N3 = 3 * SB_CUT_NL;
+            const double *KE = o->cut->K + (size_t)(N3 * N3) * (size_t)ci;
+            for (k = 0; k < nx; k++)
+                for (i = 0; i < 3; i++)
+                    for (j = 0; j < 3; j++) {
+                        exact[3 * i + j] += sc * KE[(size_t)N3 * (size_t)(3 * a + i) + (size_t)(3 * (8 + k) + j)];
+                        xsum[3 * i + j] += xb[9 * (8 * k + a) + 3 * i + j];
+                    }
+        }
+        for (k = 0; k < 9; k++) D[k] = rnd(ldexp(exact[k], frac)) - xsum[k];
         for (b = 0; b < 8; b++) {
             int lo = a < b ? a : b, hi = a < b ? b : a, nb = 0;
             if (b == a) continue;
@@ -353,6 +396,12 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     cnt[SN_SEC_LEVEL_DOWN] = o->lod_size ? (uint32_t)nV : 0u;  esz[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_ICHOL] = (uint32_t)ic.n;           esz[SN_SEC_ICHOL] = SN_ELEM_ICHOL;
     cnt[SN_SEC_ADAPT] = o->lod_size && o->ad_on ? 1u : 0u;   esz[SN_SEC_ADAPT] = SN_ELEM_ADAPT(rs);
+    {
+        uint32_t nxb = 0;
+        if (o->cut) for (i = 0; i < o->nc; i++) nxb += 8u * (uint32_t)o->cut->cnx[i];
+        cnt[SN_SEC_CELLX] = o->cut ? (uint32_t)o->nc : 0u;   esz[SN_SEC_CELLX] = SN_ELEM_CELLX;
+        cnt[SN_SEC_CELLXK] = nxb;   esz[SN_SEC_CELLXK] = SN_ELEM_CELLXK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
+    }
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -509,6 +558,34 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         } else
             for (k = 0; k < 36 * 9; k++)
                 put_real(&w, off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs, blk[k], 0);
+    }
+    if (o->cut) { /* the cut level: each cell's extras and their blocks (sb_cut.h) */
+        uint32_t first = 0;
+        for (i = 0; i < o->nc; i++) {
+            size_t at = off[SN_SEC_CELLX] + (size_t)i * SN_ELEM_CELLX;
+            double xb[8 * SB_CUT_MAXX * 9];
+            int xe[8 * SB_CUT_MAXX], nx, q, m = 0;
+            nx = cut_blocks(o, i, h * h / m0, flavour, b->frac_S, xb, xe);
+            if (nx < 0) { w.err = 1; continue; }
+            for (q = 0; q < 27; q++) {
+                int id;
+                if (!((q % 3) & 1) && !((q / 3 % 3) & 1) && !((q / 9) & 1)) continue; /* a corner */
+                id = o->cut->csub[27 * i + q];
+                put_u16(&w, at + 2 * (size_t)m++, id < 0 ? SN_CUT_NONE : (unsigned)(o->cut_nv0 + id));
+            }
+            put_u8(&w, at + 38, (unsigned)nx);
+            put_u32(&w, at + 40, first);
+            for (k = 0; k < 8 * nx; k++) {
+                size_t bt = off[SN_SEC_CELLXK] + (size_t)(first + (uint32_t)k) * esz[SN_SEC_CELLXK];
+                int l;
+                if (flavour == SB_FIXED) {
+                    for (l = 0; l < 9; l++) put_u16(&w, bt + 2 * (size_t)l, (unsigned)(uint16_t)(int16_t)ldexp(xb[9 * k + l], -xe[k]));
+                    put_u8(&w, bt + 18, (unsigned)xe[k]);
+                } else
+                    for (l = 0; l < 9; l++) put_real(&w, bt + (size_t)l * (size_t)rs, xb[9 * k + l], 0);
+            }
+            first += 8u * (uint32_t)nx;
+        }
     }
     {   /* beyond 64 internal units the state clamps anyway (NUMERICS.md): say so once */
         int beyond = 0;

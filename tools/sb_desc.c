@@ -530,8 +530,11 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
         d->lrules[d->nlr++] = r;
     } else if (!strcmp(kw, "levels")) {   /* level of detail: the lattice and its subdivision (sb_level.c) */
         double n_;
-        if (nargs(c, 1) || num(c, 1, &n_)) return -1;
+        if (c->nt == 3 && !strcmp(c->tok[2], "cut")) d->levels_cut = 1;   /* 'levels 2 cut': level 0 cut at level 1's skeleton */
+        else if (nargs(c, 1)) return -1;
+        if (num(c, 1, &n_)) return -1;
         if (!(n_ >= 1 && n_ <= 2 && n_ == floor(n_))) return sb_fail("%s:%d: levels: 1 (the lattice) or 2 (and the lattice subdivided once)", c->path, c->line);
+        if (d->levels_cut && n_ != 2) return sb_fail("%s:%d: levels %g cut: the cut level needs 'levels 2 cut' (level 1's skeleton)", c->path, c->line, n_);
         d->levels = (int)n_;
         d->levels_line = c->line;
     } else if (!strcmp(kw, "adapt")) {   /* adaptation on level 1 (runtime/LEVELS.md §3): thresholds in level-0 cells */

@@ -717,6 +717,7 @@ int sb_build(const sb_desc *d, const sb_mesh *m, sb_model *o, int quiet)
     o->S = sb_alloc(sizeof(double) * 9 * (size_t)o->nbptr[o->nv]);
     o->T = sb_alloc(sizeof(double) * (size_t)o->nbptr[o->nv]);   /* twist retired: stays 0 */
     o->Se = sb_alloc(sizeof(double) * 576 * (size_t)o->nc);
+    if (d->lod_level && d->levels_cut) o->Me = sb_alloc(sizeof(double) * 64 * (size_t)o->nc);   /* the cut level's Galerkin mass (sb_cut.c) */
 
     /* 13. integrals */
     if (sb_integrate_frac(d, o, frac, fidx)) goto done;

@@ -9,6 +9,7 @@
  * the hierarchical matrices with every function active are the finest nodal
  * matrices in another basis (tests/test_bake_level.c). */
 #include "sb_level.h"
+#include "sb_cut.h"
 #include "../runtime/src/sn_format.h"
 #include <math.h>
 #include <stdio.h>
@@ -576,11 +577,22 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
     sb_desc d2;
     sb_model o2;
     sb_blob b0, b1;
+    sb_cut cut;
     uint16_t *up = NULL, *down = NULL;
     int rc = -1, nF, nS, nC;
-    memset(&o2, 0, sizeof o2); memset(&b0, 0, sizeof b0); memset(&b1, 0, sizeof b1);
+    memset(&o2, 0, sizeof o2); memset(&b0, 0, sizeof b0); memset(&b1, 0, sizeof b1); memset(&cut, 0, sizeof cut);
     sb_level_desc(d, o, &d2);
     if (sb_level_model(d, &d2, m, &o2)) goto done;
+    if (d->levels_cut) {   /* level 0 becomes the cut level: its hats cut at level 1's skeleton (sb_cut.c) */
+        /* surface points and segment attachments follow the cut field (sn_surface_point); constraint, contact and
+         * crease rows weigh a surface point by its cell's 8 corners alone, and adaptation's coarse field is trilinear */
+        const char *what = o->crease ? "crease collision" : (o->max_cons || o->max_cols || o->max_contacts) ? "constraints and contacts"
+                         : d->adapt_line ? "adaptation ('adapt')" : NULL;
+        if (what) { sb_fail("%s:%d: levels 2 cut: %s are not supported on the cut level (remove them or 'cut')", d->path, d->levels_line, what); goto done; }
+        if (sb_cut_build(o, &o2, d->air, &cut)) goto done;
+        sb_cut_apply(d, o, &o2, &cut);
+        info->cut_nx = cut.nx; info->cut_freed = cut.nfreed; info->cut_air = cut.nair; info->cut_lost = cut.nlost;
+    }
     /* shared surface data */
     o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
     o2.cr_vnbr = o->cr_vnbr; o2.cr_tnbr = o->cr_tnbr; o2.cr_list = o->cr_list; o2.cr_active = o->cr_active;
@@ -620,6 +632,7 @@ done:
     o2.cr_pairs = NULL; o2.cr_vnbr = o2.cr_tnbr = NULL; o2.crease = 0;   /* borrowed */
     sb_model_free(&o2);
     sb_blob_free(&b0); sb_blob_free(&b1);
+    o->cut = NULL; sb_cut_free(&cut);
     free(up); free(down);
     return rc;
 }

@@ -233,7 +233,7 @@ static sn_status sn_check_contents(const sn_view *v) {
             uint32_t a = sn_rd_u32(rp + 4 * (size_t)i), b = sn_rd_u32(rp + 4 * (size_t)i + 4);
             uint32_t prev = i;
             SN_CHK(a <= b && b <= v->nnz, SN_ERR_INDEX);
-            SN_CHK(b - a <= SN_MAX_ROW_BLOCKS, SN_ERR_INDEX);
+            SN_CHK(b - a <= (v->cut ? SN_MAX_ROW_BLOCKS_CUT : SN_MAX_ROW_BLOCKS), SN_ERR_INDEX);
             for (k = a; k < b; k++) {
                 uint32_t c = sn_rd_u16(cols + 2 * (size_t)k);
                 SN_CHK(c > prev && c < v->nV, SN_ERR_INDEX);
@@ -304,6 +304,42 @@ static sn_status sn_check_ichol(const sn_view *v, uint32_t nic) {
         const unsigned char *b = s + (size_t)i * SN_ELEM_ICHOL;
         for (k = 0; k < 9; k++) SN_CHK(sn_rd_u16(b + 2 * k) != 0x8000u, SN_ERR_VALUE);
         SN_CHK(b[18] <= SN_ICHOL_FRAC_MAX && b[19] == 0, SN_ERR_VALUE);
+    }
+    return SN_OK;
+}
+
+/* The cut level (format 6.3; LEVELS.md §2 "The cut level"): CELLXK only with
+ * CELLX; per cell at most SN_CUT_MAXX extras, each a skeleton vertex (nF..nV-1:
+ * no row, its value from its bone), nx the entries set, first the running sum
+ * of 8 nx, ending at CELLXK's count; blocks as CELLK's off-diagonal ones
+ * (fixed |m| <= 2^15 - 1, e <= 12; float |entry| <= 2^27), so a cell row with
+ * its extras sums 27 blocks of 3 products < 2^55: < 2^61.4 (sn_solve.c). */
+static sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk) {
+    const unsigned char *s = sn_sec(v, SN_SEC_CELLX), *K = sn_sec(v, SN_SEC_CELLXK);
+    uint32_t i, k, first = 0;
+    SN_CHK(ncx != 0 || nxk == 0, SN_ERR_SECTION);
+    for (i = 0; i < ncx; i++) {
+        const unsigned char *c = s + (size_t)i * SN_ELEM_CELLX;
+        uint32_t nx = 0;
+        for (k = 0; k < SN_CUT_MAXX; k++) {
+            uint32_t x = sn_rd_u16(c + 2 * k);
+            if (x == SN_CUT_NONE) continue;
+            SN_CHK(x >= v->nF && x < v->nV, SN_ERR_INDEX);
+            nx++;
+        }
+        SN_CHK(c[38] == nx && c[39] == 0, SN_ERR_VALUE);
+        SN_CHK(sn_rd_u32(c + 40) == first, SN_ERR_INDEX);
+        first += 8u * nx;
+    }
+    SN_CHK(first == nxk, SN_ERR_SECTION);
+    for (i = 0; i < nxk; i++) {
+#if defined(SN_FLOAT)
+        SN_CHK(sn_reals_ok(K + (size_t)i * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES), 9, SN_ENTRY_LIM, 0), SN_ERR_VALUE);
+#else
+        const unsigned char *b = K + (size_t)i * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
+        for (k = 0; k < 9; k++) SN_CHK(sn_rd_u16(b + 2 * k) != 0x8000u, SN_ERR_VALUE);
+        SN_CHK(b[18] <= SN_CELLK_EXP_MAX && b[19] == 0, SN_ERR_VALUE);
+#endif
     }
     return SN_OK;
 }
@@ -397,6 +433,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     cnt[SN_SEC_TRIS] = v.nT;
     cnt[SN_SEC_ICHOL] = 0; /* 0 or nFF: taken from the table below */
     cnt[SN_SEC_ADAPT] = 0; /* 0 or 1: taken from the table below */
+    cnt[SN_SEC_CELLX] = 0; /* 0 or nC: taken from the table below */
+    cnt[SN_SEC_CELLXK] = 0; /* <= 8 x 19 nC: taken from the table below, checked with CELLX */
     /* rig sections: counts from the table, bounded (cost per step, u16/u32 indices) */
     {
         const unsigned char *t = p + SN_H_SECTIONS + 8;
@@ -473,7 +511,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_VSHARE, SN_ELEM_SEGMESH(SN_REAL_BYTES), SN_ELEM_SEGNODES(SN_REAL_BYTES),
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
             SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP,
-            SN_ELEM_ICHOL, SN_ELEM_ADAPT(SN_REAL_BYTES)};
+            SN_ELEM_ICHOL, SN_ELEM_ADAPT(SN_REAL_BYTES), SN_ELEM_CELLX, SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -482,6 +520,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             if (k == SN_SEC_CONSTRAINTS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record */
             if (k == SN_SEC_ICHOL && sn_rd_u32(e + 8) <= v.nnz) cnt[k] = sn_rd_u32(e + 8); /* 0 or nFF: checked with COLS */
             if (k == SN_SEC_ADAPT && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record: checked with the pair (sn_adapt.c) */
+            if (k == SN_SEC_CELLX && sn_rd_u32(e + 8) == v.nC) cnt[k] = v.nC; /* optional: the cut level */
+            if (k == SN_SEC_CELLXK && (uint64_t)sn_rd_u32(e + 8) <= 8u * SN_CUT_MAXX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -500,6 +540,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     st = sn_check_contents(&v);
     if (st != SN_OK) return st;
     st = sn_check_ichol(&v, cnt[SN_SEC_ICHOL]);
+    if (st != SN_OK) return st;
+    st = sn_check_cut(&v, cnt[SN_SEC_CELLX], cnt[SN_SEC_CELLXK]);
     if (st != SN_OK) return st;
     st = sn_check_forces(&v);
     if (st != SN_OK) return st;
@@ -579,14 +621,14 @@ static void sn_view_header(sn_view *v, const unsigned char *p) {
     v->nL = v->nK = v->nR = v->nRS = v->nRE = 0;
     v->nP = v->nVP = v->nM = v->nSN = v->nSA = v->segB = 0;
     v->nD = v->crB = 0;
-    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_nq = v->ic = v->ic_pad = 0;
+    v->nCR = v->cr_list = v->cr_active = v->cr_nv = v->cr_nt = v->cr_nq = v->ic = v->cut = 0;
     v->cr_depth = v->cr_push = 0;
     v->nCon = v->nCol = v->nCt = v->nRows = v->conB = 0;
 }
 
 static void sn_view_sections(sn_view *v) {
     int k;
-    for (k = 0; k < SN_SEC_COUNT; k++)
+    for (k = 0; k < SN_SEC_VIEWED; k++)
         v->sec[k] = v->base + sn_rd_u32(v->base + SN_H_SECTIONS + k * SN_SECTION_ENTRY);
     v->nL = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_LIMIT * SN_SECTION_ENTRY + 8);
     v->nK = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CONTROLS * SN_SECTION_ENTRY + 8);
@@ -596,6 +638,7 @@ static void sn_view_sections(sn_view *v) {
     v->nP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SHARES * SN_SECTION_ENTRY + 8);
     v->nVP = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_VSHARE * SN_SECTION_ENTRY + 8);
     v->ic = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_ICHOL * SN_SECTION_ENTRY + 8) != 0;
+    v->cut = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_CELLX * SN_SECTION_ENTRY + 8) != 0;
     v->nM = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGMESH * SN_SECTION_ENTRY + 8);
     v->nSN = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGNODES * SN_SECTION_ENTRY + 8);
     v->nSA = sn_rd_u32(v->base + SN_H_SECTIONS + SN_SEC_SEGATTACH * SN_SECTION_ENTRY + 8);

@@ -16,7 +16,7 @@
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
 #define SN_FORMAT_MAJOR 6
-#define SN_FORMAT_MINOR 2
+#define SN_FORMAT_MINOR 3
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
 #define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
@@ -176,6 +176,16 @@ enum {
     SN_SEC_ADAPT,        /* 0 or 1 x {u16 max_active (A_max, 0..nF of level 1), u16 0, u32 0, R refine, R coarsen (Q22 internal,
                             0 <= coarsen <= refine <= SN_ADAPT_MAX)}: level 1's detail vertices (free, at no level-0 vertex) are
                             active while their detail stays >= coarsen, join at >= refine, at most A_max of them (sn_adapt.c) */
+    /* ---- the cut level (issue 13; runtime/LEVELS.md §2 "The cut level"), format 6.3; both count 0, or CELLX has
+       count nC: level 0's hats cut at level 1's skeleton, whose vertices are extra skeleton vertices of this lattice ---- */
+    SN_SEC_CELLX,        /* nC x {u16 x[19]: the extra skeleton vertex (nF..nV-1) at each non-corner point of the cell's closure
+                            (half-cell points p + 3q + 9r, p, q, r in 0..2, corners skipped, in that order), SN_CUT_NONE where
+                            the cut field is the cell's trilinear one; u8 nx (the entries not SN_CUT_NONE), u8 0,
+                            u32 first (its first CELLXK block: 8 nx blocks per cell, running sum from 0)} */
+    SN_SEC_CELLXK,       /* sum of 8 nx blocks: for each cell, each extra in x[] order, corners 0..7: the cut element's block
+                            [corner rows x extra columns], entry [3i+j] = K_E[3a+i][3x+j] (Q frac_S, as CELLK).
+                            fixed: {i16 m[9], u8 e (<= SN_CELLK_EXP_MAX), u8 0}, entry = m 2^e, |m| <= 2^15 - 1;
+                            float: R[9], |entry| <= 2^27 */
     SN_SEC_COUNT
 };
 
@@ -227,6 +237,10 @@ enum {
 #define SN_ELEM_LEVEL_MAP    8
 #define SN_ELEM_ADAPT(R)   (8 + 2 * (R))
 #define SN_ADAPT_MAX ((int32_t)1 << 30) /* Q22: 256 internal units, beyond any detail (|p| <= SN_LIM = 2^28) */
+#define SN_ELEM_CELLX       44
+#define SN_CUT_MAXX         19   /* non-corner points of a cell's closure at half cells */
+#define SN_CUT_NONE         0xFFFFu
+#define SN_ELEM_CELLXK(flavour, R) ((flavour) == SN_FLAVOUR_FIXED ? 20 : 9 * (R))
 #define SN_ELEM_ICHOL       20   /* every flavour: int16 mantissas, one exponent per block */
 #define SN_ICHOL_FRAC_MAX   47   /* forward sweep shift frac + k_j - k_i <= 62 (k <= 15) */
 
@@ -322,6 +336,11 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
 /* A stored row holds only neighbours j > i of a hex lattice vertex: at most 26.
  * The runtime relies on it to sum a row's own blocks without clamping. */
 #define SN_MAX_ROW_BLOCKS 26u
+/* The cut level (CELLX): a free vertex's row also holds the extra skeleton vertices on its
+ * cells' closures, at most the 5^3 - 3^3 = 98 half-cell points of its 8 cells with an odd
+ * coordinate; the mass pass's row sum (1 + 124 products < 2^55) and a free vertex's accumulator
+ * (its row plus <= 26 transposed free blocks: 151 products) stay < 2^62.3. */
+#define SN_MAX_ROW_BLOCKS_CUT 124u
 
 /* Fixed-point formats of the internal state (flavour 0). */
 #define SN_Q_LEN 22   /* internal lengths, velocities per step (h*v), forces (m0 * unit) */

@@ -82,6 +82,9 @@ SN_INLINE sn_adapt_state *sn_ad(const sn_ihdr *h) {
     return (sn_adapt_state *)(void *)((unsigned char *)(uintptr_t)h + h->v.instance_bytes);
 }
 
+/* the cut level's correction to the trilinear field in a cell (sn_embed.c; LEVELS.md §2 "The cut level") */
+void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]);
+
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
 
 #define ARR(h, off, T) ((T *)(void *)((unsigned char *)(h) + (h)->off))

@@ -298,10 +298,11 @@ SN_INLINE uint32_t sn_div64n(uint64_t n, uint32_t d) {
 float sn_frsqrt(float x);
 #endif
 
+#define SN_SEC_VIEWED SN_SEC_CELLX
 /* ---- validated blob, decoded once (pointers into the read-only blob) ---- */
 typedef struct sn_view {
     const unsigned char *base;
-    const unsigned char *sec[SN_SEC_COUNT];
+    const unsigned char *sec[SN_SEC_VIEWED]; /* sections before the cut level's (sn_sec for those: the header stays 832 B) */
     uint32_t nV, nF, nC, nJ, nS, nT, nnz, nL; /* nL: LIMIT entries, 0 or nF */
     uint32_t nK, nR, nRS, nRE; /* controls, rigs, rig samples, rig entries (section counts) */
     uint32_t nP, nVP, nFrc;    /* share profiles, vertex profile entries (0 or nF), force slots */
@@ -309,7 +310,7 @@ typedef struct sn_view {
     uint32_t nD, crB;          /* crease: seed pairs, state bytes (SN_CREASE_STATE_BYTES, 0 without) */
     uint16_t nCR, cr_list, cr_active, cr_nv, cr_nt, cr_nq; /* crease: CREASE count (0 or 1), max list, max active,
                                                               VNBR / TNBR row widths, neighbourhood rows (0 without) */
-    uint16_t ic, ic_pad;       /* 1 with an ICHOL section; 0 (16-bit: the view sits in the instance header) */
+    uint16_t ic, cut;          /* 1 with an ICHOL section; 1 with CELLX (the cut level; 16-bit: the view sits in the instance header) */
     sn_q cr_depth, cr_push;    /* crease: deepest detected penetration, push-out cap per step (Q22) */
     uint32_t nCon, nCol, nCt, nRows, conB; /* max constraints, colliders, contacts; rows per step; constraint state bytes */
     uint32_t cg_default, cg_max, instance_bytes, total, flags;
@@ -318,6 +319,10 @@ typedef struct sn_view {
     sn_q energy, cell, disp_bound; /* health scalars (NUMERICS.md) */
     sn_q force;                    /* right-hand-side units per newton (Q frac_F) */
 } sn_view;
+/* a section's first byte from the blob's table (the cut level's two, not kept in the view) */
+SN_INLINE const unsigned char *sn_sec(const sn_view *v, int k) {
+    return v->base + sn_rd_u32(v->base + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY);
+}
 
 /* Instance bytes for these counts: the runtime's layout (sn_instance.c), the
  * one source of the size (SN_INSTANCE_BYTES in sn_format.h is tested equal). */

@@ -140,7 +140,8 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level) {
                 const sn_q *src = vtx < nfsrc ? Sf + 3 * vtx : Ss + 3 * (vtx - nfsrc);
                 for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], src[k]);
             }
-            /* convex weights: no result exceeds its sources (the conversion never clamps) */
+            if (h->v.cut) sn_cut_interp(&h->v, sn_rd_u16(e), t, Sf, Ss, acc); /* from the cut level: its field (sn_embed.c) */
+            /* convex weights: no result exceeds its sources (the conversion never clamps; the cut level's may, counted) */
             for (k = 0; k < 3; k++) val[3 * i + k] = sn_out(acc[k], SN_Q_ROT, &sat);
         }
     }

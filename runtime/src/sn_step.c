@@ -15,7 +15,7 @@ static void step(sn_ihdr *h) {
     sn_frames(h, &sat);
     sn_skeleton(h, &sat);
     sn_crease_step(h, &sat);
-    if (h->mode == SN_MODE_BLENDED) sn_blended_solve(h, &sat); /* seed 000 §4.5 (sn_blended.c) */
+    if (h->mode == SN_MODE_BLENDED && !h->v.cut) sn_blended_solve(h, &sat); /* seed 000 §4.5 (sn_blended.c); the cut level steps warped */
     else sn_solve(h, &sat);
     sn_limits(h, &sat);
     sn_adapt_step(h, &sat); /* level 1's active set for the next step (seed 000 §4.7, sn_adapt.c) */

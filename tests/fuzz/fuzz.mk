@@ -73,15 +73,15 @@ $(FUZZ_DIR)/lf_seed_blob_float: tests/fuzz/lf_seed_blob.c tests/fuzz/sn_tblob.h 
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 # a writer that falls behind the format only costs its seeds (reported), not the build
-$(FUZZ_DIR)/seeds/fuzz_blob_fixed/.stamp: $(FUZZ_DIR)/lf_seed_blob_fixed $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob
+$(FUZZ_DIR)/seeds/fuzz_blob_fixed/.stamp: $(FUZZ_DIR)/lf_seed_blob_fixed $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob $(LEVEL_EX)/limb_cut.blob
 	@rm -rf $(@D) && mkdir -p $(@D)
 	-$(FUZZ_DIR)/lf_seed_blob_fixed $(@D)
-	cp $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob $(@D)/
+	cp $(EX)/cow.blob $(EX)/limb.blob $(EX)/beam1.blob $(LEVEL_EX)/limb_cut.blob $(@D)/
 	@touch $@
-$(FUZZ_DIR)/seeds/fuzz_blob_float/.stamp: $(FUZZ_DIR)/lf_seed_blob_float $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob
+$(FUZZ_DIR)/seeds/fuzz_blob_float/.stamp: $(FUZZ_DIR)/lf_seed_blob_float $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob $(LEVEL_EX)/limb_cut_float.blob
 	@rm -rf $(@D) && mkdir -p $(@D)
 	-$(FUZZ_DIR)/lf_seed_blob_float $(@D)
-	cp $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob $(@D)/
+	cp $(EX)/cow_float.blob $(EX)/limb_float.blob $(EX)/beam1_float.blob $(LEVEL_EX)/limb_cut_float.blob $(@D)/
 	@touch $@
 $(FUZZ_DIR)/seeds/fuzz_clip/.stamp: $(wildcard tools/examples/*/*.clip)
 	@rm -rf $(@D) && mkdir -p $(@D)

@@ -230,6 +230,8 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_LEVEL_DOWN] = 0;       elem[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
     cnt[SN_SEC_ICHOL] = 0;            elem[SN_SEC_ICHOL] = SN_ELEM_ICHOL; /* block Jacobi; tb_add_ichol adds it */
     cnt[SN_SEC_ADAPT] = 0;            elem[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
+    cnt[SN_SEC_CELLX] = 0;            elem[SN_SEC_CELLX] = SN_ELEM_CELLX; /* format 6.3: not a cut level */
+    cnt[SN_SEC_CELLXK] = 0;           elem[SN_SEC_CELLXK] = (uint32_t)SN_ELEM_CELLXK(SN_FLAVOUR, R);
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -463,6 +465,8 @@ static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
     tb_u32(e + 4, n * SN_ELEM_ICHOL);
     tb_u32(e + 8, n);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_ADAPT, total); /* format 6.1: the empty ADAPT section follows */
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLX, total); /* format 6.3: and the empty cut-level ones */
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLXK, total);
     tb_u32(b + SN_H_TOTAL_SIZE, total);
     tb_fix_crc(b);
     return total;

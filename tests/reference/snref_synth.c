@@ -279,6 +279,8 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_LEVEL_DOWN] = 0; el[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
         cnt[SN_SEC_ICHOL] = 0; el[SN_SEC_ICHOL] = SN_ELEM_ICHOL;   /* format 6.0: block Jacobi */
         cnt[SN_SEC_ADAPT] = 0; el[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
+        cnt[SN_SEC_CELLX] = 0; el[SN_SEC_CELLX] = SN_ELEM_CELLX;   /* format 6.3: not a cut level */
+        cnt[SN_SEC_CELLXK] = 0; el[SN_SEC_CELLXK] = SN_ELEM_CELLXK(SN_FLAVOUR_FLOAT32, R);
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;

@@ -192,17 +192,23 @@ pmake "$BUILD/level/cow_lod.blob" "$BUILD/level/cow_lod_float.blob" > "$L/build_
 ADAPT_SKIP="x86_64-gcc-O0 float-gcc-O0"
 pmake "$BUILD/level/cow_adapt.blob" "$BUILD/level/cow_adapt_float.blob" > "$L/build_adapt.log" 2>&1 || \
     { bad "adapt: blobs failed to bake"; tail -n 5 "$L/build_adapt.log"; }
+# ---- the cut level (runtime/LEVELS.md §2 "The cut level"): the cow baked with
+# 'levels 2 cut', 200 steps of the trot, level 1 from 100 to 150 (cut_* hashes) ----
+CUT_STEPS=200; CUT_SW=100:1,150:0
+pmake "$BUILD/level/cow_cut.blob" "$BUILD/level/cow_cut_float.blob" > "$L/build_cut.log" 2>&1 || \
+    { bad "cut: blobs failed to bake"; tail -n 5 "$L/build_cut.log"; }
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
     case $name in float-*) b=$BUILD/examples/limb_crease_float.blob; bl=$BUILD/level/cow_lod_float.blob
-                           ba=$BUILD/level/cow_adapt_float.blob ;;
+                           ba=$BUILD/level/cow_adapt_float.blob; bc=$BUILD/level/cow_cut_float.blob ;;
                         *) b=$BUILD/examples/limb_crease.blob; bl=$BUILD/level/cow_lod.blob
-                           ba=$BUILD/level/cow_adapt.blob ;; esac
+                           ba=$BUILD/level/cow_adapt.blob; bc=$BUILD/level/cow_cut.blob ;; esac
     r=""; [ "$runner" = - ] || r=$runner
     case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || r=qemu-i386 ;; esac
     launch "$L/rc_crease_$name" "$L/run_crease_$name.log" $r "$target" "$b" --steps $CR_STEPS --clip $CR_CLIP
     launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $STEPS $clip_arg --lod $LOD_SW --main-only
+    launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW --main-only
     case " $ADAPT_SKIP " in *" $name "*) continue ;; esac
     launch "$L/rc_adapt_$name" "$L/run_adapt_$name.log" $r "$target" "$ba" --steps $STEPS $clip_arg --lod $LOD_SW \
         --main-only --shared
@@ -259,11 +265,11 @@ $plats
 EOF2
 
 # the crease and level-of-detail runs: "fixed"/"float" lists per scenario
-crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""
+crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
-    for sc in crease lod adapt; do
+    for sc in crease lod adapt cut; do
         case $sc:" $ADAPT_SKIP " in adapt:*" $name "*) continue ;; esac
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
             echo "determinism: $sc $name $h"
@@ -272,6 +278,8 @@ while read -r name target runner; do
 " ;;            crease-*) crfixed="$crfixed$name $h
 " ;;            lod-float-*) lodfloat="$lodfloat$name $h
 " ;;            lod-*) lodfixed="$lodfixed$name $h
+" ;;            cut-float-*) cutfloat="$cutfloat$name $h
+" ;;            cut-*) cutfixed="$cutfixed$name $h
 " ;;            adapt-float-*) adfloat="$adfloat$name $h
 " ;;            *) adfixed="$adfixed$name $h
 " ;;        esac
@@ -360,6 +368,8 @@ agree "level of detail, fixed flavour" "$lodfixed" 2
 agree "level of detail, float flavour" "$lodfloat" 2
 agree "adaptation (shared workspace), fixed flavour" "$adfixed" 2
 agree "adaptation (shared workspace), float flavour" "$adfloat" 2
+agree "cut level, fixed flavour" "$cutfixed" 2
+agree "cut level, float flavour" "$cutfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -385,6 +395,8 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "level of detail, float flavour" "$lodfloat" lod_float
     expect_hash "adaptation (shared workspace), fixed flavour" "$adfixed" adapt_fixed
     expect_hash "adaptation (shared workspace), float flavour" "$adfloat" adapt_float
+    expect_hash "cut level, fixed flavour" "$cutfixed" cut_fixed
+    expect_hash "cut level, float flavour" "$cutfloat" cut_float
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi

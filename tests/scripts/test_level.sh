@@ -30,6 +30,11 @@ for fl in "" _float; do
         suite "adapt_runtime$fl $c" "$B/tests/adapt_runtime$fl" "$L/${c}_lod$fl.blob" "$L/${c}_adapt$fl.blob"
     done
 done
+# the cut level (tests/test_runtime_cut.c): the study's held poses (runtime/LEVELS.md §3)
+for fl in "" _float; do
+    suite "cut_runtime$fl cow" "$B/tests/cut_runtime$fl" "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" neck y 90
+    suite "cut_runtime$fl beast" "$B/tests/cut_runtime$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob" elbow_l y 90
+done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
 for fl in fixed float; do
     if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_lod.blob; else P=$B/sinew-play-float; BL=$L/cow_lod_float.blob; fi
@@ -47,6 +52,15 @@ for fl in fixed float; do
     want=$(sed -n "s/^adapt_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
     if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: adapt_$fl hash $got"; p=$((p + 1));
     else echo "FAIL: adapt_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
+done
+# the cut level: 200 steps of the trot, level 1 from 100 to 150 (tests/scripts/update_hashes.sh)
+for fl in fixed float; do
+    if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_cut.blob; else P=$B/sinew-play-float; BL=$L/cow_cut_float.blob; fi
+    got=$("$P" "$BL" --clip tools/examples/cow/trot.clip --frames 200 --lod 100:1,150:0 --hash --quiet 2>/dev/null |
+          sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' | tail -n 1)
+    want=$(sed -n "s/^cut_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
+    if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: cut_$fl hash $got"; p=$((p + 1));
+    else echo "FAIL: cut_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
 done
 echo "$p passed, $f failed"
 [ "$f" -eq 0 ]

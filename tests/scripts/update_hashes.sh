@@ -49,6 +49,13 @@ adfixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/level/cow_adapt_float.blob" --clip "$CLIP" --frames $STEPS --lod $LOD_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 adfloat=$(hash_of "$T")
 [ -n "$adfixed" ] && [ -n "$adfloat" ] || { echo "update_hashes: a player printed no adaptation hash"; exit 1; }
+# the cut level (runtime/LEVELS.md §2 "The cut level"; tests/level.mk): 200 steps of the trot, up at 100, down at 150
+CUT_STEPS=200; CUT_SW=100:1,150:0
+"$BUILD/sinew-play" "$BUILD/level/cow_cut.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+cutfixed=$(hash_of "$T")
+"$BUILD/sinew-play-float" "$BUILD/level/cow_cut_float.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+cutfloat=$(hash_of "$T")
+[ -n "$cutfixed" ] && [ -n "$cutfloat" ] || { echo "update_hashes: a player printed no cut-level hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -85,5 +92,10 @@ lod_float $lodfloat
 # on level 1, runtime/LEVELS.md §3), checked by tests/scripts/test_level.sh.
 adapt_fixed $adfixed
 adapt_float $adfloat
+# The cow baked with 'levels 2 cut' (the cut level, runtime/LEVELS.md §2; tests/level.mk),
+# $CUT_STEPS steps of the trot, level 1 from step 100 to 150 (--lod $CUT_SW), checked by
+# tests/scripts/test_level.sh and tests/scripts/test_determinism.sh.
+cut_fixed $cutfixed
+cut_float $cutfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"

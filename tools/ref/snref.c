@@ -295,7 +295,7 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SEC_CNT(SN_SEC_SEGMESH), SEC_CNT(SN_SEC_SEGNODES), SEC_CNT(SN_SEC_SEGATTACH), 1u,
             SEC_CNT(SN_SEC_CREASE), SEC_CNT(SN_SEC_CREASE_PAIRS), SEC_CNT(SN_SEC_CREASE_VNBR), SEC_CNT(SN_SEC_CREASE_TNBR),
             SEC_CNT(SN_SEC_LEVEL_BLOB), SEC_CNT(SN_SEC_LEVEL_UP), SEC_CNT(SN_SEC_LEVEL_DOWN),
-            SEC_CNT(SN_SEC_ICHOL), SEC_CNT(SN_SEC_ADAPT) };
+            SEC_CNT(SN_SEC_ICHOL), SEC_CNT(SN_SEC_ADAPT), SEC_CNT(SN_SEC_CELLX), SEC_CNT(SN_SEC_CELLXK) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(m->flavour, R),
@@ -303,10 +303,15 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SN_ELEM_RIG_SAMPLES(R), SN_ELEM_RIG_VERTS, SN_ELEM_RIG_FORCES(R), SN_ELEM_SHARES(R), SN_ELEM_VSHARE,
             SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R), SN_ELEM_CONSTRAINTS,
             SN_ELEM_CREASE(R), SN_ELEM_CREASE_PAIRS, SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR,
-            SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP, SN_ELEM_ICHOL, SN_ELEM_ADAPT(R) };
+            SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP, SN_ELEM_ICHOL, SN_ELEM_ADAPT(R),
+            SN_ELEM_CELLX, SN_ELEM_CELLXK(m->flavour, R) };
 #undef SEC_CNT
-        typedef char sec_count_check[SN_SEC_COUNT == 36 ? 1 : -1];   /* format 6.1 (ADAPT, not read: the reference models level 0): update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
+        typedef char sec_count_check[SN_SEC_COUNT == 38 ? 1 : -1];   /* format 6.3 (CELLX, CELLXK: the cut level, read below); 6.1 (ADAPT, not read: the reference models level 0): update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
         (void)sizeof(sec_count_check);
+        {   /* the cut level: CELLX 0 or nC, CELLXK its running sum (checked when read) */
+            uint32_t ncx = rd_u32(d + SN_H_SECTIONS + SN_SEC_CELLX * SN_SECTION_ENTRY + 8);
+            if (ncx != 0 && ncx != m->nC) FAIL("CELLX count %u, want 0 or nC", (unsigned)ncx);
+        }
         for (i = 0; i < SN_SEC_COUNT; i++) {
             const unsigned char *e = d + SN_H_SECTIONS + i * SN_SECTION_ENTRY;
             uint32_t off = rd_u32(e), sz = rd_u32(e + 4), cnt = rd_u32(e + 8), el = rd_u32(e + 12);
@@ -385,6 +390,39 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             }
         }
     }
+    if (rd_u32(d + SN_H_SECTIONS + SN_SEC_CELLX * SN_SECTION_ENTRY + 8) != 0) {
+        /* the cut level (BLOB.md "CELLX, CELLXK"): per cell its extra skeleton vertices and their [corner x extra] blocks */
+        uint32_t nxk = rd_u32(d + SN_H_SECTIONS + SN_SEC_CELLXK * SN_SECTION_ENTRY + 8), first = 0, xsz = SN_ELEM_CELLXK(m->flavour, R);
+        ALLOC(m->cutx, (size_t)SN_CUT_MAXX * m->nC); ALLOC(m->cutk, (size_t)SN_CUT_MAXX * 72 * m->nC); ALLOC(m->cutn, m->nC);
+        for (i = 0; i < m->nC; i++) {
+            const unsigned char *c = d + sec_off[SN_SEC_CELLX] + SN_ELEM_CELLX * i;
+            unsigned k2, a, q, nx = 0;
+            if (rd_u32(c + 40) != first) FAIL("CELLX %u: first %u, want %u", i, (unsigned)rd_u32(c + 40), (unsigned)first);
+            for (k2 = 0; k2 < SN_CUT_MAXX; k2++) {
+                unsigned x = rd_u16(c + 2 * k2);
+                if (x == SN_CUT_NONE) continue;
+                if (x < m->nF || x >= m->nV || first + 8 * nx + 8 > nxk) FAIL("CELLX %u: extra %u", i, x);
+                m->cutx[SN_CUT_MAXX * i + nx] = x;
+                for (a = 0; a < 8; a++) {
+                    const unsigned char *b = d + sec_off[SN_SEC_CELLXK] + (size_t)xsz * (first + 8 * nx + a);
+                    for (q = 0; q < 9; q++) {
+                        double v;
+                        if (m->flavour != SN_FLAVOUR_FIXED) v = rd_real(&r, b + q * R, (int)m->frac_S);
+                        else {
+                            int mm = (int)rd_u16(b + 2 * q);
+                            if (mm >= 32768) mm -= 65536;
+                            v = ldexp((double)mm, (int)b[18] - (int)m->frac_S);
+                        }
+                        m->cutk[(size_t)72 * (SN_CUT_MAXX * i + nx) + 9 * a + q] = v;
+                    }
+                }
+                nx++;
+            }
+            m->cutn[i] = nx;
+            first += 8 * nx;
+        }
+        if (first != nxk) FAIL("CELLXK count %u, want %u", (unsigned)nxk, (unsigned)first);
+    }
     for (i = 0; i < m->nC; i++) {
         const unsigned char *cf = d + sec_off[SN_SEC_CFRAMES] + SN_ELEM_CFRAMES * i;
         const unsigned char *ck = d + sec_off[SN_SEC_CELLK] + (size_t)SN_ELEM_CELLK(m->flavour, R) * i;
@@ -461,7 +499,7 @@ int snref_load_file(snref_model *m, const char *path, char *err, size_t errn) {
 void snref_free(snref_model *m) {
     free(m->jparent); free(m->jrest); free(m->jname); free(m->rest); free(m->fb1); free(m->fb2); free(m->fw);
     free(m->mdiag); free(m->precond); free(m->ichol); free(m->mlump); free(m->rowptr); free(m->cols); free(m->moff);
-    free(m->cells); free(m->cb1); free(m->cb2); free(m->cw); free(m->cellk); free(m->limit); free(m->sdiag);
+    free(m->cutx); free(m->cutk); free(m->cutn); free(m->cells); free(m->cb1); free(m->cb2); free(m->cw); free(m->cellk); free(m->limit); free(m->sdiag);
     free(m->adjp); free(m->adj); free(m->ecell); free(m->et); free(m->tris);
     free(m->kname); free(m->kkind); free(m->kjoint); free(m->kaxis); free(m->kvalue0);
     free(m->rctl); free(m->rns); free(m->rfrac); free(m->rfs); free(m->rfe); free(m->rne);
@@ -703,6 +741,21 @@ static double cell_terms(const snref_state *s, const double *p, const double *w,
             for (k = 0; k < 24; k++) { t += K[24 * i + k] * dd[k]; tw += K[24 * i + k] * dw[k]; }
             E += 0.5 * sc * dd[i] * t;
             g[i] = sc * (t + tw);
+        }
+        if (m->cutn) {   /* the cut level's extras: g_a += K_ax (d_x + R^T (w_x - w_0)) (the energy keeps the corner block, as the runtime's) */
+            unsigned x;
+            for (x = 0; x < m->cutn[e]; x++) {
+                unsigned vx = m->cutx[SN_CUT_MAXX * e + x];
+                const double *B = m->cutk + (size_t)72 * (SN_CUT_MAXX * e + x);
+                double u[3], y[3], yw[3] = { 0, 0, 0 };
+                for (k = 0; k < 3; k++) u[k] = p[3 * vx + k] - p[3 * cv[0] + k];
+                matT_vec(Re, u, y);
+                for (k = 0; k < 3; k++) y[k] -= m->rest[3 * vx + k] - m->rest[3 * cv[0] + k];
+                if (w) { for (k = 0; k < 3; k++) u[k] = w[3 * vx + k] - w[3 * cv[0] + k]; matT_vec(Re, u, yw); }
+                for (a = 0; a < 8; a++)
+                    for (i = 0; i < 3; i++)
+                        for (k = 0; k < 3; k++) g[3 * a + i] += sc * B[9 * a + 3 * i + k] * (y[k] + yw[k]);
+            }
         }
         if (out)
             for (a = 0; a < 8; a++) {

@@ -55,6 +55,8 @@ typedef struct snref_model {
     int *cb1, *cb2;       /* nC cell frame bones (CFRAMES) */
     double *cw;           /* nC cell frame weight */
     double *cellk;        /* nC*576: S^_e as a full 24x24 row-major matrix, dof 3a+i (corner a) */
+    unsigned *cutn, *cutx; /* the cut level (CELLX; NULL without): per cell its extras' count, SN_CUT_MAXX vertex slots */
+    double *cutk;         /* per cell, per extra slot: 8 blocks [corner a x extra] of 9, row-major (as cellk) */
     double *limit;        /* nF limits L_i (internal units, 0 = none); NULL when LIMIT is empty */
     unsigned *ecell;      /* nS */
     double *et;           /* nS*3 */

@@ -1,0 +1,198 @@
+/* test_bake_cut.c -- the cut level's elements (tools/sb_cut.c; runtime/LEVELS.md
+ * §2 "The cut level") on the cow, in double precision, against level 1's
+ * assembled matrices: for random vectors x over the cut level's functions
+ * (level 0's vertices, then the extras),
+ *
+ *     sum_E K_E x_E   ==   P^T S_1 P x     (and M alike),
+ *
+ * K_E the bake's per-cell sums over E's children of W_c^T S_c W_c, S_1 level 1's
+ * assembled stiffness (sb_build's pattern S, not its per-cell matrices) minus the
+ * kept level-1 cells outside every kept level-0 cell, P level 1's vertices as the
+ * cut basis gives them: a level-0 vertex's own value, a level-1 skeleton vertex
+ * its extra, a free one the dyadic weights of the level-0 grid points around it
+ * (from positions here, not from the bake's cell walk). Built with air 0, so
+ * the children level 1 did not keep add nothing. Also: every cut element's rows
+ * sum to 0 over its corners and extras (translations: W_c's rows sum to 1). */
+#include "sb_level.h"
+#include "sb_cut.h"
+#include "sn_test.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned long rng = 4242;
+static double rnd(void) { rng = rng * 6364136223846793005UL + 1442695040888963407UL; return (double)(rng >> 11) / 9007199254740992.0 - 0.5; }
+
+static int coarse_vertex(const sb_model *o, const int g[3])
+{
+    if (g[0] < 0 || g[1] < 0 || g[2] < 0 || g[0] >= o->gn[0] || g[1] >= o->gn[1] || g[2] >= o->gn[2]) return -1;
+    return o->gvert[g[0] + o->gn[0] * (g[1] + o->gn[1] * g[2])];
+}
+
+static void check(const char *path)
+{
+    sb_desc d, d2;
+    sb_mesh m;
+    sb_srcmap src;
+    sb_model o, o2;
+    sb_cut cut;
+    int i, k, E, a, b, n, N, bad = 0, norphan = 0, *pn, *pi, *xof, *orphan;
+    double *pw, *x, *ya, *yb, *ma, *mb, *px, *spx, *mpx, ea = 0, sa = 0, em = 0, sm = 0, rowsum = 0, rowscale = 0;
+    const int NL = SB_CUT_NL, N3 = 3 * SB_CUT_NL;
+    memset(&m, 0, sizeof m); memset(&o, 0, sizeof o); memset(&o2, 0, sizeof o2);
+    if (sb_desc_load(path, &d) || sb_desc_mesh(&d, &m, &src) || sb_build(&d, &m, &o, 1)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
+    d.levels = 2; d.levels_cut = 1;
+    sb_level_desc(&d, &o, &d2);
+    if (sb_level_model(&d, &d2, &m, &o2) || sb_cut_build(&o, &o2, 0.0, &cut)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
+    N = o.nv + cut.nx;
+    /* P's rows over level 1's vertices, from positions on the two grids */
+    xof = malloc(sizeof(int) * (size_t)o2.nv);
+    for (n = 0; n < o2.nv; n++) xof[n] = -1;
+    for (i = 0; i < cut.nx; i++) xof[cut.xv[i]] = o.nv + i;
+    pn = calloc((size_t)o2.nv + 1, sizeof(int)); pi = malloc(sizeof(int) * 8 * (size_t)o2.nv); pw = malloc(sizeof(double) * 8 * (size_t)o2.nv);
+    for (n = 0; n < o2.nv; n++) {
+        double t[3];
+        int g[3], odd = 0;
+        for (k = 0; k < 3; k++) { t[k] = (o2.x[3 * n + k] - o.gorg[k]) / o.c; g[k] = (int)floor(t[k] + 1e-9); t[k] -= g[k]; odd |= fabs(t[k] - 0.5) < 1e-9; }
+        pn[n + 1] = pn[n];
+        if (odd && n >= o2.nf && xof[n] >= 0) { pi[pn[n + 1]] = xof[n]; pw[pn[n + 1]++] = 1; continue; }
+        for (a = 0; a < 8; a++) {
+            int ga[3], v;
+            double w = 1;
+            for (k = 0; k < 3; k++) { ga[k] = g[k] + (a >> k & 1); w *= (a >> k & 1) ? t[k] : 1 - t[k]; }
+            if (w < 1e-12) continue;
+            if ((v = coarse_vertex(&o, ga)) < 0) { pn[n + 1] = pn[n]; pi[pn[n]] = -1; break; }   /* outside level 0: no row */
+            pi[pn[n + 1]] = v; pw[pn[n + 1]++] = w;
+        }
+    }
+    /* the kept level-1 cells in no kept level-0 cell: taken out of level 1's sums */
+    orphan = calloc((size_t)o2.nc, sizeof(int));
+    {
+        int *cellat = malloc(sizeof(int) * (size_t)o.gn[0] * (size_t)o.gn[1] * (size_t)o.gn[2]);
+        for (i = 0; i < o.gn[0] * o.gn[1] * o.gn[2]; i++) cellat[i] = -1;
+        for (E = 0; E < o.nc; E++) cellat[o.cell_grid[E]] = E;
+        for (i = 0; i < o2.nc; i++) {
+            int g[3];
+            const double *x0 = o2.x + 3 * o2.cells[8 * i];
+            for (k = 0; k < 3; k++) g[k] = (int)floor((x0[k] - o.gorg[k]) / o.c + 1e-9);
+            orphan[i] = g[0] < 0 || g[1] < 0 || g[2] < 0 || g[0] >= o.gn[0] - 1 || g[1] >= o.gn[1] - 1 || g[2] >= o.gn[2] - 1 ||
+                        cellat[g[0] + (o.gn[0] - 1) * (g[1] + (o.gn[1] - 1) * g[2])] < 0;
+            norphan += orphan[i];
+        }
+        free(cellat);
+    }
+    x = malloc(sizeof(double) * 3 * (size_t)N); ya = calloc(3 * (size_t)N, sizeof(double)); yb = calloc(3 * (size_t)N, sizeof(double));
+    ma = calloc(3 * (size_t)N, sizeof(double)); mb = calloc(3 * (size_t)N, sizeof(double));
+    px = calloc(3 * (size_t)o2.nv, sizeof(double)); spx = calloc(3 * (size_t)o2.nv, sizeof(double)); mpx = calloc(3 * (size_t)o2.nv, sizeof(double));
+    for (i = 0; i < 3 * N; i++) x[i] = rnd();
+    /* the bake's elements, scattered */
+    for (E = 0; E < o.nc; E++) {
+        int vl[SB_CUT_NL], nl = 8 + cut.cnx[E], r, s;
+        const double *KE = cut.K + (size_t)(N3 * N3) * (size_t)E, *ME = cut.M + (size_t)(NL * NL) * (size_t)E;
+        for (a = 0; a < 8; a++) vl[a] = o.cells[8 * E + a];
+        for (a = 0; a < cut.cnx[E]; a++) vl[8 + a] = o.nv + cut.cx[SB_CUT_MAXX * E + a];
+        for (a = 0; a < nl; a++)
+            for (r = 0; r < 3; r++) {
+                double rs = 0, sc = 0;
+                for (b = 0; b < nl; b++) {
+                    ma[3 * vl[a] + r] += ME[NL * a + b] * x[3 * vl[b] + r];
+                    for (s = 0; s < 3; s++) {
+                        double kk = KE[(size_t)N3 * (size_t)(3 * a + r) + (size_t)(3 * b + s)];
+                        ya[3 * vl[a] + r] += kk * x[3 * vl[b] + s];
+                        rs += kk; sc += fabs(kk);
+                    }
+                }
+                rowsum = fmax(rowsum, fabs(rs)); rowscale = fmax(rowscale, sc);
+            }
+    }
+    /* level 1's assembled matrices through P */
+    for (n = 0; n < o2.nv; n++) {
+        if (pn[n + 1] == pn[n] && pi[pn[n]] == -1) continue;
+        for (k = pn[n]; k < pn[n + 1]; k++) for (a = 0; a < 3; a++) px[3 * n + a] += pw[k] * x[3 * pi[k] + a];
+    }
+    for (n = 0; n < o2.nv; n++)
+        for (k = o2.nbptr[n]; k < o2.nbptr[n + 1]; k++) {
+            int j = o2.nb[k], r, s;
+            for (r = 0; r < 3; r++) {
+                mpx[3 * n + r] += o2.M[k] * px[3 * j + r];
+                for (s = 0; s < 3; s++) spx[3 * n + r] += o2.S[9 * (size_t)k + (size_t)(3 * r + s)] * px[3 * j + s];
+            }
+        }
+    for (i = 0; i < o2.nc; i++) {
+        int r, s;
+        if (!orphan[i]) continue;
+        for (a = 0; a < 8; a++)
+            for (b = 0; b < 8; b++)
+                for (r = 0; r < 3; r++) {
+                    int na = o2.cells[8 * i + a], nb = o2.cells[8 * i + b];
+                    mpx[3 * na + r] -= o2.Me[64 * (size_t)i + (size_t)(8 * a + b)] * px[3 * nb + r];
+                    for (s = 0; s < 3; s++) spx[3 * na + r] -= o2.Se[576 * (size_t)i + (size_t)(24 * (3 * a + r) + 3 * b + s)] * px[3 * nb + s];
+                }
+    }
+    for (n = 0; n < o2.nv; n++) {
+        if (pn[n + 1] == pn[n]) {   /* no row (outside level 0's grid): nothing of its may remain */
+            for (a = 0; a < 3; a++) bad += fabs(spx[3 * n + a]) > 1e-9 || fabs(mpx[3 * n + a]) > 1e-12;
+            continue;
+        }
+        for (k = pn[n]; k < pn[n + 1]; k++)
+            for (a = 0; a < 3; a++) { yb[3 * pi[k] + a] += pw[k] * spx[3 * n + a]; mb[3 * pi[k] + a] += pw[k] * mpx[3 * n + a]; }
+    }
+    for (i = 0; i < 3 * N; i++) {
+        ea = fmax(ea, fabs(ya[i] - yb[i])); sa = fmax(sa, fabs(ya[i]));
+        em = fmax(em, fabs(ma[i] - mb[i])); sm = fmax(sm, fabs(ma[i]));
+    }
+    T_FIGURE("%s: cut level: %d extras, %d level-1 cells outside the kept level-0 cells; sum_E K_E x vs P^T S_1 P x %.2e, mass %.2e "
+             "(of the largest entry of the product); element rows sum to %.2e of the row's |K| sum", path, cut.nx, norphan, ea / sa, em / sm,
+             rowsum / rowscale);
+    /* 1e-12: each product entry sums <= 8 children x 64 corner pairs x 81 weighted terms, in another order than
+     * the assembled route (rounding ~1e-15 relative per term); the rows' null space likewise */
+    T_CHECK(ea <= 1e-12 * sa && em <= 1e-12 * sm, "%s: cut elements vs level 1's assembled Galerkin product: stiffness %g, mass %g (want <= 1e-12)",
+            path, ea / sa, em / sm);
+    T_CHECK(rowsum <= 1e-12 * rowscale, "%s: cut element rows sum to %g of their scale (want <= 1e-12: translations)", path, rowsum / rowscale);
+    T_CHECK(bad == 0, "%s: %d level-1 rows outside level 0's grid kept a stiffness or mass", path, bad);
+    free(x); free(ya); free(yb); free(ma); free(mb); free(px); free(spx); free(mpx); free(pn); free(pi); free(pw); free(xof); free(orphan);
+    sb_cut_free(&cut); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
+}
+
+/* What the cut level cannot carry is refused at bake time, the error naming the 'levels' line (the limb plus
+ * one extra line each; $BUILD/tests/cut_refuse/) */
+static void refusals(void)
+{
+    static const char *extra[3][2] = {{"constraints 4\n", "constraints and contacts"},
+                                      {"adapt 0.03 0.01 10\n", "adaptation"},
+                                      {"colliders 2 8\n", "constraints and contacts"}};
+    const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
+    char d[600], path[700], cmd[1500], want[64];
+    int i, c;
+    snprintf(d, sizeof d, "%s/tests/cut_refuse", b);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp tools/examples/limb/limb.obj '%s/limb.obj'", d, d);
+    if (system(cmd) != 0) { T_CHECK(0, "cannot make %s", d); return; }
+    for (i = 0; i < 3; i++) {
+        FILE *in = fopen("tools/examples/limb/limb.sinew", "r"), *f;
+        sb_model o;
+        sb_blob bl;
+        int line = 1, rc;
+        snprintf(path, sizeof path, "%s/limb%d.sinew", d, i);
+        f = fopen(path, "w");
+        if (!in || !f) { T_CHECK(0, "cannot write %s", path); if (in) fclose(in); if (f) fclose(f); return; }
+        while ((c = fgetc(in)) != EOF) { fputc(c, f); line += c == '\n'; }
+        fclose(in);
+        fputs(extra[i][0], f);
+        fputs("levels 2 cut\n", f);
+        fclose(f);
+        rc = sb_bake_file(path, SB_FIXED, 1, &o, &bl);
+        snprintf(want, sizeof want, ":%d: levels 2 cut: %s", line + 1, extra[i][1]);
+        T_CHECK(rc != 0 && strstr(sb_error(), want) != NULL, "cut level with '%.*s': refused naming the levels line ('%s' in '%s')",
+                (int)strlen(extra[i][0]) - 1, extra[i][0], want, rc ? sb_error() : "baked");
+        if (rc == 0) { sb_model_free(&o); sb_blob_free(&bl); }
+    }
+}
+
+int main(void)
+{
+    (void)t_seed;
+    check("tools/examples/cow/cow.sinew");
+    refusals();
+    return T_END();
+}
