@@ -30,7 +30,7 @@ void sn_m4_cell_row(sn_acc s[3], const struct sn_m4_row *c);
 __asm__(
     ".syntax unified\n"
     ".thumb\n"
-    ".section .text.sn_m4_cell_row,\"ax\",%progbits\n"
+    ".pushsection .text.sn_m4_cell_row,\"ax\",%progbits\n"
     ".align 2\n"
     ".global sn_m4_cell_row\n"
     ".thumb_func\n"
@@ -148,7 +148,7 @@ __asm__(
     "add   sp, sp, #40\n"
     "pop   {r4-r11, pc}\n"
     ".size sn_m4_cell_row, .-sn_m4_cell_row\n"
-    ".text\n");
+    ".popsection\n");
 
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     const uint32_t k0 = (uint32_t)(uintptr_t)K;
