@@ -1,66 +1,171 @@
 /* sn_kernels_m4.c -- Cortex-M4/M7 (ARMv7E-M, DSP extension) kernels of
- * sn_kernels.h, fixed flavour. Plain C written so the compiler keeps the
- * row accumulators in registers and emits one SMLAL per multiply-add
- * (RdLo:RdHi += Rn * Rm, exact 64-bit). Each block is decoded once
- * (LDRSH of the int16 mantissa, LSL by its exponent; the diagonal's int32)
- * and used both ways: row a's three sums stay in registers for the whole
- * row, the transposed block's three go to corner b's sums in memory.
- * The same exact products as the scalar reference, summed in another order
+ * sn_kernels.h, fixed flavour. sn_k_cell_mul's rows in Thumb-2 assembly
+ * (GCC's C spilled the row sums); sn_k_cell_mul2 is sn_kernels.c's C; the
+ * CG dot and axpy in C written for one SMLAL per multiply-add. The same
+ * exact products as the scalar reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_M4)
 
+/* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
+ * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
+ * sums of the rows above): the diagonal block (a,a), then each block (i,j),
+ * j > i, decoded once (LDRSH, LSL by its exponent: m 2^e, |.| < 2^27, exact
+ * in int32) and used both ways, column c at a time: s_r += B_rc b_c (SMLAL)
+ * and corner j's sum t_c += B_rc a_r in r6:r7, loaded and stored once
+ * (LDRD/STRD). a, the pointers and the end live on the stack (GCC's C
+ * spilled the sums: ~100 instructions a block, here 72). The same exact
+ * products as the reference, another order (NUMERICS.md "SIMD kernels"). */
+struct sn_m4_row {
+    const sn_q *ua;         /* 0: u + 3 i (corner j's operand follows) */
+    const uint8_t *fcp;     /* 4: fc + i + 1 */
+    uint32_t m0, e0;        /* 8, 12: block (a,b)'s mantissas at m0 + 18 b, exponent at e0 + b */
+    const unsigned char *d; /* 16: diagonal block (a,a) */
+    sn_acc *lend;           /* 20: l + 3 nf */
+};
+typedef char sn_m4_row_layout_[sizeof(struct sn_m4_row) == 24 ? 1 : -1];
+void sn_m4_cell_row(sn_acc s[3], const struct sn_m4_row *c);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_cell_row,\"ax\",%progbits\n"
+    ".align 2\n"
+    ".global sn_m4_cell_row\n"
+    ".thumb_func\n"
+    ".type sn_m4_cell_row, %function\n"
+    "sn_m4_cell_row:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #40\n"           /* [sp] a0 a1 a2 fcp ub m0 e0 lend s */
+    "str   r0, [sp, #32]\n"
+    "add   lr, r0, #24\n"           /* lb = l + 3 (i + 1) */
+    "ldm   r1, {r2-r7}\n"           /* ua fcp m0 e0 d lend */
+    "str   r3, [sp, #12]\n"
+    "str   r4, [sp, #20]\n"
+    "str   r5, [sp, #24]\n"
+    "str   r7, [sp, #28]\n"
+    "add   r3, r2, #12\n"
+    "str   r3, [sp, #16]\n"         /* ub = ua + 3 */
+    "mov   r10, r6\n"               /* d */
+    "ldm   r2, {r6-r8}\n"           /* a0 a1 a2 */
+    "stm   sp, {r6-r8}\n"
+    "ldm   r0, {r0-r5}\n"           /* s0 s1 s2, lo:hi */
+    "ldr   r12, [r10]\n"            /* diagonal: xx yy zz xy xz yz */
+    "smlal r0, r1, r12, r6\n"
+    "ldr   r12, [r10, #12]\n"
+    "smlal r0, r1, r12, r7\n"
+    "smlal r2, r3, r12, r6\n"
+    "ldr   r12, [r10, #16]\n"
+    "smlal r0, r1, r12, r8\n"
+    "smlal r4, r5, r12, r6\n"
+    "ldr   r12, [r10, #4]\n"
+    "smlal r2, r3, r12, r7\n"
+    "ldr   r12, [r10, #20]\n"
+    "smlal r2, r3, r12, r8\n"
+    "smlal r4, r5, r12, r7\n"
+    "ldr   r12, [r10, #8]\n"
+    "smlal r4, r5, r12, r8\n"
+    "ldr   r12, [sp, #28]\n"
+    "cmp   lr, r12\n"
+    "beq   2f\n"                    /* the last row: no block (i,j) */
+    "1:\n"
+    "ldr   r12, [sp, #12]\n"
+    "ldrb  r9, [r12], #1\n"         /* b = *fcp++ */
+    "str   r12, [sp, #12]\n"
+    "ldr   r12, [sp, #24]\n"
+    "ldrb  r11, [r12, r9]\n"        /* e */
+    "ldr   r12, [sp, #20]\n"
+    "add   r10, r12, r9, lsl #4\n"
+    "add   r10, r10, r9, lsl #1\n"  /* m = m0 + 18 b */
+    "ldr   r12, [sp, #16]\n"
+    "ldr   r9, [r12, #0]\n"        /* b_0 */
+    "ldrd  r6, r7, [lr, #0]\n"     /* t = lb[0] */
+    "ldrsh r8, [r10, #0]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r0, r1, r8, r9\n"
+    "ldr   r12, [sp, #0]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #6]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r2, r3, r8, r9\n"
+    "ldr   r12, [sp, #4]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #12]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r4, r5, r8, r9\n"
+    "ldr   r12, [sp, #8]\n"
+    "smlal r6, r7, r8, r12\n"
+    "strd  r6, r7, [lr, #0]\n"
+    "ldr   r12, [sp, #16]\n"
+    "ldr   r9, [r12, #4]\n"        /* b_1 */
+    "ldrd  r6, r7, [lr, #8]\n"     /* t = lb[1] */
+    "ldrsh r8, [r10, #2]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r0, r1, r8, r9\n"
+    "ldr   r12, [sp, #0]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #8]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r2, r3, r8, r9\n"
+    "ldr   r12, [sp, #4]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #14]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r4, r5, r8, r9\n"
+    "ldr   r12, [sp, #8]\n"
+    "smlal r6, r7, r8, r12\n"
+    "strd  r6, r7, [lr, #8]\n"
+    "ldr   r12, [sp, #16]\n"
+    "ldr   r9, [r12, #8]\n"        /* b_2 */
+    "ldrd  r6, r7, [lr, #16]\n"     /* t = lb[2] */
+    "ldrsh r8, [r10, #4]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r0, r1, r8, r9\n"
+    "ldr   r12, [sp, #0]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #10]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r2, r3, r8, r9\n"
+    "ldr   r12, [sp, #4]\n"
+    "smlal r6, r7, r8, r12\n"
+    "ldrsh r8, [r10, #16]\n"
+    "lsl   r8, r8, r11\n"
+    "smlal r4, r5, r8, r9\n"
+    "ldr   r12, [sp, #8]\n"
+    "smlal r6, r7, r8, r12\n"
+    "strd  r6, r7, [lr, #16]\n"
+    "ldr   r12, [sp, #16]\n"
+    "add   r12, r12, #12\n"
+    "str   r12, [sp, #16]\n"        /* ub += 3 */
+    "add   lr, lr, #24\n"           /* lb += 3 */
+    "ldr   r12, [sp, #28]\n"
+    "cmp   lr, r12\n"
+    "bne   1b\n"
+    "2:\n"
+    "ldr   r12, [sp, #32]\n"
+    "stm   r12, {r0-r5}\n"
+    "add   sp, sp, #40\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_cell_row, .-sn_m4_cell_row\n"
+    ".popsection\n");
+
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
-    uint32_t i, j;
+    const uint32_t k0 = (uint32_t)(uintptr_t)K;
+    struct sn_m4_row c;
+    uint32_t i;
     for (i = 0; i < 3 * nf; i++) l[i] = 0;
+    c.lend = l + 3 * nf;
     for (i = 0; i < nf; i++) {
         const uint32_t a = fc[i];
-        const int32_t ax = u[3 * i], ay = u[3 * i + 1], az = u[3 * i + 2];
-        const unsigned char *d = K + SN_CELLK_DIAG + 24u * a;
-        const int32_t dxx = sn_rd_i32(d), dyy = sn_rd_i32(d + 4), dzz = sn_rd_i32(d + 8);
-        const int32_t dxy = sn_rd_i32(d + 12), dxz = sn_rd_i32(d + 16), dyz = sn_rd_i32(d + 20);
-        /* diagonal block (a,a), symmetric */
-        int64_t s0 = l[3 * i] + (int64_t)dxx * ax + (int64_t)dxy * ay + (int64_t)dxz * az;
-        int64_t s1 = l[3 * i + 1] + (int64_t)dxy * ax + (int64_t)dyy * ay + (int64_t)dyz * az;
-        int64_t s2 = l[3 * i + 2] + (int64_t)dxz * ax + (int64_t)dyz * ay + (int64_t)dzz * az;
-        for (j = i + 1; j < nf; j++) {
-            const uint32_t o = SN_CELLK_OFFIDX(a, fc[j]);
-            const unsigned char *m = K + SN_CELLK_OFF + 18u * o;
-            const int32_t sc = (int32_t)1 << K[SN_CELLK_EXP + o];
-            const int32_t bx = u[3 * j], by = u[3 * j + 1], bz = u[3 * j + 2];
-            sn_acc *lb = l + 3 * j;
-            int32_t B0 = sn_k_rd_i16(m) * sc, B1 = sn_k_rd_i16(m + 2) * sc, B2 = sn_k_rd_i16(m + 4) * sc;
-            int64_t t0 = lb[0], t1 = lb[1], t2 = lb[2];
-            s0 += (int64_t)B0 * bx;
-            s0 += (int64_t)B1 * by;
-            s0 += (int64_t)B2 * bz;
-            t0 += (int64_t)B0 * ax;
-            t1 += (int64_t)B1 * ax;
-            t2 += (int64_t)B2 * ax;
-            B0 = sn_k_rd_i16(m + 6) * sc;
-            B1 = sn_k_rd_i16(m + 8) * sc;
-            B2 = sn_k_rd_i16(m + 10) * sc;
-            s1 += (int64_t)B0 * bx;
-            s1 += (int64_t)B1 * by;
-            s1 += (int64_t)B2 * bz;
-            t0 += (int64_t)B0 * ay;
-            t1 += (int64_t)B1 * ay;
-            t2 += (int64_t)B2 * ay;
-            B0 = sn_k_rd_i16(m + 12) * sc;
-            B1 = sn_k_rd_i16(m + 14) * sc;
-            B2 = sn_k_rd_i16(m + 16) * sc;
-            s2 += (int64_t)B0 * bx;
-            s2 += (int64_t)B1 * by;
-            s2 += (int64_t)B2 * bz;
-            lb[0] = t0 + (int64_t)B0 * az;
-            lb[1] = t1 + (int64_t)B1 * az;
-            lb[2] = t2 + (int64_t)B2 * az;
-        }
-        l[3 * i] = s0;
-        l[3 * i + 1] = s1;
-        l[3 * i + 2] = s2;
+        /* SN_CELLK_OFFIDX(a, b) = base + b = a (13 - a) / 2 - 1 + b >= 0 (b > a) */
+        const uint32_t base = a * (13u - a) / 2u - 1u;
+        c.ua = u + 3 * i;
+        c.fcp = fc + i + 1;
+        c.m0 = k0 + SN_CELLK_OFF + 18u * base;
+        c.e0 = k0 + SN_CELLK_EXP + base;
+        c.d = K + SN_CELLK_DIAG + 24u * a;
+        sn_m4_cell_row(l + 3 * i, &c);
     }
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
 }
