@@ -2,7 +2,7 @@
 #   make ports            Cortex-M4 images (QEMU mps2-an386) + cross determinism drivers
 #   make bench-baremetal  instructions per step on the Cortex-M4, flash/RAM (needs QEMU)
 #   make profile-m4       Cortex-M4 instructions per step per function (QEMU plugin)
-#   make determinism-m4  the full level-of-detail and adaptation runs on the M4 (QEMU, ~1 min)
+#   make determinism-m4  the full level-of-detail, adaptation and cut-level runs on the M4 (QEMU, ~1 min)
 #   make bench-baremetal-level  their instructions per step on each level (qemu -icount, ~70 s)
 #   make deps             install the cross toolchains and QEMU (Debian, root)
 # Inputs from other fragments: SN_SRCS / SN_INC (runtime.mk), the host tool's
@@ -128,10 +128,15 @@ comma := ,
 BM_LEVEL_LOD   = 250:1,500:0,750:1
 BM_SLICE_STEPS = 60
 BM_SLICE_LOD   = 20:1,40:0,50:1
+# the cut level (cow_cut, LEVELS.md §2 "The cut level"): the full run is
+# test_determinism.sh's cut scenario (tests/expected_hashes.txt cut_fixed);
+# its slice has the level slice's steps and switches
+BM_CUT_STEPS   = 200
+BM_LEVEL_CUT   = 100:1,150:0
 $(BM_DIR)/gen/cow_%_blob.c: $(BUILD)/level/cow/%.sinew $(BAKE)
 	@mkdir -p $(dir $@)
 	$(BAKE) $< --c-array $@ --name sinew_cow_$*_blob --quiet
-.SECONDARY: $(BM_DIR)/gen/cow_lod_blob.c $(BM_DIR)/gen/cow_adapt_blob.c
+.SECONDARY: $(BM_DIR)/gen/cow_lod_blob.c $(BM_DIR)/gen/cow_adapt_blob.c $(BM_DIR)/gen/cow_cut_blob.c
 $(BM_DIR)/obj/cow_%_blob.o: $(BM_DIR)/gen/cow_%_blob.c
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
@@ -160,22 +165,27 @@ $(eval $(call bm_level_image,level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0))
 $(eval $(call bm_level_image,level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1))
 $(eval $(call bm_level_image,level_lod_slice,cow_lod,$(BM_SLICE_STEPS),BM_SLICE_LOD,0))
 $(eval $(call bm_level_image,level_adapt_slice,cow_adapt,$(BM_SLICE_STEPS),BM_SLICE_LOD,1))
+$(eval $(call bm_level_image,level_cut,cow_cut,$(BM_CUT_STEPS),BM_LEVEL_CUT,0))
+$(eval $(call bm_level_image,level_cut_slice,cow_cut,$(BM_SLICE_STEPS),BM_SLICE_LOD,0))
 # timed (make bench-baremetal-level): instructions per step on each level
 $(eval $(call bm_level_image,bench_level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0,1))
 $(eval $(call bm_level_image,bench_level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1,1))
+$(eval $(call bm_level_image,bench_level_cut,cow_cut,$(BM_CUT_STEPS),BM_LEVEL_CUT,0,1))
 .PHONY: bench-baremetal-level
-bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf
+bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf $(BM_DIR)/bench_level_cut.elf
 	for i in lod adapt; do echo "== level_$$i (1000 steps, switches $(BM_LEVEL_LOD), qemu -icount shift=0)"; \
 	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_$$i.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)' || exit 1; done
-BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice,$(BM_DIR)/$(i).elf)
+	echo "== level_cut ($(BM_CUT_STEPS) steps, switches $(BM_LEVEL_CUT), qemu -icount shift=0)"; \
+	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_cut.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)'
+BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice level_cut level_cut_slice,$(BM_DIR)/$(i).elf)
 BM_QEMU_ICOUNT = qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
                  -semihosting-config enable=on,target=native -icount shift=0,sleep=off
 .PHONY: print-bm-level determinism-m4
 determinism-m4:   # the full runs alone, against tests/expected_hashes.txt
 	BUILD=$(BUILD) sh ports/baremetal/determinism_m4.sh
 .PHONY: print-bm-level
-print-bm-level:   # for test_determinism.sh: steps and switches of both runs
-	@echo $(BM_STEPS) $(BM_LEVEL_LOD) $(BM_SLICE_STEPS) $(BM_SLICE_LOD)
+print-bm-level:   # for test_determinism.sh: steps and switches of the runs (full, slice, cut)
+	@echo $(BM_STEPS) $(BM_LEVEL_LOD) $(BM_SLICE_STEPS) $(BM_SLICE_LOD) $(BM_CUT_STEPS) $(BM_LEVEL_CUT)
 
 BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bench_limb.elf
 ports-baremetal: $(BM_IMAGES) $(BM_LEVEL_IMAGES)
@@ -281,6 +291,6 @@ TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
                $(if $(shell command -v $(DET_CC_$(d)) 2>/dev/null),$(CROSS_DIR)/det_$(d)))
 ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
 TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf $(BM_DIR)/test_kernels.elf \
-             $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf \
+             $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf $(BM_DIR)/level_cut_slice.elf \
              $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
 endif

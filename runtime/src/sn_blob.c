@@ -28,6 +28,7 @@
  */
 #include "sn_internal.h"
 #include "sn_adapt.h" /* sn_check_adapt, sn_adapt_bytes */
+#include "sn_cut.h"   /* sn_check_cut: CELLX, CELLXK */
 
 static const unsigned char *sn_bytes(const sn_blob *b) {
     return (const unsigned char *)(const void *)b;
@@ -304,42 +305,6 @@ static sn_status sn_check_ichol(const sn_view *v, uint32_t nic) {
         const unsigned char *b = s + (size_t)i * SN_ELEM_ICHOL;
         for (k = 0; k < 9; k++) SN_CHK(sn_rd_u16(b + 2 * k) != 0x8000u, SN_ERR_VALUE);
         SN_CHK(b[18] <= SN_ICHOL_FRAC_MAX && b[19] == 0, SN_ERR_VALUE);
-    }
-    return SN_OK;
-}
-
-/* The cut level (format 6.3; LEVELS.md §2 "The cut level"): CELLXK only with
- * CELLX; per cell at most SN_CUT_MAXX extras, each a skeleton vertex (nF..nV-1:
- * no row, its value from its bone), nx the entries set, first the running sum
- * of 8 nx, ending at CELLXK's count; blocks as CELLK's off-diagonal ones
- * (fixed |m| <= 2^15 - 1, e <= 12; float |entry| <= 2^27), so a cell row with
- * its extras sums 27 blocks of 3 products < 2^55: < 2^61.4 (sn_solve.c). */
-static sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk) {
-    const unsigned char *s = sn_sec(v, SN_SEC_CELLX), *K = sn_sec(v, SN_SEC_CELLXK);
-    uint32_t i, k, first = 0;
-    SN_CHK(ncx != 0 || nxk == 0, SN_ERR_SECTION);
-    for (i = 0; i < ncx; i++) {
-        const unsigned char *c = s + (size_t)i * SN_ELEM_CELLX;
-        uint32_t nx = 0;
-        for (k = 0; k < SN_CUT_MAXX; k++) {
-            uint32_t x = sn_rd_u16(c + 2 * k);
-            if (x == SN_CUT_NONE) continue;
-            SN_CHK(x >= v->nF && x < v->nV, SN_ERR_INDEX);
-            nx++;
-        }
-        SN_CHK(c[38] == nx && c[39] == 0, SN_ERR_VALUE);
-        SN_CHK(sn_rd_u32(c + 40) == first, SN_ERR_INDEX);
-        first += 8u * nx;
-    }
-    SN_CHK(first == nxk, SN_ERR_SECTION);
-    for (i = 0; i < nxk; i++) {
-#if defined(SN_FLOAT)
-        SN_CHK(sn_reals_ok(K + (size_t)i * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES), 9, SN_ENTRY_LIM, 0), SN_ERR_VALUE);
-#else
-        const unsigned char *b = K + (size_t)i * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
-        for (k = 0; k < 9; k++) SN_CHK(sn_rd_u16(b + 2 * k) != 0x8000u, SN_ERR_VALUE);
-        SN_CHK(b[18] <= SN_CELLK_EXP_MAX && b[19] == 0, SN_ERR_VALUE);
-#endif
     }
     return SN_OK;
 }

@@ -1,6 +1,6 @@
 /* sn_embed.c -- outputs: deformed lattice, embedded surface (trilinear in
  * each cell, seed 000 §3.1) and area-weighted normals. */
-#include "sn_instance.h"
+#include "sn_cut.h" /* sn_cut_interp: the cut level's field */
 
 /* ---- outputs ---- */
 
@@ -38,46 +38,6 @@ void sn_trilinear(const uint32_t t[3], sn_q phi[8]) {
     phi[4] = SN_TRI(xy0, z1); phi[5] = SN_TRI(xy1, z1); phi[6] = SN_TRI(xy2, z1); phi[7] = SN_TRI(xy3, z1);
 #endif
 #undef SN_TRI
-}
-
-/* The cut level (CELLX; LEVELS.md §2 "The cut level"): the field in a cell is
- * trilinear in the child (half cell) holding the point, whose corners carry the
- * cell's trilinear field except at an extra skeleton vertex x, which carries
- * its own position: so acc += phi'_k (p_x - P p(x)) for each child corner k at
- * an extra (phi' the child's weights, P p(x) = sum_a (n_a / 8) p_a, n_a the
- * dyadic weights 0, 1, 2, 4, 8 of the cell's corners at that half-cell point).
- * Values: free vertices' in vf, skeleton vertices' (nF..nV-1) in vs. */
-static const uint8_t cut_slot[27] = { /* half-cell point -> its CELLX entry (255: a corner) */
-    255, 0, 255, 1, 2, 3, 255, 4, 255, 5, 6, 7, 8, 9, 10, 11, 12, 13, 255, 14, 255, 15, 16, 17, 255, 18, 255};
-void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]) {
-    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)cell * SN_ELEM_CELLX;
-    const unsigned char *cl = v->sec[SN_SEC_CELLS] + (size_t)cell * SN_ELEM_CELLS;
-    uint32_t b[3], tc[3], k, a, c, dummy = 0, nF = v->nF;
-    sn_q phi[8];
-    for (c = 0; c < 3; c++) {
-        b[c] = t[c] >= 16384u; /* the child: t = 1/2 belongs to the upper one (its weight there is the same) */
-        tc[c] = 2u * t[c] - 32768u * b[c];
-    }
-    sn_trilinear(tc, phi);
-    for (k = 0; k < 8; k++) {
-        uint32_t p0 = b[0] + (k & 1u), p1 = b[1] + (k >> 1 & 1u), p2 = b[2] + (k >> 2 & 1u), slot = cut_slot[p0 + 3 * p1 + 9 * p2], x;
-        sn_acc s8[3] = {0, 0, 0};
-        if (slot == 255u || (x = sn_rd_u16(cx + 2 * slot)) == SN_CUT_NONE) continue;
-        for (a = 0; a < 8; a++) { /* n_a = prod over axes of (a bit ? p : 2 - p), p in 0..2 */
-            uint32_t n = ((a & 1u) ? p0 : 2u - p0) * ((a >> 1 & 1u) ? p1 : 2u - p1) * ((a >> 2 & 1u) ? p2 : 2u - p2);
-            uint32_t vtx = sn_rd_u16(cl + 2 * a);
-            const sn_q *src = vtx < nF ? vf + 3 * vtx : vs + 3 * (vtx - nF);
-            for (c = 0; c < 3; c++) s8[c] += (sn_acc)n * src[c];
-        }
-        for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-            sn_q px = s8[c] * 0.125f;
-#else
-            sn_q px = (sn_q)sn_rshr64(s8[c], 3);
-#endif
-            acc[c] += sn_mul(phi[k], sn_add(vs[3 * (x - nF) + c], -px, &dummy));
-        }
-    }
 }
 
 /* Current position (internal) of surface vertex s: trilinear in its cell

@@ -10,6 +10,7 @@
  *   sn_crease.c    self-collision near creases: list C, detection, rows (seed 003 §3.4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
+ *   sn_cut.c       the cut level: its validation, extras' terms, cut field (sn_cut.h)
  *   sn_constraint.c constraint rows, their factorization and the CG's projection (seed 000 §4.4)
  *   sn_contact.c   the game's colliders -> one-sided contact rows (seed 003 eq. 9)
  *   sn_step.c      the step: the stages in order
@@ -81,9 +82,6 @@ typedef char sn_adapt_state_fits_[sizeof(sn_adapt_state) == SN_ADAPT_STATE_BYTES
 SN_INLINE sn_adapt_state *sn_ad(const sn_ihdr *h) {
     return (sn_adapt_state *)(void *)((unsigned char *)(uintptr_t)h + h->v.instance_bytes);
 }
-
-/* the cut level's correction to the trilinear field in a cell (sn_embed.c; LEVELS.md §2 "The cut level") */
-void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]);
 
 typedef char sn_ihdr_fits_[sizeof(sn_ihdr) <= SN_HDR_BYTES ? 1 : -1];
 

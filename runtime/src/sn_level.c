@@ -11,6 +11,7 @@
 #include "sn_blended.h" /* SN_VIEW_BLENDED */
 #include "sn_instance.h"
 #include "sn_adapt.h"
+#include "sn_cut.h" /* sn_cut_interp */
 
 uint32_t sn_level_sec_count(const sn_view *v, int sec) {
     return sn_rd_u32(v->base + SN_H_SECTIONS + (size_t)sec * SN_SECTION_ENTRY + 8);
@@ -140,7 +141,7 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level) {
                 const sn_q *src = vtx < nfsrc ? Sf + 3 * vtx : Ss + 3 * (vtx - nfsrc);
                 for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], src[k]);
             }
-            if (h->v.cut) sn_cut_interp(&h->v, sn_rd_u16(e), t, Sf, Ss, acc); /* from the cut level: its field (sn_embed.c) */
+            if (h->v.cut) sn_cut_interp(&h->v, sn_rd_u16(e), t, Sf, Ss, acc); /* from the cut level: its field (sn_cut.c) */
             /* convex weights: no result exceeds its sources (the conversion never clamps; the cut level's may, counted) */
             for (k = 0; k < 3; k++) val[3 * i + k] = sn_out(acc[k], SN_Q_ROT, &sat);
         }

@@ -14,6 +14,7 @@
 #include "sn_blended.h" /* sn_rhs and the CG arithmetic, shared with the blended mode */
 #include "sn_kernels_rot.h" /* sn_k_rot_t, sn_k_rot, sn_k_rot_acc: the frame rotations, reference or SIMD */
 #include "sn_adapt.h"   /* the active set of level 1 (seed 000 §4.7) */
+#include "sn_cut.h"     /* the cut level's extras (sn_cut_terms) */
 
 SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[0] += sn_mul(m, e[0]);
@@ -66,50 +67,6 @@ SN_INLINE sn_q w_at(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a
     return a < h->v.nF ? w[3 * a + c] : coef(vel[3 * a + c], h->v.b1, &counted);
 }
 
-/* The cut level (CELLX, format 6.3; LEVELS.md §2 "The cut level"): cell e's
- * extra skeleton vertices x enter its free corners' rows through the cut
- * element's blocks [corner x extra]: lx_a = sum_x K_ax (d_x + u_x), d_x and
- * u_x formed as a corner's (relative to corner 0, in the cell's frame). The
- * extras' own rows are the skeleton's (no unknowns), so the energy stat keeps
- * the corner block's d.K d. Bound: 19 x 3 more products < 2^55 per row. */
-static void cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], const sn_q *w, uint32_t fr,
-                      sn_acc lx[24], uint32_t *sat) {
-    const sn_view *v = &h->v;
-    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX, *rest = v->sec[SN_SEC_REST];
-    const unsigned char *K = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
-    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    uint32_t j, a, c, i;
-    for (i = 0; i < 24; i++) lx[i] = 0;
-    for (j = 0; j < SN_CUT_MAXX; j++) {
-        uint32_t x = sn_rd_u16(cx + 2 * j);
-        sn_q t[3], sw[3], l[3], uu[3], y[3];
-        if (x == SN_CUT_NONE) continue;
-        for (c = 0; c < 3; c++) {
-            t[c] = sn_add(pos[3 * x + c], -pos[3 * a0 + c], sat);
-            sw[c] = sn_add(w_at(h, w, vel, x, c), -w0[c], sat);
-        }
-        sn_k_rot_t(R, t, l, sat);
-        sn_k_rot_t(R, sw, uu, sat);
-        for (c = 0; c < 3; c++) {
-            sn_q xr = sn_add(rd_real(rest, 3 * x + c), -rd_real(rest, 3 * a0 + c), sat);
-            y[c] = sn_add(sn_add(l[c], -xr, sat), uu[c], sat);
-        }
-        for (a = 0; a < 8; a++, K += SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES)) {
-            if (!(fr >> a & 1u)) continue;
-            for (i = 0; i < 3; i++)
-                for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-                    sn_q m = rd_real(K, 3 * i + c);
-#else
-                    sn_q m = (sn_q)((int32_t)(int16_t)sn_rd_u16(K + 2 * (3 * i + c)) * ((int32_t)1 << K[18]));
-#endif
-                    lx[3 * a + i] += sn_mul(m, y[c]);
-                }
-        }
-    }
-    for (i = 0; i < 24; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
-}
-
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
  * acc_a = sum_e R_e S^_e (d_e + R_e^T (w - w_a0))_a over free corners, and twice
  * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per free vertex. */
@@ -146,7 +103,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
             }
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
-        if (v->cut) cut_terms(h, e, R, a0, w0, w, fr, lx, sat);
+        if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, lx, sat); /* the cut level (sn_cut.c) */
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {

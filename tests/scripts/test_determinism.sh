@@ -10,8 +10,8 @@
 # and sinew-play-float).
 # The crease, level-of-detail and adaptation scenarios run on every hosted
 # platform too (adaptation as a shared instance: sn_step_with's workspace);
-# the level-of-detail and adaptation ones on the Cortex-M4 too (in full under
-# `make determinism`, a slice compared with x86-64 in `make test`).
+# the level-of-detail, adaptation and cut-level ones on the Cortex-M4 too (in
+# full under `make determinism`, a slice compared with x86-64 in `make test`).
 # Every platform must also give the hash committed in tests/expected_hashes.txt
 # (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
@@ -57,18 +57,20 @@ if ! sel cortex-m4-qemu; then :
 elif ! have arm-none-eabi-gcc; then skip "cortex-m4: no arm-none-eabi-gcc (make deps)"
 elif ! have qemu-system-arm; then skip "cortex-m4: no qemu-system-arm (make deps)"
 else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; m4=1; fi
-# the level-of-detail and adaptation scenarios on the Cortex-M4 (issue 13,
-# ports/baremetal/main_level.c, the cow_lod / cow_adapt C arrays): the full
-# 1000 steps in `make determinism` (QEMU: ~16 s lod + ~46 s adapt), checked
+# the level-of-detail, adaptation and cut-level scenarios on the Cortex-M4
+# (issue 13, ports/baremetal/main_level.c, the cow_lod / cow_adapt / cow_cut C
+# arrays): the full runs in `make determinism` (QEMU: ~16 s lod + ~46 s adapt
+# + ~2 s cut, whose run is CUT_STEPS/CUT_SW below), checked
 # with every other platform and tests/expected_hashes.txt; in the slice a
 # short run with earlier switches (print-bm-level) whose hash must equal an
 # x86-64 det_main's of the same run, made here (a cross-platform identity).
 m4lvl=""
 if [ -n "${m4:-}" ] && [ -n "$clip_arg" ]; then
-    if [ "${DET_SET:-slice}" = full ]; then m4lvl="level_lod level_adapt"; else m4lvl="level_lod_slice level_adapt_slice"; fi
+    if [ "${DET_SET:-slice}" = full ]; then m4lvl="level_lod level_adapt level_cut"
+    else m4lvl="level_lod_slice level_adapt_slice level_cut_slice"; fi
 elif [ -n "${m4:-}" ]; then skip "cortex-m4 level of detail: the images play $COW_CLIP, which is missing"; fi
 # shellcheck disable=SC2046
-set -- $(pmake print-bm-level); M4_STEPS=$1; M4_SW=$2; M4_SLICE_STEPS=$3; M4_SLICE_SW=$4
+set -- $(pmake print-bm-level); M4_STEPS=$1; M4_SW=$2; M4_SLICE_STEPS=$3; M4_SLICE_SW=$4; M4_CUT_STEPS=$5; M4_CUT_SW=$6
 want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
 # clang cross: needs the cross gcc for headers, crt files and libgcc
 if have clang; then want mips-be-clang-O2 mips-linux-gnu-gcc qemu-mips; else skip "mips-be-clang-O2: no clang"; fi
@@ -226,6 +228,8 @@ case $m4lvl in *_slice*)
             --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only
         launch "$L/rc_m4ref_adapt" "$L/run_m4ref_adapt.log" "$D/det_$m4ref" "$BUILD/level/cow_adapt.blob" \
             --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only --shared
+        launch "$L/rc_m4ref_cut" "$L/run_m4ref_cut.log" "$D/det_$m4ref" "$BUILD/level/cow_cut.blob" \
+            --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only
     else bad "cortex-m4 level slice: no x86-64 det_main built to compare with"; fi ;;
 esac
 # the desktop players: the crease and the cow (fixed: the blob file of the
@@ -291,9 +295,11 @@ EOF2
 # the Cortex-M4 level runs: the image's own checks (bm_level_check), then
 # its hash joins the full run's lists, or must equal the x86-64 slice's
 case $m4lvl in level_lod*) [ "$M4_SW" = "$LOD_SW" ] || bad "cortex-m4: BM_LEVEL_LOD $M4_SW (baremetal.mk) is not LOD_SW $LOD_SW" ;; esac
+case " $m4lvl " in *" level_cut "*) [ "$M4_CUT_SW" = "$CUT_SW" ] && [ "$M4_CUT_STEPS" = "$CUT_STEPS" ] || \
+    bad "cortex-m4: BM_CUT_STEPS/BM_LEVEL_CUT $M4_CUT_STEPS $M4_CUT_SW (baremetal.mk) are not CUT_STEPS/CUT_SW $CUT_STEPS $CUT_SW" ;; esac
 for i in $m4lvl; do
-    case $i in level_adapt*) sc=adapt; ad=1; ;; *) sc=lod; ad=0 ;; esac
-    case $i in *_slice) sw=$M4_SLICE_SW; n=$M4_SLICE_STEPS ;; *) sw=$M4_SW; n=$M4_STEPS ;; esac
+    case $i in level_adapt*) sc=adapt; ad=1; ;; level_cut*) sc=cut; ad=0 ;; *) sc=lod; ad=0 ;; esac
+    case $i in *_slice) sw=$M4_SLICE_SW; n=$M4_SLICE_STEPS ;; level_cut) sw=$M4_CUT_SW; n=$M4_CUT_STEPS ;; *) sw=$M4_SW; n=$M4_STEPS ;; esac
     [ -f "$L/rc_m4_$i" ] || continue   # build failed: reported above
     if rc_ok "$L/rc_m4_$i" && h=$(hash_of "$L/run_m4_$i.log") && [ -n "$h" ]; then
         echo "determinism: $sc cortex-m4-qemu $h ($n steps, switches $sw, $(cut -d' ' -f2 "$L/rc_m4_$i")s)"
@@ -301,6 +307,7 @@ for i in $m4lvl; do
         case $i in
             level_lod) lodfixed="${lodfixed}cortex-m4-qemu $h
 " ;;        level_adapt) adfixed="${adfixed}cortex-m4-qemu $h
+" ;;        level_cut) cutfixed="${cutfixed}cortex-m4-qemu $h
 " ;;        *) if rc_ok "$L/rc_m4ref_$sc" && r=$(hash_of "$L/run_m4ref_$sc.log") && [ -n "$r" ]; then
                    if [ "$h" = "$r" ]; then ok "cortex-m4 $i: hash $h = $m4ref det_main's ($n steps, switches $sw)"
                    else bad "cortex-m4 $i: hash $h, $m4ref det_main $r ($n steps, switches $sw)"; fi

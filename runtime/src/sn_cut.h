@@ -1,0 +1,24 @@
+/* sn_cut.h -- the cut level (CELLX, CELLXK; format 6.3; LEVELS.md §2
+ * "The cut level"), internal: level 0's cells cut at level 1's skeleton,
+ * whose vertices are extra skeleton vertices of the cell (sn_cut.c).
+ */
+#ifndef SN_CUT_H
+#define SN_CUT_H
+
+#include "sn_instance.h"
+
+/* Validator (sn_blob.c): CELLX (ncx entries) and CELLXK (nxk blocks). */
+sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk);
+
+/* Step 4 (sn_solve.c cell_forces): cell e's extras' terms lx (24 rows, the
+ * cell product's scale) for its free corners fr (bit a: corner a free);
+ * R the cell frame, a0 its corner 0, w0 w at a0. */
+void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
+                  sn_acc lx[24], uint32_t *sat);
+
+/* Outputs and the level switch (sn_embed.c, sn_level.c): the correction to
+ * the trilinear field in a cell at t (Q15); free vertices' values in vf,
+ * skeleton vertices' (nF..nV-1) in vs. */
+void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]);
+
+#endif /* SN_CUT_H */
