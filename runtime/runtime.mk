@@ -63,7 +63,7 @@ $(BUILD)/tests/test_runtime_$(1): tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN
 	$(CC) $(SN_TCFLAGS) $(SN_TCFLAGS_$(1)) -o $$@ $$< $(SN_LIB_FIXED) -lm
 $(BUILD)/tests/test_runtime_$(1)_float: tests/test_runtime_$(1).c $(SN_TEST_HDRS) $(SN_LIB_FLOAT)
 	@mkdir -p $$(@D)
-	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $$@ $$< $(SN_LIB_FLOAT) -lm
+	$(CC) $(SN_TCFLAGS) $(SN_TCFLAGS_$(1)) -DSN_FLOAT -o $$@ $$< $(SN_LIB_FLOAT) -lm
 endef
 $(foreach t,$(SN_TESTS),$(eval $(call SN_TEST_RULE,$(t))))
 TEST_BINS += $(foreach t,$(SN_TESTS),$(BUILD)/tests/test_runtime_$(t) $(BUILD)/tests/test_runtime_$(t)_float)

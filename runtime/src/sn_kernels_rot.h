@@ -14,7 +14,8 @@
  * shift by 30 minus 2^32 is floor((x + 2^29) / 2^30), sn_rshr64's value;
  * then the same clamp and count. NEON: below. Same integers as the
  * reference (exact products, one rounding per output). Other paths: the
- * reference (the M4: narrowed to int32 before its clamp, below). */
+ * reference (the M4: narrowed to int32 before its clamp, below). Float:
+ * AVX2 and aarch64 by sn_kernels_fsimd.h's lanes, the reference's bits. */
 #ifndef SN_KERNELS_ROT_H
 #define SN_KERNELS_ROT_H
 
@@ -128,6 +129,26 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
         out[k] = sn_k_rot_out1(sn_mul(R[3 * k], v[0]) + sn_mul(R[3 * k + 1], v[1]) + sn_mul(R[3 * k + 2], v[2]), sat);
 }
 #define sn_k_rot_acc sn_rot_acc
+
+#elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#include "sn_kernels_fsimd.h"
+/* Float (sn_kernels_fsimd.h): lane k is the reference's output k, the
+ * same operations in the same order, through sn_out's clamp and count. */
+SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_fv r[3];
+    fv_rows(R, r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 */
+    fv_st3(out, fv_out3(FV_MAC3(r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_fv c[3];
+    fv_cols(R, c); /* lane k: R[3k] v0 + R[3k+1] v1 + R[3k+2] v2 */
+    fv_st3(out, fv_out3(FV_MAC3(c, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
+    sn_fv c[3];
+    fv_cols(R, c);
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(c, FV_SET1(t[0]), FV_SET1(t[1]), FV_SET1(t[2]))));
+}
 #else
 #define sn_k_rot_t sn_rot_t
 #define sn_k_rot sn_rot
