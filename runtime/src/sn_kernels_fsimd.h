@@ -25,6 +25,7 @@ typedef __m128 sn_fv;
 #define FV_SET1(x) _mm_set1_ps(x)
 #define FV_ADD(a, b) _mm_add_ps((a), (b))
 #define FV_MUL(a, b) _mm_mul_ps((a), (b))
+#define FV_SUB(a, b) _mm_sub_ps((a), (b))
 #define FV_LD4(p) _mm_loadu_ps((const float *)(const void *)(p))
 #define FV_ST4(p, v) _mm_storeu_ps((float *)(void *)(p), (v))
 SN_INLINE sn_fv fv_ld3(const float *p) { return _mm_maskload_ps(p, _mm_setr_epi32(-1, -1, -1, 0)); }
@@ -73,6 +74,7 @@ typedef float32x4_t sn_fv;
 #define FV_SET1(x) vdupq_n_f32(x)
 #define FV_ADD(a, b) vaddq_f32((a), (b))
 #define FV_MUL(a, b) vmulq_f32((a), (b))
+#define FV_SUB(a, b) vsubq_f32((a), (b))
 #define FV_LD4(p) vld1q_f32((const float *)(const void *)(p))
 #define FV_ST4(p, v) vst1q_f32((float *)(void *)(p), (v))
 SN_INLINE sn_fv fv_ld3(const float *p) { return vcombine_f32(vld1_f32(p), vld1_dup_f32(p + 2)); }

@@ -82,36 +82,35 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
-        sn_q d[24], uu[24], w0[3];
+        sn_q d[24], uu[24], w0[3], x0[3];
         sn_acc ld[24], lu[24], ec = 0;
         uint32_t fr = 0; /* the free corners: lu's rows read below */
         for (c = 0; c < 3; c++) w0[c] = w_at(h, w, vel, a0, c);
+        for (c = 0; c < 3; c++) x0[c] = rd_real(rest, 3 * a0 + c);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], s[3], l[3];
+            sn_q t[3], s[3], l[3], wa[3], xa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
             for (c = 0; c < 3; c++) {
-                t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
-                s[c] = sn_add(w_at(h, w, vel, a, c), -w0[c], sat);
+                wa[c] = w_at(h, w, vel, a, c);
+                xa[c] = rd_real(rest, 3 * a + c);
             }
+            sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
+            sn_k_sub3(wa, w0, s, sat);
             sn_k_rot_t(R, t, l, sat);
             sn_k_rot_t(R, s, uu + 3 * k, sat);
-            for (c = 0; c < 3; c++) {
-                sn_q xr = sn_add(rd_real(rest, 3 * a + c), -rd_real(rest, 3 * a0 + c), sat);
-                d[3 * k + c] = sn_add(l[c], -xr, sat);
-            }
+            sn_k_sub3(xa, x0, xr, sat);
+            sn_k_sub3(l, xr, d + 3 * k, sat);
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3];
-            int sh;
+            sn_acc ls[3];
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
-            sh = v->frac_S - SN_KREL(kk[a]);
-            for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c], sh, sat);
-            sn_k_rot_acc(acc + 3 * a, R, t);
+            for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c];
+            sn_k_out_rot_acc(acc + 3 * a, R, ls, v->frac_S - SN_KREL(kk[a]), sat); /* R round(ld + lu) */
         }
     }
 }
@@ -226,7 +225,7 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
 SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
                           const sn_q *d, sn_acc *acc, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t k, c, vi[8], nf = 0, nF = h->v.nF;
+    uint32_t k, vi[8], nf = 0, nF = h->v.nF;
     sn_q u[24];
     sn_acc l[24];
     uint8_t fc[8];
@@ -241,10 +240,7 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_k_cell_mul(K, fc, nf, u, l);
     for (k = 0; k < nf; k++) {
         uint32_t a = vi[k];
-        sn_q t[3];
-        int sh = h->v.frac_S - SN_KREL(kk[a]);
-        for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-        sn_k_rot_acc(acc + 3 * a, R, t);
+        sn_k_out_rot_acc(acc + 3 * a, R, l + 3 * k, h->v.frac_S - SN_KREL(kk[a]), sat); /* R round(l) */
     }
 }
 
@@ -264,23 +260,17 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint
     const sn_q *cR = CARR(h, o_cR, sn_q);
     sn_acc *acc = WARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t e, i, k, nF = v->nF;
+    uint32_t e, i, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
-    for (i = 0; i < 3 * nF; i++) {
+    for (i = 0; i < 3 * nF; i++)
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
-        q[i] = sn_out(acc[i], SN_Q_ROT, sat);
-    }
+    sn_k_outv(q, acc, 3 * nF, SN_Q_ROT, sat); /* sn_kernels_rot.h */
     pass_M_ff(h, d, mask, acc);
-    for (i = 0; i < nF; i++)
-        for (k = 0; k < 3; k++) {
-            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
-            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
-            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
-        }
+    sn_k_mix(q, acc, kk, 3 * nF, v->frac_M, ck, cm, sat); /* q = (1+b1) q + (1+a1) M^ d */
 }
 
 /* ---- CG scalars ---- */
