@@ -387,6 +387,87 @@ static void test_axpy(void) {
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", clamps);
 }
 
+/* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
+ * sn_k_sym_out, sn_k_out_rot_acc, sn_k_outv, sn_k_mix) against the
+ * formulas written here with sn_out/sn_add/sn_mul (sn_internal.h, the
+ * reference arithmetic): bit for bit with the same clamp counts. Float:
+ * values past SN_FLIM and NaNs included (every path must clamp and count
+ * them alike); fixed: values up to the state bound, shifts 0..30. */
+static sn_q rnd_val(int wild) {
+#if defined(SN_FLOAT)
+    if (wild && rnd32() % 16u == 0) return nanf("");
+    return (float)rnd_in(1 << 20) * (wild ? 0.01f : 0.001f);
+#else
+    return wild ? rnd_in(1 << 28) : rnd_in(1 << 24);
+#endif
+}
+static sn_acc rnd_acc(int wild) {
+#if defined(SN_FLOAT)
+    return rnd_val(wild);
+#else
+    return (int64_t)rnd_in(1 << 30) * (wild ? (1 << 26) : (1 << 12));
+#endif
+}
+static void test_loops(void) {
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        int wild = t % 4 == 0, sh = (int)(rnd32() % 31u), k;
+        sn_q x[3], y[3], o1[3], o2[3], R[9], q1[40], q2[40], ck = rnd_val(0), cm = rnd_val(0);
+        sn_acc ya[3], a1[3], a2[3], l[3], in[40];
+        unsigned char D[24];
+        uint8_t kk[14];
+        uint32_t s1 = 0, s2 = 0, n = rnd32() % 41u, i;
+#if defined(SN_FLOAT)
+        ck *= 0.001f; /* |q ck| mostly inside SN_FLIM */
+        cm *= 0.001f;
+#endif
+        for (k = 0; k < 3; k++) { x[k] = rnd_val(wild); y[k] = rnd_val(wild); ya[k] = rnd_acc(wild); l[k] = rnd_acc(wild); a1[k] = a2[k] = rnd_acc(0); }
+        for (k = 0; k < 9; k++) R[k] = rnd_val(0);
+        for (k = 0; k < 6; k++) {
+            sn_q d = rnd_val(0);
+            memcpy(D + 4 * k, &d, 4); /* little-endian hosts (the SIMD paths') */
+        }
+        for (k = 0; k < 14; k++) kk[k] = (uint8_t)(rnd32() % 4u);
+        for (i = 0; i < n; i++) { in[i] = rnd_acc(wild); q1[i] = q2[i] = rnd_val(wild); }
+        sn_k_sub3(x, y, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        memcpy(o1, x, sizeof x);
+        sn_k_sub3a(o1, ya, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_sym_out(D, x, o1, sh, &s1);
+        {
+            sn_q xx = rd_real(D, 0), yy = rd_real(D, 1), zz = rd_real(D, 2), xy = rd_real(D, 3), xz = rd_real(D, 4), yz = rd_real(D, 5);
+            sn_acc m[3] = {0, 0, 0};
+            m[0] += sn_mul(xx, x[0]) + sn_mul(xy, x[1]) + sn_mul(xz, x[2]);
+            m[1] += sn_mul(xy, x[0]) + sn_mul(yy, x[1]) + sn_mul(yz, x[2]);
+            m[2] += sn_mul(xz, x[0]) + sn_mul(yz, x[1]) + sn_mul(zz, x[2]);
+            for (k = 0; k < 3; k++) o2[k] = sn_out(m[k], sh, &s2);
+        }
+        bad += (memcmp(o1, o2, sizeof o1) != 0 && x[0] == x[0] && x[1] == x[1] && x[2] == x[2]) || s1 != s2;
+        sn_k_out_rot_acc(a1, R, l, sh, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_out(l[k], sh, &s2);
+        sn_rot_acc(a2, R, o2);
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        sn_k_outv(q1, in, n, sh, &s1);
+        for (i = 0; i < n; i++) q2[i] = sn_out(in[i], sh, &s2);
+        bad += memcmp(q1, q2, n * sizeof q1[0]) != 0 || s1 != s2;
+        for (i = 0; i < n; i++) q1[i] = q2[i] = rnd_val(wild);
+        sn_k_mix(q1, in, kk, n, sh + 8, ck, cm, &s1);
+        for (i = 0; i < n; i++) {
+            sn_q mk = sn_out(in[i], sh + 8 - SN_KREL(kk[i / 3]), &s2);
+            sn_acc m = sn_mul(q2[i], ck) + sn_mul(mk, cm);
+            q2[i] = sn_out(m, SN_Q_COEF, &s2);
+        }
+        bad += memcmp(q1, q2, n * sizeof q1[0]) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "loop helpers (path %s): %d of 24000 results or clamp counts off the reference formulas", sn_kernels_name(), bad);
+    T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -457,5 +538,6 @@ int main(void) {
     test_ic();
     test_rot();
     test_axpy();
+    test_loops();
     return T_END();
 }
