@@ -28,8 +28,16 @@ typedef __m128 sn_fv;
 #define FV_SUB(a, b) _mm_sub_ps((a), (b))
 #define FV_LD4(p) _mm_loadu_ps((const float *)(const void *)(p))
 #define FV_ST4(p, v) _mm_storeu_ps((float *)(void *)(p), (v))
-SN_INLINE sn_fv fv_ld3(const float *p) { return _mm_maskload_ps(p, _mm_setr_epi32(-1, -1, -1, 0)); }
-SN_INLINE void fv_st3(float *p, sn_fv v) { _mm_maskstore_ps(p, _mm_setr_epi32(-1, -1, -1, 0), v); }
+SN_INLINE sn_fv fv_ld3(const float *p) { /* MOVSD + MOVSS (no masked load: see fv_st3) */
+    return _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)p)), _mm_load_ss(p + 2));
+}
+/* lanes 0-1 by MOVLPS, lane 2 by EXTRACTPS (VMASKMOVPS stores are
+ * microcoded and slow on AMD Zen) */
+SN_INLINE void fv_st3(float *p, sn_fv v) {
+    const int z = _mm_extract_ps(v, 2);
+    _mm_storel_pi((__m64 *)(void *)p, v);
+    memcpy(p + 2, &z, 4);
+}
 /* rows and columns of a row-major 3x3 from v0 = B0..B7, v1 = B1..B8 */
 #define FV_PERM(v, a, b, c) _mm256_castps256_ps128(_mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, 0, 0, 0, 0)))
 SN_INLINE void fv_rows8(__m256 v0, __m256 v1, sn_fv r[3]) {
