@@ -388,7 +388,7 @@ static void test_axpy(void) {
 }
 
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
- * sn_k_sym_out, sn_k_out_rot_acc, sn_k_outv, sn_k_mix) against the
+ * sn_k_add3, sn_k_coef3, sn_k_sub3r, sn_k_sym_out, sn_k_out_rot_acc, sn_k_outv, sn_k_mix) against the
  * formulas written here with sn_out/sn_add/sn_mul (sn_internal.h, the
  * reference arithmetic): bit for bit with the same clamp counts. Float:
  * values past SN_FLIM and NaNs included (every path must clamp and count
@@ -433,6 +433,20 @@ static void test_loops(void) {
         sn_k_sub3(x, y, o1, &s1);
         for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
         bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_add3(x, y, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_coef3(x, ck, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_mulq(x[k], ck, SN_Q_COEF, &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        {
+            unsigned char sec[24];
+            memcpy(sec, x, 12); /* little-endian hosts (the SIMD paths') */
+            memcpy(sec + 12, y, 12);
+            sn_k_sub3r(sec, 0, 3, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(rd_real(sec, (uint32_t)k), -rd_real(sec, 3u + (uint32_t)k), &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        }
         memcpy(o1, x, sizeof x);
         sn_k_sub3a(o1, ya, &s1);
         for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
@@ -464,7 +478,7 @@ static void test_loops(void) {
         bad += memcmp(q1, q2, n * sizeof q1[0]) != 0 || s1 != s2;
         clamps += s2;
     }
-    T_CHECK(bad == 0, "loop helpers (path %s): %d of 24000 results or clamp counts off the reference formulas", sn_kernels_name(), bad);
+    T_CHECK(bad == 0, "loop helpers (path %s): %d of 36000 results or clamp counts off the reference formulas", sn_kernels_name(), bad);
     T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", clamps);
 }
 

@@ -159,6 +159,8 @@ SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
  *   sn_k_out_rot_acc(acc, R, l, sh, sat): t = sn_out(l, sh) per entry, acc += R t
  *   sn_k_sub3(x, y, out, sat): out = sn_add(x, -y) per entry
  *   sn_k_sub3a(x, y, sat): x = sn_out(x - y, 0) per entry (y accumulators)
+ *   sn_k_add3(x, y, out, sat): out = sn_add(x, y); sn_k_coef3(x, c, out, sat): out = coef(x, c)
+ *   sn_k_sub3r(sec, ia, ib, out, sat): out = sn_add(real ia + c, -real ib + c) of a blob section
  *   sn_k_sym_out(b, e, out, sh, sat): out = sn_out(0 + D e, sh), D the
  *     symmetric block of 6 reals at b (xx yy zz xy xz yz; sn_precond.c)
  * Float SIMD paths: lanes as in sn_kernels_fsimd.h (the same floats and
@@ -183,6 +185,16 @@ SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t
 }
 SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     fv_st3(x, fv_out3(FV_SUB(fv_ld3(x), fv_ld3(y)), sat));
+}
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_ADD(fv_ld3(x), fv_ld3(y)), sat));
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)sec; /* float blob reals, little-endian host */
+    fv_st3(out, fv_out3(FV_ADD(fv_ld3(f + ia), SN_K_NEG(fv_ld3(f + ib))), sat));
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_MUL(fv_ld3(x), FV_SET1(c)), sat));
 }
 /* the symmetric block's columns (xx xy xz) (xy yy yz) (xz yz zz) */
 SN_INLINE void sn_k_sym_cols(const unsigned char *b, sn_fv c[3]) {
@@ -218,6 +230,21 @@ SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t
     out[0] = sn_add(x[0], -y[0], sat);
     out[1] = sn_add(x[1], -y[1], sat);
     out[2] = sn_add(x[2], -y[2], sat);
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    out[0] = sn_add(rd_real(sec, ia), -rd_real(sec, ib), sat);
+    out[1] = sn_add(rd_real(sec, ia + 1), -rd_real(sec, ib + 1), sat);
+    out[2] = sn_add(rd_real(sec, ia + 2), -rd_real(sec, ib + 2), sat);
+}
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    out[0] = sn_add(x[0], y[0], sat);
+    out[1] = sn_add(x[1], y[1], sat);
+    out[2] = sn_add(x[2], y[2], sat);
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    out[0] = coef(x[0], c, sat);
+    out[1] = coef(x[1], c, sat);
+    out[2] = coef(x[2], c, sat);
 }
 SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     x[0] = sn_out((sn_acc)x[0] - y[0], 0, sat);

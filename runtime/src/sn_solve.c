@@ -58,12 +58,14 @@ SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
 #define E_Q32(x) sn_rshr64((x), 12)
 #endif
 
-/* w of corner a, component c: stored for free vertices ((1+b1) v), b1 v'
- * for skeleton ones, computed here as rhs would have stored it (the same
- * product; its clamps are counted once in rhs). */
-SN_INLINE sn_q w_at(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, uint32_t c) {
+/* w at corner a: stored for free vertices ((1+b1) v), b1 v' for skeleton
+ * ones, computed into tmp as rhs would have stored it (the same product;
+ * its clamps are counted once in rhs). */
+SN_INLINE const sn_q *w_of(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, sn_q tmp[3]) {
     uint32_t counted = 0;
-    return a < h->v.nF ? w[3 * a + c] : coef(vel[3 * a + c], h->v.b1, &counted);
+    if (a < h->v.nF) return w + 3 * a;
+    sn_k_coef3(vel + 3 * a, h->v.b1, tmp, &counted);
+    return tmp;
 }
 
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
@@ -82,24 +84,19 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
-        sn_q d[24], uu[24], w0[3], x0[3];
+        sn_q d[24], uu[24], w0s[3];
         sn_acc ld[24], lu[24], ec = 0;
         uint32_t fr = 0; /* the free corners: lu's rows read below */
-        for (c = 0; c < 3; c++) w0[c] = w_at(h, w, vel, a0, c);
-        for (c = 0; c < 3; c++) x0[c] = rd_real(rest, 3 * a0 + c);
+        const sn_q *w0 = w_of(h, w, vel, a0, w0s);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], s[3], l[3], wa[3], xa[3], xr[3];
+            sn_q t[3], s[3], l[3], wa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
-            for (c = 0; c < 3; c++) {
-                wa[c] = w_at(h, w, vel, a, c);
-                xa[c] = rd_real(rest, 3 * a + c);
-            }
             sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
-            sn_k_sub3(wa, w0, s, sat);
+            sn_k_sub3(w_of(h, w, vel, a, wa), w0, s, sat);
             sn_k_rot_t(R, t, l, sat);
             sn_k_rot_t(R, s, uu + 3 * k, sat);
-            sn_k_sub3(xa, x0, xr, sat);
+            sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
             sn_k_sub3(l, xr, d + 3 * k, sat);
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
@@ -135,7 +132,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
 
     /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
      * Stored over free vertices; the skeleton's, computed in cell_forces
-     * (w_at), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
+     * (w_of), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], ck, sat);
     if (v->b1 > ONE_COEF)
@@ -160,15 +157,13 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_q yi[3], yj[3];
         sn_acc l[3] = {0, 0, 0};
-        for (k = 0; k < 3; k++) yi[k] = coef(vel[3 * i + k], v->a1, sat);
+        sn_k_coef3(vel + 3 * i, v->a1, yi, sat); /* sn_kernels_rot.h: coef per entry */
         sca_row(l, rd_real(md, i), yi);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m = rd_real(mo, e);
-            for (k = 0; k < 3; k++) {
-                yj[k] = coef(vel[3 * j + k], v->a1, sat);
-                if (j >= nF) yj[k] = sn_add(yj[k], ds[3 * (j - nF) + k], sat);
-            }
+            sn_k_coef3(vel + 3 * j, v->a1, yj, sat);
+            if (j >= nF) sn_k_add3(yj, ds + 3 * (j - nF), yj, sat);
             sca_row(l, m, yj);
             if (j < nF) sca_mac(acc + 3 * j, m, yi);
         }
