@@ -91,7 +91,9 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
 }
 
-#if defined(SN_KERNELS_FAVX2)
+#if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)
+const char *sn_kernels_name(void) { return "avx512"; }
+#elif defined(SN_KERNELS_FAVX2)
 const char *sn_kernels_name(void) { return "avx2"; }
 #else
 const char *sn_kernels_name(void) { return "neon"; }
