@@ -79,6 +79,7 @@ SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l
 
 #if defined(SN_KERNELS_AVX2)
 #include <immintrin.h>
+#include "sn_kernels_rot.h" /* sn_k_ld3q, sn_k_st3q */
 /* 4 int64 lanes (the 4th unused). Round half up for 0 <= s <= 62 without an
  * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
  * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
@@ -94,14 +95,12 @@ SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
  * 20-byte block); lane c = sum_r U[3r+c] y[r]. s < 0 (scale-up and clamp,
  * a rare blob): the reference. */
 SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
-    const __m256i m3 = _mm256_setr_epi64x(-1, -1, -1, 0);
     __m256i p;
     if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
     p = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), _mm256_set1_epi64x(y[0])),
                                           _mm256_mul_epi32(SN_K_IC_W(b + 6), _mm256_set1_epi64x(y[1]))),
                          _mm256_mul_epi32(SN_K_IC_W(b + 12), _mm256_set1_epi64x(y[2])));
-    p = _mm256_add_epi64(_mm256_maskload_epi64((const long long *)(const void *)a, m3), sn_k_ic_rshr(p, s));
-    _mm256_maskstore_epi64((long long *)(void *)a, m3, p);
+    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(p, s))); /* sn_kernels_rot.h: no masked moves */
 }
 
 /* rows of U as lanes: (U0,U3,U6) (U1,U4,U7) from bytes 0..15, (U2,U5,U8)
