@@ -229,33 +229,28 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     sn_k_sym_cols(b, c);
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
-#else
+#else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     sn_q t[3];
-    t[0] = sn_out(l[0], sh, sat);
-    t[1] = sn_out(l[1], sh, sat);
-    t[2] = sn_out(l[2], sh, sat);
+    int c;
+    for (c = 0; c < 3; c++) t[c] = sn_out(l[c], sh, sat);
     sn_k_rot_acc(acc, R, t);
 }
 SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
-    out[0] = sn_add(x[0], -y[0], sat);
-    out[1] = sn_add(x[1], -y[1], sat);
-    out[2] = sn_add(x[2], -y[2], sat);
+    int c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(x[c], -y[c], sat);
 }
 SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
-    out[0] = sn_add(rd_real(sec, ia), -rd_real(sec, ib), sat);
-    out[1] = sn_add(rd_real(sec, ia + 1), -rd_real(sec, ib + 1), sat);
-    out[2] = sn_add(rd_real(sec, ia + 2), -rd_real(sec, ib + 2), sat);
+    uint32_t c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(rd_real(sec, ia + c), -rd_real(sec, ib + c), sat);
 }
 SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
-    out[0] = sn_add(x[0], y[0], sat);
-    out[1] = sn_add(x[1], y[1], sat);
-    out[2] = sn_add(x[2], y[2], sat);
+    int c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(x[c], y[c], sat);
 }
 SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
-    out[0] = coef(x[0], c, sat);
-    out[1] = coef(x[1], c, sat);
-    out[2] = coef(x[2], c, sat);
+    int k;
+    for (k = 0; k < 3; k++) out[k] = coef(x[k], c, sat);
 }
 SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     x[0] = sn_out((sn_acc)x[0] - y[0], 0, sat);
@@ -312,12 +307,22 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         c += sn_k_bits4(m1) + sn_k_bits4(m2);
     }
     *sat += c;
-#endif
     for (; i < n; i++) {
         sn_q mk = sn_out(acc[i], fm - SN_KREL(kk[i / 3]), sat);
         sn_acc s = sn_mul(q[i], ck) + sn_mul(mk, cm);
         q[i] = sn_out(s, SN_Q_COEF, sat);
     }
+#else /* per vertex, its shift once (the loop the mat-vec had) */
+    for (; i < n / 3; i++) {
+        int sh = fm - SN_KREL(kk[i]);
+        uint32_t k;
+        for (k = 0; k < 3; k++) {
+            sn_q mk = sn_out(acc[3 * i + k], sh, sat);
+            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
+            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
+        }
+    }
+#endif
 }
 
 #endif /* SN_KERNELS_ROT_H */
