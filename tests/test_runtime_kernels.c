@@ -71,6 +71,41 @@ static void make_rec(unsigned char *K, double S[24][24], int extreme) {
 }
 #endif
 
+#if defined(SN_FLOAT)
+/* The float summation order of sn_kernels.h, written here from BLOB.md's
+ * float CELLK (36 upper blocks, row r holding (r,r)..(r,7), 9 row-major
+ * floats each): outputs of row a take B u_b for b = a..7, outputs of row b
+ * the transposed blocks (a,b), a < b, as the rows go; each block term is
+ * (p0 + p1) + p2 added to the output. Separate statements: no contraction
+ * by any compiler. Every path's float must be this one, bit for bit. */
+static float kf(const unsigned char *K, int n, int k) {
+    float f;
+    uint32_t u = (uint32_t)K[36 * n + 4 * k] | (uint32_t)K[36 * n + 4 * k + 1] << 8 |
+                 (uint32_t)K[36 * n + 4 * k + 2] << 16 | (uint32_t)K[36 * n + 4 * k + 3] << 24;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static void order_ref(const unsigned char *K, const float *u, float *l) {
+    int a, b, r, n = 0;
+    for (a = 0; a < 24; a++) l[a] = 0.0f;
+    for (a = 0; a < 8; a++)
+        for (b = a; b < 8; b++, n++)
+            for (r = 0; r < 3; r++) {
+                float p0 = kf(K, n, 3 * r) * u[3 * b], p1 = kf(K, n, 3 * r + 1) * u[3 * b + 1];
+                float p2 = kf(K, n, 3 * r + 2) * u[3 * b + 2], t = p0 + p1;
+                t = t + p2;
+                l[3 * a + r] = l[3 * a + r] + t;
+                if (b == a) continue;
+                p0 = kf(K, n, r) * u[3 * a];
+                p1 = kf(K, n, 3 + r) * u[3 * a + 1];
+                p2 = kf(K, n, 6 + r) * u[3 * a + 2];
+                t = p0 + p1;
+                t = t + p2;
+                l[3 * b + r] = l[3 * b + r] + t;
+            }
+}
+#endif
+
 /* reference row r of S u; fixed: exact, the operand split into a high
  * part (>> 13) and a low one so that every product and partial sum is an
  * integer below 2^53 (exact in double) */
@@ -236,7 +271,6 @@ static void test_rot(void) {
         int extreme = t % 16 == 0;
         for (k = 0; k < 9; k++) {
 #if defined(SN_FLOAT)
-            (void)extreme;
             R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
 #else
             R[k] = extreme ? (rnd32() & 1 ? (1 << 30) : -(1 << 30)) : rnd_in(1 << 30);
@@ -246,6 +280,7 @@ static void test_rot(void) {
         for (k = 0; k < 3; k++) {
 #if defined(SN_FLOAT)
             v[k] = (float)rnd_in(1 << 20) / 1024.0f; /* below SN_FLIM / 3: no clamp */
+            if (extreme) v[k] = k == 2 && t % 48 == 0 ? nanf("") : (float)rnd_in(1 << 20) * 0.03125f; /* clamps, NaN */
             a1[k] = a2[k] = (float)rnd_in(1 << 20);
 #else
             v[k] = extreme ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in(1 << 28);
@@ -258,7 +293,11 @@ static void test_rot(void) {
         sn_rot(R, v, p2, &s2);
         sn_k_rot_acc(a1, R, v);
         sn_rot_acc(a2, R, v);
-        bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || s1 != s2;
+        bad_path += memcmp(a1, a2, sizeof a1) != 0 && v[2] == v[2]; /* a NaN's payload may differ: not state */
+#if defined(SN_FLOAT)
+        if (extreme) { clamps += s2; continue; } /* the float clamp (and NaN -> 0): against sn_rot* only */
+#endif
         for (k = 0; k < 3; k++) {
             double xt = rot_ref(Rd + k, 3, v, &mag), mt = mag, xr = rot_ref(Rd + 3 * k, 1, v, &mag), mr = mag;
 #if defined(SN_FLOAT)
@@ -321,6 +360,16 @@ static void test_axpy(void) {
             mag[i] = 0;
 #endif
         }
+#if defined(SN_FLOAT)
+        if (t % 16 == 0) { /* the float clamp and NaN -> 0, each counted: against sn_add/sn_mulq bit for bit */
+            s = 1.0e3f;
+            for (i = 0; i < n; i++) {
+                if (rnd32() % 8u == 0) x[i] = nanf("");
+                ref[i] = (double)sn_add(a[i], sn_mulq(s, x[i], sh, &sd), &sd);
+                mag[i] = 0;
+            }
+        }
+#endif
         if (alias == 1) { memcpy(o, a, sizeof a); sn_k_axpy(o, o, s, x, n, sh, &sat); }
         else if (alias == 2) { memcpy(o, x, sizeof x); sn_k_axpy(o, a, s, o, n, sh, &sat); }
         else sn_k_axpy(o, a, s, x, n, sh, &sat);
@@ -422,10 +471,106 @@ static void test_rshr(void) {
 }
 #endif
 
+/* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
+ * sn_k_add3, sn_k_coef3, sn_k_sub3r, sn_k_sym_out, sn_k_out_rot_acc, sn_k_outv, sn_k_mix) against the
+ * formulas written here with sn_out/sn_add/sn_mul (sn_internal.h, the
+ * reference arithmetic): bit for bit with the same clamp counts. Float:
+ * values past SN_FLIM and NaNs included (every path must clamp and count
+ * them alike); fixed: values up to the state bound, shifts 0..30. */
+static sn_q rnd_val(int wild) {
+#if defined(SN_FLOAT)
+    if (wild && rnd32() % 16u == 0) return nanf("");
+    return (float)rnd_in(1 << 20) * (wild ? 0.01f : 0.001f);
+#else
+    return wild ? rnd_in(1 << 28) : rnd_in(1 << 24);
+#endif
+}
+static sn_acc rnd_acc(int wild) {
+#if defined(SN_FLOAT)
+    return rnd_val(wild);
+#else
+    return (int64_t)rnd_in(1 << 30) * (wild ? (1 << 26) : (1 << 12));
+#endif
+}
+static void test_loops(void) {
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        int wild = t % 4 == 0, sh = (int)(rnd32() % 31u), k;
+        sn_q x[3], y[3], o1[3], o2[3], R[9], q1[40], q2[40], ck = rnd_val(0), cm = rnd_val(0);
+        sn_acc ya[3], a1[3], a2[3], l[3], in[40];
+        unsigned char D[24];
+        uint8_t kk[14];
+        uint32_t s1 = 0, s2 = 0, n = rnd32() % 41u, i;
+#if defined(SN_FLOAT)
+        ck *= 0.001f; /* |q ck| mostly inside SN_FLIM */
+        cm *= 0.001f;
+#endif
+        for (k = 0; k < 3; k++) { x[k] = rnd_val(wild); y[k] = rnd_val(wild); ya[k] = rnd_acc(wild); l[k] = rnd_acc(wild); a1[k] = a2[k] = rnd_acc(0); }
+        for (k = 0; k < 9; k++) R[k] = rnd_val(0);
+        for (k = 0; k < 6; k++) {
+            sn_q d = rnd_val(0);
+            memcpy(D + 4 * k, &d, 4); /* little-endian hosts (the SIMD paths') */
+        }
+        for (k = 0; k < 14; k++) kk[k] = (uint8_t)(rnd32() % 4u);
+        for (i = 0; i < n; i++) { in[i] = rnd_acc(wild); q1[i] = q2[i] = rnd_val(wild); }
+        sn_k_sub3(x, y, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_add3(x, y, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_coef3(x, ck, o1, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_mulq(x[k], ck, SN_Q_COEF, &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        {
+            unsigned char sec[24];
+            memcpy(sec, x, 12); /* little-endian hosts (the SIMD paths') */
+            memcpy(sec + 12, y, 12);
+            sn_k_sub3r(sec, 0, 3, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(rd_real(sec, (uint32_t)k), -rd_real(sec, 3u + (uint32_t)k), &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        }
+        memcpy(o1, x, sizeof x);
+        sn_k_sub3a(o1, ya, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
+        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        sn_k_sym_out(D, x, o1, sh, &s1);
+        {
+            sn_q xx = rd_real(D, 0), yy = rd_real(D, 1), zz = rd_real(D, 2), xy = rd_real(D, 3), xz = rd_real(D, 4), yz = rd_real(D, 5);
+            sn_acc m[3] = {0, 0, 0};
+            m[0] += sn_mul(xx, x[0]) + sn_mul(xy, x[1]) + sn_mul(xz, x[2]);
+            m[1] += sn_mul(xy, x[0]) + sn_mul(yy, x[1]) + sn_mul(yz, x[2]);
+            m[2] += sn_mul(xz, x[0]) + sn_mul(yz, x[1]) + sn_mul(zz, x[2]);
+            for (k = 0; k < 3; k++) o2[k] = sn_out(m[k], sh, &s2);
+        }
+        bad += (memcmp(o1, o2, sizeof o1) != 0 && x[0] == x[0] && x[1] == x[1] && x[2] == x[2]) || s1 != s2;
+        sn_k_out_rot_acc(a1, R, l, sh, &s1);
+        for (k = 0; k < 3; k++) o2[k] = sn_out(l[k], sh, &s2);
+        sn_rot_acc(a2, R, o2);
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        sn_k_outv(q1, in, n, sh, &s1);
+        for (i = 0; i < n; i++) q2[i] = sn_out(in[i], sh, &s2);
+        bad += memcmp(q1, q2, n * sizeof q1[0]) != 0 || s1 != s2;
+        for (i = 0; i < n; i++) q1[i] = q2[i] = rnd_val(wild);
+        n -= n % 3; /* the mat-vec's 3 nF values */
+        sn_k_mix(q1, in, kk, n, sh + 8, ck, cm, &s1);
+        for (i = 0; i < n; i++) {
+            sn_q mk = sn_out(in[i], sh + 8 - SN_KREL(kk[i / 3]), &s2);
+            sn_acc m = sn_mul(q2[i], ck) + sn_mul(mk, cm);
+            q2[i] = sn_out(m, SN_Q_COEF, &s2);
+        }
+        bad += memcmp(q1, q2, n * sizeof q1[0]) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "loop helpers (path %s): %d of 36000 results or clamp counts off the reference formulas", sn_kernels_name(), bad);
+    T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", clamps);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
-    int t, bad_full = 0, bad_list = 0, bad_two = 0, lists = 0;
+    int t, bad_full = 0, bad_list = 0, bad_two = 0, lists = 0, bad_order = 0;
     printf("cell product kernels (%s flavour, path %s)\n", SN_FLAVOUR ? "float" : "fixed", sn_kernels_name());
     rng = (uint32_t)T_SEED();
     for (t = 0; t < 4000; t++) {
@@ -447,6 +592,13 @@ int main(void) {
         }
         sn_k_cell_mul(K, all8, 8, u, l);
         for (r = 0; r < 24; r++) bad_full += !row_ok(S, u, r, l[r]);
+#if defined(SN_FLOAT)
+        {
+            float lo[24];
+            order_ref(K, u, lo);
+            bad_order += memcmp(lo, l, sizeof lo) != 0;
+        }
+#endif
         /* two products at once = two calls */
         sn_k_cell_mul2(K, u, u2, lm1, lm2, 0xFFu);
         sn_k_cell_mul(K, all8, 8, u2, l2);
@@ -475,6 +627,12 @@ int main(void) {
     T_CHECK(bad_full == 0, "%d of 96000 rows of the full product off the reference", bad_full);
     T_CHECK(bad_two == 0, "sn_k_cell_mul2 (all rows, then a random row set) differs from two calls in %d of 8000 cases", bad_two);
     T_CHECK(bad_list == 0, "free-corner product differs from the zero-padded full product in %d rows (%d lists)", bad_list, lists);
+#if defined(SN_FLOAT)
+    T_CHECK(bad_order == 0, "float cell product (path %s): %d of 4000 cells differ from the reference order's floats",
+            sn_kernels_name(), bad_order);
+#else
+    (void)bad_order;
+#endif
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
     test_ic();
     test_rot();
@@ -483,5 +641,6 @@ int main(void) {
     test_rshr();
     test_dot();
 #endif
+    test_loops();
     return T_END();
 }

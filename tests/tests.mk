@@ -5,6 +5,7 @@ TEST_DEPS ?=
 include tests/physics.mk
 include tests/health.mk
 include tests/level.mk
+include tests/kernels.mk
 # The build runs in TEST_JOBS lanes (default 2, the CI machine's cores), then
 # the suites; `make test-build` alone builds what they need.
 TEST_JOBS ?= 2

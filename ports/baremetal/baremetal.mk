@@ -263,10 +263,16 @@ endef
 $(eval $(call det_float,float-gcc-O0,gcc,-O0))
 $(eval $(call det_float,float-gcc-O2,gcc,-O2))
 $(eval $(call det_float,float-clang-O2,clang,-O2))
-# the float flavour keeps the scalar kernels on every SIMD setting (same hash;
-# clang's -mavx512f implies FMA: -ffp-contract=off, as above, keeps it equal)
+# the float SIMD kernels (AVX2, aarch64 NEON: sn_kernels_fsimd.c) compute the
+# scalar reference's floats, so every path gives the one float hash (clang's
+# -mavx512f implies FMA: -ffp-contract=off, as above, keeps the scalar code
+# unfused; the kernels' intrinsics never fuse)
 $(eval $(call det_float,float-gcc-O2-avx2,gcc,-O2 -mavx2))
+$(eval $(call det_float,float-clang-O2-avx2,clang,-O2 -mavx2))
 $(eval $(call det_float,float-clang-O2-avx512,clang,-O2 -mavx2 -mavx512f -mavx512vl))
+$(eval $(call det_float,float-aarch64-gcc-O2,aarch64-linux-gnu-gcc,-O2 -static))
+$(eval $(call det_float,float-aarch64-gcc-O2-scalar,aarch64-linux-gnu-gcc,-O2 -DSN_SIMD_SCALAR -static))
+$(eval $(call det_float,float-aarch64-clang-O2,clang --target=aarch64-linux-gnu,-O2 -static))
 
 # every driver whose compiler is installed (make deps installs them all)
 CROSS_HAVE = $(foreach d,x86_64-gcc-O2:gcc x86_64-clang-O2:clang i686-gcc-O2:i686-linux-gnu-gcc \
@@ -283,7 +289,8 @@ ports: ports-baremetal ports-cross
 # level slice, and the objects of test_nofloat.sh.
 # A driver whose compiler is missing is left out here; the script reports it.
 DET_SLICE = cortex-m4-qemu mips-be-gcc-O2 armhf-gcc-O2-neon aarch64-gcc-O2 x86_64-gcc-O0 \
-            x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2
+            x86_64-gcc-O2-avx2 x86_64-clang-O2 float-gcc-O2 float-clang-O2 \
+            float-gcc-O2-avx2 float-aarch64-gcc-O2
 .PHONY: print-det-slice
 print-det-slice:
 	@echo $(DET_SLICE)

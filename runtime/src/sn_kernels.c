@@ -1,6 +1,7 @@
 /* sn_kernels.c -- portable scalar reference of the kernels in sn_kernels.h
- * (the float flavour and every target without a SIMD/DSP path). The
- * per-ISA files must give the same integers (fixed flavour). */
+ * (every target without a SIMD/DSP path, both flavours). The per-ISA files
+ * must give the same integers (fixed flavour) or the same floats (float:
+ * sn_kernels_fsimd.c). */
 #include "sn_kernels.h"
 #include "sn_instance.h"
 

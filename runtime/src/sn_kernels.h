@@ -3,7 +3,9 @@
  * (sn_kernels_avx2.c, sn_kernels_neon.c, sn_kernels_m4.c), chosen at build
  * time from the compiler's target macros (make SIMD=..., runtime/runtime.mk):
  *
- *   SN_SIMD_SCALAR defined, or the float flavour  -> scalar reference
+ *   SN_SIMD_SCALAR defined                          -> scalar reference
+ *   float flavour: __AVX2__, or aarch64 NEON        -> sn_kernels_fsimd.c
+ *                  (other targets, armhf included)  -> scalar reference
  *   __AVX2__ (also under AVX-512)                  -> sn_kernels_avx2.c
  *   __ARM_NEON (aarch64; armhf with -mfpu=neon)    -> sn_kernels_neon.c
  *   __ARM_FEATURE_DSP, no NEON (Cortex-M4/M7)      -> sn_kernels_m4.c
@@ -14,15 +16,23 @@
  * the kernel, and every partial sum of any subset of those products is
  * bounded below 2^63 (NUMERICS.md "SIMD kernels"), so any summation order
  * gives the same int64. Rounding happens only in the callers, unchanged.
- * Float flavour: always the scalar reference (float sums are not
- * associative; one order everywhere keeps the float hash the same too).
+ * Float flavour: float sums are not associative, so the SIMD paths compute
+ * each output with the reference's operations in the reference's order
+ * (lanes are outputs, never terms of one sum; no FMA): the same floats, the
+ * same float hash on every path (sn_kernels_fsimd.h).
  */
 #ifndef SN_KERNELS_H
 #define SN_KERNELS_H
 
 #include "sn_internal.h"
 
-#if defined(SN_FLOAT) || defined(SN_SIMD_SCALAR)
+#if defined(SN_SIMD_SCALAR)
+#define SN_KERNELS_SCALAR 1
+#elif defined(SN_FLOAT) && defined(__AVX2__)
+#define SN_KERNELS_FAVX2 1 /* float: sn_kernels_fsimd.c, the scalar reference's bits */
+#elif defined(SN_FLOAT) && defined(__aarch64__) && defined(__ARM_NEON) && SN_HOST_LE
+#define SN_KERNELS_FNEON 1
+#elif defined(SN_FLOAT)
 #define SN_KERNELS_SCALAR 1
 #elif defined(__AVX2__)
 #define SN_KERNELS_AVX2 1
@@ -113,8 +123,8 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
  * (each entry is read before it is written). Fixed: |s x| <= 2^31 2^28,
  * |a| <= SN_LIM (a state vector) and 0 <= sh <= 62, every product rounded
  * and clamped alone (order-free);
- * float: the reference on every path. */
-#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON) || defined(SN_KERNELS_M4)
+ * float: out = sn_out(a + sn_out(s x)) per entry on every path (the same bits). */
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON) || defined(SN_KERNELS_M4) || defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat);
 #else /* the reference, inline as the loops it replaced */
 SN_INLINE void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {

@@ -79,6 +79,7 @@ SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l
 
 #if defined(SN_KERNELS_AVX2)
 #include <immintrin.h>
+#include "sn_kernels_rot.h" /* sn_k_ld3q, sn_k_st3q */
 /* 4 int64 lanes (the 4th unused). Round half up for 0 <= s <= 62 without an
  * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
  * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
@@ -94,14 +95,12 @@ SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
  * 20-byte block); lane c = sum_r U[3r+c] y[r]. s < 0 (scale-up and clamp,
  * a rare blob): the reference. */
 SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
-    const __m256i m3 = _mm256_setr_epi64x(-1, -1, -1, 0);
     __m256i p;
     if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
     p = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), _mm256_set1_epi64x(y[0])),
                                           _mm256_mul_epi32(SN_K_IC_W(b + 6), _mm256_set1_epi64x(y[1]))),
                          _mm256_mul_epi32(SN_K_IC_W(b + 12), _mm256_set1_epi64x(y[2])));
-    p = _mm256_add_epi64(_mm256_maskload_epi64((const long long *)(const void *)a, m3), sn_k_ic_rshr(p, s));
-    _mm256_maskstore_epi64((long long *)(void *)a, m3, p);
+    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(p, s))); /* sn_kernels_rot.h: no masked moves */
 }
 
 /* rows of U as lanes: (U0,U3,U6) (U1,U4,U7) from bytes 0..15, (U2,U5,U8)
@@ -200,6 +199,74 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
                        (int64_t)sn_k_ic_i16(b + 10) * z2, s, r);
     l[2] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 12) * z0 + (int64_t)sn_k_ic_i16(b + 14) * z1 +
                        (int64_t)sn_k_ic_i16(b + 16) * z2, s, r);
+}
+
+#elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#include "sn_kernels_fsimd.h"
+/* Float: U's rows (col) or columns (row) in lanes, decoded exactly as the
+ * reference (int16 -> float, times 2^-frac: exact), the reference's
+ * operations in its order per lane (sn_kernels_fsimd.h). AVX2: rows from
+ * three 8-byte VPMOVSXWD loads (U0..3, U3..6, U6..9: inside the 20-byte
+ * element; lane 3 junk), columns by the fixed path's byte shuffle; aarch64:
+ * the 9 entries decoded to floats in memory, then the layer's loads. */
+SN_INLINE float sn_k_ic_scale(const unsigned char *b) {
+    uint32_t u = (uint32_t)(127 - b[18]) << 23; /* 2^-frac, as sn_k_ic_block */
+    float s;
+    memcpy(&s, &u, 4);
+    return s;
+}
+#if defined(SN_KERNELS_FAVX2)
+#define SN_K_IC_F(v) _mm_cvtepi32_ps(_mm_cvtepi16_epi32(v))
+SN_INLINE void sn_k_ic_rows(const unsigned char *b, sn_fv r[3]) {
+    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    r[0] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)b)), s);
+    r[1] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 6))), s);
+    r[2] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 12))), s);
+}
+SN_INLINE void sn_k_ic_cols(const unsigned char *b, sn_fv c[3]) {
+    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, 0, 1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
+    const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
+    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    c[0] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh0)), s);
+    c[1] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh1)), s);
+    c[2] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(w, sh0)), s);
+}
+#undef SN_K_IC_F
+#else
+SN_INLINE void sn_k_ic_f9(const unsigned char *b, float U[12]) {
+    const int16x8_t v = vld1q_s16((const int16_t *)(const void *)b);
+    const float32x4_t s = vdupq_n_f32(sn_k_ic_scale(b));
+    vst1q_f32(U, vmulq_f32(vcvtq_f32_s32(vmovl_s16(vget_low_s16(v))), s));
+    vst1q_f32(U + 4, vmulq_f32(vcvtq_f32_s32(vmovl_s16(vget_high_s16(v))), s));
+    U[8] = (float)sn_k_ic_i16(b + 16) * vgetq_lane_f32(s, 0);
+    U[9] = U[10] = U[11] = 0.0f;
+}
+SN_INLINE void sn_k_ic_rows(const unsigned char *b, sn_fv r[3]) {
+    float U[12];
+    sn_k_ic_f9(b, U);
+    fv_rows(U, r);
+}
+SN_INLINE void sn_k_ic_cols(const unsigned char *b, sn_fv c[3]) {
+    float U[12];
+    sn_k_ic_f9(b, U);
+    fv_cols(U, c);
+}
+#endif
+/* a[c] += U[c] y0 + U[3+c] y1 + U[6+c] y2 (float: no rounding step) */
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    sn_fv r[3];
+    (void)s; (void)sat;
+    sn_k_ic_rows(b, r);
+    fv_st3(a, FV_ADD(fv_ld3(a), FV_MAC3(r, FV_SET1(y[0]), FV_SET1(y[1]), FV_SET1(y[2]))));
+}
+/* l[r] += U[3r] z0 + U[3r+1] z1 + U[3r+2] z2; l has 4 entries */
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+    sn_fv c[3];
+    (void)sat;
+    sn_k_ic_cols(b, c);
+    FV_ST4(l, FV_ADD(FV_LD4(l), FV_MAC3(c, FV_SET1(z[0]), FV_SET1(z[1]), FV_SET1(z[2]))));
 }
 
 #else

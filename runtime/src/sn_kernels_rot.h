@@ -14,7 +14,8 @@
  * shift by 30 minus 2^32 is floor((x + 2^29) / 2^30), sn_rshr64's value;
  * then the same clamp and count. NEON: below. Same integers as the
  * reference (exact products, one rounding per output). Other paths: the
- * reference (the M4: narrowed to int32 before its clamp, below). */
+ * reference (the M4: narrowed to int32 before its clamp, below). Float:
+ * AVX2 and aarch64 by sn_kernels_fsimd.h's lanes, the reference's bits. */
 #ifndef SN_KERNELS_ROT_H
 #define SN_KERNELS_ROT_H
 
@@ -25,6 +26,15 @@
 #include <immintrin.h>
 
 #define SN_K_R8(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
+/* 3 int64 without VPMASKMOVQ (microcoded, slow on AMD Zen): 16 + 8 bytes */
+SN_INLINE __m256i sn_k_ld3q(const int64_t *p) {
+    return _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)p)),
+                                   _mm_loadl_epi64((const __m128i *)(const void *)(p + 2)), 1);
+}
+SN_INLINE void sn_k_st3q(int64_t *p, __m256i v) {
+    _mm_storeu_si128((__m128i *)(void *)p, _mm256_castsi256_si128(v));
+    _mm_storel_epi64((__m128i *)(void *)(p + 2), _mm256_extracti128_si256(v, 1));
+}
 /* lane k = sum_c R[i_c(k)] v[c]; i0, i1 index R0..R7, i2 indexes R1..R8 */
 SN_INLINE __m256i sn_k_rot3(const sn_q *R, const sn_q v[3], __m256i i0, __m256i i1, __m256i i2) {
     const __m256i r0 = SN_K_R8(R), r1 = SN_K_R8(R + 1);
@@ -43,8 +53,12 @@ SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
     *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2));
-    _mm_maskstore_epi32((int *)(void *)out, _mm_setr_epi32(-1, -1, -1, 0),
-                        _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+    {
+        const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
+        const int32_t o2 = _mm_extract_epi32(o, 2);
+        _mm_storel_epi64((__m128i *)(void *)out, o); /* no VPMASKMOVD (see sn_k_st3q) */
+        memcpy(out + 2, &o2, 4);
+    }
 }
 /* out = R^T v: lane k = R[k] v0 + R[3+k] v1 + R[6+k] v2 */
 SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
@@ -62,9 +76,7 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
 }
 /* acc += R t (int64, masked to the 3 entries) */
 SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
-    const __m256i m3 = _mm256_setr_epi64x(-1, -1, -1, 0);
-    _mm256_maskstore_epi64((long long *)(void *)acc, m3,
-                           _mm256_add_epi64(_mm256_maskload_epi64((const long long *)(const void *)acc, m3), sn_k_rot_x(R, t)));
+    sn_k_st3q(acc, _mm256_add_epi64(sn_k_ld3q(acc), sn_k_rot_x(R, t)));
 }
 #undef SN_K_R8
 
@@ -128,10 +140,189 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
         out[k] = sn_k_rot_out1(sn_mul(R[3 * k], v[0]) + sn_mul(R[3 * k + 1], v[1]) + sn_mul(R[3 * k + 2], v[2]), sat);
 }
 #define sn_k_rot_acc sn_rot_acc
+
+#elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#include "sn_kernels_fsimd.h"
+/* Float (sn_kernels_fsimd.h): lane k is the reference's output k, the
+ * same operations in the same order, through sn_out's clamp and count. */
+SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_fv r[3];
+    fv_rows(R, r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 */
+    fv_st3(out, fv_out3(FV_MAC3(r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_fv c[3];
+    fv_cols(R, c); /* lane k: R[3k] v0 + R[3k+1] v1 + R[3k+2] v2 */
+    fv_st3(out, fv_out3(FV_MAC3(c, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
+    sn_fv c[3];
+    fv_cols(R, c);
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(c, FV_SET1(t[0]), FV_SET1(t[1]), FV_SET1(t[2]))));
+}
 #else
 #define sn_k_rot_t sn_rot_t
 #define sn_k_rot sn_rot
 #define sn_k_rot_acc sn_rot_acc
 #endif
+
+/* Helpers of the per-corner loops (sn_solve.c), written on the kernels above:
+ *   sn_k_out_rot_acc(acc, R, l, sh, sat): t = sn_out(l, sh) per entry, acc += R t
+ *   sn_k_sub3(x, y, out, sat): out = sn_add(x, -y) per entry
+ *   sn_k_sub3a(x, y, sat): x = sn_out(x - y, 0) per entry (y accumulators)
+ *   sn_k_add3(x, y, out, sat): out = sn_add(x, y); sn_k_coef3(x, c, out, sat): out = coef(x, c)
+ *   sn_k_sub3r(sec, ia, ib, out, sat): out = sn_add(real ia + c, -real ib + c) of a blob section
+ *   sn_k_sym_out(b, e, out, sh, sat): out = sn_out(0 + D e, sh), D the
+ *     symmetric block of 6 reals at b (xx yy zz xy xz yz; sn_precond.c)
+ * Float SIMD paths: lanes as in sn_kernels_fsimd.h (the same floats and
+ * counts); every other path: the reference loops. */
+#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#if defined(SN_KERNELS_FAVX2)
+#define SN_K_LANE(v, k) _mm_permute_ps((v), _MM_SHUFFLE(k, k, k, k))
+#define SN_K_NEG(v) _mm_xor_ps((v), _mm_set1_ps(-0.0f))
+#else
+#define SN_K_LANE(v, k) vdupq_laneq_f32((v), (k))
+#define SN_K_NEG(v) vnegq_f32(v)
+#endif
+SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    sn_fv c[3];
+    const sn_fv t = fv_out3(fv_ld3(l), sat);
+    (void)sh;
+    fv_cols(R, c);
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
+SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_ADD(fv_ld3(x), SN_K_NEG(fv_ld3(y))), sat));
+}
+SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
+    fv_st3(x, fv_out3(FV_SUB(fv_ld3(x), fv_ld3(y)), sat));
+}
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_ADD(fv_ld3(x), fv_ld3(y)), sat));
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)sec; /* float blob reals, little-endian host */
+    fv_st3(out, fv_out3(FV_ADD(fv_ld3(f + ia), SN_K_NEG(fv_ld3(f + ib))), sat));
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_MUL(fv_ld3(x), FV_SET1(c)), sat));
+}
+/* the symmetric block's columns (xx xy xz) (xy yy yz) (xz yz zz) */
+SN_INLINE void sn_k_sym_cols(const unsigned char *b, sn_fv c[3]) {
+#if defined(SN_KERNELS_FAVX2)
+    const __m256 v = _mm256_insertf128_ps(_mm256_castps128_ps256(FV_LD4(b)), FV_LD4(b + 8), 1); /* xx yy zz xy zz xy xz yz */
+    c[0] = FV_PERM(v, 0, 3, 6);
+    c[1] = FV_PERM(v, 3, 1, 7);
+    c[2] = FV_PERM(v, 6, 7, 2);
+#else
+    const float32x4_t lo = FV_LD4(b);              /* xx yy zz xy */
+    const float32x4_t hi = FV_LD4(b + 8);          /* zz xy xz yz */
+    const float32x4_t t = vextq_f32(hi, hi, 1);    /* xy xz yz zz */
+    c[0] = vsetq_lane_f32(vgetq_lane_f32(lo, 0), vextq_f32(lo, t, 3), 0); /* xy xy xz yz -> xx xy xz yz */
+    c[1] = vsetq_lane_f32(vgetq_lane_f32(lo, 1), t, 1);                    /* xy yy yz zz */
+    c[2] = vextq_f32(t, t, 1);                                             /* xz yz zz xy */
+#endif
+}
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    sn_fv c[3];
+    (void)sh;
+    sn_k_sym_cols(b, c);
+    fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
+}
+#else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
+SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    sn_q t[3];
+    int c;
+    for (c = 0; c < 3; c++) t[c] = sn_out(l[c], sh, sat);
+    sn_k_rot_acc(acc, R, t);
+}
+SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    int c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(x[c], -y[c], sat);
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    uint32_t c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(rd_real(sec, ia + c), -rd_real(sec, ib + c), sat);
+}
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    int c;
+    for (c = 0; c < 3; c++) out[c] = sn_add(x[c], y[c], sat);
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    int k;
+    for (k = 0; k < 3; k++) out[k] = coef(x[k], c, sat);
+}
+SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
+    x[0] = sn_out((sn_acc)x[0] - y[0], 0, sat);
+    x[1] = sn_out((sn_acc)x[1] - y[1], 0, sat);
+    x[2] = sn_out((sn_acc)x[2] - y[2], 0, sat);
+}
+/* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
+ * block Jacobi of format 5 did: float keeps its signed zeros); out = sn_out(l, sh) */
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    sn_acc l[3];
+    l[0] = l[1] = l[2] = 0;
+    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
+    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
+    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
+    out[0] = sn_out(l[0], sh, sat);
+    out[1] = sn_out(l[1], sh, sat);
+    out[2] = sn_out(l[2], sh, sat);
+}
+#endif
+
+/* The mat-vec's last passes (sn_solve.c matvec), over n = 3 nF values:
+ *   sn_k_outv(out, in, n, s, sat): out[i] = sn_out(in[i], s)
+ *   sn_k_mix(q, acc, kk, n, fm, ck, cm, sat): q[i] = sn_out(q[i] ck +
+ *     sn_out(acc[i], fm - SN_KREL(k of i's vertex)) cm, SN_Q_COEF)
+ * Float SIMD paths: 4 entries per iteration (each entry alone: the same
+ * floats and counts), the tail as the reference. */
+#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3 & 1)); }
+#endif
+SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_t *sat) {
+    uint32_t i = 0;
+#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+    uint32_t c = 0;
+    for (; i + 4 <= n; i += 4) {
+        int m;
+        FV_ST4(out + i, fv_clamp(FV_LD4(in + i), &m));
+        c += sn_k_bits4(m);
+    }
+    *sat += c;
+#endif
+    for (; i < n; i++) out[i] = sn_out(in[i], s, sat);
+}
+SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t n, int fm, sn_q ck, sn_q cm, uint32_t *sat) {
+    uint32_t i = 0;
+#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+    const sn_fv vk = FV_SET1(ck), vm = FV_SET1(cm);
+    uint32_t c = 0;
+    for (; i + 4 <= n; i += 4) {
+        int m1, m2;
+        const sn_fv mk = fv_clamp(FV_LD4(acc + i), &m1);
+        FV_ST4(q + i, fv_clamp(FV_ADD(FV_MUL(FV_LD4(q + i), vk), FV_MUL(mk, vm)), &m2));
+        c += sn_k_bits4(m1) + sn_k_bits4(m2);
+    }
+    *sat += c;
+    for (; i < n; i++) {
+        sn_q mk = sn_out(acc[i], fm - SN_KREL(kk[i / 3]), sat);
+        sn_acc s = sn_mul(q[i], ck) + sn_mul(mk, cm);
+        q[i] = sn_out(s, SN_Q_COEF, sat);
+    }
+#else /* per vertex, its shift once (the loop the mat-vec had) */
+    for (; i < n / 3; i++) {
+        int sh = fm - SN_KREL(kk[i]);
+        uint32_t k;
+        for (k = 0; k < 3; k++) {
+            sn_q mk = sn_out(acc[3 * i + k], sh, sat);
+            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
+            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
+        }
+    }
+#endif
+}
 
 #endif /* SN_KERNELS_ROT_H */

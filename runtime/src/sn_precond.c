@@ -35,9 +35,7 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
     for (j = 0; j < nF; j++) {
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
-        yj[0] = sn_out((sn_acc)yj[0] - acc[3 * j], 0, sat);
-        yj[1] = sn_out((sn_acc)yj[1] - acc[3 * j + 1], 0, sat);
-        yj[2] = sn_out((sn_acc)yj[2] - acc[3 * j + 2], 0, sat);
+        sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
             const unsigned char *blk = L + (size_t)n * SN_ELEM_ICHOL;
@@ -70,21 +68,8 @@ static void ic_backward(const sn_view *v, uint32_t n, sn_q *z, uint32_t *sat) {
         for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
             sn_k_ic_row(blk, z + 3 * sn_rd_u16(cols + 2 * e), l, sat); /* l += round(U_ji z_i) */
         }
-        z[3 * j] = sn_out((sn_acc)z[3 * j] - l[0], 0, sat);
-        z[3 * j + 1] = sn_out((sn_acc)z[3 * j + 1] - l[1], 0, sat);
-        z[3 * j + 2] = sn_out((sn_acc)z[3 * j + 2] - l[2], 0, sat);
+        sn_k_sub3a(z + 3 * j, l, sat);
     }
-}
-
-/* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
- * block Jacobi of format 5 did: float keeps its signed zeros) */
-SN_INLINE void sym_mul(sn_acc l[3], const unsigned char *b, const sn_q e[3]) {
-    sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
-    sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
-    l[0] = l[1] = l[2] = 0;
-    l[0] += sn_mul(xx, e[0]) + sn_mul(xy, e[1]) + sn_mul(xz, e[2]);
-    l[1] += sn_mul(xy, e[0]) + sn_mul(yy, e[1]) + sn_mul(yz, e[2]);
-    l[2] += sn_mul(xz, e[0]) + sn_mul(yz, e[1]) + sn_mul(zz, e[2]);
 }
 
 /* t = s t, s a Q30 scale in (0, 1] (adaptation's source rows): no clamp */
@@ -109,15 +94,11 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     if (!v->ic) { /* block Jacobi: z_i = R_i P_i R_i^T r_i */
         for (i = 0; i < v->nF; i++) {
             sn_q t[3], s[3];
-            sn_acc a[3];
             int sh = v->frac_P + SN_KREL(kk[i]); /* r is Q(19+k_i), z is Q22 */
             if (mask && !mask[i] == !inv) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
             sn_k_rot_t(R + rs * i, r + 3 * i, t, sat);
             if (sc) scale3(t, sc[i], sat);
-            sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, t);
-            s[0] = sn_out(a[0], sh, sat);
-            s[1] = sn_out(a[1], sh, sat);
-            s[2] = sn_out(a[2], sh, sat);
+            sn_k_sym_out(P + (size_t)i * 6 * SN_REAL_BYTES, t, s, sh, sat); /* s = round(P_i t) */
             if (sc) scale3(s, sc[i], sat);
             sn_k_rot(R + rs * i, s, z + 3 * i, sat);
         }
@@ -132,12 +113,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     }
     n = ic_forward(v, kk, z, WARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
-        sn_acc a[3];
-        int sh = v->frac_P + SN_KREL(kk[i]);
-        sym_mul(a, P + (size_t)i * 6 * SN_REAL_BYTES, z + 3 * i);
-        z[3 * i] = sn_out(a[0], sh, sat);
-        z[3 * i + 1] = sn_out(a[1], sh, sat);
-        z[3 * i + 2] = sn_out(a[2], sh, sat);
+        sn_k_sym_out(P + (size_t)i * 6 * SN_REAL_BYTES, z + 3 * i, z + 3 * i, v->frac_P + SN_KREL(kk[i]), sat);
     }
     ic_backward(v, n, z, sat);
     for (i = 0; i < v->nF; i++) {

@@ -59,12 +59,14 @@ SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
 #define E_Q32(x) sn_rshr64((x), 12)
 #endif
 
-/* w of corner a, component c: stored for free vertices ((1+b1) v), b1 v'
- * for skeleton ones, computed here as rhs would have stored it (the same
- * product; its clamps are counted once in rhs). */
-SN_INLINE sn_q w_at(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, uint32_t c) {
+/* w at corner a: stored for free vertices ((1+b1) v), b1 v' for skeleton
+ * ones, computed into tmp as rhs would have stored it (the same product;
+ * its clamps are counted once in rhs). */
+SN_INLINE const sn_q *w_of(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, sn_q tmp[3]) {
     uint32_t counted = 0;
-    return a < h->v.nF ? w[3 * a + c] : coef(vel[3 * a + c], h->v.b1, &counted);
+    if (a < h->v.nF) return w + 3 * a;
+    sn_k_coef3(vel + 3 * a, h->v.b1, tmp, &counted);
+    return tmp;
 }
 
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
@@ -83,24 +85,20 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
-        sn_q d[24], uu[24], w0[3];
+        sn_q d[24], uu[24], w0s[3];
         sn_acc ld[24], lu[24], lx[24], ec = 0;
         uint32_t fr = 0; /* the free corners: lu's rows read below */
-        for (c = 0; c < 3; c++) w0[c] = w_at(h, w, vel, a0, c);
+        const sn_q *w0 = w_of(h, w, vel, a0, w0s);
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], s[3], l[3];
+            sn_q t[3], s[3], l[3], wa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
-            for (c = 0; c < 3; c++) {
-                t[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], sat);
-                s[c] = sn_add(w_at(h, w, vel, a, c), -w0[c], sat);
-            }
+            sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
+            sn_k_sub3(w_of(h, w, vel, a, wa), w0, s, sat);
             sn_k_rot_t(R, t, l, sat);
             sn_k_rot_t(R, s, uu + 3 * k, sat);
-            for (c = 0; c < 3; c++) {
-                sn_q xr = sn_add(rd_real(rest, 3 * a + c), -rd_real(rest, 3 * a0 + c), sat);
-                d[3 * k + c] = sn_add(l[c], -xr, sat);
-            }
+            sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
+            sn_k_sub3(l, xr, d + 3 * k, sat);
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, lx, sat); /* the cut level (sn_cut.c) */
@@ -108,12 +106,10 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3];
-            int sh;
+            sn_acc ls[3];
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
-            sh = v->frac_S - SN_KREL(kk[a]);
-            for (c = 0; c < 3; c++) t[c] = sn_out(ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0), sh, sat);
-            sn_k_rot_acc(acc + 3 * a, R, t);
+            for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0);
+            sn_k_out_rot_acc(acc + 3 * a, R, ls, v->frac_S - SN_KREL(kk[a]), sat); /* R round(ld + lu [+ lx]) */
         }
     }
 }
@@ -138,7 +134,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
 
     /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
      * Stored over free vertices; the skeleton's, computed in cell_forces
-     * (w_at), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
+     * (w_of), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
     for (i = 0; i < nF; i++)
         for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], ck, sat);
     if (v->b1 > ONE_COEF)
@@ -163,15 +159,13 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_q yi[3], yj[3];
         sn_acc l[3] = {0, 0, 0};
-        for (k = 0; k < 3; k++) yi[k] = coef(vel[3 * i + k], v->a1, sat);
+        sn_k_coef3(vel + 3 * i, v->a1, yi, sat); /* sn_kernels_rot.h: coef per entry */
         sca_row(l, rd_real(md, i), yi);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m = rd_real(mo, e);
-            for (k = 0; k < 3; k++) {
-                yj[k] = coef(vel[3 * j + k], v->a1, sat);
-                if (j >= nF) yj[k] = sn_add(yj[k], ds[3 * (j - nF) + k], sat);
-            }
+            sn_k_coef3(vel + 3 * j, v->a1, yj, sat);
+            if (j >= nF) sn_k_add3(yj, ds + 3 * (j - nF), yj, sat);
             sca_row(l, m, yj);
             if (j < nF) sca_mac(acc + 3 * j, m, yi);
         }
@@ -228,7 +222,7 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
 SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
                           const sn_q *d, sn_acc *acc, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t k, c, vi[8], nf = 0, nF = h->v.nF;
+    uint32_t k, vi[8], nf = 0, nF = h->v.nF;
     sn_q u[24];
     sn_acc l[24];
     uint8_t fc[8];
@@ -243,10 +237,7 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_k_cell_mul(K, fc, nf, u, l);
     for (k = 0; k < nf; k++) {
         uint32_t a = vi[k];
-        sn_q t[3];
-        int sh = h->v.frac_S - SN_KREL(kk[a]);
-        for (c = 0; c < 3; c++) t[c] = sn_out(l[3 * k + c], sh, sat);
-        sn_k_rot_acc(acc + 3 * a, R, t);
+        sn_k_out_rot_acc(acc + 3 * a, R, l + 3 * k, h->v.frac_S - SN_KREL(kk[a]), sat); /* R round(l) */
     }
 }
 
@@ -266,23 +257,17 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint
     const sn_q *cR = CARR(h, o_cR, sn_q);
     sn_acc *acc = WARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
-    uint32_t e, i, k, nF = v->nF;
+    uint32_t e, i, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
     acc_zero(acc, 3 * nF);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
-    for (i = 0; i < 3 * nF; i++) {
+    for (i = 0; i < 3 * nF; i++)
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
-        q[i] = sn_out(acc[i], SN_Q_ROT, sat);
-    }
+    sn_k_outv(q, acc, 3 * nF, SN_Q_ROT, sat); /* sn_kernels_rot.h */
     pass_M_ff(h, d, mask, acc);
-    for (i = 0; i < nF; i++)
-        for (k = 0; k < 3; k++) {
-            sn_q mk = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
-            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
-            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
-        }
+    sn_k_mix(q, acc, kk, 3 * nF, v->frac_M, ck, cm, sat); /* q = (1+b1) q + (1+a1) M^ d */
 }
 
 /* ---- CG scalars ---- */

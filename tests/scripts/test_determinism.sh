@@ -106,6 +106,11 @@ if have clang; then
     want_cpu float-clang-O2-avx512 clang avx512f avx512vl
 fi
 want_cpu float-gcc-O2-avx2 gcc avx2
+if have clang; then want_cpu float-clang-O2-avx2 clang avx2; fi
+# the float flavour's NEON kernels (aarch64 only) and its scalar reference there
+want float-aarch64-gcc-O2 aarch64-linux-gnu-gcc qemu-aarch64
+want float-aarch64-gcc-O2-scalar aarch64-linux-gnu-gcc qemu-aarch64
+if have clang; then want float-aarch64-clang-O2 aarch64-linux-gnu-gcc qemu-aarch64; fi
 want armhf-gcc-O2-neon arm-linux-gnueabihf-gcc qemu-arm
 want aarch64-gcc-O2  aarch64-linux-gnu-gcc qemu-aarch64
 want aarch64-gcc-O2-scalar aarch64-linux-gnu-gcc qemu-aarch64
@@ -123,7 +128,8 @@ pmake -k -j2 $targets > "$L/build.log" 2>&1 || true
 
 # ---- run, two at a time ----
 cmd_for() {  # name target runner -> command line
-    case $1 in float-*) echo "$2 $BUILD/examples/cow_float.blob --steps $STEPS $clip_arg"; return ;; esac
+    case $1 in float-*) r=""; [ "$3" = - ] || r="$3 "
+                        echo "$r$2 $BUILD/examples/cow_float.blob --steps $STEPS $clip_arg"; return ;; esac
     case $3 in
         -) echo "$2 --steps $STEPS $clip_arg" ;;
         qemu-system-arm) echo "$BM_QEMU_RUN -kernel $2" ;;

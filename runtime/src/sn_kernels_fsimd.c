@@ -1,0 +1,104 @@
+/* sn_kernels_fsimd.c -- the float flavour's SIMD kernels of sn_kernels.h
+ * (x86-64 AVX2, aarch64 AdvSIMD; the layer in sn_kernels_fsimd.h).
+ *
+ * cell_mul: a corner's 3 outputs are lanes 0..2. Block (a,b) adds B u_b to
+ * L_a (B's columns times broadcast u_b[c]) and B^T u_a to L_b (B's rows),
+ * each as ((p0 + p1) + p2) added to the accumulator, and the blocks come in
+ * the reference's order (rows ascending; a corner's row takes the
+ * transposed blocks of the rows above it, then its own row): every output
+ * is the scalar reference's float, bit for bit. */
+#include "sn_kernels_fsimd.h"
+
+#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+
+#define BLKP(K, a, b) ((K) + (size_t)SN_K_BLK(a, b) * SN_REAL_BYTES)
+
+/* the nf accumulators to l (3 floats each; 4-lane stores in ascending
+ * order, each overwriting the previous one's lane 3, the last masked) */
+SN_INLINE void store_rows(sn_acc *l, const sn_fv *L, uint32_t nf) {
+    uint32_t i;
+    for (i = 0; i + 1 < nf; i++) FV_ST4(l + 3 * i, L[i]);
+    if (nf) fv_st3(l + 3 * (nf - 1), L[nf - 1]);
+}
+
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    sn_fv L[8], r[3], c[3];
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) L[i] = FV_SET1(0.0f);
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        const sn_fv ua0 = FV_SET1(u[3 * i]), ua1 = FV_SET1(u[3 * i + 1]), ua2 = FV_SET1(u[3 * i + 2]);
+        sn_fv la;
+        fv_cols(BLKP(K, a, a), c);
+        la = FV_ADD(L[i], FV_MAC3(c, ua0, ua1, ua2)); /* diagonal block (a,a) */
+        for (j = i + 1; j < nf; j++) {
+            const sn_fv ub0 = FV_SET1(u[3 * j]), ub1 = FV_SET1(u[3 * j + 1]), ub2 = FV_SET1(u[3 * j + 2]);
+            fv_blk(BLKP(K, a, fc[j]), r, c);
+            la = FV_ADD(la, FV_MAC3(c, ub0, ub1, ub2));
+            L[j] = FV_ADD(L[j], FV_MAC3(r, ua0, ua1, ua2));
+        }
+        L[i] = la;
+    }
+    store_rows(l, L, nf);
+}
+
+/* Both right-hand-side products over all 8 corners, one block load for
+ * both (every row of l2 computed: the unread ones are allowed). */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
+    sn_fv L1[8], L2[8], r[3], c[3];
+    uint32_t a, b;
+    (void)rows2;
+    for (a = 0; a < 8; a++) L1[a] = L2[a] = FV_SET1(0.0f);
+    for (a = 0; a < 8; a++) {
+        const sn_fv xa0 = FV_SET1(u1[3 * a]), xa1 = FV_SET1(u1[3 * a + 1]), xa2 = FV_SET1(u1[3 * a + 2]);
+        const sn_fv ya0 = FV_SET1(u2[3 * a]), ya1 = FV_SET1(u2[3 * a + 1]), ya2 = FV_SET1(u2[3 * a + 2]);
+        sn_fv la1, la2;
+        fv_cols(BLKP(K, a, a), c);
+        la1 = FV_ADD(L1[a], FV_MAC3(c, xa0, xa1, xa2));
+        la2 = FV_ADD(L2[a], FV_MAC3(c, ya0, ya1, ya2));
+        for (b = a + 1; b < 8; b++) {
+            const sn_fv xb0 = FV_SET1(u1[3 * b]), xb1 = FV_SET1(u1[3 * b + 1]), xb2 = FV_SET1(u1[3 * b + 2]);
+            const sn_fv yb0 = FV_SET1(u2[3 * b]), yb1 = FV_SET1(u2[3 * b + 1]), yb2 = FV_SET1(u2[3 * b + 2]);
+            fv_blk(BLKP(K, a, b), r, c);
+            la1 = FV_ADD(la1, FV_MAC3(c, xb0, xb1, xb2));
+            L1[b] = FV_ADD(L1[b], FV_MAC3(r, xa0, xa1, xa2));
+            la2 = FV_ADD(la2, FV_MAC3(c, yb0, yb1, yb2));
+            L2[b] = FV_ADD(L2[b], FV_MAC3(r, ya0, ya1, ya2));
+        }
+        L1[a] = la1;
+        L2[a] = la2;
+    }
+    store_rows(l1, L1, 8);
+    store_rows(l2, L2, 8);
+}
+
+/* out[i] = sn_add(a[i], sn_mulq(s, x[i])): s x clamped and counted, added to
+ * a[i], clamped and counted again; 4 entries per iteration, the tail in
+ * scalar (each entry alone: the same floats and counts) */
+void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
+    const sn_fv vs = FV_SET1(s);
+    uint32_t i, c = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m1, m2;
+        sn_fv q = fv_clamp(FV_MUL(vs, FV_LD4(x + i)), &m1);
+        q = fv_clamp(FV_ADD(FV_LD4(a + i), q), &m2);
+        FV_ST4(out + i, q);
+        c += (uint32_t)((m1 & 1) + (m1 >> 1 & 1) + (m1 >> 2 & 1) + (m1 >> 3 & 1));
+        c += (uint32_t)((m2 & 1) + (m2 >> 1 & 1) + (m2 >> 2 & 1) + (m2 >> 3 & 1));
+    }
+    *sat += c;
+    for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
+}
+
+#if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)
+const char *sn_kernels_name(void) { return "avx512"; }
+#elif defined(SN_KERNELS_FAVX2)
+const char *sn_kernels_name(void) { return "avx2"; }
+#else
+const char *sn_kernels_name(void) { return "neon"; }
+#endif
+
+#else
+typedef int sn_kernels_fsimd_unused_; /* ISO C: no empty translation unit */
+#endif
