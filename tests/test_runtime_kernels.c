@@ -564,7 +564,7 @@ static void test_loops(void) {
         clamps += s2;
     }
     T_CHECK(bad == 0, "loop helpers (path %s): %d of 36000 results or clamp counts off the reference formulas", sn_kernels_name(), bad);
-    T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", clamps);
+    T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", (unsigned)clamps);
 }
 
 int main(void) {
