@@ -82,19 +82,11 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
 #endif
 
 #if !defined(SN_FLOAT) && !defined(SN_KERNELS_AVX2) && !defined(SN_KERNELS_NEON) && !defined(SN_KERNELS_M4)
-/* The bound uses the OR of the magnitudes (same bit length as their
- * maximum, no compares). */
+/* The scale: sn_k_dot_scale (sn_kernels.h). */
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
-    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
-    int s;
+    uint32_t i, k, nv = n / 3;
+    const int s = sn_k_dot_scale(a, b, 0, n, 0, 0);
     int64_t sum = 0;
-    for (i = 0; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
     for (i = 0; i < nv; i++) {
         int sh = s + kk[i];
         int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;

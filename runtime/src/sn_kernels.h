@@ -25,6 +25,7 @@
 #define SN_KERNELS_H
 
 #include "sn_internal.h"
+#include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_SIMD_SCALAR)
 #define SN_KERNELS_SCALAR 1
@@ -116,6 +117,20 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
  * by s + k_i (round half up), returns the sum and *e = s. Each product is
  * rounded alone, so the sum is exact and order-free (|sum| < 2^62). */
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e);
+
+/* sn_k_dot's s, every path's: oa, ob the ORs of |a|, |b| over [0, i) (a
+ * SIMD head; the OR has the bit length of the maximum, no compares), the
+ * rest gathered here. */
+SN_INLINE int sn_k_dot_scale(const sn_q *a, const sn_q *b, uint32_t i, uint32_t n, uint32_t oa, uint32_t ob) {
+    int s;
+    for (; i < n; i++) {
+        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
+        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
+    }
+    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
+    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
+    return s < 0 ? 0 : s;
+}
 #endif
 
 /* The CG's vector updates (sn_solve.c axpy, the direction update):

@@ -118,13 +118,7 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
     for (k = 0; k < 8; k++) oa |= t[k];
     _mm256_storeu_si256((__m256i *)(void *)t, vb);
     for (k = 0; k < 8; k++) ob |= t[k];
-    for (; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
+    s = sn_k_dot_scale(a, b, i, n, oa, ob);
     {
         const __m256i vs = _mm256_set1_epi64x(s);
         for (i = 0; i + 4 <= nv; i += 4) {

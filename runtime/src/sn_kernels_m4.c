@@ -176,15 +176,9 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * the shift is done on the two words: the same rounded terms (sn_rshr64_var's
  * identity), summed in the same order. */
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
-    uint32_t i, k, oa = 0, ob = 0, nv = n / 3;
-    int s;
+    uint32_t i, k, nv = n / 3;
+    const int s = sn_k_dot_scale(a, b, 0, n, 0, 0);
     int64_t sum = 0;
-    for (i = 0; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
     for (i = 0; i < nv; i++) {
         const int sh = s + kk[i];
         if (sh > 0 && sh < 32) {

@@ -103,13 +103,7 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
     }
     oa = vgetq_lane_u32(va, 0) | vgetq_lane_u32(va, 1) | vgetq_lane_u32(va, 2) | vgetq_lane_u32(va, 3);
     ob = vgetq_lane_u32(vb, 0) | vgetq_lane_u32(vb, 1) | vgetq_lane_u32(vb, 2) | vgetq_lane_u32(vb, 3);
-    for (; i < n; i++) {
-        oa |= a[i] < 0 ? (uint32_t)-(int64_t)a[i] : (uint32_t)a[i];
-        ob |= b[i] < 0 ? (uint32_t)-(int64_t)b[i] : (uint32_t)b[i];
-    }
-    /* n * max|a| * max|b| < 2^62 after shifting each product right by s */
-    s = bitlen64(oa) + bitlen64(ob) + bitlen64(n) - 62;
-    s = s < 0 ? 0 : s;
+    s = sn_k_dot_scale(a, b, i, n, oa, ob);
     for (i = 0; i + 2 <= nv; i += 2) {
         const sn_q *pa = a + 3 * i, *pb = b + 3 * i;
         const int64x1_t n0 = vdup_n_s64(-(int64_t)(s + kk[i])), n1 = vdup_n_s64(-(int64_t)(s + kk[i + 1]));
