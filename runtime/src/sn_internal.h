@@ -141,6 +141,14 @@ SN_INLINE int64_t sn_rshr64(int64_t x, int s) {
     return (x + ((int64_t)1 << (s - 1))) >> s;
 }
 
+/* x >> s (floor) for 0 < s < 32 on the two 32-bit words: lo >> s | hi <<
+ * (32 - s) and hi >> s, a 32-bit core's cheap form of a variable 64-bit
+ * shift (the Cortex-M paths: sn_rshr64_var, the M4 kernels). */
+SN_INLINE int64_t sn_shr_words(uint32_t lo, int32_t hi, int s) {
+    return (int64_t)(hi >> s) * ((int64_t)1 << 32) + (int64_t)((lo >> s) | ((uint32_t)hi << (32 - s)));
+}
+SN_INLINE int64_t sn_shr64_w(int64_t x, int s) { return sn_shr_words((uint32_t)x, (int32_t)(x >> 32), s); }
+
 /* sn_rshr64 for a shift known only at run time, on a 32-bit Cortex-M: for
  * 0 < s < 32 the add's carry and the shift on the two words (10
  * instructions instead of GCC's 19 for a variable 64-bit shift and its
@@ -155,7 +163,7 @@ SN_INLINE int64_t sn_rshr64_var(int64_t x, int s) {
         const uint32_t bit = (uint32_t)1 << (s - 1), lo = (uint32_t)x + bit;
         const int32_t hi = (int32_t)(x >> 32) + (int32_t)(lo < bit);
         SN_RANGE(x <= INT64_MAX - ((int64_t)1 << (s - 1)), "rounding add overflows int64", x);
-        return (int64_t)(hi >> s) * ((int64_t)1 << 32) + (int64_t)((lo >> s) | ((uint32_t)hi << (32 - s)));
+        return sn_shr_words(lo, hi, s);
     }
     return sn_rshr64(x, s);
 }

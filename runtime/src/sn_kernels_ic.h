@@ -170,35 +170,28 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
  * share the shift split over the two words: lo >> s | hi << (32 - s) and
  * hi >> s, the value of sn_rshr64 (the sum is exact, < 2^44.6 + 2^30, no
  * overflow). Other s (s < 0 scales up and clamps): the reference. */
-SN_INLINE sn_acc sn_k_ic_sh(int64_t p, int s, int r) { /* p >> s, 0 < s < 32, r = 32 - s */
-    const uint32_t lo = (uint32_t)p;
-    const int32_t hi = (int32_t)(p >> 32);
-    return (int64_t)(hi >> s) * ((int64_t)1 << 32) + (int64_t)((lo >> s) | ((uint32_t)hi << r));
+/* out[k] += (2^(s-1) + sum_j U[ko k + ji j] v[j]) >> s over the block's 9
+ * int16 entries (byte strides: column products ko 2, ji 6; row products ko
+ * 6, ji 2) */
+SN_INLINE void sn_k_ic_m4(const unsigned char *b, const sn_q v[3], int s, uint32_t ko, uint32_t ji, sn_acc out[3]) {
+    const int64_t bias = (int64_t)((uint32_t)1 << (s - 1));
+    const int32_t v0 = v[0], v1 = v[1], v2 = v[2];
+    /* written out: GCC keeps a loop of 3 (+0.1 M a cow step) */
+#define SN_K_IC_T(k) sn_shr64_w(bias + (int64_t)sn_k_ic_i16(b + (k) * ko) * v0 + \
+                                (int64_t)sn_k_ic_i16(b + (k) * ko + ji) * v1 + (int64_t)sn_k_ic_i16(b + (k) * ko + 2 * ji) * v2, s)
+    out[0] += SN_K_IC_T(0);
+    out[1] += SN_K_IC_T(1);
+    out[2] += SN_K_IC_T(2);
+#undef SN_K_IC_T
 }
 SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
-    const int64_t bias = (int64_t)((uint32_t)1 << ((s - 1) & 31));
-    const int r = 32 - s;
-    const int32_t y0 = y[0], y1 = y[1], y2 = y[2];
-    if (s <= 0 || s >= 32) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
-    a[0] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b) * y0 + (int64_t)sn_k_ic_i16(b + 6) * y1 +
-                       (int64_t)sn_k_ic_i16(b + 12) * y2, s, r);
-    a[1] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 2) * y0 + (int64_t)sn_k_ic_i16(b + 8) * y1 +
-                       (int64_t)sn_k_ic_i16(b + 14) * y2, s, r);
-    a[2] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 4) * y0 + (int64_t)sn_k_ic_i16(b + 10) * y1 +
-                       (int64_t)sn_k_ic_i16(b + 16) * y2, s, r);
+    if (s <= 0 || s >= 32) sn_k_ic_col_ref(b, y, s, a, sat);
+    else sn_k_ic_m4(b, y, s, 2, 6, a);
 }
 SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
     const int s = b[18];
-    const int64_t bias = (int64_t)((uint32_t)1 << ((s - 1) & 31));
-    const int r = 32 - s;
-    const int32_t z0 = z[0], z1 = z[1], z2 = z[2];
-    if (s <= 0 || s >= 32) { sn_k_ic_row_ref(b, z, l, sat); return; }
-    l[0] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b) * z0 + (int64_t)sn_k_ic_i16(b + 2) * z1 +
-                       (int64_t)sn_k_ic_i16(b + 4) * z2, s, r);
-    l[1] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 6) * z0 + (int64_t)sn_k_ic_i16(b + 8) * z1 +
-                       (int64_t)sn_k_ic_i16(b + 10) * z2, s, r);
-    l[2] += sn_k_ic_sh(bias + (int64_t)sn_k_ic_i16(b + 12) * z0 + (int64_t)sn_k_ic_i16(b + 14) * z1 +
-                       (int64_t)sn_k_ic_i16(b + 16) * z2, s, r);
+    if (s <= 0 || s >= 32) sn_k_ic_row_ref(b, z, l, sat);
+    else sn_k_ic_m4(b, z, s, 6, 2, l);
 }
 
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)

@@ -183,20 +183,11 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
         const int sh = s + kk[i];
         if (sh > 0 && sh < 32) {
             const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
-            const int r = 32 - sh;
             const sn_q *ai = a + 3 * i, *bi = b + 3 * i;
             /* written out: GCC kept a loop of 3 (15 instructions a term) */
-#define SN_DOT_T(k)                                                                                       \
-    do {                                                                                                  \
-        const int64_t p = bias + (int64_t)ai[k] * bi[k];                                                  \
-        const uint32_t lo = (uint32_t)p;                                                                  \
-        const int32_t hi = (int32_t)(p >> 32);                                                            \
-        sum += (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | ((uint32_t)hi << r));   \
-    } while (0)
-            SN_DOT_T(0);
-            SN_DOT_T(1);
-            SN_DOT_T(2);
-#undef SN_DOT_T
+            sum += sn_shr64_w(bias + (int64_t)ai[0] * bi[0], sh);
+            sum += sn_shr64_w(bias + (int64_t)ai[1] * bi[1], sh);
+            sum += sn_shr64_w(bias + (int64_t)ai[2] * bi[2], sh);
         } else {
             const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
             for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
@@ -214,12 +205,8 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     uint32_t i;
     if (sh > 0 && sh < 32) {
         const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
-        const int r = 32 - sh;
         for (i = 0; i < n; i++) {
-            const int64_t p = bias + (int64_t)s * x[i];
-            const uint32_t lo = (uint32_t)p;
-            const int32_t hi = (int32_t)(p >> 32);
-            const int64_t v = (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | ((uint32_t)hi << r));
+            const int64_t v = sn_shr64_w(bias + (int64_t)s * x[i], sh);
             sn_q q;
             if (v > SN_LIM) { (*sat)++; q = SN_LIM; }
             else if (v < -SN_LIM) { (*sat)++; q = -SN_LIM; }
