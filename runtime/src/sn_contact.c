@@ -34,6 +34,7 @@
  * rows share the contacts' baked rows (max_contacts), after the normal ones.
  */
 #include "sn_constraint.h"
+#include "sn_cut.h" /* sn_point_weights: the cut level's field */
 
 typedef struct sn_col {
     uint32_t kind;
@@ -167,14 +168,14 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
  * room_a = min(cell/2, cell/2 - n.(p_a + v_a + g^ - skin_a)). Skeleton
  * corners are the bones' own: the row never moves them. Returns the bound
  * (<= 0: no room, no row). Q22; S2 Q60 (fixed). */
-static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, const sn_q *vp,
+static sn_q ct_yield(sn_ihdr *h, const uint16_t *vx, const sn_q *phi, uint32_t ne, const sn_q n[3], sn_acc S2, const sn_q *vp,
                      uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *pos = CARR(h, o_pos, sn_q);
     const sn_q dv = (sn_q)(v->cell / 2), dmax = (sn_q)(v->cell / 2);
     sn_q m = SN_LIM_OR_BIG;
     uint32_t k, q;
-    for (k = 0; k < 8; k++) {
+    for (k = 0; k < ne; k++) {
         uint32_t a = vx[k];
         sn_q sk[3], dev, room, ratio;
         sn_acc d = 0;
@@ -205,10 +206,10 @@ static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const 
 
 /* the free corner with the largest weight (first on ties); SN_NO_DOM: not yet */
 #define SN_NO_DOM 0xFFFFFFFFu
-static uint32_t ct_dom(const uint16_t *vx16, const sn_q phi[8], uint32_t nF) {
+static uint32_t ct_dom(const uint16_t *vx16, const sn_q *phi, uint32_t ne, uint32_t nF) {
     uint32_t k, best = 0xFFFFu;
     sn_q m = 0;
-    for (k = 0; k < 8; k++)
+    for (k = 0; k < ne; k++)
         if (vx16[k] < nF && phi[k] > m) { m = phi[k]; best = vx16[k]; }
     return best;
 }
@@ -268,9 +269,9 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3], dom = SN_NO_DOM, anyf = 0;
-        uint16_t vx[8];
-        sn_q phi[8], P[3], Vp[3];
+        uint32_t t[3], dom = SN_NO_DOM, anyf = 0, ne = 8;
+        uint16_t vx[SN_CUT_POINT_MAX]; /* the cell's corners, then (cut level) the extras of the point's child */
+        sn_q phi[SN_CUT_POINT_MAX], P[3], Vp[3];
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
         for (k = 0; k < 8; k++) {
             vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
@@ -278,10 +279,11 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         }
         if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
-        sn_trilinear(t, phi);
+        if (v->cut) ne = sn_point_weights(v, sn_rd_u16(e), t, vx, phi); /* the rendered point's field (extras: skeleton) */
+        else sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
-        for (k = 0; k < 8; k++)
+        for (k = 0; k < 8; k++) /* the free vertices are corners */
             if (vx[k] < v->nF) fw += sn_mul(phi[k], phi[k]);
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
@@ -291,14 +293,14 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
         if (exact) /* the hot loop: each corner's two rows read straight from the arrays */
-            for (k = 0; k < 8; k++) {
+            for (k = 0; k < ne; k++) {
                 const uint32_t a = vx[k];
                 const sn_q *pp = a < v->nF ? pos + 3 * a : pst + 3 * (a - v->nF), *vv = a < v->nF ? vpre + 3 * a : vel + 3 * a;
                 sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
                 sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
             }
         else
-            for (k = 0; k < 8; k++)
+            for (k = 0; k < ne; k++)
                 for (q = 0; q < 3; q++) {
                     sp[q] += sn_mul(phi[k], ct_start(h, NULL, vx[k], q, sat));
                     sv[q] += sn_mul(phi[k], ct_vel(h, NULL, vx[k], q, sat));
@@ -331,7 +333,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
             target = sn_add(vcn, want, sat);
             if (dn > 0) {
-                lim = ct_yield(h, vx, phi, n, fw, vpre, sat);
+                lim = ct_yield(h, vx, phi, ne, n, fw, vpre, sat);
                 if (!(lim > 0)) continue; /* the free corners are already as far out as the bound lets them: no row */
                 if (dn > lim) {           /* yield: ask only what the free corners can give within the bound */
                     target = sn_add(sn_add(vcn, vr, sat), lim, sat);
@@ -342,7 +344,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
              * corner's three unknowns from several contacts are nearly
              * dependent (their normals 30-60 deg apart) and leave no room for
              * the contact's friction rows */
-            if (dom == SN_NO_DOM) dom = ct_dom(vx, phi, v->nF); /* once a vertex, and only for a contact */
+            if (dom == SN_NO_DOM) dom = ct_dom(vx, phi, ne, v->nF); /* once a vertex, and only for a contact */
             for (j = first; j < h->n_rows; j++) /* every row since first is a contact's (one-sided) */
                 if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && (uint32_t)rx[j].a == dom) break;
             if (j < h->n_rows && !(score < rx[j].spare)) continue;
@@ -353,8 +355,8 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             {
                 sn_row r;
                 memset(&r, 0, sizeof r);
-                r.n = 8;
-                for (k = 0; k < 8; k++) { r.vtx[k] = vx[k]; r.w[k] = phi[k]; }
+                r.n = (uint8_t)ne;
+                for (k = 0; k < ne; k++) { r.vtx[k] = vx[k]; r.w[k] = phi[k]; }
                 for (q = 0; q < 3; q++) r.dir[q] = n[q];
                 r.target = target;
                 r.one_sided = 1;

@@ -128,3 +128,47 @@ void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const s
         }
     }
 }
+
+/* A point's row weights (sn_cut.h): plain, the trilinear phi_a; cut, the same
+ * field sn_cut_interp gives the surface written over the lattice vertices:
+ * w_a = sum over the child's corners k not at an extra of phi'_k n_a(k) / 8
+ * (the cell's trilinear field there), w_x = phi'_k at an extra x (zero
+ * weights left out). Non-negative, summing to one within the Q30 roundings
+ * (8 + 7 terms); fixed: sum_k phi'_k n_a(k) <= 8 2^30 before the shift. */
+uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], uint16_t vtx[SN_CUT_POINT_MAX],
+                          sn_q w[SN_CUT_POINT_MAX]) {
+    const unsigned char *cl = v->sec[SN_SEC_CELLS] + (size_t)cell * SN_ELEM_CELLS, *cx;
+    uint32_t b[3], tc[3], k, a, c, n = 8;
+    sn_acc s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    sn_q phi[8];
+    for (a = 0; a < 8; a++) vtx[a] = (uint16_t)sn_rd_u16(cl + 2 * a);
+    if (!v->cut) {
+        sn_trilinear(t, w);
+        return 8;
+    }
+    cx = sn_sec(v, SN_SEC_CELLX) + (size_t)cell * SN_ELEM_CELLX;
+    for (c = 0; c < 3; c++) { /* the child, as sn_cut_interp */
+        b[c] = t[c] >= 16384u;
+        tc[c] = 2u * t[c] - 32768u * b[c];
+    }
+    sn_trilinear(tc, phi);
+    for (k = 0; k < 8; k++) {
+        uint32_t p0 = b[0] + (k & 1u), p1 = b[1] + (k >> 1 & 1u), p2 = b[2] + (k >> 2 & 1u), slot = cut_slot[p0 + 3 * p1 + 9 * p2], x;
+        if (slot != 255u && (x = sn_rd_u16(cx + 2 * slot)) != SN_CUT_NONE) {
+            if (phi[k] != 0) { vtx[n] = (uint16_t)x; w[n] = phi[k]; n++; }
+            continue;
+        }
+        for (a = 0; a < 8; a++) { /* n_a as sn_cut_interp */
+            uint32_t na = ((a & 1u) ? p0 : 2u - p0) * ((a >> 1 & 1u) ? p1 : 2u - p1) * ((a >> 2 & 1u) ? p2 : 2u - p2);
+            s[a] += (sn_acc)na * phi[k];
+        }
+    }
+    for (a = 0; a < 8; a++) {
+#if defined(SN_FLOAT)
+        w[a] = s[a] * 0.125f;
+#else
+        w[a] = (sn_q)sn_rshr64(s[a], 3);
+#endif
+    }
+    return n;
+}
