@@ -592,7 +592,7 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
         info->cut_nx = cut.nx; info->cut_freed = cut.nfreed; info->cut_air = cut.nair; info->cut_lost = cut.nlost;
     }
     /* shared surface data */
-    o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
+    o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt; o2.cr_nq = o->cr_nq;
     o2.cr_vnbr = o->cr_vnbr; o2.cr_tnbr = o->cr_tnbr; o2.cr_list = o->cr_list; o2.cr_active = o->cr_active;
     o2.cr_depth = o->cr_depth; o2.cr_push = o->cr_push; o2.cr_exclude = o->cr_exclude;
     if (sb_blob_make(&o2, flavour, &b1) || sb_blob_make(o, flavour, &b0)) goto done;

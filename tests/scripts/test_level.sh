@@ -35,6 +35,13 @@ for fl in "" _float; do
     suite "cut_runtime$fl cow" "$B/tests/cut_runtime$fl" "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" neck y 90
     suite "cut_runtime$fl beast" "$B/tests/cut_runtime$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob" elbow_l y 90
 done
+# rows on the cut level (tests/test_runtime_cut_rows.c): pins, a sphere, crease; the cow also against
+# levels 0 and 1 (--compare), the beast the cut level alone (its level 1 is 30 M instructions a step)
+for fl in "" _float; do
+    suite "cut_rows$fl cow" "$B/tests/cut_rows$fl" --compare "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" "$L/limb_crease_cut$fl.blob"
+    suite "cut_rows$fl beast" "$B/tests/cut_rows$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob"
+    suite "cut_rows_fold$fl limb_crease" "$B/tests/cut_rows_fold$fl" -c "$L/limb_crease_cut$fl.blob"
+done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
 for fl in fixed float; do
     if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_lod.blob; else P=$B/sinew-play-float; BL=$L/cow_lod_float.blob; fi
