@@ -131,10 +131,20 @@ void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const s
 
 /* A point's row weights (sn_cut.h): plain, the trilinear phi_a; cut, the same
  * field sn_cut_interp gives the surface written over the lattice vertices:
- * w_a = sum over the child's corners k not at an extra of phi'_k n_a(k) / 8
- * (the cell's trilinear field there), w_x = phi'_k at an extra x (zero
- * weights left out). Non-negative, summing to one within the Q30 roundings
- * (8 + 7 terms); fixed: sum_k phi'_k n_a(k) <= 8 2^30 before the shift. */
+ * w_a = sum over the child's corners k not at an extra of phi'_k n_a(k) / 8,
+ * = phi_a(t) - sum over the child's corners k at an extra of phi'_k n_a(k) / 8
+ * (the trilinear field restricted to the child is the child's trilinear
+ * interpolation of its corner values), w_x = phi'_k at an extra x (zero
+ * weights left out). A child without extras: the plain weights. Sum one
+ * within the Q30 roundings (8 + 7 terms); fixed: sum_k phi'_k n_a(k) <=
+ * 8 2^30 before the shift; a w_a whose true value is 0 may round to -1 LSB. */
+static const uint8_t cut_na[27][8] = { /* n_a at half-cell point p0 + 3 p1 + 9 p2: prod over axes of (a bit ? p : 2 - p) */
+    {8, 0, 0, 0, 0, 0, 0, 0}, {4, 4, 0, 0, 0, 0, 0, 0}, {0, 8, 0, 0, 0, 0, 0, 0}, {4, 0, 4, 0, 0, 0, 0, 0}, {2, 2, 2, 2, 0, 0, 0, 0},
+    {0, 4, 0, 4, 0, 0, 0, 0}, {0, 0, 8, 0, 0, 0, 0, 0}, {0, 0, 4, 4, 0, 0, 0, 0}, {0, 0, 0, 8, 0, 0, 0, 0}, {4, 0, 0, 0, 4, 0, 0, 0},
+    {2, 2, 0, 0, 2, 2, 0, 0}, {0, 4, 0, 0, 0, 4, 0, 0}, {2, 0, 2, 0, 2, 0, 2, 0}, {1, 1, 1, 1, 1, 1, 1, 1}, {0, 2, 0, 2, 0, 2, 0, 2},
+    {0, 0, 4, 0, 0, 0, 4, 0}, {0, 0, 2, 2, 0, 0, 2, 2}, {0, 0, 0, 4, 0, 0, 0, 4}, {0, 0, 0, 0, 8, 0, 0, 0}, {0, 0, 0, 0, 4, 4, 0, 0},
+    {0, 0, 0, 0, 0, 8, 0, 0}, {0, 0, 0, 0, 4, 0, 4, 0}, {0, 0, 0, 0, 2, 2, 2, 2}, {0, 0, 0, 0, 0, 4, 0, 4}, {0, 0, 0, 0, 0, 0, 8, 0},
+    {0, 0, 0, 0, 0, 0, 4, 4}, {0, 0, 0, 0, 0, 0, 0, 8}};
 uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], uint16_t vtx[SN_CUT_POINT_MAX],
                           sn_q w[SN_CUT_POINT_MAX]) {
     const unsigned char *cl = v->sec[SN_SEC_CELLS] + (size_t)cell * SN_ELEM_CELLS, *cx;
@@ -142,10 +152,8 @@ uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], 
     sn_acc s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     sn_q phi[8];
     for (a = 0; a < 8; a++) vtx[a] = (uint16_t)sn_rd_u16(cl + 2 * a);
-    if (!v->cut) {
-        sn_trilinear(t, w);
-        return 8;
-    }
+    sn_trilinear(t, w);
+    if (!v->cut) return 8;
     cx = sn_sec(v, SN_SEC_CELLX) + (size_t)cell * SN_ELEM_CELLX;
     for (c = 0; c < 3; c++) { /* the child, as sn_cut_interp */
         b[c] = t[c] >= 16384u;
@@ -153,22 +161,20 @@ uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], 
     }
     sn_trilinear(tc, phi);
     for (k = 0; k < 8; k++) {
-        uint32_t p0 = b[0] + (k & 1u), p1 = b[1] + (k >> 1 & 1u), p2 = b[2] + (k >> 2 & 1u), slot = cut_slot[p0 + 3 * p1 + 9 * p2], x;
-        if (slot != 255u && (x = sn_rd_u16(cx + 2 * slot)) != SN_CUT_NONE) {
-            if (phi[k] != 0) { vtx[n] = (uint16_t)x; w[n] = phi[k]; n++; }
-            continue;
-        }
-        for (a = 0; a < 8; a++) { /* n_a as sn_cut_interp */
-            uint32_t na = ((a & 1u) ? p0 : 2u - p0) * ((a >> 1 & 1u) ? p1 : 2u - p1) * ((a >> 2 & 1u) ? p2 : 2u - p2);
-            s[a] += (sn_acc)na * phi[k];
-        }
+        uint32_t p = b[0] + (k & 1u) + 3u * (b[1] + (k >> 1 & 1u)) + 9u * (b[2] + (k >> 2 & 1u)), slot = cut_slot[p], x;
+        if (slot == 255u || (x = sn_rd_u16(cx + 2 * slot)) == SN_CUT_NONE || phi[k] == 0) continue;
+        vtx[n] = (uint16_t)x;
+        w[n] = phi[k];
+        n++;
+        for (a = 0; a < 8; a++) s[a] += (sn_acc)cut_na[p][a] * phi[k];
     }
-    for (a = 0; a < 8; a++) {
+    if (n > 8)
+        for (a = 0; a < 8; a++) {
 #if defined(SN_FLOAT)
-        w[a] = s[a] * 0.125f;
+            w[a] -= s[a] * 0.125f;
 #else
-        w[a] = (sn_q)sn_rshr64(s[a], 3);
+            w[a] -= (sn_q)sn_rshr64(s[a], 3);
 #endif
-    }
+        }
     return n;
 }
