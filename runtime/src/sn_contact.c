@@ -159,6 +159,19 @@ SN_INLINE sn_q ct_start(const sn_ihdr *h, const sn_q *pst, uint32_t a, uint32_t 
 
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat);
 
+/* sp += sum phi_k p_k (start points), sv += sum phi_k v_k (predicted velocities) over ne entries, from
+ * ct_predict's arrays; inlined with ne = 8 for the plain lattice (its loop unrolled as before the cut level) */
+SN_INLINE void ct_sum(uint32_t nF, const sn_q *pos, const sn_q *pst, const sn_q *vel, const sn_q *vpre, const uint16_t *vx,
+                      const sn_q *phi, uint32_t ne, sn_acc sp[3], sn_acc sv[3]) {
+    uint32_t k;
+    for (k = 0; k < ne; k++) {
+        const uint32_t a = vx[k];
+        const sn_q *pp = a < nF ? pos + 3 * a : pst + 3 * (a - nF), *vv = a < nF ? vpre + 3 * a : vel + 3 * a;
+        sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
+        sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
+    }
+}
+
 /* The yield bound (NUMERICS.md "Contacts"): the most normal velocity change
  * a contact row may ask of its point so that no free corner of its cell
  * changes its velocity by more than cell/2 this step or ends more than
@@ -270,8 +283,10 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
         uint32_t t[3], dom = SN_NO_DOM, anyf = 0, ne = 8;
-        uint16_t vx[SN_CUT_POINT_MAX]; /* the cell's corners, then (cut level) the extras of the point's child */
-        sn_q phi[SN_CUT_POINT_MAX], P[3], Vp[3];
+        uint16_t vx[8], cvx[SN_CUT_POINT_MAX];
+        sn_q phi[8], cw[SN_CUT_POINT_MAX], P[3], Vp[3];
+        const uint16_t *X = vx; /* the row's entries: the cell's corners, or (cut level) cvx: the corners, then the extras of the child */
+        const sn_q *W = phi;
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
         for (k = 0; k < 8; k++) {
             vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
@@ -279,12 +294,16 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         }
         if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
-        if (v->cut) ne = sn_point_weights(v, sn_rd_u16(e), t, vx, phi); /* the rendered point's field (extras: skeleton) */
-        else sn_trilinear(t, phi);
+        if (v->cut) { /* the rendered point's field (extras: skeleton entries) */
+            ne = sn_point_weights(v, sn_rd_u16(e), t, cvx, cw);
+            X = cvx;
+            W = cw;
+        } else
+            sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
         for (k = 0; k < 8; k++) /* the free vertices are corners */
-            if (vx[k] < v->nF) fw += sn_mul(phi[k], phi[k]);
+            if (X[k] < v->nF) fw += sn_mul(W[k], W[k]);
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
@@ -292,18 +311,15 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
-        if (exact) /* the hot loop: each corner's two rows read straight from the arrays */
-            for (k = 0; k < ne; k++) {
-                const uint32_t a = vx[k];
-                const sn_q *pp = a < v->nF ? pos + 3 * a : pst + 3 * (a - v->nF), *vv = a < v->nF ? vpre + 3 * a : vel + 3 * a;
-                sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
-                sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
-            }
+        if (exact && !v->cut) /* the hot loop: each corner's two rows read straight from the arrays (8: unrolled) */
+            ct_sum(v->nF, pos, pst, vel, vpre, vx, phi, 8u, sp, sv);
+        else if (exact)
+            ct_sum(v->nF, pos, pst, vel, vpre, X, W, ne, sp, sv);
         else
             for (k = 0; k < ne; k++)
                 for (q = 0; q < 3; q++) {
-                    sp[q] += sn_mul(phi[k], ct_start(h, NULL, vx[k], q, sat));
-                    sv[q] += sn_mul(phi[k], ct_vel(h, NULL, vx[k], q, sat));
+                    sp[q] += sn_mul(W[k], ct_start(h, NULL, X[k], q, sat));
+                    sv[q] += sn_mul(W[k], ct_vel(h, NULL, X[k], q, sat));
                 }
         for (q = 0; q < 3; q++) {
             P[q] = sn_out(sp[q], 30, sat);
@@ -333,7 +349,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
             target = sn_add(vcn, want, sat);
             if (dn > 0) {
-                lim = ct_yield(h, vx, phi, ne, n, fw, vpre, sat);
+                lim = ct_yield(h, X, W, ne, n, fw, vpre, sat);
                 if (!(lim > 0)) continue; /* the free corners are already as far out as the bound lets them: no row */
                 if (dn > lim) {           /* yield: ask only what the free corners can give within the bound */
                     target = sn_add(sn_add(vcn, vr, sat), lim, sat);
@@ -344,7 +360,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
              * corner's three unknowns from several contacts are nearly
              * dependent (their normals 30-60 deg apart) and leave no room for
              * the contact's friction rows */
-            if (dom == SN_NO_DOM) dom = ct_dom(vx, phi, ne, v->nF); /* once a vertex, and only for a contact */
+            if (dom == SN_NO_DOM) dom = ct_dom(X, W, ne, v->nF); /* once a vertex, and only for a contact */
             for (j = first; j < h->n_rows; j++) /* every row since first is a contact's (one-sided) */
                 if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && (uint32_t)rx[j].a == dom) break;
             if (j < h->n_rows && !(score < rx[j].spare)) continue;
@@ -356,7 +372,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
                 sn_row r;
                 memset(&r, 0, sizeof r);
                 r.n = (uint8_t)ne;
-                for (k = 0; k < ne; k++) { r.vtx[k] = vx[k]; r.w[k] = phi[k]; }
+                for (k = 0; k < ne; k++) { r.vtx[k] = X[k]; r.w[k] = W[k]; }
                 for (q = 0; q < 3; q++) r.dir[q] = n[q];
                 r.target = target;
                 r.one_sided = 1;
