@@ -67,13 +67,20 @@ $(BUILD)/tests/cut_rows: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $
 $(BUILD)/tests/cut_rows_float: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(CUT_ROWS_BLOBS)
 	@mkdir -p $(@D)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
-# the runtime built with every crease pair's skeleton entries folded into its target (the limb's pairs need no fold)
-$(BUILD)/tests/cut_rows_fold: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(SN_SRCS) $(LEVEL_EX)/limb_crease_cut.blob
+# the runtime with every crease pair's skeleton entries folded into its target (the limb's pairs need no fold):
+# sn_crease.c alone rebuilt with -DSN_CR_FOLD_ALL, linked ahead of the library (whose sn_crease.o is then not pulled)
+$(BUILD)/tests/fold/sn_crease.o: runtime/src/sn_crease.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(PHYS_CFLAGS) -Iruntime/src $(SN_SIMD_FLAGS) -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(SN_SRCS) -lm
-$(BUILD)/tests/cut_rows_fold_float: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(SN_SRCS) $(LEVEL_EX)/limb_crease_cut_float.blob
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_CR_FOLD_ALL -c $< -o $@
+$(BUILD)/tests/fold/sn_crease_float.o: runtime/src/sn_crease.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(PHYS_CFLAGS) -Iruntime/src $(SN_SIMD_FLAGS) -DSN_FLOAT -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(SN_SRCS) -lm
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_FLOAT -DSN_CR_FOLD_ALL -c $< -o $@
+$(BUILD)/tests/cut_rows_fold: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(BUILD)/tests/fold/sn_crease.o $(SN_LIB_FIXED) $(LEVEL_EX)/limb_crease_cut.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(BUILD)/tests/fold/sn_crease.o $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/cut_rows_fold_float: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(BUILD)/tests/fold/sn_crease_float.o $(SN_LIB_FLOAT) $(LEVEL_EX)/limb_crease_cut_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(BUILD)/tests/fold/sn_crease_float.o $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/cut_rows $(BUILD)/tests/cut_rows_float $(BUILD)/tests/cut_rows_fold $(BUILD)/tests/cut_rows_fold_float
 
 # Adaptation (runtime/src/sn_adapt.c, tests/test_runtime_adapt.c): the same

@@ -35,11 +35,13 @@ for fl in "" _float; do
     suite "cut_runtime$fl cow" "$B/tests/cut_runtime$fl" "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" neck y 90
     suite "cut_runtime$fl beast" "$B/tests/cut_runtime$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob" elbow_l y 90
 done
-# rows on the cut level (tests/test_runtime_cut_rows.c): pins, a sphere, crease; the cow also against
-# levels 0 and 1 (--compare), the beast the cut level alone (its level 1 is 30 M instructions a step)
+# rows on the cut level (tests/test_runtime_cut_rows.c): pins, a sphere, crease on the cow and the crease
+# limb, both flavours (fixed also against levels 0 and 1: --compare); the beast's cut level, fixed (its float
+# run and the comparisons: runtime/LEVELS.md's commands)
+suite "cut_rows cow" "$B/tests/cut_rows" --compare "$L/cow_cut.blob" "$L/cow_lod.blob" "$L/limb_crease_cut.blob"
+suite "cut_rows_float cow" "$B/tests/cut_rows_float" "$L/cow_cut_float.blob" "$L/cow_lod_float.blob" "$L/limb_crease_cut_float.blob"
+suite "cut_rows beast" "$B/tests/cut_rows" "$L/beast_cut.blob" "$L/beast_lod.blob"
 for fl in "" _float; do
-    suite "cut_rows$fl cow" "$B/tests/cut_rows$fl" --compare "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" "$L/limb_crease_cut$fl.blob"
-    suite "cut_rows$fl beast" "$B/tests/cut_rows$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob"
     suite "cut_rows_fold$fl limb_crease" "$B/tests/cut_rows_fold$fl" -c "$L/limb_crease_cut$fl.blob"
 done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
