@@ -159,6 +159,37 @@ SN_INLINE sn_q ct_start(const sn_ihdr *h, const sn_q *pst, uint32_t a, uint32_t 
 
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat);
 
+static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, const sn_q P[3], sn_q reach, sn_q *g, sn_q n[3], uint32_t *sat);
+SN_INLINE void ct_sum(uint32_t nF, const sn_q *pos, const sn_q *pst, const sn_q *vel, const sn_q *vpre, const uint16_t *vx,
+                      const sn_q *phi, uint32_t ne, sn_acc sp[3], sn_acc sv[3]);
+/* The cut level's prefilter (exact: it drops only vertices sn_contact_rows
+ * would drop): a vertex's cut point and predicted velocity differ from its
+ * cell's trilinear ones by at most the step's largest extra deviations Dp,
+ * Dv (sn_cut_dev: phi' >= 0 sums to one), so its gap by <= sqrt 3 Dp and
+ * its reach (a 1-norm) by <= 3 Dv. 0: no collider within the trilinear
+ * point's reach + margin (2 Dp + 3 Dv + cell/64 for the roundings), the
+ * vertex can take no contact. Its own clamp count (the real pass counts). */
+static int ct_near(const sn_ihdr *h, const sn_col *cols, const sn_q A[][3], const sn_q B[][3], const sn_q *R, const sn_q V[][3],
+                   const uint16_t vx[8], const uint32_t t[3], const sn_q *pst, const sn_q *vpre, sn_q margin) {
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0};
+    sn_q phi[8], P[3], Vp[3], g, n[3];
+    uint32_t c, q, ds = 0;
+    sn_trilinear(t, phi);
+    ct_sum(h->v.nF, pos, pst, vel, vpre, vx, phi, 8u, sp, sv);
+    for (q = 0; q < 3; q++) { P[q] = sn_out(sp[q], 30, &ds); Vp[q] = sn_out(sv[q], 30, &ds); }
+    for (c = 0; c < h->n_col; c++) {
+        sn_acc r = margin;
+        for (q = 0; q < 3; q++) {
+            sn_q rel = sn_add(Vp[q], -V[c][q], &ds);
+            r += rel < 0 ? -(sn_acc)rel : (sn_acc)rel;
+        }
+        if (!(r < (sn_acc)SN_LIM)) return 1; /* too far out to bound: the real test decides */
+        if (ct_gap(cols + c, A[c], B[c], R[c], P, (sn_q)r, &g, n, &ds)) return 1;
+    }
+    return 0;
+}
+
 /* sp += sum phi_k p_k (start points), sv += sum phi_k v_k (predicted velocities) over ne entries, from
  * ct_predict's arrays; inlined with ne = 8 for the plain lattice (its loop unrolled as before the cut level) */
 SN_INLINE void ct_sum(uint32_t nF, const sn_q *pos, const sn_q *pst, const sn_q *vel, const sn_q *vpre, const uint16_t *vx,
@@ -258,6 +289,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_q *pst, *vpre; /* ct_predict's (vpre NULL: not holding) */
     uint32_t c, s, k, first = h->n_rows, ncol = h->n_col;
     uint32_t q;
+    sn_q margin = 0;
     int exact;
     if (ncol == 0) return;
     for (c = 0; c < ncol; c++) { /* the solids at the start of the step, internal units; velocity per step */
@@ -279,6 +311,10 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
     vpre = exact ? CARR(h, o_q, sn_q) : NULL;
     pst = CARR(h, o_d, sn_q);
+    if (v->cut && exact) { /* the cut level's prefilter margin (ct_near) */
+        sn_acc m = 2 * (sn_acc)sn_cut_dev(v, pos, pst) + 3 * (sn_acc)sn_cut_dev(v, vpre, vel + 3 * v->nF) + (sn_acc)(v->cell / 64);
+        margin = m < (sn_acc)SN_LIM ? (sn_q)m : 0; /* 0: no prefilter (a state that far out is rare) */
+    }
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
@@ -294,6 +330,8 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         }
         if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
+        if (margin > 0 && !ct_near(h, cols, (const sn_q (*)[3])A, (const sn_q (*)[3])B, R, (const sn_q (*)[3])V, vx, t, pst, vpre, margin))
+            continue; /* beyond every collider's reach, whatever the extras: the weights below not needed */
         if (v->cut) { /* the rendered point's field (extras: skeleton entries) */
             ne = sn_point_weights(v, sn_rd_u16(e), t, cvx, cw);
             X = cvx;

@@ -178,3 +178,48 @@ uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], 
         }
     return n;
 }
+
+/* sn_cut.h: the deviation bound. Per CELLX entry the trilinear value at its
+ * half-cell point (the dyadic n_a / 8, one rounding shift) and the
+ * difference; fixed |difference| <= 2^29, kept in int64, clamped to SN_LIM.
+ * Cost: the cells' extras x 8 corners x 3, once a step. */
+static const uint8_t cut_pt[SN_CUT_MAXX] = {1, 3, 4, 5, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 19, 21, 22, 23, 25}; /* slot -> point */
+sn_q sn_cut_dev(const sn_view *v, const sn_q *vf, const sn_q *vs) {
+    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX), *cl = v->sec[SN_SEC_CELLS];
+    uint32_t e, j, a, c, nF = v->nF;
+#if defined(SN_FLOAT)
+    float m = 0.0f;
+#else
+    int64_t m = 0;
+#endif
+    for (e = 0; e < v->nC; e++, cx += SN_ELEM_CELLX, cl += SN_ELEM_CELLS) {
+        if (cx[38] == 0) continue;
+        for (j = 0; j < SN_CUT_MAXX; j++) {
+            uint32_t x = sn_rd_u16(cx + 2 * j);
+            const uint8_t *na = cut_na[cut_pt[j]];
+            sn_acc s8[3] = {0, 0, 0};
+            if (x == SN_CUT_NONE) continue;
+            for (a = 0; a < 8; a++) {
+                uint32_t vtx = sn_rd_u16(cl + 2 * a);
+                const sn_q *src = vtx < nF ? vf + 3 * vtx : vs + 3 * (vtx - nF);
+                if (na[a]) for (c = 0; c < 3; c++) s8[c] += (sn_acc)na[a] * src[c];
+            }
+            for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+                float d = vs[3 * (x - nF) + c] - s8[c] * 0.125f;
+                d = d < 0 ? -d : d;
+                m = d > m ? d : m; /* NaN never: the state is finite */
+#else
+                int64_t d = (int64_t)vs[3 * (x - nF) + c] - sn_rshr64(s8[c], 3);
+                d = d < 0 ? -d : d;
+                m = d > m ? d : m;
+#endif
+            }
+        }
+    }
+#if defined(SN_FLOAT)
+    return m;
+#else
+    return (sn_q)(m > SN_LIM ? SN_LIM : m);
+#endif
+}

@@ -30,4 +30,11 @@ void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const s
 uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], uint16_t vtx[SN_CUT_POINT_MAX],
                           sn_q w[SN_CUT_POINT_MAX]);
 
+/* The contacts' prefilter (sn_contact.c): the largest |value at x - the cell's
+ * trilinear value at x| (max-norm over the components) over every cell's
+ * extras x, free vertices' values in vf, skeleton vertices' (nF..nV-1) in vs;
+ * at most SN_LIM (fixed). A point's cut value differs from its trilinear one
+ * by at most this (phi' >= 0, sum <= 1). */
+sn_q sn_cut_dev(const sn_view *v, const sn_q *vf, const sn_q *vs);
+
 #endif /* SN_CUT_H */
