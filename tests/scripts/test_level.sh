@@ -71,5 +71,15 @@ for fl in fixed float; do
     if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: cut_$fl hash $got"; p=$((p + 1));
     else echo "FAIL: cut_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
 done
+# the same with colliders and pins: the rows on the cut level (tests/scripts/update_hashes.sh CUT_ROWS)
+for fl in fixed float; do
+    if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_cut.blob; else P=$B/sinew-play-float; BL=$L/cow_cut_float.blob; fi
+    got=$("$P" "$BL" --clip tools/examples/cow/trot.clip --frames 200 --lod 100:1,150:0 --ground -3.587 \
+          --sphere 1,-4.337,0,1@0,0.3,0 --pin 2126,2362,1732 --hash --quiet 2>/dev/null |
+          sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' | tail -n 1)
+    want=$(sed -n "s/^cut_contact_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
+    if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: cut_contact_$fl hash $got"; p=$((p + 1));
+    else echo "FAIL: cut_contact_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
+done
 echo "$p passed, $f failed"
 [ "$f" -eq 0 ]
