@@ -17,19 +17,25 @@ $(LEVEL_EX)/%_lod_float.blob: $(LEVEL_EX)/%/lod.sinew $(BAKE)
 LEVEL_BLOBS = $(foreach c,cow beast,$(LEVEL_EX)/$(c)_lod.blob $(LEVEL_EX)/$(c)_lod_float.blob)
 
 # The cut level (runtime/LEVELS.md §2 "The cut level", tests/test_runtime_cut.c): the same
-# two-level descriptions with 'levels 2 cut', without the constraint and collider slots
-# (the cut level refuses them at bake time).
+# two-level descriptions with 'levels 2 cut', their constraint and collider slots kept (the
+# rows follow the cut field: tests/test_runtime_cut_rows.c).
 $(LEVEL_EX)/%/cut.sinew: $(LEVEL_EX)/%/lod.sinew tests/level.mk
-	sed -e 's/^levels 2$$/levels 2 cut/' -e '/^constraints /d' -e '/^colliders /d' $< > $@
+	sed -e 's/^levels 2$$/levels 2 cut/' $< > $@
 $(LEVEL_EX)/%_cut.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
 	$(BAKE) $< -o $@ --quiet
 $(LEVEL_EX)/%_cut_float.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 .PRECIOUS: $(LEVEL_EX)/%/cut.sinew
-# the limb's cut level: the fuzzers' seed (tests/fuzz/fuzz.mk) and a small blob for hostile runs
+# the limb's cut level: the fuzzers' seed (tests/fuzz/fuzz.mk) and a small blob for hostile runs,
+# with constraint and collider slots (the rows' code and the CONSTRAINTS record under the fuzzers)
 $(LEVEL_EX)/limb/cut.sinew: tools/examples/limb/limb.sinew tests/level.mk
 	@mkdir -p $(@D)
-	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' -e '/^constraints /d' -e '/^colliders /d' $< > $@
+	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' $< > $@
+	printf 'constraints 4\ncolliders 2 8\nlevels 2 cut\n' >> $@
+# the crease limb's cut level (crease rows on the cut level: tests/test_runtime_cut_rows.c)
+$(LEVEL_EX)/limb_crease/cut.sinew: tools/examples/limb/limb_crease.sinew tests/level.mk
+	@mkdir -p $(@D)
+	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' $< > $@
 	echo 'levels 2 cut' >> $@
 $(LEVEL_EX)/%_cut_double.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour double --quiet
@@ -49,6 +55,33 @@ $(BUILD)/tests/cut_runtime_float: tests/test_runtime_cut.c $(SN_TEST_HDRS) tests
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/cut_runtime $(BUILD)/tests/cut_runtime_float
+# constraint, contact and crease rows on the cut level (tests/test_runtime_cut_rows.c; run by tests/scripts/test_level.sh)
+$(LEVEL_EX)/%_crease_cut.blob: $(LEVEL_EX)/%_crease/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_crease_cut_float.blob: $(LEVEL_EX)/%_crease/cut.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+CUT_ROWS_BLOBS = $(CUT_BLOBS) $(LEVEL_BLOBS) $(LEVEL_EX)/limb_crease_cut.blob $(LEVEL_EX)/limb_crease_cut_float.blob
+$(BUILD)/tests/cut_rows: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FIXED) $(CUT_ROWS_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(REF_SRC) $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/cut_rows_float: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(SN_LIB_FLOAT) $(CUT_ROWS_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
+# the runtime with every crease pair's skeleton entries folded into its target (the limb's pairs need no fold):
+# sn_crease.c alone rebuilt with -DSN_CR_FOLD_ALL, linked ahead of the library (whose sn_crease.o is then not pulled)
+$(BUILD)/tests/fold/sn_crease.o: runtime/src/sn_crease.c $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_CR_FOLD_ALL -c $< -o $@
+$(BUILD)/tests/fold/sn_crease_float.o: runtime/src/sn_crease.c $(SN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_FLOAT -DSN_CR_FOLD_ALL -c $< -o $@
+$(BUILD)/tests/cut_rows_fold: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(BUILD)/tests/fold/sn_crease.o $(SN_LIB_FIXED) $(LEVEL_EX)/limb_crease_cut.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(BUILD)/tests/fold/sn_crease.o $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/cut_rows_fold_float: tests/test_runtime_cut_rows.c $(REF_SRC) $(PHYS_HDRS) $(BUILD)/tests/fold/sn_crease_float.o $(SN_LIB_FLOAT) $(LEVEL_EX)/limb_crease_cut_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -DSN_CR_FOLD_ALL -o $@ $< $(REF_SRC) $(BUILD)/tests/fold/sn_crease_float.o $(SN_LIB_FLOAT) -lm
+TEST_DEPS += $(BUILD)/tests/cut_rows $(BUILD)/tests/cut_rows_float $(BUILD)/tests/cut_rows_fold $(BUILD)/tests/cut_rows_fold_float
 
 # Adaptation (runtime/src/sn_adapt.c, tests/test_runtime_adapt.c): the same
 # two-level blobs with 'adapt REFINE COARSEN MAX_ACTIVE' (level-0 cells); the

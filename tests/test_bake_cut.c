@@ -155,21 +155,23 @@ static void check(const char *path)
     sb_cut_free(&cut); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
 }
 
-/* What the cut level cannot carry is refused at bake time, the error naming the 'levels' line (the limb plus
- * one extra line each; $BUILD/tests/cut_refuse/) */
+/* What the cut level carries and what it refuses at bake time (the limb plus one extra line each;
+ * $BUILD/tests/cut_refuse/): constraints, colliders and crease bake (their rows follow the cut field,
+ * sn_point_weights); 'adapt' is refused, the error naming the 'levels' line. */
 static void refusals(void)
 {
-    static const char *extra[3][2] = {{"constraints 4\n", "constraints and contacts"},
-                                      {"adapt 0.03 0.01 10\n", "adaptation"},
-                                      {"colliders 2 8\n", "constraints and contacts"}};
+    static const char *extra[4][3] = {{"tools/examples/limb/limb.sinew", "constraints 4\n", NULL},
+                                      {"tools/examples/limb/limb.sinew", "adapt 0.03 0.01 10\n", "adaptation"},
+                                      {"tools/examples/limb/limb.sinew", "colliders 2 8\n", NULL},
+                                      {"tools/examples/limb/limb_crease.sinew", "", NULL}};
     const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
     char d[600], path[700], cmd[1500], want[64];
     int i, c;
     snprintf(d, sizeof d, "%s/tests/cut_refuse", b);
     snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp tools/examples/limb/limb.obj '%s/limb.obj'", d, d);
     if (system(cmd) != 0) { T_CHECK(0, "cannot make %s", d); return; }
-    for (i = 0; i < 3; i++) {
-        FILE *in = fopen("tools/examples/limb/limb.sinew", "r"), *f;
+    for (i = 0; i < 4; i++) {
+        FILE *in = fopen(extra[i][0], "r"), *f;
         sb_model o;
         sb_blob bl;
         int line = 1, rc;
@@ -178,13 +180,17 @@ static void refusals(void)
         if (!in || !f) { T_CHECK(0, "cannot write %s", path); if (in) fclose(in); if (f) fclose(f); return; }
         while ((c = fgetc(in)) != EOF) { fputc(c, f); line += c == '\n'; }
         fclose(in);
-        fputs(extra[i][0], f);
+        fputs(extra[i][1], f);
         fputs("levels 2 cut\n", f);
         fclose(f);
         rc = sb_bake_file(path, SB_FIXED, 1, &o, &bl);
-        snprintf(want, sizeof want, ":%d: levels 2 cut: %s", line + 1, extra[i][1]);
-        T_CHECK(rc != 0 && strstr(sb_error(), want) != NULL, "cut level with '%.*s': refused naming the levels line ('%s' in '%s')",
-                (int)strlen(extra[i][0]) - 1, extra[i][0], want, rc ? sb_error() : "baked");
+        if (extra[i][2]) {
+            snprintf(want, sizeof want, ":%d: levels 2 cut: %s", line + 1, extra[i][2]);
+            T_CHECK(rc != 0 && strstr(sb_error(), want) != NULL, "cut level with '%.*s': refused naming the levels line ('%s' in '%s')",
+                    (int)strlen(extra[i][1]) - 1, extra[i][1], want, rc ? sb_error() : "baked");
+        } else
+            T_CHECK(rc == 0 && (i != 3 || o.crease), "cut level with %s: bakes (%s)", i == 3 ? "limb_crease's crease lines" : extra[i][1],
+                    rc ? sb_error() : "ok");
         if (rc == 0) { sb_model_free(&o); sb_blob_free(&bl); }
     }
 }

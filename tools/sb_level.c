@@ -584,17 +584,15 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
     sb_level_desc(d, o, &d2);
     if (sb_level_model(d, &d2, m, &o2)) goto done;
     if (d->levels_cut) {   /* level 0 becomes the cut level: its hats cut at level 1's skeleton (sb_cut.c) */
-        /* surface points and segment attachments follow the cut field (sn_surface_point); constraint, contact and
-         * crease rows weigh a surface point by its cell's 8 corners alone, and adaptation's coarse field is trilinear */
-        const char *what = o->crease ? "crease collision" : (o->max_cons || o->max_cols || o->max_contacts) ? "constraints and contacts"
-                         : d->adapt_line ? "adaptation ('adapt')" : NULL;
-        if (what) { sb_fail("%s:%d: levels 2 cut: %s are not supported on the cut level (remove them or 'cut')", d->path, d->levels_line, what); goto done; }
+        /* surface points, segment attachments and the constraint, contact and crease rows follow the cut field
+         * (sn_surface_point, sn_point_weights); adaptation's coarse field is trilinear: refused */
+        if (d->adapt_line) { sb_fail("%s:%d: levels 2 cut: adaptation ('adapt') is not supported on the cut level (remove it or 'cut')", d->path, d->levels_line); goto done; }
         if (sb_cut_build(o, &o2, d->air, &cut)) goto done;
         sb_cut_apply(d, o, &o2, &cut);
         info->cut_nx = cut.nx; info->cut_freed = cut.nfreed; info->cut_air = cut.nair; info->cut_lost = cut.nlost;
     }
     /* shared surface data */
-    o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt;
+    o2.crease = o->crease; o2.cr_nD = o->cr_nD; o2.cr_pairs = o->cr_pairs; o2.cr_kv = o->cr_kv; o2.cr_kt = o->cr_kt; o2.cr_nq = o->cr_nq;
     o2.cr_vnbr = o->cr_vnbr; o2.cr_tnbr = o->cr_tnbr; o2.cr_list = o->cr_list; o2.cr_active = o->cr_active;
     o2.cr_depth = o->cr_depth; o2.cr_push = o->cr_push; o2.cr_exclude = o->cr_exclude;
     if (sb_blob_make(&o2, flavour, &b1) || sb_blob_make(o, flavour, &b0)) goto done;

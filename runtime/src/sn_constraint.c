@@ -18,13 +18,14 @@
  * like y, Q19 for force-like (clamped to the state range, counted).
  */
 #include "sn_constraint.h"
+#include "sn_cut.h" /* sn_point_weights: a point's weights under the cut field */
 
 typedef struct sn_con {
-    uint16_t vtx[8];  /* lattice vertices of the point (SN_AT_LATTICE: one) */
+    uint16_t vtx[8];  /* lattice vertices of the point (SN_AT_LATTICE: one); cut: cell, t[3] */
     sn_q w[8];        /* their weights, Q30, summing to 1 */
     sn_real target[3];/* world target, public units */
     sn_q dir[3];      /* SN_AXIS_DIR: unit direction, Q30 */
-    uint8_t n, axes, pad0, pad1;
+    uint8_t n, axes, cut, pad1; /* cut: a point on the cut level, its <= 15 weights formed per step (sn_point_weights) */
 } sn_con;
 typedef char sn_con_fits_[sizeof(sn_con) <= SN_CON_BYTES ? 1 : -1];
 
@@ -455,10 +456,15 @@ void sn_user_rows(sn_ihdr *h, uint32_t *sat) {
         sn_q p[3], t[3];
         sn_row r;
         memset(&r, 0, sizeof r);
-        r.n = cn->n;
-        for (k = 0; k < cn->n; k++) { r.vtx[k] = cn->vtx[k]; r.w[k] = cn->w[k]; }
+        if (cn->cut) {
+            const uint32_t tc[3] = {cn->vtx[1], cn->vtx[2], cn->vtx[3]};
+            r.n = (uint8_t)sn_point_weights(&h->v, cn->vtx[0], tc, r.vtx, r.w);
+        } else {
+            r.n = cn->n;
+            for (k = 0; k < cn->n; k++) { r.vtx[k] = cn->vtx[k]; r.w[k] = cn->w[k]; }
+        }
         r.source = SN_ROW_SRC(SN_SRC_USER, i);
-        con_point(h, cn->vtx, cn->w, cn->n, p, sat);
+        con_point(h, r.vtx, r.w, r.n, p, sat);
         for (c = 0; c < 3; c++) {
 #if defined(SN_FLOAT)
             t[c] = sn_add(pub_to_int(h, cn->target[c] - h->origin[c]), -p[c], sat);
@@ -555,6 +561,11 @@ sn_status sn_set_constraints(sn_instance *inst, const sn_constraint *list, uint3
             cn->n = 8;
             sn_trilinear(t, cn->w);
             for (k = 0; k < 8; k++) cn->vtx[k] = (uint16_t)sn_rd_u16(cl + 2 * k);
+            if (h->v.cut) { /* the cut field: up to 15 weights, formed each step (sn_user_rows) */
+                cn->cut = 1;
+                cn->vtx[0] = (uint16_t)cell;
+                for (k = 0; k < 3; k++) cn->vtx[1 + k] = (uint16_t)t[k];
+            }
         }
         cn->target[0] = q->target.x;
         cn->target[1] = q->target.y;

@@ -34,6 +34,7 @@
  * rows share the contacts' baked rows (max_contacts), after the normal ones.
  */
 #include "sn_constraint.h"
+#include "sn_cut.h" /* sn_point_weights: the cut level's field */
 
 typedef struct sn_col {
     uint32_t kind;
@@ -158,6 +159,50 @@ SN_INLINE sn_q ct_start(const sn_ihdr *h, const sn_q *pst, uint32_t a, uint32_t 
 
 static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V[][3], const sn_q *vpre, uint32_t *sat);
 
+static int ct_gap(const sn_col *cl, const sn_q A[3], const sn_q B[3], sn_q R, const sn_q P[3], sn_q reach, sn_q *g, sn_q n[3], uint32_t *sat);
+SN_INLINE void ct_sum(uint32_t nF, const sn_q *pos, const sn_q *pst, const sn_q *vel, const sn_q *vpre, const uint16_t *vx,
+                      const sn_q *phi, uint32_t ne, sn_acc sp[3], sn_acc sv[3]);
+/* The cut level's prefilter (exact: it drops only vertices sn_contact_rows
+ * would drop): a vertex's cut point and predicted velocity differ from its
+ * cell's trilinear ones by at most the step's largest extra deviations Dp,
+ * Dv (sn_cut_dev: phi' >= 0 sums to one), so its gap by <= sqrt 3 Dp and
+ * its reach (a 1-norm) by <= 3 Dv. 0: no collider within the trilinear
+ * point's reach + margin (2 Dp + 3 Dv + cell/64 for the roundings), the
+ * vertex can take no contact. Its own clamp count (the real pass counts). */
+static int ct_near(const sn_ihdr *h, const sn_col *cols, const sn_q A[][3], const sn_q B[][3], const sn_q *R, const sn_q V[][3],
+                   const uint16_t vx[8], const uint32_t t[3], const sn_q *pst, const sn_q *vpre, sn_q margin) {
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0};
+    sn_q phi[8], P[3], Vp[3], g, n[3];
+    uint32_t c, q, ds = 0;
+    sn_trilinear(t, phi);
+    ct_sum(h->v.nF, pos, pst, vel, vpre, vx, phi, 8u, sp, sv);
+    for (q = 0; q < 3; q++) { P[q] = sn_out(sp[q], 30, &ds); Vp[q] = sn_out(sv[q], 30, &ds); }
+    for (c = 0; c < h->n_col; c++) {
+        sn_acc r = margin;
+        for (q = 0; q < 3; q++) {
+            sn_q rel = sn_add(Vp[q], -V[c][q], &ds);
+            r += rel < 0 ? -(sn_acc)rel : (sn_acc)rel;
+        }
+        if (!(r < (sn_acc)SN_LIM)) return 1; /* too far out to bound: the real test decides */
+        if (ct_gap(cols + c, A[c], B[c], R[c], P, (sn_q)r, &g, n, &ds)) return 1;
+    }
+    return 0;
+}
+
+/* sp += sum phi_k p_k (start points), sv += sum phi_k v_k (predicted velocities) over ne entries, from
+ * ct_predict's arrays; inlined with ne = 8 for the plain lattice (its loop unrolled as before the cut level) */
+SN_INLINE void ct_sum(uint32_t nF, const sn_q *pos, const sn_q *pst, const sn_q *vel, const sn_q *vpre, const uint16_t *vx,
+                      const sn_q *phi, uint32_t ne, sn_acc sp[3], sn_acc sv[3]) {
+    uint32_t k;
+    for (k = 0; k < ne; k++) {
+        const uint32_t a = vx[k];
+        const sn_q *pp = a < nF ? pos + 3 * a : pst + 3 * (a - nF), *vv = a < nF ? vpre + 3 * a : vel + 3 * a;
+        sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
+        sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
+    }
+}
+
 /* The yield bound (NUMERICS.md "Contacts"): the most normal velocity change
  * a contact row may ask of its point so that no free corner of its cell
  * changes its velocity by more than cell/2 this step or ends more than
@@ -167,14 +212,14 @@ static void friction_rows(sn_ihdr *h, uint32_t first, uint32_t end, const sn_q V
  * room_a = min(cell/2, cell/2 - n.(p_a + v_a + g^ - skin_a)). Skeleton
  * corners are the bones' own: the row never moves them. Returns the bound
  * (<= 0: no room, no row). Q22; S2 Q60 (fixed). */
-static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const sn_q n[3], sn_acc S2, const sn_q *vp,
+static sn_q ct_yield(sn_ihdr *h, const uint16_t *vx, const sn_q *phi, uint32_t ne, const sn_q n[3], sn_acc S2, const sn_q *vp,
                      uint32_t *sat) {
     const sn_view *v = &h->v;
     const sn_q *pos = CARR(h, o_pos, sn_q);
     const sn_q dv = (sn_q)(v->cell / 2), dmax = (sn_q)(v->cell / 2);
     sn_q m = SN_LIM_OR_BIG;
     uint32_t k, q;
-    for (k = 0; k < 8; k++) {
+    for (k = 0; k < ne; k++) {
         uint32_t a = vx[k];
         sn_q sk[3], dev, room, ratio;
         sn_acc d = 0;
@@ -205,10 +250,10 @@ static sn_q ct_yield(sn_ihdr *h, const uint16_t vx[8], const sn_q phi[8], const 
 
 /* the free corner with the largest weight (first on ties); SN_NO_DOM: not yet */
 #define SN_NO_DOM 0xFFFFFFFFu
-static uint32_t ct_dom(const uint16_t *vx16, const sn_q phi[8], uint32_t nF) {
+static uint32_t ct_dom(const uint16_t *vx16, const sn_q *phi, uint32_t ne, uint32_t nF) {
     uint32_t k, best = 0xFFFFu;
     sn_q m = 0;
-    for (k = 0; k < 8; k++)
+    for (k = 0; k < ne; k++)
         if (vx16[k] < nF && phi[k] > m) { m = phi[k]; best = vx16[k]; }
     return best;
 }
@@ -244,6 +289,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
     const sn_q *pst, *vpre; /* ct_predict's (vpre NULL: not holding) */
     uint32_t c, s, k, first = h->n_rows, ncol = h->n_col;
     uint32_t q;
+    sn_q margin = 0;
     int exact;
     if (ncol == 0) return;
     for (c = 0; c < ncol; c++) { /* the solids at the start of the step, internal units; velocity per step */
@@ -265,12 +311,18 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
     vpre = exact ? CARR(h, o_q, sn_q) : NULL;
     pst = CARR(h, o_d, sn_q);
+    if (v->cut && exact) { /* the cut level's prefilter margin (ct_near) */
+        sn_acc m = 2 * (sn_acc)sn_cut_dev(v, pos, pst) + 3 * (sn_acc)sn_cut_dev(v, vpre, vel + 3 * v->nF) + (sn_acc)(v->cell / 64);
+        margin = m < (sn_acc)SN_LIM ? (sn_q)m : 0; /* 0: no prefilter (a state that far out is rare) */
+    }
     for (s = 0; s < v->nS; s++) {
         const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
         const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-        uint32_t t[3], dom = SN_NO_DOM, anyf = 0;
-        uint16_t vx[8];
-        sn_q phi[8], P[3], Vp[3];
+        uint32_t t[3], dom = SN_NO_DOM, anyf = 0, ne = 8;
+        uint16_t vx[8], cvx[SN_CUT_POINT_MAX];
+        sn_q phi[8], cw[SN_CUT_POINT_MAX], P[3], Vp[3];
+        const uint16_t *X = vx; /* the row's entries: the cell's corners, or (cut level) cvx: the corners, then the extras of the child */
+        const sn_q *W = phi;
         sn_acc sp[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, fw = 0;
         for (k = 0; k < 8; k++) {
             vx[k] = (uint16_t)sn_rd_u16(cell + 2 * k);
@@ -278,11 +330,18 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
         }
         if (!anyf) continue; /* no free corner (fw = 0): the bones carry it, whatever t */
         for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k);
-        sn_trilinear(t, phi);
+        if (margin > 0 && !ct_near(h, cols, (const sn_q (*)[3])A, (const sn_q (*)[3])B, R, (const sn_q (*)[3])V, vx, t, pst, vpre, margin))
+            continue; /* beyond every collider's reach, whatever the extras: the weights below not needed */
+        if (v->cut) { /* the rendered point's field (extras: skeleton entries) */
+            ne = sn_point_weights(v, sn_rd_u16(e), t, cvx, cw);
+            X = cvx;
+            W = cw;
+        } else
+            sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
-        for (k = 0; k < 8; k++)
-            if (vx[k] < v->nF) fw += sn_mul(phi[k], phi[k]);
+        for (k = 0; k < 8; k++) /* the free vertices are corners */
+            if (X[k] < v->nF) fw += sn_mul(W[k], W[k]);
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
@@ -290,18 +349,15 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
-        if (exact) /* the hot loop: each corner's two rows read straight from the arrays */
-            for (k = 0; k < 8; k++) {
-                const uint32_t a = vx[k];
-                const sn_q *pp = a < v->nF ? pos + 3 * a : pst + 3 * (a - v->nF), *vv = a < v->nF ? vpre + 3 * a : vel + 3 * a;
-                sp[0] += sn_mul(phi[k], pp[0]); sp[1] += sn_mul(phi[k], pp[1]); sp[2] += sn_mul(phi[k], pp[2]);
-                sv[0] += sn_mul(phi[k], vv[0]); sv[1] += sn_mul(phi[k], vv[1]); sv[2] += sn_mul(phi[k], vv[2]);
-            }
+        if (exact && !v->cut) /* the hot loop: each corner's two rows read straight from the arrays (8: unrolled) */
+            ct_sum(v->nF, pos, pst, vel, vpre, vx, phi, 8u, sp, sv);
+        else if (exact)
+            ct_sum(v->nF, pos, pst, vel, vpre, X, W, ne, sp, sv);
         else
-            for (k = 0; k < 8; k++)
+            for (k = 0; k < ne; k++)
                 for (q = 0; q < 3; q++) {
-                    sp[q] += sn_mul(phi[k], ct_start(h, NULL, vx[k], q, sat));
-                    sv[q] += sn_mul(phi[k], ct_vel(h, NULL, vx[k], q, sat));
+                    sp[q] += sn_mul(W[k], ct_start(h, NULL, X[k], q, sat));
+                    sv[q] += sn_mul(W[k], ct_vel(h, NULL, X[k], q, sat));
                 }
         for (q = 0; q < 3; q++) {
             P[q] = sn_out(sp[q], 30, sat);
@@ -331,7 +387,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             vcn = sn_out(sn_mul(n[0], V[c][0]) + sn_mul(n[1], V[c][1]) + sn_mul(n[2], V[c][2]), 30, sat);
             target = sn_add(vcn, want, sat);
             if (dn > 0) {
-                lim = ct_yield(h, vx, phi, n, fw, vpre, sat);
+                lim = ct_yield(h, X, W, ne, n, fw, vpre, sat);
                 if (!(lim > 0)) continue; /* the free corners are already as far out as the bound lets them: no row */
                 if (dn > lim) {           /* yield: ask only what the free corners can give within the bound */
                     target = sn_add(sn_add(vcn, vr, sat), lim, sat);
@@ -342,7 +398,7 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
              * corner's three unknowns from several contacts are nearly
              * dependent (their normals 30-60 deg apart) and leave no room for
              * the contact's friction rows */
-            if (dom == SN_NO_DOM) dom = ct_dom(vx, phi, v->nF); /* once a vertex, and only for a contact */
+            if (dom == SN_NO_DOM) dom = ct_dom(X, W, ne, v->nF); /* once a vertex, and only for a contact */
             for (j = first; j < h->n_rows; j++) /* every row since first is a contact's (one-sided) */
                 if (rows[j].source == SN_ROW_SRC(SN_SRC_CONTACT, c) && (uint32_t)rx[j].a == dom) break;
             if (j < h->n_rows && !(score < rx[j].spare)) continue;
@@ -353,8 +409,8 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             {
                 sn_row r;
                 memset(&r, 0, sizeof r);
-                r.n = 8;
-                for (k = 0; k < 8; k++) { r.vtx[k] = vx[k]; r.w[k] = phi[k]; }
+                r.n = (uint8_t)ne;
+                for (k = 0; k < ne; k++) { r.vtx[k] = X[k]; r.w[k] = W[k]; }
                 for (q = 0; q < 3; q++) r.dir[q] = n[q];
                 r.target = target;
                 r.one_sided = 1;

@@ -31,6 +31,7 @@
  * blob count or a baked maximum; a triangle test has no data-dependent loop).
  */
 #include "sn_crease.h"
+#include "sn_cut.h" /* sn_point_weights: the cut level's field */
 
 /* ---------------- instance arrays (layout: SN_CREASE_STATE_BYTES) ---------------- */
 
@@ -156,25 +157,34 @@ static void cr_tri(const sn_ihdr *h, const sn_q ra[3], uint32_t t, cr_geo *g, in
     if (full && g->below) cr_finish(ra, p0, g, sat);
 }
 
-/* Lattice vertices and weights (Q30) of surface vertex s's cell. */
-static void cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[8], sn_q phi[8]) {
+/* Lattice vertices and weights (Q30) of surface vertex s: its cell's 8
+ * corners (trilinear), on the cut level then its child's extras (the cut
+ * field, sn_point_weights). Returns the entries (8, <= 15 cut). */
+static uint32_t cr_cell(const sn_ihdr *h, uint32_t s, uint32_t vtx[SN_CUT_POINT_MAX], sn_q phi[SN_CUT_POINT_MAX]) {
     const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
     const unsigned char *cell = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
-    uint32_t t[3], a;
+    uint32_t t[3], a, n;
+    uint16_t v16[SN_CUT_POINT_MAX];
     for (a = 0; a < 3; a++) t[a] = sn_rd_u16(e + 2 + 2 * a);
+    if (h->v.cut) {
+        n = sn_point_weights(&h->v, sn_rd_u16(e), t, v16, phi);
+        for (a = 0; a < n; a++) vtx[a] = v16[a];
+        return n;
+    }
     sn_trilinear(t, phi);
     for (a = 0; a < 8; a++) vtx[a] = sn_rd_u16(cell + 2 * a);
+    return 8;
 }
 
 /* Rest position (Q22) of surface vertex s: its cell's REST corners
  * trilinearly weighted (a convex combination of validated coordinates). */
 static void cr_rest(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
     const unsigned char *rest = h->v.sec[SN_SEC_REST];
-    uint32_t vtx[8], a, k, dummy = 0;
-    sn_q phi[8];
+    uint32_t vtx[SN_CUT_POINT_MAX], a, k, n, dummy = 0;
+    sn_q phi[SN_CUT_POINT_MAX];
     sn_acc acc[3] = {0, 0, 0};
-    cr_cell(h, s, vtx, phi);
-    for (a = 0; a < 8; a++)
+    n = cr_cell(h, s, vtx, phi);
+    for (a = 0; a < n; a++)
         for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], SN_RD_REAL(rest + (size_t)SN_REAL_BYTES * (3u * vtx[a] + k)));
     for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
 }
@@ -291,34 +301,55 @@ static void cr_try(sn_ihdr *h, uint32_t a, uint32_t rowv, uint32_t *sat) {
  * so a row has at most 16 entries; shared lattice vertices merged. target =
  * min(penetration depth, push cap): the pair moves apart by the depth in one
  * step, at most by the cap. Returns chi = (v_i - v_b).n of the last step's
- * velocities (Q22). */
+ * velocities (Q22).
+ * The cut level: each side <= 15 entries (8 corners, the extras of its
+ * child), <= 30 merged; beyond SN_ROW_MAX_ENT the skeleton entries (known
+ * velocities: rows_factor would move them to the right-hand side) are folded
+ * into the target now, f = sum w (n . v_x), and chi is returned less f, so
+ * chi < target still compares the whole pair. The free entries (corners)
+ * are <= 16, sum |w| <= 2 as before. */
 static sn_q cr_row(const sn_ihdr *h, const sn_crease_pair *P, sn_row *r, uint32_t *sat) {
     const sn_q *vel = CARR(h, o_vel, sn_q);
-    uint32_t vi[8], vp[8], a, b, k;
-    sn_q pi[8], pp[8], rv[3];
+    uint32_t vi[SN_CUT_POINT_MAX], vp[SN_CUT_POINT_MAX], ev[2 * SN_CUT_POINT_MAX], a, b, k, ni, np, ne = 0;
+    sn_q pi[SN_CUT_POINT_MAX], pp[SN_CUT_POINT_MAX], ew[2 * SN_CUT_POINT_MAX], rv[3], fold = 0;
     sn_acc acc[3] = {0, 0, 0}, chi = 0;
     cr_geo g;
     cr_tri(h, cr_pos(h, P->vertex), P->tri, &g, 0, sat);
     cr_finish(cr_pos(h, P->vertex), cr_pos(h, cr_tri_corner(h, P->tri, 0)), &g, sat);
-    cr_cell(h, P->vertex, vi, pi);
-    cr_cell(h, P->corner, vp, pp);
-    r->n = 0;
-    for (a = 0; a < 8; a++) { r->vtx[r->n] = (uint16_t)vi[a]; r->w[r->n] = pi[a]; r->n++; }
-    for (b = 0; b < 8; b++) {
-        for (a = 0; a < 8 && vi[a] != vp[b]; a++) {}
-        if (a < 8) r->w[a] -= pp[b]; /* |pi - pp| <= 2^30 */
-        else { r->vtx[r->n] = (uint16_t)vp[b]; r->w[r->n] = -pp[b]; r->n++; }
+    ni = cr_cell(h, P->vertex, vi, pi);
+    np = cr_cell(h, P->corner, vp, pp);
+    for (a = 0; a < ni; a++) { ev[ne] = vi[a]; ew[ne] = pi[a]; ne++; }
+    for (b = 0; b < np; b++) {
+        for (a = 0; a < ni && vi[a] != vp[b]; a++) {}
+        if (a < ni) ew[a] -= pp[b]; /* |pi - pp| <= 2^30 */
+        else { ev[ne] = vp[b]; ew[ne] = -pp[b]; ne++; }
     }
     for (k = 0; k < 3; k++) r->dir[k] = g.n[k];
-    r->target = -g.d < h->v.cr_push ? -g.d : h->v.cr_push; /* d <= 0 for a listed pair (step 1 keeps only those) */
-    r->target = r->target < 0 ? 0 : r->target;
-    r->one_sided = 1;
-    r->source = SN_ROW_SRC(SN_SRC_CREASE, P - cr_pairs(h));
-    for (a = 0; a < r->n; a++)
-        for (k = 0; k < 3; k++) acc[k] += sn_mul(r->w[a], vel[3u * r->vtx[a] + k]); /* 16 x 2^30 x 2^28 < 2^63 */
+    for (a = 0; a < ne; a++)
+        for (k = 0; k < 3; k++) acc[k] += sn_mul(ew[a], vel[3u * ev[a] + k]); /* sum |w| <= 2: 2^31 x 2^28 */
     for (k = 0; k < 3; k++) rv[k] = sn_out(acc[k], SN_Q_ROT, sat);
     for (k = 0; k < 3; k++) chi += sn_mul(rv[k], g.n[k]);
-    return sn_out(chi, SN_Q_ROT, sat);
+    r->n = 0;
+#if defined(SN_CR_FOLD_ALL) /* test build (tests/test_runtime_cut_rows.c): every pair folded, the fold's arithmetic checked */
+    if (0)
+#else
+    if (ne <= SN_ROW_MAX_ENT)
+#endif
+        for (a = 0; a < ne; a++) { r->vtx[r->n] = (uint16_t)ev[a]; r->w[r->n] = ew[a]; r->n++; }
+    else { /* cut level only (a plain pair has <= 16) */
+        sn_acc f = 0;
+        for (a = 0; a < ne; a++) {
+            if (ev[a] < h->v.nF) { r->vtx[r->n] = (uint16_t)ev[a]; r->w[r->n] = ew[a]; r->n++; continue; }
+            for (k = 0; k < 3; k++) f += sn_mul(ew[a], sn_mulq(g.n[k], vel[3u * ev[a] + k], SN_Q_ROT, sat));
+        }
+        fold = sn_out(f, SN_Q_ROT, sat);
+    }
+    r->target = -g.d < h->v.cr_push ? -g.d : h->v.cr_push; /* d <= 0 for a listed pair (step 1 keeps only those) */
+    r->target = r->target < 0 ? 0 : r->target;
+    r->target = sn_add(r->target, -fold, sat);
+    r->one_sided = 1;
+    r->source = SN_ROW_SRC(SN_SRC_CREASE, P - cr_pairs(h));
+    return sn_add(sn_out(chi, SN_Q_ROT, sat), -fold, sat);
 }
 
 /* ---------------- the step ---------------- */

@@ -128,3 +128,98 @@ void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const s
         }
     }
 }
+
+/* A point's row weights (sn_cut.h): plain, the trilinear phi_a; cut, the same
+ * field sn_cut_interp gives the surface written over the lattice vertices:
+ * w_a = sum over the child's corners k not at an extra of phi'_k n_a(k) / 8,
+ * = phi_a(t) - sum over the child's corners k at an extra of phi'_k n_a(k) / 8
+ * (the trilinear field restricted to the child is the child's trilinear
+ * interpolation of its corner values), w_x = phi'_k at an extra x (zero
+ * weights left out). A child without extras: the plain weights. Sum one
+ * within the Q30 roundings (8 + 7 terms); fixed: sum_k phi'_k n_a(k) <=
+ * 8 2^30 before the shift; a w_a whose true value is 0 may round to -1 LSB. */
+static const uint8_t cut_na[27][8] = { /* n_a at half-cell point p0 + 3 p1 + 9 p2: prod over axes of (a bit ? p : 2 - p) */
+    {8, 0, 0, 0, 0, 0, 0, 0}, {4, 4, 0, 0, 0, 0, 0, 0}, {0, 8, 0, 0, 0, 0, 0, 0}, {4, 0, 4, 0, 0, 0, 0, 0}, {2, 2, 2, 2, 0, 0, 0, 0},
+    {0, 4, 0, 4, 0, 0, 0, 0}, {0, 0, 8, 0, 0, 0, 0, 0}, {0, 0, 4, 4, 0, 0, 0, 0}, {0, 0, 0, 8, 0, 0, 0, 0}, {4, 0, 0, 0, 4, 0, 0, 0},
+    {2, 2, 0, 0, 2, 2, 0, 0}, {0, 4, 0, 0, 0, 4, 0, 0}, {2, 0, 2, 0, 2, 0, 2, 0}, {1, 1, 1, 1, 1, 1, 1, 1}, {0, 2, 0, 2, 0, 2, 0, 2},
+    {0, 0, 4, 0, 0, 0, 4, 0}, {0, 0, 2, 2, 0, 0, 2, 2}, {0, 0, 0, 4, 0, 0, 0, 4}, {0, 0, 0, 0, 8, 0, 0, 0}, {0, 0, 0, 0, 4, 4, 0, 0},
+    {0, 0, 0, 0, 0, 8, 0, 0}, {0, 0, 0, 0, 4, 0, 4, 0}, {0, 0, 0, 0, 2, 2, 2, 2}, {0, 0, 0, 0, 0, 4, 0, 4}, {0, 0, 0, 0, 0, 0, 8, 0},
+    {0, 0, 0, 0, 0, 0, 4, 4}, {0, 0, 0, 0, 0, 0, 0, 8}};
+uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], uint16_t vtx[SN_CUT_POINT_MAX],
+                          sn_q w[SN_CUT_POINT_MAX]) {
+    const unsigned char *cl = v->sec[SN_SEC_CELLS] + (size_t)cell * SN_ELEM_CELLS, *cx;
+    uint32_t b[3], tc[3], k, a, c, n = 8;
+    sn_acc s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    sn_q phi[8];
+    for (a = 0; a < 8; a++) vtx[a] = (uint16_t)sn_rd_u16(cl + 2 * a);
+    sn_trilinear(t, w);
+    if (!v->cut) return 8;
+    cx = sn_sec(v, SN_SEC_CELLX) + (size_t)cell * SN_ELEM_CELLX;
+    for (c = 0; c < 3; c++) { /* the child, as sn_cut_interp */
+        b[c] = t[c] >= 16384u;
+        tc[c] = 2u * t[c] - 32768u * b[c];
+    }
+    sn_trilinear(tc, phi);
+    for (k = 0; k < 8; k++) {
+        uint32_t p = b[0] + (k & 1u) + 3u * (b[1] + (k >> 1 & 1u)) + 9u * (b[2] + (k >> 2 & 1u)), slot = cut_slot[p], x;
+        if (slot == 255u || (x = sn_rd_u16(cx + 2 * slot)) == SN_CUT_NONE || phi[k] == 0) continue;
+        vtx[n] = (uint16_t)x;
+        w[n] = phi[k];
+        n++;
+        for (a = 0; a < 8; a++) s[a] += (sn_acc)cut_na[p][a] * phi[k];
+    }
+    if (n > 8)
+        for (a = 0; a < 8; a++) {
+#if defined(SN_FLOAT)
+            w[a] -= s[a] * 0.125f;
+#else
+            w[a] -= (sn_q)sn_rshr64(s[a], 3);
+#endif
+        }
+    return n;
+}
+
+/* sn_cut.h: the deviation bound. Per CELLX entry the trilinear value at its
+ * half-cell point (the dyadic n_a / 8, one rounding shift) and the
+ * difference; fixed |difference| <= 2^29, kept in int64, clamped to SN_LIM.
+ * Cost: the cells' extras x 8 corners x 3, once a step. */
+static const uint8_t cut_pt[SN_CUT_MAXX] = {1, 3, 4, 5, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 19, 21, 22, 23, 25}; /* slot -> point */
+sn_q sn_cut_dev(const sn_view *v, const sn_q *vf, const sn_q *vs) {
+    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX), *cl = v->sec[SN_SEC_CELLS];
+    uint32_t e, j, a, c, nF = v->nF;
+#if defined(SN_FLOAT)
+    float m = 0.0f;
+#else
+    int64_t m = 0;
+#endif
+    for (e = 0; e < v->nC; e++, cx += SN_ELEM_CELLX, cl += SN_ELEM_CELLS) {
+        if (cx[38] == 0) continue;
+        for (j = 0; j < SN_CUT_MAXX; j++) {
+            uint32_t x = sn_rd_u16(cx + 2 * j);
+            const uint8_t *na = cut_na[cut_pt[j]];
+            sn_acc s8[3] = {0, 0, 0};
+            if (x == SN_CUT_NONE) continue;
+            for (a = 0; a < 8; a++) {
+                uint32_t vtx = sn_rd_u16(cl + 2 * a);
+                const sn_q *src = vtx < nF ? vf + 3 * vtx : vs + 3 * (vtx - nF);
+                if (na[a]) for (c = 0; c < 3; c++) s8[c] += (sn_acc)na[a] * src[c];
+            }
+            for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+                float d = vs[3 * (x - nF) + c] - s8[c] * 0.125f;
+                d = d < 0 ? -d : d;
+                m = d > m ? d : m; /* NaN never: the state is finite */
+#else
+                int64_t d = (int64_t)vs[3 * (x - nF) + c] - sn_rshr64(s8[c], 3);
+                d = d < 0 ? -d : d;
+                m = d > m ? d : m;
+#endif
+            }
+        }
+    }
+#if defined(SN_FLOAT)
+    return m;
+#else
+    return (sn_q)(m > SN_LIM ? SN_LIM : m);
+#endif
+}

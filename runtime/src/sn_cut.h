@@ -21,4 +21,20 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
  * skeleton vertices' (nF..nV-1) in vs. */
 void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]);
 
+/* Rows (sn_constraint.c, sn_contact.c, sn_crease.c): the lattice vertices
+ * and weights (Q30 / float, >= 0, summing to one) of the point at t (Q15) in
+ * cell under the surface's field: the cell's 8 corners (trilinear on a plain
+ * lattice), on the cut level then the extras of the child holding the point
+ * (skeleton vertices). Returns the entries: 8 plain, <= 15 cut. */
+#define SN_CUT_POINT_MAX 15
+uint32_t sn_point_weights(const sn_view *v, uint32_t cell, const uint32_t t[3], uint16_t vtx[SN_CUT_POINT_MAX],
+                          sn_q w[SN_CUT_POINT_MAX]);
+
+/* The contacts' prefilter (sn_contact.c): the largest |value at x - the cell's
+ * trilinear value at x| (max-norm over the components) over every cell's
+ * extras x, free vertices' values in vf, skeleton vertices' (nF..nV-1) in vs;
+ * at most SN_LIM (fixed). A point's cut value differs from its trilinear one
+ * by at most this (phi' >= 0, sum <= 1). */
+sn_q sn_cut_dev(const sn_view *v, const sn_q *vf, const sn_q *vs);
+
 #endif /* SN_CUT_H */

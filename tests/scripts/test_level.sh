@@ -35,6 +35,15 @@ for fl in "" _float; do
     suite "cut_runtime$fl cow" "$B/tests/cut_runtime$fl" "$L/cow_cut$fl.blob" "$L/cow_lod$fl.blob" neck y 90
     suite "cut_runtime$fl beast" "$B/tests/cut_runtime$fl" "$L/beast_cut$fl.blob" "$L/beast_lod$fl.blob" elbow_l y 90
 done
+# rows on the cut level (tests/test_runtime_cut_rows.c): pins, a sphere, crease on the cow and the crease
+# limb, both flavours (fixed also against levels 0 and 1: --compare); the beast's cut level, fixed (its float
+# run and the comparisons: runtime/LEVELS.md's commands)
+suite "cut_rows cow" "$B/tests/cut_rows" --compare "$L/cow_cut.blob" "$L/cow_lod.blob" "$L/limb_crease_cut.blob"
+suite "cut_rows_float cow" "$B/tests/cut_rows_float" "$L/cow_cut_float.blob" "$L/cow_lod_float.blob" "$L/limb_crease_cut_float.blob"
+suite "cut_rows beast" "$B/tests/cut_rows" "$L/beast_cut.blob" "$L/beast_lod.blob"
+for fl in "" _float; do
+    suite "cut_rows_fold$fl limb_crease" "$B/tests/cut_rows_fold$fl" -c "$L/limb_crease_cut$fl.blob"
+done
 # determinism: the trot with level switches gives the committed hashes (tests/expected_hashes.txt)
 for fl in fixed float; do
     if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_lod.blob; else P=$B/sinew-play-float; BL=$L/cow_lod_float.blob; fi
@@ -61,6 +70,16 @@ for fl in fixed float; do
     want=$(sed -n "s/^cut_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
     if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: cut_$fl hash $got"; p=$((p + 1));
     else echo "FAIL: cut_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
+done
+# the same with colliders and pins: the rows on the cut level (tests/scripts/update_hashes.sh CUT_ROWS)
+for fl in fixed float; do
+    if [ $fl = fixed ]; then P=$B/sinew-play; BL=$L/cow_cut.blob; else P=$B/sinew-play-float; BL=$L/cow_cut_float.blob; fi
+    got=$("$P" "$BL" --clip tools/examples/cow/trot.clip --frames 200 --lod 100:1,150:0 --ground -3.587 \
+          --sphere 1,-4.337,0,1@0,0.3,0 --pin 2126,2362,1732 --hash --quiet 2>/dev/null |
+          sed -n 's/^hash: \([0-9a-f]\{16\}\)$/\1/p' | tail -n 1)
+    want=$(sed -n "s/^cut_contact_$fl \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)
+    if [ -n "$got" ] && [ "$got" = "$want" ]; then echo "  ok: cut_contact_$fl hash $got"; p=$((p + 1));
+    else echo "FAIL: cut_contact_$fl: hash '$got', tests/expected_hashes.txt says '$want'"; f=$((f + 1)); fi
 done
 echo "$p passed, $f failed"
 [ "$f" -eq 0 ]

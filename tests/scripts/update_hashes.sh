@@ -56,6 +56,15 @@ cutfixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/level/cow_cut_float.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 cutfloat=$(hash_of "$T")
 [ -n "$cutfixed" ] && [ -n "$cutfloat" ] || { echo "update_hashes: a player printed no cut-level hash"; exit 1; }
+# the same with colliders and pins: the rows on the cut level (and on level 1 from 100 to 150)
+CUT_ROWS="--ground -3.587 --sphere 1,-4.337,0,1@0,0.3,0 --pin 2126,2362,1732"
+# shellcheck disable=SC2086
+"$BUILD/sinew-play" "$BUILD/level/cow_cut.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW $CUT_ROWS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+cutcfixed=$(hash_of "$T")
+# shellcheck disable=SC2086
+"$BUILD/sinew-play-float" "$BUILD/level/cow_cut_float.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW $CUT_ROWS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
+cutcfloat=$(hash_of "$T")
+[ -n "$cutcfixed" ] && [ -n "$cutcfloat" ] || { echo "update_hashes: a player printed no cut-level contact hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -97,5 +106,10 @@ adapt_float $adfloat
 # tests/scripts/test_level.sh and tests/scripts/test_determinism.sh.
 cut_fixed $cutfixed
 cut_float $cutfloat
+# The same run with a ground plane under the feet, a rising sphere under the belly and
+# three pinned surface points (sinew-play $CUT_ROWS):
+# constraint and contact rows on the cut level, checked by tests/scripts/test_level.sh.
+cut_contact_fixed $cutcfixed
+cut_contact_float $cutcfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"
