@@ -220,6 +220,10 @@ pmake "$BUILD/level/cow_adapt.blob" "$BUILD/level/cow_adapt_float.blob" > "$L/bu
 # ---- the cut level (runtime/LEVELS.md §2 "The cut level"): the cow baked with
 # 'levels 2 cut', 200 steps of the trot, level 1 from 100 to 150 (cut_* hashes) ----
 CUT_STEPS=200; CUT_SW=100:1,150:0
+# the cut run also plays det_main's contact and blended scenarios on the cut
+# level (rows weigh points by the cut field, sn_point_weights): their hashes
+# must agree across platforms (about 3 s of CPU under qemu; test_level.sh
+# checks the players' cut_contact_* lines against tests/expected_hashes.txt)
 pmake "$BUILD/level/cow_cut.blob" "$BUILD/level/cow_cut_float.blob" > "$L/build_cut.log" 2>&1 || \
     { bad "cut: blobs failed to bake"; tail -n 5 "$L/build_cut.log"; }
 while read -r name target runner; do
@@ -234,7 +238,7 @@ while read -r name target runner; do
     case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || r=qemu-i386 ;; esac
     launch "$L/rc_crease_$name" "$L/run_crease_$name.log" $r "$target" "$b" --steps $CR_STEPS --clip $CR_CLIP
     launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $STEPS $clip_arg --lod $LOD_SW --main-only
-    launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW --main-only
+    launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW
     case " $ADAPT_SKIP " in *" $name "*) continue ;; esac
     launch "$L/rc_adapt_$name" "$L/run_adapt_$name.log" $r "$target" "$ba" --steps $STEPS $clip_arg --lod $LOD_SW \
         --main-only --shared
@@ -293,7 +297,7 @@ $plats
 EOF2
 
 # the crease and level-of-detail runs: "fixed"/"float" lists per scenario
-crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""
+crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
@@ -302,6 +306,13 @@ while read -r name target runner; do
         case $sc:" $ADAPT_SKIP " in adapt:*" $name "*) continue ;; esac
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
             echo "determinism: $sc $name $h"
+            if [ $sc = cut ] && hc=$(hashc_of "$L/run_cut_$name.log") && [ -n "$hc" ]; then
+                hb=$(hashb_of "$L/run_cut_$name.log")
+                echo "determinism: cut contact $name $hc blended ${hb:-none}"
+                case $name in float-*) cutcfloat="$cutcfloat$name $hc/$hb
+" ;; *) cutcfixed="$cutcfixed$name $hc/$hb
+" ;; esac
+            fi
             case $sc-$name in
                 crease-float-*) crfloat="$crfloat$name $h
 " ;;            crease-*) crfixed="$crfixed$name $h
@@ -402,6 +413,8 @@ agree "adaptation (shared workspace), fixed flavour" "$adfixed" 2
 agree "adaptation (shared workspace), float flavour" "$adfloat" 2
 agree "cut level, fixed flavour" "$cutfixed" 2
 agree "cut level, float flavour" "$cutfloat" 2
+agree "cut level, contact/blended scenarios, fixed flavour" "$cutcfixed" 2
+agree "cut level, contact/blended scenarios, float flavour" "$cutcfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
