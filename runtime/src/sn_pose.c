@@ -137,11 +137,12 @@ void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]) {
 }
 
 /* Slots of joint_frames' cache of slerp pair parts (sn_qslerp_pair), direct
- * mapped by bone pair: the entries of one pair share its angle, so most
- * frames skip its square root and CORDIC (cow: 216 slerps a step, 30 pairs,
- * ~150 hits). Which entries hit is fixed by the blob: the cost stays the
- * blob's. */
-#define FRAME_SLOTS 16u
+ * mapped by a multiplicative hash of the bone pair: the entries of one pair
+ * share its angle, so most frames skip its square root and CORDIC (cow: 216
+ * slerps a step, 30 pairs). 64 slots (16 with (3 b1 + b2) mod 16 until
+ * issue 15's fewer-operations round: colliding pairs evicted each other).
+ * Which entries hit is fixed by the blob: the cost stays the blob's. */
+#define FRAME_SLOTS 64u
 /* Slots of joint_frames' memo of whole frames: many entries repeat the
  * (b1, b2, w) of an earlier one (cow: 79 of its 214 slerps a step), and a
  * frame is a function of its entry and the pose only, so a repeat copies
@@ -183,7 +184,7 @@ static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp
         }
         if (cache) { /* key: the pair + 1 (never 0), in a slot by the pair */
             const uint32_t key = (b1 << 8 | b2) + 1u;
-            sn_slerp_pair *p = cache + ((3u * b1 + b2) & (FRAME_SLOTS - 1u));
+            sn_slerp_pair *p = cache + (((b1 << 8 | b2) * 2654435761u) >> 26); /* 6 bits: FRAME_SLOTS */
             if (p->key != key) {
                 sn_qslerp_pair(pq + 4 * b1, pq + 4 * b2, 1, p);
                 p->key = key;
