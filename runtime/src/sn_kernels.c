@@ -63,7 +63,15 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     uint32_t a, b;
     blk_t B;
     for (a = 0; a < 24; a++) l1[a] = l2[a] = 0;
-    for (a = 0; a < 8; a++) {
+    /* row 0: corner 0's operands are 0 (sn_kernels.h), so its diagonal block
+     * and the transposed uses of its blocks add exact zeros (float: +-0 to a
+     * +0 partial sum, which stays +0): only B u_b into row 0 */
+    for (b = 1; b < 8; b++) {
+        BLK_GET(K, 0, b, B);
+        BLK_ROW(l1, B, u1 + 3 * b);
+        if (rows2 & 1u) BLK_ROW(l2, B, u2 + 3 * b);
+    }
+    for (a = 1; a < 8; a++) {
         const uint32_t ra = rows2 >> a & 1u;
         BLK_GET(K, a, a, B);
         BLK_ROW(l1 + 3 * a, B, u1 + 3 * a);

@@ -89,7 +89,11 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         sn_acc ld[24], lu[24], lx[24], ec = 0;
         uint32_t fr = 0; /* the free corners: lu's rows read below */
         const sn_q *w0 = w_of(h, w, vel, a0, w0s);
-        for (k = 0; k < 8; k++) {
+        /* corner 0 is a0: its t, s and rest difference are 0, so d_0 = uu_0 = 0
+         * exactly (no clamp), without its two rotations */
+        for (c = 0; c < 3; c++) d[c] = uu[c] = 0;
+        fr = (uint32_t)(a0 < nF);
+        for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3], wa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
@@ -102,7 +106,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, lx, sat); /* the cut level (sn_cut.c) */
-        for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
+        for (k = 3; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat)); /* d_0 = 0: no term */
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
