@@ -316,6 +316,16 @@ $(BUILD)/tests/test_runtime_precond_float: tests/test_runtime_precond.c $(REF_SR
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(REF_SRC) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_precond $(BUILD)/tests/test_runtime_precond_float
 
+# The step's frames (sn_pose.c: pair cache and frame memo) against each frame
+# computed alone, bit for bit: runtime internals.
+$(BUILD)/tests/test_runtime_frames: tests/test_runtime_frames.c $(PHYS_HDRS) $(SN_LIB_FIXED) $(EX)/cow.blob $(EX)/beast.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_frames_float: tests/test_runtime_frames.c $(PHYS_HDRS) $(SN_LIB_FLOAT) $(EX)/cow_float.blob $(EX)/beast_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_frames $(BUILD)/tests/test_runtime_frames_float
+
 # make seg-study (issue 15): the segment meshes' gap through the cow's trot for
 # blobs given in SEG_BLOBS (default: the cow, fixed and float); tests/scripts/seg_study.sh
 # bakes the sweep-count variants.

@@ -12,7 +12,8 @@
  *   x |entry| |operand| x 2^-23 (float accumulation of 24 products).
  * Free-corner lists: the mat-vec's product over a random subset of corners
  * equals the full product's rows with zero operands elsewhere (fixed:
- * exactly; float: bit for bit), and sn_k_cell_mul2 equals two calls. */
+ * exactly; float: bit for bit), and sn_k_cell_mul2 equals two calls
+ * (corner 0's operands 0, its contract). */
 #include <stdint.h>
 #include <string.h>
 #include "sn_test.h"
@@ -576,7 +577,7 @@ int main(void) {
     for (t = 0; t < 4000; t++) {
         static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
         sn_q u[24], u2[24], uc[24], uz[24];
-        sn_acc l[24], l2[24], lm1[24], lm2[24], lc[24], lz[24];
+        sn_acc l[24], l0[24], l2[24], lm1[24], lm2[24], lc[24], lz[24];
         uint8_t fc[8];
         uint32_t nf = 0, k, c, mask = rnd32() & 0xFFu;
         int extreme = t % 16 == 0, r;
@@ -599,15 +600,21 @@ int main(void) {
             bad_order += memcmp(lo, l, sizeof lo) != 0;
         }
 #endif
-        /* two products at once = two calls */
-        sn_k_cell_mul2(K, u, u2, lm1, lm2, 0xFFu);
-        sn_k_cell_mul(K, all8, 8, u2, l2);
-        bad_two += memcmp(lm1, l, sizeof l) != 0 || memcmp(lm2, l2, sizeof l2) != 0;
-        /* l2 only at the rows of a random corner set (the rhs's free corners) */
-        sn_k_cell_mul2(K, u, u2, lm1, lm2, mask);
-        bad_two += memcmp(lm1, l, sizeof l) != 0;
-        for (k = 0; k < 8; k++)
-            if (mask >> k & 1u) bad_two += memcmp(lm2 + 3 * k, l2 + 3 * k, 3 * sizeof l2[0]) != 0;
+        /* two products at once = two calls (corner 0's operands 0, the contract) */
+        {
+            sn_q u0[24];
+            memcpy(u0, u, sizeof u0);
+            u0[0] = u0[1] = u0[2] = u2[0] = u2[1] = u2[2] = 0;
+            sn_k_cell_mul(K, all8, 8, u0, l0);
+            sn_k_cell_mul2(K, u0, u2, lm1, lm2, 0xFFu);
+            sn_k_cell_mul(K, all8, 8, u2, l2);
+            bad_two += memcmp(lm1, l0, sizeof l0) != 0 || memcmp(lm2, l2, sizeof l2) != 0;
+            /* l2 only at the rows of a random corner set (the rhs's free corners) */
+            sn_k_cell_mul2(K, u0, u2, lm1, lm2, mask);
+            bad_two += memcmp(lm1, l0, sizeof l0) != 0;
+            for (k = 0; k < 8; k++)
+                if (mask >> k & 1u) bad_two += memcmp(lm2 + 3 * k, l2 + 3 * k, 3 * sizeof l2[0]) != 0;
+        }
         /* listed corners = the full product with zero operands at the others */
         for (k = 0; k < 8; k++) {
             if (mask >> k & 1u) {

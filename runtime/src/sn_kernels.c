@@ -55,15 +55,54 @@ const char *sn_kernels_name(void) { return "scalar"; }
 #endif /* SN_KERNELS_SCALAR */
 
 #if defined(SN_KERNELS_SCALAR) || defined(SN_KERNELS_M4)
+/* First writes of BLK_ROW / BLK_MAC_T into an output: (sn_acc)0 + the
+ * block term, the value the += had from a zeroed output (float: the same
+ * sum, signed zeros included; fixed: the term), so the outputs need no
+ * zeroing pass (the Cortex-M4's newlib-nano memset is a byte loop). */
+#define BLK_ROW0(l, B, e) do { \
+    (l)[0] = (sn_acc)0 + (sn_mul(ENT(B, 0), (e)[0]) + sn_mul(ENT(B, 1), (e)[1]) + sn_mul(ENT(B, 2), (e)[2])); \
+    (l)[1] = (sn_acc)0 + (sn_mul(ENT(B, 3), (e)[0]) + sn_mul(ENT(B, 4), (e)[1]) + sn_mul(ENT(B, 5), (e)[2])); \
+    (l)[2] = (sn_acc)0 + (sn_mul(ENT(B, 6), (e)[0]) + sn_mul(ENT(B, 7), (e)[1]) + sn_mul(ENT(B, 8), (e)[2])); \
+} while (0)
+#define BLK_MAC_T0(acc, B, e) do { \
+    (acc)[0] = (sn_acc)0 + (sn_mul(ENT(B, 0), (e)[0]) + sn_mul(ENT(B, 3), (e)[1]) + sn_mul(ENT(B, 6), (e)[2])); \
+    (acc)[1] = (sn_acc)0 + (sn_mul(ENT(B, 1), (e)[0]) + sn_mul(ENT(B, 4), (e)[1]) + sn_mul(ENT(B, 7), (e)[2])); \
+    (acc)[2] = (sn_acc)0 + (sn_mul(ENT(B, 2), (e)[0]) + sn_mul(ENT(B, 5), (e)[1]) + sn_mul(ENT(B, 8), (e)[2])); \
+} while (0)
 /* Both right-hand-side products, one decode per block; each output's
  * partial sums in sn_k_cell_mul's order (the M4 compiles this C to SMLAL).
- * l2's rows outside rows2 (skeleton corners) are skipped, left 0. */
+ * Row 0: corner 0's operands are 0 (sn_kernels.h), so its diagonal block
+ * and the transposed uses of its blocks add exact zeros (float: +-0 to a
+ * +0 partial sum, which stays +0): only B u_b into row 0. So row 0's first
+ * term is block (0,1)'s, row 1's its diagonal block's, row b > 1's the
+ * transposed block (1,b)'s: those are first writes (BLK_ROW0, BLK_MAC_T0).
+ * l2's rows outside rows2 (skeleton corners) are skipped, not written. */
 void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
                     uint32_t rows2) {
     uint32_t a, b;
     blk_t B;
-    for (a = 0; a < 24; a++) l1[a] = l2[a] = 0;
-    for (a = 0; a < 8; a++) {
+    BLK_GET(K, 0, 1, B);
+    BLK_ROW0(l1, B, u1 + 3);
+    if (rows2 & 1u) BLK_ROW0(l2, B, u2 + 3);
+    for (b = 2; b < 8; b++) {
+        BLK_GET(K, 0, b, B);
+        BLK_ROW(l1, B, u1 + 3 * b);
+        if (rows2 & 1u) BLK_ROW(l2, B, u2 + 3 * b);
+    }
+    {   /* row 1: the first write of every row b > 1 */
+        const uint32_t ra = rows2 >> 1 & 1u;
+        BLK_GET(K, 1, 1, B);
+        BLK_ROW0(l1 + 3, B, u1 + 3);
+        if (ra) BLK_ROW0(l2 + 3, B, u2 + 3);
+        for (b = 2; b < 8; b++) {
+            BLK_GET(K, 1, b, B);
+            BLK_ROW(l1 + 3, B, u1 + 3 * b);
+            BLK_MAC_T0(l1 + 3 * b, B, u1 + 3);
+            if (ra) BLK_ROW(l2 + 3, B, u2 + 3 * b);
+            if (rows2 >> b & 1u) BLK_MAC_T0(l2 + 3 * b, B, u2 + 3);
+        }
+    }
+    for (a = 2; a < 8; a++) {
         const uint32_t ra = rows2 >> a & 1u;
         BLK_GET(K, a, a, B);
         BLK_ROW(l1 + 3 * a, B, u1 + 3 * a);
@@ -77,7 +116,8 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
         }
     }
     for (a = 0; a < 24; a++)
-        SN_RANGE(SN_WITHIN(l1[a], 60) && SN_WITHIN(l2[a], 60), "cell row beyond 24 * 2^55", l1[a]);
+        SN_RANGE(SN_WITHIN(l1[a], 60) && (!(rows2 >> (a / 3) & 1u) || SN_WITHIN(l2[a], 60)), "cell row beyond 24 * 2^55",
+                 l1[a]);
 }
 #endif
 

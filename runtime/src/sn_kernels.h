@@ -106,7 +106,10 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * k with bit k of rows2 set (the right-hand side's two products: the second
  * is read only at free corners), each block decoded once; those rows are
  * the sums of two calls of sn_k_cell_mul with the 8 corners listed, in the
- * same order (float: the same bits). l2's other rows are unspecified. */
+ * same order (float: the same bits). l2's other rows are unspecified.
+ * Corner 0's operands u1_0 and u2_0 are 0 (the right-hand side's cell
+ * vectors are differences from corner 0, a0): a path may skip the terms
+ * they feed. */
 void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
                     uint32_t rows2);
 

@@ -82,14 +82,71 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     }
 }
 
-/* the right-hand side's two products: two calls (the block decode is a few
- * vector instructions here) */
+/* the right-hand side's two products, each block loaded once: row 0 takes
+ * B u_b only (corner 0's operands are 0, sn_kernels.h), l1 every row, l2
+ * the rows in rows2 (the others are left unspecified: their sums are
+ * skipped). Exact int64 sums, the same integers as two sn_k_cell_mul calls. */
 void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
                     uint32_t rows2) {
-    static const uint8_t all8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    (void)rows2; /* every row of l2 */
-    sn_k_cell_mul(K, all8, 8, u1, l1);
-    sn_k_cell_mul(K, all8, 8, u2, l2);
+    const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0), ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0);
+    const __m256i ir0 = _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0), ir1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0);
+    const __m256i ir2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0);
+    __m256i L1[8], L2[8];
+    uint32_t a, b;
+    for (a = 0; a < 8; a++) L1[a] = L2[a] = _mm256_setzero_si256();
+    for (a = 0; a < 8; a++) {
+        const uint32_t ra = rows2 >> a & 1u;
+        const __m256i xa0 = _mm256_set1_epi32(u1[3 * a]), xa1 = _mm256_set1_epi32(u1[3 * a + 1]);
+        const __m256i xa2 = _mm256_set1_epi32(u1[3 * a + 2]);
+        const __m256i ya0 = _mm256_set1_epi32(u2[3 * a]), ya1 = _mm256_set1_epi32(u2[3 * a + 1]);
+        const __m256i ya2 = _mm256_set1_epi32(u2[3 * a + 2]);
+        __m256i v0, v1, c0, c1, c2, la1 = L1[a], la2 = L2[a];
+        if (a) { /* the diagonal block (a,a); corner 0's is a product with 0 */
+            blk_ld(K, a, a, &v0, &v1);
+            c0 = _mm256_permutevar8x32_epi32(v0, ic0);
+            c1 = _mm256_permutevar8x32_epi32(v0, ic1);
+            c2 = _mm256_permutevar8x32_epi32(v1, ic1);
+            la1 = _mm256_add_epi64(la1, _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(c0, xa0), _mm256_mul_epi32(c1, xa1)),
+                                                         _mm256_mul_epi32(c2, xa2)));
+            if (ra)
+                la2 = _mm256_add_epi64(la2, _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(c0, ya0), _mm256_mul_epi32(c1, ya1)),
+                                                             _mm256_mul_epi32(c2, ya2)));
+        }
+        for (b = a + 1; b < 8; b++) {
+            const uint32_t rb = rows2 >> b & 1u;
+            blk_ld(K, a, b, &v0, &v1);
+            c0 = _mm256_permutevar8x32_epi32(v0, ic0);
+            c1 = _mm256_permutevar8x32_epi32(v0, ic1);
+            c2 = _mm256_permutevar8x32_epi32(v1, ic1);
+            la1 = _mm256_add_epi64(la1, _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(c0, _mm256_set1_epi32(u1[3 * b])),
+                                                                          _mm256_mul_epi32(c1, _mm256_set1_epi32(u1[3 * b + 1]))),
+                                                         _mm256_mul_epi32(c2, _mm256_set1_epi32(u1[3 * b + 2]))));
+            if (ra)
+                la2 = _mm256_add_epi64(la2, _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(c0, _mm256_set1_epi32(u2[3 * b])),
+                                                                              _mm256_mul_epi32(c1, _mm256_set1_epi32(u2[3 * b + 1]))),
+                                                             _mm256_mul_epi32(c2, _mm256_set1_epi32(u2[3 * b + 2]))));
+            if (!a) continue; /* B^T u_0 = 0 */
+            L1[b] = _mm256_add_epi64(L1[b], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, xa0), MUL(v0, ir1, xa1)),
+                                                             MUL(v1, ir2, xa2)));
+            if (rb)
+                L2[b] = _mm256_add_epi64(L2[b], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ir0, ya0), MUL(v0, ir1, ya1)),
+                                                                 MUL(v1, ir2, ya2)));
+        }
+        L1[a] = la1;
+        L2[a] = la2;
+    }
+    for (a = 0; a < 8; a++) {
+        int64_t t[4], w[4];
+        _mm256_storeu_si256((__m256i *)(void *)t, L1[a]);
+        _mm256_storeu_si256((__m256i *)(void *)w, L2[a]);
+        l1[3 * a] = t[0];
+        l1[3 * a + 1] = t[1];
+        l1[3 * a + 2] = t[2];
+        l2[3 * a] = w[0];
+        l2[3 * a + 1] = w[1];
+        l2[3 * a + 2] = w[2];
+        SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60), "cell row beyond 24 * 2^55", t[0]);
+    }
 }
 
 /* Block-floating dot product: magnitudes ORed 8 lanes at a time (VPABSD of

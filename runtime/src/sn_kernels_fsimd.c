@@ -42,29 +42,34 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     store_rows(l, L, nf);
 }
 
-/* Both right-hand-side products over all 8 corners, one block load for
- * both (every row of l2 computed: the unread ones are allowed). */
+/* Both right-hand-side products, one block load for both: row 0 takes B
+ * u_b only (corner 0's operands are 0, sn_kernels.h: the skipped terms are
+ * +-0 added to a +0 partial sum, which stays +0), l1 every row, l2 the
+ * rows in rows2 (the others unspecified): each output's sums in the
+ * reference's order, the same floats. */
 void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
                     uint32_t rows2) {
     sn_fv L1[8], L2[8], r[3], c[3];
     uint32_t a, b;
-    (void)rows2;
     for (a = 0; a < 8; a++) L1[a] = L2[a] = FV_SET1(0.0f);
     for (a = 0; a < 8; a++) {
+        const uint32_t ra = rows2 >> a & 1u;
         const sn_fv xa0 = FV_SET1(u1[3 * a]), xa1 = FV_SET1(u1[3 * a + 1]), xa2 = FV_SET1(u1[3 * a + 2]);
         const sn_fv ya0 = FV_SET1(u2[3 * a]), ya1 = FV_SET1(u2[3 * a + 1]), ya2 = FV_SET1(u2[3 * a + 2]);
-        sn_fv la1, la2;
-        fv_cols(BLKP(K, a, a), c);
-        la1 = FV_ADD(L1[a], FV_MAC3(c, xa0, xa1, xa2));
-        la2 = FV_ADD(L2[a], FV_MAC3(c, ya0, ya1, ya2));
+        sn_fv la1 = L1[a], la2 = L2[a];
+        if (a) {
+            fv_cols(BLKP(K, a, a), c);
+            la1 = FV_ADD(la1, FV_MAC3(c, xa0, xa1, xa2));
+            if (ra) la2 = FV_ADD(la2, FV_MAC3(c, ya0, ya1, ya2));
+        }
         for (b = a + 1; b < 8; b++) {
-            const sn_fv xb0 = FV_SET1(u1[3 * b]), xb1 = FV_SET1(u1[3 * b + 1]), xb2 = FV_SET1(u1[3 * b + 2]);
-            const sn_fv yb0 = FV_SET1(u2[3 * b]), yb1 = FV_SET1(u2[3 * b + 1]), yb2 = FV_SET1(u2[3 * b + 2]);
+            const uint32_t rb = rows2 >> b & 1u;
             fv_blk(BLKP(K, a, b), r, c);
-            la1 = FV_ADD(la1, FV_MAC3(c, xb0, xb1, xb2));
+            la1 = FV_ADD(la1, FV_MAC3(c, FV_SET1(u1[3 * b]), FV_SET1(u1[3 * b + 1]), FV_SET1(u1[3 * b + 2])));
+            if (ra) la2 = FV_ADD(la2, FV_MAC3(c, FV_SET1(u2[3 * b]), FV_SET1(u2[3 * b + 1]), FV_SET1(u2[3 * b + 2])));
+            if (!a) continue;
             L1[b] = FV_ADD(L1[b], FV_MAC3(r, xa0, xa1, xa2));
-            la2 = FV_ADD(la2, FV_MAC3(c, yb0, yb1, yb2));
-            L2[b] = FV_ADD(L2[b], FV_MAC3(r, ya0, ya1, ya2));
+            if (rb) L2[b] = FV_ADD(L2[b], FV_MAC3(r, ya0, ya1, ya2));
         }
         L1[a] = la1;
         L2[a] = la2;

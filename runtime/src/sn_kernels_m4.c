@@ -154,7 +154,10 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     const uint32_t k0 = (uint32_t)(uintptr_t)K;
     struct sn_m4_row c;
     uint32_t i;
-    for (i = 0; i < 3 * nf; i++) l[i] = 0;
+    for (i = 0; i < 3 * nf; i++) {
+        l[i] = 0;
+        __asm__("" : : : "memory"); /* a store a word, not GCC's memset call (newlib-nano's is a byte loop) */
+    }
     c.lend = l + 3 * nf;
     for (i = 0; i < nf; i++) {
         const uint32_t a = fc[i];

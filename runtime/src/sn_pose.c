@@ -137,16 +137,29 @@ void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]) {
 }
 
 /* Slots of joint_frames' cache of slerp pair parts (sn_qslerp_pair), direct
- * mapped by bone pair: the entries of one pair share its angle, so most
- * frames skip its square root and CORDIC (cow: 216 slerps a step, 30 pairs,
- * ~150 hits). Which entries hit is fixed by the blob: the cost stays the
- * blob's. */
-#define FRAME_SLOTS 16u
+ * mapped by a multiplicative hash of the bone pair: the entries of one pair
+ * share its angle, so most frames skip its square root and CORDIC (cow: 216
+ * slerps a step, 30 pairs). 64 slots (16 with (3 b1 + b2) mod 16 until
+ * issue 15's fewer-operations round: colliding pairs evicted each other).
+ * Which entries hit is fixed by the blob: the cost stays the blob's. */
+#define FRAME_SLOTS 64u
+/* Slots of joint_frames' memo of whole frames: many entries repeat the
+ * (b1, b2, w) of an earlier one (cow: 79 of its 214 slerps a step), and a
+ * frame is a function of its entry and the pose only, so a repeat copies
+ * the earlier frame's 9 values (the same bits) instead of its slerp_at
+ * (sin/cos, a division, a square root) and quaternion-to-matrix. Direct
+ * mapped by a hash of the entry; which entries hit is fixed by the blob. */
+#define FRAME_R_SLOTS 256u
+typedef struct frame_memo {
+    uint32_t key[FRAME_R_SLOTS]; /* b1 << 24 | b2 << 16 | w (never 0: b1 != b2 there), 0 empty */
+    const sn_q *R[FRAME_R_SLOTS]; /* the frame computed for it */
+} frame_memo;
 
 /* Rotation of a vertex's or cell's frame from its (b1, b2, w) entry:
  * R = slerp_path(q_b1, q_b2, w) (seed 003 §3.3), the bone's jR when w = 0.
- * cache: FRAME_SLOTS pair parts of this pose (keys 0 when empty), or NULL. */
-static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp_pair *cache) {
+ * cache: FRAME_SLOTS pair parts of this pose (keys 0 when empty), or NULL;
+ * memo: the frames of this pose so far (frame_memo), or NULL. */
+static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp_pair *cache, frame_memo *memo) {
     const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q);
     uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
     if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I */
@@ -160,9 +173,18 @@ static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp
 #else
         sn_q t = (sn_q)(w << (SN_Q_ROT - SN_Q_W));
 #endif
+        if (memo) {
+            const uint32_t key = b1 << 24 | b2 << 16 | w, m = (key * 2654435761u) >> 24; /* 8 bits: FRAME_R_SLOTS */
+            if (memo->key[m] == key) {
+                memcpy(R, memo->R[m], 9 * sizeof(sn_q));
+                return;
+            }
+            memo->key[m] = key;
+            memo->R[m] = R;
+        }
         if (cache) { /* key: the pair + 1 (never 0), in a slot by the pair */
             const uint32_t key = (b1 << 8 | b2) + 1u;
-            sn_slerp_pair *p = cache + ((3u * b1 + b2) & (FRAME_SLOTS - 1u));
+            sn_slerp_pair *p = cache + (((b1 << 8 | b2) * 2654435761u) >> 26); /* 6 bits: FRAME_SLOTS */
             if (p->key != key) {
                 sn_qslerp_pair(pq + 4 * b1, pq + 4 * b2, 1, p);
                 p->key = key;
@@ -201,8 +223,10 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
     sn_q *cR = ARR(h, o_cR, sn_q), xroot[3], rx[3];
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
     sn_slerp_pair cache[FRAME_SLOTS];
+    frame_memo memo;
     uint32_t i, j, k;
     for (k = 0; k < FRAME_SLOTS; k++) cache[k].key = 0;
+    for (k = 0; k < FRAME_R_SLOTS; k++) memo.key[k] = 0;
     for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
     for (j = 0; j < v->nJ; j++) {
         sn_rot(jR + 9 * j, xroot, rx, sat);
@@ -216,9 +240,9 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
         }
     }
     for (i = 0; i < v->nF; i++) /* free vertices only: a skeleton vertex's frame is its bone's jR */
-        frame_of(h, fr + 4 * i, R + 9 * i, cache);
+        frame_of(h, fr + 4 * i, R + 9 * i, cache, &memo);
     for (i = 0; i < v->nC; i++)
-        frame_of(h, cfr + 4 * i, cR + 9 * i, cache);
+        frame_of(h, cfr + 4 * i, cR + 9 * i, cache, &memo);
     h->frame_mode = h->mode;
 }
 
@@ -369,7 +393,7 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
         sn_q Rn[9];
         if (h->mode == SN_MODE_UNWARPED) carry_vertex(h, i, jR, Rroot, &sat);
         else {
-            frame_of(h, fr + 4 * i, Rn, NULL);
+            frame_of(h, fr + 4 * i, Rn, NULL, NULL);
             carry_vertex(h, i, Rn, R + 9 * i, &sat);
         }
     }

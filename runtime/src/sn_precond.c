@@ -35,6 +35,7 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
     for (j = 0; j < nF; j++) {
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
+        const uint32_t n0 = n;
         sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
@@ -47,22 +48,23 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
 #endif
             sn_k_ic_col(blk, yj, s, acc + 3 * i, sat); /* acc_i += round(U_ji^T y_j) */
         }
+        acc[3 * j] = (sn_acc)(n - n0); /* acc_j is consumed: row j's free column count, for ic_backward */
     }
     (void)kk;
     return n;
 }
 
 /* z = (I + L^)^-T z in place: for j descending, z_j -= sum_i U_ji z_i (Q22;
- * each block row rounded by frac, < 2^44.6; their sum < 2^49.3) */
-static void ic_backward(const sn_view *v, uint32_t n, sn_q *z, uint32_t *sat) {
+ * each block row rounded by frac, < 2^44.6; their sum < 2^49.3). cnt[3 j]:
+ * row j's free column count (ic_forward leaves it in its accumulators). */
+static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z, uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
-    uint32_t j = v->nF, e, nF = v->nF;
+    uint32_t j = v->nF, e;
     while (j-- > 0) {
-        uint32_t b = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4), f = b;
+        uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
         sn_acc l[4] = {0, 0, 0, 0};
         const unsigned char *blk;
-        while (f < end && sn_rd_u16(cols + 2 * f) < nF) f++; /* free columns first */
         n -= f - b;
         blk = L + (size_t)n * SN_ELEM_ICHOL;
         for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
@@ -115,7 +117,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
         sn_k_sym_out(P + (size_t)i * 6 * SN_REAL_BYTES, z + 3 * i, z + 3 * i, v->frac_P + SN_KREL(kk[i]), sat);
     }
-    ic_backward(v, n, z, sat);
+    ic_backward(v, n, WARR(h, o_acc, sn_acc), z, sat);
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
         if (mask && !mask[i] == !inv) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }

@@ -89,7 +89,11 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         sn_acc ld[24], lu[24], lx[24], ec = 0;
         uint32_t fr = 0; /* the free corners: lu's rows read below */
         const sn_q *w0 = w_of(h, w, vel, a0, w0s);
-        for (k = 0; k < 8; k++) {
+        /* corner 0 is a0: its t, s and rest difference are 0, so d_0 = uu_0 = 0
+         * exactly (no clamp), without its two rotations */
+        for (c = 0; c < 3; c++) d[c] = uu[c] = 0;
+        fr = (uint32_t)(a0 < nF);
+        for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3], wa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
@@ -102,7 +106,7 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, lx, sat); /* the cut level (sn_cut.c) */
-        for (k = 0; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat));
+        for (k = 3; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat)); /* d_0 = 0: no term */
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
@@ -129,6 +133,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     sn_acc *acc = WARR(h, o_acc, sn_acc);
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t i, k, nF = v->nF, nV = v->nV, esat = 0;
+    int pre;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
     sn_acc e2 = 0;
 
@@ -153,19 +158,34 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     }
     sn_set_energy(h, e2);
 
-    /* mass pass: acc_i = M^_ij y_j, y = a1 v (free), a1 v' + (v' - v) (skeleton) */
+    /* mass pass: acc_i = M^_ij y_j, y = a1 v (free), a1 v' + (v' - v) (skeleton).
+     * With |a1| <= 1 the free y cannot clamp (|a1 v| <= SN_LIM after the
+     * rounding): formed once per vertex into q's storage (w is dead after
+     * cell_forces) instead of at each of its blocks; the same values and no
+     * clamp count lost. Otherwise (and for skeleton y) per block as before. */
     acc_zero(acc, 3 * nF);
+    pre = v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF;
+    if (pre)
+        for (i = 0; i < nF; i++) sn_k_coef3(vel + 3 * i, v->a1, u + 3 * i, sat);
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
-        sn_q yi[3], yj[3];
+        sn_q yis[3], yjs[3];
+        const sn_q *yi = u + 3 * i;
         sn_acc l[3] = {0, 0, 0};
-        sn_k_coef3(vel + 3 * i, v->a1, yi, sat); /* sn_kernels_rot.h: coef per entry */
+        if (!pre) {
+            sn_k_coef3(vel + 3 * i, v->a1, yis, sat); /* sn_kernels_rot.h: coef per entry */
+            yi = yis;
+        }
         sca_row(l, rd_real(md, i), yi);
         for (; e < end; e++) {
             uint32_t j = sn_rd_u16(cols + 2 * e);
             sn_q m = rd_real(mo, e);
-            sn_k_coef3(vel + 3 * j, v->a1, yj, sat);
-            if (j >= nF) sn_k_add3(yj, ds + 3 * (j - nF), yj, sat);
+            const sn_q *yj = u + 3 * j;
+            if (j >= nF || !pre) {
+                sn_k_coef3(vel + 3 * j, v->a1, yjs, sat);
+                if (j >= nF) sn_k_add3(yjs, ds + 3 * (j - nF), yjs, sat);
+                yj = yjs;
+            }
             sca_row(l, m, yj);
             if (j < nF) sca_mac(acc + 3 * j, m, yi);
         }
