@@ -385,6 +385,21 @@ SN_INLINE seg_n narrow(int64_t x) {
 }
 #endif
 
+/* sn_out(v, 0, sat) of a value known to be within int32 (fixed: clamp to
+ * +-SN_LIM, counted): the same value, but with seg_n int32 on a 32-bit
+ * target two 32-bit compares instead of a 64-bit difference and 64-bit
+ * compares (the endpoints' differences below: each endpoint < 2^30) */
+#if defined(SN_FLOAT)
+#define SEG_OUT(v, sat) sn_out((v), 0, (sat))
+#else
+#define SEG_OUT(v, sat) seg_out((v), (sat))
+SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return v;
+}
+#endif
+
 /* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
  * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
 SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
@@ -498,9 +513,9 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     hb = sb > 0 ? hb : -hb;
     /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
      * t = omega gamma d / 2: |.| < 2^28 (components written out) */
-    d[0] = sn_out((B[0] + r30(MUL(B[3], hb))) - (A[0] + r30(MUL(A[3], ha))), 0, &ls);
-    d[1] = sn_out((B[1] + r30(MUL(B[4], hb))) - (A[1] + r30(MUL(A[4], ha))), 0, &ls);
-    d[2] = sn_out((B[2] + r30(MUL(B[5], hb))) - (A[2] + r30(MUL(A[5], ha))), 0, &ls);
+    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30(MUL(B[3], hb))) - NARROW(A[0] + r30(MUL(A[3], ha))), &ls);
+    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30(MUL(B[4], hb))) - NARROW(A[1] + r30(MUL(A[4], ha))), &ls);
+    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30(MUL(B[5], hb))) - NARROW(A[2] + r30(MUL(A[5], ha))), &ls);
     t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
     t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
     t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
@@ -550,8 +565,9 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     }
     m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
     for (j = 0; j < k; j++) {
-        seg_n d0 = NARROW(sn_out((sn_acc)m0 - P[j][0], 0, &ls)), d1 = NARROW(sn_out((sn_acc)m1 - P[j][1], 0, &ls)),
-              d2 = NARROW(sn_out((sn_acc)m2 - P[j][2], 0, &ls)), t0, t1, t2;
+        /* |m| <= 2^28, |P| < 2^30: the difference within int32 */
+        seg_n d0 = SEG_OUT((seg_n)m0 - P[j][0], &ls), d1 = SEG_OUT((seg_n)m1 - P[j][1], &ls),
+              d2 = SEG_OUT((seg_n)m2 - P[j][2], &ls), t0, t1, t2;
         if (j + 1 < k) {
             t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
             l0 -= t0; l1 -= t1; l2 -= t2;
