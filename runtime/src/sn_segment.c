@@ -599,10 +599,17 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
         *sat += ls;
         return;
     }
-    t0 = sn_out((sn_acc)d[0] * C->g1, SN_Q_ROT, &ls);
-    t1 = sn_out((sn_acc)d[1] * C->g1, SN_Q_ROT, &ls);
-    t2 = sn_out((sn_acc)d[2] * C->g1, SN_Q_ROT, &ls);
-    kf = seg_kf(L, a, sa, C->rf1, &sh);
+    /* omega gamma < 2^31 as its int32 copy g1n: one 32x32 product (the same
+     * product as with the int64 g1) */
+    t0 = sn_out(MUL(d[0], C->g1n), SN_Q_ROT, &ls);
+    t1 = sn_out(MUL(d[1], C->g1n), SN_Q_ROT, &ls);
+    t2 = sn_out(MUL(d[2], C->g1n), SN_Q_ROT, &ls);
+    if (L->l == 0) { /* level 0: the sweep's turn factor (seg_kf of the level's half) */
+        kf = sa > 0 ? C->kf1 : -C->kf1;
+        sh = L->sh;
+    } else {
+        kf = seg_kf(L, a, sa, C->rf1, &sh);
+    }
     move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
     *sat += ls;
 }
