@@ -155,6 +155,56 @@ SN_INLINE sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
     return S[12];
 }
 
+/* A value the bounds (NUMERICS.md "Fixed point, bounds") keep within int32 (fixed; float: float), so on
+ * a 32-bit target a product of two is one 32x32->64 multiply (SMULL on a
+ * Cortex-M4, not a 64x64 one); on a 64-bit target int64 (no sign
+ * extensions). The same values either way: the same bits. */
+#if defined(SN_FLOAT)
+typedef float seg_n;
+#define MUL(a, b) ((a) * (b))
+#else
+#if UINTPTR_MAX > 0xFFFFFFFFu
+typedef int64_t seg_n;
+#else
+typedef int32_t seg_n;
+#endif
+#define MUL(a, b) ((int64_t)(a) * (b))
+#endif
+/* an int64 value into seg_n; the range-checking build asserts the int32 bound
+ * on every target (a 64-bit seg_n would hide a value a 32-bit one truncates) */
+#if defined(SN_FLOAT)
+#define NARROW(x) (x)
+#else
+#define NARROW(x) narrow(x)
+SN_INLINE seg_n narrow(int64_t x) {
+    seg_n v;
+    SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
+    v = (seg_n)x;
+#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
+    /* no code, the same value: GCC would otherwise multiply the 64-bit value
+     * v came from (known to fit) as 64 x 64 bits (UMULL and two MLA, seen on
+     * the Cortex-M4) instead of one SMULL */
+    __asm__("" : "+r"(v));
+#endif
+    return v;
+}
+#endif
+
+/* sn_out(v, 0, sat) of a value known to be within int32 (fixed: clamp to
+ * +-SN_LIM, counted): the same value, but with seg_n int32 on a 32-bit
+ * target two 32-bit compares instead of a 64-bit difference and 64-bit
+ * compares (the endpoints' differences below: each endpoint < 2^30) */
+#if defined(SN_FLOAT)
+#define SEG_OUT(v, sat) sn_out((v), 0, (sat))
+#else
+#define SEG_OUT(v, sat) seg_out((v), (sat))
+SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return v;
+}
+#endif
+
 /* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,
  * one clamp of the sum (fixed); float the same expression */
 SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
@@ -169,9 +219,10 @@ SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *
     int64_t o0 = sn_rshr64((int64_t)S[3] * hl, SN_Q_ROT), o1 = sn_rshr64((int64_t)S[4] * hl, SN_Q_ROT),
             o2 = sn_rshr64((int64_t)S[5] * hl, SN_Q_ROT);
 #endif
-    P[0] = sn_out(s > 0 ? S[0] + o0 : S[0] - o0, 0, sat);
-    P[1] = sn_out(s > 0 ? S[1] + o1 : S[1] - o1, 0, sat);
-    P[2] = sn_out(s > 0 ? S[2] + o2 : S[2] - o2, 0, sat);
+    /* |G| <= 2^28, offset <= 2^29: the end within int32, clamped as one (seg_out) */
+    P[0] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[0] + o0 : S[0] - o0), sat);
+    P[1] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[1] + o1 : S[1] - o1), sat);
+    P[2] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[2] + o2 : S[2] - o2), sat);
 }
 
 void seg_end(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) { end_of(L, i, s, P, sat); }
@@ -349,56 +400,6 @@ SN_INLINE sn_acc rsh(sn_acc a, int s) {
 #endif
 }
 SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
-
-/* A value the bounds above keep within int32 (fixed; float: float), so on
- * a 32-bit target a product of two is one 32x32->64 multiply (SMULL on a
- * Cortex-M4, not a 64x64 one); on a 64-bit target int64 (no sign
- * extensions). The same values either way: the same bits. */
-#if defined(SN_FLOAT)
-typedef float seg_n;
-#define MUL(a, b) ((a) * (b))
-#else
-#if UINTPTR_MAX > 0xFFFFFFFFu
-typedef int64_t seg_n;
-#else
-typedef int32_t seg_n;
-#endif
-#define MUL(a, b) ((int64_t)(a) * (b))
-#endif
-/* an int64 value into seg_n; the range-checking build asserts the int32 bound
- * on every target (a 64-bit seg_n would hide a value a 32-bit one truncates) */
-#if defined(SN_FLOAT)
-#define NARROW(x) (x)
-#else
-#define NARROW(x) narrow(x)
-SN_INLINE seg_n narrow(int64_t x) {
-    seg_n v;
-    SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
-    v = (seg_n)x;
-#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
-    /* no code, the same value: GCC would otherwise multiply the 64-bit value
-     * v came from (known to fit) as 64 x 64 bits (UMULL and two MLA, seen on
-     * the Cortex-M4) instead of one SMULL */
-    __asm__("" : "+r"(v));
-#endif
-    return v;
-}
-#endif
-
-/* sn_out(v, 0, sat) of a value known to be within int32 (fixed: clamp to
- * +-SN_LIM, counted): the same value, but with seg_n int32 on a 32-bit
- * target two 32-bit compares instead of a 64-bit difference and 64-bit
- * compares (the endpoints' differences below: each endpoint < 2^30) */
-#if defined(SN_FLOAT)
-#define SEG_OUT(v, sat) sn_out((v), 0, (sat))
-#else
-#define SEG_OUT(v, sat) seg_out((v), (sat))
-SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
-    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
-    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
-    return v;
-}
-#endif
 
 /* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
  * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
