@@ -488,6 +488,11 @@ typedef struct seg_ctx {
      * each target is computed once per step, not once per sweep and level */
     sn_q T[SEG_TCACHE][3];
     uint32_t Tsat[SEG_TCACHE];
+    /* their rod ends on the current level (sweep_prep): count (0: the
+     * attached node is not a node of the level), segments, signs */
+    unsigned ak[SEG_TCACHE];
+    uint32_t aseg[SEG_TCACHE][5];
+    int asgn[SEG_TCACHE][5];
 } seg_ctx;
 
 /* pair constraint between two endpoints of equal masses: d = P2 - P1,
@@ -667,27 +672,40 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
     else star(C, L, seg, sgn, 3u, sat);
 }
 
+/* What every sweep of level L reads and no sweep changes, once per level:
+ * level 0's turn factors and the first SEG_TCACHE attachments' rod ends
+ * (none where the attached fine node is not a node of the level) */
+static void sweep_prep(seg_ctx *C, const seg_lvl *L) {
+    const seg_mesh *M = C->M;
+    uint32_t i;
+    int sh;
+    C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
+    C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
+    for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
+        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        int64_t ln = level_node(M, L, sn_rd_u16(rec));
+        C->ak[i] = ln < 0 ? 0u : seg_node_ends(L, (uint32_t)ln, C->aseg[i], C->asgn[i]);
+    }
+}
+
 static void sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const seg_mesh *M = C->M;
     uint32_t n, seg[5], i, q;
     int sgn[5];
     unsigned j, k;
-    {
-        int sh;
-        C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
-        C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
-    }
     for (i = 0; i < M->n_attach; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
-        int64_t ln = level_node(M, L, sn_rd_u16(rec));
+        int64_t ln;
         sn_q T[3];
-        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
-        if (i < SEG_TCACHE) { /* the same target and clamp count as attach_target's */
-            for (k = 0; k < 3; k++) T[k] = C->T[i][k];
+        if (i < SEG_TCACHE) { /* the same target, clamp count and ends as computed per sweep */
+            if (C->ak[i] == 0) continue;
             *sat += C->Tsat[i];
-        } else {
-            attach_target(C->h, rec, T, sat);
+            for (j = 0; j < C->ak[i]; j++) pin(C, L, C->aseg[i][j], C->asgn[i][j], C->T[i], measure, sat);
+            continue;
         }
+        ln = level_node(M, L, sn_rd_u16(rec));
+        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
+        attach_target(C->h, rec, T, sat);
         k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
         for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
     }
@@ -971,6 +989,7 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
             /* level 0 takes `sweeps`, the coarser ones `coarse_sweeps`: a
              * coarse level starts each step with its constraints met
              * (restriction), its sweeps only pin it and follow its dynamics */
+            sweep_prep(&C, &L);
             for (s = 0; s < (l ? M.coarse_sweeps : M.sweeps); s++) sweep(&C, &L, 0, s & 1u, sat);
             renormalize(&L); /* the Newton steps of the moves leave |u| within 2% of 1 */
             seg_node_means(&L, sat);
@@ -978,6 +997,7 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat) {
             velocities(&L, sat);
         }
         seg_level(&M, 0, &L);
+        sweep_prep(&C, &L);
         sweep(&C, &L, 1, 0, sat); /* measure the gaps left (no displacement) */
         {
             sn_real g = gap_of(C.gap2, &L);
