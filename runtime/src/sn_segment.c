@@ -784,17 +784,22 @@ static void dynamics(seg_ctx *C, const seg_lvl *L, sn_q inv_mass, uint32_t *sat)
      * J = m L^2/12 about the perpendicular axes (seed 004 §3.2.2, app. A) */
     for (n = 0; n < L->nn; n++) {
         const sn_q *J = L->N + NODE_W * n + 3;
+        sn_q f[3], fe[3];
+        uint32_t ls = 0;
         ne = seg_node_ends(L, n, seg, sgn);
+        /* f and fe are the node's, the same at each of its ends: formed once,
+         * their clamps counted once per end as when formed per end */
+        for (k = 0; k < 3; k++) {
+            f[k] = sn_mulq(mean_k(J[k], ne, &ls), inv_mass, 16, &ls);
+            fe[k] = sn_add(f[k], -sn_mulq(f[k], M->centre, SN_Q_ROT, &ls), &ls);
+        }
+        *sat += ls * ne;
         for (j = 0; j < ne; j++) {
-            sn_q *S = L->S + SEG_W * seg[j], f[3], fe[3], c[3];
+            sn_q *S = L->S + SEG_W * seg[j], c[3];
             sn_q rr;
             int rs;
             sn_q hl = seg_half(L, seg[j], &rr, &rs);
-            for (k = 0; k < 3; k++) {
-                f[k] = sn_mulq(mean_k(J[k], ne, sat), inv_mass, 16, sat);
-                S[6 + k] = sn_add(S[6 + k], f[k], sat);
-                fe[k] = sn_add(f[k], -sn_mulq(f[k], M->centre, SN_Q_ROT, sat), sat);
-            }
+            for (k = 0; k < 3; k++) S[6 + k] = sn_add(S[6 + k], f[k], sat);
             c[0] = sn_out(sn_mul_sub(S[4], fe[2], S[5], fe[1]), SN_Q_ROT, sat);
             c[1] = sn_out(sn_mul_sub(S[5], fe[0], S[3], fe[2]), SN_Q_ROT, sat);
             c[2] = sn_out(sn_mul_sub(S[3], fe[1], S[4], fe[0]), SN_Q_ROT, sat);
