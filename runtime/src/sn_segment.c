@@ -199,6 +199,7 @@ SN_INLINE seg_n narrow(int64_t x) {
 #else
 #define SEG_OUT(v, sat) seg_out((v), (sat))
 SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
+    SN_RANGE(v >= -INT32_MAX && v <= INT32_MAX, "segment sum beyond int32", v);
     if (v > SN_LIM) { (*sat)++; return SN_LIM; }
     if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
     return v;
