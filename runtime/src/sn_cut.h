@@ -22,7 +22,7 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
 void sn_cut_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const sn_q *vf, const sn_q *vs, sn_acc acc[3]);
 
 /* Rows (sn_constraint.c, sn_contact.c, sn_crease.c): the lattice vertices
- * and weights (Q30 / float, >= 0, summing to one) of the point at t (Q15) in
+ * and weights (Q30 / float, >= 0 but for a -1 LSB rounding, summing to one) of the point at t (Q15) in
  * cell under the surface's field: the cell's 8 corners (trilinear on a plain
  * lattice), on the cut level then the extras of the child holding the point
  * (skeleton vertices). Returns the entries: 8 plain, <= 15 cut. */
