@@ -50,18 +50,24 @@ sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk) {
  * element's blocks [corner x extra]: lx_a = sum_x K_ax (d_x + u_x), d_x and
  * u_x formed as a corner's (relative to corner 0, in the cell's frame). The
  * extras' own rows are the skeleton's (no unknowns), so the energy stat keeps
- * the corner block's d.K d. Bound: 19 x 3 more products < 2^55 per row. */
+ * the corner block's d.K d. Bound: 19 x 3 more products < 2^55 per row.
+ * Cost (LEVELS.md §2): y_x first, then per free corner (set bits of fr) its
+ * 3 rows summed over the extras in registers; each row's additions come in
+ * the same order as extra-major loops would give them (x, then c), so float
+ * keeps its bits; fixed sums a block row's 3 int16 mantissa products and
+ * scales once by 2^e (m y = mant y 2^e, all exact in int64: same integers). */
 void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
                   sn_acc lx[24], uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX, *rest = v->sec[SN_SEC_REST];
-    const unsigned char *K = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
+    const unsigned char *K0 = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    uint32_t j, a, c, i, counted = 0; /* coef's clamps are counted once in rhs */
+    sn_q y[SN_CUT_MAXX][3];
+    uint32_t j, a, c, i, n = 0, counted = 0; /* coef's clamps are counted once in rhs */
     for (i = 0; i < 24; i++) lx[i] = 0;
     for (j = 0; j < SN_CUT_MAXX; j++) {
         uint32_t x = sn_rd_u16(cx + 2 * j);
-        sn_q t[3], sw[3], l[3], uu[3], y[3];
+        sn_q t[3], sw[3], l[3], uu[3];
         if (x == SN_CUT_NONE) continue;
         for (c = 0; c < 3; c++) {
             t[c] = sn_add(pos[3 * x + c], -pos[3 * a0 + c], sat);
@@ -71,20 +77,33 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
         sn_k_rot_t(R, sw, uu, sat);
         for (c = 0; c < 3; c++) {
             sn_q xr = sn_add(rd_real(rest, 3 * x + c), -rd_real(rest, 3 * a0 + c), sat);
-            y[c] = sn_add(sn_add(l[c], -xr, sat), uu[c], sat);
+            y[n][c] = sn_add(sn_add(l[c], -xr, sat), uu[c], sat);
         }
-        for (a = 0; a < 8; a++, K += SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES)) {
-            if (!(fr >> a & 1u)) continue;
-            for (i = 0; i < 3; i++)
-                for (c = 0; c < 3; c++) {
+        n++;
+    }
+    for (; fr != 0; fr &= fr - 1u) {
+        const unsigned char *K;
+        sn_acc s0 = 0, s1 = 0, s2 = 0;
+        for (a = 0; !(fr >> a & 1u); a++) {}
+        K = K0 + (size_t)a * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES); /* block (x, a) at 8 x + a */
+        for (j = 0; j < n; j++, K += 8 * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES)) {
+            const sn_q *yx = y[j];
 #if defined(SN_FLOAT)
-                    sn_q m = rd_real(K, 3 * i + c);
+            s0 += sn_mul(rd_real(K, 0), yx[0]); s0 += sn_mul(rd_real(K, 1), yx[1]); s0 += sn_mul(rd_real(K, 2), yx[2]);
+            s1 += sn_mul(rd_real(K, 3), yx[0]); s1 += sn_mul(rd_real(K, 4), yx[1]); s1 += sn_mul(rd_real(K, 5), yx[2]);
+            s2 += sn_mul(rd_real(K, 6), yx[0]); s2 += sn_mul(rd_real(K, 7), yx[1]); s2 += sn_mul(rd_real(K, 8), yx[2]);
 #else
-                    sn_q m = (sn_q)((int32_t)(int16_t)sn_rd_u16(K + 2 * (3 * i + c)) * ((int32_t)1 << K[18]));
+            int64_t sc = (int64_t)1 << K[18];
+#define SN_CUT_M(k) ((int64_t)(int16_t)sn_rd_u16(K + 2 * (k)))
+            s0 += (SN_CUT_M(0) * yx[0] + SN_CUT_M(1) * yx[1] + SN_CUT_M(2) * yx[2]) * sc;
+            s1 += (SN_CUT_M(3) * yx[0] + SN_CUT_M(4) * yx[1] + SN_CUT_M(5) * yx[2]) * sc;
+            s2 += (SN_CUT_M(6) * yx[0] + SN_CUT_M(7) * yx[1] + SN_CUT_M(8) * yx[2]) * sc;
+#undef SN_CUT_M
 #endif
-                    lx[3 * a + i] += sn_mul(m, y[c]);
-                }
         }
+        lx[3 * a] = s0;
+        lx[3 * a + 1] = s1;
+        lx[3 * a + 2] = s2;
     }
     for (i = 0; i < 24; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
 }
