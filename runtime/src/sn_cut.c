@@ -63,8 +63,8 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
     const unsigned char *K0 = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
     sn_q y[SN_CUT_MAXX][3];
+    uint32_t xo[SN_CUT_MAXX], o = 0;
     uint32_t j, a, c, i, n = 0, counted = 0; /* coef's clamps are counted once in rhs */
-    for (i = 0; i < 24; i++) lx[i] = 0;
     for (j = 0; j < SN_CUT_MAXX; j++) {
         uint32_t x = sn_rd_u16(cx + 2 * j);
         sn_q t[3], sw[3], l[3], uu[3];
@@ -79,15 +79,16 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
             sn_q xr = sn_add(rd_real(rest, 3 * x + c), -rd_real(rest, 3 * a0 + c), sat);
             y[n][c] = sn_add(sn_add(l[c], -xr, sat), uu[c], sat);
         }
-        n++;
+        xo[n] = o++;
+        n += !(y[n][0] == 0 && y[n][1] == 0 && y[n][2] == 0); /* y = 0: its products are exact zeros, left out */
     }
-    for (; fr != 0; fr &= fr - 1u) {
-        const unsigned char *K;
+    for (a = 0; a < 8; a++) {
+        const unsigned char *K = K0 + (size_t)a * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES); /* block (x, a) at 8 x + a */
         sn_acc s0 = 0, s1 = 0, s2 = 0;
-        for (a = 0; !(fr >> a & 1u); a++) {}
-        K = K0 + (size_t)a * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES); /* block (x, a) at 8 x + a */
-        for (j = 0; j < n; j++, K += 8 * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES)) {
+        if (!(fr >> a & 1u)) continue; /* not free: its lx not read (cell_forces) */
+        for (j = 0; j < n; j++) {
             const sn_q *yx = y[j];
+            K = K0 + ((size_t)8 * xo[j] + a) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
 #if defined(SN_FLOAT)
             s0 += sn_mul(rd_real(K, 0), yx[0]); s0 += sn_mul(rd_real(K, 1), yx[1]); s0 += sn_mul(rd_real(K, 2), yx[2]);
             s1 += sn_mul(rd_real(K, 3), yx[0]); s1 += sn_mul(rd_real(K, 4), yx[1]); s1 += sn_mul(rd_real(K, 5), yx[2]);
@@ -104,8 +105,8 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
         lx[3 * a] = s0;
         lx[3 * a + 1] = s1;
         lx[3 * a + 2] = s2;
+        for (i = 3 * a; i < 3 * a + 3; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
     }
-    for (i = 0; i < 24; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
 }
 
 /* The cut field (surface, sn_embed.c; level switch, sn_level.c): the field in a cell is

@@ -12,7 +12,8 @@ sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk);
 
 /* Step 4 (sn_solve.c cell_forces): cell e's extras' terms lx (24 rows, the
  * cell product's scale) for its free corners fr (bit a: corner a free);
- * R the cell frame, a0 its corner 0, w0 w at a0. */
+ * R the cell frame, a0 its corner 0, w0 w at a0. Only free corners' rows
+ * are written (cell_forces reads no other). */
 void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
                   sn_acc lx[24], uint32_t *sat);
 
