@@ -51,7 +51,7 @@ sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk) {
  * u_x formed as a corner's (relative to corner 0, in the cell's frame). The
  * extras' own rows are the skeleton's (no unknowns), so the energy stat keeps
  * the corner block's d.K d. Bound: 19 x 3 more products < 2^55 per row.
- * Cost (LEVELS.md §2): y_x first (an exactly zero y left out), then per
+ * Cost (LEVELS.md §2; blob-fixed: no skip on the values): y_x first, then per
  * free corner its 3 rows summed over the extras in registers; each row's additions come in
  * the same order as extra-major loops would give them (x, then c), so float
  * keeps its bits; fixed sums a block row's 3 int16 mantissa products and
@@ -63,7 +63,6 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
     const unsigned char *K0 = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
     sn_q y[SN_CUT_MAXX][3];
-    uint32_t xo[SN_CUT_MAXX], o = 0;
     uint32_t j, a, c, i, n = 0, counted = 0; /* coef's clamps are counted once in rhs */
     for (j = 0; j < SN_CUT_MAXX; j++) {
         uint32_t x = sn_rd_u16(cx + 2 * j);
@@ -79,15 +78,14 @@ void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q
             sn_q xr = sn_add(rd_real(rest, 3 * x + c), -rd_real(rest, 3 * a0 + c), sat);
             y[n][c] = sn_add(sn_add(l[c], -xr, sat), uu[c], sat);
         }
-        xo[n] = o++;
-        n += !(y[n][0] == 0 && y[n][1] == 0 && y[n][2] == 0); /* y = 0: its products are exact zeros, left out */
+        n++;
     }
     for (a = 0; a < 8; a++) {
         sn_acc s0 = 0, s1 = 0, s2 = 0;
         if (!(fr >> a & 1u)) continue; /* not free: its lx not read (cell_forces) */
         for (j = 0; j < n; j++) {
-            const sn_q *yx = y[j]; /* block (extra o, corner a) at 8 o + a */
-            const unsigned char *K = K0 + ((size_t)8 * xo[j] + a) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
+            const sn_q *yx = y[j]; /* block (extra j, corner a) at 8 j + a */
+            const unsigned char *K = K0 + ((size_t)8 * j + a) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
 #if defined(SN_FLOAT)
             s0 += sn_mul(rd_real(K, 0), yx[0]); s0 += sn_mul(rd_real(K, 1), yx[1]); s0 += sn_mul(rd_real(K, 2), yx[2]);
             s1 += sn_mul(rd_real(K, 3), yx[0]); s1 += sn_mul(rd_real(K, 4), yx[1]); s1 += sn_mul(rd_real(K, 5), yx[2]);
