@@ -21,10 +21,11 @@
  * Two builds of the same file (tests/fuzz/fuzz.mk... see runtime/runtime.mk):
  *   test_runtime_fuzz     -DSN_VALIDATE_NO_CHECKSUM: the checksum is skipped so
  *                         mutations reach every later rule and the stepper;
- *                         -DSN_FUZZ_RANDOM_ONLY: by default only the cow's
- *                         random flips (everything else runs in
- *                         test_runtime_fuzz_range, the same objects plus the
- *                         range checks); --full: every case below;
+ *                         -DSN_FUZZ_RANDOM_ONLY: without arguments (make
+ *                         test) only the cow's random flips (everything else
+ *                         runs in test_runtime_fuzz_range, the same objects
+ *                         plus the range checks); --full, --all or a blob
+ *                         named: every case below;
  *   test_runtime_fuzz_ck  normal validator: every flip must be rejected
  *                         (CRC-32 detects every single-bit error; bytes 0..15,
  *                         outside the CRC, are magic/version/endian/CRC); by
@@ -1398,14 +1399,13 @@ int main(int argc, char **argv) {
      * hand-built blob, crafted cases, matrix and the cow's header, edge,
      * padding and truncation cases with strictly more checks; here only what
      * it does not: the cow's random flips (100 a section; the range build
-     * draws its own 40). --full (make fuzz-blobs) runs everything. */
-    g_random_only = !full && !all;
+     * draws its own 40). With a blob named, --all or --full (make
+     * fuzz-blobs): everything, as the other builds. */
+    g_random_only = !full && !all && !path;
     if (g_random_only) {
-        printf("  random flips only (hand-built blob, crafted, matrix, header/edge flips, truncations: test_runtime_fuzz_range, same cases + range checks; --full runs them here)\n");
-        if (!path) {
-            sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
-            path = defpath;
-        }
+        printf("  the cow's random flips only (hand-built blob, crafted, matrix, header/edge flips, truncations: test_runtime_fuzz_range, same cases + range checks; --full runs them here)\n");
+        sprintf(defpath, "%s/%s", bdir ? bdir : "build", DEFAULT_BLOB);
+        path = defpath;
     }
 #else
     (void)full;
