@@ -120,6 +120,12 @@ $(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) t
 TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(BUILD)/examples/cow.blob \
              $(BUILD)/examples/cow_float.blob $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob
 
+# tests/scripts/test_level.sh with the float cow's adaptation run too (make
+# test runs the float beast's, which also overflows A_max)
+.PHONY: level-all
+level-all: test-build
+	LEVEL_ALL=1 BUILD=$(BUILD) sh tests/scripts/test_level.sh
+
 # The hostile-blob fuzzer over a blob with LEVEL_BLOB and ADAPT (both levels
 # stepped, adaptation on level 1, then blended): part of `make fuzz-blobs`,
 # not of make test (about 85 s of CPU per 100 flips a section on a two-level
