@@ -89,6 +89,16 @@ void sn_level_counts(const sn_view *v, uint32_t *nV, uint32_t *nF, uint32_t *nC)
     }
 }
 
+uint32_t sn_level_fpairs(const sn_view *v) {
+    uint32_t n = sn_level_sec_count(v, SN_SEC_FPAIRS);
+    if (sn_level_sec_count(v, SN_SEC_LEVEL_BLOB) != 0) {
+        sn_view f;
+        sn_view_init(&f, (const sn_blob *)(const void *)v->sec[SN_SEC_LEVEL_BLOB]);
+        if (sn_level_sec_count(&f, SN_SEC_FPAIRS) > n) n = sn_level_sec_count(&f, SN_SEC_FPAIRS);
+    }
+    return n;
+}
+
 uint32_t sn_lod_levels(const sn_blob *blob) {
     sn_view v;
     if (!blob) return 0;
