@@ -374,7 +374,8 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * crease state SN_CREASE_STATE_BYTES (0 without a CREASE section; a multiple
  * of 8, so the sum rounds as the runtime's separate arrays do);
  * plus the frame pairs' scratch, SN_FPAIR_BYTES per FPAIRS entry (format 6.4;
- * the largest level's count; 0 without);
+ * the largest level's count; 0 without: the runtime places it after the
+ * constraint state, a multiple of 8, so the total is the same);
  * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record and
  * the crease rows (0 without either). Per vertex 24 (position, velocity),
  * per free vertex 96 + 1 (accumulators, frame, CG vectors x r q -- z and w
