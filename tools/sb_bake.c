@@ -11,7 +11,7 @@ static const char *sec_name[] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDI
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
                                              "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
-                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK"};
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK", "FPAIRS", "FREFS"};
 /* one name per section: a new section without its name fails to compile
  * (format 6.1's ADAPT printed as "(null)", a NULL through %s) */
 typedef char sb_sec_name_count_[sizeof sec_name / sizeof sec_name[0] == SN_SEC_COUNT ? 1 : -1];

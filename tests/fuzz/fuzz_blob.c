@@ -579,7 +579,7 @@ static void crease_set(unsigned char *b, uint32_t list, uint32_t active, double 
     tb_real(cr + 12, depth, SN_Q_LEN);
     tb_real(cr + 16, push, SN_Q_LEN);
     tb_u32(b + SN_H_INSTANCE_BYTES,
-           SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + SN_CREASE_STATE_BYTES(TB_NS, list),
+           SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + SN_CREASE_STATE_BYTES(TB_NS, list) + TB_FPB,
                              SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, active))));
 }
 static size_t craft_crease(void) {
