@@ -6,7 +6,9 @@
  *   sn_solve.c     right-hand side, per-cell stiffness, mat-vec, preconditioner, PCG
  *   sn_rig.c       controls, tau maps, rig forces (seed 003 §4)
  *   sn_force.c     external forces and impulses, multilevel shares, joint wrench (seed 004 ch. 4)
- *   sn_segment.c   segment meshes: chains and sheets (seed 004 ch. 3-4)
+ *   sn_segment.c   segment meshes: chains and sheets (seed 004 ch. 3-4): dynamics, the step;
+ *                  sn_segment_sweep.c their constraint sweeps, sn_segment_mesh.c records,
+ *                  topology, reset, teleport, hash; sn_segment_level.c levels; _api.c validator
  *   sn_crease.c    self-collision near creases: list C, detection, rows (seed 003 §3.4)
  *   sn_health.c    limits and the health report
  *   sn_embed.c     outputs: lattice, surface, normals
@@ -220,7 +222,7 @@ void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat);   /* 5: pose controls, b += ri
 void sn_controls_reset(sn_ihdr *h);                 /* abstract controls to their baked values */
 void sn_forces_rhs(sn_ihdr *h, sn_q *b, uint32_t *sat); /* 5: b += applied forces' fine and coarse shares (sn_force.c) */
 void sn_forces_clear(sn_ihdr *h);                   /* after the step: slots emptied */
-void sn_segments_reset(sn_ihdr *h);                 /* segment meshes at rest (sn_segment.c) */
+void sn_segments_reset(sn_ihdr *h);                 /* segment meshes at rest (sn_segment_mesh.c) */
 void sn_segments_step(sn_ihdr *h, uint32_t *sat);   /* 8b: segment meshes after the flesh (sn_segment.c) */
 /* sn_teleport: every segment mesh moved rigidly with the root, x' = M (x - T0) + T1
  * (M the root's turn, Q30; T0, T1 the root's internal position before and after),

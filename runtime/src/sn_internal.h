@@ -345,7 +345,7 @@ sn_status sn_check_frefs(const sn_view *v, uint32_t nfp, uint32_t nfr);
  * integer in [lo, hi]; float, finite and in [lo, hi] / 2^q (q <= 30). */
 int sn_real_ok(const unsigned char *p, int32_t lo, int32_t hi, int q);
 
-/* Segment sections (sn_segment.c): contents valid, and *segB = the state
+/* Segment sections (sn_segment_api.c): contents valid, and *segB = the state
  * bytes they need. Called by the validator once the table is checked. */
 sn_status sn_check_segments(const sn_view *v, uint32_t *segB);
 /* Crease sections (sn_crease.c): contents valid (table counts already

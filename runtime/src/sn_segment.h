@@ -1,5 +1,9 @@
-/* sn_segment.h -- segment meshes (seed 004 ch. 3-4), shared by the solver
- * (sn_segment.c) and the multilevel transfers (sn_segment_level.c).
+/* sn_segment.h -- segment meshes (seed 004 ch. 3-4), shared by the step
+ * (sn_segment.c: dynamics, velocities, the step's order), the displacement
+ * constraint's sweeps (sn_segment_sweep.c), the mesh records, topology and
+ * state (sn_segment_mesh.c: levels, ends, reset, teleport, hash) and the
+ * multilevel transfers (sn_segment_level.c); the API and validator are
+ * sn_segment_api.c.
  *
  * Instance state (h->o_seg), per mesh in blob order: every level's segments
  * (finest first, SEG_W words each), then every level's nodes (NODE_W words).
@@ -61,4 +65,194 @@ void seg_restrict(const seg_mesh *M, uint32_t *sat);
 void seg_prolong(const seg_mesh *M, unsigned l, uint32_t *sat);
 /* unit vector of x (any scale) into u; unchanged if x = 0 */
 void seg_unit(const sn_q x[3], sn_q u[3]);
+/* ---- shared by the sweeps and the step: values, limits, ends (inlined) ---- */
+
+/* largest rotation per constraint or per step, per component: 0.25 rad
+ * (the small-angle update u + theta x u stays within 3% of a true rotation) */
+#if defined(SN_FLOAT)
+#define ROT_MAX 0.25f
+#else
+#define ROT_MAX ((int32_t)1 << 28)
+/* dynamics() caps angular velocity sums at ROT_MAX where sn_add would clamp
+ * at SN_LIM: the same value only while the two are equal */
+typedef char sn_rot_max_is_state_lim_[ROT_MAX == SN_LIM ? 1 : -1];
+#endif
+
+/* sheet node (r, c) of side s in ring order: left (end), up (end), right
+ * (start), down (start); no brace */
+SN_INLINE unsigned sheet_ends(uint32_t s, uint32_t r, uint32_t c, uint32_t seg[5], int sgn[5]) {
+    uint32_t h = r * (s - 1u) + c, n = r * s + c, nh = s * (s - 1u);
+    unsigned k = 0;
+    if (c > 0) { seg[k] = h - 1u; sgn[k++] = 1; }
+    if (r > 0) { seg[k] = nh + n - s; sgn[k++] = 1; }
+    if (c + 1u < s) { seg[k] = h; sgn[k++] = -1; }
+    if (r + 1u < s) { seg[k] = nh + n; sgn[k++] = -1; }
+    return k;
+}
+
+SN_INLINE int is_brace(const seg_lvl *L, uint32_t i) {
+    return L->kind == SN_SEG_SHEET && L->side == 2u && i >= 4u;
+}
+
+/* half length of segment i with its reciprocal and shift: the level's on
+ * the finest level; on a coarser one the segment's own (words 12-14, set by
+ * seg_from_nodes from its restricted nodes) */
+SN_INLINE sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
+    const sn_q *S = L->S + SEG_W * i;
+    if (L->l == 0) { *r = L->rh; *sh = L->sh; return L->half; }
+    *r = S[13];
+    *sh = (int)S[14];
+    return S[12];
+}
+
+/* A value the bounds (NUMERICS.md "Fixed point, bounds") keep within int32 (fixed; float: float), so on
+ * a 32-bit target a product of two is one 32x32->64 multiply (SMULL on a
+ * Cortex-M4, not a 64x64 one); on a 64-bit target int64 (no sign
+ * extensions). The same values either way: the same bits. */
+#if defined(SN_FLOAT)
+typedef float seg_n;
+#define MUL(a, b) ((a) * (b))
+#else
+#if UINTPTR_MAX > 0xFFFFFFFFu
+typedef int64_t seg_n;
+#else
+typedef int32_t seg_n;
+#endif
+#define MUL(a, b) ((int64_t)(a) * (b))
+#endif
+/* an int64 value into seg_n; the range-checking build asserts the int32 bound
+ * on every target (a 64-bit seg_n would hide a value a 32-bit one truncates) */
+#if defined(SN_FLOAT)
+#define NARROW(x) (x)
+#else
+#define NARROW(x) narrow(x)
+SN_INLINE seg_n narrow(int64_t x) {
+    seg_n v;
+    SN_RANGE(x >= -INT32_MAX && x <= INT32_MAX, "segment factor beyond int32", x);
+    v = (seg_n)x;
+#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
+    /* no code, the same value: GCC would otherwise multiply the 64-bit value
+     * v came from (known to fit) as 64 x 64 bits (UMULL and two MLA, seen on
+     * the Cortex-M4) instead of one SMULL */
+    __asm__("" : "+r"(v));
+#endif
+    return v;
+}
+#endif
+
+/* sn_out(v, 0, sat) of a value known to be within int32 (fixed: clamp to
+ * +-SN_LIM, counted): the same value, but with seg_n int32 on a 32-bit
+ * target two 32-bit compares instead of a 64-bit difference and 64-bit
+ * compares (the endpoints' differences below: each endpoint < 2^30) */
+#if defined(SN_FLOAT)
+#define SEG_OUT(v, sat) sn_out((v), 0, (sat))
+#else
+#define SEG_OUT(v, sat) seg_out((v), (sat))
+SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
+    SN_RANGE(v >= -INT32_MAX && v <= INT32_MAX, "segment sum beyond int32", v);
+    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
+    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
+    return v;
+}
+#endif
+
+/* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,
+ * one clamp of the sum (fixed); float the same expression */
+SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {
+    const sn_q *S = L->S + SEG_W * i;
+    sn_q r;
+    int sh;
+    sn_q hl = seg_half(L, i, &r, &sh);
+    /* components written out: compilers kept the loop (it runs per end per sweep) */
+#if defined(SN_FLOAT)
+    sn_q o0 = S[3] * hl, o1 = S[4] * hl, o2 = S[5] * hl;
+#else
+    int64_t o0 = sn_rshr64((int64_t)S[3] * hl, SN_Q_ROT), o1 = sn_rshr64((int64_t)S[4] * hl, SN_Q_ROT),
+            o2 = sn_rshr64((int64_t)S[5] * hl, SN_Q_ROT);
+#endif
+    /* |G| <= 2^28, offset <= 2^29: the end within int32, clamped as one (seg_out) */
+    P[0] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[0] + o0 : S[0] - o0), sat);
+    P[1] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[1] + o1 : S[1] - o1), sat);
+    P[2] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[2] + o2 : S[2] - o2), sat);
+}
+
+/* mean of k <= 5 values: fixed sum x round(2^30/k) >> 30 (sums of five Q22 values < 2^31.4) */
+SN_INLINE sn_q mean_k(sn_acc sum, unsigned k, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    return sn_out(sum / (float)k, 0, sat);
+#else
+    static const int32_t inv[6] = {0, 1 << 30, 1 << 29, 357913941, 1 << 28, 214748365};
+    return sn_out(sum * inv[k], SN_Q_ROT, sat);
+#endif
+}
+
+/* a Q60 product sum known to be within +-2^61 to Q30 (rounded), no clamp */
+SN_INLINE sn_q shr30(sn_acc a) {
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return (sn_q)sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+
+/* One multiply-only Newton step towards unit length: u = x (3 - |x|^2)/2
+ * (no square root, no division). For |x| = n the result has length
+ * n (3 - n^2)/2 <= 1 (equality at n = 1): an error e = n^2 - 1 becomes
+ * -3e^2/4 + e^3/4. A turn of u (|u| in [0.987, 1]) by e perpendicular to u
+ * with |e_k| <= 0.25 gives n^2 <= 1.1875, so the result stays in
+ * [0.987, 1] (NUMERICS.md "Fixed point, bounds"); the small turns of the
+ * later sweeps restore the length to the LSB, and the sweeps' end
+ * renormalizes exactly (renormalize, once per segment and step). */
+SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
+#if defined(SN_FLOAT)
+    float f = 1.5f - 0.5f * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    u[0] = x[0] * f; u[1] = x[1] * f; u[2] = x[2] * f;
+#else
+    /* |x_k| < 1.5 2^30: the sum of squares <= 1.19 2^60 (Q60); f in Q30
+     * within [0.9, 1.01] 2^30; x_k f < 2^61 */
+    int64_t n2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    int64_t f = sn_rshr64(((int64_t)3 << 60) - n2, SN_Q_ROT + 1);
+    unsigned k;
+    for (k = 0; k < 3; k++) u[k] = (sn_q)sn_rshr64(x[k] * f, SN_Q_ROT);
+#endif
+}
+
+#define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */
+typedef struct seg_ctx {
+    sn_ihdr *h;
+    const seg_mesh *M;
+    /* Palazzi's factors times the over-relaxation omega = relax/32 (1 when
+     * relax = 32: then these are exactly the plain factors, same bits) */
+    sn_q gh, rf1, rf2;  /* omega gamma/2, omega (1-gamma), omega (1-gamma)/2 */
+    sn_acc g1;          /* omega gamma (fixed Q30, < 2^31: int64) */
+    sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
+    seg_n kf0, kf1;     /* level 0's turn factors rf2/half, rf1/half (seg_kf), set by sweep */
+    seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
+    sn_q fn[3], foff;   /* floor in the internal frame */
+    int floor_on;
+    sn_len2 gap2;        /* the measuring pass's largest |d|^2 */
+    /* the first SEG_TCACHE attachments' targets and their clamp counts:
+     * the joints and the flesh do not move during the segment step, so
+     * each target is computed once per step, not once per sweep and level */
+    sn_q T[SEG_TCACHE][3];
+    uint32_t Tsat[SEG_TCACHE];
+    /* their rod ends on the current level (sweep_prep): count (0: the
+     * attached node is not a node of the level), segments, signs */
+    unsigned ak[SEG_TCACHE];
+    uint32_t aseg[SEG_TCACHE][5];
+    int asgn[SEG_TCACHE][5];
+} seg_ctx;
+
+
+/* sweeps (sn_segment_sweep.c) */
+/* attachment target of record rec in the internal frame */
+void seg_attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3], uint32_t *sat);
+/* what every sweep of level L reads and none changes: once per level */
+void seg_sweep_prep(seg_ctx *C, const seg_lvl *L);
+/* one sweep in direction dir (0 up / row-major, 1 back), or (measure) the gaps it would close */
+void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat);
+/* every segment's u of level L to unit length (three Newton steps) */
+void seg_renormalize(const seg_lvl *L);
+/* the measuring pass's largest |d|^2 as a length in public Q16.16 segment lengths (or float) */
+sn_real seg_gap(sn_len2 n2, const seg_lvl *L);
 #endif

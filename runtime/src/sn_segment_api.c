@@ -61,7 +61,7 @@ sn_status sn_check_segments(const sn_view *v, uint32_t *segB) {
             return SN_ERR_VALUE;
         {   /* format 6.2: coarse_sweeps (a one-level mesh: = sweeps), relax,
              * u16 0. omega = relax/32 in [1, 2) (SOR converges below 2), and
-             * omega (1 - gamma) <= 1: the turn factors (sn_segment.c seg_kf,
+             * omega (1 - gamma) <= 1: the turn factors (sn_segment_sweep.c seg_kf,
              * move_seg) keep their int32 bound, a turn closes at most all of
              * the gap's perpendicular part */
             const unsigned char *X = R + 9 * SN_REAL_BYTES;

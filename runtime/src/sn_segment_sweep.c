@@ -1,0 +1,391 @@
+/* sn_segment_sweep.c -- segment meshes' displacement constraint (seed 004
+ * §3.2, Gascuel and Gascuel's method as Palazzi applies it): the moves of one
+ * segment end (pair, star, pin, floor), one Gauss-Seidel sweep over a level
+ * in a fixed order, the measuring pass. The hot part of the segment step
+ * (NUMERICS.md "Segment meshes": Sweep, "Fewer operations in the sweeps").
+ * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
+ */
+#include "sn_segment.h"
+
+/* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
+
+/* every segment's u of a level to unit length: every write of u leaves
+ * |u| in [0.9876, 1] (newton_unit's bound, below), so three Newton steps
+ * reach the LSB (|u|^2 - 1: 2.5e-2 -> 4.6e-4 -> 1.6e-7 -> 2e-14, below
+ * Q30's 1e-9) without a square root or a division */
+void seg_renormalize(const seg_lvl *L) {
+    uint32_t i;
+    unsigned it, k;
+    for (i = 0; i < L->ns; i++) {
+        sn_q *u = L->S + SEG_W * i + 3;
+        for (it = 0; it < 3; it++) {
+            sn_acc x[3];
+            for (k = 0; k < 3; k++) x[k] = u[k];
+            newton_unit(x, u);
+        }
+    }
+}
+
+/* Move segment i so its endpoint (sign s) closes part of the gap d: the
+ * centre by t, and a rotation closing the share rf of the gap's part
+ * perpendicular to the segment, seed 004 eq. 3.8 with Palazzi's user factor:
+ *   dTheta = rf (r x d) / |r|^2,  r = s half u,  so  dTheta = s rf (u x d) / half,
+ * applied as u + dTheta x u = u + e, e = s rf d_perp / half (for a unit u,
+ * (u x d) x u = d - (d.u) u = d_perp): no cross products. Each component
+ * of the turn e is limited to ROT_MAX (0.25 rad; a designed limiter of the
+ * small-angle update, not counted in sat) and e's part along u removed
+ * again (the limiter may tilt it), so |u + e|^2 <= |u|^2 + 3/16; then one
+ * Newton step towards unit length (newton_unit).
+ * Fixed: kf = s rf r / 2^30 (|kf| <= 2^30) with r the half length's
+ * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: see
+ * move_seg; d_perp kf <= 2^59.6; e.u <= 2^58.8 in Q60. */
+SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+SN_INLINE sn_acc rsh(sn_acc a, int s) {
+#if defined(SN_FLOAT)
+    (void)s;
+    return a;
+#else
+    return sn_rshr64_var(a, s);
+#endif
+}
+SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
+
+/* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
+ * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
+SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
+    sn_q r;
+    seg_n kf;
+    (void)seg_half(L, i, &r, sh);
+    kf = NARROW(r30(MUL(rf, r)));
+    return s > 0 ? kf : -kf;
+}
+
+/* the move on one segment's words S, all in registers (see above). Fixed,
+ * |u| <= 1 (+LSBs) kept by every write of u: |d_k| <= 2^28 (clamped to the
+ * state range), d.u -> Q22 <= sqrt(3) 2^28, d_perp_k <= 2^29.6, e_k <=
+ * 2^28, e.u <= sqrt(3) 2^28, x_k < 1.5 2^30 (u plus e's part across u,
+ * |.| <= |e|), f in [0.47, 1.01] 2^30: every factor within int32 (NARROW). */
+/* the hot move inlined into its few callers (GCC/Clang would otherwise
+ * call it: about 20 instructions of call overhead on a ~130-instruction body) */
+#if defined(__GNUC__)
+#define SEG_HOT static inline __attribute__((always_inline))
+#else
+#define SEG_HOT static inline
+#endif
+SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+                        int sh, uint32_t *sat) {
+    seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
+    d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
+    du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
+    e0 = NARROW(lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
+    e1 = NARROW(lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
+    e2 = NARROW(lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
+    eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
+    x0 = NARROW(u0 + e0 - r30(MUL(eu, u0)));
+    x1 = NARROW(u1 + e1 - r30(MUL(eu, u1)));
+    x2 = NARROW(u2 + e2 - r30(MUL(eu, u2)));
+#if defined(SN_FLOAT)
+    f = 1.5f - 0.5f * (x0 * x0 + x1 * x1 + x2 * x2);
+#else
+    f = NARROW(sn_rshr64(((int64_t)3 << 60) - (MUL(x0, x0) + MUL(x1, x1) + MUL(x2, x2)), SN_Q_ROT + 1));
+#endif
+    S[3] = (sn_q)r30(MUL(x0, f));
+    S[4] = (sn_q)r30(MUL(x1, f));
+    S[5] = (sn_q)r30(MUL(x2, f));
+    /* |G| <= 2^28, |t| <= 2^29 (a star's last end, else <= 2^28): the sum
+     * within int32, no overflow test (sn_add's) needed, same value */
+    S[0] = (sn_q)SEG_OUT((seg_n)S[0] + t0, sat);
+    S[1] = (sn_q)SEG_OUT((seg_n)S[1] + t1, sat);
+    S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
+}
+
+static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
+                     uint32_t *sat) {
+    int sh;
+    seg_n kf = seg_kf(L, i, s, rf, &sh);
+    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
+}
+
+/* The measuring pass keeps the largest |d|^2 and converts it once (seg_gap):
+ * the conversion is monotonic, so the same value as the largest converted
+ * |d| (fixed), without a square root per pair (sn_norm2, sn_internal.h). */
+
+/* sqrt(n2) in public Q16.16 segment lengths (or float) */
+sn_real seg_gap(sn_len2 n2, const seg_lvl *L) {
+#if defined(SN_FLOAT)
+    return n2 > 0.0f ? n2 * sn_frsqrt(n2) / (2.0f * L->half) : 0.0f;
+#else
+    int64_t g = ((int64_t)sn_isqrt64(n2) << 16) / (2 * (int64_t)L->half);
+    return g > INT32_MAX ? INT32_MAX : (sn_real)g;
+#endif
+}
+
+/* pair constraint between two endpoints of equal masses: d = P2 - P1,
+ * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
+ * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
+ * perpendicular part */
+SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                  uint32_t *sat) {
+    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
+    seg_n ha, hb, ka, kb, t[3];
+    uint32_t ls = 0; /* local count: no aliasing with the state words */
+    int sha, shb;
+    if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
+        ha = hb = L->half;
+        sha = shb = L->sh;
+        ka = kb = C->kf0;
+    } else {
+        ha = A[12]; hb = B[12];
+        sha = (int)A[14]; shb = (int)B[14];
+        ka = NARROW(r30(MUL(C->rf2, A[13])));
+        kb = NARROW(r30(MUL(C->rf2, B[13])));
+    }
+    ha = sa > 0 ? ha : -ha;
+    hb = sb > 0 ? hb : -hb;
+    /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
+     * t = omega gamma d / 2: |.| < 2^28 (components written out) */
+    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30(MUL(B[3], hb))) - NARROW(A[0] + r30(MUL(A[3], ha))), &ls);
+    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30(MUL(B[4], hb))) - NARROW(A[1] + r30(MUL(A[4], ha))), &ls);
+    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30(MUL(B[5], hb))) - NARROW(A[2] + r30(MUL(A[5], ha))), &ls);
+    t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
+    t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
+    t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
+    if (measure) {
+        sn_len2 g = sn_norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
+    } else {
+        ka = sa > 0 ? ka : -ka;
+        kb = sb > 0 ? kb : -kb;
+        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
+        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
+    }
+    *sat += ls;
+}
+
+/* The ends meeting at a sheet node (k >= 3) projected together towards
+ * their mean m (one Gauss-Seidel step on the node's constraint "all ends
+ * coincide", equal masses): end j takes D_j = m - P_j like an attachment
+ * to m, t = omega gamma D_j and a turn closing omega (1-gamma) of D_j's
+ * perpendicular part. At k = 2 this is pair() (D = d/2). A ring of k pairs
+ * costs 2k endpoints and 2k moves; this k and k, and each end reaches the
+ * node's mean in one projection instead of exchanging with its two ring
+ * neighbours in turn (NUMERICS.md "Segment meshes", Sweep).
+ * Linear momentum exact: the last end's t is minus the sum of the others'.
+ * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
+ * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
+ * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
+SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                  uint32_t *sat) {
+    seg_n P[5][3], kf[5], h0 = L->half, k0 = C->kf1;
+    int sh[5];
+    sn_acc s0 = 0, s1 = 0, s2 = 0, l0 = 0, l1 = 0, l2 = 0;
+    sn_q m0, m1, m2;
+    uint32_t ls = 0;
+    unsigned j;
+    for (j = 0; j < k; j++) { /* components written out: compilers kept the loop */
+        const sn_q *S = L->S + SEG_W * seg[j];
+        seg_n h = h0, f = k0;
+        sh[j] = L->sh;
+        if (L->l != 0) { h = S[12]; sh[j] = (int)S[14]; f = NARROW(r30(MUL(C->rf1, S[13]))); }
+        if (sgn[j] < 0) { h = -h; f = -f; }
+        kf[j] = f;
+        P[j][0] = NARROW(S[0] + r30(MUL(S[3], h)));
+        P[j][1] = NARROW(S[1] + r30(MUL(S[4], h)));
+        P[j][2] = NARROW(S[2] + r30(MUL(S[5], h)));
+        s0 += P[j][0]; s1 += P[j][1]; s2 += P[j][2];
+    }
+    m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
+    for (j = 0; j < k; j++) {
+        /* |m| <= 2^28, |P| < 2^30: the difference within int32 */
+        seg_n d0 = SEG_OUT((seg_n)m0 - P[j][0], &ls), d1 = SEG_OUT((seg_n)m1 - P[j][1], &ls),
+              d2 = SEG_OUT((seg_n)m2 - P[j][2], &ls), t0, t1, t2;
+        if (j + 1 < k) {
+            t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
+            l0 -= t0; l1 -= t1; l2 -= t2;
+        } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
+            t0 = NARROW(lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(lim(l1, (sn_acc)2 * SN_LIM));
+            t2 = NARROW(lim(l2, (sn_acc)2 * SN_LIM));
+        }
+        move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
+    }
+    *sat += ls;
+}
+
+/* an endpoint against a point of infinite mass: the segment takes gamma d
+ * and rotates to close (1-gamma) of the perpendicular part */
+SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
+    /* the end P, then d = T - P and t = omega gamma d (|d| 2^31 < 2^60),
+     * each clamped and counted */
+    sn_q *S = L->S + SEG_W * a, P[3], d[3], t0, t1, t2;
+    int sh;
+    seg_n kf;
+    uint32_t ls = 0;
+    end_of(L, a, sa, P, &ls);
+    d[0] = sn_add(T[0], -P[0], &ls);
+    d[1] = sn_add(T[1], -P[1], &ls);
+    d[2] = sn_add(T[2], -P[2], &ls);
+    if (measure) {
+        sn_len2 g = sn_norm2(d);
+        C->gap2 = g > C->gap2 ? g : C->gap2;
+        *sat += ls;
+        return;
+    }
+    /* omega gamma < 2^31 as its int32 copy g1n: one 32x32 product (the same
+     * product as with the int64 g1) */
+    t0 = sn_out(MUL(d[0], C->g1n), SN_Q_ROT, &ls);
+    t1 = sn_out(MUL(d[1], C->g1n), SN_Q_ROT, &ls);
+    t2 = sn_out(MUL(d[2], C->g1n), SN_Q_ROT, &ls);
+    if (L->l == 0) { /* level 0: the sweep's turn factor (seg_kf of the level's half) */
+        kf = sa > 0 ? C->kf1 : -C->kf1;
+        sh = L->sh;
+    } else {
+        kf = seg_kf(L, a, sa, C->rf1, &sh);
+    }
+    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
+    *sat += ls;
+}
+
+/* attachment target in the internal frame */
+void seg_attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3], uint32_t *sat) {
+    uint32_t tgt = sn_rd_u16(rec + 4), k;
+    if (rec[2] == SN_SEGATT_JOINT) {
+        const sn_q *jR = CARR(h, o_jR, sn_q), *jT = CARR(h, o_jT, sn_q);
+        sn_q p0[3];
+        for (k = 0; k < 3; k++) p0[k] = rd_real(rec + 8, k);
+        sn_rot(jR + 9 * tgt, p0, T, sat);
+        for (k = 0; k < 3; k++) T[k] = sn_add(T[k], jT[3 * tgt + k], sat);
+    } else { /* surface vertex: trilinear in its cell, as sn_get_surface */
+        sn_surface_point(h, tgt, T);
+    }
+}
+
+/* fine node n of the mesh at level l, or -1 if it is not a node there */
+static int64_t level_node(const seg_mesh *M, const seg_lvl *L, uint32_t n) {
+    uint32_t r, c, m;
+    if (L->l == 0) return n;
+    r = n / M->side; c = n % M->side; m = (1u << L->l) - 1u;
+    if ((r & m) || (c & m)) return -1;
+    return (int64_t)(r >> L->l) * L->side + (c >> L->l);
+}
+
+/* One sweep, or (measure) the gaps it would close. Order (NUMERICS.md):
+ * attachments first, so the pinned ends propagate through the same sweep;
+ * then the nodes: a chain from node 0 up on even sweeps (dir 0) and back
+ * down on odd ones (symmetric Gauss-Seidel: a chain held at either end
+ * has one sweep in each pass running away from its holder); a sheet
+ * row-major, reversed on odd sweeps (symmetric too), each node of 3-4
+ * ends by star, a corner by its pair; the brace crossing of a 2x2 level;
+ * the floor last. The measuring pass measures at a node with k ends the
+ * pairs (e0,e1), ..., (e_k-2, e_k-1) and, for k >= 3, (e_k-1, e0): a ring. */
+/* the pairs around one sheet node's ring of k ends: each end with the next,
+ * and the last with the first when the ring closes (k >= 3); moves only at
+ * k = 2 (one pair), measures any k */
+SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int measure,
+                    uint32_t *sat) {
+    unsigned j;
+    for (j = 0; j + 1 < k; j++) pair(C, L, seg[j], sgn[j], seg[j + 1], sgn[j + 1], measure, sat);
+    if (k >= 3) pair(C, L, seg[k - 1], sgn[k - 1], seg[0], sgn[0], measure, sat);
+}
+
+/* a sheet node's ends: measured as ring pairs (the gap's definition);
+ * projected by star at k = 3 or 4 (a sheet node has 2 to 4 ends, a braced
+ * 2x2 level's 3: the constant k lets the compiler unroll), pair at k = 2 */
+SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
+                         int measure, uint32_t *sat) {
+    if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
+    else if (k == 4) star(C, L, seg, sgn, 4u, sat);
+    else star(C, L, seg, sgn, 3u, sat);
+}
+
+/* What every sweep of level L reads and no sweep changes, once per level:
+ * level 0's turn factors and the first SEG_TCACHE attachments' rod ends
+ * (none where the attached fine node is not a node of the level) */
+void seg_sweep_prep(seg_ctx *C, const seg_lvl *L) {
+    const seg_mesh *M = C->M;
+    uint32_t i;
+    int sh;
+    C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
+    C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
+    for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
+        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        int64_t ln = level_node(M, L, sn_rd_u16(rec));
+        C->ak[i] = ln < 0 ? 0u : seg_node_ends(L, (uint32_t)ln, C->aseg[i], C->asgn[i]);
+    }
+}
+
+void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
+    const seg_mesh *M = C->M;
+    uint32_t n, seg[5], i, q;
+    int sgn[5];
+    unsigned j, k;
+    for (i = 0; i < M->n_attach; i++) {
+        const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
+        int64_t ln;
+        sn_q T[3];
+        if (i < SEG_TCACHE) { /* the same target, clamp count and ends as computed per sweep */
+            if (C->ak[i] == 0) continue;
+            *sat += C->Tsat[i];
+            for (j = 0; j < C->ak[i]; j++) pin(C, L, C->aseg[i][j], C->asgn[i][j], C->T[i], measure, sat);
+            continue;
+        }
+        ln = level_node(M, L, sn_rd_u16(rec));
+        if (ln < 0) continue; /* a fine node between the level's nodes: not pinned there */
+        seg_attach_target(C->h, rec, T, sat);
+        k = seg_node_ends(L, (uint32_t)ln, seg, sgn);
+        for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
+    }
+    if (L->kind == SN_SEG_CHAIN) {
+        /* interior node n joins segment n-1's end and segment n's start (one
+         * pair; the chain's two end nodes have one end each, none) */
+        for (q = 1; q + 1u < L->nn; q++) {
+            n = dir ? L->nn - 1u - q : q;
+            pair(C, L, n - 1u, 1, n, -1, measure, sat);
+        }
+    } else { /* sheet: row-major, reversed on odd sweeps (symmetric Gauss-Seidel) */
+        uint32_t sd = L->side, r, c;
+        for (r = 0; r < sd; r++)
+            for (c = 0; c < sd; c++) {
+                uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
+                if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
+                else k = sheet_ends(sd, rr, cc, seg, sgn);
+                node_proj(C, L, seg, sgn, k, measure, sat);
+            }
+    }
+    if (is_brace(L, 4) && !measure) {
+        /* the braces keep the offset of their centres at the step's start
+         * (node words: the restricted nodes until seg_node_means): a flat
+         * cell stays flat, so the braced 2x2 level is rigid (fig. 4.4) and
+         * not a mechanism folding about a diagonal */
+        sn_q *B4 = L->S + SEG_W * 4, *B5 = L->S + SEG_W * 5, t;
+        const sn_q *N = L->N;
+        for (k = 0; k < 3; k++) {
+            sn_q d0 = sn_add(mean_k((sn_acc)N[NODE_W + k] + N[2 * NODE_W + k], 2, sat),
+                             -mean_k((sn_acc)N[k] + N[3 * NODE_W + k], 2, sat), sat);
+            t = sn_mulq(sn_add(sn_add(B5[k], -B4[k], sat), -d0, sat), C->gb, SN_Q_ROT, sat);
+            B4[k] = sn_add(B4[k], t, sat);
+            B5[k] = sn_add(B5[k], -t, sat);
+        }
+    }
+    if (C->floor_on && !measure)
+        for (i = 0; i < L->ns; i++)
+            for (j = 0; j < 2; j++) {
+                int s = j ? 1 : -1;
+                sn_q P[3], d[3], t[3], pen;
+                seg_end(L, i, s, P, sat);
+                pen = sn_add(C->foff, -sn_out(sn_mul(C->fn[0], P[0]) + sn_mul(C->fn[1], P[1]) +
+                                                  sn_mul(C->fn[2], P[2]), SN_Q_ROT, sat), sat);
+                pen = pen > 0 ? pen : 0; /* one-sided: only a penetration is pushed out */
+                for (k = 0; k < 3; k++) {
+                    d[k] = sn_mulq(C->fn[k], pen, SN_Q_ROT, sat);
+                    t[k] = sn_mulq(d[k], M->gamma, SN_Q_ROT, sat);
+                }
+                seg_move(L, i, s, t, d, C->rfu, sat);
+            }
+}
+
