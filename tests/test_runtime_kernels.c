@@ -568,6 +568,29 @@ static void test_loops(void) {
     T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", (unsigned)clamps);
 }
 
+/* The integer square root of this build (sn_isqrt64: on the M4 image
+ * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
+ * hosts bit by bit) and both 32-bit methods: the exact floor, checked
+ * analytically (r^2 <= x < (r + 1)^2 in uint64, r + 1 = 2^32 excepted),
+ * tolerance 0: every method must give the same integer. Inputs: edges,
+ * squares and their neighbours at every width, random widths. */
+static void test_isqrt(void) {
+    static const uint64_t edge[] = {0, 1, 2, 3, 4, 8, 9, 15, 16, 17, 0xFFFFFFFFull, 0x100000000ull,
+        0xFFFFFFFE00000000ull, 0xFFFFFFFE00000001ull, 0xFFFFFFFFFFFFFFFFull, 0x3FFFFFFFFFFFFFFFull, 0x4000000000000000ull};
+    int i, bad = 0, n = (int)(sizeof edge / sizeof edge[0]) + 30000;
+    for (i = 0; i < n; i++) {
+        uint64_t x, r;
+        uint32_t w = rnd32() % 33u, k = w ? (rnd32() | 1u << 31) >> (32u - w) : 0; /* a root of w bits */
+        if (i < (int)(sizeof edge / sizeof edge[0])) x = edge[i];
+        else if (i % 2) x = (uint64_t)k * k + (uint64_t)(int64_t)((int)(rnd32() % 5u) - 2) * (k != 0);
+        else x = ((uint64_t)rnd32() << 32 | rnd32()) >> (rnd32() % 64u);
+        r = sn_isqrt64(x);
+        bad += !(r * r <= x && (r == 0xFFFFFFFFull || (r + 1) * (r + 1) > x)) || sn_isqrt64_kara(x) != r ||
+               sn_isqrt64_digits(x) != r;
+    }
+    T_CHECK(bad == 0, "isqrt (this build's, Karatsuba, digits): %d of %d inputs not the exact floor", bad, n);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -644,6 +667,7 @@ int main(void) {
     test_ic();
     test_rot();
     test_axpy();
+    test_isqrt();
 #if !defined(SN_FLOAT)
     test_rshr();
     test_dot();

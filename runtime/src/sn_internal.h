@@ -274,6 +274,8 @@ uint64_t sn_udiv64(uint64_t n, uint64_t D);
 uint32_t sn_isqrt64(uint64_t x);
 /* the same by two-bit digits in 32-bit words (sn_isqrt64 on a 32-bit target) */
 uint32_t sn_isqrt64_digits(uint64_t x);
+/* the same by Karatsuba square root with 32-bit divides (sn_isqrt64 on a Cortex-M with UDIV) */
+uint32_t sn_isqrt64_kara(uint64_t x);
 /* floor(n / d) for a normalized d in [2^31, 2^32) and n < d 2^32 (the
  * quotient fits 32 bits): two 32/32 divisions on 16-bit digits with at most
  * two corrections each (Knuth D; Warren, Hacker's Delight fig. 9-3 divlu),
