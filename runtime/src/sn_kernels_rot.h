@@ -130,14 +130,24 @@ SN_INLINE sn_q sn_k_rot_out1(int64_t x, uint32_t *sat) {
     if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
     return v;
 }
+/* Written out, v in int32 registers (an empty asm: GCC otherwise kept
+ * the int64 a clamped v came from, or hoisted v's sign extensions out of a
+ * loop of 3, and multiplied 64 x 64: UMULL, MUL, MLA a term, not one
+ * SMLAL). */
+#define SN_K_I32(v0, v1, v2) __asm__("" : "+r"(v0), "+r"(v1), "+r"(v2))
 SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
-    int k;
-    for (k = 0; k < 3; k++) out[k] = sn_k_rot_out1(sn_mul(R[k], v[0]) + sn_mul(R[3 + k], v[1]) + sn_mul(R[6 + k], v[2]), sat);
+    int32_t v0 = v[0], v1 = v[1], v2 = v[2];
+    SN_K_I32(v0, v1, v2);
+    out[0] = sn_k_rot_out1(sn_mul(R[0], v0) + sn_mul(R[3], v1) + sn_mul(R[6], v2), sat);
+    out[1] = sn_k_rot_out1(sn_mul(R[1], v0) + sn_mul(R[4], v1) + sn_mul(R[7], v2), sat);
+    out[2] = sn_k_rot_out1(sn_mul(R[2], v0) + sn_mul(R[5], v1) + sn_mul(R[8], v2), sat);
 }
 SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
-    int k;
-    for (k = 0; k < 3; k++)
-        out[k] = sn_k_rot_out1(sn_mul(R[3 * k], v[0]) + sn_mul(R[3 * k + 1], v[1]) + sn_mul(R[3 * k + 2], v[2]), sat);
+    int32_t v0 = v[0], v1 = v[1], v2 = v[2];
+    SN_K_I32(v0, v1, v2);
+    out[0] = sn_k_rot_out1(sn_mul(R[0], v0) + sn_mul(R[1], v1) + sn_mul(R[2], v2), sat);
+    out[1] = sn_k_rot_out1(sn_mul(R[3], v0) + sn_mul(R[4], v1) + sn_mul(R[5], v2), sat);
+    out[2] = sn_k_rot_out1(sn_mul(R[6], v0) + sn_mul(R[7], v1) + sn_mul(R[8], v2), sat);
 }
 #define sn_k_rot_acc sn_rot_acc
 
@@ -318,7 +328,11 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         uint32_t k;
         for (k = 0; k < 3; k++) {
             sn_q mk = sn_out(acc[3 * i + k], sh, sat);
-            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
+            sn_acc s;
+#if defined(SN_KERNELS_M4)
+            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
+#endif
+            s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
             q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
         }
     }
