@@ -76,7 +76,7 @@ SN_INLINE int lz32(uint32_t w) {
 /* floor(sqrt(x)) for every uint64 x, exact, by Zimmermann's Karatsuba
  * square root (P. Zimmermann, "Karatsuba Square Root", INRIA RR-3805, 1999,
  * Algorithm SqrtRem) on a 32-bit core with a 32-bit divider (Cortex-M4
- * UDIV; sn_isqrt64 there: ~95 instructions against the digits' ~390).
+ * UDIV; sn_isqrt64 there: 88 instructions against the digits' 393).
  * x 4^k = N, N's top two bits not both 0, so floor(sqrt(x)) =
  * floor(sqrt(N)) >> k. From (s, r) = root and remainder of N's top w bits
  * (r = P - s^2 <= 2s), the top 2w bits P b^2 + a1 b + a0 (b = 2^(w/2)):
@@ -179,8 +179,13 @@ static int32_t sn_sat32(int64_t x) {
     return (int32_t)sn_clamp64(x, (int64_t)INT32_MAX);
 }
 
-/* Number of significant bits of x (0 for 0); 6 fixed steps. */
+/* Number of significant bits of x (0 for 0); 6 fixed steps (Cortex-M:
+ * CLZ on a word). */
 static int sn_bitlen64(uint64_t x) {
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__GNUC__)
+    const uint32_t hi = (uint32_t)(x >> 32), lo = (uint32_t)x;
+    return hi ? 64 - lz32(hi) : (lo ? 32 - lz32(lo) : 0);
+#else
     int n = 0, s;
     for (s = 32; s > 0; s >>= 1)
         if (x >> s) {
@@ -188,6 +193,7 @@ static int sn_bitlen64(uint64_t x) {
             n += s;
         }
     return n + (x != 0);
+#endif
 }
 
 /* out = c/|c| in Q30 for n <= 4 components (any int64 except INT64_MIN).
@@ -313,7 +319,7 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
     int i;
     if (x == 0 && y == 0) return 0;
     for (i = 0; i < 32; i++) {
-        int64_t dx = sn_rshr64(Y, i), dy = sn_rshr64(X, i);
+        int64_t dx = sn_rshr64_var(Y, i), dy = sn_rshr64_var(X, i); /* Cortex-M: the shift on two words */
         if (Y > 0) {
             X += dx;
             Y -= dy;
