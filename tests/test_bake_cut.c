@@ -37,7 +37,7 @@ static void check(const char *path)
     sb_srcmap src;
     sb_model o, o2;
     sb_cut cut;
-    int i, k, E, a, b, n, N, bad = 0, norphan = 0, *pn, *pi, *xof, *orphan;
+    int i, k, E, a, b, n, N, wd, bad = 0, norphan = 0, *pn, *pi, *xof, *dof, *orphan;
     double *pw, *x, *ya, *yb, *ma, *mb, *px, *spx, *mpx, ea = 0, sa = 0, em = 0, sm = 0, rowsum = 0, rowscale = 0;
     const int NL = SB_CUT_NL, N3 = 3 * SB_CUT_NL;
     memset(&m, 0, sizeof m); memset(&o, 0, sizeof o); memset(&o2, 0, sizeof o2);
@@ -45,12 +45,16 @@ static void check(const char *path)
     d.levels = 2; d.levels_cut = 1;
     sb_level_desc(&d, &o, &d2);
     if (sb_level_model(&d, &d2, &m, &o2) || sb_cut_build(&o, &o2, 0.0, &cut)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
-    N = o.nv + cut.nx;
+    for (wd = 0; wd < 2; wd++) {
+    /* wd 1: the details too (level-1 free vertices at non-corner points of kept cells, after the extras) */
+    N = o.nv + cut.nx + (wd ? cut.nd : 0);
+    norphan = 0; bad = 0; ea = sa = em = sm = rowsum = rowscale = 0;
     /* P's rows over level 1's vertices, from positions on the two grids */
-    xof = malloc(sizeof(int) * (size_t)o2.nv);
-    for (n = 0; n < o2.nv; n++) xof[n] = -1;
+    xof = malloc(sizeof(int) * (size_t)o2.nv); dof = malloc(sizeof(int) * (size_t)o2.nv);
+    for (n = 0; n < o2.nv; n++) xof[n] = dof[n] = -1;
     for (i = 0; i < cut.nx; i++) xof[cut.xv[i]] = o.nv + i;
-    pn = calloc((size_t)o2.nv + 1, sizeof(int)); pi = malloc(sizeof(int) * 8 * (size_t)o2.nv); pw = malloc(sizeof(double) * 8 * (size_t)o2.nv);
+    for (i = 0; wd && i < cut.nd; i++) dof[cut.dv[i]] = o.nv + cut.nx + i;
+    pn = calloc((size_t)o2.nv + 1, sizeof(int)); pi = malloc(sizeof(int) * 9 * (size_t)o2.nv); pw = malloc(sizeof(double) * 9 * (size_t)o2.nv);
     for (n = 0; n < o2.nv; n++) {
         double t[3];
         int g[3], odd = 0;
@@ -65,6 +69,8 @@ static void check(const char *path)
             if ((v = coarse_vertex(&o, ga)) < 0) { pn[n + 1] = pn[n]; pi[pn[n]] = -1; break; }   /* outside level 0: no row */
             pi[pn[n + 1]] = v; pw[pn[n + 1]++] = w;
         }
+        if (pn[n + 1] > pn[n] && dof[n] >= 0) { pi[pn[n + 1]] = dof[n]; pw[pn[n + 1]++] = 1; }   /* + its detail */
+        if (pn[n + 1] == pn[n] && dof[n] >= 0) bad++;   /* a detail where level 0 has no row */
     }
     /* the kept level-1 cells in no kept level-0 cell: taken out of level 1's sums */
     orphan = calloc((size_t)o2.nc, sizeof(int));
@@ -88,10 +94,11 @@ static void check(const char *path)
     for (i = 0; i < 3 * N; i++) x[i] = rnd();
     /* the bake's elements, scattered */
     for (E = 0; E < o.nc; E++) {
-        int vl[SB_CUT_NL], nl = 8 + cut.cnx[E], r, s;
+        int vl[SB_CUT_NL], nl = 8 + cut.cnx[E] + (wd ? cut.cnd[E] : 0), r, s;
         const double *KE = cut.K + (size_t)(N3 * N3) * (size_t)E, *ME = cut.M + (size_t)(NL * NL) * (size_t)E;
         for (a = 0; a < 8; a++) vl[a] = o.cells[8 * E + a];
         for (a = 0; a < cut.cnx[E]; a++) vl[8 + a] = o.nv + cut.cx[SB_CUT_MAXX * E + a];
+        for (a = 0; wd && a < cut.cnd[E]; a++) vl[8 + cut.cnx[E] + a] = o.nv + cut.nx + cut.cd[SB_CUT_MAXX * E + a];
         for (a = 0; a < nl; a++)
             for (r = 0; r < 3; r++) {
                 double rs = 0, sc = 0;
@@ -100,7 +107,8 @@ static void check(const char *path)
                     for (s = 0; s < 3; s++) {
                         double kk = KE[(size_t)N3 * (size_t)(3 * a + r) + (size_t)(3 * b + s)];
                         ya[3 * vl[a] + r] += kk * x[3 * vl[b] + s];
-                        rs += kk; sc += fabs(kk);
+                        if (b < 8 + cut.cnx[E]) rs += kk;   /* a translation: corners and extras move, details stay 0 */
+                        sc += fabs(kk);
                     }
                 }
                 rowsum = fmax(rowsum, fabs(rs)); rowscale = fmax(rowscale, sc);
@@ -142,16 +150,18 @@ static void check(const char *path)
         ea = fmax(ea, fabs(ya[i] - yb[i])); sa = fmax(sa, fabs(ya[i]));
         em = fmax(em, fabs(ma[i] - mb[i])); sm = fmax(sm, fabs(ma[i]));
     }
-    T_FIGURE("%s: cut level: %d extras, %d level-1 cells outside the kept level-0 cells; sum_E K_E x vs P^T S_1 P x %.2e, mass %.2e "
-             "(of the largest entry of the product); element rows sum to %.2e of the row's |K| sum", path, cut.nx, norphan, ea / sa, em / sm,
-             rowsum / rowscale);
+    T_FIGURE("%s: cut level%s: %d extras, %d details, %d level-1 cells outside the kept level-0 cells; sum_E K_E x vs P^T S_1 P x %.2e, "
+             "mass %.2e (of the largest entry of the product); element rows sum to %.2e of the row's |K| sum", path,
+             wd ? " with every detail" : "", cut.nx, wd ? cut.nd : 0, norphan, ea / sa, em / sm, rowsum / rowscale);
     /* 1e-12: each product entry sums <= 8 children x 64 corner pairs x 81 weighted terms, in another order than
      * the assembled route (rounding ~1e-15 relative per term); the rows' null space likewise */
     T_CHECK(ea <= 1e-12 * sa && em <= 1e-12 * sm, "%s: cut elements vs level 1's assembled Galerkin product: stiffness %g, mass %g (want <= 1e-12)",
             path, ea / sa, em / sm);
     T_CHECK(rowsum <= 1e-12 * rowscale, "%s: cut element rows sum to %g of their scale (want <= 1e-12: translations)", path, rowsum / rowscale);
     T_CHECK(bad == 0, "%s: %d level-1 rows outside level 0's grid kept a stiffness or mass", path, bad);
-    free(x); free(ya); free(yb); free(ma); free(mb); free(px); free(spx); free(mpx); free(pn); free(pi); free(pw); free(xof); free(orphan);
+    free(x); free(ya); free(yb); free(ma); free(mb); free(px); free(spx); free(mpx); free(pn); free(pi); free(pw); free(xof); free(dof);
+    free(orphan);
+    }
     sb_cut_free(&cut); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
 }
 
