@@ -59,7 +59,7 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
     cut->cx = sb_alloc(sizeof(int) * SB_CUT_MAXX * (size_t)o->nc);
     cut->csub = sb_alloc(sizeof(int) * 27 * (size_t)o->nc);
     cut->dv = sb_alloc(sizeof(int) * (size_t)o2->nv); cut->dcell = sb_alloc(sizeof(int) * (size_t)o2->nv);
-    cut->dpoint = sb_alloc(sizeof(int) * (size_t)o2->nv);
+    cut->dpoint = sb_alloc(sizeof(int) * (size_t)o2->nv); cut->dx = sb_alloc(sizeof(double) * 3 * (size_t)o2->nv);
     cut->cnd = sb_alloc(sizeof(int) * (size_t)o->nc);
     cut->cd = sb_alloc(sizeof(int) * SB_CUT_MAXX * (size_t)o->nc);
     cut->dsub = sb_alloc(sizeof(int) * 27 * (size_t)o->nc);
@@ -95,7 +95,9 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
             if (!(u[0] & 1) && !(u[1] & 1) && !(u[2] & 1)) continue;
             n = hv[(q0[0] + u[0]) + hn[0] * ((q0[1] + u[1]) + hn[1] * (q0[2] + u[2]))];
             if (n < 0 || n >= o2->nf) continue;
-            if (did[n] < 0) { did[n] = cut->nd; cut->dv[cut->nd] = n; cut->dcell[cut->nd] = E; cut->dpoint[cut->nd] = k; cut->nd++; }
+            if (did[n] < 0) { did[n] = cut->nd; cut->dv[cut->nd] = n; cut->dcell[cut->nd] = E; cut->dpoint[cut->nd] = k;
+                for (j = 0; j < 3; j++) cut->dx[3 * cut->nd + j] = o2->x[3 * n + j];
+                cut->nd++; }
             cut->dsub[27 * E + k] = did[n];
             dlid[k] = 8 + cut->cnx[E] + cut->cnd[E];
             cut->cd[SB_CUT_MAXX * E + cut->cnd[E]++] = did[n];
@@ -148,7 +150,7 @@ done:
 void sb_cut_free(sb_cut *cut)
 {
     free(cut->v1); free(cut->xv); free(cut->cnx); free(cut->cx); free(cut->csub); free(cut->K); free(cut->M);
-    free(cut->dv); free(cut->dcell); free(cut->dpoint); free(cut->cnd); free(cut->cd); free(cut->dsub);
+    free(cut->dv); free(cut->dx); free(cut->dcell); free(cut->dpoint); free(cut->cnd); free(cut->cd); free(cut->dsub);
     memset(cut, 0, sizeof *cut);
 }
 

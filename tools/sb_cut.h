@@ -28,6 +28,7 @@ typedef struct sb_cut {
     int *csub;       /* per cell x 27: point x + 3y + 9z of E's closure (in half cells) -> extra id, -1 */
     int nd;          /* detail functions: level-1 free vertices at non-corner points of kept level-0 cells (hats of level 1) */
     int *dv;         /* per detail: its level-1 vertex */
+    double *dx;      /* per detail: its point at rest (level 1's vertex: the dyadic point) */
     int *dcell, *dpoint; /* per detail: the first cell holding it and its point there (x + 3y + 9z) */
     int *cnd;        /* per level-0 cell: its details */
     int *cd;         /* per cell x SB_CUT_MAXX: detail ids (local 8 + cnx + k), ordered by their 3x3x3 point */
