@@ -1,0 +1,168 @@
+/* test_runtime_details.c -- the cut level's details (format 6.4: DETAILS, DETAIL,
+ * CELLD, CELLDK; runtime/LEVELS.md §3 "Details on the cut level"), fixed or float:
+ *
+ * 1. the cow's cut level baked with and without 'details 50 0.03 0.01' has the
+ *    same bytes in every section before the details' (the details add columns to
+ *    the cut element, never change its corner or extra blocks), and both step the
+ *    same state hash over the violent swing (no detail is active in this runtime:
+ *    what stage 2's "none active" must keep);
+ * 2. the validator on the limb's cut blob with 'details 8 0.03 0.01' (the fuzzers'
+ *    seed): every crafted change to the four sections refused with its status,
+ *    the checksum fixed after each. */
+#include "sinew.h"
+#include "sn_format.h"
+#include "sn_test.h"
+#include "fuzz/sn_tblob.h"
+#include "level_util.h"
+
+#if defined(SN_FLOAT)
+#define SN_TB_SUFFIX "_float"
+#else
+#define SN_TB_SUFFIX ""
+#endif
+
+static uint32_t rd16(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8; }
+static uint32_t sec_at(const unsigned char *b, int k, int f) { return tb_rd32(b + SN_H_SECTIONS + SN_SECTION_ENTRY * (uint32_t)k + 4u * (uint32_t)f); }
+
+static const char *path(const char *name, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s/level/%s", getenv("BUILD") ? getenv("BUILD") : "build", name);
+    return buf;
+}
+
+/* 1. with and without the details: the same sections, the same steps */
+static void same_cut(void)
+{
+    char p0[600], p1[600];
+    size_t n0, n1;
+    unsigned char *b0 = load(path("cow_cut" SN_TB_SUFFIX ".blob", p0, sizeof p0), &n0), *b1 = load(path("cow_details" SN_TB_SUFFIX ".blob", p1, sizeof p1), &n1);
+    const sn_blob *c0 = NULL, *c1 = NULL;
+    sn_blob_info i0;
+    void *m0 = NULL, *m1 = NULL;
+    sn_instance *s0, *s1;
+    sn_xform *xf;
+    int k, same = 1, steps = 48, diff = -1;
+    if (!b0 || !b1) { T_CHECK(0, "cannot read %s / %s (tests/level.mk)", p0, p1); free(b0); free(b1); return; }
+    T_CHECK(sn_blob_validate(b0, n0, &c0) == SN_OK && sn_blob_validate(b1, n1, &c1) == SN_OK, "[%s] cow cut / details blobs validate", FL);
+    if (!c0 || !c1) { free(b0); free(b1); return; }
+    T_CHECK(sec_at(b0, SN_SEC_DETAILS, 2) == 0 && sec_at(b1, SN_SEC_DETAILS, 2) == 1 && sec_at(b1, SN_SEC_DETAIL, 2) > 0,
+            "[%s] the details blob has them (%u details), the cut blob not", FL, sec_at(b1, SN_SEC_DETAIL, 2));
+    for (k = 0; k < SN_SEC_DETAILS; k++) {
+        uint32_t sz = sec_at(b0, k, 1);
+        if (sz != sec_at(b1, k, 1) || memcmp(b0 + sec_at(b0, k, 0), b1 + sec_at(b1, k, 0), sz) != 0) { same = 0; break; }
+    }
+    T_CHECK(same, "[%s] every section before the details' is the cut blob's, byte for byte (first differing: %d)", FL, same ? -1 : k);
+    T_FIGURE("[%s] cow details: %u details, %u CELLDK elements (%u bytes), dshift %u; blob %lu -> %lu bytes", FL, sec_at(b1, SN_SEC_DETAIL, 2),
+             sec_at(b1, SN_SEC_CELLDK, 2), sec_at(b1, SN_SEC_CELLDK, 1), b1[sec_at(b1, SN_SEC_DETAILS, 0) + 2], (unsigned long)n0,
+             (unsigned long)n1);
+    sn_blob_get_info(c0, &i0);
+    m0 = malloc(i0.instance_bytes); m1 = malloc(i0.instance_bytes);
+    xf = malloc(sizeof *xf * i0.joints);
+    if (sn_instance_init(m0, i0.instance_bytes, c0, &s0) != SN_OK || sn_instance_init(m1, i0.instance_bytes, c1, &s1) != SN_OK) {
+        T_CHECK(0, "[%s] instances", FL);
+    } else {
+        for (k = 1; k <= steps && diff < 0; k++) {
+            pose_at(c0, i0.joints, k, xf);
+            sn_set_pose(s0, xf, i0.joints); sn_set_pose(s1, xf, i0.joints);
+            sn_step(s0); sn_step(s1);
+            if (sn_state_hash(s0) != sn_state_hash(s1)) diff = k;
+        }
+        T_CHECK(diff < 0, "[%s] the cow's cut level with its details baked steps the cut level's bits (%d swing steps; first differing %d)",
+                FL, steps, diff);
+    }
+    free(xf); free(m0); free(m1); free(b0); free(b1);
+}
+
+/* 2. the validator */
+static void crafted(void)
+{
+    char p[600];
+    size_t n;
+    unsigned char *bb = load(path("limb_cut" SN_TB_SUFFIX ".blob", p, sizeof p), &n), *h, *hd, *dr, *cd, *dk, *cx;
+    const sn_blob *out;
+    uint32_t nd, nc, e, slot = 0, xslot = 0, kb = (uint32_t)SN_ELEM_CELLDK(SN_FLAVOUR, 4), de = (uint32_t)SN_ELEM_DETAIL(4), own = 0, ncases = 0;
+    if (!bb) { T_CHECK(0, "cannot read %s (tests/level.mk)", p); return; }
+    T_CHECK(sn_blob_validate(bb, n, &out) == SN_OK, "[%s] limb cut blob with details validates", FL);
+    nd = sec_at(bb, SN_SEC_DETAIL, 2); nc = sec_at(bb, SN_SEC_CELLD, 2);
+    T_CHECK(nd > 0 && sec_at(bb, SN_SEC_DETAILS, 2) == 1, "[%s] limb: %u details", FL, nd);
+    if (nd == 0) { free(bb); return; }
+    h = malloc(n + 8);
+    /* a cell with a detail and an extra: its first detail's slot, an extra's slot */
+    cd = bb + sec_at(bb, SN_SEC_CELLD, 0); cx = bb + sec_at(bb, SN_SEC_CELLX, 0);
+    for (e = 0; e < nc; e++) if (cd[e * SN_ELEM_CELLD + 38] && cx[e * SN_ELEM_CELLX + 38]) break;
+    T_CHECK(e < nc, "[%s] limb: a cell with a detail and an extra", FL);
+    if (e == nc) { free(h); free(bb); return; }
+    while (rd16(cd + e * SN_ELEM_CELLD + 2 * slot) == SN_CUT_NONE) slot++;
+    while (rd16(cx + e * SN_ELEM_CELLX + 2 * xslot) == SN_CUT_NONE) xslot++;
+    /* cell e's first detail's own block: after its 8 + nx columns */
+    own = tb_rd32(cd + e * SN_ELEM_CELLD + 40) + 8u + cx[e * SN_ELEM_CELLX + 38];
+#define D_CASE(want, what, change) do { \
+        memcpy(h, bb, n); hd = h + sec_at(h, SN_SEC_DETAILS, 0); dr = h + sec_at(h, SN_SEC_DETAIL, 0); \
+        cd = h + sec_at(h, SN_SEC_CELLD, 0); dk = h + sec_at(h, SN_SEC_CELLDK, 0); cx = h + sec_at(h, SN_SEC_CELLX, 0); \
+        (void)hd; (void)dr; (void)cd; (void)dk; (void)cx; \
+        change; tb_fix_crc(h); ncases++; \
+        T_CHECK(sn_blob_validate(h, n, &out) == (want), "[%s] details: %s: got %s, want %s", FL, what, \
+                sn_status_str(sn_blob_validate(h, n, &out)), sn_status_str(want)); } while (0)
+    D_CASE(SN_OK, "unchanged", (void)0);
+    D_CASE(SN_OK, "A_max = nD", tb_u16(hd, nd));
+    D_CASE(SN_ERR_VALUE, "A_max = nD + 1", tb_u16(hd, nd + 1));
+    D_CASE(SN_ERR_VALUE, "DETAILS pad byte", hd[3] = 1);
+    D_CASE(SN_ERR_VALUE, "DETAILS pad word", hd[5] = 1);
+#if defined(SN_FLOAT)
+    D_CASE(SN_ERR_VALUE, "dshift 1 (float)", hd[2] = 1);
+    D_CASE(SN_ERR_VALUE, "refine NaN", tb_u32(hd + 8, 0x7FC00000u));
+    D_CASE(SN_ERR_VALUE, "a block entry 2^28", tb_u32(dk, 0x4D800000u));
+    D_CASE(SN_ERR_VALUE, "a mass 2^28", tb_u32(dk + 36, 0x4D800000u));
+    D_CASE(SN_ERR_VALUE, "a detail's own mass 0", tb_u32(dk + (size_t)own * kb + 36, 0));
+#else
+    D_CASE(SN_OK, "dshift 4", hd[2] = 4);
+    D_CASE(SN_ERR_VALUE, "dshift 5", hd[2] = 5);
+    D_CASE(SN_ERR_VALUE, "refine 2^30 + 1", tb_u32(hd + 8, (1u << 30) + 1u));
+    D_CASE(SN_ERR_VALUE, "a block exponent 13", dk[18] = 13);
+    D_CASE(SN_ERR_VALUE, "a mantissa -2^15", tb_u16(dk, 0x8000u));
+    D_CASE(SN_ERR_VALUE, "a block pad byte", dk[19] = 1);
+    D_CASE(SN_ERR_VALUE, "a mass 2^27 + 1", tb_u32(dk + 20, (1u << 27) + 1u));
+    D_CASE(SN_ERR_VALUE, "a detail's own mass 0", tb_u32(dk + (size_t)own * kb + 20, 0));
+    D_CASE(SN_OK, "another element's mass 0", tb_u32(dk + 20, 0));
+#endif
+    D_CASE(SN_ERR_VALUE, "coarsen above refine", tb_u32(hd + 8 + 4, tb_rd32(hd + 8) + 1u));
+    D_CASE(SN_ERR_INDEX, "DETAIL cell nC", tb_u16(dr, nc));
+    D_CASE(SN_ERR_INDEX, "DETAIL point a corner", dr[2] = 0);
+    D_CASE(SN_ERR_INDEX, "DETAIL point 27", dr[2] = 27);
+    D_CASE(SN_ERR_INDEX, "DETAIL pad byte", dr[3] = 1);
+    D_CASE(SN_ERR_INDEX, "DETAIL naming another detail's place", tb_u16(dr, rd16(dr + de)); dr[2] = dr[de + 2]);
+#if defined(SN_FLOAT)
+    D_CASE(SN_ERR_VALUE, "DETAIL rest 2^28 (beyond REST's bound)", tb_u32(dr + 4, 0x4D800000u));
+#else
+    D_CASE(SN_ERR_VALUE, "DETAIL rest 2^31 - 1 (beyond REST's bound)", tb_u32(dr + 4, 0x7FFFFFFFu));
+#endif
+    D_CASE(SN_ERR_INDEX, "CELLD entry nD", tb_u16(cd + e * SN_ELEM_CELLD + 2 * slot, nd));
+    D_CASE(SN_ERR_INDEX, "CELLD entry where CELLX has an extra",
+           (tb_u16(cd + e * SN_ELEM_CELLD + 2 * xslot, rd16(cd + e * SN_ELEM_CELLD + 2 * slot)),
+            tb_u16(cd + e * SN_ELEM_CELLD + 2 * slot, SN_CUT_NONE)));
+    D_CASE(SN_ERR_VALUE, "CELLD nd one short", cd[e * SN_ELEM_CELLD + 38]--);
+    D_CASE(SN_ERR_VALUE, "CELLD pad byte", cd[e * SN_ELEM_CELLD + 39] = 1);
+    D_CASE(SN_ERR_INDEX, "CELLD first off the running sum", cd[(nc - 1) * SN_ELEM_CELLD + 40]++);
+    {   /* refused by whichever check meets it first: the cell's blocks then read a corner column as a detail's own
+         * mass (not > 0: VALUE), or the later cells' first is off the sum (INDEX; SECTION for the last cell) */
+        sn_status st;
+        memcpy(h, bb, n); cd = h + sec_at(h, SN_SEC_CELLD, 0);
+        tb_u16(cd + e * SN_ELEM_CELLD + 2 * slot, SN_CUT_NONE); cd[e * SN_ELEM_CELLD + 38]--;
+        tb_fix_crc(h); ncases++;
+        st = sn_blob_validate(h, n, &out);
+        T_CHECK(st == SN_ERR_VALUE || st == SN_ERR_INDEX || st == SN_ERR_SECTION, "[%s] details: a CELLD entry dropped: got %s, want refused",
+                FL, sn_status_str(st));
+    }
+    D_CASE(SN_ERR_SECTION, "CELLD count 1", tb_u32(h + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_CELLD + 8, 1));
+#undef D_CASE
+    T_FIGURE("[%s] limb: %u details, %u crafted cases", FL, nd, ncases);
+    free(h); free(bb);
+}
+
+int main(void)
+{
+    (void)t_seed; (void)cell_of; (void)tb_build;
+    same_cut();
+    crafted();
+    return T_END();
+}
