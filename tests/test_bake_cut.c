@@ -12,9 +12,13 @@
  * its extra, a free one the dyadic weights of the level-0 grid points around it
  * (from positions here, not from the bake's cell walk). Built with air 0, so
  * the children level 1 did not keep add nothing. Also: every cut element's rows
- * sum to 0 over its corners and extras (translations: W_c's rows sum to 1). */
+ * sum to 0 over its corners and extras (translations: W_c's rows sum to 1).
+ * Then the same with every detail (format 6.4: level 1's free vertices at
+ * non-corner points, P's row there the coarse weights plus 1 on the detail),
+ * and 'details' refused without 'levels 2 cut'. */
 #include "sb_level.h"
 #include "sb_cut.h"
+#include "sn_format.h"
 #include "sn_test.h"
 #include <math.h>
 #include <stdio.h>
@@ -205,10 +209,43 @@ static void refusals(void)
     }
 }
 
+/* 'details' needs the cut level: refused after plain 'levels 2', naming the details line; with 'levels 2 cut' it
+ * bakes (the limb: its details counted in the summary's info) */
+static void details_line(void)
+{
+    const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
+    char path[700], want[96];
+    int k;
+    for (k = 0; k < 2; k++) {
+        FILE *in = fopen("tools/examples/limb/limb.sinew", "r"), *f;
+        sb_model o;
+        sb_blob bl;
+        int line = 1, c, rc;
+        snprintf(path, sizeof path, "%s/tests/cut_refuse/limb_details%d.sinew", b, k);
+        f = fopen(path, "w");
+        if (!in || !f) { T_CHECK(0, "cannot write %s", path); if (in) fclose(in); if (f) fclose(f); return; }
+        while ((c = fgetc(in)) != EOF) { fputc(c, f); line += c == '\n'; }
+        fclose(in);
+        fputs(k ? "levels 2 cut\n" : "levels 2\n", f);
+        fputs("details 8 0.03 0.01\n", f);
+        fclose(f);
+        rc = sb_bake_file(path, SB_FIXED, 1, &o, &bl);
+        if (k == 0) {
+            snprintf(want, sizeof want, ":%d: details need 'levels 2 cut'", line + 1);
+            T_CHECK(rc != 0 && strstr(sb_error(), want) != NULL, "details without the cut level: refused naming its line ('%s' in '%s')", want,
+                    rc ? sb_error() : "baked");
+        } else
+            T_CHECK(rc == 0 && bl.sec_size[SN_SEC_DETAILS] > 0 && bl.sec_size[SN_SEC_CELLDK] > 0, "details on the limb's cut level: bakes (%s)",
+                    rc ? sb_error() : "ok");
+        if (rc == 0) { sb_model_free(&o); sb_blob_free(&bl); }
+    }
+}
+
 int main(void)
 {
     (void)t_seed;
     check("tools/examples/cow/cow.sinew");
     refusals();
+    details_line();
     return T_END();
 }
