@@ -209,8 +209,41 @@ static void refusals(void)
     }
 }
 
+static uint32_t rd32_(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static double rd64_(const unsigned char *p) { uint64_t u = (uint64_t)rd32_(p) | (uint64_t)rd32_(p + 4) << 32; double x; memcpy(&x, &u, 8); return x; }
+
+/* The fixed blob's details against the double blob's (the bake's double elements, h^2/m0 and 1/m0 units): every
+ * CELLDK entry within half its grid step 2^(e - (frac_S - dshift)), every mass within half of 2^-frac_M, CELLD and
+ * DETAIL's indices equal, the rest points within half a Q22 step. Returns the largest error in grid steps. */
+static double details_rounding(const sb_blob *fx, const sb_blob *db, int *bad)
+{
+    const unsigned char *f = fx->bytes, *d = db->bytes;
+    uint32_t n = fx->sec_size[SN_SEC_CELLDK] / 24u, i, k;
+    int dsh = f[fx->sec_off[SN_SEC_DETAILS] + 2], fs = fx->frac_S - dsh, fm = fx->frac_M;
+    double worst = 0;
+    *bad = n == 0 || db->sec_size[SN_SEC_CELLDK] != n * 80u || db->sec_size[SN_SEC_CELLD] != fx->sec_size[SN_SEC_CELLD] ||
+           memcmp(f + fx->sec_off[SN_SEC_CELLD], d + db->sec_off[SN_SEC_CELLD], fx->sec_size[SN_SEC_CELLD]) != 0;
+    if (*bad) return 0;
+    for (i = 0; i < n; i++) {
+        const unsigned char *a = f + fx->sec_off[SN_SEC_CELLDK] + 24u * i, *b = d + db->sec_off[SN_SEC_CELLDK] + 80u * i;
+        double step = ldexp(1.0, a[18] - fs), m = (double)(int32_t)rd32_(a + 20);
+        for (k = 0; k < 9; k++) {
+            double q = (double)(int16_t)(a[2 * k] | a[2 * k + 1] << 8) * step;
+            worst = fmax(worst, fabs(q - rd64_(b + 8 * k)) / step);
+        }
+        worst = fmax(worst, fabs(ldexp(m, -fm) - rd64_(b + 72)) / ldexp(1.0, -fm));
+    }
+    n = fx->sec_size[SN_SEC_DETAIL] / 16u;
+    for (i = 0; i < n; i++) {
+        const unsigned char *a = f + fx->sec_off[SN_SEC_DETAIL] + 16u * i, *b = d + db->sec_off[SN_SEC_DETAIL] + 28u * i;
+        *bad += memcmp(a, b, 4) != 0;
+        for (k = 0; k < 3; k++) worst = fmax(worst, fabs(ldexp((double)(int32_t)rd32_(a + 4 + 4 * k), -22) - rd64_(b + 4 + 8 * k)) / ldexp(1.0, -22));
+    }
+    return worst;
+}
+
 /* 'details' needs the cut level: refused after plain 'levels 2', naming the details line; with 'levels 2 cut' it
- * bakes (the limb: its details counted in the summary's info) */
+ * bakes (the limb), and its fixed blocks are the double blob's rounded */
 static void details_line(void)
 {
     const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
@@ -234,9 +267,21 @@ static void details_line(void)
             snprintf(want, sizeof want, ":%d: details need 'levels 2 cut'", line + 1);
             T_CHECK(rc != 0 && strstr(sb_error(), want) != NULL, "details without the cut level: refused naming its line ('%s' in '%s')", want,
                     rc ? sb_error() : "baked");
-        } else
+        } else {
+            sb_model o2;
+            sb_blob b2;
             T_CHECK(rc == 0 && bl.sec_size[SN_SEC_DETAILS] > 0 && bl.sec_size[SN_SEC_CELLDK] > 0, "details on the limb's cut level: bakes (%s)",
                     rc ? sb_error() : "ok");
+            if (rc == 0 && sb_bake_file(path, SB_DOUBLE, 1, &o2, &b2) == 0) {
+                int bad = 0;
+                double w = details_rounding(&bl, &b2, &bad);
+                T_FIGURE("limb details: fixed blocks, masses and rest points vs the double blob's: %.3f of their grid step at worst "
+                         "(dshift %u)", w, bl.bytes[bl.sec_off[SN_SEC_DETAILS] + 2]);
+                /* round to nearest: half a step, + 1e-6 for the double blob's own last bits */
+                T_CHECK(bad == 0 && w <= 0.5 + 1e-6, "limb details: fixed = the double blob's rounded (%.4f steps, %d index mismatches)", w, bad);
+                sb_model_free(&o2); sb_blob_free(&b2);
+            } else T_CHECK(0, "details: double bake (%s)", sb_error());
+        }
         if (rc == 0) { sb_model_free(&o); sb_blob_free(&bl); }
     }
 }
