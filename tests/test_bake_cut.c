@@ -34,14 +34,43 @@ static int coarse_vertex(const sb_model *o, const int g[3])
     return o->gvert[g[0] + o->gn[0] * (g[1] + o->gn[1] * g[2])];
 }
 
+/* Dense Cholesky solve of the SPD system A x = b (n unknowns, A overwritten, x in b); a zero row (an unknown no
+ * element reaches) is pinned at 0. Returns -1 if a pivot is not positive. */
+static int chol_solve(double *A, int n, double *b)
+{
+    int i, j, k, *fst = malloc(sizeof(int) * (size_t)n);   /* each row's first nonzero: the factor keeps the profile */
+    for (i = 0; i < n; i++) {
+        if (A[(size_t)n * i + i] == 0) { A[(size_t)n * i + i] = 1; b[i] = 0; }
+        for (fst[i] = 0; fst[i] < i && A[(size_t)n * i + fst[i]] == 0; fst[i]++) {}
+    }
+    for (j = 0; j < n; j++) {
+        double *rj = A + (size_t)n * j, d = rj[j];
+        for (k = fst[j]; k < j; k++) d -= rj[k] * rj[k];
+        if (!(d > 0)) { free(fst); return -1; }
+        rj[j] = d = sqrt(d);
+        for (i = j + 1; i < n; i++) {
+            double *ri = A + (size_t)n * i, t = ri[j];
+            if (fst[i] > j) continue;
+            for (k = fst[i] > fst[j] ? fst[i] : fst[j]; k < j; k++) t -= ri[k] * rj[k];
+            ri[j] = t / d;
+        }
+    }
+    free(fst);
+    for (i = 0; i < n; i++) { for (k = 0; k < i; k++) b[i] -= A[(size_t)n * i + k] * b[k]; b[i] /= A[(size_t)n * i + i]; }
+    for (i = n - 1; i >= 0; i--) { for (k = i + 1; k < n; k++) b[i] -= A[(size_t)n * k + i] * b[k]; b[i] /= A[(size_t)n * i + i]; }
+    return 0;
+}
+
 static void check(const char *path)
 {
     sb_desc d, d2;
     sb_mesh m;
     sb_srcmap src;
     sb_model o, o2;
-    sb_cut cut;
+    sb_cut cut, cutA;
     int i, k, E, a, b, n, N, wd, bad = 0, norphan = 0, *pn, *pi, *xof, *dof, *orphan;
+    double *u1 = NULL, smax[2], srms[2], fmaxs[2], frms[2];
+    int sunk[2];
     double *pw, *x, *ya, *yb, *ma, *mb, *px, *spx, *mpx, ea = 0, sa = 0, em = 0, sm = 0, rowsum = 0, rowscale = 0;
     const int NL = SB_CUT_NL, N3 = 3 * SB_CUT_NL;
     memset(&m, 0, sizeof m); memset(&o, 0, sizeof o); memset(&o2, 0, sizeof o2);
@@ -49,6 +78,9 @@ static void check(const char *path)
     d.levels = 2; d.levels_cut = 1;
     sb_level_desc(&d, &o, &d2);
     if (sb_level_model(&d, &d2, &m, &o2) || sb_cut_build(&o, &o2, 0.0, &cut)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
+    /* the statics below take the bake's air element (d.air: without it a coarse vertex outside level 1's lattice,
+     * with every detail around it active, has no stiffness left: the details cancel its hat in the kept children) */
+    if (sb_cut_build(&o, &o2, d.air, &cutA)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
     for (wd = 0; wd < 2; wd++) {
     /* wd 1: the details too (level-1 free vertices at non-corner points of kept cells, after the extras) */
     N = o.nv + cut.nx + (wd ? cut.nd : 0);
@@ -163,10 +195,144 @@ static void check(const char *path)
             path, ea / sa, em / sm);
     T_CHECK(rowsum <= 1e-12 * rowscale, "%s: cut element rows sum to %g of their scale (want <= 1e-12: translations)", path, rowsum / rowscale);
     T_CHECK(bad == 0, "%s: %d level-1 rows outside level 0's grid kept a stiffness or mass", path, bad);
+    {   /* linear statics under gravity (rest frame, skeleton held): the cut level (wd 0) and with every detail (wd 1)
+         * against level 1 (its kept cells in kept level-0 cells), on level 1's vertices: what stage 2's runtime
+         * test asks in motion (LEVELS.md §3 "Details on the cut level") */
+        int nu = 0, *uid = malloc(sizeof(int) * (size_t)N), r, s2;
+        double *A, *f, um = 0, em = 0, e2 = 0;
+        double *key = malloc(sizeof(double) * (size_t)N);
+        int *ord = malloc(sizeof(int) * (size_t)N), m2;
+        for (i = 0; i < N; i++) {   /* unknowns numbered along z, then y, x (a short profile for the factor) */
+            const double *xp = i < o.nv ? o.x + 3 * i : i >= o.nv + cut.nx ? cut.dx + 3 * (i - o.nv - cut.nx) : NULL;
+            int fr = i < o.nv ? i < o.nf || (cut.v1[i] >= 0 && cut.v1[i] < o2.nf) : i >= o.nv + cut.nx;
+            uid[i] = fr ? 0 : -1;
+            key[i] = xp ? (xp[2] * 1e6 + xp[1]) * 1e6 + xp[0] : 0;
+            ord[i] = i;
+        }
+        for (i = 1; i < N; i++) {   /* insertion sort by key (ties by index) */
+            int t = ord[i];
+            for (m2 = i; m2 > 0 && key[ord[m2 - 1]] > key[t]; m2--) ord[m2] = ord[m2 - 1];
+            ord[m2] = t;
+        }
+        for (i = 0; i < N; i++) if (uid[ord[i]] >= 0) uid[ord[i]] = nu++;
+        free(key); free(ord);
+        A = calloc((size_t)9 * (size_t)nu * (size_t)nu, sizeof(double)); f = calloc(3 * (size_t)nu, sizeof(double));
+        for (E = 0; E < o.nc; E++) {
+            int vl[SB_CUT_NL], nl = 8 + cut.cnx[E] + (wd ? cut.cnd[E] : 0);
+            const double *KE = cutA.K + (size_t)(N3 * N3) * (size_t)E, *ME = cutA.M + (size_t)(NL * NL) * (size_t)E;
+            for (a = 0; a < 8; a++) vl[a] = o.cells[8 * E + a];
+            for (a = 0; a < cut.cnx[E]; a++) vl[8 + a] = o.nv + cut.cx[SB_CUT_MAXX * E + a];
+            for (a = 0; wd && a < cut.cnd[E]; a++) vl[8 + cut.cnx[E] + a] = o.nv + cut.nx + cut.cd[SB_CUT_MAXX * E + a];
+            for (a = 0; a < nl; a++) {
+                int ia = uid[vl[a]];
+                if (ia < 0) continue;
+                for (b = 0; b < 8 + cut.cnx[E]; b++) f[3 * ia + 1] -= ME[NL * a + b];   /* g = -y: the cut basis sums to 1 without the details */
+                for (b = 0; b < nl; b++) {
+                    int ib = uid[vl[b]];
+                    if (ib < 0) continue;
+                    for (r = 0; r < 3; r++)
+                        for (s2 = 0; s2 < 3; s2++)
+                            A[(size_t)3 * nu * (size_t)(3 * ia + r) + (size_t)(3 * ib + s2)] += KE[(size_t)N3 * (size_t)(3 * a + r) + (size_t)(3 * b + s2)];
+                }
+            }
+        }
+        if (!u1) {   /* level 1, once: its assembled matrices less the cells in no kept level-0 cell */
+            int n1 = o2.nf;
+            double *A1 = calloc((size_t)9 * (size_t)n1 * (size_t)n1, sizeof(double));
+            u1 = calloc(3 * (size_t)o2.nv, sizeof(double));
+            for (n = 0; n < n1; n++)
+                for (k = o2.nbptr[n]; k < o2.nbptr[n + 1]; k++) {
+                    int j = o2.nb[k];
+                    u1[3 * n + 1] -= o2.M[k];
+                    if (j >= n1) continue;
+                    for (r = 0; r < 3; r++) for (s2 = 0; s2 < 3; s2++) A1[(size_t)3 * n1 * (size_t)(3 * n + r) + (size_t)(3 * j + s2)] += o2.S[9 * (size_t)k + (size_t)(3 * r + s2)];
+                }
+            for (i = 0; i < o2.nc; i++) {
+                if (!orphan[i]) continue;
+                for (a = 0; a < 8; a++)
+                    for (b = 0; b < 8; b++) {
+                        int na = o2.cells[8 * i + a], nb = o2.cells[8 * i + b];
+                        if (na >= n1) continue;
+                        u1[3 * na + 1] += o2.Me[64 * (size_t)i + (size_t)(8 * a + b)];
+                        if (nb >= n1) continue;
+                        for (r = 0; r < 3; r++) for (s2 = 0; s2 < 3; s2++)
+                            A1[(size_t)3 * n1 * (size_t)(3 * na + r) + (size_t)(3 * nb + s2)] -= o2.Se[576 * (size_t)i + (size_t)(24 * (3 * a + r) + 3 * b + s2)];
+                    }
+            }
+            for (i = 0; i < 9 * n1 * n1; i++) if (fabs(A1[i]) < 1e-9 * fabs(A1[(size_t)(3 * n1 + 1) * (size_t)(i / (3 * n1))])) A1[i] = 0;   /* the orphans' cancellation */
+            T_CHECK(chol_solve(A1, 3 * n1, u1) == 0, "%s: level 1's static system is positive definite", path);
+            free(A1);
+        }
+        T_CHECK(chol_solve(A, 3 * nu, f) == 0, "%s: the cut level's static system%s is positive definite", path, wd ? " with every detail" : "");
+        for (n = 0; n < o2.nv; n++) if (n < o2.nf) for (a = 0; a < 3; a++) um = fmax(um, fabs(u1[3 * n + a]));
+        for (n = 0, k = 0; n < o2.nv; n++) {
+            double pu[3] = {0, 0, 0}, q;
+            int kk;
+            if (pn[n + 1] == pn[n]) continue;
+            for (kk = pn[n]; kk < pn[n + 1]; kk++) if (uid[pi[kk]] >= 0) for (a = 0; a < 3; a++) pu[a] += pw[kk] * f[3 * uid[pi[kk]] + a];
+            for (a = 0; a < 3; a++) { q = fabs(pu[a] - (n < o2.nf ? u1[3 * n + a] : 0)); em = fmax(em, q); e2 += q * q; }
+            k++;
+        }
+        smax[wd] = em / um; srms[wd] = sqrt(e2 / (3.0 * k)) / um; sunk[wd] = 3 * nu;
+        {   /* the surface (what the runtime draws): level 1's trilinear in its cell; the cut field in the child holding
+             * the point, its corners the coarse field's dyadic values, 0 at an extra, + the detail there (wd 1) */
+            double sm = 0, se = 0, s2e = 0;
+            int sv;
+            for (sv = 0; sv < o.ns; sv++) {
+                const double *t = o.emb_t + 3 * sv, *t1 = o2.emb_t + 3 * sv;
+                int c0[3], ch, q;
+                double w1[3] = {0, 0, 0}, wc[3] = {0, 0, 0};
+                E = o.emb_cell[sv];
+                for (a = 0; a < 8; a++) {   /* level 1 */
+                    int v = o2.cells[8 * o2.emb_cell[sv] + a];
+                    double w = 1;
+                    for (q = 0; q < 3; q++) w *= (a >> q & 1) ? t1[q] : 1 - t1[q];
+                    if (v < o2.nf) for (q = 0; q < 3; q++) w1[q] += w * u1[3 * v + q];
+                }
+                for (q = 0; q < 3; q++) { c0[q] = t[q] >= 0.5; }
+                for (ch = 0; ch < 8; ch++) {   /* the child's corner ch at half-cell point pt */
+                    int uu[3], pt, b2;
+                    double w = 1, val[3] = {0, 0, 0};
+                    for (q = 0; q < 3; q++) {
+                        double tc = 2 * t[q] - c0[q];
+                        uu[q] = c0[q] + (ch >> q & 1);
+                        w *= (ch >> q & 1) ? tc : 1 - tc;
+                    }
+                    pt = uu[0] + 3 * uu[1] + 9 * uu[2];
+                    if (cut.csub[27 * E + pt] >= 0) continue;   /* an extra: held */
+                    for (b2 = 0; b2 < 8; b2++) {   /* the coarse field there */
+                        double wb = 1;
+                        int id = uid[o.cells[8 * E + b2]];
+                        for (q = 0; q < 3; q++) wb *= (b2 >> q & 1) ? 0.5 * uu[q] : 1 - 0.5 * uu[q];
+                        if (wb != 0 && id >= 0) for (q = 0; q < 3; q++) val[q] += wb * f[3 * id + q];
+                    }
+                    if (wd && cut.dsub[27 * E + pt] >= 0) {
+                        int id = uid[o.nv + cut.nx + cut.dsub[27 * E + pt]];
+                        for (q = 0; q < 3; q++) val[q] += f[3 * id + q];
+                    }
+                    for (q = 0; q < 3; q++) wc[q] += w * val[q];
+                }
+                for (q = 0; q < 3; q++) {
+                    double dq = fabs(wc[q] - w1[q]);
+                    sm = fmax(sm, fabs(w1[q])); se = fmax(se, dq); s2e += dq * dq;
+                }
+            }
+            fmaxs[wd] = se / sm; frms[wd] = sqrt(s2e / (3.0 * o.ns)) / sm;
+        }
+        free(A); free(f); free(uid);
+    }
     free(x); free(ya); free(yb); free(ma); free(mb); free(px); free(spx); free(mpx); free(pn); free(pi); free(pw); free(xof); free(dof);
     free(orphan);
     }
-    sb_cut_free(&cut); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
+    T_FIGURE("%s: linear statics under gravity against level 1 (%d unknowns), of its largest displacement: lattice: cut level (%d unknowns) "
+             "max %.3g rms %.3g, with every detail (%d) max %.3g rms %.3g; surface: cut level max %.3g rms %.3g, with every detail max %.3g rms %.3g",
+             path, 3 * o2.nf, sunk[0], smax[0], srms[0], sunk[1], smax[1], srms[1], fmaxs[0], frms[0], fmaxs[1], frms[1]);
+    /* the details add level 1's free hats inside the kept cells: nearer level 1 at every measure */
+    T_CHECK(smax[1] < smax[0] && srms[1] < srms[0] && fmaxs[1] < fmaxs[0] && frms[1] < frms[0],
+            "%s: statics with every detail nearer level 1 than the cut level (lattice max %.3g vs %.3g, rms %.3g vs %.3g; surface max %.3g vs %.3g, "
+            "rms %.3g vs %.3g)", path, smax[1], smax[0], srms[1], srms[0], fmaxs[1], fmaxs[0], frms[1], frms[0]);
+    free(u1);
+    sb_cut_free(&cut); sb_cut_free(&cutA); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
 }
 
 /* What the cut level carries and what it refuses at bake time (the limb plus one extra line each;
