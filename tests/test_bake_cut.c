@@ -61,6 +61,60 @@ static int chol_solve(double *A, int n, double *b)
     return 0;
 }
 
+/* The preconditioner study (`test_bake_cut --precond`, not in make test): PCG on the step matrix
+ * A = (1+a1) M + (1+b1) h^2 K (NUMERICS step 5-6, rest frame) from 0 to |r| <= 1e-4 |b|, b the gravity load, with
+ * (1) IC(0) of A on its pattern (every function: the design's masked IC(0) with all active; diagonal shift s A_ii
+ * doubled from 1e-3 until the pivots are positive), (2) IC(0) of the coarse block + 3x3 block Jacobi on the
+ * details (coupling dropped). Returns the iterations (500: not converged); *shift the shift used. */
+static int ic0(const double *A, int n, const int *blk, double *L, double *shift)
+{
+    int i, j, k;
+    for (*shift = 0;; *shift = *shift ? 2 * *shift : 1e-3) {
+        int ok = 1;
+        for (i = 0; i < n && ok; i++)
+            for (j = 0; j <= i; j++) {
+                double t = A[(size_t)n * i + j];
+                if (t == 0 || (blk && blk[i] != blk[j])) { L[(size_t)n * i + j] = 0; continue; }   /* IC(0): A's pattern, within a block */
+                if (i == j) t *= 1 + *shift;
+                for (k = 0; k < j; k++) t -= L[(size_t)n * i + k] * L[(size_t)n * j + k];
+                if (i == j) { if (!(t > 0)) { ok = 0; break; } L[(size_t)n * i + i] = sqrt(t); }
+                else L[(size_t)n * i + j] = t / L[(size_t)n * j + j];
+            }
+        if (ok) return 0;
+        if (*shift > 1) return -1;
+    }
+}
+static void ic0_apply(const double *L, int n, const double *r, double *z)
+{
+    int i, k;
+    for (i = 0; i < n; i++) { double t = r[i]; for (k = 0; k < i; k++) t -= L[(size_t)n * i + k] * z[k]; z[i] = t / L[(size_t)n * i + i]; }
+    for (i = n - 1; i >= 0; i--) { double t = z[i]; for (k = i + 1; k < n; k++) t -= L[(size_t)n * k + i] * z[k]; z[i] = t / L[(size_t)n * i + i]; }
+}
+static int pcg_iters(const double *A, int n, const double *b, const double *L)
+{
+    double *x = calloc((size_t)n, sizeof(double)), *r = calloc((size_t)n, sizeof(double)), *z = calloc((size_t)n, sizeof(double));
+    double *d = malloc(sizeof(double) * (size_t)n), *q = malloc(sizeof(double) * (size_t)n), rz, bn = 0, rn;
+    int i, k, it;
+    for (i = 0; i < n; i++) { r[i] = b[i]; bn += b[i] * b[i]; }
+    ic0_apply(L, n, r, z);
+    for (i = 0, rz = 0; i < n; i++) { d[i] = z[i]; rz += r[i] * z[i]; }
+    for (it = 0; it < 500; it++) {
+        double dq = 0, al, rz2 = 0;
+        for (i = 0, rn = 0; i < n; i++) rn += r[i] * r[i];
+        if (rn <= 1e-8 * bn) break;
+        for (i = 0; i < n; i++) { double t = 0; const double *ai = A + (size_t)n * i; for (k = 0; k < n; k++) t += ai[k] * d[k]; q[i] = t; dq += d[i] * t; }
+        al = rz / dq;
+        for (i = 0; i < n; i++) { x[i] += al * d[i]; r[i] -= al * q[i]; }
+        ic0_apply(L, n, r, z);
+        for (i = 0; i < n; i++) rz2 += r[i] * z[i];
+        for (i = 0; i < n; i++) d[i] = z[i] + rz2 / rz * d[i];
+        rz = rz2;
+    }
+    free(x); free(r); free(z); free(d); free(q);
+    return it;
+}
+static int g_precond;
+
 static void check(const char *path)
 {
     sb_desc d, d2;
@@ -263,6 +317,29 @@ static void check(const char *path)
             T_CHECK(chol_solve(A1, 3 * n1, u1) == 0, "%s: level 1's static system is positive definite", path);
             free(A1);
         }
+        if (g_precond) {   /* the step matrix: the mass as its own pass (it needs the element's mass blocks again) */
+            int n3 = 3 * nu, *blk = malloc(sizeof(int) * (size_t)n3), it1, it2;
+            double *S = malloc(sizeof(double) * (size_t)n3 * (size_t)n3), *L = malloc(sizeof(double) * (size_t)n3 * (size_t)n3), sh1, sh2;
+            double hh = o.h, a1 = hh * o.alpha, b1 = o.beta / hh;
+            for (i = 0; i < n3 * n3; i++) S[i] = (1 + b1) * hh * hh * A[i];
+            for (E = 0; E < o.nc; E++) {
+                int vl[SB_CUT_NL], nl = 8 + cut.cnx[E] + (wd ? cut.cnd[E] : 0);
+                const double *ME = cutA.M + (size_t)(NL * NL) * (size_t)E;
+                for (a = 0; a < 8; a++) vl[a] = o.cells[8 * E + a];
+                for (a = 0; a < cut.cnx[E]; a++) vl[8 + a] = o.nv + cut.cx[SB_CUT_MAXX * E + a];
+                for (a = 0; wd && a < cut.cnd[E]; a++) vl[8 + cut.cnx[E] + a] = o.nv + cut.nx + cut.cd[SB_CUT_MAXX * E + a];
+                for (a = 0; a < nl; a++)
+                    for (b = 0; b < nl; b++)
+                        if (uid[vl[a]] >= 0 && uid[vl[b]] >= 0)
+                            for (r = 0; r < 3; r++) S[(size_t)n3 * (size_t)(3 * uid[vl[a]] + r) + (size_t)(3 * uid[vl[b]] + r)] += (1 + a1) * ME[NL * a + b];
+            }
+            for (i = 0; i < N; i++) if (uid[i] >= 0) for (r = 0; r < 3; r++) blk[3 * uid[i] + r] = i < o.nv ? 0 : 1 + uid[i];
+            it1 = ic0(S, n3, NULL, L, &sh1) ? -1 : pcg_iters(S, n3, f, L);
+            it2 = ic0(S, n3, blk, L, &sh2) ? -1 : pcg_iters(S, n3, f, L);
+            printf("  precond %s%s: %d unknowns: IC(0) of every function %d iterations (shift %g); coarse IC(0) + block Jacobi on the details %d "
+                   "(shift %g)\n", path, wd ? " every detail" : " cut level", n3, it1, sh1, it2, sh2);
+            free(S); free(L); free(blk);
+        }
         T_CHECK(chol_solve(A, 3 * nu, f) == 0, "%s: the cut level's static system%s is positive definite", path, wd ? " with every detail" : "");
         for (n = 0; n < o2.nv; n++) if (n < o2.nf) for (a = 0; a < 3; a++) um = fmax(um, fabs(u1[3 * n + a]));
         for (n = 0, k = 0; n < o2.nv; n++) {
@@ -452,9 +529,10 @@ static void details_line(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     (void)t_seed;
+    g_precond = argc > 1 && !strcmp(argv[1], "--precond");
     check("tools/examples/cow/cow.sinew");
     refusals();
     details_line();
