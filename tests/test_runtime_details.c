@@ -5,7 +5,8 @@
  *    same bytes in every section before the details' (the details add columns to
  *    the cut element, never change its corner or extra blocks), and both step the
  *    same state hash over the violent swing (no detail is active in this runtime:
- *    what stage 2's "none active" must keep);
+ *    what stage 2's "none active" must keep); every detail's rest point is its
+ *    cell's dyadic point of REST (one Q22 step; float 1e-6 of a cell);
  * 2. the validator on the limb's cut blob with 'details 8 0.03 0.01' (the fuzzers'
  *    seed): every crafted change to the four sections refused with its status,
  *    the checksum fixed after each. */
@@ -30,6 +31,48 @@ static const char *path(const char *name, char *buf, size_t n)
     return buf;
 }
 
+/* a stored real as a double in internal units (fixed Q22) */
+static double real_of(const unsigned char *p)
+{
+#if defined(SN_FLOAT)
+    float f;
+    memcpy(&f, p, 4);
+    return (double)f;
+#else
+    return ldexp((double)(int32_t)tb_rd32(p), -22);
+#endif
+}
+
+/* every DETAIL's rest point is the dyadic point of its cell's corners (REST): within one Q22 step (fixed: the
+ * corners' and the detail's rounding) or 1e-6 of the cell (float); the largest difference in cells */
+static double rest_points(const unsigned char *b, int *bad)
+{
+    uint32_t nd = sec_at(b, SN_SEC_DETAIL, 2), i, k, a, de = (uint32_t)SN_ELEM_DETAIL(4);
+    const unsigned char *dr = b + sec_at(b, SN_SEC_DETAIL, 0), *cl = b + sec_at(b, SN_SEC_CELLS, 0), *rest = b + sec_at(b, SN_SEC_REST, 0);
+    double worst = 0, cell = real_of(b + SN_H_REALS + 4 * SN_R_CELL);
+    *bad = 0;
+    for (i = 0; i < nd; i++) {
+        const unsigned char *d = dr + (size_t)i * de;
+        uint32_t c = rd16(d), pt = d[2], u[3] = {pt % 3, pt / 3 % 3, pt / 9};
+        for (k = 0; k < 3; k++) {
+            double want = 0;
+            for (a = 0; a < 8; a++) {
+                double w = 1;
+                uint32_t q;
+                for (q = 0; q < 3; q++) w *= (a >> q & 1) ? 0.5 * u[q] : 1 - 0.5 * u[q];
+                if (w != 0) want += w * real_of(rest + 12u * rd16(cl + (size_t)c * SN_ELEM_CELLS + 2 * a) + 4 * k);
+            }
+            worst = fmax(worst, fabs(real_of(d + 4 + 4 * k) - want) / cell);
+#if defined(SN_FLOAT)
+            *bad += fabs(real_of(d + 4 + 4 * k) - want) > 1e-6 * cell;
+#else
+            *bad += fabs(real_of(d + 4 + 4 * k) - want) > ldexp(1.0, -22);
+#endif
+        }
+    }
+    return worst;
+}
+
 /* 1. with and without the details: the same sections, the same steps */
 static void same_cut(void)
 {
@@ -52,6 +95,11 @@ static void same_cut(void)
         if (sz != sec_at(b1, k, 1) || memcmp(b0 + sec_at(b0, k, 0), b1 + sec_at(b1, k, 0), sz) != 0) { same = 0; break; }
     }
     T_CHECK(same, "[%s] every section before the details' is the cut blob's, byte for byte (first differing: %d)", FL, same ? -1 : k);
+    {
+        int bad = 0;
+        double w = rest_points(b1, &bad);
+        T_CHECK(bad == 0, "[%s] cow: every detail's rest point is its cell's dyadic point (%d coordinates off; worst %.2g cell)", FL, bad, w);
+    }
     T_FIGURE("[%s] cow details: %u details, %u CELLDK elements (%u bytes), dshift %u; blob %lu -> %lu bytes", FL, sec_at(b1, SN_SEC_DETAIL, 2),
              sec_at(b1, SN_SEC_CELLDK, 2), sec_at(b1, SN_SEC_CELLDK, 1), b1[sec_at(b1, SN_SEC_DETAILS, 0) + 2], (unsigned long)n0,
              (unsigned long)n1);
