@@ -66,7 +66,7 @@ static int chol_solve(double *A, int n, double *b)
  * (1) IC(0) of A on its pattern (every function: the design's masked IC(0) with all active; diagonal shift s A_ii
  * doubled from 1e-3 until the pivots are positive), (2) IC(0) of the coarse block + 3x3 block Jacobi on the
  * details (coupling dropped). Returns the iterations (500: not converged); *shift the shift used. */
-static int ic0(const double *A, int n, const int *blk, double *L, double *shift)
+static int ic0(const double *A, int n, const int *blk, double *L, double *shift, int nfix)
 {
     int i, j, k;
     for (*shift = 0;; *shift = *shift ? 2 * *shift : 1e-3) {
@@ -75,7 +75,7 @@ static int ic0(const double *A, int n, const int *blk, double *L, double *shift)
             for (j = 0; j <= i; j++) {
                 double t = A[(size_t)n * i + j];
                 if (t == 0 || (blk && blk[i] != blk[j])) { L[(size_t)n * i + j] = 0; continue; }   /* IC(0): A's pattern, within a block */
-                if (i == j) t *= 1 + *shift;
+                if (i == j && i >= nfix) t *= 1 + *shift;   /* rows before nfix unshifted */
                 for (k = 0; k < j; k++) t -= L[(size_t)n * i + k] * L[(size_t)n * j + k];
                 if (i == j) { if (!(t > 0)) { ok = 0; break; } L[(size_t)n * i + i] = sqrt(t); }
                 else L[(size_t)n * i + j] = t / L[(size_t)n * j + j];
@@ -90,7 +90,7 @@ static void ic0_apply(const double *L, int n, const double *r, double *z)
     for (i = 0; i < n; i++) { double t = r[i]; for (k = 0; k < i; k++) t -= L[(size_t)n * i + k] * z[k]; z[i] = t / L[(size_t)n * i + i]; }
     for (i = n - 1; i >= 0; i--) { double t = z[i]; for (k = i + 1; k < n; k++) t -= L[(size_t)n * k + i] * z[k]; z[i] = t / L[(size_t)n * i + i]; }
 }
-static int pcg_iters(const double *A, int n, const double *b, const double *L)
+static int pcg_iters(const double *A, int n, const double *b, const double *L, double *xout)
 {
     double *x = calloc((size_t)n, sizeof(double)), *r = calloc((size_t)n, sizeof(double)), *z = calloc((size_t)n, sizeof(double));
     double *d = malloc(sizeof(double) * (size_t)n), *q = malloc(sizeof(double) * (size_t)n), rz, bn = 0, rn;
@@ -110,6 +110,7 @@ static int pcg_iters(const double *A, int n, const double *b, const double *L)
         for (i = 0; i < n; i++) d[i] = z[i] + rz2 / rz * d[i];
         rz = rz2;
     }
+    if (xout) memcpy(xout, x, sizeof(double) * (size_t)n);
     free(x); free(r); free(z); free(d); free(q);
     return it;
 }
@@ -334,8 +335,56 @@ static void check(const char *path)
                             for (r = 0; r < 3; r++) S[(size_t)n3 * (size_t)(3 * uid[vl[a]] + r) + (size_t)(3 * uid[vl[b]] + r)] += (1 + a1) * ME[NL * a + b];
             }
             for (i = 0; i < N; i++) if (uid[i] >= 0) for (r = 0; r < 3; r++) blk[3 * uid[i] + r] = i < o.nv ? 0 : 1 + uid[i];
-            it1 = ic0(S, n3, NULL, L, &sh1) ? -1 : pcg_iters(S, n3, f, L);
-            it2 = ic0(S, n3, blk, L, &sh2) ? -1 : pcg_iters(S, n3, f, L);
+            it1 = ic0(S, n3, NULL, L, &sh1, 0) ? -1 : pcg_iters(S, n3, f, L, NULL);
+            it2 = ic0(S, n3, blk, L, &sh2, 0) ? -1 : pcg_iters(S, n3, f, L, NULL);
+            {   /* (3) coarse rows first, unshifted (the cut level's own IC(0): no detail active = the cut level's factor),
+                 * then the details, the shift on their pivots only: masking off inactive details restricts it exactly */
+                int *pm = malloc(sizeof(int) * (size_t)n3), nc3 = 0, it3, jj;
+                double *P2 = malloc(sizeof(double) * (size_t)n3 * (size_t)n3), *f2 = malloc(sizeof(double) * (size_t)n3), sh3;
+                for (i = 0; i < n3; i++) if (blk[i] == 0) pm[nc3++] = i;
+                for (i = 0, jj = nc3; i < n3; i++) if (blk[i] != 0) pm[jj++] = i;
+                for (i = 0; i < n3; i++) {
+                    f2[i] = f[pm[i]];
+                    for (jj = 0; jj < n3; jj++) P2[(size_t)n3 * i + jj] = S[(size_t)n3 * pm[i] + pm[jj]];
+                }
+                double *xs = calloc((size_t)n3, sizeof(double));
+                it3 = ic0(P2, n3, NULL, L, &sh3, nc3) ? -1 : pcg_iters(P2, n3, f2, L, xs);
+                printf("  precond %s%s: coarse rows first (unshifted), the details after (shift %g on their pivots): %d iterations\n", path,
+                       wd ? " every detail" : " cut level", sh3, it3);
+                if (wd && it3 >= 0) {   /* the same factor masked to the coarse rows + the K details of largest |x| (the static answer) */
+                    static const int Ks[3] = {0, 25, 50};
+                    int kq, nd3 = (n3 - nc3) / 3;
+                    for (kq = 0; kq < 3; kq++) {
+                        int *on = calloc((size_t)nd3, sizeof(int)), *ix = malloc(sizeof(int) * (size_t)n3), na = 0, t2, q2;
+                        double *Aa, *La, *fa;
+                        for (t2 = 0; t2 < Ks[kq]; t2++) {   /* the K largest, ties by index */
+                            int best = -1;
+                            double bm = -1;
+                            for (q2 = 0; q2 < nd3; q2++) {
+                                double mm = 0;
+                                for (jj = 0; jj < 3; jj++) mm = fmax(mm, fabs(xs[nc3 + 3 * q2 + jj]));
+                                if (!on[q2] && mm > bm) { bm = mm; best = q2; }
+                            }
+                            if (best >= 0) on[best] = 1;
+                        }
+                        for (i = 0; i < n3; i++) if (i < nc3 || on[(i - nc3) / 3]) ix[na++] = i;
+                        Aa = malloc(sizeof(double) * (size_t)na * (size_t)na); La = malloc(sizeof(double) * (size_t)na * (size_t)na);
+                        fa = malloc(sizeof(double) * (size_t)na);
+                        for (i = 0; i < na; i++) {
+                            fa[i] = f2[ix[i]];
+                            for (jj = 0; jj < na; jj++) {
+                                Aa[(size_t)na * i + jj] = P2[(size_t)n3 * ix[i] + ix[jj]];
+                                La[(size_t)na * i + jj] = L[(size_t)n3 * ix[i] + ix[jj]];
+                            }
+                        }
+                        printf("  precond %s: that factor masked to the coarse rows + the %d details of largest static answer: %d iterations\n", path,
+                               Ks[kq], pcg_iters(Aa, na, fa, La, NULL));
+                        free(on); free(ix); free(Aa); free(La); free(fa);
+                    }
+                }
+                free(xs);
+                free(pm); free(P2); free(f2);
+            }
             printf("  precond %s%s: %d unknowns: IC(0) of every function %d iterations (shift %g); coarse IC(0) + block Jacobi on the details %d "
                    "(shift %g)\n", path, wd ? " every detail" : " cut level", n3, it1, sh1, it2, sh2);
             free(S); free(L); free(blk);
