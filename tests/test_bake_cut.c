@@ -124,8 +124,8 @@ static void check(const char *path)
     sb_model o, o2;
     sb_cut cut, cutA;
     int i, k, E, a, b, n, N, wd, bad = 0, norphan = 0, *pn, *pi, *xof, *dof, *orphan;
-    double *u1 = NULL, smax[2], srms[2], fmaxs[2], frms[2];
-    int sunk[2];
+    double *u1 = NULL, smax[3], srms[3], fmaxs[3], frms[3];
+    int sunk[3], *held, nheld = 0, nair = 0, nfree0 = 0, air0ok = -1;
     double *pw, *x, *ya, *yb, *ma, *mb, *px, *spx, *mpx, ea = 0, sa = 0, em = 0, sm = 0, rowsum = 0, rowscale = 0;
     const int NL = SB_CUT_NL, N3 = 3 * SB_CUT_NL;
     memset(&m, 0, sizeof m); memset(&o, 0, sizeof o); memset(&o2, 0, sizeof o2);
@@ -136,15 +136,41 @@ static void check(const char *path)
     /* the statics below take the bake's air element (d.air: without it a coarse vertex outside level 1's lattice,
      * with every detail around it active, has no stiffness left: the details cancel its hat in the kept children) */
     if (sb_cut_build(&o, &o2, d.air, &cutA)) { T_CHECK(0, "%s: %s", path, sb_error()); return; }
-    for (wd = 0; wd < 2; wd++) {
-    /* wd 1: the details too (level-1 free vertices at non-corner points of kept cells, after the extras) */
+    /* The air-held coarse vertices (LEVELS.md §3): a coarse unknown at a grid point where level 1 has no vertex
+     * has, in the kept children, a hat that is a sum of the level-1 hats at its neighbouring points; with all of
+     * those details active they cancel it and only the air holds its mode. Rule (ii): per such vertex (index
+     * order) hold out its own detail, the one of largest weight on it (4/8 an edge point, 2/8 a face, 1/8 the
+     * centre) not held out already, ties by the detail's index (one shared by two vertices leaves a combination
+     * of their hats cancelled). */
+    held = calloc((size_t)cut.nd + 1, sizeof(int));
+    for (i = 0; i < o.nv; i++) {
+        int best = -1, bw = 0;
+        if (!(i < o.nf || (cut.v1[i] >= 0 && cut.v1[i] < o2.nf)) || cut.v1[i] >= 0) continue;
+        nair++;
+        for (E = 0; E < o.nc; E++)
+            for (a = 0; a < 8; a++) {
+                int pt;
+                if (o.cells[8 * E + a] != i) continue;
+                for (pt = 0; pt < 27; pt++) {
+                    int p3[3] = {pt % 3, pt / 3 % 3, pt / 9}, w = 1, dd = cut.dsub[27 * E + pt];
+                    for (k = 0; k < 3; k++) w *= (a >> k & 1) ? p3[k] : 2 - p3[k];
+                    if (dd < 0 || w == 0) continue;
+                    if (held[dd]) continue;
+                    if (w > bw || (w == bw && dd < best)) { bw = w; best = dd; }
+                }
+            }
+        if (best >= 0) { held[best] = 1; nheld++; } else nfree0++;
+    }
+    for (wd = 0; wd < 3; wd++) {
+    /* wd 1: the details too (level-1 free vertices at non-corner points of kept cells, after the extras);
+     * wd 2: every detail but the held-out ones (their columns 0, their rows left out of the comparison) */
     N = o.nv + cut.nx + (wd ? cut.nd : 0);
     norphan = 0; bad = 0; ea = sa = em = sm = rowsum = rowscale = 0;
     /* P's rows over level 1's vertices, from positions on the two grids */
     xof = malloc(sizeof(int) * (size_t)o2.nv); dof = malloc(sizeof(int) * (size_t)o2.nv);
     for (n = 0; n < o2.nv; n++) xof[n] = dof[n] = -1;
     for (i = 0; i < cut.nx; i++) xof[cut.xv[i]] = o.nv + i;
-    for (i = 0; wd && i < cut.nd; i++) dof[cut.dv[i]] = o.nv + cut.nx + i;
+    for (i = 0; wd && i < cut.nd; i++) if (wd == 1 || !held[i]) dof[cut.dv[i]] = o.nv + cut.nx + i;
     pn = calloc((size_t)o2.nv + 1, sizeof(int)); pi = malloc(sizeof(int) * 9 * (size_t)o2.nv); pw = malloc(sizeof(double) * 9 * (size_t)o2.nv);
     for (n = 0; n < o2.nv; n++) {
         double t[3];
@@ -182,7 +208,7 @@ static void check(const char *path)
     x = malloc(sizeof(double) * 3 * (size_t)N); ya = calloc(3 * (size_t)N, sizeof(double)); yb = calloc(3 * (size_t)N, sizeof(double));
     ma = calloc(3 * (size_t)N, sizeof(double)); mb = calloc(3 * (size_t)N, sizeof(double));
     px = calloc(3 * (size_t)o2.nv, sizeof(double)); spx = calloc(3 * (size_t)o2.nv, sizeof(double)); mpx = calloc(3 * (size_t)o2.nv, sizeof(double));
-    for (i = 0; i < 3 * N; i++) x[i] = rnd();
+    for (i = 0; i < 3 * N; i++) x[i] = wd == 2 && i >= 3 * (o.nv + cut.nx) && held[i / 3 - o.nv - cut.nx] ? 0 : rnd();
     /* the bake's elements, scattered */
     for (E = 0; E < o.nc; E++) {
         int vl[SB_CUT_NL], nl = 8 + cut.cnx[E] + (wd ? cut.cnd[E] : 0), r, s;
@@ -238,12 +264,13 @@ static void check(const char *path)
             for (a = 0; a < 3; a++) { yb[3 * pi[k] + a] += pw[k] * spx[3 * n + a]; mb[3 * pi[k] + a] += pw[k] * mpx[3 * n + a]; }
     }
     for (i = 0; i < 3 * N; i++) {
+        if (wd == 2 && i >= 3 * (o.nv + cut.nx) && held[i / 3 - o.nv - cut.nx]) continue;
         ea = fmax(ea, fabs(ya[i] - yb[i])); sa = fmax(sa, fabs(ya[i]));
         em = fmax(em, fabs(ma[i] - mb[i])); sm = fmax(sm, fabs(ma[i]));
     }
     T_FIGURE("%s: cut level%s: %d extras, %d details, %d level-1 cells outside the kept level-0 cells; sum_E K_E x vs P^T S_1 P x %.2e, "
              "mass %.2e (of the largest entry of the product); element rows sum to %.2e of the row's |K| sum", path,
-             wd ? " with every detail" : "", cut.nx, wd ? cut.nd : 0, norphan, ea / sa, em / sm, rowsum / rowscale);
+             wd == 1 ? " with every detail" : wd ? " with every detail but the held-out" : "", cut.nx, wd == 1 ? cut.nd : wd ? cut.nd - nheld : 0, norphan, ea / sa, em / sm, rowsum / rowscale);
     /* 1e-12: each product entry sums <= 8 children x 64 corner pairs x 81 weighted terms, in another order than
      * the assembled route (rounding ~1e-15 relative per term); the rows' null space likewise */
     T_CHECK(ea <= 1e-12 * sa && em <= 1e-12 * sm, "%s: cut elements vs level 1's assembled Galerkin product: stiffness %g, mass %g (want <= 1e-12)",
@@ -259,7 +286,7 @@ static void check(const char *path)
         int *ord = malloc(sizeof(int) * (size_t)N), m2;
         for (i = 0; i < N; i++) {   /* unknowns numbered along z, then y, x (a short profile for the factor) */
             const double *xp = i < o.nv ? o.x + 3 * i : i >= o.nv + cut.nx ? cut.dx + 3 * (i - o.nv - cut.nx) : NULL;
-            int fr = i < o.nv ? i < o.nf || (cut.v1[i] >= 0 && cut.v1[i] < o2.nf) : i >= o.nv + cut.nx;
+            int fr = i < o.nv ? i < o.nf || (cut.v1[i] >= 0 && cut.v1[i] < o2.nf) : i >= o.nv + cut.nx && !(wd == 2 && held[i - o.nv - cut.nx]);
             uid[i] = fr ? 0 : -1;
             key[i] = xp ? (xp[2] * 1e6 + xp[1]) * 1e6 + xp[0] : 0;
             ord[i] = i;
@@ -290,6 +317,27 @@ static void check(const char *path)
                             A[(size_t)3 * nu * (size_t)(3 * ia + r) + (size_t)(3 * ib + s2)] += KE[(size_t)N3 * (size_t)(3 * a + r) + (size_t)(3 * b + s2)];
                 }
             }
+        }
+        if (wd == 2) {   /* with air 0 (the bake's elements without the air element) the held-out rule leaves no
+                          * coarse hat cancelled: the system stays positive definite (every detail: singular) */
+            double *A0 = calloc((size_t)9 * (size_t)nu * (size_t)nu, sizeof(double)), *f0 = calloc(3 * (size_t)nu, sizeof(double));
+            for (E = 0; E < o.nc; E++) {
+                int vl[SB_CUT_NL], nl = 8 + cut.cnx[E] + cut.cnd[E];
+                const double *KE = cut.K + (size_t)(N3 * N3) * (size_t)E;
+                for (a = 0; a < 8; a++) vl[a] = o.cells[8 * E + a];
+                for (a = 0; a < cut.cnx[E]; a++) vl[8 + a] = o.nv + cut.cx[SB_CUT_MAXX * E + a];
+                for (a = 0; a < cut.cnd[E]; a++) vl[8 + cut.cnx[E] + a] = o.nv + cut.nx + cut.cd[SB_CUT_MAXX * E + a];
+                for (a = 0; a < nl; a++)
+                    for (b = 0; b < nl; b++)
+                        if (uid[vl[a]] >= 0 && uid[vl[b]] >= 0)
+                            for (r = 0; r < 3; r++)
+                                for (s2 = 0; s2 < 3; s2++)
+                                    A0[(size_t)3 * nu * (size_t)(3 * uid[vl[a]] + r) + (size_t)(3 * uid[vl[b]] + s2)] +=
+                                        KE[(size_t)N3 * (size_t)(3 * a + r) + (size_t)(3 * b + s2)];
+            }
+            for (i = 0; i < 3 * nu; i++) f0[i] = 1;
+            air0ok = chol_solve(A0, 3 * nu, f0) == 0;
+            free(A0); free(f0);
         }
         if (!u1) {   /* level 1, once: its assembled matrices less the cells in no kept level-0 cell */
             int n1 = o2.nf;
@@ -350,7 +398,7 @@ static void check(const char *path)
                 double *xs = calloc((size_t)n3, sizeof(double));
                 it3 = ic0(P2, n3, NULL, L, &sh3, nc3) ? -1 : pcg_iters(P2, n3, f2, L, xs);
                 printf("  precond %s%s: coarse rows first (unshifted), the details after (shift %g on their pivots): %d iterations\n", path,
-                       wd ? " every detail" : " cut level", sh3, it3);
+                       wd == 1 ? " every detail" : wd ? " every detail but the held-out" : " cut level", sh3, it3);
                 if (wd && it3 >= 0) {   /* the same factor masked to the coarse rows + the K details of largest |x| (the static answer) */
                     static const int Ks[3] = {0, 25, 50};
                     int kq, nd3 = (n3 - nc3) / 3;
@@ -386,7 +434,7 @@ static void check(const char *path)
                 free(pm); free(P2); free(f2);
             }
             printf("  precond %s%s: %d unknowns: IC(0) of every function %d iterations (shift %g); coarse IC(0) + block Jacobi on the details %d "
-                   "(shift %g)\n", path, wd ? " every detail" : " cut level", n3, it1, sh1, it2, sh2);
+                   "(shift %g)\n", path, wd == 1 ? " every detail" : wd ? " every detail but the held-out" : " cut level", n3, it1, sh1, it2, sh2);
             free(S); free(L); free(blk);
         }
         T_CHECK(chol_solve(A, 3 * nu, f) == 0, "%s: the cut level's static system%s is positive definite", path, wd ? " with every detail" : "");
@@ -434,7 +482,7 @@ static void check(const char *path)
                     }
                     if (wd && cut.dsub[27 * E + pt] >= 0) {
                         int id = uid[o.nv + cut.nx + cut.dsub[27 * E + pt]];
-                        for (q = 0; q < 3; q++) val[q] += f[3 * id + q];
+                        if (id >= 0) for (q = 0; q < 3; q++) val[q] += f[3 * id + q];
                     }
                     for (q = 0; q < 3; q++) wc[q] += w * val[q];
                 }
@@ -453,11 +501,17 @@ static void check(const char *path)
     T_FIGURE("%s: linear statics under gravity against level 1 (%d unknowns), of its largest displacement: lattice: cut level (%d unknowns) "
              "max %.3g rms %.3g, with every detail (%d) max %.3g rms %.3g; surface: cut level max %.3g rms %.3g, with every detail max %.3g rms %.3g",
              path, 3 * o2.nf, sunk[0], smax[0], srms[0], sunk[1], smax[1], srms[1], fmaxs[0], frms[0], fmaxs[1], frms[1]);
+    T_FIGURE("%s: air-held coarse vertices (free, at no level-1 vertex) %d; details held out (one in each one's support) %d of %d; "
+             "statics with the rest (%d unknowns): lattice max %.3g rms %.3g, surface max %.3g rms %.3g; with air 0 %s",
+             path, nair, nheld, cut.nd, sunk[2], smax[2], srms[2], fmaxs[2], frms[2], air0ok ? "positive definite" : "singular");
+    T_CHECK(air0ok == 1, "%s: with the held-out details inactive and air 0 the static system is positive definite", path);
+    T_CHECK(smax[2] < smax[0] && srms[2] < srms[0] && fmaxs[2] < fmaxs[0] && frms[2] < frms[0],
+            "%s: statics with every detail but the held-out nearer level 1 than the cut level", path);
     /* the details add level 1's free hats inside the kept cells: nearer level 1 at every measure */
     T_CHECK(smax[1] < smax[0] && srms[1] < srms[0] && fmaxs[1] < fmaxs[0] && frms[1] < frms[0],
             "%s: statics with every detail nearer level 1 than the cut level (lattice max %.3g vs %.3g, rms %.3g vs %.3g; surface max %.3g vs %.3g, "
             "rms %.3g vs %.3g)", path, smax[1], smax[0], srms[1], srms[0], fmaxs[1], fmaxs[0], frms[1], frms[0]);
-    free(u1);
+    free(u1); free(held);
     sb_cut_free(&cut); sb_cut_free(&cutA); sb_model_free(&o2); sb_model_free(&o); sb_mesh_free(&m); sb_srcmap_free(&src); sb_desc_free(&d);
 }
 
