@@ -9,12 +9,24 @@
  *    cell's dyadic point of REST (one Q22 step; float 1e-6 of a cell);
  * 2. the validator on the limb's cut blob with 'details 8 0.03 0.01' (the fuzzers'
  *    seed): every crafted change to the four sections refused with its status,
- *    the checksum fixed after each. */
+ *    the checksum fixed after each.
+ * 3. stage 2's cell product (sn_detail_cell_mul) on the cow's details blob:
+ *    every cell with details, random operands, every detail active and a
+ *    random half, against the cell's dense local matrix assembled here in
+ *    double from CELLDK's blocks (detail rows, and the corner rows through
+ *    the transposed blocks; the detail-detail blocks below the diagonal as
+ *    the transposes), and the mass product (sn_detail_cell_mass, CELLDK's
+ *    scalar masses, symmetric) likewise. Bounds (of each row's sum of |terms|): fixed 1e-14
+ *    (the kernel is exact in int64; the double reference rounds <= 81
+ *    products of <= 2^57 at 2^-53 each), float 1e-5 (<= 81 float additions,
+ *    2^-24 of the partial sum each: 81 * 6e-8 = 4.8e-6). */
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
 #include "fuzz/sn_tblob.h"
 #include "level_util.h"
+#include "sn_instance.h" /* sn_view_init: the kernel under test reads the validated view */
+#include "sn_detail.h"   /* sn_detail_cell_mul */
 
 #if defined(SN_FLOAT)
 #define SN_TB_SUFFIX "_float"
@@ -207,10 +219,123 @@ static void crafted(void)
     free(h); free(bb);
 }
 
+/* 3. the cell product */
+static unsigned long long rng3 = 99;
+static double rnd3(void) { rng3 = rng3 * 6364136223846793005ULL + 1442695040888963407ULL; return (double)(rng3 >> 11) / 9007199254740992.0 - 0.5; }
+/* a CELLDK entry in the kernel's units: fixed m 2^e (the integer the kernel sums), float the real */
+static double blk_of(const unsigned char *b, int k)
+{
+#if defined(SN_FLOAT)
+    return real_of(b + 4 * k);
+#else
+    return ldexp((double)(int16_t)rd16(b + 2 * k), b[18]);
+#endif
+}
+static void cell_product(void)
+{
+    char p1[600];
+    size_t n1;
+    unsigned char *b = load(path("cow_details" SN_TB_SUFFIX ".blob", p1, sizeof p1), &n1);
+    const sn_blob *c1 = NULL;
+    sn_view v;
+    const size_t KB = (size_t)SN_ELEM_CELLDK(SN_FLAVOUR, 4);
+    uint32_t e, nc, cells = 0, rows = 0, sat = 0, pass;
+    double worst = 0, mworst = 0;
+    int ds;
+    if (!b || sn_blob_validate(b, n1, &c1) != SN_OK) { T_CHECK(0, "[%s] cannot read/validate %s", FL, p1); free(b); return; }
+    sn_view_init(&v, c1);
+    nc = sec_at(b, SN_SEC_CELLS, 2);
+    ds = b[sec_at(b, SN_SEC_DETAILS, 0) + 2];
+    for (e = 0; e < nc; e++) {
+        const unsigned char *cd = b + sec_at(b, SN_SEC_CELLD, 0) + (size_t)e * SN_ELEM_CELLD, *cx = b + sec_at(b, SN_SEC_CELLX, 0) + (size_t)e * SN_ELEM_CELLX;
+        const unsigned char *K = b + sec_at(b, SN_SEC_CELLDK, 0) + (size_t)tb_rd32(cd + 40) * KB;
+        uint32_t nd = cd[38], nx = cx[38], nl = 8 + nx + nd, j, c, i, q, r, on;
+        static double D[81][81], Mm[27][27];
+        if (nd == 0) continue;
+        cells++;
+        memset(D, 0, sizeof D); memset(Mm, 0, sizeof Mm);
+        for (j = 0; j < nd; j++)   /* detail j's run: corners, extras, details k >= j */
+            for (c = 0; c < 8 + nx + nd - j; c++, K += KB) {
+                uint32_t col = c < 8 + nx ? c : c + j, row = 8 + nx + j;
+                for (i = 0; i < 3; i++)
+                    for (q = 0; q < 3; q++) {
+                        D[3 * col + q][3 * row + i] = blk_of(K, (int)(3 * i + q));   /* the mirror first: the block itself wins on (j, j) */
+                    }
+                for (i = 0; i < 3; i++)
+                    for (q = 0; q < 3; q++) D[3 * row + i][3 * col + q] = blk_of(K, (int)(3 * i + q));
+#if defined(SN_FLOAT)
+                Mm[row][col] = Mm[col][row] = real_of(K + 36);
+#else
+                Mm[row][col] = Mm[col][row] = ldexp((double)(int32_t)tb_rd32(K + 20), 0);
+#endif
+            }
+        for (pass = 0; pass < 2; pass++) {
+            sn_q yc[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], y[81];
+            sn_acc lc[24], ld[3 * SN_CUT_MAXX], mc[24], md[3 * SN_CUT_MAXX];
+            on = pass == 0 ? (1u << nd) - 1u : (uint32_t)(rnd3() * 1048576.0 + 524288.0) & ((1u << nd) - 1u);
+            for (i = 0; i < 3 * nl; i++) {
+#if defined(SN_FLOAT)
+                y[i] = (sn_q)(32.0 * rnd3());
+#else
+                y[i] = (sn_q)(134217728.0 * rnd3());   /* +-2^26: 16 internal units, Q22 */
+#endif
+            }
+            for (i = 0; i < 24; i++) { yc[i] = y[i]; lc[i] = mc[i] = 0; }
+            for (j = 0; j < nx; j++) for (q = 0; q < 3; q++) yx[j][q] = y[24 + 3 * j + q];
+            for (j = 0; j < nd; j++) for (q = 0; q < 3; q++) yd[j][q] = y[3 * (8 + nx + j) + q];
+            sn_detail_cell_mul(&v, e, on, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ld, &sat);
+            sn_detail_cell_mass(&v, e, on, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, mc, md);
+            for (r = 0; r < 3 * (8 + nd); r++) {   /* the mass: scalar blocks, the same rows */
+                uint32_t row = r < 24 ? r / 3 : 8 + nx + (r - 24) / 3, dj = r < 24 ? 0 : (r - 24) / 3;
+                double want = 0, mag = 0, got = r < 24 ? (double)mc[r] : (double)md[r - 24];
+                if (r >= 24 && !(on >> dj & 1u)) { mworst = fmax(mworst, got != 0 ? 1.0 : 0.0); continue; }
+                for (c = 0; c < nl; c++) {
+                    double t;
+                    if (c >= 8 + nx && !(on >> (c - 8 - nx) & 1u)) continue;
+                    if (r < 24 && c < 8 + nx) continue;
+                    t = Mm[row][c] * (double)y[3 * c + r % 3];
+                    want += t; mag += fabs(t);
+                }
+                if (mag > 0) mworst = fmax(mworst, fabs(got - want) / mag);
+            }
+            for (r = 0; r < 3 * (8 + nd); r++) {   /* corner rows 0..23, then the details' */
+                uint32_t row = r < 24 ? r : 3 * (8 + nx) + (r - 24), dj = r < 24 ? 0 : (r - 24) / 3;
+                double want = 0, mag = 0, got;
+                if (r >= 24 && !(on >> dj & 1u)) { worst = fmax(worst, ld[r - 24] != 0 ? 1.0 : 0.0); continue; }
+                for (c = 0; c < 3 * nl; c++) {
+                    uint32_t lc_ = c / 3;
+                    double t;
+                    if (lc_ >= 8 + nx && !(on >> (lc_ - 8 - nx) & 1u)) continue;   /* inactive detail: no column */
+                    if (r < 24 && lc_ < 8 + nx) continue;   /* corner rows: only the details' columns */
+                    t = D[row][c] * (double)y[c];
+                    want += t; mag += fabs(t);
+                }
+                got = r < 24 ? (double)lc[r] : (double)ld[r - 24];
+#if !defined(SN_FLOAT)
+                if (r < 24) { want = ldexp(want, ds); mag = ldexp(mag, ds); }
+#endif
+                if (mag > 0) worst = fmax(worst, fabs(got - want) / mag);
+                rows++;
+            }
+        }
+    }
+    T_FIGURE("[%s] cow: the details' cell product on %u cells (every detail, a random half), %u rows: worst %.3g of the row's sum of |terms| "
+             "(dshift %d); mass %.3g", FL, cells, rows, worst, ds, mworst);
+#if defined(SN_FLOAT)
+    T_CHECK(cells > 0 && worst <= 1e-5 && sat == 0, "[%s] the details' cell product vs the dense double product: %.3g (want <= 1e-5)", FL, worst);
+    T_CHECK(mworst <= 1e-5, "[%s] the details' mass product vs the dense double product: %.3g (want <= 1e-5)", FL, mworst);
+#else
+    T_CHECK(cells > 0 && worst <= 1e-14 && sat == 0, "[%s] the details' cell product vs the dense double product: %.3g (want <= 1e-14)", FL, worst);
+    T_CHECK(mworst <= 1e-14, "[%s] the details' mass product vs the dense double product: %.3g (want <= 1e-14)", FL, mworst);
+#endif
+    free(b);
+}
+
 int main(void)
 {
     (void)t_seed; (void)cell_of; (void)tb_build;
     same_cut();
     crafted();
+    cell_product();
     return T_END();
 }

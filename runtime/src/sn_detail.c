@@ -72,3 +72,133 @@ sn_status sn_check_details(const sn_view *v, uint32_t nhd, uint32_t nd, uint32_t
     }
     return SN_OK;
 }
+
+/* ---- stage 2's cell product (LEVELS.md §3 "Details on the cut level") ---- */
+
+/* l += B y (tr: B^T y), B one CELLDK block: fixed m 2^e per entry, a row's 3
+ * int16 x Q22 products (< 2^44.6) summed exactly, then scaled by 2^e (e <= 12:
+ * < 2^56.6); float the 3 products one by one, in column order. */
+SN_INLINE void blk_mac(const unsigned char *b, const sn_q y[3], int tr, sn_acc l[3]) {
+    uint32_t i;
+    for (i = 0; i < 3; i++) {
+        uint32_t s0 = tr ? i : 3 * i, st = tr ? 3 : 1;
+#if defined(SN_FLOAT)
+        l[i] += rd_real(b, s0) * y[0];
+        l[i] += rd_real(b, s0 + st) * y[1];
+        l[i] += rd_real(b, s0 + 2 * st) * y[2];
+#else
+        int64_t m = (int64_t)(int16_t)sn_rd_u16(b + 2 * s0) * y[0] + (int64_t)(int16_t)sn_rd_u16(b + 2 * (s0 + st)) * y[1] +
+                    (int64_t)(int16_t)sn_rd_u16(b + 2 * (s0 + 2 * st)) * y[2];
+        l[i] += m * ((int64_t)1 << b[18]);
+#endif
+    }
+}
+
+/* Cell e's active details' share of the cut element's product (sn_detail.h).
+ * The blocks of detail j (compact, CELLD order) start after those of the
+ * details before it: sum_{i<j} (8 + nx + nd - i) elements; in its run column
+ * c < 8 is corner c, 8 + x extra x, 8 + nx + (k - j) detail k >= j; the rows
+ * of k < j over j are block (k, j) transposed. Bounds (fixed): a detail row
+ * sums <= 27 blocks (nd + nx <= 19) < 27 * 3 * 2^55 < 2^61.4 (as the cut
+ * level's corner rows); a corner row's detail part <= 19 blocks < 2^60.8 at
+ * the details' scale, clamped to 2^(61 - dshift) (counted) and shifted up by
+ * dshift to the corners' scale: with the corner rows' own < 2^61.6 (cell_forces:
+ * ld + lu + lx) the sum stays < 2^62.3, below sn_out's 2^62.5. */
+void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
+                        sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
+    const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
+    const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
+    const uint32_t nd = cd[38], nx = cx[38];
+    sn_acc dc[24];
+    uint32_t j, k, c;
+#if !defined(SN_FLOAT)
+    const int ds = sn_sec(v, SN_SEC_DETAILS)[2];
+    const int64_t lim = ((int64_t)1 << (61 - ds));
+#endif
+    for (c = 0; c < 24; c++) dc[c] = 0;
+    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) {
+        sn_acc *l = ld + 3 * j;
+        l[0] = l[1] = l[2] = 0;
+        if (!(on >> j & 1u)) continue;
+        for (c = 0; c < 8; c++) {
+            blk_mac(Kj + (size_t)c * KB, yc + 3 * c, 0, l);
+            blk_mac(Kj + (size_t)c * KB, yd[j], 1, dc + 3 * c); /* corner c's row: block (j, c) transposed */
+        }
+        if (yx)
+            for (c = 0; c < nx; c++) blk_mac(Kj + (size_t)(8u + c) * KB, yx[c], 0, l);
+        for (k = 0; k < nd; k++) { /* k < j: block (k, j) transposed, in k's run at column 8 + nx + (j - k) */
+            const unsigned char *Kk = K;
+            uint32_t i;
+            if (!(on >> k & 1u)) continue;
+            if (k >= j) { blk_mac(Kj + (size_t)(8u + nx + k - j) * KB, yd[k], 0, l); continue; }
+            for (i = 0; i < k; i++) Kk += (size_t)(8u + nx + nd - i) * KB;
+            blk_mac(Kk + (size_t)(8u + nx + j - k) * KB, yd[k], 1, l);
+        }
+        for (c = 0; c < 3; c++) SN_RANGE(SN_WITHIN(l[c], 61), "detail row beyond 27 * 3 * 2^55", l[c]);
+    }
+    for (c = 0; c < 24; c++) {
+#if defined(SN_FLOAT)
+        lc[c] += dc[c];
+#else
+        int64_t t = dc[c];
+        if (t > lim) { t = lim; (*sat)++; }
+        if (t < -lim) { t = -lim; (*sat)++; }
+        lc[c] += t * ((int64_t)1 << ds);
+#endif
+    }
+    (void)sat;
+}
+
+/* A CELLDK element's mass M_E[d][col] / m0 (Q frac_M, as MOFF). */
+SN_INLINE sn_q blk_mass(const unsigned char *b) {
+#if defined(SN_FLOAT)
+    return rd_real(b, 9);
+#else
+    return rd_real(b + 20, 0);
+#endif
+}
+
+/* Cell e's active details' share of the Galerkin mass product (sn_detail.h):
+ * the same runs as sn_detail_cell_mul, one scalar per block. Bound (fixed):
+ * |mass| <= 2^27 (validator), |y| <= 2^28: a row sums <= 27 products < 2^59.8;
+ * a corner row's detail part <= 19 of them < 2^59.3, at MOFF's scale. */
+void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
+                         sn_acc mc[24], sn_acc md[3 * SN_CUT_MAXX]) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
+    const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
+    const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
+    const uint32_t nd = cd[38], nx = cx[38];
+    uint32_t j, k, c, q;
+    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) {
+        sn_acc *l = md + 3 * j;
+        l[0] = l[1] = l[2] = 0;
+        if (!(on >> j & 1u)) continue;
+        for (c = 0; c < 8; c++) {
+            sn_q m = blk_mass(Kj + (size_t)c * KB);
+            for (q = 0; q < 3; q++) {
+                l[q] += sn_mul(m, yc[3 * c + q]);
+                mc[3 * c + q] += sn_mul(m, yd[j][q]);
+            }
+        }
+        if (yx)
+            for (c = 0; c < nx; c++) {
+                sn_q m = blk_mass(Kj + (size_t)(8u + c) * KB);
+                for (q = 0; q < 3; q++) l[q] += sn_mul(m, yx[c][q]);
+            }
+        for (k = 0; k < nd; k++) {
+            const unsigned char *b = Kj + (size_t)(8u + nx + k - j) * KB;
+            sn_q m;
+            uint32_t i;
+            if (!(on >> k & 1u)) continue;
+            if (k < j) /* block (k, j): in k's run at column 8 + nx + (j - k); the mass is symmetric */
+                for (i = 0, b = K; i < k; i++) b += (size_t)(8u + nx + nd - i) * KB;
+            if (k < j) b += (size_t)(8u + nx + j - k) * KB;
+            m = blk_mass(b);
+            for (q = 0; q < 3; q++) l[q] += sn_mul(m, yd[k][q]);
+        }
+        for (q = 0; q < 3; q++) SN_RANGE(SN_WITHIN(l[q], 60), "detail mass row beyond 27 * 2^55", l[q]);
+    }
+}
