@@ -331,11 +331,84 @@ static void cell_product(void)
     free(b);
 }
 
+/* 4. the surface's detail term: every surface vertex of the cow, a random half of the details active with
+ * random coefficients, against the child's trilinear weights in double times the coefficients at the child's
+ * corners that are active details (the slot: the point's rank among the 19 non-corner points). Bound: the
+ * kernel's weights are sn_trilinear's (fixed Q30, <= 2 LSB each: 8 * 2^-29 of the largest coefficient; float
+ * 1e-6 of it: 8 weights of float rounding 6e-8 plus their products' ). */
+static void surface_term(void)
+{
+    char p1[600];
+    size_t n1;
+    unsigned char *b = load(path("cow_details" SN_TB_SUFFIX ".blob", p1, sizeof p1), &n1);
+    const sn_blob *c1 = NULL;
+    sn_view v;
+    uint32_t nd, ns, s2, k, q, with = 0, slot_of[27];
+    uint16_t *seat;
+    sn_q *coef;
+    double worst = 0, cmax = 0;
+    if (!b || sn_blob_validate(b, n1, &c1) != SN_OK) { T_CHECK(0, "[%s] cannot read/validate %s", FL, p1); free(b); return; }
+    sn_view_init(&v, c1);
+    nd = sec_at(b, SN_SEC_DETAIL, 2); ns = sec_at(b, SN_SEC_EMBED, 2);
+    for (k = 0, q = 0; k < 27; k++) slot_of[k] = (k % 3 != 1 && k / 3 % 3 != 1 && k / 9 != 1) ? 255u : q++;
+    seat = malloc(sizeof *seat * nd); coef = malloc(sizeof *coef * 3 * nd);
+    for (k = 0; k < nd; k++) {
+        seat[k] = rnd3() < 0 ? (uint16_t)k : (uint16_t)0xFFFFu;
+        for (q = 0; q < 3; q++) {
+#if defined(SN_FLOAT)
+            coef[3 * k + q] = (sn_q)(32.0 * rnd3());
+#else
+            coef[3 * k + q] = (sn_q)(134217728.0 * rnd3());
+#endif
+            cmax = fmax(cmax, fabs((double)coef[3 * k + q]));
+        }
+    }
+    for (s2 = 0; s2 < ns; s2++) {
+        const unsigned char *e = b + sec_at(b, SN_SEC_EMBED, 0) + (size_t)s2 * SN_ELEM_EMBED;
+        uint32_t cell = rd16(e), t[3], up[3], any = 0;
+        const unsigned char *cd = b + sec_at(b, SN_SEC_CELLD, 0) + (size_t)cell * SN_ELEM_CELLD;
+        double want[3] = {0, 0, 0}, tc[3];
+        sn_acc acc[3] = {0, 0, 0};
+        for (q = 0; q < 3; q++) {
+            t[q] = rd16(e + 2 + 2 * q);
+            up[q] = t[q] >= 16384u;
+            tc[q] = (2.0 * t[q] - 32768.0 * up[q]) / 32768.0;
+        }
+        for (k = 0; k < 8; k++) {
+            uint32_t p = (up[0] + (k & 1u)) + 3u * (up[1] + (k >> 1 & 1u)) + 9u * (up[2] + (k >> 2 & 1u)), d;
+            double w = 1;
+            for (q = 0; q < 3; q++) w *= (k >> q & 1u) ? tc[q] : 1 - tc[q];
+            if (slot_of[p] == 255u || (d = rd16(cd + 2 * slot_of[p])) == 0xFFFFu || seat[d] == 0xFFFFu) continue;
+            any = 1;
+            for (q = 0; q < 3; q++) want[q] += w * (double)coef[3 * seat[d] + q];
+        }
+        with += any;
+        sn_detail_interp(&v, cell, t, seat, coef, acc);
+        for (q = 0; q < 3; q++) {
+#if defined(SN_FLOAT)
+            double got = (double)acc[q];
+#else
+            double got = ldexp((double)acc[q], -30);
+#endif
+            worst = fmax(worst, fabs(got - want[q]) / cmax);
+        }
+    }
+    T_FIGURE("[%s] cow: the surface's detail term at %u surface vertices (%u with an active detail in their child): worst %.3g of the "
+             "largest coefficient", FL, ns, with, worst);
+#if defined(SN_FLOAT)
+    T_CHECK(with > 0 && worst <= 1e-6, "[%s] the surface's detail term vs double: %.3g (want <= 1e-6)", FL, worst);
+#else
+    T_CHECK(with > 0 && worst <= 8.0 / 536870912.0, "[%s] the surface's detail term vs double: %.3g (want <= 8 2^-29)", FL, worst);
+#endif
+    free(seat); free(coef); free(b);
+}
+
 int main(void)
 {
     (void)t_seed; (void)cell_of; (void)tb_build;
     same_cut();
     crafted();
     cell_product();
+    surface_term();
     return T_END();
 }

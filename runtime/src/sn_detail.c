@@ -202,3 +202,27 @@ void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q y
         for (q = 0; q < 3; q++) SN_RANGE(SN_WITHIN(l[q], 60), "detail mass row beyond 27 * 2^55", l[q]);
     }
 }
+
+/* The surface's detail term (sn_detail.h): in the child holding t (as
+ * sn_cut_interp: t = 1/2 belongs to the upper child), each child corner k at
+ * a point whose CELLD entry names a detail with a seat adds phi'_k c (phi'
+ * the child's trilinear weights, Q30; c the seat's coefficient, Q22): the
+ * detail's level-1 hat is phi'_k in this child. <= 8 products of <= 2^30 x
+ * 2^28: the acc's Q52 sum stays < 2^61. */
+void sn_detail_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const uint16_t *seat_of, const sn_q *coef,
+                      sn_acc acc[3]) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)cell * SN_ELEM_CELLD;
+    uint32_t b[3], tc[3], k, c;
+    sn_q phi[8];
+    if (cd[38] == 0) return;
+    for (c = 0; c < 3; c++) {
+        b[c] = t[c] >= 16384u;
+        tc[c] = 2u * t[c] - 32768u * b[c];
+    }
+    sn_trilinear(tc, phi);
+    for (k = 0; k < 8; k++) {
+        uint32_t p = b[0] + (k & 1u) + 3u * (b[1] + (k >> 1 & 1u)) + 9u * (b[2] + (k >> 2 & 1u)), slot = d_slot[p], d, s;
+        if (slot == 255u || (d = sn_rd_u16(cd + 2 * slot)) == SN_CUT_NONE || (s = seat_of[d]) == SN_CUT_NONE) continue;
+        for (c = 0; c < 3; c++) acc[c] += sn_mul(phi[k], coef[3 * s + c]);
+    }
+}

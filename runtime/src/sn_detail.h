@@ -30,4 +30,10 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
 void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                          sn_acc mc[24], sn_acc md[3 * SN_CUT_MAXX]);
 
+/* The surface (stage 2, for sn_embed.c): acc (the cut field's, Q52 fixed) +=
+ * the active details' term at t (Q15) in cell: seat_of[d] the seat of detail d
+ * (SN_CUT_NONE: inactive), coef[3 s] the seat's coefficient (Q22). */
+void sn_detail_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], const uint16_t *seat_of, const sn_q *coef,
+                      sn_acc acc[3]);
+
 #endif /* SN_DETAIL_H */
