@@ -195,3 +195,8 @@ $(BUILD)/tests/hier_picture: tests/hier_picture.c tests/hier_study.c tests/sn_te
 .PHONY: hier-picture
 hier-picture: $(BUILD)/tests/hier_picture
 	$(BUILD)/tests/hier_picture ports/desktop/hier_levels.png
+# what the details' cell kernels cost per mat-vec (callgrind; runtime/LEVELS.md §3): not a suite
+$(BUILD)/tests/detail_cost: tests/detail_cost.c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+TEST_DEPS += $(BUILD)/tests/detail_cost
