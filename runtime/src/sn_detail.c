@@ -111,6 +111,7 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
     const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
     const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
     const uint32_t nd = cd[38], nx = cx[38];
+    const unsigned char *run[SN_CUT_MAXX];
     sn_acc dc[24];
     uint32_t j, k, c;
 #if !defined(SN_FLOAT)
@@ -118,8 +119,10 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
     const int64_t lim = ((int64_t)1 << (61 - ds));
 #endif
     for (c = 0; c < 24; c++) dc[c] = 0;
-    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) {
+    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) run[j] = Kj;
+    for (j = 0; j < nd; j++) {
         sn_acc *l = ld + 3 * j;
+        Kj = run[j];
         l[0] = l[1] = l[2] = 0;
         if (!(on >> j & 1u)) continue;
         for (c = 0; c < 8; c++) {
@@ -129,12 +132,9 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
         if (yx)
             for (c = 0; c < nx; c++) blk_mac(Kj + (size_t)(8u + c) * KB, yx[c], 0, l);
         for (k = 0; k < nd; k++) { /* k < j: block (k, j) transposed, in k's run at column 8 + nx + (j - k) */
-            const unsigned char *Kk = K;
-            uint32_t i;
             if (!(on >> k & 1u)) continue;
-            if (k >= j) { blk_mac(Kj + (size_t)(8u + nx + k - j) * KB, yd[k], 0, l); continue; }
-            for (i = 0; i < k; i++) Kk += (size_t)(8u + nx + nd - i) * KB;
-            blk_mac(Kk + (size_t)(8u + nx + j - k) * KB, yd[k], 1, l);
+            if (k >= j) blk_mac(Kj + (size_t)(8u + nx + k - j) * KB, yd[k], 0, l);
+            else blk_mac(run[k] + (size_t)(8u + nx + j - k) * KB, yd[k], 1, l);
         }
         for (c = 0; c < 3; c++) SN_RANGE(SN_WITHIN(l[c], 61), "detail row beyond 27 * 3 * 2^55", l[c]);
     }
@@ -171,9 +171,12 @@ void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q y
     const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
     const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
     const uint32_t nd = cd[38], nx = cx[38];
+    const unsigned char *run[SN_CUT_MAXX];
     uint32_t j, k, c, q;
-    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) {
+    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) run[j] = Kj;
+    for (j = 0; j < nd; j++) {
         sn_acc *l = md + 3 * j;
+        Kj = run[j];
         l[0] = l[1] = l[2] = 0;
         if (!(on >> j & 1u)) continue;
         for (c = 0; c < 8; c++) {
@@ -188,15 +191,10 @@ void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q y
                 sn_q m = blk_mass(Kj + (size_t)(8u + c) * KB);
                 for (q = 0; q < 3; q++) l[q] += sn_mul(m, yx[c][q]);
             }
-        for (k = 0; k < nd; k++) {
-            const unsigned char *b = Kj + (size_t)(8u + nx + k - j) * KB;
+        for (k = 0; k < nd; k++) { /* k < j: block (k, j), in k's run at column 8 + nx + (j - k); the mass is symmetric */
             sn_q m;
-            uint32_t i;
             if (!(on >> k & 1u)) continue;
-            if (k < j) /* block (k, j): in k's run at column 8 + nx + (j - k); the mass is symmetric */
-                for (i = 0, b = K; i < k; i++) b += (size_t)(8u + nx + nd - i) * KB;
-            if (k < j) b += (size_t)(8u + nx + j - k) * KB;
-            m = blk_mass(b);
+            m = blk_mass(k >= j ? Kj + (size_t)(8u + nx + k - j) * KB : run[k] + (size_t)(8u + nx + j - k) * KB);
             for (q = 0; q < 3; q++) l[q] += sn_mul(m, yd[k][q]);
         }
         for (q = 0; q < 3; q++) SN_RANGE(SN_WITHIN(l[q], 60), "detail mass row beyond 27 * 2^55", l[q]);
