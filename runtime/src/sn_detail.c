@@ -136,7 +136,7 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
             if (k >= j) blk_mac(Kj + (size_t)(8u + nx + k - j) * KB, yd[k], 0, l);
             else blk_mac(run[k] + (size_t)(8u + nx + j - k) * KB, yd[k], 1, l);
         }
-        for (c = 0; c < 3; c++) SN_RANGE(SN_WITHIN(l[c], 61), "detail row beyond 27 * 3 * 2^55", l[c]);
+        for (c = 0; c < 3; c++) SN_RANGE(SN_WITHIN(l[c], 62), "detail row beyond 27 * 3 * 2^55 (2^61.4)", l[c]);
     }
     for (c = 0; c < 24; c++) {
 #if defined(SN_FLOAT)

@@ -55,6 +55,8 @@
 #include "sn_format.h"
 #include "sn_tblob.h"
 #include "sn_thostile.h"
+#include "sn_instance.h" /* sn_view_init: the details' kernels (stage 2, not yet in the step) read the view */
+#include "sn_detail.h"
 
 #if defined(__has_include)
 #if __has_include(<sanitizer/common_interface_defs.h>)
@@ -153,6 +155,46 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
     (void)sn_state_hash(si);
 }
 
+/* The details' kernels (sn_detail.c; stage 2: the step does not call them
+ * yet) on an accepted blob with details: every cell, every detail active,
+ * operands at +-SN_LIM (the state's bound) in both sign patterns, and the
+ * surface term at the cell's corners, centre and child boundaries: the
+ * bounds they document must hold for anything the validator accepts. */
+static void exercise_details(const sn_blob *blob) {
+    sn_view v;
+    uint32_t e, j, k, sat = 0, nd;
+    static uint16_t seat[SN_CUT_MAXX * 65536u / 16u];
+    static sn_q coef[3 * (SN_CUT_MAXX * 65536u / 16u)];
+    sn_q yc[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3];
+    sn_acc lc[24], ld[3 * SN_CUT_MAXX], mc[24], md[3 * SN_CUT_MAXX], acc[3];
+    static const uint32_t ts[4] = {0, 16383, 16384, 32767};
+    sn_view_init(&v, blob);
+    if (sn_level_sec_count(&v, SN_SEC_DETAILS) == 0) return;
+    nd = sn_level_sec_count(&v, SN_SEC_DETAIL);
+    if (nd > sizeof seat / sizeof seat[0]) nd = sizeof seat / sizeof seat[0]; /* the validator's 19 nC <= 19 * 65535 */
+    for (j = 0; j < nd; j++) {
+        seat[j] = (uint16_t)j;
+        for (k = 0; k < 3; k++) coef[3 * j + k] = (j + k) & 1u ? (sn_q)SN_LIM : (sn_q)-SN_LIM;
+    }
+    for (e = 0; e < v.nC; e++) {
+        int sg;
+        for (sg = 0; sg < 2; sg++) {
+            for (k = 0; k < 24; k++) { yc[k] = (k + (uint32_t)sg) & 1u ? (sn_q)SN_LIM : (sn_q)-SN_LIM; lc[k] = mc[k] = 0; }
+            for (j = 0; j < SN_CUT_MAXX; j++)
+                for (k = 0; k < 3; k++) yx[j][k] = yd[j][k] = (j + k + (uint32_t)sg) & 1u ? (sn_q)-SN_LIM : (sn_q)SN_LIM;
+            sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ld, &sat);
+            sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, NULL, (const sn_q(*)[3])yd, lc, ld, &sat);
+            sn_detail_cell_mass(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, mc, md);
+        }
+        if (nd == sn_level_sec_count(&v, SN_SEC_DETAIL))
+            for (k = 0; k < 64; k++) {
+                uint32_t t[3] = {ts[k & 3u], ts[k >> 2 & 3u], ts[k >> 4 & 3u]};
+                acc[0] = acc[1] = acc[2] = 0;
+                sn_detail_interp(&v, e, t, seat, coef, acc);
+            }
+    }
+}
+
 /* Use an accepted blob the way a game would. */
 static void exercise(const sn_blob *blob) {
     sn_blob_info info;
@@ -166,6 +208,7 @@ static void exercise(const sn_blob *blob) {
     int s;
 
     sn_blob_get_info(blob, &info);
+    exercise_details(blob);
     for (j = 0; j < info.joints; j++) {
         const char *n = sn_joint_name(blob, j);
         (void)sn_joint_parent(blob, j);
