@@ -157,7 +157,7 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
 
 /* The details' kernels (sn_detail.c; stage 2: the step does not call them
  * yet) on an accepted blob with details: every cell, every detail active,
- * operands at +-SN_LIM (the state's bound) in both sign patterns, and the
+ * operands all +SN_LIM, then all -SN_LIM (the state's bound), and the
  * surface term at the cell's corners, centre and child boundaries: the
  * bounds they document must hold for anything the validator accepts. */
 static void exercise_details(const sn_blob *blob) {
@@ -179,9 +179,9 @@ static void exercise_details(const sn_blob *blob) {
     for (e = 0; e < v.nC; e++) {
         int sg;
         for (sg = 0; sg < 2; sg++) {
-            for (k = 0; k < 24; k++) { yc[k] = (k + (uint32_t)sg) & 1u ? (sn_q)SN_LIM : (sn_q)-SN_LIM; lc[k] = mc[k] = 0; }
+            for (k = 0; k < 24; k++) { yc[k] = sg ? (sn_q)-SN_LIM : (sn_q)SN_LIM; lc[k] = mc[k] = 0; } /* one sign: no cancellation */
             for (j = 0; j < SN_CUT_MAXX; j++)
-                for (k = 0; k < 3; k++) yx[j][k] = yd[j][k] = (j + k + (uint32_t)sg) & 1u ? (sn_q)-SN_LIM : (sn_q)SN_LIM;
+                for (k = 0; k < 3; k++) yx[j][k] = yd[j][k] = sg ? (sn_q)-SN_LIM : (sn_q)SN_LIM;
             sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ld, &sat);
             sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, NULL, (const sn_q(*)[3])yd, lc, ld, &sat);
             sn_detail_cell_mass(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, mc, md);
@@ -1303,6 +1303,47 @@ static int matrix_all(void) {
 #define SN_FUZZ_EDGE 4
 #endif
 static size_t g_edge = SN_FUZZ_EDGE; /* bytes flipped bit by bit at each end of a section (--edge) */
+/* The details' blocks at the validator's bounds (format 6.4; a blob with
+ * details given): every CELLDK mantissa 2^15 - 1 at exponent 12 (float:
+ * every entry 2^27), every mass 2^27 (float 1): the blob must be accepted
+ * and exercise() runs the details' kernels on it at +-SN_LIM (exercise_details):
+ * the rows at their stated bounds (2^61.4, the clamped corner part) under
+ * UBSan and, in the range build, their assertions. */
+static int details_at_bounds(const char *name) {
+    unsigned char *b;
+    const sn_blob *blob;
+    uint32_t n, i, k, off;
+    const size_t KB = (size_t)SN_ELEM_CELLDK(SN_FLAVOUR, 4);
+    if (g_size < SN_H_SECTIONS + 16u * (SN_SEC_CELLDK + 1u) || rd32(g_orig + SN_H_SECTIONS + 16 * SN_SEC_DETAILS + 8) != 1u) return 0;
+    b = (unsigned char *)malloc(g_size);
+    if (!b) return 1;
+    memcpy(b, g_orig, g_size);
+    off = tb_sec(b, SN_SEC_CELLDK);
+    n = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLDK + 8);
+    for (i = 0; i < n; i++) {
+        unsigned char *e = b + off + (size_t)i * KB;
+#if defined(SN_FLOAT)
+        for (k = 0; k < 9; k++) tb_real(e + 4 * k, 134217728.0, 0);
+        tb_real(e + 36, 1.0, 0); /* float: a detail's own mass is below 2 (INT32_MAX at Q30); float sums cannot overflow */
+#else
+        for (k = 0; k < 9; k++) tb_u16(e + 2 * k, 0x7FFFu); /* one sign with one-signed operands: every row at its bound */
+        e[18] = SN_CELLK_EXP_MAX;
+        tb_u32(e + 20, 0x08000000u);
+#endif
+    }
+    tb_fix_crc(b);
+    snprintf(g_case, sizeof g_case, "%s: CELLDK at the validator's bounds", name);
+    if (sn_blob_validate(b, g_size, &blob) != SN_OK) {
+        printf("FAIL: %s: the details' blocks at the validator's bounds refused\n", name);
+        free(b);
+        return 1;
+    }
+    exercise(blob);
+    printf("  figure: %s: the details' kernels on CELLDK at the validator's bounds (%u elements), operands +-2^28: no finding\n", name, n);
+    free(b);
+    return 0;
+}
+
 static int fuzz_one(const char *name, int all, unsigned long per_section) {
     size_t n;
     int i, k, fails = 0;
@@ -1457,6 +1498,7 @@ int main(int argc, char **argv) {
             if (!g_orig || fread(g_orig, 1, g_size, f) != g_size) { printf("FAIL: cannot read %s\n", path); return 1; }
             fclose(f);
             fails += fuzz_one(path, all, per_section);
+            fails += details_at_bounds(path);
             runs++;
             free(g_orig);
         } else {
