@@ -6,7 +6,7 @@
 #                                    the runtime as one file (tools/amalgamate.sh)
 # Inputs from other fragments: SN_SRCS, SN_HDRS, SN_LIB_FIXED, SN_LIB_FLOAT
 # (runtime.mk), BAKE (tools.mk). The suite's check is
-# tests/scripts/test_integration.sh.
+# tests/scripts/test_integration.sh (make test: libraries; make integration-full: all).
 PREFIX       ?= /usr/local
 DESTDIR      ?=
 BINDIR       ?= $(PREFIX)/bin
@@ -43,6 +43,14 @@ $(AMAL_DIR)/sources: sn-amal-sources-force
 $(AMAL_DIR)/sinew.c: tools/amalgamate.sh $(AMAL_DIR)/sources $(SN_SRCS) $(SN_HDRS)
 	sh tools/amalgamate.sh $(AMAL_DIR) $(SN_SRCS)
 TEST_DEPS += $(AMAL_DIR)/sinew.c
+
+# make test runs tests/scripts/test_integration.sh with the CMake project's
+# libraries only; `make integration-full` also builds its sinew-bake and
+# players from scratch and checks them against make's (the cow baked byte for
+# byte, sinew-play's hash), the installed sinew-bake and sinew::bake.
+.PHONY: integration-full
+integration-full:
+	SN_INTEGRATION_FULL=1 BUILD=$(BUILD) sh tests/scripts/test_integration.sh
 
 # for tests/scripts/test_integration.sh: the names this build uses
 .PHONY: print-integration-vars

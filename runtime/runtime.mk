@@ -109,7 +109,7 @@ SN_FUZZ_OBJS_float = $(call sn_fuzz_objs,float)
 SN_FUZZ_OBJS_range = $(call sn_fuzz_objs,range)
 $(BUILD)/tests/test_runtime_fuzz: $(SN_FUZZ_DEPS) $(SN_FUZZ_OBJS_nock)
 	@mkdir -p $(@D)
-	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -o $@ tests/fuzz/fuzz_blob.c $(SN_FUZZ_OBJS_nock) -lm
+	$(CC) $(SN_FUZZ_CFLAGS) -DSN_VALIDATE_NO_CHECKSUM -DSN_FUZZ_RANDOM_ONLY -o $@ tests/fuzz/fuzz_blob.c $(SN_FUZZ_OBJS_nock) -lm
 # the range-checking build's checks fire (no library: sn_internal.h inline code)
 $(BUILD)/tests/test_runtime_range: tests/test_runtime_range.c $(SN_TEST_HDRS)
 	@mkdir -p $(@D)
@@ -131,12 +131,15 @@ TEST_BINS += $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_c
 # the long campaign of the same hostile blobs (make test samples 100 random
 # flips per section, the range build 40, and every bit of each section's
 # first and last 4 bytes): 2000 per section and 16 bytes at each end, every build
+# (--full: in make test the plain build test_runtime_fuzz runs only the cow's
+# random flips, SN_FUZZ_RANDOM_ONLY; the range build runs its other cases
+# with the same sanitizers plus the range checks)
 FUZZ_BLOB_PER_SECTION ?= 2000
 .PHONY: fuzz-blobs
 fuzz-blobs: $(BUILD)/tests/test_runtime_fuzz $(BUILD)/tests/test_runtime_fuzz_float $(BUILD)/tests/test_runtime_fuzz_range \
             $(BUILD)/tests/test_runtime_fuzz_ck $(BUILD)/examples/cow.blob $(BUILD)/examples/cow_float.blob
 	for t in test_runtime_fuzz test_runtime_fuzz_float test_runtime_fuzz_range test_runtime_fuzz_ck; do \
-	    BUILD=$(BUILD) $(BUILD)/tests/$$t --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16 || exit 1; done
+	    BUILD=$(BUILD) $(BUILD)/tests/$$t --full --per-section $(FUZZ_BLOB_PER_SECTION) --edge 16 || exit 1; done
 
 # ---- make bench (runtime part): runtime/bench/bench.sh ----
 # (--contact: the determinism driver's contact scenario, ports/cross/sn_det.c)

@@ -32,7 +32,7 @@ $(LEVEL_EX)/limb/cut.sinew: tools/examples/limb/limb.sinew tests/level.mk
 	@mkdir -p $(@D)
 	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' $< > $@
 	printf 'constraints 4\ncolliders 2 8\nlevels 2 cut\ndetails 8 0.03 0.01\n' >> $@
-# details on the cut level (runtime/LEVELS.md §3 "Details on the cut level"; format 6.4): the cut
+# details on the cut level (runtime/LEVELS.md §3 "Details on the cut level"; format 6.5): the cut
 # descriptions with 'details 50 0.03 0.01' (the study's A_max and runtime thresholds)
 $(LEVEL_EX)/%/details.sinew: $(LEVEL_EX)/%/cut.sinew tests/level.mk
 	cp $< $@ && echo 'details 50 0.03 0.01' >> $@
@@ -138,6 +138,12 @@ $(BUILD)/tests/level_runtime_float: tests/test_runtime_level.c $(SN_TEST_HDRS) t
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_DEPS += $(BUILD)/tests/level_runtime $(BUILD)/tests/level_runtime_float $(BUILD)/examples/cow.blob \
              $(BUILD)/examples/cow_float.blob $(BUILD)/examples/beast.blob $(BUILD)/examples/beast_float.blob
+
+# tests/scripts/test_level.sh with the float cow's adaptation run too (make
+# test runs the float beast's, which also overflows A_max)
+.PHONY: level-all
+level-all: test-build
+	LEVEL_ALL=1 BUILD=$(BUILD) sh tests/scripts/test_level.sh
 
 # The hostile-blob fuzzer over a blob with LEVEL_BLOB and ADAPT (both levels
 # stepped, adaptation on level 1, then blended): part of `make fuzz-blobs`,

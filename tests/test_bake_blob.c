@@ -55,7 +55,7 @@ static void check_structure(const sb_blob *bl, int flavour, const char *what)
     T_CHECK(u32(b + SN_H_ONE) == (flavour == 0 ? SN_ONE_FIXED : flavour == 1 ? SN_ONE_FLOAT32 : 0u) &&
             u32(b + SN_H_ONE_HI) == (flavour == 2 ? SN_ONE_FLOAT64_HI : 0u), "%s: known 1.0", what);
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], seg_state_bytes(b) + crease_state_bytes(b), cons_state_bytes(b)),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], seg_state_bytes(b) + crease_state_bytes(b) + sec_cnt(b, SN_SEC_FPAIRS) * SN_FPAIR_BYTES, cons_state_bytes(b)),
             "%s: instance bytes from SN_INSTANCE_BYTES", what);
     for (k = 0; k < SN_SEC_COUNT; k++) {
         uint32_t off = sec_off(b, (int)k), size = u32(b + SN_H_SECTIONS + 16 * k + 4), cnt = sec_cnt(b, (int)k), es = u32(b + SN_H_SECTIONS + 16 * k + 12);
@@ -94,17 +94,18 @@ static uint32_t spec_crc32(const unsigned char *p, size_t n)
 static void check_spec(const sb_blob *bl, int flavour, const char *what)
 {
     const unsigned char *b = bl->bytes;
-    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 42u;
+    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 44u;
     uint32_t total = u32(b + 16), nV = u32(b + 32), nF = u32(b + 36), nC = u32(b + 40), nJ = u32(b + 44), nS = u32(b + 48),
              nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
-    const uint32_t elem[42] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, flavour == 0 ? 724u : 324 * R, R, 8, 6,
+    const uint32_t elem[44] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, flavour == 0 ? 724u : 324 * R, R, 8, 6,
                                40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 20 + 9 * R, 3 * R, 8 + 3 * R, 8,
                                12 + 3 * R, 4, 2, 2, 1, 8, 8, 20, 8 + 2 * R,
                                44, flavour == 0 ? 20u : 9 * R,    /* format 6.3: CELLX, CELLXK */
-                               8 + 2 * R, 4 + 3 * R, 44, flavour == 0 ? 24u : 10 * R};   /* format 6.4: DETAILS, DETAIL, CELLD, CELLDK */
-    uint32_t want[42], inst, segB = 0, conB = 0, crB = 0, crRows = 0;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 4, "%s: spec: magic SNWB, version 6.4", what);
+                               2, 4,                              /* format 6.4: FPAIRS, FREFS */
+                               8 + 2 * R, 4 + 3 * R, 44, flavour == 0 ? 24u : 10 * R};   /* format 6.5: DETAILS, DETAIL, CELLD, CELLDK */
+    uint32_t want[44], inst, segB = 0, conB = 0, crB = 0, crRows = 0, nfp = 0;
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 5, "%s: spec: magic SNWB, version 6.5", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
@@ -143,14 +144,50 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         nsamp += r[2]; nent += u32(r + 12);
     }
     {
-        const uint32_t w[42] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
+        const uint32_t w[44] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
                                 u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0, 0, 0, 0, 0, 0,
                                 0, 0, 0,    /* format 6.0: the level sections (none without 'levels 2') */
                                 0,
                                 0,          /* format 6.1: ADAPT, only beside a LEVEL_BLOB */
                                 0, 0,       /* format 6.3: CELLX, CELLXK, only with 'levels 2 cut' */
-                                0, 0, 0, 0};   /* format 6.4: the details, only with 'levels 2 cut' and 'details' */
+                                0, nF + nC,    /* format 6.4: FPAIRS (below), FREFS: one per free vertex and cell */
+                                0, 0, 0, 0};   /* format 6.5: the details, only with 'levels 2 cut' and 'details' */
         memcpy(want, w, sizeof want);
+    }
+    {   /* FPAIRS / FREFS (BLOB.md "Frame references"), over the free vertices' FRAMES entries then CFRAMES':
+         * an entry slerps when bone1 != bone2 and w != 0; the pairs are its distinct (bone1, bone2), increasing
+         * as bone1 256 + bone2; an entry's reference is 0xFFFFFFFF if it does not slerp, the index of the first
+         * earlier entry with the same 4 bytes, else 2^31 + its pair's index */
+        const unsigned char *fr = b + u32(b + 176 + 16 * 3), *cf = b + u32(b + 176 + 16 * 11);
+        const unsigned char *pr = b + u32(b + 176 + 16 * 38), *rf = b + u32(b + 176 + 16 * 39);
+        uint32_t i, j, seen[256 * 256 / 32], nbad = 0, np = u32(b + 176 + 16 * 38 + 8);
+        memset(seen, 0, sizeof seen);
+        for (i = 0; i < nF + nC; i++) {
+            const unsigned char *e = i < nF ? fr + 4 * i : cf + 4 * (i - nF);
+            if (e[0] != e[1] && u16(e + 2) != 0) seen[(e[0] * 256u + e[1]) / 32] |= 1u << ((e[0] * 256u + e[1]) % 32);
+        }
+        for (k = 0; k < 256 * 256; k++)
+            if (seen[k / 32] >> (k % 32) & 1u) {
+                nbad += nfp >= np || u16(pr + 2 * nfp) != (k >> 8 | (k & 255u) << 8); /* stored bone1, bone2 */
+                nfp++;
+            }
+        want[38] = nfp;
+        for (i = 0; i < nF + nC && np == nfp; i++) {
+            const unsigned char *e = i < nF ? fr + 4 * i : cf + 4 * (i - nF);
+            uint32_t r = 0xFFFFFFFFu;
+            if (e[0] != e[1] && u16(e + 2) != 0) {
+                for (j = 0; j < i; j++)
+                    if (!memcmp(e, j < nF ? fr + 4 * j : cf + 4 * (j - nF), 4)) break;
+                if (j < i) r = j;
+                else {
+                    for (k = 0; k < np; k++)
+                        if (pr[2 * k] == e[0] && pr[2 * k + 1] == e[1]) break;
+                    r = 0x80000000u + k;
+                }
+            }
+            nbad += u32(rf + 4 * i) != r;
+        }
+        T_CHECK(nbad == 0 && np == nfp, "%s: spec: %u frame pairs (want %u), %u wrong pairs or references", what, np, nfp, nbad);
     }
     {   /* CREASE (0 or 1): its record fixes the rows (format 6.0: u16 nQ at +6) and their widths; state 14 per surface vertex + 8 per list entry; max_active rows */
         uint32_t on = u32(b + 176 + 16 * 27 + 8);
@@ -211,7 +248,7 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
     for (k = prev; k < total; k++) if (b[k]) break;
     T_CHECK(k == total, "%s: spec: trailing padding is zero", what);
     inst = (832u + (76u + 48u) * nJ + 24u * nV + 97u * nF + 12u * (nV - nF > nF ? nV - nF : nF) + 36u * nC + 4u * nK + 64u * b[78] +
-            segB + crB + 7u) & ~7u;
+            segB + crB + 40u * nfp + 7u) & ~7u;   /* format 6.4: 40 per frame pair */
     inst = (inst + conB + 7u) & ~7u;
     T_CHECK(u32(b + 60) == inst, "%s: spec: instance bytes %u, README formula %u", what, u32(b + 60), inst);
 }

@@ -13,7 +13,7 @@
  * (from positions here, not from the bake's cell walk). Built with air 0, so
  * the children level 1 did not keep add nothing. Also: every cut element's rows
  * sum to 0 over its corners and extras (translations: W_c's rows sum to 1).
- * Then the same with every detail (format 6.4: level 1's free vertices at
+ * Then the same with every detail (format 6.5: level 1's free vertices at
  * non-corner points, P's row there the coarse weights plus 1 on the detail),
  * and 'details' refused without 'levels 2 cut'. */
 #include "sb_level.h"

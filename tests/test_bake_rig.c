@@ -290,7 +290,7 @@ static void check_blob(const char *desc, int flavour, int print)
     T_CHECK(es[SN_SEC_CONTROLS] == 40u + 4u * (uint32_t)rs && es[SN_SEC_RIGS] == 16 && es[SN_SEC_RIG_SAMPLES] == 2u * (uint32_t)rs &&
                 es[SN_SEC_RIG_VERTS] == 2 && es[SN_SEC_RIG_FORCES] == 3u * (uint32_t)rs, "%s: element sizes", desc);
     T_CHECK(u32(B + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(B + SN_H_N_VERTICES), u32(B + SN_H_N_FREE), u32(B + SN_H_N_JOINTS),
-                                                              u32(B + SN_H_N_CELLS), cnt[SN_SEC_CONTROLS], B[SN_H_MAX_FORCES], seg_state_bytes(B) + crease_state_bytes(B), cons_state_bytes(B)), "%s: instance bytes count the controls", desc);
+                                                              u32(B + SN_H_N_CELLS), cnt[SN_SEC_CONTROLS], B[SN_H_MAX_FORCES], seg_state_bytes(B) + crease_state_bytes(B) + cnt[SN_SEC_FPAIRS] * SN_FPAIR_BYTES, cons_state_bytes(B)), "%s: instance bytes count the controls", desc);
     for (k = SN_SEC_CONTROLS; k <= SN_SEC_RIG_FORCES; k++) T_CHECK(off[k] % 8 == 0 && off[k] + cnt[k] * es[k] <= b.size, "%s: section %d placed", desc, k);
     for (a = 0; a < (int)cnt[SN_SEC_CONTROLS]; a++) {
         const unsigned char *c = B + off[SN_SEC_CONTROLS] + (size_t)a * es[SN_SEC_CONTROLS];

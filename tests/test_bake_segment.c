@@ -215,7 +215,7 @@ static void check_blob(const sb_blob *bl, int flavour, double h)
     }
     T_CHECK(segB == 728 + (64 + 48) + (58 * 64 + 38 * 24), "segment state bytes by hand");
     T_CHECK(u32(b + SN_H_INSTANCE_BYTES) == SN_INSTANCE_BYTES(u32(b + SN_H_N_VERTICES), u32(b + SN_H_N_FREE), u32(b + SN_H_N_JOINTS),
-                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], segB + crease_state_bytes(b), cons_state_bytes(b)),
+                                                            u32(b + SN_H_N_CELLS), sec_cnt(b, SN_SEC_CONTROLS), b[SN_H_MAX_FORCES], segB + crease_state_bytes(b) + sec_cnt(b, SN_SEC_FPAIRS) * SN_FPAIR_BYTES, cons_state_bytes(b)),
             "%s: instance bytes include %u segment state bytes", fname, (unsigned)segB);
 }
 

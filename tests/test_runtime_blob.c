@@ -175,13 +175,13 @@ static void test_header(void) {
     CASE(SN_ERR_HEADER, "nC = 0", tb_u32(b + SN_H_N_CELLS, 0));
     CASE(SN_ERR_HEADER, "nC = 65536", tb_u32(b + SN_H_N_CELLS, 65536));
     CASE(SN_ERR_HEADER, "instance_bytes too small",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB) - 8));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB + TB_FPB, TB_CONB) - 8));
     CASE(SN_ERR_HEADER, "instance_bytes of the 1.0 formula (no per-cell memory)",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, 0, TB_NK, TB_NFRC, TB_SEGB + TB_CRB + TB_FPB, TB_CONB)));
     CASE(SN_ERR_HEADER, "instance_bytes larger than the formula (a blob cannot ask for memory)",
          tb_u32(b + SN_H_INSTANCE_BYTES, 1u << 20));
     CASE(SN_ERR_HEADER, "instance_bytes without the control values",
-         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB)));
+         tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, 0, TB_NFRC, TB_SEGB + TB_CRB + TB_FPB, TB_CONB)));
 
     /* physics scalars */
 #define RL(i) (b + SN_H_REALS + 4 * (i))
@@ -334,7 +334,7 @@ static void test_contents(void) {
     CASE(SN_ERR_INDEX, "bone1 >= nJ", SEC(SN_SEC_FRAMES)[0] = TB_NJ);
     CASE(SN_ERR_INDEX, "bone2 >= nJ", SEC(SN_SEC_FRAMES)[4 * 3 + 1] = 255);
     CASE(SN_ERR_VALUE, "w > 1", tb_u16(SEC(SN_SEC_FRAMES) + 4 * 2 + 2, 32769));
-    CASE(SN_OK, "w = 1", tb_u16(SEC(SN_SEC_FRAMES) + 4 * 2 + 2, 32768));
+    CASE(SN_OK, "w = 1", tb_u16(SEC(SN_SEC_FRAMES) + 4 * 2 + 2, 32768); tb_fix_frefs(b)); /* format 6.4: its references follow */
     CASE(SN_ERR_INDEX, "skeleton bone1 != bone2", SEC(SN_SEC_FRAMES)[4 * TB_NF + 1] = 1);
     CASE(SN_ERR_VALUE, "skeleton w != 0", tb_u16(SEC(SN_SEC_FRAMES) + 4 * (TB_NV - 1) + 2, 1));
     /* matrices */
@@ -372,7 +372,46 @@ static void test_contents(void) {
     CASE(SN_ERR_VALUE, "CFRAMES w > 32768", tb_u16(SEC(SN_SEC_CFRAMES) + 4 * (TB_NC - 1) + 2, 32769));
     CASE(SN_ERR_VALUE, "CFRAMES w 0xFFFF", tb_u16(SEC(SN_SEC_CFRAMES) + 2, 0xFFFF));
     CASE(SN_OK, "CFRAMES w = 32768", tb_u16(SEC(SN_SEC_CFRAMES) + 2, 32768));
-    CASE(SN_OK, "CFRAMES bone1 = bone2", SEC(SN_SEC_CFRAMES)[1] = 0);
+    CASE(SN_OK, "CFRAMES bone1 = bone2", SEC(SN_SEC_CFRAMES)[1] = 0; tb_fix_frefs(b));
+    /* frame references (format 6.4, sn_pose.c sn_check_frefs): every field against what it stands for */
+    {
+        const uint32_t none = TB_NF + TB_NC;
+        uint32_t ia = none, ip = none, ib = none, i, r; /* the blob's slerping entries are free vertices and cells (w = 0 only at skeleton vertices) */
+        for (i = TB_NF + TB_NC; i-- > 0;) { /* the last alias, pair and bone entries of the base blob */
+            r = tb_rd32(g_base.b + tb_sec(g_base.b, SN_SEC_FREFS) + 4 * i);
+            if (r == SN_FREF_BONE) ib = ib < none ? ib : i;
+            else if (r & SN_FREF_PAIR) ip = ip < none ? ip : i;
+            else ia = ia < none ? ia : i;
+        }
+        T_CHECK(ia < TB_NF && ip < none && ib == none, "test blob: an alias (%u, a free vertex), a pair (%u), no bone entry (%u)", ia, ip, ib);
+#define FREF(i) (SEC(SN_SEC_FREFS) + 4 * (i))
+        CASE(SN_ERR_INDEX, "FREFS alias = its own index", tb_u32(FREF(ia), ia));
+        CASE(SN_ERR_INDEX, "FREFS alias after its own index", tb_u32(FREF(ia), TB_NF + TB_NC - 1 > ia ? TB_NF + TB_NC - 1 : ia + 1));
+        CASE(SN_ERR_VALUE, "FREFS alias to an entry of other bytes", tb_u32(FREF(ip), ib < ip ? ib : 0));
+        CASE(SN_ERR_INDEX, "FREFS pair index = nFP", tb_u32(FREF(ip), SN_FREF_PAIR | TB_NFP));
+        CASE(SN_ERR_INDEX, "FREFS slerping entry marked bone", tb_u32(FREF(ip), SN_FREF_BONE));
+        /* entry ia made a bone entry (w = 0): no slerp, so SN_FREF_BONE only */
+        CASE(SN_ERR_VALUE, "FREFS bone entry given a pair", tb_u16(SEC(SN_SEC_FRAMES) + 4 * ia + 2, 0); tb_u32(FREF(ia), SN_FREF_PAIR));
+        CASE(SN_ERR_VALUE, "FREFS bone entry given an alias", tb_u16(SEC(SN_SEC_FRAMES) + 4 * ia + 2, 0));
+        CASE(SN_OK, "FREFS bone entry marked bone", tb_u16(SEC(SN_SEC_FRAMES) + 4 * ia + 2, 0); tb_u32(FREF(ia), SN_FREF_BONE));
+        CASE(SN_OK, "FREFS alias computed instead (its own pair)", tb_u32(FREF(ia), SN_FREF_PAIR));
+        CASE(SN_ERR_VALUE, "FPAIRS (1, 0): not the entries' bones", SEC(SN_SEC_FPAIRS)[0] = 1; SEC(SN_SEC_FPAIRS)[1] = 0);
+        CASE(SN_ERR_INDEX, "FPAIRS bone1 = bone2", SEC(SN_SEC_FPAIRS)[1] = 0);
+        CASE(SN_ERR_INDEX, "FPAIRS bone2 >= nJ", SEC(SN_SEC_FPAIRS)[1] = TB_NJ);
+        CASE(SN_ERR_SECTION, "FREFS count nF + nC - 1", tb_u32(TAB(SN_SEC_FREFS, 2), TB_NF + TB_NC - 1);
+             tb_u32(TAB(SN_SEC_FREFS, 1), 4 * (TB_NF + TB_NC - 1)));
+        CASE(SN_ERR_SECTION, "FPAIRS count nJ (nJ - 1) + 1", tb_u32(TAB(SN_SEC_FPAIRS, 2), TB_NJ * (TB_NJ - 1) + 1);
+             tb_u32(TAB(SN_SEC_FPAIRS, 1), 2 * (TB_NJ * (TB_NJ - 1) + 1)));
+        CASE(SN_ERR_SECTION, "FPAIRS without FREFS", memset(FREF(0), 0, 4 * (TB_NF + TB_NC));
+             tb_u32(TAB(SN_SEC_FREFS, 2), 0); tb_u32(TAB(SN_SEC_FREFS, 1), 0));
+        CASE(SN_OK, "neither FPAIRS nor FREFS (every frame slerped alone)", memset(FREF(0), 0, 4 * (TB_NF + TB_NC));
+             memset(SEC(SN_SEC_FPAIRS), 0, 2); tb_u32(TAB(SN_SEC_FREFS, 2), 0); tb_u32(TAB(SN_SEC_FREFS, 1), 0);
+             tb_u32(TAB(SN_SEC_FPAIRS, 2), 0); tb_u32(TAB(SN_SEC_FPAIRS, 1), 0);
+             tb_u32(b + SN_H_INSTANCE_BYTES, tb_rd32(b + SN_H_INSTANCE_BYTES) - TB_FPB));
+        CASE(SN_ERR_HEADER, "instance bytes without the frame pairs' scratch",
+             tb_u32(b + SN_H_INSTANCE_BYTES, tb_rd32(b + SN_H_INSTANCE_BYTES) - TB_FPB));
+#undef FREF
+    }
     /* limits: 0 <= L <= 2^28 (64 internal units) */
     CASE(SN_ERR_VALUE, "LIMIT < 0", tb_real(SEC(SN_SEC_LIMIT) + 4 * 3, -0.25, SN_Q_LEN));
     CASE(SN_ERR_VALUE, "LIMIT most negative", tb_u32(SEC(SN_SEC_LIMIT) + 4 * (TB_NF - 1), SN_FLOAT_OR(0xFF7FFFFFu, 0x80000000u)));
@@ -487,7 +526,7 @@ static void test_accessors(int len_shift) {
             "info counts");
     T_CHECK(info.offdiag_blocks == tb_rd32(b + SN_H_N_OFFDIAG) && info.offdiag_blocks > 0, "info nnz");
     T_CHECK(info.cg_iters_default == 8 && info.cg_iters_max == 32, "info cg");
-    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB), "info instance bytes");
+    T_CHECK(info.instance_bytes == SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB + TB_FPB, TB_CONB), "info instance bytes");
     T_CHECK(sn_instance_size(blob) == info.instance_bytes, "sn_instance_size");
     T_CHECK(info.blob_bytes == tb_rd32(b + SN_H_TOTAL_SIZE), "info blob bytes");
 #if defined(SN_FLOAT)
@@ -678,13 +717,16 @@ static void test_instance_size_formula(void) {
     static const uint32_t nfr[] = {0, 1, 32}, sgb[] = {0, 88, 1234568};
     static const uint32_t cnb[] = {0, SN_CONS_BYTES(1, 0, 3), SN_CONS_BYTES(2, 1, 9), SN_CONS_BYTES(64, 16, 448)};
     static const uint32_t crb[] = {0, SN_CREASE_STATE_BYTES(4, 4), SN_CREASE_STATE_BYTES(65535, 256)};
+    static const uint32_t nfp[] = {0, 1, 30, 64770}; /* frame pairs (format 6.4): none .. nJ (nJ - 1) at 255 joints */
     int a, b, c, d, e, f, bad = 0, n = 0;
     for (a = 0; a < 4; a++) for (b = 0; b < 4; b++) for (c = 0; c < 4; c++) for (d = 0; d < 4; d++) for (e = 0; e < 4; e++)
     for (f = 0; f < 3; f++) {
         if (nf[b] >= nv[a]) continue;
         n++;
-        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3] + crb[(c + e) % 3], cnb[(b + e) % 4]) !=
-               sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3], crb[(c + e) % 3], cnb[(b + e) % 4]);
+        bad += SN_INSTANCE_BYTES(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f],
+                                 sgb[(a + f) % 3] + crb[(c + e) % 3] + nfp[(d + e) % 4] * SN_FPAIR_BYTES, cnb[(b + e) % 4]) !=
+               sn_instance_bytes(nv[a], nf[b], nj[c], nc[d], nk[e], nfr[f], sgb[(a + f) % 3], crb[(c + e) % 3], cnb[(b + e) % 4],
+                                 nfp[(d + e) % 4]);
     }
     T_CHECK(n > 300 && bad == 0, "SN_INSTANCE_BYTES == the runtime layout's size for %d count sets (%d differ)", n, bad);
 }

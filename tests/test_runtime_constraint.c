@@ -24,6 +24,7 @@
  *  6. API: bad arguments refused with a status, nothing changes.
  */
 #include "sn_test.h"
+#define PU_WHITE_BOX /* pu_h, pu_qd, ...: the instance's internals */
 #include "reference/phys_util.h"
 #include "sn_constraint.h"
 #include "sn_clip.h"
@@ -39,72 +40,12 @@ static const double GOAL = 0.001; /* test_physics_runtime: float runtime within 
 static const double GOAL = 0.01;  /* fixed within 1% */
 #endif
 
-static sn_ihdr *H(const pu_rt *r) { return (sn_ihdr *)(void *)r->inst; }
-
-static double qd(sn_q x) {
-#if defined(SN_FLOAT)
-    return x;
-#else
-    return ldexp((double)x, -SN_Q_LEN);
-#endif
-}
 static sn_real rl(double x) { return pu_rlen(x); }
-
-/* Largest |C^T x - a| over the kept rows, in LSB of Q22 (fixed) or relative
- * to the row's scale sum |c||x| + |a| (float). Coefficients as the runtime
- * forms them (w dir rounded to Q30). */
-static double row_residual(const pu_rt *r, uint32_t *kept) {
-    sn_ihdr *h = H(r);
-    const sn_row *rows = sn_rows(h);
-    const sn_rowx *rx = CARR(h, o_rx, sn_rowx);
-    const sn_q *x = CARR(h, o_x, sn_q);
-    uint32_t j, k, c, nF = h->v.nF;
-    double worst = 0;
-    *kept = 0;
-    for (j = 0; j < h->n_rows; j++) {
-        double s = 0, res;
-#if defined(SN_FLOAT)
-        double scale = 0;
-#endif
-        if (rx[j].inv == 0) continue;
-        (*kept)++;
-        for (k = 0; k < rows[j].n; k++) {
-            uint32_t a = rows[j].vtx[k];
-            if (a >= nF) continue;
-            for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-                double e = (double)(rows[j].w[k] * rows[j].dir[c]);
-                s += e * x[3 * a + c];
-                scale += fabs(e * x[3 * a + c]);
-#else
-                double e = (double)(((int64_t)rows[j].w[k] * rows[j].dir[c] + ((int64_t)1 << 29)) >> 30);
-                s += e * x[3 * a + c];
-#endif
-            }
-        }
-#if defined(SN_FLOAT)
-        res = fabs(s - rx[j].a) / (scale + fabs(rx[j].a) + 1e-30);
-#else
-        res = fabs(ldexp(s, -30) - rx[j].a);
-#endif
-        if (res > worst) worst = res;
-    }
-    return worst;
-}
-
-static int finite_state(const pu_rt *r) {
-    sn_ihdr *h = H(r);
-    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    uint32_t i;
-    for (i = 0; i < 3 * h->v.nV; i++) /* finite and within the state range (fixed: +-64 internal units; float: the guard) */
-        if (!(fabs(qd(pos[i])) <= 4096.0) || !(fabs(qd(vel[i])) <= 4096.0)) return 0;
-    return 1;
-}
 
 /* squared length of a surface vertex's row over the free lattice vertices:
  * sum of phi_a^2 over its cell's free corners (the runtime drops rows below 2^-8) */
 static double free_w2(const pu_rt *r, uint32_t s) {
-    const sn_ihdr *h = H(r);
+    const sn_ihdr *h = pu_h(r);
     const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
     const unsigned char *cl = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
     double t[3], w2 = 0;
@@ -178,10 +119,10 @@ static void test_pins(void) {
         double w;
         uint32_t kp;
         sn_step(r.inst);
-        w = row_residual(&r, &kp);
+        w = pu_row_residual(&r, PU_ANY_PRODUCER, &kp);
         worst = w > worst ? w : worst;
         kept = kp;
-        rows_total = H(&r)->n_rows;
+        rows_total = pu_h(&r)->n_rows;
         if (step >= 1)
             for (i = 0; i < 8; i++) {
                 double p[3], d;
@@ -203,11 +144,11 @@ static void test_pins(void) {
 #endif
     /* a kept pin is at its target: the row's error (above) plus the Q16.16 output and the unit's rounding */
     T_CHECK(kept < rows_total || worst_pos <= 1e-4, "pinned points at their targets within 1e-4 mesh units (%.3g)", worst_pos);
-    T_CHECK(st.saturations == 0 && finite_state(&r), "no saturation (%u), state finite", st.saturations);
+    T_CHECK(st.saturations == 0 && pu_finite_state(&r), "no saturation (%u), state finite", st.saturations);
     /* clearing: count 0 */
     T_CHECK(sn_set_constraints(r.inst, NULL, 0) == SN_OK, "constraints cleared");
     sn_step(r.inst);
-    T_CHECK(H(&r)->n_rows == 0 && H(&r)->rows_kept == 0, "no rows after clearing");
+    T_CHECK(pu_h(&r)->n_rows == 0 && pu_h(&r)->rows_kept == 0, "no rows after clearing");
     pu_rt_close(&r);
 }
 
@@ -293,8 +234,8 @@ static void test_reference(void) {
         disp = e > disp ? e : disp;
     }
     T_FIGURE("constrained cow, 40 steps with 6 pins: runtime vs double reference %.3g mesh units, largest displacement %.3g (%.3g%%); reference kept %u of %u rows, runtime %u",
-             err, disp, 100 * err / disp, s.rows_kept, s.nrows, H(&r)->rows_kept);
-    T_CHECK(s.rows_kept == H(&r)->rows_kept, "runtime and reference keep the same rows (%u, %u)", H(&r)->rows_kept, s.rows_kept);
+             err, disp, 100 * err / disp, s.rows_kept, s.nrows, pu_h(&r)->rows_kept);
+    T_CHECK(s.rows_kept == pu_h(&r)->rows_kept, "runtime and reference keep the same rows (%u, %u)", pu_h(&r)->rows_kept, s.rows_kept);
     T_CHECK(err <= GOAL * disp, "runtime within %.2g%% of the largest displacement of the reference's constrained solve (%.3g%%)",
             100 * GOAL, 100 * err / disp);
     free(a); free(b); free(start);
@@ -332,15 +273,15 @@ static void test_drops(void) {
     sn_step(r.inst);
     sn_step(r2.inst);
     sn_get_stats(r.inst, &st);
-    worst = row_residual(&r, &kept);
-    T_FIGURE("drops: %u rows, %u kept, %u dropped (duplicate 3, conflicting 3, dependent direction 1, neighbour %u)", H(&r)->n_rows,
+    worst = pu_row_residual(&r, PU_ANY_PRODUCER, &kept);
+    T_FIGURE("drops: %u rows, %u kept, %u dropped (duplicate 3, conflicting 3, dependent direction 1, neighbour %u)", pu_h(&r)->n_rows,
              st.constraint_rows, st.constraint_drops, st.constraint_drops - 7);
-    T_CHECK(H(&r)->n_rows == 13 && st.constraint_drops >= 7 && st.constraint_rows == 13 - st.constraint_drops,
-            "duplicate, conflicting and dependent rows dropped and counted (%u dropped of %u)", st.constraint_drops, H(&r)->n_rows);
-    T_CHECK(CARR(H(&r), o_rx, sn_rowx)[0].inv != 0 && CARR(H(&r), o_rx, sn_rowx)[3].inv == 0 && CARR(H(&r), o_rx, sn_rowx)[6].inv == 0,
+    T_CHECK(pu_h(&r)->n_rows == 13 && st.constraint_drops >= 7 && st.constraint_rows == 13 - st.constraint_drops,
+            "duplicate, conflicting and dependent rows dropped and counted (%u dropped of %u)", st.constraint_drops, pu_h(&r)->n_rows);
+    T_CHECK(CARR(pu_h(&r), o_rx, sn_rowx)[0].inv != 0 && CARR(pu_h(&r), o_rx, sn_rowx)[3].inv == 0 && CARR(pu_h(&r), o_rx, sn_rowx)[6].inv == 0,
             "the first of equal rows is kept, later ones dropped (list order)");
     T_CHECK(worst <= SN_FLOAT_OR(1e-6, 1.0), "the kept rows hold (%.3g)", worst);
-    T_CHECK(finite_state(&r) && st.saturations == 0, "state finite, no saturation");
+    T_CHECK(pu_finite_state(&r) && st.saturations == 0, "state finite, no saturation");
     T_CHECK(sn_state_hash(r.inst) == sn_state_hash(r2.inst), "same list, same state hash");
     pu_rt_close(&r);
     pu_rt_close(&r2);
@@ -431,7 +372,7 @@ static void test_ground(void) {
      * which the skeleton corners of hoof cells turn with the leg */
     T_CHECK(below <= 0.03, "no flesh-carried surface vertex more than 0.03 mesh units below the ground during the trot (%.4g)", below);
     T_CHECK(below < 0.5 * below_free, "the ground holds the flesh up (%.4g without it)", below_free);
-    T_CHECK(st.saturations == 0 && finite_state(&r), "no saturation, state finite");
+    T_CHECK(st.saturations == 0 && pu_finite_state(&r), "no saturation, state finite");
     /* resting on the plane: energy does not grow */
     sn_reset(r.inst);
     sn_set_colliders(r.inst, &g, 1);
@@ -503,7 +444,7 @@ static void test_sphere(void) {
      * cell: a vertex up to half a cell (0.6) from the contact can be inside
      * by the sphere's sagitta there, r - sqrt(r^2 - 0.6^2) = 0.2 for r = 1 */
     T_CHECK(worst <= 0.2, "no flesh-carried surface vertex more than the sagitta over half a cell (0.2) inside the sphere (%.4g)", worst);
-    T_CHECK(st.contacts > 0 && st.saturations == 0 && finite_state(&r), "contacts active, no saturation, state finite");
+    T_CHECK(st.contacts > 0 && st.saturations == 0 && pu_finite_state(&r), "contacts active, no saturation, state finite");
     free(buf);
     pu_rt_close(&r);
 }
@@ -551,7 +492,7 @@ static void beast_go(pu_rt *r, const sn_clip *clip, uint32_t steps, int have_pla
     sn_get_stats(r->inst, &st);
     o->sat = st.saturations;
     o->bound_steps = st.bound_steps;
-    o->finite = finite_state(r);
+    o->finite = pu_finite_state(r);
     o->e_max = pu_len(st.energy_max);
     o->disp_max = pu_len(st.disp_max);
 }
@@ -659,7 +600,7 @@ static void test_beast_sphere(void) {
     T_FIGURE("beast: sphere r=15 pressed 6 into the belly's front (z %.3g): deepest flesh-carried vertex %.3g inside; largest displacement %.3g cells, energy %.4g J; %u contacts in the last step, %u saturations",
              bz, worst, pu_len(st.disp_max), pu_len(st.energy_max), st.contacts, st.saturations);
     T_CHECK(bz > 10 && bz < 60, "belly found at the front (z %.3g)", bz);
-    T_CHECK(st.contacts > 0 && st.saturations == 0 && finite_state(&r), "contacts active, no saturation, state finite");
+    T_CHECK(st.contacts > 0 && st.saturations == 0 && pu_finite_state(&r), "contacts active, no saturation, state finite");
     /* bounded deformation: the press is 6 = cell/4; the flesh moves at most
      * the yield bound (cell/2 beyond its skinned place) plus the solve's own */
     T_CHECK(pu_len(st.disp_max) <= 1.5, "largest displacement from the skinned place at most 1.5 cells, the walk's own (%.3g)", pu_len(st.disp_max));
@@ -675,7 +616,7 @@ static void test_beast_sphere(void) {
  * and the smallest relative pivot L_jj^2 / G_jj among the kept rows */
 typedef struct fr_rows { uint32_t normal, tang, drop_normal, drop_tang; double min_piv; } fr_rows;
 static fr_rows friction_rows_of(const pu_rt *r) {
-    sn_ihdr *h = H(r);
+    sn_ihdr *h = pu_h(r);
     const sn_row *rows = sn_rows(h);
     const sn_rowx *rx = CARR(h, o_rx, sn_rowx);
     const sn_q *L = CARR(h, o_L, sn_q);
@@ -714,7 +655,7 @@ static fr_rows friction_rows_of(const pu_rt *r) {
  * weight phi, velocity of the last step along z and displacement from the
  * skinned place (y, z), internal units */
 static void trace_corners(const pu_rt *r, uint32_t s) {
-    sn_ihdr *h = H(r);
+    sn_ihdr *h = pu_h(r);
     const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
     const unsigned char *cl = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
     const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
@@ -728,7 +669,7 @@ static void trace_corners(const pu_rt *r, uint32_t s) {
         if (a >= h->v.nF || w == 0) continue;
         sn_skinned(h, a, sk, &sat);
         printf("      free corner %u phi %.3f: velocity z %+.5f, from its skinned place y %+.4f z %+.4f (cell %.4f)\n", a, w,
-               qd(vel[3 * a + 2]), qd(sn_add(pos[3 * a + 1], -sk[1], &sat)), qd(sn_add(pos[3 * a + 2], -sk[2], &sat)), qd((sn_q)h->v.cell));
+               pu_qd(vel[3 * a + 2]), pu_qd(sn_add(pos[3 * a + 1], -sk[1], &sat)), pu_qd(sn_add(pos[3 * a + 2], -sk[2], &sat)), pu_qd((sn_q)h->v.cell));
         (void)q;
     }
 }
@@ -736,15 +677,15 @@ static void trace_corners(const pu_rt *r, uint32_t s) {
 /* internal length -> mesh units */
 static double i2m(const pu_rt *r, sn_q v) {
 #if defined(SN_FLOAT)
-    return int_to_pub(H(r), v);
+    return int_to_pub(pu_h(r), v);
 #else
-    return pu_len((sn_real)int_to_pub64(H(r), v));
+    return pu_len((sn_real)int_to_pub64(pu_h(r), v));
 #endif
 }
 /* the free corner of surface vertex s's cell with the largest weight (its
  * weight in *phi), and the sum of the free weights (*wsum) */
 static uint32_t dominant_corner(const pu_rt *r, uint32_t s, double *phi, double *wsum) {
-    const sn_ihdr *h = H(r);
+    const sn_ihdr *h = pu_h(r);
     const unsigned char *e = h->v.sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
     const unsigned char *cl = h->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
     double t[3];
@@ -816,7 +757,7 @@ static void friction_case(const fr_case *fc) {
             sn_set_colliders(r[m].inst, &c, 1);
             sn_step(r[m].inst);
             if (step >= 60) { /* the drag: rows, the dominant corner's displacement from its skinned place along q */
-                sn_ihdr *h = H(&r[m]);
+                sn_ihdr *h = pu_h(&r[m]);
                 const sn_q *pos = CARR(h, o_pos, sn_q), *vl = CARR(h, o_vel, sn_q);
                 fr_rows fr = friction_rows_of(&r[m]);
                 sn_q sk[3];
@@ -833,7 +774,7 @@ static void friction_case(const fr_case *fc) {
                 if (step == 60) dev0[m] = d;
                 {   /* the rows as the yield pass left them (sn_contact_yield retargets the contact rows it moves) */
                     uint32_t kept;
-                    double res = row_residual(&r[m], &kept);
+                    double res = pu_row_residual(&r[m], PU_ANY_PRODUCER, &kept);
                     res_max = res > res_max ? res : res_max;
                 }
                 if (fabs(vq) > vmax[m]) vmax[m] = fabs(vq);
@@ -863,7 +804,7 @@ static void friction_case(const fr_case *fc) {
                 surf_of(&r[m], s_at, pt);
                 x0[m] = fc->q[0] * pt[0] + fc->q[1] * pt[1] + fc->q[2] * pt[2];
                 corner = dominant_corner(&r[m], s_at, &phi, &wsum);
-                cell = i2m(&r[m], (sn_q)H(&r[m])->v.cell);
+                cell = i2m(&r[m], (sn_q)pu_h(&r[m])->v.cell);
             }
         }
         mean[m] /= n ? n : 1;
@@ -899,7 +840,7 @@ static void friction_case(const fr_case *fc) {
 #else
     T_CHECK(res_max <= 1.0, "%s: every kept row holds during the drag: |C^T v - a| %.3g <= 1 LSB (Q22)", fc->name, res_max);
 #endif
-    T_CHECK(sat[0] == 0 && finite_state(&r[0]) && finite_state(&r[1]), "%s frictionless: no saturation (%u); both states finite", fc->name, sat[0]);
+    T_CHECK(sat[0] == 0 && pu_finite_state(&r[0]) && pu_finite_state(&r[1]), "%s frictionless: no saturation (%u); both states finite", fc->name, sat[0]);
     /* fixed point: the slide rows of neighbouring cells can be nearly
      * dependent (above the drop rule's 1/16); the projection's block
      * exponent leaves 14 bits of headroom for G^-1's growth (NUMERICS.md),
@@ -977,10 +918,10 @@ static void test_overflow(void) {
              st.constraint_drops, st.saturations);
     T_CHECK(st.constraint_refused == 8 + 2, "8 constraints and 2 colliders refused (%u)", st.constraint_refused);
     T_CHECK(st.constraint_clamps > 0, "target clamps counted");
-    T_CHECK(finite_state(&r), "state finite");
+    T_CHECK(pu_finite_state(&r), "state finite");
     T_CHECK(h1 == h2, "deterministic under overflow");
     {   /* the row capacity itself: a producer pushing beyond it is refused and counted */
-        sn_ihdr *h = H(&r);
+        sn_ihdr *h = pu_h(&r);
         sn_row row;
         uint32_t n0 = h->row_overflow, pushed = 0;
         memset(&row, 0, sizeof row);
@@ -1038,7 +979,7 @@ static void test_api(void) {
     c.axes = 0; c.target.x = INT32_MAX; c.target.y = INT32_MIN;
     T_CHECK(sn_set_constraints(r.inst, &c, 1) == SN_OK, "extreme fixed targets accepted (clamped per step, counted)");
     sn_step(r.inst);
-    T_CHECK(finite_state(&r), "extreme target: state finite");
+    T_CHECK(pu_finite_state(&r), "extreme target: state finite");
     sn_set_constraints(r.inst, NULL, 0);
     sn_reset(r.inst);
 #endif
@@ -1048,7 +989,7 @@ static void test_api(void) {
     T_CHECK(sn_set_colliders(r.inst, &k, 1) == SN_ERR_ARG, "zero plane normal refused");
     k.kind = SN_COLLIDER_SPHERE; k.radius = rl(-1);
     T_CHECK(sn_set_colliders(r.inst, &k, 1) == SN_ERR_ARG, "negative radius refused");
-    T_CHECK(sn_state_hash(r.inst) == h0 && H(&r)->n_con == 0 && H(&r)->n_col == 0, "nothing changed");
+    T_CHECK(sn_state_hash(r.inst) == h0 && pu_h(&r)->n_con == 0 && pu_h(&r)->n_col == 0, "nothing changed");
     pu_rt_close(&r);
 }
 

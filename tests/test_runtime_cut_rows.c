@@ -44,6 +44,7 @@
  *    limb's pairs stay within 16 entries: built with -DSN_CR_FOLD_ALL
  *    (cut_rows_fold, every pair folded) the same check covers the fold. */
 #include "sn_test.h"
+#define PU_WHITE_BOX /* pu_h, pu_qd, ...: the instance's internals */
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
 #include "sn_constraint.h"
@@ -56,28 +57,7 @@
 #define FL "fixed"
 #endif
 
-static sn_ihdr *H(const pu_rt *r) { return (sn_ihdr *)(void *)r->inst; }
-static double qd(sn_q x) {
-#if defined(SN_FLOAT)
-    return x;
-#else
-    return ldexp((double)x, -SN_Q_LEN);
-#endif
-}
-static double qr(sn_q x) {
-#if defined(SN_FLOAT)
-    return x;
-#else
-    return ldexp((double)x, -30);
-#endif
-}
-/* internal units -> mesh units */
-static double unit_of(const pu_rt *r) {
-    const unsigned char *b = r->bytes;
-    int ls = b[SN_H_LEN_SHIFT] < 128 ? b[SN_H_LEN_SHIFT] : b[SN_H_LEN_SHIFT] - 256;
-    return ldexp(1.0, ls);
-}
-static double cell_mesh(const pu_rt *r) { return qd(H(r)->v.cell) * unit_of(r); }
+static double cell_mesh(const pu_rt *r) { return pu_qd(pu_h(r)->v.cell) * pu_unit(r); }
 
 /* The cut field's weights of surface vertex s, double precision, written
  * independently of sn_cut.c: plain lattice, the 8 trilinear weights; cut,
@@ -127,24 +107,16 @@ static uint32_t ref_weights(const sn_view *v, uint32_t s, uint32_t vtx[15], doub
 static double free_w2(const pu_rt *r, uint32_t s) {
     uint32_t vx[15], n, k;
     double w[15], f = 0;
-    n = ref_weights(&H(r)->v, s, vx, w);
-    for (k = 0; k < n; k++) if (vx[k] < H(r)->v.nF) f += w[k] * w[k];
+    n = ref_weights(&pu_h(r)->v, s, vx, w);
+    for (k = 0; k < n; k++) if (vx[k] < pu_h(r)->v.nF) f += w[k] * w[k];
     return f;
 }
 static double extra_w(const pu_rt *r, uint32_t s) {
     uint32_t vx[15], n, k;
     double w[15], f = 0;
-    n = ref_weights(&H(r)->v, s, vx, w);
+    n = ref_weights(&pu_h(r)->v, s, vx, w);
     for (k = 8; k < n; k++) f += w[k];
     return f;
-}
-static int finite_state(const pu_rt *r) {
-    sn_ihdr *h = H(r);
-    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
-    uint32_t i;
-    for (i = 0; i < 3 * h->v.nV; i++)
-        if (!(fabs(qd(pos[i])) <= 4096.0) || !(fabs(qd(vel[i])) <= 4096.0)) return 0;
-    return 1;
 }
 /* every joint but the root swings about a tilted axis, amp degrees, its own phase */
 static void swing(const pu_rt *r, int step, double amp, sn_xform *xf) {
@@ -154,48 +126,12 @@ static void swing(const pu_rt *r, int step, double amp, sn_xform *xf) {
         local[j] = j == 0 ? pu_qident() : pu_axis_angle(1.0, 0.3, 0.2 * (j % 3), amp * sin(2 * PU_PI * step / 60.0 + 0.7 * j));
     sn_pose_from_local(r->blob, local, NULL, xf);
 }
-/* Largest |C^T x - a| over the kept rows (test_runtime_constraint.c): LSB of Q22 (fixed), relative (float) */
-static double row_residual(const pu_rt *r, unsigned producer, uint32_t *kept) {
-    sn_ihdr *h = H(r);
-    const sn_row *rows = sn_rows(h);
-    const sn_rowx *rx = CARR(h, o_rx, sn_rowx);
-    const sn_q *x = CARR(h, o_x, sn_q);
-    uint32_t j, k, c, nF = h->v.nF;
-    double worst = 0;
-    *kept = 0;
-    for (j = 0; j < h->n_rows; j++) {
-        double s = 0, scale = 0, res;
-        if (rx[j].inv == 0 || SN_ROW_PRODUCER(rows[j].source) != producer) continue;
-        (*kept)++;
-        for (k = 0; k < rows[j].n; k++) {
-            uint32_t a = rows[j].vtx[k];
-            if (a >= nF) continue;
-            for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-                double e = (double)(rows[j].w[k] * rows[j].dir[c]);
-#else
-                double e = (double)(((int64_t)rows[j].w[k] * rows[j].dir[c] + ((int64_t)1 << 29)) >> 30);
-#endif
-                s += e * x[3 * a + c];
-                scale += fabs(e * x[3 * a + c]);
-            }
-        }
-#if defined(SN_FLOAT)
-        res = fabs(s - rx[j].a) / (scale + fabs(rx[j].a) + 1e-30);
-#else
-        (void)scale;
-        res = fabs(ldexp(s, -30) - rx[j].a);
-#endif
-        if (res > worst) worst = res;
-    }
-    return worst;
-}
 
 /* 0. the rows' weights and the rendered surface against the double field */
 static double check_weights(const char *name, pu_rt *r) {
-    sn_ihdr *h = H(r);
+    sn_ihdr *h = pu_h(r);
     uint32_t ns = r->info.surface_vertices, nv = r->info.vertices, s, k, j, n, nr, vx[15], bad_ent = 0, with_x = 0, maxn = 0;
-    double *lat = malloc(3 * nv * sizeof *lat), *sur = malloc(3 * ns * sizeof *sur), w[15], werr = 0, perr = 0, ext = 0, u = unit_of(r);
+    double *lat = malloc(3 * nv * sizeof *lat), *sur = malloc(3 * ns * sizeof *sur), w[15], werr = 0, perr = 0, ext = 0, u = pu_unit(r);
     sn_xform xf[64];
     int step;
     for (step = 0; step < 20; step++) { swing(r, step, 20, xf); sn_set_pose(r->inst, xf, r->info.joints); sn_step(r->inst); }
@@ -216,7 +152,7 @@ static double check_weights(const char *name, pu_rt *r) {
         maxn = n > maxn ? n : maxn;
         for (k = 0; k < n; k++) {
             if (rv[k] != vx[k]) bad_ent++;
-            werr = fmax(werr, fabs(qr(rw[k]) - w[k]));
+            werr = fmax(werr, fabs(pu_qr(rw[k]) - w[k]));
             for (j = 0; j < 3; j++) p[j] += w[k] * lat[3 * vx[k] + j];
         }
         for (j = 0; j < 3; j++) { perr = fmax(perr, fabs(p[j] - sur[3 * s + j])); ext = fmax(ext, fabs(p[j])); }
@@ -263,19 +199,19 @@ static double pins(pu_rt *r, const uint32_t *sv, uint32_t npin, double off, doub
         swing(r, step, 12, xf);
         sn_set_pose(r->inst, xf, r->info.joints);
         sn_step(r->inst);
-        res = row_residual(r, SN_SRC_USER, &kept);
+        res = pu_row_residual(r, SN_SRC_USER, &kept);
         *resid = fmax(*resid, res);
         *kept_min = kept < *kept_min ? kept : *kept_min;
         if (step < 10) continue; /* the approach: one cell a step at most, then held */
         pu_rt_surface(r, sur);
-        if (H(r)->v.cut) pu_rt_lattice(r, lat);
+        if (pu_h(r)->v.cut) pu_rt_lattice(r, lat);
         for (i = 0; i < npin; i++) {
             const double *p = sur + 3 * sv[i];
             double d = fmax(fabs(p[0] - pu_len(cs[i].target.x)), fmax(fabs(p[1] - pu_len(cs[i].target.y)), fabs(p[2] - pu_len(cs[i].target.z))));
             worst = fmax(worst, d);
-            if (H(r)->v.cut) { /* the trilinear point of the same cell */
-                const unsigned char *e = H(r)->v.sec[SN_SEC_EMBED] + (size_t)sv[i] * SN_ELEM_EMBED;
-                const unsigned char *cl = H(r)->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+            if (pu_h(r)->v.cut) { /* the trilinear point of the same cell */
+                const unsigned char *e = pu_h(r)->v.sec[SN_SEC_EMBED] + (size_t)sv[i] * SN_ELEM_EMBED;
+                const unsigned char *cl = pu_h(r)->v.sec[SN_SEC_CELLS] + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
                 double t[3], q[3] = {0, 0, 0}, dd = 0;
                 for (k = 0; k < 3; k++) t[k] = sn_rd_u16(e + 2 + 2 * k) / 32768.0;
                 for (k = 0; k < 8; k++) {
@@ -289,7 +225,7 @@ static double pins(pu_rt *r, const uint32_t *sv, uint32_t npin, double off, doub
         }
     }
     sn_get_stats(r->inst, &st);
-    *sat = st.saturations + !finite_state(r);
+    *sat = st.saturations + !pu_finite_state(r);
     free(sur); free(lat);
     return worst;
 }
@@ -332,7 +268,7 @@ static double sphere(pu_rt *r, const unsigned char *fl, int beast, uint32_t *con
     }
     sn_get_stats(r->inst, &st);
     *contacts = st.contacts;
-    *sat = st.saturations + !finite_state(r);
+    *sat = st.saturations + !pu_finite_state(r);
     free(buf);
     return worst;
 }
@@ -348,7 +284,7 @@ static void body(const char *cutp, const char *lodp, int compare) {
         T_CHECK(0, "open %s, %s (tests/level.mk)", cutp, lodp);
         return;
     }
-    T_CHECK(H(&c)->v.cut && c.info.max_constraints > 0 && c.info.max_colliders > 0, "%s: a cut level with constraint and collider slots (%u, %u)",
+    T_CHECK(pu_h(&c)->v.cut && c.info.max_constraints > 0 && c.info.max_colliders > 0, "%s: a cut level with constraint and collider slots (%u, %u)",
             name, c.info.max_constraints, c.info.max_colliders);
     ext = check_weights(name, &c);
     (void)ext;
@@ -359,11 +295,11 @@ static void body(const char *cutp, const char *lodp, int compare) {
         uint32_t s = (uint32_t)(((uint64_t)i * 7919u + 13u) % ns), vx[15], vy[15], q, a, b, clash = 0;
         double w[15];
         if (!(free_w2(&c, s) >= 0.25 && extra_w(&c, s) >= 0.2)) continue;
-        ref_weights(&H(&c)->v, s, vx, w);
+        ref_weights(&pu_h(&c)->v, s, vx, w);
         for (q = 0; q < npin; q++) {
-            ref_weights(&H(&c)->v, sv[q], vy, w);
+            ref_weights(&pu_h(&c)->v, sv[q], vy, w);
             for (a = 0; a < 8; a++)
-                for (b = 0; b < 8; b++) clash |= vx[a] == vy[b] && vx[a] < H(&c)->v.nF;
+                for (b = 0; b < 8; b++) clash |= vx[a] == vy[b] && vx[a] < pu_h(&c)->v.nF;
         }
         if (!clash) sv[npin++] = s;
     }
@@ -378,7 +314,7 @@ static void body(const char *cutp, const char *lodp, int compare) {
 #if defined(SN_FLOAT)
     tol = 4e-6 * ext; /* the kept rows hold to 1e-6 of their scale; the weights and the sums round to 2^-24 each */
 #else
-    tol = 4 * ldexp(unit_of(&c), -22) + ldexp(1, -16);
+    tol = 4 * ldexp(pu_unit(&c), -22) + ldexp(1, -16);
 #endif
     T_FIGURE("%s [%s] pins (%u surface vertices, 0.1 cell away, every joint swinging 12 deg): rendered vs target, worst over steps 10-59: "
              "cut %.3g, baked level 0 %.3g, level 1 %.3g mesh units (bound %.3g); row residual %.3g / %.3g / %.3g %s; rows kept at least %u / %u / %u of %u; "
@@ -426,10 +362,10 @@ static void crease(const char *path) {
     double *prev, *cur, worst = 0, resid = 0, push;
     const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
     if (pu_rt_open(&r, path)) { T_CHECK(0, "open %s (tests/level.mk)", path); return; }
-    T_CHECK(H(&r)->v.cut && H(&r)->v.nCR, "%s: a cut level with crease data", name);
+    T_CHECK(pu_h(&r)->v.cut && pu_h(&r)->v.nCR, "%s: a cut level with crease data", name);
     ns = r.info.surface_vertices;
     prev = malloc(3 * ns * sizeof *prev); cur = malloc(3 * ns * sizeof *cur);
-    push = qd(H(&r)->v.cr_push);
+    push = pu_qd(pu_h(&r)->v.cr_push);
     pu_rt_surface(&r, prev);
     for (k = 0; k < 180; k++) {
         double deg = k < 120 ? 120.0 * (k + 1) / 120.0 : 120.0, res;
@@ -439,14 +375,14 @@ static void crease(const char *path) {
         sn_set_pose(r.inst, xf, r.info.joints);
         sn_step(r.inst);
         pu_rt_surface(&r, cur);
-        res = row_residual(&r, SN_SRC_CREASE, &kept);
+        res = pu_row_residual(&r, SN_SRC_CREASE, &kept);
         resid = fmax(resid, res);
         {   /* each kept crease row: the rendered pair separates along n at a target in [0, push] (internal units) */
-            const sn_ihdr *h = H(&r);
+            const sn_ihdr *h = pu_h(&r);
             const sn_row *rows = sn_rows((sn_ihdr *)(uintptr_t)h);
             const sn_rowx *rx = CARR(h, o_rx, sn_rowx);
             const sn_crease_pair *C = sn_crease_list(h);
-            double u = unit_of(&r);
+            double u = pu_unit(&r);
             for (j = 0; j < h->n_rows; j++) {
                 const sn_crease_pair *P;
                 uint32_t vi[15], vc[15], ni, nc, a, b, merged, q;
@@ -463,7 +399,7 @@ static void crease(const char *path) {
                 for (a = 0; a < ni; a++) skel += vi[a] >= h->v.nF;
                 for (a = 0; a < nc; a++) skel += vc[a] >= h->v.nF;
                 for (q = 0; q < 3; q++)
-                    dn += qr(rows[j].dir[q]) * ((cur[3 * P->vertex + q] - prev[3 * P->vertex + q]) - (cur[3 * P->corner + q] - prev[3 * P->corner + q])) / u;
+                    dn += pu_qr(rows[j].dir[q]) * ((cur[3 * P->vertex + q] - prev[3 * P->vertex + q]) - (cur[3 * P->corner + q] - prev[3 * P->corner + q])) / u;
                 worst = fmax(worst, fmax(-dn, dn - push));
                 checked++;
             }
@@ -483,7 +419,7 @@ static void crease(const char *path) {
     T_FIGURE("%s [%s] (SN_CR_FOLD_ALL: every crease row's skeleton entries folded into its target) %u skeleton entries folded", name, FL, skel);
     T_CHECK(skel > 0, "%s: folded rows among the checked ones (%u skeleton entries)", name, skel);
 #endif
-    T_CHECK(st.saturations == 0 && finite_state(&r), "%s: no saturation (%u), state finite", name, st.saturations);
+    T_CHECK(st.saturations == 0 && pu_finite_state(&r), "%s: no saturation (%u), state finite", name, st.saturations);
 #if defined(SN_FLOAT)
     T_CHECK(worst <= 1e-5 && resid <= 1e-6, "%s: the kept crease rows move the rendered pair apart at their targets (%.3g <= 1e-5; rows %.3g)", name,
             worst, resid);

@@ -1,4 +1,4 @@
-/* test_runtime_details.c -- the cut level's details (format 6.4: DETAILS, DETAIL,
+/* test_runtime_details.c -- the cut level's details (format 6.5: DETAILS, DETAIL,
  * CELLD, CELLDK; runtime/LEVELS.md §3 "Details on the cut level"), fixed or float:
  *
  * 1. the cow's cut level baked with and without 'details 50 0.03 0.01' has the

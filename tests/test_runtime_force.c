@@ -20,6 +20,7 @@
  *     under the point; full slots, bad arguments: refused, counted, no change.
  */
 #include "sn_test.h"
+#define PU_WHITE_BOX /* pu_h, pu_qd, ...: the instance's internals */
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
 #include "sn_instance.h"
@@ -54,15 +55,6 @@ static double shares(const snref_model *m, const pu_rt *r, unsigned prof, unsign
     { float f; memcpy(&f, &u, 4); return f; }
 #else
     return ldexp((double)(int32_t)u, -30);
-#endif
-}
-
-/* internal state as doubles (internal units) */
-static double qd(sn_q x) {
-#if defined(SN_FLOAT)
-    return x;
-#else
-    return ldexp((double)x, -SN_Q_LEN);
 #endif
 }
 
@@ -159,7 +151,7 @@ static void rt_distribute(pu_rt *r, const sn_force *f, double *out, double *lsb,
 static void state_pos(const pu_rt *r, double *pos) {
     const sn_ihdr *h = chdr_of(r->inst);
     unsigned i;
-    for (i = 0; i < 3 * r->info.vertices; i++) pos[i] = qd(CARR(h, o_pos, sn_q)[i]);
+    for (i = 0; i < 3 * r->info.vertices; i++) pos[i] = pu_qd(CARR(h, o_pos, sn_q)[i]);
 }
 
 /* surface vertices whose cell has at least 4 free corners, spread over the mesh */
@@ -521,7 +513,7 @@ static void test_api(void) {
                 uint32_t wx = (c & 1u) ? slot->t[0] : 32768u - slot->t[0], wy = (c & 2u) ? slot->t[1] : 32768u - slot->t[1];
                 uint32_t wz = (c & 4u) ? slot->t[2] : 32768u - slot->t[2];
                 phi[c] = 0;
-                for (d = 0; d < 3; d++) q[d] += (double)wx * wy * wz / 35184372088832.0 * qd(pos[3 * m.cells[8 * slot->cell + c] + d]);
+                for (d = 0; d < 3; d++) q[d] += (double)wx * wy * wz / 35184372088832.0 * pu_qd(pos[3 * m.cells[8 * slot->cell + c] + d]);
             }
             (void)phi;
             for (d = 0; d < 3; d++) {

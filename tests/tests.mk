@@ -14,6 +14,8 @@ test:
 	$(MAKE) -j$(TEST_JOBS) test-build
 	TEST_JOBS=$(TEST_JOBS) sh tests/run_tests.sh $(BUILD)
 test-build: $(TEST_BINS) $(TEST_DEPS)
+# The long campaigns beside make test (determinism, fuzz-blobs, fuzz,
+# integration-full, cantilever-float, level-all, soak*): tests/CAMPAIGNS.md.
 # every build of the determinism matrix (make test runs a slice of it, see
 # tests/scripts/test_determinism.sh)
 .PHONY: determinism

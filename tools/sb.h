@@ -451,6 +451,9 @@ int sb_segment_build(const sb_desc *d, const sb_mesh *m, sb_model *o);
 void sb_segment_free(sb_model *o);
 /* instance state bytes of o's segment meshes (SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes) */
 uint32_t sb_segment_state_bytes(const sb_model *o);
+/* The frames' references (format 6.4, sb_frefs.c): refs (nf + nc, or NULL),
+ * pairs (b1 << 8 | b2, or NULL); returns the distinct pairs' count. */
+int sb_frame_refs(const sb_model *o, uint32_t *refs, uint16_t *pairs);
 /* SEGNODES and SEGATTACH counts of o's segment meshes */
 void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach);
 /* write the three segment sections at their offsets (blob bytes, rs: real size,

@@ -11,7 +11,7 @@ static const char *sec_name[] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDI
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
                                              "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
-                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK",
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK", "FPAIRS", "FREFS",
                                              "DETAILS", "DETAIL", "CELLD", "CELLDK"};
 /* one name per section: a new section without its name fails to compile
  * (format 6.1's ADAPT printed as "(null)", a NULL through %s) */

@@ -270,7 +270,9 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     double m0 = 0, maxS = 0, maxM = 0, maxP = 0, maxx = 0, h = o->h, a1, b1, U, *P, *lump;
     sb_ichol_t ic = {0, NULL, NULL, 0, 0};
     const double *root = o->joints[0].pos;
-    uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total;
+    uint32_t cnt[SN_SEC_COUNT], esz[SN_SEC_COUNT], off[SN_SEC_COUNT], total, *frefs;
+    uint16_t *fpairs;
+    int nfp;
     wr_t w;
 
     int nlim = 0, efrac = 0, ffrac = 0;
@@ -405,6 +407,12 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         cnt[SN_SEC_CELLX] = o->cut ? (uint32_t)o->nc : 0u;   esz[SN_SEC_CELLX] = SN_ELEM_CELLX;
         cnt[SN_SEC_CELLXK] = nxb;   esz[SN_SEC_CELLXK] = SN_ELEM_CELLXK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
     }
+    /* the frames' references (format 6.4): every entry's, and the distinct pairs */
+    frefs = sb_alloc(sizeof(uint32_t) * (size_t)(nF + o->nc));
+    fpairs = sb_alloc(sizeof(uint16_t) * (size_t)(nF + o->nc));
+    nfp = sb_frame_refs(o, frefs, fpairs);
+    cnt[SN_SEC_FPAIRS] = (uint32_t)nfp;              esz[SN_SEC_FPAIRS] = SN_ELEM_FPAIRS;
+    cnt[SN_SEC_FREFS] = (uint32_t)(nF + o->nc);      esz[SN_SEC_FREFS] = SN_ELEM_FREFS;
     {   /* the cut level's details (sb_cut.h): per cell nd (8 + nx) + nd (nd + 1) / 2 blocks */
         uint32_t ndb = 0, on = o->cut && o->det_on ? 1u : 0u;
         if (on) for (i = 0; i < o->nc; i++) ndb += detail_blocks(o->cut->cnd[i], o->cut->cnx[i]);
@@ -446,7 +454,8 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     put_u32(&w, SN_H_N_OFFDIAG, (uint32_t)nnz);
     put_u32(&w, SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(nV, nF, nJ, o->nc, (uint32_t)o->nctl, (uint32_t)o->max_forces,
                                                        sb_segment_state_bytes(o) +
-                                                       (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u),
+                                                       (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u) +
+                                                       (uint32_t)nfp * SN_FPAIR_BYTES,
                                                        (o->max_cons || o->max_cols || o->max_contacts || o->crease)
                                                            ? SN_CONS_BYTES(o->max_cons, o->max_cols,
                                                                            SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
@@ -598,6 +607,13 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             first += 8u * (uint32_t)nx;
         }
     }
+    for (k = 0; k < nfp; k++) {
+        put_u8(&w, off[SN_SEC_FPAIRS] + 2 * (size_t)k, (unsigned)(fpairs[k] >> 8));
+        put_u8(&w, off[SN_SEC_FPAIRS] + 2 * (size_t)k + 1, (unsigned)(fpairs[k] & 255u));
+    }
+    for (i = 0; i < nF + o->nc; i++) put_u32(&w, off[SN_SEC_FREFS] + 4 * (size_t)i, frefs[i]);
+    free(frefs);
+    free(fpairs);
     if (cnt[SN_SEC_DETAILS]) { /* the details: record, rest points, per-cell lists, blocks with their mass (sn_format.h) */
         const sb_cut *cut = o->cut;
         const int N3 = 3 * SB_CUT_NL, NL = SB_CUT_NL;

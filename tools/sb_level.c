@@ -539,10 +539,11 @@ static int embed_points(const sb_model *L, const double *pts, int n, uint16_t *o
     return far;
 }
 
-static uint32_t inst_bytes(const sb_model *o, int nV, int nF, int nC)
+static uint32_t inst_bytes(const sb_model *o, int nV, int nF, int nC, int nFP)
 {
     return SN_INSTANCE_BYTES((uint32_t)nV, (uint32_t)nF, (uint32_t)o->nj, (uint32_t)nC, (uint32_t)o->nctl, (uint32_t)o->max_forces,
-                             sb_segment_state_bytes(o) + (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u),
+                             sb_segment_state_bytes(o) + (o->crease ? SN_CREASE_STATE_BYTES(o->ns, o->cr_list) : 0u) +
+                                 (uint32_t)nFP * SN_FPAIR_BYTES,
                              (o->max_cons || o->max_cols || o->max_contacts || o->crease)
                                  ? SN_CONS_BYTES(o->max_cons, o->max_cols, SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0))
                                  : 0u);
@@ -579,7 +580,7 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
     sb_blob b0, b1;
     sb_cut cut;
     uint16_t *up = NULL, *down = NULL;
-    int rc = -1, nF, nS, nC;
+    int rc = -1, nF, nS, nC, np0, np1;
     memset(&o2, 0, sizeof o2); memset(&b0, 0, sizeof b0); memset(&b1, 0, sizeof b1); memset(&cut, 0, sizeof cut);
     sb_level_desc(d, o, &d2);
     if (sb_level_model(d, &d2, m, &o2)) goto done;
@@ -612,8 +613,9 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
     nC = o->nc > o2.nc ? o->nc : o2.nc;
     o->lod_blob = b1.bytes; o->lod_size = (uint32_t)b1.size; o->lod_nv1 = (uint32_t)o2.nv;
     o->lod_up = up; o->lod_down = down;
-    o->lod_inst_bytes = inst_bytes(o, nF + nS, nF, nC);
-    info->inst0 = inst_bytes(o, o->nv, o->nf, o->nc); info->inst1 = inst_bytes(&o2, o2.nv, o2.nf, o2.nc);
+    np0 = sb_frame_refs(o, NULL, NULL); np1 = sb_frame_refs(&o2, NULL, NULL);   /* the frame pairs' scratch: the larger level's */
+    o->lod_inst_bytes = inst_bytes(o, nF + nS, nF, nC, np0 > np1 ? np0 : np1);
+    info->inst0 = inst_bytes(o, o->nv, o->nf, o->nc, np0); info->inst1 = inst_bytes(&o2, o2.nv, o2.nf, o2.nc, np1);
     info->inst = o->lod_inst_bytes;
     if (d->adapt_line) {   /* adaptation of level 1 (sn_adapt.c): A_max within its free vertices, thresholds in level-0 cells */
         if (o->nv > o2.nf) {

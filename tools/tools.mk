@@ -1,6 +1,6 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_level.c tools/sb_cut.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_ichol.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c tools/sb_retarget.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_level.c tools/sb_cut.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_ichol.c tools/sb_frefs.c tools/sb_blob.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c tools/sb_retarget.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h tools/sb_level.h tools/sb_cut.h tools/sb_lbfgsb.h tools/sb_retarget.h runtime/src/sn_format.h tools/ref/snref.h

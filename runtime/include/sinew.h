@@ -221,10 +221,10 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local,
                         const sn_vec3 *root_offset, sn_xform *out);
 
 /// Advance one timestep h with the current pose. Cost is fixed by the blob and
-/// the iteration count: no data-dependent loop exits. Stack: under 7 KB (the
-/// frames' pair cache and memo; Cortex-M4 peaks 5,944 B for the cow, 6,680 B
-/// on its cut level; tests/scripts/test_runtime_rules.sh prints the x86-64
-/// worst case per entry point). SN_ERR_NULL or
+/// the iteration count: no data-dependent loop exits. Stack: under 3 KB
+/// (Cortex-M4 peaks 2,568 B for the cow, 2,512 B on its cut level; x86-64
+/// worst case 1,808 B, which tests/scripts/test_runtime_rules.sh prints per
+/// entry point): the frames' shared work is in the blob (format 6.4). SN_ERR_NULL or
 /// SN_ERR_INSTANCE (nothing happens) if inst is not an initialised instance;
 /// SN_ERR_MEMORY (nothing happens) for an sn_instance_init_shared instance,
 /// which steps with sn_step_with.

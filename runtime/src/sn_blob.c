@@ -401,7 +401,9 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     cnt[SN_SEC_ADAPT] = 0; /* 0 or 1: taken from the table below */
     cnt[SN_SEC_CELLX] = 0; /* 0 or nC: taken from the table below */
     cnt[SN_SEC_CELLXK] = 0; /* <= 8 x 19 nC: taken from the table below, checked with CELLX */
-    cnt[SN_SEC_DETAILS] = 0; /* format 6.4, the details: 0 or 1, <= 19 nC, 0 or nC, <= 342 nC; checked together */
+    cnt[SN_SEC_FPAIRS] = 0; /* <= nJ (nJ - 1): taken from the table below, checked with FREFS */
+    cnt[SN_SEC_FREFS] = 0;  /* 0 or nF + nC: taken from the table below */
+    cnt[SN_SEC_DETAILS] = 0; /* format 6.5, the details: 0 or 1, <= 19 nC, 0 or nC, <= 342 nC; checked together */
     cnt[SN_SEC_DETAIL] = 0;
     cnt[SN_SEC_CELLD] = 0;
     cnt[SN_SEC_CELLDK] = 0;
@@ -482,6 +484,7 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
             SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP,
             SN_ELEM_ICHOL, SN_ELEM_ADAPT(SN_REAL_BYTES), SN_ELEM_CELLX, SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES),
+            SN_ELEM_FPAIRS, SN_ELEM_FREFS,
             SN_ELEM_DETAILS(SN_REAL_BYTES), SN_ELEM_DETAIL(SN_REAL_BYTES), SN_ELEM_CELLD, SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
@@ -493,6 +496,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             if (k == SN_SEC_ADAPT && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u; /* optional record: checked with the pair (sn_adapt.c) */
             if (k == SN_SEC_CELLX && sn_rd_u32(e + 8) == v.nC) cnt[k] = v.nC; /* optional: the cut level */
             if (k == SN_SEC_CELLXK && (uint64_t)sn_rd_u32(e + 8) <= 8u * SN_CUT_MAXX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
+            if (k == SN_SEC_FPAIRS && sn_rd_u32(e + 8) <= v.nJ * (v.nJ - 1u)) cnt[k] = sn_rd_u32(e + 8); /* distinct pairs */
+            if (k == SN_SEC_FREFS && sn_rd_u32(e + 8) == v.nF + v.nC) cnt[k] = v.nF + v.nC; /* optional */
             if (k == SN_SEC_DETAILS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u;
             if (k == SN_SEC_DETAIL && (uint64_t)sn_rd_u32(e + 8) <= SN_CUT_MAXX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
             if (k == SN_SEC_CELLD && sn_rd_u32(e + 8) == v.nC) cnt[k] = v.nC;
@@ -517,6 +522,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     st = sn_check_ichol(&v, cnt[SN_SEC_ICHOL]);
     if (st != SN_OK) return st;
     st = sn_check_cut(&v, cnt[SN_SEC_CELLX], cnt[SN_SEC_CELLXK]);
+    if (st != SN_OK) return st;
+    st = sn_check_frefs(&v, cnt[SN_SEC_FPAIRS], cnt[SN_SEC_FREFS]);
     if (st != SN_OK) return st;
     st = sn_check_details(&v, cnt[SN_SEC_DETAILS], cnt[SN_SEC_DETAIL], cnt[SN_SEC_CELLD], cnt[SN_SEC_CELLDK], cnt[SN_SEC_CELLX]);
     if (st != SN_OK) return st;
@@ -556,7 +563,8 @@ sn_status sn_blob_validate(const void *data, size_t size, const sn_blob **out) {
     }
     /* the instance size is the runtime's layout (one source: sn_instance.c) for the largest level's counts */
     sn_level_counts(&v, &nV, &nF, &nC);
-    if (v.instance_bytes != sn_instance_bytes(nV, nF, v.nJ, nC, v.nK, v.nFrc, v.segB, v.crB, v.conB)) return SN_ERR_HEADER;
+    if (v.instance_bytes != sn_instance_bytes(nV, nF, v.nJ, nC, v.nK, v.nFrc, v.segB, v.crB, v.conB, sn_level_fpairs(&v)))
+        return SN_ERR_HEADER;
     *out = (const sn_blob *)data;
     return SN_OK;
 }

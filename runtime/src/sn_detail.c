@@ -1,4 +1,4 @@
-/* sn_detail.c -- details on the cut level (sn_detail.h; format 6.4; LEVELS.md
+/* sn_detail.c -- details on the cut level (sn_detail.h; format 6.5; LEVELS.md
  * §3 "Details on the cut level"): their validation. */
 #include "sn_detail.h"
 

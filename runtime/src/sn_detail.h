@@ -1,5 +1,5 @@
 /* sn_detail.h -- details on the cut level (DETAILS, DETAIL, CELLD, CELLDK;
- * format 6.4; LEVELS.md §3 "Details on the cut level"), internal: level 1's
+ * format 6.5; LEVELS.md §3 "Details on the cut level"), internal: level 1's
  * free vertices inside the cut level's cells, each a level-1 hat added to the
  * cut field (the hierarchical basis of seed 000 §3.1), with the cut element's
  * blocks [detail x corner / extra / detail] and their mass (sn_detail.c).

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 6.0).
+/* sn_format.h -- byte layout of a Sinew blob (format 6.5).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -16,7 +16,7 @@
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
 #define SN_FORMAT_MAJOR 6
-#define SN_FORMAT_MINOR 4
+#define SN_FORMAT_MINOR 5
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
 #define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
@@ -186,7 +186,16 @@ enum {
                             [corner rows x extra columns], entry [3i+j] = K_E[3a+i][3x+j] (Q frac_S, as CELLK).
                             fixed: {i16 m[9], u8 e (<= SN_CELLK_EXP_MAX), u8 0}, entry = m 2^e, |m| <= 2^15 - 1;
                             float: R[9], |entry| <= 2^27 */
-    /* ---- details on the cut level (issue 13 item 2; runtime/LEVELS.md §3 "Details on the cut level"), format 6.4; all
+    /* ---- the frames' shared work (issue 15; BLOB.md "Frame references"), format 6.4; both count 0 (every frame
+       computed alone), or FREFS has count nF + nC ---- */
+    SN_SEC_FPAIRS,       /* nFP x {u8 bone1, u8 bone2}: the distinct bone pairs the frames slerp between, bone1 != bone2 (< nJ),
+                            strictly increasing as bone1 << 8 | bone2 (so nFP <= nJ (nJ - 1)); their slerp parts are computed
+                            once a step (sn_qslerp_pair) */
+    SN_SEC_FREFS,        /* nF + nC x u32, the free vertices' FRAMES entries then the CFRAMES entries (one index i over both):
+                            SN_FREF_BONE for an entry that does not slerp (bone1 = bone2 or w = 0: the bone's rotation);
+                            SN_FREF_PAIR | p for the first entry of its (bone1, bone2, w), slerped from pair p (< nFP, the
+                            same bones); a < i for a repeat: the frame of entry a (the same 4 bytes), copied */
+    /* ---- details on the cut level (issue 13 item 2; runtime/LEVELS.md §3 "Details on the cut level"), format 6.5; all
        four count 0, or (with CELLX) DETAILS 1, DETAIL nD >= 1, CELLD nC: level 1's free vertices at the non-corner
        points of the cut level's cells, each a level-1 hat added to the cut field (the hierarchical basis) ---- */
     SN_SEC_DETAILS,      /* 0 or 1 x {u16 max_active (A_max, 0..nD), u8 dshift (fixed: CELLDK's blocks are in
@@ -259,6 +268,12 @@ enum {
 #define SN_CUT_MAXX         19   /* non-corner points of a cell's closure at half cells */
 #define SN_CUT_NONE         0xFFFFu
 #define SN_ELEM_CELLXK(flavour, R) ((flavour) == SN_FLAVOUR_FIXED ? 20 : 9 * (R))
+#define SN_ELEM_FPAIRS       2
+#define SN_ELEM_FREFS        4
+#define SN_FREF_BONE        0xFFFFFFFFu
+#define SN_FREF_PAIR        0x80000000u
+/* instance bytes per frame pair: its slerp part (sn_slerp_pair, sn_internal.h), the step's scratch */
+#define SN_FPAIR_BYTES      40u
 #define SN_ELEM_DETAILS(R)  (8 + 2 * (R))
 #define SN_ELEM_DETAIL(R)   (4 + 3 * (R))
 #define SN_ELEM_CELLD       44
@@ -382,6 +397,9 @@ static inline void sn_seg_counts(unsigned kind, unsigned side, unsigned levels, 
  * SN_SEG_SEG_BYTES segs + SN_SEG_NODE_BYTES nodes (sn_seg_counts), plus the
  * crease state SN_CREASE_STATE_BYTES (0 without a CREASE section; a multiple
  * of 8, so the sum rounds as the runtime's separate arrays do);
+ * plus the frame pairs' scratch, SN_FPAIR_BYTES per FPAIRS entry (format 6.4;
+ * the largest level's count; 0 without: the runtime places it after the
+ * constraint state, a multiple of 8, so the total is the same);
  * conB: constraint state bytes, SN_CONS_BYTES of the CONSTRAINTS record and
  * the crease rows (0 without either). Per vertex 24 (position, velocity),
  * per free vertex 96 + 1 (accumulators, frame, CG vectors x r q -- z and w

@@ -10,7 +10,8 @@
  * per free: R9 x3 r3 | d3 (max(nF, nV-nF) rows: ds shares it) | per free: q3 (z and w share it) |
  * per cell: R9 | per control: value |
  * crease state (crB: surface positions, list, membership; sn_crease.c) | per free: k (u8) |
- * (8-aligned) constraint state: records, colliders, rows, row state, factor (sn_cons_layout)
+ * (8-aligned) constraint state: records, colliders, rows, row state, factor (sn_cons_layout) |
+ * (8-aligned) per frame pair: its slerp part (the step's scratch, sn_pose.c joint_frames)
  * Only free vertices keep a frame: a skeleton vertex's is its bone's jR
  * (BLOB.md: bone1 = bone2, w = 0), and every frame origin c is computed
  * where it is read (sn_vertex_origin). ds (skeleton velocity change) is live
@@ -24,9 +25,10 @@
  * The 8-byte arrays come first (the header and each of them are multiples
  * of 8). Array offsets into off[] in the order of SN_LAYOUT_ARRAYS; returns
  * the total, rounded up to 8. Counts are validated (nV <= 65535 ...): no wrap. */
-#define SN_LAYOUT_ARRAYS 20
+#define SN_LAYOUT_ARRAYS 21
 static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                               uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t off[SN_LAYOUT_ARRAYS]) {
+                               uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t nFP,
+                               uint32_t off[SN_LAYOUT_ARRAYS]) {
     const uint32_t nDS = nV - nF > nF ? nV - nF : nF; /* rows of d's storage: d (nF) or ds (nV - nF) */
     const uint32_t bytes[SN_LAYOUT_ARRAYS] = {
         nF * 3u * 8u, /* acc: 8 bytes per accumulator in both flavours */
@@ -36,10 +38,10 @@ static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t n
         nF * 9u * 4u, nF * 3u * 4u, nF * 3u * 4u,                       /* R x r */
         nDS * 3u * 4u, nF * 3u * 4u,                                     /* d (and ds) q */
         nC * 9u * 4u, nK * 4u, crB, nF,                                  /* cR ctl crease k */
-        conB};                                                            /* constraint state (sn_constraint.c), 8-aligned */
+        conB, nFP * SN_FPAIR_BYTES};                                      /* constraint state (sn_constraint.c), frame pairs: 8-aligned */
     uint32_t o = SN_HDR_BYTES, i;
     for (i = 0; i < SN_LAYOUT_ARRAYS; i++) {
-        if (i == SN_LAYOUT_ARRAYS - 1) o = (o + 7u) & ~7u;
+        if (i >= SN_LAYOUT_ARRAYS - 2) o = (o + 7u) & ~7u;
         off[i] = o;
         o += bytes[i];
     }
@@ -47,25 +49,26 @@ static uint32_t layout_offsets(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t n
 }
 
 uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB) {
+                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t nFP) {
     uint32_t off[SN_LAYOUT_ARRAYS];
-    return layout_offsets(nV, nF, nJ, nC, nK, nFrc, segB, crB, conB, off);
+    return layout_offsets(nV, nF, nJ, nC, nK, nFrc, segB, crB, conB, nFP, off);
 }
 
 /* sn_instance_init_shared's layout: the same arrays, the scratch ones
- * (acc, r, rows, row state, factor: written before read in every step) moved
+ * (frame pairs, acc, r, rows, row state, factor: written before read in every step) moved
  * to the workspace sn_step_with passes. State: hdr | workspace address | wrench frc seg | pq pt
  * jR jT | pos vel | R x | d q | cR ctl crease k | (8-aligned) records
- * colliders | (8-aligned) adaptation's state and mask. Workspace: acc | r |
- * rows | row state | factor | (8-aligned) the blended mode's arrays.
+ * colliders | (8-aligned) adaptation's state and mask. Workspace: frame pairs | acc | r |
+ * rows | row state | factor | (8-aligned) the blended mode's arrays. (Frames
+ * refreshed between steps, without a workspace, slerp each pair alone: sn_pose.c.)
  * d and q stay in the state: sn_set_lod and adaptation's sn_adapt_begin
  * (sn_reset, sn_set_adapt) use them between steps. Offsets into off[] in the
  * order of SN_LAYOUT_ARRAYS (off[19]: the records; *row: the rows in the
- * workspace); returns the state bytes before adaptation's, *ws the workspace
- * bytes before the blended mode's. */
+ * workspace; off[20]: the frame pairs, at the workspace's start); returns the
+ * state bytes before adaptation's, *ws the workspace bytes before the blended mode's. */
 static uint32_t shared_offsets(const sn_view *v, uint32_t off[SN_LAYOUT_ARRAYS], uint32_t *row, uint32_t *ws) {
     uint32_t nV, nF, nC, nDS, o = SN_HDR_BYTES + SN_WS_SLOT_BYTES, i; /* the workspace's address (sn_ws) */
-    uint32_t bytes[SN_LAYOUT_ARRAYS];
+    uint32_t bytes[SN_LAYOUT_ARRAYS], spB = sn_level_fpairs(v) * SN_FPAIR_BYTES;
     sn_level_counts(v, &nV, &nF, &nC); /* the largest level, as layout() */
     nDS = nV - nF > nF ? nV - nF : nF;
     bytes[0] = 0; bytes[12] = 0;      /* acc, r: in the workspace */
@@ -75,14 +78,15 @@ static uint32_t shared_offsets(const sn_view *v, uint32_t off[SN_LAYOUT_ARRAYS],
     bytes[13] = nDS * 12u; bytes[14] = nF * 12u;
     bytes[15] = nC * 36u; bytes[16] = v->nK * 4u; bytes[17] = v->crB; bytes[18] = nF;
     bytes[19] = v->nCon * SN_CON_BYTES + v->nCol * SN_COL_BYTES;
-    for (i = 1; i < SN_LAYOUT_ARRAYS; i++) {
+    for (i = 1; i < SN_LAYOUT_ARRAYS - 1; i++) {
         if (i == 12) continue;
-        if (i == SN_LAYOUT_ARRAYS - 1) o = (o + 7u) & ~7u;
+        if (i == SN_LAYOUT_ARRAYS - 2) o = (o + 7u) & ~7u;
         off[i] = o;
         o += bytes[i];
     }
-    off[0] = 0;               /* acc first: 8-byte accumulators at the workspace's 8-aligned start */
-    off[12] = nF * 24u;
+    off[20] = 0;              /* the frame pairs first (8-byte fields, 40 bytes each), */
+    off[0] = spB;             /* then acc: 8-byte accumulators, 8-aligned */
+    off[12] = spB + nF * 24u;
     *row = off[12] + nF * 12u;
     *ws = (*row + v->nRows * (SN_ROW_BYTES + SN_ROWAUX_BYTES) + 4u * (v->nRows * (v->nRows + 1u) / 2u) + 7u) & ~7u;
     return (o + 7u) & ~7u;
@@ -94,6 +98,7 @@ static void set_offsets(sn_ihdr *h, const uint32_t off[SN_LAYOUT_ARRAYS], uint32
     h->o_pos = off[8]; h->o_vel = off[9]; h->o_R = off[10]; h->o_x = off[11]; h->o_r = off[12];
     h->o_d = off[13]; h->o_ds = off[13]; h->o_q = off[14];
     h->o_cR = off[15]; h->o_ctl = off[16]; h->o_crs = off[17]; h->o_k = off[18];
+    h->o_sp = off[20];
     sn_cons_layout(h, off[19], row);
 }
 
@@ -108,7 +113,7 @@ static void layout(sn_ihdr *h) {
         return;
     }
     sn_level_counts(&h->v, &nV, &nF, &nC); /* the largest level (sn_level.c): one layout for every level */
-    (void)layout_offsets(nV, nF, h->v.nJ, nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, off);
+    (void)layout_offsets(nV, nF, h->v.nJ, nC, h->v.nK, h->v.nFrc, h->v.segB, h->v.crB, h->v.conB, sn_level_fpairs(&h->v), off);
     set_offsets(h, off, off[19] + h->v.nCon * SN_CON_BYTES + h->v.nCol * SN_COL_BYTES);
 }
 

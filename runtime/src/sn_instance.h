@@ -36,7 +36,8 @@ typedef struct sn_ihdr {
 #endif
     /* byte offsets of the arrays from the instance start */
     uint32_t o_acc, o_pq, o_pt, o_jR, o_jT, o_R, o_pos, o_vel, o_x, o_r, o_d, o_q, o_ds, /* o_ds = o_d; q, z, w share o_q */
-        o_k, o_cR, o_ctl, o_wr, o_frc, o_seg, o_crs;
+        o_k, o_cR, o_ctl, o_wr, o_frc, o_seg, o_crs,
+        o_sp;               /* the frame pairs' slerp parts (FPAIRS), scratch: of sn_ws (sn_pose.c) */
     uint32_t frame_mode;    /* the mode the frames (R, cR, jT) were last built in: the origins sn_vertex_origin derives follow it */
     uint32_t n_forces;      /* force slots filled since the last step (sn_force.c) */
     uint32_t force_drops;   /* forces refused since init/reset: slots full */

@@ -248,7 +248,8 @@ void sn_qslerp(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
 void sn_qslerp_path(const sn_q a[4], const sn_q b[4], sn_q t, sn_q out[4]);
 /* sn_qslerp(_path) in two parts: the pair's (b's sign, v = b - (a.b) a,
  * |v|, the angle; independent of t) and the slerp at t from it, the same
- * bits as one call. key: the caller's (sn_pose.c's cache of bone pairs). */
+ * bits as one call. sn_pose.c keeps one per FPAIRS entry in the step's
+ * scratch (SN_FPAIR_BYTES each). */
 typedef struct sn_slerp_pair {
 #if defined(SN_FLOAT)
     float v[4], s, th;
@@ -259,8 +260,8 @@ typedef struct sn_slerp_pair {
     int32_t v[4];
 #endif
     int flip;
-    uint32_t key;
 } sn_slerp_pair;
+typedef char sn_slerp_pair_fits_[sizeof(sn_slerp_pair) <= SN_FPAIR_BYTES ? 1 : -1];
 void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p);
 void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]);
 /* Angle (public degrees: fixed Q16.16) of the rotation q about the unit
@@ -335,7 +336,10 @@ SN_INLINE const unsigned char *sn_sec(const sn_view *v, int k) {
 /* Instance bytes for these counts: the runtime's layout (sn_instance.c), the
  * one source of the size (SN_INSTANCE_BYTES in sn_format.h is tested equal). */
 uint32_t sn_instance_bytes(uint32_t nV, uint32_t nF, uint32_t nJ, uint32_t nC, uint32_t nK,
-                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB);
+                           uint32_t nFrc, uint32_t segB, uint32_t crB, uint32_t conB, uint32_t nFP);
+/* Frame references (sn_pose.c, format 6.4): FPAIRS and FREFS valid against
+ * FRAMES and CFRAMES (counts already checked by the table). */
+sn_status sn_check_frefs(const sn_view *v, uint32_t nfp, uint32_t nfr);
 
 /* One stored real in range (validator helper, sn_blob.c): fixed, the stored
  * integer in [lo, hi]; float, finite and in [lo, hi] / 2^q (q <= 30). */
@@ -363,6 +367,7 @@ void sn_view_constraints(sn_view *v); /* decode only (validated blob) */
 uint32_t sn_level_sec_count(const sn_view *v, int sec);
 sn_status sn_check_levels(const sn_view *coarse, const sn_view *fine);
 void sn_level_counts(const sn_view *v, uint32_t *nV, uint32_t *nF, uint32_t *nC);
+uint32_t sn_level_fpairs(const sn_view *v); /* FPAIRS entries, the largest over the levels (the step's pair scratch) */
 
 /* Decode the header of a blob that sn_blob_validate() accepted (no checks). */
 void sn_view_init(sn_view *v, const sn_blob *blob);

@@ -89,6 +89,15 @@ void sn_level_counts(const sn_view *v, uint32_t *nV, uint32_t *nF, uint32_t *nC)
     }
 }
 
+uint32_t sn_level_fpairs(const sn_view *v) {
+    uint32_t n = sn_level_sec_count(v, SN_SEC_FPAIRS);
+    if (sn_level_sec_count(v, SN_SEC_LEVEL_BLOB) != 0) { /* the nested blob's table (no view: init's stack) */
+        uint32_t m = sn_rd_u32(v->sec[SN_SEC_LEVEL_BLOB] + SN_H_SECTIONS + SN_SEC_FPAIRS * SN_SECTION_ENTRY + 8);
+        if (m > n) n = m;
+    }
+    return n;
+}
+
 uint32_t sn_lod_levels(const sn_blob *blob) {
     sn_view v;
     if (!blob) return 0;

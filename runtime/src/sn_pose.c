@@ -136,30 +136,15 @@ void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]) {
     origin_of(h, h->v.sec[SN_SEC_FRAMES] + 4 * (size_t)i, h->frame_mode, c);
 }
 
-/* Slots of joint_frames' cache of slerp pair parts (sn_qslerp_pair), direct
- * mapped by a multiplicative hash of the bone pair: the entries of one pair
- * share its angle, so most frames skip its square root and CORDIC (cow: 216
- * slerps a step, 30 pairs). 64 slots (16 with (3 b1 + b2) mod 16 until
- * issue 15's fewer-operations round: colliding pairs evicted each other).
- * Which entries hit is fixed by the blob: the cost stays the blob's. */
-#define FRAME_SLOTS 64u
-/* Slots of joint_frames' memo of whole frames: many entries repeat the
- * (b1, b2, w) of an earlier one (cow: 79 of its 214 slerps a step), and a
- * frame is a function of its entry and the pose only, so a repeat copies
- * the earlier frame's 9 values (the same bits) instead of its slerp_at
- * (sin/cos, a division, a square root) and quaternion-to-matrix. Direct
- * mapped by a hash of the entry; which entries hit is fixed by the blob. */
-#define FRAME_R_SLOTS 256u
-typedef struct frame_memo {
-    uint32_t key[FRAME_R_SLOTS]; /* b1 << 24 | b2 << 16 | w (never 0: b1 != b2 there), 0 empty */
-    const sn_q *R[FRAME_R_SLOTS]; /* the frame computed for it */
-} frame_memo;
-
 /* Rotation of a vertex's or cell's frame from its (b1, b2, w) entry:
  * R = slerp_path(q_b1, q_b2, w) (seed 003 §3.3), the bone's jR when w = 0.
- * cache: FRAME_SLOTS pair parts of this pose (keys 0 when empty), or NULL;
- * memo: the frames of this pose so far (frame_memo), or NULL. */
-static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp_pair *cache, frame_memo *memo) {
+ * rf: FREFS (entry ri's reference: an earlier entry with the same
+ * (b1, b2, w), whose frame is copied, or the pair whose slerp part sp holds),
+ * or NULL; sp: this pose's pair parts, or NULL (slerped alone:
+ * sn_qslerp_path is the pair part and sn_qslerp_at in a row, the same bits,
+ * test_runtime_math). */
+static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, const unsigned char *rf, uint32_t ri,
+                     const sn_slerp_pair *sp) {
     const sn_q *pq = CARR(h, o_pq, sn_q), *jR = CARR(h, o_jR, sn_q);
     uint32_t b1 = f[0], b2 = f[1], w = sn_rd_u16(f + 2), k;
     if (h->mode == SN_MODE_UNWARPED) { /* global linear: R = I */
@@ -167,32 +152,63 @@ static void frame_of(const sn_ihdr *h, const unsigned char *f, sn_q *R, sn_slerp
     } else if (b1 == b2 || w == 0) {
         memcpy(R, jR + 9 * b1, 9 * sizeof(sn_q));
     } else {
+        const sn_slerp_pair *p = NULL;
         sn_q q[4];
 #if defined(SN_FLOAT)
         sn_q t = (float)w * (1.0f / 32768.0f);
 #else
         sn_q t = (sn_q)(w << (SN_Q_ROT - SN_Q_W));
 #endif
-        if (memo) {
-            const uint32_t key = b1 << 24 | b2 << 16 | w, m = (key * 2654435761u) >> 24; /* 8 bits: FRAME_R_SLOTS */
-            if (memo->key[m] == key) {
-                memcpy(R, memo->R[m], 9 * sizeof(sn_q));
+        if (rf) {
+            uint32_t r = sn_rd_u32(rf + 4 * (size_t)ri);
+            if (!(r & SN_FREF_PAIR)) { /* a frame is a function of its entry and the pose: the same bits */
+                memcpy(R, r < h->v.nF ? CARR(h, o_R, sn_q) + 9 * r : CARR(h, o_cR, sn_q) + 9 * (r - h->v.nF),
+                       9 * sizeof(sn_q));
                 return;
             }
-            memo->key[m] = key;
-            memo->R[m] = R;
+            if (sp) p = sp + (r & ~SN_FREF_PAIR);
         }
-        if (cache) { /* key: the pair + 1 (never 0), in a slot by the pair */
-            const uint32_t key = (b1 << 8 | b2) + 1u;
-            sn_slerp_pair *p = cache + (((b1 << 8 | b2) * 2654435761u) >> 26); /* 6 bits: FRAME_SLOTS */
-            if (p->key != key) {
-                sn_qslerp_pair(pq + 4 * b1, pq + 4 * b2, 1, p);
-                p->key = key;
-            }
-            sn_qslerp_at(pq + 4 * b1, pq + 4 * b2, p, t, q);
-        } else sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
+        if (p) sn_qslerp_at(pq + 4 * b1, pq + 4 * b2, p, t, q);
+        else sn_qslerp_path(pq + 4 * b1, pq + 4 * b2, t, q);
         sn_qtomat(q, R);
     }
+}
+
+/* Frame references (format 6.4, BLOB.md "Frame references"): FPAIRS' pairs
+ * distinct (strictly increasing), bones < nJ and different; each FREFS
+ * entry SN_FREF_BONE exactly when its frame does not slerp, else a pair
+ * < nFP with its entry's bones, or an earlier entry with its 4 bytes. So a
+ * referenced frame holds the bits its own entry gives (frame_of), and every
+ * index the step follows is in range. Both counts 0: no references. */
+sn_status sn_check_frefs(const sn_view *v, uint32_t nfp, uint32_t nfr) {
+    const unsigned char *pr = sn_sec(v, SN_SEC_FPAIRS), *rf = sn_sec(v, SN_SEC_FREFS);
+    uint32_t i, prev = 0;
+    if (nfr == 0) return nfp == 0 ? SN_OK : SN_ERR_SECTION;
+    for (i = 0; i < nfp; i++) {
+        uint32_t b1 = pr[2 * i], b2 = pr[2 * i + 1], key = b1 << 8 | b2;
+        if (b1 >= v->nJ || b2 >= v->nJ || b1 == b2) return SN_ERR_INDEX;
+        if (i > 0 && key <= prev) return SN_ERR_VALUE;
+        prev = key;
+    }
+    for (i = 0; i < nfr; i++) {
+        const unsigned char *f = i < v->nF ? v->sec[SN_SEC_FRAMES] + 4 * (size_t)i
+                                           : v->sec[SN_SEC_CFRAMES] + 4 * (size_t)(i - v->nF);
+        uint32_t r = sn_rd_u32(rf + 4 * (size_t)i), k;
+        if (f[0] == f[1] || sn_rd_u16(f + 2) == 0) {
+            if (r != SN_FREF_BONE) return SN_ERR_VALUE;
+        } else if (r & SN_FREF_PAIR) {
+            r &= ~SN_FREF_PAIR;
+            if (r >= nfp) return SN_ERR_INDEX;
+            if (pr[2 * r] != f[0] || pr[2 * r + 1] != f[1]) return SN_ERR_VALUE;
+        } else {
+            const unsigned char *g;
+            if (r >= i) return SN_ERR_INDEX;
+            g = r < v->nF ? v->sec[SN_SEC_FRAMES] + 4 * (size_t)r : v->sec[SN_SEC_CFRAMES] + 4 * (size_t)(r - v->nF);
+            for (k = 0; k < 4; k++)
+                if (g[k] != f[k]) return SN_ERR_VALUE;
+        }
+    }
+    return SN_OK;
 }
 
 /* Joint rotations R_j from the pose quaternions, and the root joint's world
@@ -218,15 +234,22 @@ static void joint_rotations(sn_ihdr *h, sn_real target[3], uint32_t *sat) {
  * then the frames of every free vertex and cell. */
 static void joint_frames(sn_ihdr *h, uint32_t *sat) {
     const sn_view *v = &h->v;
-    const sn_q *pt = CARR(h, o_pt, sn_q), *jR = CARR(h, o_jR, sn_q);
+    const sn_q *pt = CARR(h, o_pt, sn_q), *jR = CARR(h, o_jR, sn_q), *pq = CARR(h, o_pq, sn_q);
     sn_q *jT = ARR(h, o_jT, sn_q), *R = ARR(h, o_R, sn_q);
     sn_q *cR = ARR(h, o_cR, sn_q), xroot[3], rx[3];
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *cfr = v->sec[SN_SEC_CFRAMES];
-    sn_slerp_pair cache[FRAME_SLOTS];
-    frame_memo memo;
+    /* FREFS (format 6.4): repeats copy an earlier frame, and each bone pair's
+     * slerp part is computed once, into the step's scratch (the instance's,
+     * or the workspace's: none between steps of a shared instance) */
+    const unsigned char *rf = sn_level_sec_count(v, SN_SEC_FREFS) ? sn_sec(v, SN_SEC_FREFS) : NULL;
+    unsigned char *ws = sn_ws(h);
+    sn_slerp_pair *sp = rf && ws && h->mode != SN_MODE_UNWARPED ? (sn_slerp_pair *)(void *)(ws + h->o_sp) : NULL;
     uint32_t i, j, k;
-    for (k = 0; k < FRAME_SLOTS; k++) cache[k].key = 0;
-    for (k = 0; k < FRAME_R_SLOTS; k++) memo.key[k] = 0;
+    if (sp) {
+        const unsigned char *pr = sn_sec(v, SN_SEC_FPAIRS);
+        uint32_t n = sn_level_sec_count(v, SN_SEC_FPAIRS);
+        for (i = 0; i < n; i++) sn_qslerp_pair(pq + 4 * pr[2 * i], pq + 4 * pr[2 * i + 1], 1, sp + i);
+    }
     for (k = 0; k < 3; k++) xroot[k] = rd_real(v->sec[SN_SEC_JOINTS] + 8, k);
     for (j = 0; j < v->nJ; j++) {
         sn_rot(jR + 9 * j, xroot, rx, sat);
@@ -240,9 +263,9 @@ static void joint_frames(sn_ihdr *h, uint32_t *sat) {
         }
     }
     for (i = 0; i < v->nF; i++) /* free vertices only: a skeleton vertex's frame is its bone's jR */
-        frame_of(h, fr + 4 * i, R + 9 * i, cache, &memo);
+        frame_of(h, fr + 4 * i, R + 9 * i, rf, i, sp);
     for (i = 0; i < v->nC; i++)
-        frame_of(h, cfr + 4 * i, cR + 9 * i, cache, &memo);
+        frame_of(h, cfr + 4 * i, cR + 9 * i, rf, v->nF + i, sp);
     h->frame_mode = h->mode;
 }
 
@@ -393,7 +416,7 @@ sn_status sn_teleport(sn_instance *inst, const sn_xform *joints, uint32_t n_join
         sn_q Rn[9];
         if (h->mode == SN_MODE_UNWARPED) carry_vertex(h, i, jR, Rroot, &sat);
         else {
-            frame_of(h, fr + 4 * i, Rn, NULL, NULL);
+            frame_of(h, fr + 4 * i, Rn, NULL, 0, NULL);
             carry_vertex(h, i, Rn, R + 9 * i, &sat);
         }
     }

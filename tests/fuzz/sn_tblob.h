@@ -56,6 +56,8 @@
 #define TB_NCON 2    /* constraints (format 5.0) */
 #define TB_NCOL 1    /* colliders */
 #define TB_NCT 3     /* contacts per step */
+#define TB_NFP 1     /* frame pairs (format 6.4): (0, 1) */
+#define TB_FPB (TB_NFP * SN_FPAIR_BYTES) /* their instance bytes (SN_INSTANCE_BYTES' segB) */
 /* constraint state with the crease rows (TB_CR_ACTIVE, below) */
 #define TB_CONB SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, TB_CR_ACTIVE))
 #define TB_CONB_NOCR SN_CONS_BYTES(TB_NCON, TB_NCOL, SN_ROWS_CAP(TB_NCON, TB_NCT, 0))
@@ -147,6 +149,31 @@ static int tb_vid(int ix, int iy, int iz) {
 /* Write the blob into b (zeroed by the caller? no: written whole here);
  * returns its size. len_shift: internal unit = 2^len_shift mesh units.
  * cap must be >= 4096. */
+/* FREFS (format 6.4) from FRAMES, CFRAMES and FPAIRS: each slerping entry's
+ * first equal entry, else its pair (SN_FREF_PAIR | 0x7FFFFFFF, an invalid
+ * index, if FPAIRS lacks it); SN_FREF_BONE for the others. No CRC. */
+static void tb_fix_frefs(unsigned char *b) {
+    const unsigned char *fr = b + tb_sec(b, SN_SEC_FRAMES), *cf = b + tb_sec(b, SN_SEC_CFRAMES), *pr = b + tb_sec(b, SN_SEC_FPAIRS);
+    unsigned char *rf = b + tb_sec(b, SN_SEC_FREFS);
+    uint32_t nF = tb_rd32(b + SN_H_N_FREE), n = tb_rd32(b + SN_H_SECTIONS + 16 * SN_SEC_FREFS + 8);
+    uint32_t np = tb_rd32(b + SN_H_SECTIONS + 16 * SN_SEC_FPAIRS + 8), i, j;
+    for (i = 0; i < n; i++) {
+        const unsigned char *f = i < nF ? fr + 4 * i : cf + 4 * (i - nF);
+        uint32_t r = SN_FREF_BONE;
+        if (f[0] != f[1] && (f[2] | f[3]) != 0) {
+            for (j = 0; j < i; j++)
+                if (!memcmp(f, j < nF ? fr + 4 * j : cf + 4 * (j - nF), 4)) break;
+            if (j < i) r = j;
+            else {
+                for (j = 0; j < np; j++)
+                    if (pr[2 * j] == f[0] && pr[2 * j + 1] == f[1]) break;
+                r = SN_FREF_PAIR | (j < np ? j : 0x7FFFFFFFu);
+            }
+        }
+        tb_u32(rf + 4 * i, r);
+    }
+}
+
 static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     const int R = 4;
     double X[TB_NV][3], M[TB_NV][TB_NV], K[TB_NC][24][24], Sd[TB_NV][9], m0 = 0.0;
@@ -232,7 +259,9 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_ADAPT] = 0;            elem[SN_SEC_ADAPT] = SN_ELEM_ADAPT(R); /* format 6.1: no adaptation */
     cnt[SN_SEC_CELLX] = 0;            elem[SN_SEC_CELLX] = SN_ELEM_CELLX; /* format 6.3: not a cut level */
     cnt[SN_SEC_CELLXK] = 0;           elem[SN_SEC_CELLXK] = (uint32_t)SN_ELEM_CELLXK(SN_FLAVOUR, R);
-    cnt[SN_SEC_DETAILS] = 0;          elem[SN_SEC_DETAILS] = (uint32_t)SN_ELEM_DETAILS(R); /* format 6.4: no details */
+    cnt[SN_SEC_FPAIRS] = TB_NFP;      elem[SN_SEC_FPAIRS] = SN_ELEM_FPAIRS; /* format 6.4: the one pair (0, 1) */
+    cnt[SN_SEC_FREFS] = TB_NF + TB_NC; elem[SN_SEC_FREFS] = SN_ELEM_FREFS;
+    cnt[SN_SEC_DETAILS] = 0;          elem[SN_SEC_DETAILS] = (uint32_t)SN_ELEM_DETAILS(R); /* format 6.5: no details */
     cnt[SN_SEC_DETAIL] = 0;           elem[SN_SEC_DETAIL] = (uint32_t)SN_ELEM_DETAIL(R);
     cnt[SN_SEC_CELLD] = 0;            elem[SN_SEC_CELLD] = SN_ELEM_CELLD;
     cnt[SN_SEC_CELLDK] = 0;           elem[SN_SEC_CELLDK] = (uint32_t)SN_ELEM_CELLDK(SN_FLAVOUR, R);
@@ -298,6 +327,8 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
         tb_u16(f + 2, (uint32_t)((c + 0.5) * cell * 32768.0 + 0.5)); /* cell centre x */
         tb_cellk(ck, K[c]);
     }
+    b[secoff[SN_SEC_FPAIRS]] = 0; /* frame references (format 6.4): the pair (0, 1) */
+    b[secoff[SN_SEC_FPAIRS] + 1] = 1;
     {
         static const uint16_t emb[TB_NS][4] = {
             {0, 16384, 0, 32768}, {1, 32768, 0, 32768}, {1, 32768, 32768, 32768}, {0, 16384, 32768, 32768}};
@@ -422,7 +453,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_u32(b + SN_H_N_SURFACE, TB_NS);
     tb_u32(b + SN_H_N_TRIANGLES, TB_NT);
     tb_u32(b + SN_H_N_OFFDIAG, (uint32_t)nnz);
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB, TB_CONB));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_CRB + TB_FPB, TB_CONB));
     b[SN_H_MAX_FORCES] = TB_NFRC;
     tb_u16(b + SN_H_CG_DEFAULT, 8);
     tb_u16(b + SN_H_CG_MAX, 32);
@@ -443,6 +474,7 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     tb_real(b + SN_H_REALS + SN_R_CELL * R, cell, SN_Q_LEN);
     tb_real(b + SN_H_REALS + SN_R_DISP_BOUND * R, 2.0, 16);
     tb_real(b + SN_H_REALS + SN_R_FORCE * R, 1.0 / 1024.0, TB_FRAC_F); /* 2^30 at Q40 */
+    tb_fix_frefs(b);
     tb_fix_crc(b);
     return off;
 }
@@ -454,12 +486,14 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
  * U with SPD D^-1 gives an SPD preconditioner). Returns the new total size
  * (CRC recomputed), or 0 if it does not fit. */
 static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
-    unsigned char *e = b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL;
+    unsigned char *e = b + SN_H_SECTIONS + 16 * SN_SEC_ICHOL, tail[512];
     const unsigned char *cols = b + tb_sec(b, SN_SEC_COLS);
     uint32_t nnz = tb_rd32(b + SN_H_N_OFFDIAG), nF = tb_rd32(b + SN_H_N_FREE), off = tb_rd32(e), i, n = 0, k, total;
+    uint32_t tl = tb_rd32(b + SN_H_TOTAL_SIZE) - off, sp = tb_sec(b, SN_SEC_FPAIRS) - off, sr = tb_sec(b, SN_SEC_FREFS) - off;
     for (i = 0; i < nnz; i++) n += (uint32_t)(cols[2 * i] | cols[2 * i + 1] << 8) < nF;
     total = (off + n * SN_ELEM_ICHOL + 7u) & ~7u;
-    if (total > cap) return 0;
+    if (total + tl > cap || tl > sizeof tail) return 0;
+    memcpy(tail, b + off, tl); /* format 6.4: the frame references follow, moved after the factor */
     memset(b + off, 0, total - off);
     for (i = 0; i < n; i++) {
         unsigned char *q = b + off + i * SN_ELEM_ICHOL;
@@ -471,7 +505,11 @@ static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_ADAPT, total); /* format 6.1: the empty ADAPT section follows */
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLX, total); /* format 6.3: and the empty cut-level ones */
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLXK, total);
-    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_DETAILS, total); /* format 6.4: the empty details' */
+    memcpy(b + total, tail, tl);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_FPAIRS, total + sp);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_FREFS, total + sr);
+    total += tl;
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_DETAILS, total); /* format 6.5: the empty details', after the frame references */
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_DETAIL, total);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLD, total);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLDK, total);
@@ -499,7 +537,7 @@ static inline void tb_drop_crease(unsigned char *b) {
         tb_u32(e + 4, 0);
         tb_u32(e + 8, 0);
     }
-    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB, TB_CONB_NOCR));
+    tb_u32(b + SN_H_INSTANCE_BYTES, SN_INSTANCE_BYTES(TB_NV, TB_NF, TB_NJ, TB_NC, TB_NK, TB_NFRC, TB_SEGB + TB_FPB, TB_CONB_NOCR));
 }
 /* Empty every section after TRIS (rigs, force shares, segment meshes,
  * constraints, crease), placing them (8-aligned) at offset at (the end of

@@ -182,4 +182,84 @@ static inline double pu_maxdist(const double *a, const double *b, unsigned n) {
     return mx;
 }
 
+/* White-box helpers for tests that read the instance's internals (built with
+ * -Iruntime/src; define PU_WHITE_BOX before including this header):
+ * pu_h, the instance header; pu_qd, an internal length (Q22 in fixed,
+ * SN_Q_LEN) in internal units; pu_qr, a Q30 weight or coefficient;
+ * pu_unit, one internal unit in mesh units (2^len_shift, from the blob);
+ * pu_finite_state, pu_row_residual: the constraint tests' state and row checks. */
+#ifdef PU_WHITE_BOX
+#include "sn_instance.h"
+#include "sn_constraint.h" /* pu_row_residual: the rows */
+static inline sn_ihdr *pu_h(const pu_rt *r) { return (sn_ihdr *)(void *)r->inst; }
+static inline double pu_qd(sn_q x) {
+#if defined(SN_FLOAT)
+    return x;
+#else
+    return ldexp((double)x, -SN_Q_LEN);
+#endif
+}
+static inline double pu_qr(sn_q x) {
+#if defined(SN_FLOAT)
+    return x;
+#else
+    return ldexp((double)x, -30);
+#endif
+}
+static inline double pu_unit(const pu_rt *r) {
+    const unsigned char *b = (const unsigned char *)r->bytes;
+    int ls = b[SN_H_LEN_SHIFT] < 128 ? b[SN_H_LEN_SHIFT] : b[SN_H_LEN_SHIFT] - 256;
+    return ldexp(1.0, ls);
+}
+/* the state finite and within the state range (fixed: +-64 internal units; float: the guard) */
+static inline int pu_finite_state(const pu_rt *r) {
+    sn_ihdr *h = pu_h(r);
+    const sn_q *pos = CARR(h, o_pos, sn_q), *vel = CARR(h, o_vel, sn_q);
+    uint32_t i;
+    for (i = 0; i < 3 * h->v.nV; i++)
+        if (!(fabs(pu_qd(pos[i])) <= 4096.0) || !(fabs(pu_qd(vel[i])) <= 4096.0)) return 0;
+    return 1;
+}
+/* Largest |C^T x - a| over the kept rows of one producer (SN_SRC_*, or
+ * PU_ANY_PRODUCER), in LSB of Q22 (fixed) or relative to the row's scale
+ * sum |c||x| + |a| (float). Coefficients as the runtime forms them (w dir
+ * rounded to Q30). */
+#define PU_ANY_PRODUCER (~0u)
+static inline double pu_row_residual(const pu_rt *r, unsigned producer, uint32_t *kept) {
+    sn_ihdr *h = pu_h(r);
+    const sn_row *rows = sn_rows(h);
+    const sn_rowx *rx = CARR(h, o_rx, sn_rowx);
+    const sn_q *x = CARR(h, o_x, sn_q);
+    uint32_t j, k, c, nF = h->v.nF;
+    double worst = 0;
+    *kept = 0;
+    for (j = 0; j < h->n_rows; j++) {
+        double s = 0, scale = 0, res;
+        if (rx[j].inv == 0 || (producer != PU_ANY_PRODUCER && SN_ROW_PRODUCER(rows[j].source) != producer)) continue;
+        (*kept)++;
+        for (k = 0; k < rows[j].n; k++) {
+            uint32_t a = rows[j].vtx[k];
+            if (a >= nF) continue;
+            for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+                double e = (double)(rows[j].w[k] * rows[j].dir[c]);
+#else
+                double e = (double)(((int64_t)rows[j].w[k] * rows[j].dir[c] + ((int64_t)1 << 29)) >> 30);
+#endif
+                s += e * x[3 * a + c];
+                scale += fabs(e * x[3 * a + c]);
+            }
+        }
+#if defined(SN_FLOAT)
+        res = fabs(s - rx[j].a) / (scale + fabs(rx[j].a) + 1e-30);
+#else
+        (void)scale;
+        res = fabs(ldexp(s, -30) - rx[j].a);
+#endif
+        if (res > worst) worst = res;
+    }
+    return worst;
+}
+#endif /* PU_WHITE_BOX */
+
 #endif
