@@ -50,6 +50,12 @@ $(SN_LIB_FIXED): $(SN_OBJS_FIXED)
 $(SN_LIB_FLOAT): $(SN_OBJS_FLOAT)
 	@rm -f $@
 	$(AR) rcs $@ $^
+# the float objects' compile line, for tests/scripts/test_runtime_rules.sh
+# (it checks these objects instead of compiling its own gcc float set when
+# this line is its own, -g aside)
+.PHONY: print-sn-float-cc
+print-sn-float-cc:
+	@echo '$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) -DSN_FLOAT $(SN_INC)'
 
 # ---- runtime tests: each built fixed and float (suffix _float) ----
 SN_TCFLAGS = -std=c99 -Wall -Wextra -Wpedantic -Werror $(CFLAGS) $(SN_INC) -Iruntime/src -Itests

@@ -215,7 +215,8 @@ TEST_BINS += $(BUILD)/tests/test_runtime_force $(BUILD)/tests/test_runtime_force
 # Nonlinear St. Venant-Kirchhoff reference (issue 13 items 5-6,
 # tests/reference/NONLINEAR.md): bakes the limb and the cow with the tool
 # library itself and compares global linear, warped and nonlinear solutions.
-NL_SRC = tests/reference/nlref.c tools/ref/snref.c ports/desktop/raster.c ports/desktop/png.c
+# (snref: the host tool's object, as REF_SRC, not a third compile of it)
+NL_SRC = tests/reference/nlref.c $(BUILD)/tools/ref/snref.o ports/desktop/raster.c ports/desktop/png.c
 NL_HDR = tests/reference/nlref.h tools/ref/snref.h tools/sb.h tests/sn_test.h ports/desktop/raster.h ports/desktop/png.h
 $(BUILD)/tests/test_nonlinear: tests/test_nonlinear.c $(NL_SRC) $(NL_HDR) $(TOOLS_LIB) $(SN_LIB_FIXED)
 	@mkdir -p $(@D)
@@ -271,15 +272,27 @@ $(BUILD)/tests/test_runtime_constraint_float: $(CONS_RT_DEPS) $(SN_LIB_FLOAT)
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -Iports/common -DSN_FLOAT -o $@ $< $(CONS_RT_SRCS) $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_constraint $(BUILD)/tests/test_runtime_constraint_float
 # sn_contact_rows' per-use fallback (a saturated prediction): the runtime built
-# with -DSN_CT_PER_USE must give the fast path's contact hashes
+# with -DSN_CT_PER_USE must give the fast path's contact hashes. Only
+# sn_contact.c reads the macro: it alone is rebuilt with it (the library's
+# flags), linked ahead of the library, whose sn_contact.o is then not pulled
+# (as tests/level.mk's fold build), instead of the whole runtime per test
 CT_PU_SRC = ports/cross/sn_det.c ports/common/sn_clip.c ports/common/sn_clip_pose.c
-CT_PU_DEPS = tests/test_contact_per_use.c $(CT_PU_SRC) ports/cross/sn_det.h ports/common/sn_clip.h $(SN_SRCS) $(SN_TEST_HDRS)
-$(BUILD)/tests/test_contact_per_use: $(CT_PU_DEPS) $(EX)/cow.blob
+CT_PU_DEPS = tests/test_contact_per_use.c $(CT_PU_SRC) ports/cross/sn_det.h ports/common/sn_clip.h $(SN_TEST_HDRS)
+CT_PU_OBJ = $(BUILD)/tests/per_use
+$(CT_PU_OBJ)/sn_contact.o: runtime/src/sn_contact.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_TCFLAGS) $(SN_SIMD_FLAGS) -DSN_CT_PER_USE -Iports/cross -Iports/common -o $@ $< $(CT_PU_SRC) $(SN_SRCS) -lm
-$(BUILD)/tests/test_contact_per_use_float: $(CT_PU_DEPS) $(EX)/cow_float.blob
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_CT_PER_USE -c $< -o $@
+$(CT_PU_OBJ)/sn_contact_float.o: runtime/src/sn_contact.c $(SN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(SN_TCFLAGS) $(SN_SIMD_FLAGS) -DSN_FLOAT -DSN_CT_PER_USE -Iports/cross -Iports/common -o $@ $< $(CT_PU_SRC) $(SN_SRCS) -lm
+	$(CC) $(SN_WARN) $(CFLAGS) $(SN_SIMD_FLAGS) $(SN_INC) -DSN_FLOAT -DSN_CT_PER_USE -c $< -o $@
+$(BUILD)/tests/test_contact_per_use: $(CT_PU_DEPS) $(CT_PU_OBJ)/sn_contact.o $(SN_LIB_FIXED) $(EX)/cow.blob
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) $(SN_SIMD_FLAGS) -DSN_CT_PER_USE -Iports/cross -Iports/common -o $@ $< $(CT_PU_SRC) \
+	    $(CT_PU_OBJ)/sn_contact.o $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_contact_per_use_float: $(CT_PU_DEPS) $(CT_PU_OBJ)/sn_contact_float.o $(SN_LIB_FLOAT) $(EX)/cow_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) $(SN_SIMD_FLAGS) -DSN_FLOAT -DSN_CT_PER_USE -Iports/cross -Iports/common -o $@ $< $(CT_PU_SRC) \
+	    $(CT_PU_OBJ)/sn_contact_float.o $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_contact_per_use $(BUILD)/tests/test_contact_per_use_float
 # the cow with 8 contacts a step: the contact maximum overflows (test_runtime_constraint)
 $(PHYS_EX)/cow_c8/cow.sinew: tools/examples/cow/cow.sinew tests/physics.mk

@@ -219,17 +219,31 @@ print-prof-m4-steps:
 
 # ---- hosted determinism drivers (det_main) for every compiler/CPU ----
 CROSS_DIR   = $(BUILD)/cross
-DET_SRCS    = ports/cross/det_main.c $(PORT_COMMON) $(PORT_SN_SRCS)
+DET_MAIN_SRCS = ports/cross/det_main.c $(PORT_COMMON)
 # no -g: the drivers are run, never debugged (-g is a fifth of their compile
 # time and changes no code; rebuild one with -g by hand to trace a mismatch)
 DET_CFLAGS  = $(PORT_WARN) $(PORT_INC)
+# the runtime as objects per driver, $(CROSS_DIR)/obj/<name>/: compiled once
+# with the driver's compiler and code flags (-static, a link flag, left out),
+# and linked by the driver and by the kernel test of the same path
+# (tests/kernels.mk: kernels_avx2 ... link these instead of compiling the
+# runtime again); each C file is its own translation unit either way, so the
+# code is the one a single compile-and-link command made
+det_rt_objs = $(patsubst %.c,$(CROSS_DIR)/obj/$(1)/%.o,$(PORT_SN_SRCS))
+# $(1) name, $(2) compiler, $(3) flags (the float drivers: -DSN_FLOAT -ffp-contract=off too)
+define det_rt_rule
+$(CROSS_DIR)/obj/$(1)/%.o: %.c $(PORT_HDRS)
+	@mkdir -p $$(@D)
+	$(2) $(DET_CFLAGS) $(filter-out -static,$(3)) -c $$< -o $$@
+endef
 # $(1) name, $(2) compiler, $(3) flags
 define det_driver
 DET_CC_$(1) = $(firstword $(2))
-$(CROSS_DIR)/det_$(1): $(DET_SRCS) $(PORT_HDRS) $(COW_BLOB_C)
+$(eval $(call det_rt_rule,$(1),$(2),$(3)))
+$(CROSS_DIR)/det_$(1): $(DET_MAIN_SRCS) $(call det_rt_objs,$(1)) $(PORT_HDRS) $(COW_BLOB_C)
 	@mkdir -p $$(dir $$@)
 	$(2) $(DET_CFLAGS) $(3) -DSN_DET_BLOB=sinew_cow_blob -DSN_DET_BLOB_SIZE=sinew_cow_blob_size \
-	    -o $$@ $(DET_SRCS) $(COW_BLOB_C)
+	    -o $$@ $(DET_MAIN_SRCS) $(call det_rt_objs,$(1)) $(COW_BLOB_C)
 endef
 $(eval $(call det_driver,x86_64-gcc-O0,gcc,-O0))
 $(eval $(call det_driver,x86_64-gcc-O2,gcc,-O2))
@@ -256,9 +270,10 @@ $(eval $(call det_driver,aarch64-clang-O2,clang --target=aarch64-linux-gnu,-O2 -
 # agree; the blob comes from the file (the target builds it too)
 define det_float
 DET_CC_$(1) = $(firstword $(2))
-$(CROSS_DIR)/det_$(1): $(DET_SRCS) $(PORT_HDRS) $(COW_FLOAT_BLOB)
+$(eval $(call det_rt_rule,$(1),$(2),$(3) -DSN_FLOAT -ffp-contract=off))
+$(CROSS_DIR)/det_$(1): $(DET_MAIN_SRCS) $(call det_rt_objs,$(1)) $(PORT_HDRS) $(COW_FLOAT_BLOB)
 	@mkdir -p $$(dir $$@)
-	$(2) $(DET_CFLAGS) $(3) -DSN_FLOAT -ffp-contract=off -o $$@ $(DET_SRCS)
+	$(2) $(DET_CFLAGS) $(3) -DSN_FLOAT -ffp-contract=off -o $$@ $(DET_MAIN_SRCS) $(call det_rt_objs,$(1))
 endef
 $(eval $(call det_float,float-gcc-O0,gcc,-O0))
 $(eval $(call det_float,float-gcc-O2,gcc,-O2))
