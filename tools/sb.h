@@ -454,6 +454,8 @@ uint32_t sb_segment_state_bytes(const sb_model *o);
 /* The frames' references (format 6.4, sb_frefs.c): refs (nf + nc, or NULL),
  * pairs (b1 << 8 | b2, or NULL); returns the distinct pairs' count. */
 int sb_frame_refs(const sb_model *o, uint32_t *refs, uint16_t *pairs);
+/* a frame entry's weight w in [0, 1] as FRAMES/CFRAMES store it (Q15, rounded; sb_blob.c) */
+uint16_t sb_frame_w(double w);
 /* SEGNODES and SEGATTACH counts of o's segment meshes */
 void sb_segment_blob_counts(const sb_model *o, uint32_t *nodes, uint32_t *attach);
 /* write the three segment sections at their offsets (blob bytes, rs: real size,

@@ -31,6 +31,8 @@ static void put_u64(wr_t *w, size_t at, uint64_t v)
 /* round to nearest, ties away from zero */
 static double rnd(double x) { return x < 0 ? -floor(-x + 0.5) : floor(x + 0.5); }
 
+uint16_t sb_frame_w(double w) { return (uint16_t)rnd(w * 32768.0); }
+
 /* one real: fixed = round(x * 2^frac) as int32, float32, or float64 */
 static void put_real(wr_t *w, size_t at, double x, int frac)
 {
@@ -515,7 +517,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         for (k = 0; k < 3; k++) put_real(&w, off[SN_SEC_REST] + (size_t)(3 * i + k) * (size_t)rs, (o->x[3 * i + k] - root[k]) / U, SN_Q_LEN);
         put_u8(&w, at, (unsigned)o->fb1[i]);
         put_u8(&w, at + 1, (unsigned)o->fb2[i]);
-        put_u16(&w, at + 2, (unsigned)rnd(o->fw[i] * 32768.0));
+        put_u16(&w, at + 2, sb_frame_w(o->fw[i]));
     }
     nnz = 0;
     for (i = 0; i < nF; i++) {
@@ -556,7 +558,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         for (k = 0; k < 8; k++) put_u16(&w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
         put_u8(&w, at, (unsigned)o->cfb1[i]);
         put_u8(&w, at + 1, (unsigned)o->cfb2[i]);
-        put_u16(&w, at + 2, (unsigned)rnd(o->cfw[i] * 32768.0));
+        put_u16(&w, at + 2, sb_frame_w(o->cfw[i]));
         if (cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w.err = 1;
         if (flavour == SB_FIXED) { /* int32 diagonal (6 symmetric), int16 mantissas, exponents */
             size_t c0 = off[SN_SEC_CELLK] + (size_t)i * SN_CELLK_FIXED_BYTES;

@@ -4,7 +4,6 @@
  * equal (b1, b2, w) entry, and the distinct bone pairs the first ones use. */
 #include "sb.h"
 #include "../runtime/src/sn_format.h"
-#include <math.h>
 #include <stdlib.h>
 
 static int cmp_u64(const void *a, const void *b)
@@ -18,7 +17,7 @@ static uint32_t entry_key(const sb_model *o, int i)
 {
     int b1 = i < o->nf ? o->fb1[i] : o->cfb1[i - o->nf], b2 = i < o->nf ? o->fb2[i] : o->cfb2[i - o->nf];
     double w = i < o->nf ? o->fw[i] : o->cfw[i - o->nf];
-    return (uint32_t)b1 << 24 | (uint32_t)b2 << 16 | (uint32_t)floor(w * 32768.0 + 0.5);
+    return (uint32_t)b1 << 24 | (uint32_t)b2 << 16 | sb_frame_w(w);
 }
 
 /* refs (nf + nc entries, or NULL): SN_FREF_BONE, SN_FREF_PAIR | pair, or

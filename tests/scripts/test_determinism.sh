@@ -327,6 +327,14 @@ $plats
 EOF2
 
 # the crease and level-of-detail runs: "fixed"/"float" lists per scenario
+# A short run (SCENARIO NAME HASH WHAT): its hash must equal x86-64 det_main's
+# run of the same steps made in this run (run_m4ref_SCENARIO.log)
+short_eq() {
+    echo "determinism: $1 $2 $3 ($4)"
+    r=$(hash_of "$L/run_m4ref_$1.log")
+    if [ -n "$r" ] && [ "$3" = "$r" ]; then ok "$1 $2: hash $3 = $m4ref det_main's ($4)"
+    else bad "$1 $2: hash $3, x86-64 det_main ${r:-none} ($4)"; fi
+}
 crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
@@ -335,19 +343,11 @@ while read -r name target runner; do
     for sc in crease lod adapt cut; do
         case $sc:" $ADAPT_SKIP " in adapt:*" $name "*) continue ;; esac
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
-            case "$sc: $SCEN_SHORT " in lod:*" $name "*|adapt:*" $name "*)  # a short run: = x86-64's
-                echo "determinism: $sc $name $h ($M4_SLICE_STEPS steps, switches $M4_SLICE_SW)"
-                r=$(hash_of "$L/run_m4ref_$sc.log")
-                if [ -n "$r" ] && [ "$h" = "$r" ]; then ok "$sc $name: hash $h = $m4ref det_main's ($M4_SLICE_STEPS steps, switches $M4_SLICE_SW)"
-                else bad "$sc $name: hash $h, x86-64 det_main ${r:-none} ($M4_SLICE_STEPS steps, switches $M4_SLICE_SW)"; fi
-                continue ;;
+            case "$sc: $SCEN_SHORT " in lod:*" $name "*|adapt:*" $name "*)
+                short_eq "$sc" "$name" "$h" "$M4_SLICE_STEPS steps, switches $M4_SLICE_SW"; continue ;;
             esac
-            case "$sc: $CR_SHORT " in crease:*" $name "*)  # a short run: = x86-64's
-                echo "determinism: crease $name $h ($CR_SLICE_STEPS steps)"
-                r=$(hash_of "$L/run_m4ref_crease.log")
-                if [ -n "$r" ] && [ "$h" = "$r" ]; then ok "crease $name: hash $h = $m4ref det_main's ($CR_SLICE_STEPS steps)"
-                else bad "crease $name: hash $h, x86-64 det_main ${r:-none} ($CR_SLICE_STEPS steps)"; fi
-                continue ;;
+            case "$sc: $CR_SHORT " in crease:*" $name "*)
+                short_eq crease "$name" "$h" "$CR_SLICE_STEPS steps"; continue ;;
             esac
             echo "determinism: $sc $name $h"
             if [ $sc = cut ] && hc=$(hashc_of "$L/run_cut_$name.log") && [ -n "$hc" ]; then
