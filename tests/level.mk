@@ -41,6 +41,24 @@ $(LEVEL_EX)/%_details.blob: $(LEVEL_EX)/%/details.sinew $(BAKE)
 $(LEVEL_EX)/%_details_float.blob: $(LEVEL_EX)/%/details.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 .PRECIOUS: $(LEVEL_EX)/%/details.sinew
+# every detail active (stage 2's correctness run): A_max clamped to nD by the bake
+$(LEVEL_EX)/%/dall.sinew: $(LEVEL_EX)/%/cut.sinew tests/level.mk
+	cp $< $@ && echo 'details 65535 0.03 0.01' >> $@
+$(LEVEL_EX)/%_dall.blob: $(LEVEL_EX)/%/dall.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_dall_float.blob: $(LEVEL_EX)/%/dall.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/dall.sinew
+DSTEP_BLOBS = $(LEVEL_EX)/cow_lod.blob $(LEVEL_EX)/cow_lod_float.blob $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob \
+              $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob $(LEVEL_EX)/cow_dall.blob $(LEVEL_EX)/cow_dall_float.blob
+# the details stepped against level 1 (tests/test_runtime_dstep.c; LEVELS.md §3 stage 2)
+$(BUILD)/tests/test_runtime_dstep: tests/test_runtime_dstep.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(DSTEP_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_dstep_float: tests/test_runtime_dstep.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FLOAT) $(DSTEP_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float
 DETAIL_BLOBS = $(LEVEL_EX)/limb_cut.blob $(LEVEL_EX)/limb_cut_float.blob $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob \
                $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob
 # the details' sections under the validator (crafted changes) and beside the cut level (tests/test_runtime_details.c)

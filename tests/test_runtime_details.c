@@ -92,7 +92,7 @@ static void same_cut(void)
     size_t n0, n1;
     unsigned char *b0 = load(path("cow_cut" SN_TB_SUFFIX ".blob", p0, sizeof p0), &n0), *b1 = load(path("cow_details" SN_TB_SUFFIX ".blob", p1, sizeof p1), &n1);
     const sn_blob *c0 = NULL, *c1 = NULL;
-    sn_blob_info i0;
+    sn_blob_info i0, i1;
     void *m0 = NULL, *m1 = NULL;
     sn_instance *s0, *s1;
     sn_xform *xf;
@@ -116,9 +116,13 @@ static void same_cut(void)
              sec_at(b1, SN_SEC_CELLDK, 2), sec_at(b1, SN_SEC_CELLDK, 1), b1[sec_at(b1, SN_SEC_DETAILS, 0) + 2], (unsigned long)n0,
              (unsigned long)n1);
     sn_blob_get_info(c0, &i0);
-    m0 = malloc(i0.instance_bytes); m1 = malloc(i0.instance_bytes);
+    sn_blob_get_info(c1, &i1); /* the details' seats make its instance larger (sn_detail_step.c) */
+    T_CHECK(i1.instance_bytes > i0.instance_bytes && sn_instance_size(c1) == i1.instance_bytes &&
+                sn_instance_state_size(c1) - sn_instance_state_size(c0) == i1.instance_bytes - i0.instance_bytes,
+            "[%s] the details' seats: %lu more instance bytes (state size alike)", FL, (unsigned long)(i1.instance_bytes - i0.instance_bytes));
+    m0 = malloc(i0.instance_bytes); m1 = malloc(i1.instance_bytes);
     xf = malloc(sizeof *xf * i0.joints);
-    if (sn_instance_init(m0, i0.instance_bytes, c0, &s0) != SN_OK || sn_instance_init(m1, i0.instance_bytes, c1, &s1) != SN_OK) {
+    if (sn_instance_init(m0, i0.instance_bytes, c0, &s0) != SN_OK || sn_instance_init(m1, i1.instance_bytes, c1, &s1) != SN_OK) {
         T_CHECK(0, "[%s] instances", FL);
     } else {
         for (k = 1; k <= steps && diff < 0; k++) {

@@ -673,7 +673,7 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->offdiag_blocks = v.nnz;
     info->cg_iters_default = v.cg_default;
     info->cg_iters_max = v.cg_max;
-    info->instance_bytes = v.instance_bytes + sn_adapt_bytes(&v); /* == sn_instance_size */
+    info->instance_bytes = v.instance_bytes + sn_adapt_bytes(&v) + sn_detail_bytes(&v); /* == sn_instance_size */
     info->blob_bytes = v.total;
     info->timestep = v.timestep;
     info->controls = v.nK;
@@ -771,5 +771,5 @@ size_t sn_instance_size(const sn_blob *blob) {
     sn_view v;
     if (!blob) return 0;
     sn_view_init(&v, blob);
-    return (size_t)v.instance_bytes + sn_adapt_bytes(&v); /* adaptation's mask follows the layout (sn_adapt.c) */
+    return (size_t)v.instance_bytes + sn_adapt_bytes(&v) + sn_detail_bytes(&v); /* adaptation's mask, then the details' seats (sn_detail_step.c) */
 }
