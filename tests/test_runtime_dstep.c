@@ -248,6 +248,15 @@ int main(int argc, char **argv)
                 ra.sat);
         T_CHECK(rb.hash == hs, "[%s] the 50's run again after sn_reset: the same hash %016llx", FL, (unsigned long long)hs);
         printf("  hash: details50%s %016llx\n", SUF[0] ? "_float" : "_fixed", (unsigned long long)hs);
+        {   /* tests/expected_hashes.txt's line (make update-hashes writes it) */
+            FILE *f = fopen("tests/expected_hashes.txt", "r");
+            char line[256], want[40] = "";
+            while (f && fgets(line, sizeof line, f))
+                if (sscanf(line, SUF[0] ? "details50_float %39s" : "details50_fixed %39s", want) == 1) break;
+            if (f) fclose(f);
+            snprintf(line, sizeof line, "%016llx", (unsigned long long)hs);
+            T_CHECK(strcmp(line, want) == 0, "[%s] details50 hash %s, tests/expected_hashes.txt says '%s'", FL, line, want);
+        }
         if (dump) {
             FILE *f = fopen(dump, "w");
             for (i = 0; f && i < nS; i++) fprintf(f, "%.9g %.9g %.9g\n", D(last[i].x), D(last[i].y), D(last[i].z));

@@ -137,6 +137,19 @@ static void *grow(void *p, size_t *have, size_t need) {
     return p;
 }
 
+/* Details on the cut level (stage 2, sn_detail_step.c): every detail up to
+ * A_max active, so the steps on level 0 run the details' rows. */
+static void set_details(sn_instance *inst, const sn_blob *blob) {
+    static uint16_t ids[65536];
+    sn_view v;
+    uint32_t a, i;
+    sn_view_init(&v, blob);
+    if (sn_level_sec_count(&v, SN_SEC_DETAILS) == 0) return;
+    a = sn_rd_u16(sn_sec(&v, SN_SEC_DETAILS)); /* <= nD (validated) */
+    for (i = 0; i < a; i++) ids[i] = (uint16_t)i;
+    if (sn_details_set(inst, ids, a) != SN_OK) { printf("FAIL: sn_details_set refused A_max details (%s)\n", g_case); exit(1); }
+}
+
 /* The blob as an sn_instance_init_shared instance, stepped with a workspace
  * (sn_step_with) in the warped and blended modes: the sizes derive from the
  * same validated counts as sn_instance_size. Every g_shared_every-th stepped
@@ -154,6 +167,7 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
     (void)sn_set_pose(si, xf, info->joints);
     th_hostile_contacts(si, info->surface_vertices);
     (void)sn_set_iterations(si, info->cg_iters_max < (uint32_t)g_iters ? info->cg_iters_max : (uint32_t)g_iters);
+    set_details(si, blob);
     memset(g_ws, 0xA5, wb);
     if (sn_step_with(si, g_ws, wb) != SN_OK) { printf("FAIL: sn_step_with refused (%s)\n", g_case); exit(1); }
     if (sn_set_mode(si, SN_MODE_BLENDED) != SN_OK || sn_step_with(si, g_ws, wb) != SN_OK) {
@@ -163,8 +177,8 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
     (void)sn_state_hash(si);
 }
 
-/* The details' kernels (sn_detail.c; stage 2: the step does not call them
- * yet) on an accepted blob with details: every cell, every detail active,
+/* The details' kernels (sn_detail.c; the step calls them with the active set:
+ * set_details) on an accepted blob with details: every cell, every detail active,
  * operands all +SN_LIM, then all -SN_LIM (the state's bound), and the
  * surface term at the cell's corners, centre and child boundaries: the
  * bounds they document must hold for anything the validator accepts. */
@@ -283,6 +297,7 @@ static void exercise(const sn_blob *blob) {
     th_hostile_contacts(inst, info.surface_vertices); /* constraints and colliders (format 5.0) */
     (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
     (void)sn_set_mode(inst, SN_MODE_WARPED);
+    set_details(inst, blob);
     for (s = 0; s < g_steps; s++) {
         if (s == g_steps / 2) { /* teleport back to the rest pose halfway: a second violent jump */
             for (j = 0; j < info.joints; j++) { local[j].x = local[j].y = local[j].z = 0; local[j].w = REAL(1.0f, 1 << 30); }
