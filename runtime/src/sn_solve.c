@@ -106,8 +106,9 @@ SN_INLINE void seat_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
 #endif
     }
 }
-/* a corner row's detail mass part, clamped to 2^58 (counted): with <= 8 cells
- * and the assembled row's < 2^60.7 the accumulator stays < 2^61.6 */
+/* a corner row's detail mass part, clamped to 2^56 (counted): with <= 8 cells
+ * (2^59) and the assembled row's < 2^62.3 (NUMERICS.md "The cut level") the
+ * accumulator stays below sn_out's 2^62.5 */
 SN_INLINE void corner_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
     uint32_t c;
     for (c = 0; c < 3; c++) {
@@ -115,7 +116,7 @@ SN_INLINE void corner_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
         acc[c] += t[c];
         (void)sat;
 #else
-        const int64_t lim = (int64_t)1 << 58;
+        const int64_t lim = (int64_t)1 << 56;
         int64_t x = t[c];
         if (x > lim) { x = lim; (*sat)++; }
         if (x < -lim) { x = -lim; (*sat)++; }
