@@ -169,8 +169,8 @@ int main(int argc, char **argv)
     ref = malloc(sizeof *ref * nS * 48);
     s = malloc(sizeof *s * nS);
     last = malloc(sizeof *last * nS);
-    T_FIGURE("[%s] cow: %u details; instance bytes: cut %u, details A_max 50 %u, every detail (A_max %u) %u", FL, nd, in[1].instance_bytes,
-             in[2].instance_bytes, nd, in[3].instance_bytes);
+    T_FIGURE("[%s] cow: %u details, level-0 cell %.4g mesh units; instance bytes: cut %u, details A_max 50 %u, every detail (A_max %u) %u", FL,
+             nd, cell, in[1].instance_bytes, in[2].instance_bytes, nd, in[3].instance_bytes);
 
     /* 1. the contract */
     {
