@@ -19,7 +19,8 @@
  *    level at both measures (the details add level 1's functions: LEVELS.md
  *    §3's static table, 0.544 / 0.051 -> 0.076 / 0.0043 with every detail).
  * 3. No saturation; the state hash of a fixed set is reproducible (reset and
- *    the same run give the same hash). */
+ *    the same run give the same hash; an sn_instance_init_shared instance
+ *    stepped with a workspace gives it too) and is tests/expected_hashes.txt's. */
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
@@ -247,6 +248,25 @@ int main(int argc, char **argv)
         T_CHECK(r0.sat == 0 && r25.sat == 0 && r50.sat == 0 && ra.sat == 0, "[%s] saturations %u %u %u %u", FL, r0.sat, r25.sat, r50.sat,
                 ra.sat);
         T_CHECK(rb.hash == hs, "[%s] the 50's run again after sn_reset: the same hash %016llx", FL, (unsigned long long)hs);
+        {   /* an sn_instance_init_shared instance (the seats in its state, the step's scratch in a workspace): the same bits */
+            size_t sb = sn_instance_state_size(bl[2]), wb = sn_workspace_size(bl[2], SN_MODE_WARPED);
+            void *sm = malloc(sb), *ws = malloc(wb);
+            sn_instance *si;
+            uint64_t hsh = 0;
+            if (sm && ws && sn_instance_init_shared(sm, sb, bl[2], &si) == SN_OK) {
+                sn_set_iterations(si, DIT);
+                T_CHECK(sn_details_set(si, big, 50) == SN_OK, "[%s] shared: 50 set", FL);
+                for (k = 1; k <= 48; k++) {
+                    ramp_pose(bl[2], nj, joint, 90.0, (int)k, xf);
+                    sn_set_pose(si, xf, nj);
+                    sn_step_with(si, ws, wb);
+                }
+                hsh = sn_state_hash(si);
+            }
+            T_CHECK(hsh == hs, "[%s] a shared instance steps the 50 details to the same hash (%016llx, own %016llx)", FL,
+                    (unsigned long long)hsh, (unsigned long long)hs);
+            free(sm); free(ws);
+        }
         printf("  hash: details50%s %016llx\n", SUF[0] ? "_float" : "_fixed", (unsigned long long)hs);
         {   /* tests/expected_hashes.txt's line (make update-hashes writes it) */
             FILE *f = fopen("tests/expected_hashes.txt", "r");
