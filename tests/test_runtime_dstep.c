@@ -84,6 +84,61 @@ static double coef_of(const sn_instance *inst, uint32_t id)
     return m;
 }
 
+/* 4. The seats' preconditioner against double: P_s = 1/a (fixed: 2^frac_P / a),
+ * a = (1+b1) tr(sum_E S_dd)/3 + (1+a1) sum_E m_dd from CELLDK's own blocks
+ * (fixed: m 2^e at Q(frac_S - dshift), masses at Q(frac_M)). Bound: the
+ * runtime's relative 2^-29 (sn_detail_step.c seat_precond) plus one LSB
+ * (fixed); float 1e-6 (a handful of float roundings). Returns the worst
+ * relative error over the seats. */
+static double precond_check(const sn_instance *inst, const sn_blob *blob, const uint16_t *ids, uint32_t n, int *bad)
+{
+    const sn_ihdr *h = (const sn_ihdr *)(const void *)inst;
+    const sn_dstate *st = sn_detail_region(h);
+    sn_view v;
+    const size_t KB = (size_t)SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
+    double worst = 0;
+    uint32_t i, e, k;
+    sn_view_init(&v, blob);
+    for (i = 0; i < n; i++) {
+        double ss = 0, ms = 0, a, pr, got;
+        for (e = 0; e < v.nC; e++) {
+            const unsigned char *cd = sn_sec(&v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+            uint32_t nd = cd[38], nx = sn_sec(&v, SN_SEC_CELLX)[(size_t)e * SN_ELEM_CELLX + 38], j = 0;
+            size_t at = sn_rd_u32(cd + 40);
+            for (k = 0; k < SN_CUT_MAXX; k++) {
+                uint32_t d = sn_rd_u16(cd + 2 * k);
+                if (d == SN_CUT_NONE) continue;
+                if (d == ids[i]) {
+                    const unsigned char *b = sn_sec(&v, SN_SEC_CELLDK) + (at + 8u + nx) * KB;
+#if defined(SN_FLOAT)
+                    ss += (double)sn_rd_f32(b) + sn_rd_f32(b + 16) + sn_rd_f32(b + 32);
+                    ms += sn_rd_f32(b + 36);
+#else
+                    ss += ldexp((double)(int16_t)sn_rd_u16(b) + (int16_t)sn_rd_u16(b + 8) + (int16_t)sn_rd_u16(b + 16), b[18]);
+                    ms += (double)sn_rd_i32(b + 20);
+#endif
+                }
+                at += 8u + nx + nd - j;
+                j++;
+            }
+        }
+#if defined(SN_FLOAT)
+        a = (1.0 + v.b1) * ss / 3.0 + (1.0 + v.a1) * ms;
+        pr = 1.0 / a;
+        got = DT(st, o_P, const sn_q)[i];
+        if (fabs(got - pr) > 1e-6 * pr) (*bad)++;
+#else
+        a = ldexp(1.0 + ldexp(v.b1, -24), 0) * ss / 3.0 / ldexp(1.0, v.frac_S - sn_sec(&v, SN_SEC_DETAILS)[2]) +
+            (1.0 + ldexp(v.a1, -24)) * ms / ldexp(1.0, v.frac_M);
+        pr = ldexp(1.0, v.frac_P) / a;
+        got = DT(st, o_P, const sn_q)[i];
+        if (fabs(got - pr) > ldexp(pr, -29) + 1.0) (*bad)++;
+#endif
+        worst = fmax(worst, fabs(got - pr) / pr);
+    }
+    return worst;
+}
+
 static const char *bpath(char *buf, size_t n, const char *name)
 {
     snprintf(buf, n, "%s/level/%s", getenv("BUILD") ? getenv("BUILD") : "build", name);
@@ -248,6 +303,12 @@ int main(int argc, char **argv)
         T_CHECK(r0.sat == 0 && r25.sat == 0 && r50.sat == 0 && ra.sat == 0, "[%s] saturations %u %u %u %u", FL, r0.sat, r25.sat, r50.sat,
                 ra.sat);
         T_CHECK(rb.hash == hs, "[%s] the 50's run again after sn_reset: the same hash %016llx", FL, (unsigned long long)hs);
+        {
+            int bad = 0;
+            double w = precond_check(cd, bl[2], big, 50, &bad);
+            T_CHECK(bad == 0, "[%s] the seats' preconditioner against double: %d of 50 beyond the bound", FL, bad);
+            T_FIGURE("[%s] the seats' preconditioner 1/a against double: worst relative %.3g (50 seats)", FL, w);
+        }
         {   /* an sn_instance_init_shared instance (the seats in its state, the step's scratch in a workspace): the same bits */
             size_t sb = sn_instance_state_size(bl[2]), wb = sn_workspace_size(bl[2], SN_MODE_WARPED);
             void *sm = malloc(sb), *ws = malloc(wb);

@@ -114,8 +114,9 @@ static int64_t norm35(int64_t x, int *e) {
  * P = 1/a at frac_P (0 when a <= 0: a hostile blob's), clamped to 2^27 as
  * PRECOND's entries; k by sn_k_table's rule on 3P. Fixed: the sums are exact
  * int64 (<= 65535 cells x 3 x 2^27.6 stiffness, x 2^27 mass), each term brought
- * below 2^35 before its Q24 coefficient (< 2^61), the two aligned (< 2^62),
- * P = 2^62 / a shifted to frac_P. */
+ * below 2^35 before its Q24 coefficient (< 2^61), the two aligned (< 2^62) and
+ * brought below 2^31 (relative error < 2^-30), P = (2^63 - 1) / a (>= 32 bits)
+ * shifted to frac_P: P within 2^-29 of 1/a, plus its rounding (test_runtime_dstep). */
 static void seat_precond(const sn_view *v, sn_dstate *s, uint32_t seat, uint32_t det) {
     const unsigned char *cd = sn_sec(v, SN_SEC_CELLD);
     uint32_t e, k;
@@ -155,7 +156,7 @@ static void seat_precond(const sn_view *v, sn_dstate *s, uint32_t seat, uint32_t
     kk[s->nF + seat] = 0;
 #else
     /* a = t1 2^(e1 - (frac_S - ds) - 24) + t2 2^(e2 - frac_M - 24) */
-    t1 = norm35(ssum / 3, &e1) * (ONE_COEF + (int64_t)v->b1);
+    t1 = norm35(ssum, &e1) * (ONE_COEF + (int64_t)v->b1) / 3;
     t2 = norm35(msum, &e2) * (ONE_COEF + (int64_t)v->a1);
     e1 -= v->frac_S - ds;
     e2 -= v->frac_M;
@@ -165,6 +166,7 @@ static void seat_precond(const sn_view *v, sn_dstate *s, uint32_t seat, uint32_t
     A = t1 + t2; /* a = A 2^(ea - 24) */
     q = 0;
     if (A > 0) {
+        while (A >= ((int64_t)1 << 31)) { A /= 2; ea++; } /* below 2^31: the quotient keeps >= 32 bits */
         q = INT64_MAX / A; /* ~2^63 / A */
         sh = v->frac_P - (ea - 24) - 63; /* P = q 2^sh */
         if (sh >= 0) q = (sh > 30 || q > ((int64_t)1 << 27) >> sh) ? (int64_t)1 << 27 : q << sh;
