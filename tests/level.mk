@@ -31,7 +31,44 @@ $(LEVEL_EX)/%_cut_float.blob: $(LEVEL_EX)/%/cut.sinew $(BAKE)
 $(LEVEL_EX)/limb/cut.sinew: tools/examples/limb/limb.sinew tests/level.mk
 	@mkdir -p $(@D)
 	sed -e 's|^mesh \(.*\)|mesh $(CURDIR)/tools/examples/limb/\1|' $< > $@
-	printf 'constraints 4\ncolliders 2 8\nlevels 2 cut\n' >> $@
+	printf 'constraints 4\ncolliders 2 8\nlevels 2 cut\ndetails 8 0.03 0.01\n' >> $@
+# details on the cut level (runtime/LEVELS.md §3 "Details on the cut level"; format 6.5): the cut
+# descriptions with 'details 50 0.03 0.01' (the study's A_max and runtime thresholds)
+$(LEVEL_EX)/%/details.sinew: $(LEVEL_EX)/%/cut.sinew tests/level.mk
+	cp $< $@ && echo 'details 50 0.03 0.01' >> $@
+$(LEVEL_EX)/%_details.blob: $(LEVEL_EX)/%/details.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_details_float.blob: $(LEVEL_EX)/%/details.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/details.sinew
+# every detail active (stage 2's correctness run): A_max clamped to nD by the bake
+$(LEVEL_EX)/%/dall.sinew: $(LEVEL_EX)/%/cut.sinew tests/level.mk
+	cp $< $@ && echo 'details 65535 0.03 0.01' >> $@
+$(LEVEL_EX)/%_dall.blob: $(LEVEL_EX)/%/dall.sinew $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(LEVEL_EX)/%_dall_float.blob: $(LEVEL_EX)/%/dall.sinew $(BAKE)
+	$(BAKE) $< -o $@ --flavour float --quiet
+.PRECIOUS: $(LEVEL_EX)/%/dall.sinew
+DSTEP_BLOBS = $(LEVEL_EX)/cow_lod.blob $(LEVEL_EX)/cow_lod_float.blob $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob \
+              $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob $(LEVEL_EX)/cow_dall.blob $(LEVEL_EX)/cow_dall_float.blob
+# the details stepped against level 1 (tests/test_runtime_dstep.c; LEVELS.md §3 stage 2)
+$(BUILD)/tests/test_runtime_dstep: tests/test_runtime_dstep.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FIXED) $(DSTEP_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_dstep_float: tests/test_runtime_dstep.c $(SN_TEST_HDRS) tests/level_util.h $(SN_LIB_FLOAT) $(DSTEP_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float
+DETAIL_BLOBS = $(LEVEL_EX)/limb_cut.blob $(LEVEL_EX)/limb_cut_float.blob $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob \
+               $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob
+# the details' sections under the validator (crafted changes) and beside the cut level (tests/test_runtime_details.c)
+$(BUILD)/tests/test_runtime_details: tests/test_runtime_details.c $(SN_TEST_HDRS) $(SN_LIB_FIXED) $(DETAIL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_details_float: tests/test_runtime_details.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT) $(DETAIL_BLOBS)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_details $(BUILD)/tests/test_runtime_details_float
 # the crease limb's cut level (crease rows on the cut level: tests/test_runtime_cut_rows.c)
 $(LEVEL_EX)/limb_crease/cut.sinew: tools/examples/limb/limb_crease.sinew tests/level.mk
 	@mkdir -p $(@D)
@@ -182,3 +219,8 @@ $(BUILD)/tests/hier_picture: tests/hier_picture.c tests/hier_study.c tests/sn_te
 .PHONY: hier-picture
 hier-picture: $(BUILD)/tests/hier_picture
 	$(BUILD)/tests/hier_picture ports/desktop/hier_levels.png
+# what the details' cell kernels cost per mat-vec (callgrind; runtime/LEVELS.md §3): not a suite
+$(BUILD)/tests/detail_cost: tests/detail_cost.c $(SN_TEST_HDRS) $(SN_LIB_FIXED)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -o $@ $< $(SN_LIB_FIXED) -lm
+TEST_DEPS += $(BUILD)/tests/detail_cost

@@ -94,17 +94,18 @@ static uint32_t spec_crc32(const unsigned char *p, size_t n)
 static void check_spec(const sb_blob *bl, int flavour, const char *what)
 {
     const unsigned char *b = bl->bytes;
-    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 40u;
+    const unsigned R = flavour == 2 ? 8u : 4u, NSEC = 44u;
     uint32_t total = u32(b + 16), nV = u32(b + 32), nF = u32(b + 36), nC = u32(b + 40), nJ = u32(b + 44), nS = u32(b + 48),
              nT = u32(b + 52), nnz = u32(b + 56), cgd = u16(b + 64), cgm = u16(b + 66), k, nK, nR, nsamp = 0, nent = 0, prev;
     /* section k at 176 + 16 k: {offset, size, count, elem_size}; element sizes (BLOB.md "Sections" with R = real size) */
-    const uint32_t elem[40] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, flavour == 0 ? 724u : 324 * R, R, 8, 6,
+    const uint32_t elem[44] = {8 + 3 * R, 32, 3 * R, 4, R, 6 * R, R, 4, 2, R, 16, 4, flavour == 0 ? 724u : 324 * R, R, 8, 6,
                                40 + 4 * R, 16, 2 * R, 2, 3 * R, 5 * R, 1, 20 + 9 * R, 3 * R, 8 + 3 * R, 8,
                                12 + 3 * R, 4, 2, 2, 1, 8, 8, 20, 8 + 2 * R,
                                44, flavour == 0 ? 20u : 9 * R,    /* format 6.3: CELLX, CELLXK */
-                               2, 4};                             /* format 6.4: FPAIRS, FREFS */
-    uint32_t want[40], inst, segB = 0, conB = 0, crB = 0, crRows = 0, nfp = 0;
-    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 4, "%s: spec: magic SNWB, version 6.4", what);
+                               2, 4,                              /* format 6.4: FPAIRS, FREFS */
+                               8 + 2 * R, 4 + 3 * R, 44, flavour == 0 ? 24u : 10 * R};   /* format 6.5: DETAILS, DETAIL, CELLD, CELLDK */
+    uint32_t want[44], inst, segB = 0, conB = 0, crB = 0, crRows = 0, nfp = 0;
+    T_CHECK(memcmp(b, "SNWB", 4) == 0 && u16(b + 4) == 6 && u16(b + 6) == 5, "%s: spec: magic SNWB, version 6.5", what);
     T_CHECK(b[8] == 4 && b[9] == 3 && b[10] == 2 && b[11] == 1, "%s: spec: endian mark bytes 04 03 02 01", what);
     T_CHECK(total == bl->size && u32(b + 12) == spec_crc32(b + 16, total - 16), "%s: spec: total size, CRC-32 of [16, total)", what);
     T_CHECK(u32(b + 20) == 176 + 16 * NSEC && b[26] == NSEC, "%s: spec: header size 176 + 16 x %u sections", what, NSEC);
@@ -143,13 +144,14 @@ static void check_spec(const sb_blob *bl, int flavour, const char *what)
         nsamp += r[2]; nent += u32(r + 12);
     }
     {
-        const uint32_t w[40] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
+        const uint32_t w[44] = {nJ, nJ, nV, nV, nF, nF, nF, nF + 1, nnz, nnz, nC, nC, nC, 0, nS, nT, nK, nR, nsamp, nent, nent,
                                 u32(b + 176 + 16 * 21 + 8), nF, u32(b + 176 + 16 * 23 + 8), 0, 0, 0, 0, 0, 0, 0,
                                 0, 0, 0,    /* format 6.0: the level sections (none without 'levels 2') */
                                 0,
                                 0,          /* format 6.1: ADAPT, only beside a LEVEL_BLOB */
                                 0, 0,       /* format 6.3: CELLX, CELLXK, only with 'levels 2 cut' */
-                                0, nF + nC};   /* format 6.4: FPAIRS (below), FREFS: one per free vertex and cell */
+                                0, nF + nC,    /* format 6.4: FPAIRS (below), FREFS: one per free vertex and cell */
+                                0, 0, 0, 0};   /* format 6.5: the details, only with 'levels 2 cut' and 'details' */
         memcpy(want, w, sizeof want);
     }
     {   /* FPAIRS / FREFS (BLOB.md "Frame references"), over the free vertices' FRAMES entries then CFRAMES':

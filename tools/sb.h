@@ -199,6 +199,8 @@ typedef struct sb_desc {
     int lod_level;                   /* 0; 1 in the level-1 description sb_level_desc derives (rig files pick that level's fit) */
     int adapt_line, adapt_max;       /* 'adapt REFINE COARSEN MAX_ACTIVE' (with levels 2; 0: none): A_max */
     double adapt_refine, adapt_coarsen; /* level-0 cells */
+    int details_line, details_max;   /* 'details A_MAX REFINE COARSEN' (with levels 2 cut; 0: none) */
+    double details_refine, details_coarsen; /* level-0 cells */
 } sb_desc;
 /* trilinear hex with condensed Wilson-Taylor incompatible modes (default), or the plain trilinear hex */
 enum { SB_ELEM_INCOMPATIBLE = 0, SB_ELEM_TRILINEAR = 1 };
@@ -322,6 +324,8 @@ typedef struct sb_model {
     int cut_nv0;
     int ad_on, ad_max;            /* adaptation (ADAPT record, with lod_size): A_max */
     double ad_refine, ad_coarsen; /* mesh units */
+    int det_on, det_max;          /* the cut level's details (DETAILS, DETAIL, CELLD, CELLDK from cut): A_max */
+    double det_refine, det_coarsen; /* mesh units */
     int lshift_set, lshift;       /* lshift_set: the blob's length unit is at least 2^lshift (both levels share it) */
 } sb_model;
 
@@ -474,7 +478,7 @@ int sb_crease_inside(const double p[3], const double a[3], const double b[3], co
 enum { SB_FIXED = 0, SB_FLOAT = 1, SB_DOUBLE = 2 };
 typedef struct sb_blob {
     unsigned char *bytes; size_t size;
-    uint32_t sec_off[40], sec_size[40];   /* >= SN_SEC_COUNT */
+    uint32_t sec_off[44], sec_size[44];   /* >= SN_SEC_COUNT */
     int len_shift, frac_S, frac_M, frac_P;
     int ichol_n;            /* ICHOL blocks (0: block Jacobi) */
     double ichol_max;       /* largest |U entry| */

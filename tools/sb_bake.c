@@ -11,7 +11,8 @@ static const char *sec_name[] = {"JOINTS", "JOINT_NAMES", "REST", "FRAMES", "MDI
                                              "CONTROLS", "RIGS", "RIG_SAMPLES", "RIG_VERTS", "RIG_FORCES",
                                              "SHARES", "VSHARE", "SEGMESH", "SEGNODES", "SEGATTACH", "CONSTRAINTS",
                                              "CREASE", "CREASE_PAIRS", "CREASE_VNBR", "CREASE_TNBR",
-                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK", "FPAIRS", "FREFS"};
+                                             "LEVEL_BLOB", "LEVEL_UP", "LEVEL_DOWN", "ICHOL", "ADAPT", "CELLX", "CELLXK", "FPAIRS", "FREFS",
+                                             "DETAILS", "DETAIL", "CELLD", "CELLDK"};
 /* one name per section: a new section without its name fails to compile
  * (format 6.1's ADAPT printed as "(null)", a NULL through %s) */
 typedef char sb_sec_name_count_[sizeof sec_name / sizeof sec_name[0] == SN_SEC_COUNT ? 1 : -1];
@@ -63,6 +64,9 @@ int sb_bake_file(const char *desc_path, int flavour, int quiet, sb_model *o, sb_
             printf("  cut       level 0 cut at level 1's skeleton (runtime/LEVELS.md): %d extra skeleton vertices, %d of level 0's skeleton "
                    "vertices free on level 1 made unknowns, %d children with the air element, %d level-1 cells in no level-0 cell left out\n",
                    lod.cut_nx, lod.cut_freed, lod.cut_air, lod.cut_lost);
+        if (d.details_line)
+            printf("  details   %d on the cut level (level 1's free vertices inside level-0 cells), at most %d active\n", lod.cut_nd,
+                   d.details_max < lod.cut_nd ? d.details_max : lod.cut_nd);
         printf("  quality   smallest Jacobian / cell volume %.3g (1: every cell an undistorted cube)\n", o->min_jac);
         printf("  mass      %.6g kg (interior volume %.6g m^3 = %.4f x mesh volume), m0 %.6g kg\n",
                o->mass, o->inside_volume, o->inside_volume / vol, b->m0);

@@ -21,7 +21,7 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
     const int NL = SB_CUT_NL, N3 = 3 * SB_CUT_NL;
     const int hn[3] = {2 * o->gn[0] - 1, 2 * o->gn[1] - 1, 2 * o->gn[2] - 1};
     const size_t nh = (size_t)hn[0] * (size_t)hn[1] * (size_t)hn[2];
-    int E, cc, a, b, k, i, j, ch, *hv = NULL, *hc = NULL, *xid = NULL, rc = -1, full = -1;
+    int E, cc, a, b, k, i, j, ch, *hv = NULL, *hc = NULL, *xid = NULL, *did = NULL, rc = -1, full = -1;
     double *Sair = NULL, *Mair = NULL;
     memset(cut, 0, sizeof *cut);
     if (!o2->Me) return sb_fail("internal error: the cut level needs level 1's per-cell mass");
@@ -51,13 +51,18 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
     Sair = sb_alloc(sizeof(double) * 576); Mair = sb_alloc(sizeof(double) * 64);
     for (i = 0; i < 576; i++) Sair[i] = air * o2->Se[576 * (size_t)full + (size_t)i];
     for (i = 0; i < 64; i++) Mair[i] = air * o2->Me[64 * (size_t)full + (size_t)i];
-    xid = sb_alloc(sizeof(int) * (size_t)o2->nv);
-    for (i = 0; i < o2->nv; i++) xid[i] = -1;
+    xid = sb_alloc(sizeof(int) * (size_t)o2->nv); did = sb_alloc(sizeof(int) * (size_t)o2->nv);
+    for (i = 0; i < o2->nv; i++) xid[i] = did[i] = -1;
     cut->nlost = o2->nc;   /* less each kept level-1 cell a kept level-0 cell claims below */
     cut->xv = sb_alloc(sizeof(int) * (size_t)o2->nv);
     cut->cnx = sb_alloc(sizeof(int) * (size_t)o->nc);
     cut->cx = sb_alloc(sizeof(int) * SB_CUT_MAXX * (size_t)o->nc);
     cut->csub = sb_alloc(sizeof(int) * 27 * (size_t)o->nc);
+    cut->dv = sb_alloc(sizeof(int) * (size_t)o2->nv); cut->dcell = sb_alloc(sizeof(int) * (size_t)o2->nv);
+    cut->dpoint = sb_alloc(sizeof(int) * (size_t)o2->nv); cut->dx = sb_alloc(sizeof(double) * 3 * (size_t)o2->nv);
+    cut->cnd = sb_alloc(sizeof(int) * (size_t)o->nc);
+    cut->cd = sb_alloc(sizeof(int) * SB_CUT_MAXX * (size_t)o->nc);
+    cut->dsub = sb_alloc(sizeof(int) * 27 * (size_t)o->nc);
     cut->K = sb_alloc(sizeof(double) * (size_t)(N3 * N3) * (size_t)o->nc);
     cut->M = sb_alloc(sizeof(double) * (size_t)(NL * NL) * (size_t)o->nc);
     cut->v1 = sb_alloc(sizeof(int) * (size_t)o->nv);   /* each level-0 vertex's level-1 vertex (-1: none) */
@@ -67,25 +72,40 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
         cut->v1[i] = hv[q[0] + hn[0] * (q[1] + hn[1] * q[2])];
     }
     for (E = 0; E < o->nc; E++) {
-        int q0[3], lid[27];
+        int q0[3], lid[27], dlid[27];
         double *KE = cut->K + (size_t)(N3 * N3) * (size_t)E, *ME = cut->M + (size_t)(NL * NL) * (size_t)E;
         half_coords(o, o, o->cells[8 * E], q0);
         /* the extras: level-1 skeleton vertices at the non-corner points of E's closure, in point order */
         for (k = 0; k < 27; k++) {
             int u[3] = {k % 3, k / 3 % 3, k / 9}, n;
-            cut->csub[27 * E + k] = -1; lid[k] = -1;
+            cut->csub[27 * E + k] = -1; cut->dsub[27 * E + k] = -1; lid[k] = -1;
             if (!(u[0] & 1) && !(u[1] & 1) && !(u[2] & 1)) { lid[k] = (u[0] >> 1) | (u[1] >> 1) << 1 | (u[2] >> 1) << 2; continue; }
             n = hv[(q0[0] + u[0]) + hn[0] * ((q0[1] + u[1]) + hn[1] * (q0[2] + u[2]))];
-            if (n < o2->nf) continue;   /* no level-1 vertex there, or a free one: the coarse field */
+            if (n < o2->nf) continue;   /* no level-1 vertex there, or a free one: the coarse field (+ a detail, below) */
             if (xid[n] < 0) { xid[n] = cut->nx; cut->xv[cut->nx++] = n; }
             cut->csub[27 * E + k] = xid[n];
             lid[k] = 8 + cut->cnx[E];
             cut->cx[SB_CUT_MAXX * E + cut->cnx[E]++] = xid[n];
         }
+        /* the details: level-1 free vertices at the other non-corner points, locals after the extras; a child
+         * corner there is the coarse field plus the detail (dlid), so the blocks above are not touched */
+        for (k = 0; k < 27; k++) {
+            int u[3] = {k % 3, k / 3 % 3, k / 9}, n;
+            dlid[k] = -1;
+            if (!(u[0] & 1) && !(u[1] & 1) && !(u[2] & 1)) continue;
+            n = hv[(q0[0] + u[0]) + hn[0] * ((q0[1] + u[1]) + hn[1] * (q0[2] + u[2]))];
+            if (n < 0 || n >= o2->nf) continue;
+            if (did[n] < 0) { did[n] = cut->nd; cut->dv[cut->nd] = n; cut->dcell[cut->nd] = E; cut->dpoint[cut->nd] = k;
+                for (j = 0; j < 3; j++) cut->dx[3 * cut->nd + j] = o2->x[3 * n + j];
+                cut->nd++; }
+            cut->dsub[27 * E + k] = did[n];
+            dlid[k] = 8 + cut->cnx[E] + cut->cnd[E];
+            cut->cd[SB_CUT_MAXX * E + cut->cnd[E]++] = did[n];
+        }
         /* each child: W_c^T S_c W_c (the kept cell's, or the air element), mass alike */
         for (ch = 0; ch < 8; ch++) {
-            int c0[3] = {ch & 1, ch >> 1 & 1, ch >> 2 & 1}, wl[8][8], nw[8];
-            double ww[8][8];
+            int c0[3] = {ch & 1, ch >> 1 & 1, ch >> 2 & 1}, wl[8][9], nw[8];
+            double ww[8][9];
             const double *Sc, *Mc;
             cc = hc[(q0[0] + c0[0]) + hn[0] * ((q0[1] + c0[1]) + hn[1] * (q0[2] + c0[2]))];
             Sc = cc >= 0 ? o2->Se + 576 * (size_t)cc : Sair;
@@ -104,6 +124,7 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
                     for (k = 0; k < 3; k++) w *= (b >> k & 1) ? 0.5 * u[k] : 1 - 0.5 * u[k];
                     if (w != 0) { wl[a][nw[a]] = b; ww[a][nw[a]] = w; nw[a]++; }
                 }
+                if (dlid[s] >= 0) { wl[a][nw[a]] = dlid[s]; ww[a][nw[a]] = 1; nw[a]++; }   /* + the detail there (last) */
             }
             for (a = 0; a < 8; a++)
                 for (b = 0; b < 8; b++)
@@ -121,7 +142,7 @@ int sb_cut_build(const sb_model *o, const sb_model *o2, double air, sb_cut *cut)
     }
     rc = 0;
 done:
-    free(hv); free(hc); free(xid); free(Sair); free(Mair);
+    free(hv); free(hc); free(xid); free(did); free(Sair); free(Mair);
     if (rc) sb_cut_free(cut);
     return rc;
 }
@@ -129,6 +150,7 @@ done:
 void sb_cut_free(sb_cut *cut)
 {
     free(cut->v1); free(cut->xv); free(cut->cnx); free(cut->cx); free(cut->csub); free(cut->K); free(cut->M);
+    free(cut->dv); free(cut->dx); free(cut->dcell); free(cut->dpoint); free(cut->cnd); free(cut->cd); free(cut->dsub);
     memset(cut, 0, sizeof *cut);
 }
 

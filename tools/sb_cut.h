@@ -26,7 +26,15 @@ typedef struct sb_cut {
     int *cnx;        /* per level-0 cell: its extras */
     int *cx;         /* per cell x SB_CUT_MAXX: extra ids (local 8 + k), ordered by their 3x3x3 point */
     int *csub;       /* per cell x 27: point x + 3y + 9z of E's closure (in half cells) -> extra id, -1 */
-    double *K;       /* per cell: (3 NL)^2, locals 0..7 = E's corners, 8.. = cx order (N/m, rest frame) */
+    int nd;          /* detail functions: level-1 free vertices at non-corner points of kept level-0 cells (hats of level 1) */
+    int *dv;         /* per detail: its level-1 vertex */
+    double *dx;      /* per detail: its point at rest (level 1's vertex: the dyadic point) */
+    int *dcell, *dpoint; /* per detail: the first cell holding it and its point there (x + 3y + 9z) */
+    int *cnd;        /* per level-0 cell: its details */
+    int *cd;         /* per cell x SB_CUT_MAXX: detail ids (local 8 + cnx + k), ordered by their 3x3x3 point */
+    int *dsub;       /* per cell x 27: point -> detail id, -1 */
+    double *K;       /* per cell: (3 NL)^2, locals 0..7 = E's corners, 8.. = cx order, then cd order (N/m, rest frame); a
+                      * child corner at a detail's point is the coarse field there plus the detail (the hierarchical basis) */
     double *M;       /* per cell: NL^2 (kg) */
 } sb_cut;
 

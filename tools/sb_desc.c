@@ -546,6 +546,15 @@ static int parse_line(ctx_t *c, sb_desc *d, int *seen)
             return sb_fail("%s:%d: adapt: MAX_ACTIVE must be a whole number in 0..65535 (at most level 1's free vertices)", c->path, c->line);
         d->adapt_refine = r_; d->adapt_coarsen = c_; d->adapt_max = (int)m_;
         d->adapt_line = c->line;
+    } else if (!strcmp(kw, "details")) {   /* details on the cut level (runtime/LEVELS.md §3): thresholds in level-0 cells */
+        double m_, r_, c_;
+        if (nargs(c, 3) || num(c, 1, &m_) || num(c, 2, &r_) || num(c, 3, &c_)) return -1;
+        if (!(m_ >= 0 && m_ <= 65535 && m_ == floor(m_)))
+            return sb_fail("%s:%d: details A_MAX REFINE COARSEN: A_MAX must be a whole number in 0..65535 (at most the details)", c->path, c->line);
+        if (!(r_ >= 0 && c_ >= 0 && c_ <= r_ && r_ <= 64))
+            return sb_fail("%s:%d: details A_MAX REFINE COARSEN: thresholds in level-0 cells, 0 <= COARSEN <= REFINE <= 64 (got %g %g)", c->path, c->line, r_, c_);
+        d->details_max = (int)m_; d->details_refine = r_; d->details_coarsen = c_;
+        d->details_line = c->line;
     } else if (!strcmp(kw, "forces")) {
         double n_;
         if (nargs(c, 1) || num(c, 1, &n_)) return -1;
@@ -830,6 +839,7 @@ int sb_desc_load(const char *path, sb_desc *d)
     if (d->nj == 0) return sb_fail("%s: no joints", path);
     if (d->nm == 0) return sb_fail("%s: no materials", path);
     if (d->adapt_line && d->levels < 2) return sb_fail("%s:%d: adapt needs 'levels 2' (it adapts the finer level)", path, d->adapt_line);
+    if (d->details_line && !d->levels_cut) return sb_fail("%s:%d: details need 'levels 2 cut' (they refine the cut level)", path, d->details_line);
     if (d->cr_active > d->cr_list) return sb_fail("%s:%d: crease active rows (%d) exceed the list size (%d)", path, d->cr_line, d->cr_active, d->cr_list);
     if (d->cr_depth > 0 && d->cr_push > d->cr_depth) return sb_fail("%s:%d: crease push (%g) exceeds depth (%g)", path, d->cr_line, d->cr_push, d->cr_depth);
     /* resolve parents (they may be declared after their children) */

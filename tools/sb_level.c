@@ -625,8 +625,14 @@ int sb_level_bake(const sb_desc *d, const sb_mesh *m, sb_model *o, int flavour, 
         o->ad_on = 1; o->ad_max = d->adapt_max < o2.nf ? d->adapt_max : o2.nf; /* at most every free vertex */
         o->ad_refine = d->adapt_refine * o->c; o->ad_coarsen = d->adapt_coarsen * o->c;
     }
+    if (d->details_line && d->levels_cut) {   /* the cut level's details (sb_cut.h): A_max within them, thresholds in level-0 cells */
+        if (cut.nd == 0) { sb_fail("%s:%d: details: the cut level has none (no free level-1 vertex inside a level-0 cell)", d->path, d->details_line); goto done; }
+        o->det_on = 1; o->det_max = d->details_max < cut.nd ? d->details_max : cut.nd;
+        o->det_refine = d->details_refine * o->c; o->det_coarsen = d->details_coarsen * o->c;
+        info->cut_nd = cut.nd;
+    }
     rc = sb_blob_make(o, flavour, b);
-    o->lod_blob = NULL; o->lod_size = 0; o->lod_up = o->lod_down = NULL; o->ad_on = 0;
+    o->lod_blob = NULL; o->lod_size = 0; o->lod_up = o->lod_down = NULL; o->ad_on = 0; o->det_on = 0;
     (void)quiet;
 done:
     o2.cr_pairs = NULL; o2.cr_vnbr = o2.cr_tnbr = NULL; o2.crease = 0;   /* borrowed */

@@ -81,6 +81,7 @@ typedef struct sb_lodinfo {
     uint32_t size1;         /* its blob's bytes */
     int up_far, down_far;   /* vertices of one level outside every kept cell of the other (nearest cell, clamped) */
     uint32_t inst0, inst1, inst;   /* instance bytes of level 0 alone, level 1 alone, the two-level instance */
+    int cut_nd;   /* 'details' on the cut level: the details written (sb_cut.h) */
     int cut_nx, cut_freed, cut_air, cut_lost;   /* 'levels 2 cut' (sb_cut.h): extras, level-0 skeleton vertices freed, air children, level-1 cells left out */
 } sb_lodinfo;
 /* The level-1 description of d (built as o): d shallow-copied (d2 shares d's arrays: free only one)

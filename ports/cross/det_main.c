@@ -1,11 +1,13 @@
 /* det_main.c -- headless determinism driver, built by every compiler and
  * cross compiler of tests/scripts/test_determinism.sh.
  *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]
- *            [--shared] [--main-only]
+ *            [--shared] [--main-only] [--details N] [--iterations K]
  * --lod: sn_set_lod(L) before step K (a blob baked with 'levels 2', runtime/LEVELS.md).
  * --shared: a shared instance stepped by sn_step_with on a separate workspace
  * (sinew.h "Shared workspace"); its hash must equal the own-scratch one.
  * --main-only: leave out the contact and blended scenarios after the run.
+ * --details N: details 0..N-1 active on the cut level (sn_details_set, runtime/LEVELS.md §3);
+ * --iterations K: K CG iterations (sn_set_iterations) from the first step.
  * Without BLOB it uses the array linked in with -DSN_DET_BLOB=sym
  * -DSN_DET_BLOB_SIZE=sym (the host tool's C-array output), copied to
  * malloc memory because the runtime wants 8-byte alignment.
@@ -44,7 +46,7 @@ int main(int argc, char **argv) {
     const char *blob_path = NULL, *clip_path = NULL;
     char *blob, *clip_text = NULL;
     size_t blob_n = 0, clip_n = 0, mem_n;
-    unsigned long steps = 1000, trace = 0, k, lod_k[16];
+    unsigned long steps = 1000, trace = 0, k, lod_k[16], n_det = 0, iters = 0;
     unsigned lod_l[16];
     void *mem, *ws = NULL;
     size_t ws_n = 0;
@@ -69,8 +71,10 @@ int main(int argc, char **argv) {
         }
         else if (!strcmp(argv[i], "--shared")) shared = 1;
         else if (!strcmp(argv[i], "--main-only")) main_only = 1;
+        else if (!strcmp(argv[i], "--details") && i + 1 < argc) n_det = strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--iterations") && i + 1 < argc) iters = strtoul(argv[++i], NULL, 10);
         else if (argv[i][0] != '-' && !blob_path) blob_path = argv[i];
-        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]] [--shared] [--main-only]\n"); return 2; }
+        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]] [--shared] [--main-only] [--details N] [--iterations K]\n"); return 2; }
     }
     if (blob_path) {
         blob = slurp(blob_path, &blob_n);
@@ -109,6 +113,13 @@ int main(int argc, char **argv) {
                              mem, mem_n, err, sizeof err)) {
         fprintf(stderr, "det_main: %s\n", err); return 1;
     }
+    if (n_det) { /* details on the cut level: ids 0..n_det-1 */
+        uint16_t *ids = malloc(sizeof *ids * n_det);
+        for (j = 0; ids && (unsigned long)j < n_det; j++) ids[j] = (uint16_t)j;
+        if (n_det > 65535u || !ids || sn_details_set(det.inst, ids, (uint32_t)n_det) != SN_OK) { fprintf(stderr, "det_main: --details %lu refused\n", n_det); return 1; }
+        free(ids);
+    }
+    if (iters && sn_set_iterations(det.inst, (uint32_t)iters) != SN_OK) { fprintf(stderr, "det_main: --iterations %lu refused\n", iters); return 1; }
     for (k = 0; k < steps; k++) {
         sn_det_pose(&det);
         for (j = 0; j < n_lod; j++)   /* level switches before step k + 1 (as sinew-play --lod) */

@@ -11,6 +11,11 @@
  *                              ground plane, rising sphere, four pins) set
  *                              before the first step; its cost follows the
  *                              active contacts, so compare equal N only
+ *   sn_bench --details N [--iterations K] --steps S blob
+ *                              details on the cut level (runtime/LEVELS.md
+ *                              §3): ids 0..N-1 active (N <= the blob's
+ *                              A_max), K CG iterations (0: the blob's)
+ *   sn_bench --lod L --steps S blob   level L of a 'levels 2' blob
  *
  * Built against the shipping library (libsinew.a / libsinew_float.a).
  * The pose sequence: every joint swings about its own axis with its own
@@ -65,6 +70,8 @@ static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
+static int g_details, g_iters, g_lod; /* --details N, --iterations K, --lod L (--steps only) */
+
 static int bench_blob(const char *path, int only_steps, int contact) {
     size_t size, need;
     unsigned char *bytes = bench_load(path, &size);
@@ -110,6 +117,17 @@ static int bench_blob(const char *path, int only_steps, int contact) {
             d.inst = inst;
             if (!sn_det_contact(&d)) fprintf(stderr, "sn_bench: --contact: %s has no room for the contact scenario\n", path);
         }
+        if (g_details > 0) {
+            uint16_t *ids = (uint16_t *)malloc(sizeof *ids * (size_t)g_details);
+            for (k = 0; ids && k < g_details; k++) ids[k] = (uint16_t)k;
+            if (!ids || sn_details_set(inst, ids, (uint32_t)g_details) != SN_OK) {
+                fprintf(stderr, "sn_bench: --details %d refused by %s\n", g_details, path);
+                return 1;
+            }
+            free(ids);
+        }
+        if (g_iters > 0 && sn_set_iterations(inst, (uint32_t)g_iters) != SN_OK) return 1;
+        if (g_lod > 0 && sn_set_lod(inst, (uint32_t)g_lod) != SN_OK) return 1;
         bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         for (k = 0; k < only_steps; k++) sn_step(inst);
@@ -173,6 +191,9 @@ static int bench_blob(const char *path, int only_steps, int contact) {
 int main(int argc, char **argv) {
     int i, steps = -1, rc = 0, any = 0, contact = 0;
     for (i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--details") == 0 && i + 1 < argc) { g_details = atoi(argv[++i]); continue; }
+        if (strcmp(argv[i], "--iterations") == 0 && i + 1 < argc) { g_iters = atoi(argv[++i]); continue; }
+        if (strcmp(argv[i], "--lod") == 0 && i + 1 < argc) { g_lod = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) { steps = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--contact") == 0) { contact = 1; continue; }
         rc |= bench_blob(argv[i], steps, contact);

@@ -390,6 +390,20 @@ sn_status sn_set_lod(sn_instance *inst, uint32_t level);
 /// SN_ERR_ARG turning it on in a blob without adaptation data.
 sn_status sn_set_adapt(sn_instance *inst, int on);
 
+/// Details on the cut level (description 'details A_MAX REFINE COARSEN' with
+/// 'levels 2 cut'; runtime/LEVELS.md §3): the active set, n ids (< the
+/// blob's detail count, no repeat), at most the blob's A_max. Each active
+/// detail (a level-1 hat on top of the cut field) is stepped while the cut
+/// level is in force (not in SN_MODE_BLENDED). A detail already active keeps
+/// its state; one entering starts at coefficient 0 and velocity 0 (the surface
+/// does not move); one leaving drops its coefficient. sn_reset empties the
+/// set. SN_ERR_ARG (nothing changes) for n > A_max, an id out of range or
+/// repeated, or n > 0 on a blob without details; SN_ERR_NULL for ids NULL with n > 0.
+/// The details' rows are preconditioned by their own diagonal only (for now):
+/// they need more CG iterations than the cut level (sn_set_iterations; the
+/// cow: 8 for 25 details, 32 for 50, LEVELS.md §3), or the run drifts.
+sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n);
+
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
 /// (free positions, velocities, warm start, skeleton state, step count, control
 /// values), the same on every platform. Used by the determinism tests. 0 if

@@ -29,6 +29,7 @@
 #include "sn_internal.h"
 #include "sn_adapt.h" /* sn_check_adapt, sn_adapt_bytes */
 #include "sn_cut.h"   /* sn_check_cut: CELLX, CELLXK */
+#include "sn_detail.h" /* sn_check_details: DETAILS, DETAIL, CELLD, CELLDK */
 
 static const unsigned char *sn_bytes(const sn_blob *b) {
     return (const unsigned char *)(const void *)b;
@@ -402,6 +403,10 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     cnt[SN_SEC_CELLXK] = 0; /* <= 8 x 19 nC: taken from the table below, checked with CELLX */
     cnt[SN_SEC_FPAIRS] = 0; /* <= nJ (nJ - 1): taken from the table below, checked with FREFS */
     cnt[SN_SEC_FREFS] = 0;  /* 0 or nF + nC: taken from the table below */
+    cnt[SN_SEC_DETAILS] = 0; /* format 6.5, the details: 0 or 1, <= 19 nC, 0 or nC, <= 342 nC; checked together */
+    cnt[SN_SEC_DETAIL] = 0;
+    cnt[SN_SEC_CELLD] = 0;
+    cnt[SN_SEC_CELLDK] = 0;
     /* rig sections: counts from the table, bounded (cost per step, u16/u32 indices) */
     {
         const unsigned char *t = p + SN_H_SECTIONS + 8;
@@ -479,7 +484,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             SN_ELEM_SEGATTACH(SN_REAL_BYTES), SN_ELEM_CONSTRAINTS, SN_ELEM_CREASE(SN_REAL_BYTES), SN_ELEM_CREASE_PAIRS,
             SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR, SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP,
             SN_ELEM_ICHOL, SN_ELEM_ADAPT(SN_REAL_BYTES), SN_ELEM_CELLX, SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES),
-            SN_ELEM_FPAIRS, SN_ELEM_FREFS};
+            SN_ELEM_FPAIRS, SN_ELEM_FREFS,
+            SN_ELEM_DETAILS(SN_REAL_BYTES), SN_ELEM_DETAIL(SN_REAL_BYTES), SN_ELEM_CELLD, SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES)};
         prev_end = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             const unsigned char *e = p + SN_H_SECTIONS + (size_t)k * SN_SECTION_ENTRY;
@@ -492,6 +498,10 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
             if (k == SN_SEC_CELLXK && (uint64_t)sn_rd_u32(e + 8) <= 8u * SN_CUT_MAXX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
             if (k == SN_SEC_FPAIRS && sn_rd_u32(e + 8) <= v.nJ * (v.nJ - 1u)) cnt[k] = sn_rd_u32(e + 8); /* distinct pairs */
             if (k == SN_SEC_FREFS && sn_rd_u32(e + 8) == v.nF + v.nC) cnt[k] = v.nF + v.nC; /* optional */
+            if (k == SN_SEC_DETAILS && sn_rd_u32(e + 8) == 1u) cnt[k] = 1u;
+            if (k == SN_SEC_DETAIL && (uint64_t)sn_rd_u32(e + 8) <= SN_CUT_MAXX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
+            if (k == SN_SEC_CELLD && sn_rd_u32(e + 8) == v.nC) cnt[k] = v.nC;
+            if (k == SN_SEC_CELLDK && (uint64_t)sn_rd_u32(e + 8) <= SN_DETAIL_CELL_MAX * (uint64_t)v.nC) cnt[k] = sn_rd_u32(e + 8);
             if ((off & 7u) != 0 || off < prev_end || off > total || sz > total - off)
                 return SN_ERR_SECTION;
             if (sn_rd_u32(e + 8) != cnt[k] || sn_rd_u32(e + 12) != elem[k] ||
@@ -514,6 +524,8 @@ static sn_status validate_one(const void *data, size_t size, sn_view *vo) {
     st = sn_check_cut(&v, cnt[SN_SEC_CELLX], cnt[SN_SEC_CELLXK]);
     if (st != SN_OK) return st;
     st = sn_check_frefs(&v, cnt[SN_SEC_FPAIRS], cnt[SN_SEC_FREFS]);
+    if (st != SN_OK) return st;
+    st = sn_check_details(&v, cnt[SN_SEC_DETAILS], cnt[SN_SEC_DETAIL], cnt[SN_SEC_CELLD], cnt[SN_SEC_CELLDK], cnt[SN_SEC_CELLX]);
     if (st != SN_OK) return st;
     st = sn_check_forces(&v);
     if (st != SN_OK) return st;
@@ -661,7 +673,7 @@ void sn_blob_get_info(const sn_blob *blob, sn_blob_info *info) {
     info->offdiag_blocks = v.nnz;
     info->cg_iters_default = v.cg_default;
     info->cg_iters_max = v.cg_max;
-    info->instance_bytes = v.instance_bytes + sn_adapt_bytes(&v); /* == sn_instance_size */
+    info->instance_bytes = v.instance_bytes + sn_adapt_bytes(&v) + sn_detail_bytes(&v); /* == sn_instance_size */
     info->blob_bytes = v.total;
     info->timestep = v.timestep;
     info->controls = v.nK;
@@ -759,5 +771,5 @@ size_t sn_instance_size(const sn_blob *blob) {
     sn_view v;
     if (!blob) return 0;
     sn_view_init(&v, blob);
-    return (size_t)v.instance_bytes + sn_adapt_bytes(&v); /* adaptation's mask follows the layout (sn_adapt.c) */
+    return (size_t)v.instance_bytes + sn_adapt_bytes(&v) + sn_detail_bytes(&v); /* adaptation's mask, then the details' seats (sn_detail_step.c) */
 }

@@ -1,6 +1,7 @@
 /* sn_embed.c -- outputs: deformed lattice, embedded surface (trilinear in
  * each cell, seed 000 §3.1) and area-weighted normals. */
 #include "sn_cut.h" /* sn_cut_interp: the cut level's field */
+#include "sn_detail.h" /* sn_detail_interp: the active details on the surface */
 
 /* ---- outputs ---- */
 
@@ -57,6 +58,10 @@ void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
         for (k = 0; k < 3; k++) acc[k] += sn_mul(phi[a], pos[3 * vtx + k]);
     }
     if (h->v.cut) sn_cut_interp(&h->v, sn_rd_u16(e), t, pos, pos + 3 * h->v.nF, acc);
+    if (h->v.cut && h->lod == 0u) { /* the active details' hats (LEVELS.md §3; none active: no term) */
+        const sn_dstate *ds = sn_detail_region(h);
+        if (ds && ds->n) sn_detail_interp(&h->v, sn_rd_u16(e), t, DT(ds, o_of, const uint16_t), DT(ds, o_coef, const sn_q), acc);
+    }
     for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
 }
 

@@ -1,4 +1,4 @@
-/* sn_format.h -- byte layout of a Sinew blob (format 6.4).
+/* sn_format.h -- byte layout of a Sinew blob (format 6.5).
  *
  * Shared by the runtime (reader), the host tool (writer) and the tests'
  * double-precision reference (reader). Prose spec: runtime/BLOB.md.
@@ -16,7 +16,7 @@
 #define SN_MAGIC2 'W'
 #define SN_MAGIC3 'B'
 #define SN_FORMAT_MAJOR 6
-#define SN_FORMAT_MINOR 4
+#define SN_FORMAT_MINOR 5
 #define SN_ENDIAN_MARK 0x01020304u   /* stored LE: bytes 04 03 02 01 */
 #define SN_ONE_FIXED 0x40000000u     /* 1.0 in Q30 */
 #define SN_ONE_FLOAT32 0x3F800000u   /* 1.0f */
@@ -195,6 +195,24 @@ enum {
                             SN_FREF_BONE for an entry that does not slerp (bone1 = bone2 or w = 0: the bone's rotation);
                             SN_FREF_PAIR | p for the first entry of its (bone1, bone2, w), slerped from pair p (< nFP, the
                             same bones); a < i for a repeat: the frame of entry a (the same 4 bytes), copied */
+    /* ---- details on the cut level (issue 13 item 2; runtime/LEVELS.md §3 "Details on the cut level"), format 6.5; all
+       four count 0, or (with CELLX) DETAILS 1, DETAIL nD >= 1, CELLD nC: level 1's free vertices at the non-corner
+       points of the cut level's cells, each a level-1 hat added to the cut field (the hierarchical basis) ---- */
+    SN_SEC_DETAILS,      /* 0 or 1 x {u16 max_active (A_max, 0..nD), u8 dshift (fixed: CELLDK's blocks are in
+                            Q(frac_S - dshift), 0..SN_DETAIL_SHIFT_MAX; float 0), u8 0, u32 0, R refine, R coarsen (Q22 internal,
+                            0 <= coarsen <= refine <= SN_ADAPT_MAX)}: at most A_max details active, joining at an estimate
+                            >= refine, staying while their coefficient >= coarsen */
+    SN_SEC_DETAIL,       /* nD x {u16 cell (< nC), u8 point (its half-cell point p + 3q + 9r in that cell's closure, not a
+                            corner), u8 0, R rest[3] (Q22 internal, as REST: the point at rest)}: CELLD of that cell names
+                            this detail at that point */
+    SN_SEC_CELLD,        /* nC x {u16 d[19]: the detail (< nD) at each non-corner point of the cell's closure (CELLX's
+                            order), SN_CUT_NONE where none (and wherever CELLX has an extra); u8 nd (entries set), u8 0,
+                            u32 first (its first CELLDK element: nd (8 + nx) + nd (nd + 1) / 2 per cell, running sum)} */
+    SN_SEC_CELLDK,       /* per cell, per detail j in d[] order, columns: corners 0..7, the cell's extras in x[] order, the
+                            details k >= j in d[] order: the cut element's block [detail row x column], entry [3i+j] =
+                            K_E[3d+i][3col+j] (Q frac_S - dshift), and the mass M_E[d][col] / m0 (Q frac_M, as MOFF;
+                            > 0 for k = j). fixed: {i16 m[9], u8 e (<= SN_CELLK_EXP_MAX), u8 0, i32 mass}, entry = m 2^e,
+                            |m| <= 2^15 - 1; float: {R[9], R mass}; |entry|, |mass| <= 2^27 */
     SN_SEC_COUNT
 };
 
@@ -256,6 +274,12 @@ enum {
 #define SN_FREF_PAIR        0x80000000u
 /* instance bytes per frame pair: its slerp part (sn_slerp_pair, sn_internal.h), the step's scratch */
 #define SN_FPAIR_BYTES      40u
+#define SN_ELEM_DETAILS(R)  (8 + 2 * (R))
+#define SN_ELEM_DETAIL(R)   (4 + 3 * (R))
+#define SN_ELEM_CELLD       44
+#define SN_ELEM_CELLDK(flavour, R) ((flavour) == SN_FLAVOUR_FIXED ? 24 : 10 * (R))
+#define SN_DETAIL_SHIFT_MAX 4    /* a detail's own block is at most 2^4 of the largest corner block's scale */
+#define SN_DETAIL_CELL_MAX  342u /* CELLDK elements of one cell: nd (8 + nx) + nd (nd + 1) / 2, nd + nx <= 19 */
 #define SN_ELEM_ICHOL       20   /* every flavour: int16 mantissas, one exponent per block */
 #define SN_ICHOL_FRAC_MAX   47   /* forward sweep shift frac + k_j - k_i <= 62 (k <= 15) */
 

@@ -4,6 +4,7 @@
  * SN_INSTANCE_BYTES (sn_format.h) is tested against it. */
 #include "sn_blended.h" /* sn_instance.h, SN_VIEW_BLENDED */
 #include "sn_adapt.h"
+#include "sn_detail.h" /* the details' seats (sn_detail_step.c) */
 
 /* hdr | acc nF*3 acc | per joint: wrench | force slots | segment state |
  * per joint: pose q4 t3, R9, T3 | per vertex: pos3 vel3 |
@@ -122,7 +123,7 @@ size_t sn_instance_state_size(const sn_blob *blob) {
     uint32_t off[SN_LAYOUT_ARRAYS], row, ws;
     if (!blob) return 0;
     sn_view_init(&v, blob);
-    return (size_t)shared_offsets(&v, off, &row, &ws) + sn_adapt_bytes(&v);
+    return (size_t)shared_offsets(&v, off, &row, &ws) + sn_adapt_bytes(&v) + sn_detail_bytes(&v);
 }
 
 size_t sn_workspace_size(const sn_blob *blob, sn_mode mode) {
@@ -139,7 +140,7 @@ size_t sn_workspace_size(const sn_blob *blob, sn_mode mode) {
 uint32_t sn_blend_offset(const sn_ihdr *h) {
     if (h->v.flags & SN_VIEW_SHARED) /* after the factor (shared_offsets' *ws) */
         return (h->o_L + 4u * (h->v.nRows * (h->v.nRows + 1u) / 2u) + 7u) & ~7u;
-    return h->v.instance_bytes + h->ad_bytes; /* past adaptation's mask (sn_instance_size_mode) */
+    return h->v.instance_bytes + h->ad_bytes + (sn_detail_region(h) ? sn_detail_region(h)->bytes : 0u); /* past adaptation's mask and the details' seats (sn_instance_size_mode) */
 }
 
 #if !defined(SN_FLOAT)
@@ -211,6 +212,7 @@ static sn_status init(void *mem, size_t mem_size, const sn_blob *blob, sn_instan
     h->iterations = h->v.cg_default;
     h->mode = SN_MODE_WARPED;
     sn_adapt_init(h); /* the mask after the layout, before the blended arrays (sn_instance_size) */
+    sn_detail_init(h); /* the details' seats after it */
 #if defined(SN_FLOAT)
     {
         int k;
@@ -318,6 +320,7 @@ sn_status sn_reset(sn_instance *inst) {
     sn_controls_reset(h);
     sn_segments_reset(h);
     sn_cons_reset(h);
+    sn_detail_reset(h);
     if (h->ad_bytes) sn_ad(h)->refines = sn_ad(h)->coarsens = sn_ad(h)->overflow = 0;
     {
         uint32_t sat = 0; /* interpolation with convex weights: never clamps */
@@ -446,5 +449,6 @@ uint64_t sn_state_hash(const sn_instance *inst) {
         for (i = 0; i < na; i++)
             if (!m[i]) hsh = fnv_u32(hsh, i);
     }
+    hsh = sn_detail_hash(h, hsh, fnv_u32); /* no seat filled: unchanged */
     return sn_crease_hash(h, hsh);   /* no crease sections: unchanged */
 }

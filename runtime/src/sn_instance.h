@@ -71,6 +71,8 @@ typedef struct sn_ihdr {
     /* adaptation on level 1 (sn_adapt.c): its state (sn_adapt_state, then the mask) takes ad_bytes
      * after the layout, at v.instance_bytes (0: the blob has no ADAPT record) */
     uint32_t ad_bytes;
+    /* (details on the cut level, sn_detail_step.c: their region follows adaptation's, at
+     * v.instance_bytes + ad_bytes, when the blob has DETAILS; sn_detail_region) */
 } sn_ihdr;
 
 /* Adaptation's state, at v.instance_bytes (sn_adapt.c): the record's A_max and thresholds as ordered

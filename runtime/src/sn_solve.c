@@ -15,6 +15,7 @@
 #include "sn_kernels_rot.h" /* sn_k_rot_t, sn_k_rot, sn_k_rot_acc: the frame rotations, reference or SIMD */
 #include "sn_adapt.h"   /* the active set of level 1 (seed 000 §4.7) */
 #include "sn_cut.h"     /* the cut level's extras (sn_cut_terms) */
+#include "sn_detail.h"  /* details on the cut level: the seats' rows (sn_detail_step.c, kernels in sn_detail.c) */
 
 SN_INLINE void sca_row(sn_acc l[3], sn_q m, const sn_q e[3]) {
     l[0] += sn_mul(m, e[0]);
@@ -69,10 +70,81 @@ SN_INLINE const sn_q *w_of(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uin
     return tmp;
 }
 
+/* Cell e's active details (CELLD's compact order): their seats in sj (SN_CUT_NONE:
+ * inactive) and, for the active ones, y = R^T ys (ys per seat, world frame). */
+static void detail_ops(const sn_view *v, const sn_dstate *dt, uint32_t e, const sn_q *R, const sn_q *ys, uint32_t sj[SN_CUT_MAXX],
+                       sn_q yd[SN_CUT_MAXX][3], uint32_t *sat) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+    const uint16_t *of = DT(dt, o_of, const uint16_t);
+    uint32_t k, j = 0;
+    for (k = 0; k < SN_CUT_MAXX; k++) {
+        uint32_t d = sn_rd_u16(cd + 2 * k), s;
+        if (d == SN_CUT_NONE) continue;
+        s = of[d];
+        sj[j] = s;
+        if (s != SN_CUT_NONE) sn_k_rot_t(R, ys + 3 * s, yd[j], sat);
+        else yd[j][0] = yd[j][1] = yd[j][2] = 0;
+        j++;
+    }
+}
+
+/* acc += t for a seat, saturating at 2^61 (counted): a hostile blob may name one
+ * detail in many cells (the validator checks its own cell's entry only); |t| <
+ * 2^61, so the sum fits before the clamp. Float: plain. */
+SN_INLINE void seat_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
+    uint32_t c;
+    for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+        acc[c] += t[c];
+        (void)sat;
+#else
+        const int64_t lim = (int64_t)1 << 61;
+        int64_t x = acc[c] + t[c];
+        if (x > lim) { x = lim; (*sat)++; }
+        if (x < -lim) { x = -lim; (*sat)++; }
+        acc[c] = x;
+#endif
+    }
+}
+/* a corner row's detail mass part, clamped to 2^56 (counted): with <= 8 cells
+ * (2^59) and the assembled row's < 2^62.3 (NUMERICS.md "The cut level") the
+ * accumulator stays below sn_out's 2^62.5 */
+SN_INLINE void corner_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
+    uint32_t c;
+    for (c = 0; c < 3; c++) {
+#if defined(SN_FLOAT)
+        acc[c] += t[c];
+        (void)sat;
+#else
+        const int64_t lim = (int64_t)1 << 56;
+        int64_t x = t[c];
+        if (x > lim) { x = lim; (*sat)++; }
+        if (x < -lim) { x = -lim; (*sat)++; }
+        acc[c] += x;
+#endif
+    }
+}
+
+/* The details' rows of cell e (ld, the details' scale Q(frac_S - dshift)) rotated
+ * back into their seats' accumulators: R round(l) at Q(19 + k_s), as a free
+ * corner's (a detail lies in <= 4 cells: < 2^61 as the corners' 8 x sqrt(3) 2^58). */
+static void detail_rows_out(const sn_ihdr *h, const sn_dstate *dt, uint32_t on, const uint32_t sj[SN_CUT_MAXX], const sn_q *R,
+                            const sn_acc *ldd, sn_acc *sacc, uint32_t *sat) {
+    const uint8_t *dk = DT(dt, o_kk, const uint8_t) + dt->nF;
+    const int sh = h->v.frac_S - (SN_FLAVOUR == SN_FLAVOUR_FIXED ? sn_sec(&h->v, SN_SEC_DETAILS)[2] : 0);
+    uint32_t j;
+    for (j = 0; on >> j; j++)
+        if (on >> j & 1u) {
+            sn_acc t[3] = {0, 0, 0};
+            sn_k_out_rot_acc(t, R, ldd + 3 * j, sh - SN_KREL(dk[sj[j]]), sat);
+            seat_add(sacc + 3 * sj[j], t, sat);
+        }
+}
+
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
  * acc_a = sum_e R_e S^_e (d_e + R_e^T (w - w_a0))_a over free corners, and twice
  * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per free vertex. */
-static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint32_t *sat) {
+static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *acc, sn_acc *e2, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
     const unsigned char *rest = v->sec[SN_SEC_REST];
@@ -80,14 +152,18 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t e, k, c, nF = v->nF;
     uint32_t esat = 0; /* clamps of the energy estimate are not state clamps */
+    sn_acc *sacc = dt ? DT(dt, o_acc, sn_acc) : NULL;
     acc_zero(acc, 3 * nF);
+    if (dt) acc_zero(sacc, 3 * dt->n);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl);
         sn_q d[24], uu[24], w0s[3];
-        sn_acc ld[24], lu[24], lx[24], ec = 0;
+        sn_acc ld[24], lu[24], lx[24], lc[24], ec = 0;
+        sn_q yx[SN_CUT_MAXX][3];
         uint32_t fr = 0; /* the free corners: lu's rows read below */
+        uint32_t on = dt ? DT(dt, o_on, const uint32_t)[e] : 0;
         const sn_q *w0 = w_of(h, w, vel, a0, w0s);
         /* corner 0 is a0: its t, s and rest difference are 0, so d_0 = uu_0 = 0
          * exactly (no clamp), without its two rotations */
@@ -105,17 +181,91 @@ static void cell_forces(sn_ihdr *h, const sn_q *w, sn_acc *acc, sn_acc *e2, uint
             sn_k_sub3(l, xr, d + 3 * k, sat);
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
-        if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, lx, sat); /* the cut level (sn_cut.c) */
+        if (v->cut) (void)sn_cut_terms(h, e, R, a0, w0, fr, yx, lx, sat); /* the cut level (sn_cut.c) */
+        if (on) { /* the active details (LEVELS.md §3): y_d = R^T (c_d + w_d), an offset (no corner-0 difference) */
+            sn_q yc[24], yd[SN_CUT_MAXX][3];
+            sn_acc ldd[3 * SN_CUT_MAXX];
+            uint32_t sj[SN_CUT_MAXX];
+            for (k = 0; k < 24; k++) {
+                yc[k] = sn_add(d[k], uu[k], sat); /* the corners' d + u (ld + lu's operand) */
+                lc[k] = 0;
+            }
+            detail_ops(v, dt, e, R, DT(dt, o_q, const sn_q) + 3 * dt->nF, sj, yd, sat);
+            sn_detail_cell_mul(v, e, on, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ldd, sat);
+            detail_rows_out(h, dt, on, sj, R, ldd, sacc, sat);
+        }
         for (k = 3; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat)); /* d_0 = 0: no term */
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_acc ls[3];
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
-            for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0);
+            for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0) + (on ? lc[3 * k + c] : 0);
             sn_k_out_rot_acc(acc + 3 * a, R, ls, v->frac_S - SN_KREL(kk[a]), sat); /* R round(ld + lu [+ lx]) */
         }
     }
+}
+
+/* The details' share of the mass pass and their gravity (rhs): per cell with
+ * active details, sn_detail_cell_mass with y = a1 v (free corners, seats),
+ * a1 v' + (v' - v) (skeleton corners, extras) as the assembled pass; the corner
+ * rows' detail columns into acc (free corners), the seats' rows into their
+ * accumulators. Gravity on a seat is sum over corners and extras of
+ * M_E[d][col] g_E (the cut basis sums to one; g_E = g - R_E g with a modelled
+ * rest shape, as a vertex's with its frame): folded in as y - g_E at the
+ * corners and extras, which only the seats' rows read. bs: the seats' rows of
+ * b, -= round(acc) at Q(19 + k_s). ua: a1 v per free vertex (or NULL). */
+static void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua, const sn_q *dsk, sn_acc *acc, sn_q *bs, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const unsigned char *cells = v->sec[SN_SEC_CELLS];
+    const sn_q *vel = CARR(h, o_vel, sn_q), *cR = CARR(h, o_cR, sn_q);
+    const uint32_t *ons = DT(dt, o_on, const uint32_t);
+    const uint8_t *dk = DT(dt, o_kk, const uint8_t) + dt->nF;
+    sn_acc *sacc = DT(dt, o_acc, sn_acc);
+    sn_q *ys = DT(dt, o_d, sn_q) + 3 * dt->nF; /* a1 v per seat (d's seat rows: dead until the PCG) */
+    uint32_t e, i, k, c, nF = v->nF, dummy = 0;
+    for (i = 0; i < dt->n; i++) sn_k_coef3(DT(dt, o_vel, const sn_q) + 3 * i, v->a1, ys + 3 * i, sat);
+    acc_zero(sacc, 3 * dt->n);
+    for (e = 0; e < v->nC; e++) {
+        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
+        const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
+        uint32_t on = ons[e], sj[SN_CUT_MAXX], j, nx = 0;
+        sn_q yc[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], g[3], gr[3];
+        sn_acc mc[24], md[3 * SN_CUT_MAXX];
+        const sn_q I[9] = {SN_ONE_ROT, 0, 0, 0, SN_ONE_ROT, 0, 0, 0, SN_ONE_ROT};
+        if (!on) continue;
+        sn_k_rot(cR + 9 * e, v->grav, gr, sat);
+        for (c = 0; c < 3; c++) g[c] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[c], -gr[c], sat) : v->grav[c];
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            sn_q y[3];
+            if (a < nF && ua) { y[0] = ua[3 * a]; y[1] = ua[3 * a + 1]; y[2] = ua[3 * a + 2]; }
+            else sn_k_coef3(vel + 3 * a, v->a1, y, &dummy); /* counted by the assembled pass */
+            if (a >= nF) sn_k_add3(y, dsk + 3 * (a - nF), y, &dummy);
+            for (c = 0; c < 3; c++) yc[3 * k + c] = sn_add(y[c], -g[c], sat);
+        }
+        for (k = 0; k < SN_CUT_MAXX; k++) {
+            uint32_t x = sn_rd_u16(cx + 2 * k);
+            sn_q y[3];
+            if (x == SN_CUT_NONE) continue;
+            sn_k_coef3(vel + 3 * x, v->a1, y, sat);
+            sn_k_add3(y, dsk + 3 * (x - nF), y, sat);
+            for (c = 0; c < 3; c++) yx[nx][c] = sn_add(y[c], -g[c], sat);
+            nx++;
+        }
+        detail_ops(v, dt, e, I, ys, sj, yd, sat); /* the mass is scalar: the world frame */
+        for (k = 0; k < 24; k++) mc[k] = 0;
+        sn_detail_cell_mass(v, e, on, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, mc, md);
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            if (a < nF) corner_add(acc + 3 * a, mc + 3 * k, sat);
+        }
+        for (j = 0; on >> j; j++)
+            if (on >> j & 1u) seat_add(sacc + 3 * sj[j], md + 3 * j, sat);
+    }
+    for (i = 0; i < dt->n; i++)
+        for (c = 0; c < 3; c++)
+            bs[3 * i + c] = sn_add(bs[3 * i + c], -sn_out(sacc[3 * i + c], v->frac_M - SN_KREL(dk[i]), sat), sat);
 }
 
 /* Right-hand side b (into r), NUMERICS.md step 5:
@@ -136,6 +286,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     int pre;
     sn_q ck = (sn_q)(ONE_COEF + v->b1);
     sn_acc e2 = 0;
+    sn_dstate *dt = elastic ? sn_detail_live(h) : NULL; /* the seats' rows follow the free ones in b */
 
     /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
      * Stored over free vertices; the skeleton's, computed in cell_forces
@@ -144,11 +295,18 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], ck, sat);
     if (v->b1 > ONE_COEF)
         for (i = 3 * nF; i < 3 * nV; i++) (void)coef(vel[i], v->b1, sat);
-    cell_forces(h, u, acc, &e2, sat);
+    if (dt) { /* the seats' operands: c + (1+b1) v for the stiffness (in q's seat rows, dead until the PCG) */
+        sn_q *ys = DT(dt, o_q, sn_q) + 3 * dt->nF;
+        const sn_q *dc = DT(dt, o_coef, const sn_q), *dv = DT(dt, o_vel, const sn_q);
+        for (i = 0; i < 3 * dt->n; i++) ys[i] = sn_add(dc[i], coef(dv[i], ck, sat), sat);
+    }
+    cell_forces(h, dt, u, acc, &e2, sat);
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
         b[i] = elastic ? (sn_q)-sn_out(acc[i], SN_Q_ROT, sat) : 0; /* |.| <= SN_LIM */
     }
+    if (dt)
+        for (i = 0; i < 3 * dt->n; i++) b[3 * nF + i] = (sn_q)-sn_out(DT(dt, o_acc, sn_acc)[i], SN_Q_ROT, sat);
     /* kinetic energy with the lumped mass: sum m^_i |v_i|^2 (twice the energy) */
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
@@ -191,6 +349,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         }
         row_done(acc + 3 * i, l);
     }
+    if (dt) detail_mass_rhs(h, dt, pre ? u : NULL, ds, acc, b + 3 * nF, sat);
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i), gi[3], gr[3];
         /* rest shape = modelled shape: cancel gravity as the vertex frame turns it */
@@ -266,12 +425,75 @@ void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned 
     cell_stiff(h, K, cl, R, mask, d, acc, sat);
 }
 
+/* cell_stiff for a cell with active details (the mat-vec; no mask): the free
+ * corners' product plus the details' columns (sn_detail_cell_mul, lc at the
+ * corners' scale) before the rounding, and the details' rows into sacc. d's
+ * seat rows follow its free rows. */
+static void cell_stiff_det(const sn_ihdr *h, const sn_dstate *dt, uint32_t e, uint32_t on, const unsigned char *K,
+                           const unsigned char *cl, const sn_q *R, const sn_q *d, sn_acc *acc, sn_acc *sacc, uint32_t *sat) {
+    const uint8_t *kk = CARR(h, o_k, uint8_t);
+    uint32_t k, c, vi[8], nf = 0, nF = h->v.nF, sj[SN_CUT_MAXX];
+    sn_q u[24], uf[24], yd[SN_CUT_MAXX][3];
+    sn_acc l[24], lc[24], ldd[3 * SN_CUT_MAXX];
+    uint8_t fc[8];
+    for (k = 0; k < 24; k++) uf[k] = 0, lc[k] = 0;
+    for (k = 0; k < 8; k++) {
+        uint32_t a = sn_rd_u16(cl + 2 * k);
+        if (a >= nF) continue;
+        sn_k_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+        for (c = 0; c < 3; c++) uf[3 * k + c] = u[3 * nf + c];
+        fc[nf] = (uint8_t)k;
+        vi[nf++] = a;
+    }
+    detail_ops(&h->v, dt, e, R, d + 3 * nF, sj, yd, sat);
+    sn_detail_cell_mul(&h->v, e, on, uf, NULL, (const sn_q(*)[3])yd, lc, ldd, sat);
+    detail_rows_out(h, dt, on, sj, R, ldd, sacc, sat);
+    if (nf == 0) return;
+    sn_k_cell_mul(K, fc, nf, u, l);
+    for (k = 0; k < nf; k++) {
+        uint32_t a = vi[k];
+        for (c = 0; c < 3; c++) l[3 * k + c] += lc[3 * fc[k] + c];
+        sn_k_out_rot_acc(acc + 3 * a, R, l + 3 * k, h->v.frac_S - SN_KREL(kk[a]), sat);
+    }
+}
+
+/* The details' share of the mat-vec's mass pass: corner rows' detail columns
+ * into acc (free corners), the seats' rows into sacc (zeroed here). */
+static void detail_mass_mv(const sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_acc *acc, sn_acc *sacc, uint32_t *sat) {
+    const sn_view *v = &h->v;
+    const unsigned char *cells = v->sec[SN_SEC_CELLS];
+    const uint32_t *ons = DT(dt, o_on, const uint32_t);
+    const sn_q I[9] = {SN_ONE_ROT, 0, 0, 0, SN_ONE_ROT, 0, 0, 0, SN_ONE_ROT};
+    uint32_t e, k, c, j, nF = v->nF;
+    acc_zero(sacc, 3 * dt->n);
+    for (e = 0; e < v->nC; e++) {
+        const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
+        uint32_t on = ons[e], sj[SN_CUT_MAXX];
+        sn_q yc[24], yd[SN_CUT_MAXX][3];
+        sn_acc mc[24], md[3 * SN_CUT_MAXX];
+        if (!on) continue;
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            for (c = 0; c < 3; c++) yc[3 * k + c] = a < nF ? d[3 * a + c] : 0;
+        }
+        for (k = 0; k < 24; k++) mc[k] = 0;
+        detail_ops(v, dt, e, I, d + 3 * nF, sj, yd, sat);
+        sn_detail_cell_mass(v, e, on, yc, NULL, (const sn_q(*)[3])yd, mc, md);
+        for (k = 0; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            if (a < nF) corner_add(acc + 3 * a, mc + 3 * k, sat);
+        }
+        for (j = 0; on >> j; j++)
+            if (on >> j & 1u) seat_add(sacc + 3 * sj[j], md + 3 * j, sat);
+    }
+}
+
 /* q = A d = (1+a1) M^ d + (1+b1) sum_e R_e S^_e R_e^T d  (free rows).
  * The cell product runs over the cell's free corners only (9 f^2 multiply-adds
  * for f free corners instead of 576): a skeleton corner's operand is zero
  * and its rows are dropped, so the sums are the full product's. The list is
  * read from the blob's corner indices (fixed per blob: constant cost). */
-static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint32_t *sat) {
+static void matvec(sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_q *q, const uint8_t *mask, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS], *K = v->sec[SN_SEC_CELLK];
     const sn_q *cR = CARR(h, o_cR, sn_q);
@@ -279,15 +501,22 @@ static void matvec(sn_ihdr *h, const sn_q *d, sn_q *q, const uint8_t *mask, uint
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t e, i, nF = v->nF;
     sn_q cm = (sn_q)(ONE_COEF + v->a1), ck = (sn_q)(ONE_COEF + v->b1);
+    sn_acc *sacc = dt ? DT(dt, o_acc, sn_acc) : NULL;
+    const uint32_t *ons = dt ? DT(dt, o_on, const uint32_t) : NULL;
     acc_zero(acc, 3 * nF);
+    if (dt) acc_zero(sacc, 3 * dt->n);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
-        cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
+        if (dt && ons[e]) cell_stiff_det(h, dt, e, ons[e], K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, d, acc, sacc, sat);
+        else cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++)
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
     sn_k_outv(q, acc, 3 * nF, SN_Q_ROT, sat); /* sn_kernels_rot.h */
+    if (dt) sn_k_outv(q + 3 * nF, sacc, 3 * dt->n, SN_Q_ROT, sat);
     pass_M_ff(h, d, mask, acc);
+    if (dt) detail_mass_mv(h, dt, d, acc, sacc, sat);
     sn_k_mix(q, acc, kk, 3 * nF, v->frac_M, ck, cm, sat); /* q = (1+b1) q + (1+a1) M^ d */
+    if (dt) sn_k_mix(q + 3 * nF, sacc, DT(dt, o_kk, const uint8_t) + nF, 3 * dt->n, v->frac_M, ck, cm, sat);
 }
 
 /* ---- CG scalars ---- */
@@ -389,17 +618,32 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_dotv rz;
     uint32_t clamps = 0, rows, iters = h->iterations;
     const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: their dv is the coarse field's */
+    sn_dstate *dt = sn_detail_live(h); /* details on the cut level: the CG over nF + n rows, the seats after the free ones */
+    sn_q *xf = x;
 
+    if (dt) {
+        r = DT(dt, o_r, sn_q);
+        d = DT(dt, o_d, sn_q);
+        q = z = DT(dt, o_q, sn_q);
+        memcpy(DT(dt, o_kk, uint8_t), kk, v->nF); /* the free rows' k (the level's table), the seats' after */
+        kk = DT(dt, o_kk, const uint8_t);
+        mask = NULL; /* adaptation is level 1's, details the cut level's */
+    }
     sn_rhs(h, r, 1, sat);
     /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
     rows = sn_constrain_begin(h, x, sat);
+    if (dt) { /* the warm start: the free rows' x, then the seats' own */
+        x = DT(dt, o_x, sn_q);
+        memcpy(x, xf, n3 * sizeof(sn_q));
+        n3 += 3 * dt->n;
+    }
     if (rows) mask = NULL; /* rows may hold an inactive vertex: this step solves them all (sn_adapt.c projects after) */
     if (mask) sn_adapt_expand(h, mask, x, sat); /* the warm start in the reduced space */
     if (mask) iters = sn_adapt_iterations(h); /* the reduced rows' preconditioner is the lattice's: more iterations */
     /* PCG, warm-started from the previous step's solution, fixed iterations;
      * with rows, residuals and preconditioned residuals are projected onto
      * the free directions (Baraff-Witkin filtered PCG) */
-    matvec(h, x, q, NULL, sat);
+    matvec(h, dt, x, q, NULL, sat);
     for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
     if (mask) { /* refine estimates from the inactive rows, then r = P^T (b - A P x) */
         sn_adapt_estimate(h, mask, r, q, x, sat);
@@ -408,6 +652,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     if (rows) sn_rows_filter(h, r, 1, sat);
     if (mask) sn_precond_mask(h, mask, 0, sn_adapt_scales(h), r, z, sat); /* the active set's block, scaled: z = 0 at inactive rows */
     else sn_precond(h, r, z, sat); /* sn_precond.c */
+    if (dt) sn_detail_precond(h, dt, r + 3 * v->nF, z + 3 * v->nF, sat); /* the seats: block Jacobi (sn_detail_step.c) */
     if (rows) sn_rows_filter(h, z, 0, sat);
     memcpy(d, z, n3 * sizeof(sn_q));
     rz = dot(r, z, kk, n3);
@@ -417,10 +662,10 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         int flat;
         if (mask) { /* q = P^T A P d: d expanded for the product, then 0 again off the active set */
             sn_adapt_expand(h, mask, d, sat);
-            matvec(h, d, q, NULL, sat);
+            matvec(h, NULL, d, q, NULL, sat);
             for (i = 0; i < n3; i++) d[i] = mask[i / 3] ? d[i] : 0;
             sn_adapt_restrict(h, mask, q, sat);
-        } else matvec(h, d, q, NULL, sat);
+        } else matvec(h, dt, d, q, NULL, sat);
         dq = dot(q, d, kk, n3);
         flat = at_floor(rz, n3);
         alpha = flat ? 0 : ratio(rz, dq, &clamps);
@@ -430,6 +675,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         if (rows) sn_rows_filter(h, r, 1, sat);
         if (mask) sn_precond_mask(h, mask, 0, sn_adapt_scales(h), r, z, sat);
         else sn_precond(h, r, z, sat); /* sn_precond.c */
+        if (dt) sn_detail_precond(h, dt, r + 3 * v->nF, z + 3 * v->nF, sat);
         if (rows) sn_rows_filter(h, z, 0, sat);
         rz1 = dot(r, z, kk, n3);
         beta = flat ? 0 : ratio(rz1, rz, &clamps);
@@ -445,6 +691,16 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         sn_contact_yield(h, x, sat);
         sn_rows_fix(h, x, sat);
         sn_rows_fix(h, x, sat);
+    }
+    if (dt) { /* the seats as pos / vel: v += dv, c += v; the free rows' x back */
+        sn_q *dc = DT(dt, o_coef, sn_q), *dv = DT(dt, o_vel, sn_q);
+        n3 = 3 * v->nF;
+        for (i = 0; i < 3 * dt->n; i++) {
+            dv[i] = sn_add(dv[i], x[n3 + i], sat);
+            dc[i] = sn_add(dc[i], dv[i], sat);
+        }
+        memcpy(xf, x, n3 * sizeof(sn_q));
+        x = xf;
     }
     /* v += dv, p += h v  (velocities are per step: h folded in) */
     for (i = 0; i < n3; i++) {

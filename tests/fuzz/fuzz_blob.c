@@ -63,6 +63,8 @@
 #include "sn_format.h"
 #include "sn_tblob.h"
 #include "sn_thostile.h"
+#include "sn_instance.h" /* sn_view_init: the details' kernels (stage 2, not yet in the step) read the view */
+#include "sn_detail.h"
 
 #if defined(__has_include)
 #if __has_include(<sanitizer/common_interface_defs.h>)
@@ -135,6 +137,19 @@ static void *grow(void *p, size_t *have, size_t need) {
     return p;
 }
 
+/* Details on the cut level (stage 2, sn_detail_step.c): every detail up to
+ * A_max active, so the steps on level 0 run the details' rows. */
+static void set_details(sn_instance *inst, const sn_blob *blob) {
+    static uint16_t ids[65536];
+    sn_view v;
+    uint32_t a, i;
+    sn_view_init(&v, blob);
+    if (sn_level_sec_count(&v, SN_SEC_DETAILS) == 0) return;
+    a = sn_rd_u16(sn_sec(&v, SN_SEC_DETAILS)); /* <= nD (validated) */
+    for (i = 0; i < a; i++) ids[i] = (uint16_t)i;
+    if (sn_details_set(inst, ids, a) != SN_OK) { printf("FAIL: sn_details_set refused A_max details (%s)\n", g_case); exit(1); }
+}
+
 /* The blob as an sn_instance_init_shared instance, stepped with a workspace
  * (sn_step_with) in the warped and blended modes: the sizes derive from the
  * same validated counts as sn_instance_size. Every g_shared_every-th stepped
@@ -152,6 +167,7 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
     (void)sn_set_pose(si, xf, info->joints);
     th_hostile_contacts(si, info->surface_vertices);
     (void)sn_set_iterations(si, info->cg_iters_max < (uint32_t)g_iters ? info->cg_iters_max : (uint32_t)g_iters);
+    set_details(si, blob);
     memset(g_ws, 0xA5, wb);
     if (sn_step_with(si, g_ws, wb) != SN_OK) { printf("FAIL: sn_step_with refused (%s)\n", g_case); exit(1); }
     if (sn_set_mode(si, SN_MODE_BLENDED) != SN_OK || sn_step_with(si, g_ws, wb) != SN_OK) {
@@ -159,6 +175,46 @@ static void exercise_shared(const sn_blob *blob, const sn_blob_info *info, const
         exit(1);
     }
     (void)sn_state_hash(si);
+}
+
+/* The details' kernels (sn_detail.c; the step calls them with the active set:
+ * set_details) on an accepted blob with details: every cell, every detail active,
+ * operands all +SN_LIM, then all -SN_LIM (the state's bound), and the
+ * surface term at the cell's corners, centre and child boundaries: the
+ * bounds they document must hold for anything the validator accepts. */
+static void exercise_details(const sn_blob *blob) {
+    sn_view v;
+    uint32_t e, j, k, sat = 0, nd;
+    static uint16_t seat[SN_CUT_MAXX * 65536u / 16u];
+    static sn_q coef[3 * (SN_CUT_MAXX * 65536u / 16u)];
+    sn_q yc[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3];
+    sn_acc lc[24], ld[3 * SN_CUT_MAXX], mc[24], md[3 * SN_CUT_MAXX], acc[3];
+    static const uint32_t ts[4] = {0, 16383, 16384, 32767};
+    sn_view_init(&v, blob);
+    if (sn_level_sec_count(&v, SN_SEC_DETAILS) == 0) return;
+    nd = sn_level_sec_count(&v, SN_SEC_DETAIL);
+    if (nd > sizeof seat / sizeof seat[0]) nd = sizeof seat / sizeof seat[0]; /* the validator's 19 nC <= 19 * 65535 */
+    for (j = 0; j < nd; j++) {
+        seat[j] = (uint16_t)j;
+        for (k = 0; k < 3; k++) coef[3 * j + k] = (j + k) & 1u ? (sn_q)SN_LIM : (sn_q)-SN_LIM;
+    }
+    for (e = 0; e < v.nC; e++) {
+        int sg;
+        for (sg = 0; sg < 2; sg++) {
+            for (k = 0; k < 24; k++) { yc[k] = sg ? (sn_q)-SN_LIM : (sn_q)SN_LIM; lc[k] = mc[k] = 0; } /* one sign: no cancellation */
+            for (j = 0; j < SN_CUT_MAXX; j++)
+                for (k = 0; k < 3; k++) yx[j][k] = yd[j][k] = sg ? (sn_q)-SN_LIM : (sn_q)SN_LIM;
+            sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ld, &sat);
+            sn_detail_cell_mul(&v, e, 0x7FFFFu, yc, NULL, (const sn_q(*)[3])yd, lc, ld, &sat);
+            sn_detail_cell_mass(&v, e, 0x7FFFFu, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, mc, md);
+        }
+        if (nd == sn_level_sec_count(&v, SN_SEC_DETAIL))
+            for (k = 0; k < 64; k++) {
+                uint32_t t[3] = {ts[k & 3u], ts[k >> 2 & 3u], ts[k >> 4 & 3u]};
+                acc[0] = acc[1] = acc[2] = 0;
+                sn_detail_interp(&v, e, t, seat, coef, acc);
+            }
+    }
 }
 
 /* Use an accepted blob the way a game would. */
@@ -174,6 +230,7 @@ static void exercise(const sn_blob *blob) {
     int s;
 
     sn_blob_get_info(blob, &info);
+    exercise_details(blob);
     for (j = 0; j < info.joints; j++) {
         const char *n = sn_joint_name(blob, j);
         (void)sn_joint_parent(blob, j);
@@ -240,6 +297,7 @@ static void exercise(const sn_blob *blob) {
     th_hostile_contacts(inst, info.surface_vertices); /* constraints and colliders (format 5.0) */
     (void)sn_set_iterations(inst, info.cg_iters_max < (uint32_t)g_iters ? info.cg_iters_max : (uint32_t)g_iters);
     (void)sn_set_mode(inst, SN_MODE_WARPED);
+    set_details(inst, blob);
     for (s = 0; s < g_steps; s++) {
         if (s == g_steps / 2) { /* teleport back to the rest pose halfway: a second violent jump */
             for (j = 0; j < info.joints; j++) { local[j].x = local[j].y = local[j].z = 0; local[j].w = REAL(1.0f, 1 << 30); }
@@ -1270,6 +1328,47 @@ static int matrix_all(void) {
 static size_t g_edge = SN_FUZZ_EDGE; /* bytes flipped bit by bit at each end of a section (--edge) */
 /* 1: only the blob's random flips (the plain build in make test, SN_FUZZ_RANDOM_ONLY: see main) */
 static int g_random_only;
+/* The details' blocks at the validator's bounds (format 6.5; a blob with
+ * details given): every CELLDK mantissa 2^15 - 1 at exponent 12 (float:
+ * every entry 2^27), every mass 2^27 (float 1): the blob must be accepted
+ * and exercise() runs the details' kernels on it at +-SN_LIM (exercise_details):
+ * the rows at their stated bounds (2^61.4, the clamped corner part) under
+ * UBSan and, in the range build, their assertions. */
+static int details_at_bounds(const char *name) {
+    unsigned char *b;
+    const sn_blob *blob;
+    uint32_t n, i, k, off;
+    const size_t KB = (size_t)SN_ELEM_CELLDK(SN_FLAVOUR, 4);
+    if (g_size < SN_H_SECTIONS + 16u * (SN_SEC_CELLDK + 1u) || rd32(g_orig + SN_H_SECTIONS + 16 * SN_SEC_DETAILS + 8) != 1u) return 0;
+    b = (unsigned char *)malloc(g_size);
+    if (!b) return 1;
+    memcpy(b, g_orig, g_size);
+    off = tb_sec(b, SN_SEC_CELLDK);
+    n = rd32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLDK + 8);
+    for (i = 0; i < n; i++) {
+        unsigned char *e = b + off + (size_t)i * KB;
+#if defined(SN_FLOAT)
+        for (k = 0; k < 9; k++) tb_real(e + 4 * k, 134217728.0, 0);
+        tb_real(e + 36, 1.0, 0); /* float: a detail's own mass is below 2 (INT32_MAX at Q30); float sums cannot overflow */
+#else
+        for (k = 0; k < 9; k++) tb_u16(e + 2 * k, 0x7FFFu); /* one sign with one-signed operands: every row at its bound */
+        e[18] = SN_CELLK_EXP_MAX;
+        tb_u32(e + 20, 0x08000000u);
+#endif
+    }
+    tb_fix_crc(b);
+    snprintf(g_case, sizeof g_case, "%s: CELLDK at the validator's bounds", name);
+    if (sn_blob_validate(b, g_size, &blob) != SN_OK) {
+        printf("FAIL: %s: the details' blocks at the validator's bounds refused\n", name);
+        free(b);
+        return 1;
+    }
+    exercise(blob);
+    printf("  figure: %s: the details' kernels on CELLDK at the validator's bounds (%u elements), operands +-2^28: no finding\n", name, n);
+    free(b);
+    return 0;
+}
+
 static int fuzz_one(const char *name, int all, unsigned long per_section) {
     size_t n;
     int i, k, fails = 0;
@@ -1444,6 +1543,7 @@ int main(int argc, char **argv) {
             if (!g_orig || fread(g_orig, 1, g_size, f) != g_size) { printf("FAIL: cannot read %s\n", path); return 1; }
             fclose(f);
             fails += fuzz_one(path, all, per_section);
+            fails += details_at_bounds(path);
             runs++;
             free(g_orig);
         } else {

@@ -261,6 +261,10 @@ static uint32_t tb_build(unsigned char *b, uint32_t cap, int len_shift) {
     cnt[SN_SEC_CELLXK] = 0;           elem[SN_SEC_CELLXK] = (uint32_t)SN_ELEM_CELLXK(SN_FLAVOUR, R);
     cnt[SN_SEC_FPAIRS] = TB_NFP;      elem[SN_SEC_FPAIRS] = SN_ELEM_FPAIRS; /* format 6.4: the one pair (0, 1) */
     cnt[SN_SEC_FREFS] = TB_NF + TB_NC; elem[SN_SEC_FREFS] = SN_ELEM_FREFS;
+    cnt[SN_SEC_DETAILS] = 0;          elem[SN_SEC_DETAILS] = (uint32_t)SN_ELEM_DETAILS(R); /* format 6.5: no details */
+    cnt[SN_SEC_DETAIL] = 0;           elem[SN_SEC_DETAIL] = (uint32_t)SN_ELEM_DETAIL(R);
+    cnt[SN_SEC_CELLD] = 0;            elem[SN_SEC_CELLD] = SN_ELEM_CELLD;
+    cnt[SN_SEC_CELLDK] = 0;           elem[SN_SEC_CELLDK] = (uint32_t)SN_ELEM_CELLDK(SN_FLAVOUR, R);
     off = SN_HEADER_BYTES;
     for (sec = 0; sec < SN_SEC_COUNT; sec++) {
         off = (off + 7u) & ~7u;
@@ -505,6 +509,10 @@ static inline uint32_t tb_add_ichol(unsigned char *b, uint32_t cap, int frac) {
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_FPAIRS, total + sp);
     tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_FREFS, total + sr);
     total += tl;
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_DETAILS, total); /* format 6.5: the empty details', after the frame references */
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_DETAIL, total);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLD, total);
+    tb_u32(b + SN_H_SECTIONS + 16 * SN_SEC_CELLDK, total);
     tb_u32(b + SN_H_TOTAL_SIZE, total);
     tb_fix_crc(b);
     return total;

@@ -283,6 +283,10 @@ unsigned char *snsyn_build(const snsyn_box *bx, size_t *size) {
         cnt[SN_SEC_CELLXK] = 0; el[SN_SEC_CELLXK] = SN_ELEM_CELLXK(SN_FLAVOUR_FLOAT32, R);
         cnt[SN_SEC_FPAIRS] = 0; el[SN_SEC_FPAIRS] = SN_ELEM_FPAIRS; /* format 6.4: every frame slerped alone */
         cnt[SN_SEC_FREFS] = 0; el[SN_SEC_FREFS] = SN_ELEM_FREFS;
+        cnt[SN_SEC_DETAILS] = 0; el[SN_SEC_DETAILS] = SN_ELEM_DETAILS(R);   /* format 6.5: no details */
+        cnt[SN_SEC_DETAIL] = 0; el[SN_SEC_DETAIL] = SN_ELEM_DETAIL(R);
+        cnt[SN_SEC_CELLD] = 0; el[SN_SEC_CELLD] = SN_ELEM_CELLD;
+        cnt[SN_SEC_CELLDK] = 0; el[SN_SEC_CELLDK] = SN_ELEM_CELLDK(SN_FLAVOUR_FLOAT32, R);
         pos = SN_HEADER_BYTES;
         for (k = 0; k < SN_SEC_COUNT; k++) {
             pos = (pos + 7) & ~(size_t)7;

@@ -65,6 +65,10 @@ cutcfixed=$(hash_of "$T")
 "$BUILD/sinew-play-float" "$BUILD/level/cow_cut_float.blob" --clip "$CLIP" --frames $CUT_STEPS --lod $CUT_SW $CUT_ROWS --hash --quiet > "$T" 2>&1 || { cat "$T"; exit 1; }
 cutcfloat=$(hash_of "$T")
 [ -n "$cutcfixed" ] && [ -n "$cutcfloat" ] || { echo "update_hashes: a player printed no cut-level contact hash"; exit 1; }
+# details on the cut level (tests/test_runtime_dstep.c): the ramp with the 50 largest details active
+dfixed=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" 2>&1 | sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p')
+dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p')
+[ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -111,5 +115,10 @@ cut_float $cutfloat
 # constraint and contact rows on the cut level, checked by tests/scripts/test_level.sh.
 cut_contact_fixed $cutcfixed
 cut_contact_float $cutcfloat
+# The cow baked with 'levels 2 cut' and 'details 50 0.03 0.01', its 50 largest details active
+# (tests/test_runtime_dstep.c: the neck turned 90 degrees in 12 steps, held to 48; 32 iterations),
+# checked by test_runtime_dstep.
+details50_fixed $dfixed
+details50_float $dfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"

@@ -296,7 +296,8 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SEC_CNT(SN_SEC_CREASE), SEC_CNT(SN_SEC_CREASE_PAIRS), SEC_CNT(SN_SEC_CREASE_VNBR), SEC_CNT(SN_SEC_CREASE_TNBR),
             SEC_CNT(SN_SEC_LEVEL_BLOB), SEC_CNT(SN_SEC_LEVEL_UP), SEC_CNT(SN_SEC_LEVEL_DOWN),
             SEC_CNT(SN_SEC_ICHOL), SEC_CNT(SN_SEC_ADAPT), SEC_CNT(SN_SEC_CELLX), SEC_CNT(SN_SEC_CELLXK),
-            SEC_CNT(SN_SEC_FPAIRS), SEC_CNT(SN_SEC_FREFS) };
+            SEC_CNT(SN_SEC_FPAIRS), SEC_CNT(SN_SEC_FREFS),
+            SEC_CNT(SN_SEC_DETAILS), SEC_CNT(SN_SEC_DETAIL), SEC_CNT(SN_SEC_CELLD), SEC_CNT(SN_SEC_CELLDK) };
         const unsigned expect_el[SN_SEC_COUNT] = { SN_ELEM_JOINTS(R), SN_ELEM_JOINT_NAMES, SN_ELEM_REST(R),
             SN_ELEM_FRAMES, SN_ELEM_MDIAG(R), SN_ELEM_PRECOND(R), SN_ELEM_MLUMP(R), SN_ELEM_ROWPTR,
             SN_ELEM_COLS, SN_ELEM_MOFF(R), SN_ELEM_CELLS, SN_ELEM_CFRAMES, SN_ELEM_CELLK(m->flavour, R),
@@ -305,9 +306,10 @@ int snref_load(snref_model *m, const void *data, size_t size, char *err, size_t 
             SN_ELEM_SEGMESH(R), SN_ELEM_SEGNODES(R), SN_ELEM_SEGATTACH(R), SN_ELEM_CONSTRAINTS,
             SN_ELEM_CREASE(R), SN_ELEM_CREASE_PAIRS, SN_ELEM_CREASE_VNBR, SN_ELEM_CREASE_TNBR,
             SN_ELEM_LEVEL_BLOB, SN_ELEM_LEVEL_MAP, SN_ELEM_LEVEL_MAP, SN_ELEM_ICHOL, SN_ELEM_ADAPT(R),
-            SN_ELEM_CELLX, SN_ELEM_CELLXK(m->flavour, R), SN_ELEM_FPAIRS, SN_ELEM_FREFS };
+            SN_ELEM_CELLX, SN_ELEM_CELLXK(m->flavour, R), SN_ELEM_FPAIRS, SN_ELEM_FREFS, SN_ELEM_DETAILS(R), SN_ELEM_DETAIL(R),
+            SN_ELEM_CELLD, SN_ELEM_CELLDK(m->flavour, R) };
 #undef SEC_CNT
-        typedef char sec_count_check[SN_SEC_COUNT == 40 ? 1 : -1];   /* format 6.4 (FPAIRS, FREFS: the frames' shared work, not read: the reference slerps every frame); 6.3 (CELLX, CELLXK: the cut level, read below); 6.1 (ADAPT, not read: the reference models level 0): update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
+        typedef char sec_count_check[SN_SEC_COUNT == 44 ? 1 : -1];   /* format 6.5 (DETAILS, DETAIL, CELLD, CELLDK: not read, the reference models the cut level without its details); 6.4 (FPAIRS, FREFS: the frames' shared work, not read: the reference slerps every frame); 6.3 (CELLX, CELLXK: the cut level, read below); 6.1 (ADAPT, not read: the reference models level 0): update the tables above (the crease sections are not read: the reference has no crease contact; the level sections neither: the reference models level 0) */
         (void)sizeof(sec_count_check);
         {   /* the cut level: CELLX 0 or nC, CELLXK its running sum (checked when read) */
             uint32_t ncx = rd_u32(d + SN_H_SECTIONS + SN_SEC_CELLX * SN_SECTION_ENTRY + 8);
