@@ -400,8 +400,10 @@ sn_status sn_set_adapt(sn_instance *inst, int on);
 /// set. SN_ERR_ARG (nothing changes) for n > A_max, an id out of range or
 /// repeated, or n > 0 on a blob without details; SN_ERR_NULL for ids NULL with n > 0.
 /// The details' rows are preconditioned by their own diagonal only (for now):
-/// they need more CG iterations than the cut level (sn_set_iterations; the
-/// cow: 8 for 25 details, 32 for 50, LEVELS.md §3), or the run drifts.
+/// they need more CG iterations than the cut level: while a detail is active
+/// the step runs at least 16 (within the blob's maximum; below that the cow's
+/// runs drift, LEVELS.md §3), and accuracy wants 32 for 50 details
+/// (sn_set_iterations).
 sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state

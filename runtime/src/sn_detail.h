@@ -71,5 +71,15 @@ uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh, uint64_t (*fnv)(uint64_t
 /* the seats' preconditioner: z_s = P_s r_s (scalar block Jacobi: the seat's
  * own diagonal averaged, no frame), r and z the seat rows */
 void sn_detail_precond(const sn_ihdr *h, const sn_dstate *s, const sn_q *r, sn_q *z, uint32_t *sat);
+/* CG iterations with a seat filled: at least SN_DETAIL_MIN_ITERATIONS (within
+ * the blob's cg_max). With the seats' block Jacobi the cow's ramp
+ * (LEVELS.md §3, test_runtime_dstep --study) at the cut level's 4 drifts
+ * from the converged run: 1.32 cells with 50 details, 11.8 with every one;
+ * at 16: 0.085 and 0.378 (32: 0.0006, 0.034). A floor against the drift,
+ * as adaptation's SN_ADAPT_MIN_ITERATIONS; accuracy wants 32 (sn_set_iterations). */
+#ifndef SN_DETAIL_MIN_ITERATIONS
+#define SN_DETAIL_MIN_ITERATIONS 16u
+#endif
+uint32_t sn_detail_iterations(const sn_ihdr *h);
 
 #endif /* SN_DETAIL_H */

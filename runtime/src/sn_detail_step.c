@@ -189,6 +189,11 @@ void sn_detail_precond(const sn_ihdr *h, const sn_dstate *s, const sn_q *r, sn_q
         for (c = 0; c < 3; c++) z[3 * i + c] = sn_out(sn_mul(P[i], r[3 * i + c]), h->v.frac_P + SN_KREL(kk[i]), sat);
 }
 
+uint32_t sn_detail_iterations(const sn_ihdr *h) {
+    uint32_t it = h->iterations < SN_DETAIL_MIN_ITERATIONS ? SN_DETAIL_MIN_ITERATIONS : h->iterations;
+    return it > h->v.cg_max ? h->v.cg_max : it;
+}
+
 sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n) {
     sn_ihdr *h;
     sn_dstate *s;

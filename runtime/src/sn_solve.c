@@ -640,6 +640,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     if (rows) mask = NULL; /* rows may hold an inactive vertex: this step solves them all (sn_adapt.c projects after) */
     if (mask) sn_adapt_expand(h, mask, x, sat); /* the warm start in the reduced space */
     if (mask) iters = sn_adapt_iterations(h); /* the reduced rows' preconditioner is the lattice's: more iterations */
+    if (dt) iters = sn_detail_iterations(h); /* the seats' block Jacobi: more iterations (sn_detail.h) */
     /* PCG, warm-started from the previous step's solution, fixed iterations;
      * with rows, residuals and preconditioned residuals are projected onto
      * the free directions (Baraff-Witkin filtered PCG) */
