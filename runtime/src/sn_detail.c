@@ -1,5 +1,7 @@
 /* sn_detail.c -- details on the cut level (sn_detail.h; format 6.5; LEVELS.md
- * §3 "Details on the cut level"): their validation. */
+ * §3 "Details on the cut level"): their validation and the cell kernels the
+ * step calls (the details' share of a cell's stiffness and mass products, the
+ * surface's detail term). The seats and the active set: sn_detail_step.c. */
 #include "sn_detail.h"
 
 #define SN_CHK(cond, err) do { if (!(cond)) return (err); } while (0)
