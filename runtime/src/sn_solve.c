@@ -88,41 +88,31 @@ static void detail_ops(const sn_view *v, const sn_dstate *dt, uint32_t e, const 
     }
 }
 
-/* acc += t for a seat, saturating at 2^61 (counted): a hostile blob may name one
- * detail in many cells (the validator checks its own cell's entry only); |t| <
- * 2^61, so the sum fits before the clamp. Float: plain. */
+/* x clamped to +-lim, each clamp counted (fixed; float: x) */
+SN_INLINE sn_acc lim_count(sn_acc x, int lim_log2, uint32_t *sat) {
+#if defined(SN_FLOAT)
+    (void)lim_log2; (void)sat;
+    return x;
+#else
+    const int64_t lim = (int64_t)1 << lim_log2;
+    if (x > lim) { (*sat)++; return lim; }
+    if (x < -lim) { (*sat)++; return -lim; }
+    return x;
+#endif
+}
+/* acc += t for a seat, the sum saturating at 2^61 (counted): a hostile blob may
+ * name one detail in many cells (the validator checks its own cell's entry
+ * only); |t| < 2^61, so the sum fits before the clamp. */
 SN_INLINE void seat_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
     uint32_t c;
-    for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-        acc[c] += t[c];
-        (void)sat;
-#else
-        const int64_t lim = (int64_t)1 << 61;
-        int64_t x = acc[c] + t[c];
-        if (x > lim) { x = lim; (*sat)++; }
-        if (x < -lim) { x = -lim; (*sat)++; }
-        acc[c] = x;
-#endif
-    }
+    for (c = 0; c < 3; c++) acc[c] = lim_count(acc[c] + t[c], 61, sat);
 }
 /* a corner row's detail mass part, clamped to 2^56 (counted): with <= 8 cells
  * (2^59) and the assembled row's < 2^62.3 (NUMERICS.md "The cut level") the
  * accumulator stays below sn_out's 2^62.5 */
 SN_INLINE void corner_add(sn_acc acc[3], const sn_acc t[3], uint32_t *sat) {
     uint32_t c;
-    for (c = 0; c < 3; c++) {
-#if defined(SN_FLOAT)
-        acc[c] += t[c];
-        (void)sat;
-#else
-        const int64_t lim = (int64_t)1 << 56;
-        int64_t x = t[c];
-        if (x > lim) { x = lim; (*sat)++; }
-        if (x < -lim) { x = -lim; (*sat)++; }
-        acc[c] += x;
-#endif
-    }
+    for (c = 0; c < 3; c++) acc[c] += lim_count(t[c], 56, sat);
 }
 
 /* The details' rows of cell e (ld, the details' scale Q(frac_S - dshift)) rotated
