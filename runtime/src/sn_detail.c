@@ -96,6 +96,19 @@ SN_INLINE void blk_mac(const unsigned char *b, const sn_q y[3], int tr, sn_acc l
     }
 }
 
+/* Cell e's detail runs in CELLDK (detail j's starts after the details' before
+ * it: sum_{i<j} (8 + nx + nd - i) elements); returns nd, *nx the cell's extras. */
+static uint32_t cell_runs(const sn_view *v, uint32_t e, const unsigned char *run[SN_CUT_MAXX], uint32_t *nx) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+    const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
+    const unsigned char *Kj = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB;
+    const uint32_t nd = cd[38];
+    uint32_t j;
+    *nx = sn_sec(v, SN_SEC_CELLX)[(size_t)e * SN_ELEM_CELLX + 38];
+    for (j = 0; j < nd; Kj += (size_t)(8u + *nx + nd - j) * KB, j++) run[j] = Kj;
+    return nd;
+}
+
 /* Cell e's active details' share of the cut element's product (sn_detail.h).
  * The blocks of detail j (compact, CELLD order) start after those of the
  * details before it: sum_{i<j} (8 + nx + nd - i) elements; in its run column
@@ -108,12 +121,10 @@ SN_INLINE void blk_mac(const unsigned char *b, const sn_q y[3], int tr, sn_acc l
  * ld + lu + lx) the sum stays < 2^62.3, below sn_out's 2^62.5. */
 void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                         sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
-    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
-    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
     const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
-    const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
-    const uint32_t nd = cd[38], nx = cx[38];
-    const unsigned char *run[SN_CUT_MAXX];
+    const unsigned char *run[SN_CUT_MAXX], *Kj;
+    uint32_t nx;
+    const uint32_t nd = cell_runs(v, e, run, &nx);
     sn_acc dc[24];
     uint32_t j, k, c;
 #if !defined(SN_FLOAT)
@@ -121,7 +132,6 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
     const int64_t lim = ((int64_t)1 << (61 - ds));
 #endif
     for (c = 0; c < 24; c++) dc[c] = 0;
-    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) run[j] = Kj;
     for (j = 0; j < nd; j++) {
         sn_acc *l = ld + 3 * j;
         Kj = run[j];
@@ -168,14 +178,10 @@ SN_INLINE sn_q blk_mass(const unsigned char *b) {
  * a corner row's detail part <= 19 of them < 2^59.3, at MOFF's scale. */
 void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                          sn_acc mc[24], sn_acc md[3 * SN_CUT_MAXX]) {
-    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
-    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
     const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
-    const unsigned char *K = sn_sec(v, SN_SEC_CELLDK) + (size_t)sn_rd_u32(cd + 40) * KB, *Kj;
-    const uint32_t nd = cd[38], nx = cx[38];
-    const unsigned char *run[SN_CUT_MAXX];
-    uint32_t j, k, c, q;
-    for (j = 0, Kj = K; j < nd; Kj += (size_t)(8u + nx + nd - j) * KB, j++) run[j] = Kj;
+    const unsigned char *run[SN_CUT_MAXX], *Kj;
+    uint32_t nx, j, k, c, q;
+    const uint32_t nd = cell_runs(v, e, run, &nx);
     for (j = 0; j < nd; j++) {
         sn_acc *l = md + 3 * j;
         Kj = run[j];
