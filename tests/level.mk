@@ -59,7 +59,7 @@ $(BUILD)/tests/test_runtime_dstep_float: tests/test_runtime_dstep.c $(SN_TEST_HD
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float
-# the same on the beast (its elbow and neck, LEVELS.md §3's columns): not in make test (about 12 s of CPU
+# the same on the beast (its elbow and neck, LEVELS.md §3's columns): not in make test (12-17 s of CPU
 # for the four runs, 6 s more for its four details bakes; tests/CAMPAIGNS.md)
 DSTEP_BEAST_BLOBS = $(foreach k,lod cut details dall,$(LEVEL_EX)/beast_$(k).blob $(LEVEL_EX)/beast_$(k)_float.blob)
 .PHONY: dstep-beast
