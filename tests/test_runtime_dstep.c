@@ -22,7 +22,7 @@
  *    level in rms and at one of the maxima (the details add level 1's functions:
  *    LEVELS.md §3's static table, 0.544 / 0.051 -> 0.076 / 0.0043 with every
  *    detail); every detail at all three (see the check). DSTEP_WHERE=1 prints
- *    where each run's max sits.
+ *    where each run's max sits; DSTEP_SEL=K picks the largest at step K instead.
  * 3. No saturation; the state hash of a fixed set is reproducible (reset and
  *    the same run give the same hash; an sn_instance_init_shared instance
  *    stepped with a workspace gives it too) and, for the cow's neck, is tests/expected_hashes.txt's. */
@@ -57,6 +57,8 @@ static void dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, do
     *rms = sqrt(s / n) / cell;
 }
 
+static int g_sel = 48;        /* the every-detail run's step whose coefficients pick the largest (DSTEP_SEL, a study) */
+static double *g_selc;       /* their max-norms there, nD */
 static int g_axis = 1;      /* the ramp's axis: 0 x, 1 y, 2 z */
 static double g_deg = 90.0; /* and its angle */
 static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, double deg, int step, sn_xform *xf)
@@ -176,6 +178,10 @@ static run_res ramp(sn_instance *inst, const sn_blob *b, uint32_t nj, int32_t jo
         sn_set_pose(inst, xf, nj);
         sn_step(inst);
         sn_get_surface(inst, s, 0, nS);
+        if (g_selc && k == g_sel) {
+            uint32_t d;
+            for (d = 0; d < n; d++) g_selc[ids[d]] = coef_of(inst, ids[d]);
+        }
         if (ref) {
             dist(s, ref + (size_t)(k - 1) * nS, nS, cell, &a, &q);
             if (getenv("DSTEP_WHERE") && a >= r.mx) { /* where the max is (LEVELS.md's beast elbow: the hand at step 14) */
@@ -305,11 +311,15 @@ int main(int argc, char **argv)
         }
         for (i = 0; i < nd; i++) all[i] = (uint16_t)i;
         r0 = ramp(ca, bl[3], nj, joint, NULL, 0, 0, ref, nS, cell, s, xf, NULL);
+        if (getenv("DSTEP_SEL")) g_sel = atoi(getenv("DSTEP_SEL"));
+        g_selc = calloc(nd, sizeof *g_selc);
         ra = ramp(ca, bl[3], nj, joint, all, nd, DIT, ref, nS, cell, s, xf, last);
         {   /* the largest coefficients at step 48 (max-norm; ties by id): selection sort on a copy */
             double *c = malloc(sizeof *c * nd);
             double c1 = 0, c25 = 0, c50 = 0;
-            for (i = 0; i < nd; i++) c[i] = coef_of(ca, i);
+            for (i = 0; i < nd; i++) c[i] = g_selc[i]; /* step 48's unless DSTEP_SEL */
+            free(g_selc);
+            g_selc = NULL;
             for (i = 0; i < 50; i++) {
                 uint32_t j, b = 0;
                 double bv = -1;
@@ -321,8 +331,8 @@ int main(int argc, char **argv)
                 if (i == 24) c25 = bv;
                 if (i == 49) c50 = bv;
             }
-            T_FIGURE("[%s] largest coefficients at step 48 (every detail active): %.3g (the 25th %.3g, the 50th %.3g) internal units", FL,
-                     c1, c25, c50);
+            T_FIGURE("[%s] largest coefficients at step %d (every detail active): %.3g (the 25th %.3g, the 50th %.3g) internal units", FL,
+                     g_sel, c1, c25, c50);
             free(c);
         }
         r25 = ramp(cd, bl[2], nj, joint, big, 25, DIT, ref, nS, cell, s, xf, NULL);
