@@ -59,6 +59,15 @@ $(BUILD)/tests/test_runtime_dstep_float: tests/test_runtime_dstep.c $(SN_TEST_HD
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float
+# the same on the beast (its elbow and neck, LEVELS.md §3's columns): not in make test (12-17 s of CPU
+# for the four runs, 6 s more for its four details bakes; tests/CAMPAIGNS.md)
+DSTEP_BEAST_BLOBS = $(foreach k,lod cut details dall,$(LEVEL_EX)/beast_$(k).blob $(LEVEL_EX)/beast_$(k)_float.blob)
+.PHONY: dstep-beast
+dstep-beast: $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float $(DSTEP_BEAST_BLOBS)
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_dstep beast elbow_l y 90
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_dstep_float beast elbow_l y 90
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_dstep beast neck y 60
+	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_dstep_float beast neck y 60
 DETAIL_BLOBS = $(LEVEL_EX)/limb_cut.blob $(LEVEL_EX)/limb_cut_float.blob $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob \
                $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob
 # the details' sections under the validator (crafted changes) and beside the cut level (tests/test_runtime_details.c)

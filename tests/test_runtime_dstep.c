@@ -1,26 +1,31 @@
 /* test_runtime_dstep.c -- details on the cut level, stepped (runtime/LEVELS.md
- * §3 "Details on the cut level", stage 2): the cow's cut level with its
+ * §3 "Details on the cut level", stage 2): a character's cut level with its
  * details active against level 1 of the same description, in motion.
  *
- *   test_runtime_dstep[_float]                 the suite ($BUILD/level/ blobs, tests/level.mk)
- *   test_runtime_dstep[_float] --study         also the CG iterations each set needs (not in make test)
- *   test_runtime_dstep[_float] --dump FILE     the every-detail surface at step 48 (the fixed / float comparison)
+ *   test_runtime_dstep[_float] [CHAR JOINT AXIS DEG]             the suite ($BUILD/level/ blobs, tests/level.mk)
+ *   test_runtime_dstep[_float] --study [CHAR JOINT AXIS DEG]     also the CG iterations each set needs (not in make test)
+ *   test_runtime_dstep[_float] --dump FILE [CHAR JOINT AXIS DEG] the every-detail surface at step 48 (fixed / float)
+ * CHAR JOINT AXIS DEG: the character's blobs CHAR_{lod,cut,details,dall}, the joint ramped
+ * about the axis (x, y or z) to DEG; default cow neck y 90 (the one whose hash is in
+ * tests/expected_hashes.txt); `make dstep-beast` runs the beast's elbow_l y 90 and neck y 60.
  *
  * 1. sn_details_set's contract: A_max, ids in range, no repeat, nothing changes
  *    on a refusal; an entering detail leaves the surface where it was.
- * 2. The ramp of test_runtime_cut.c (the neck turns 90 degrees about y in 12
+ * 2. The ramp of test_runtime_cut.c (the joint turns DEG degrees about AXIS in 12
  *    steps, held to 48; gravity; the cut level its default iterations, the
  *    details' runs DIT): the surface of the
  *    cut level with no detail, the 25 / 50 largest, every detail (a blob baked
- *    with 'details 65535'), against level 1 (cow_lod.blob's), max over the
- *    steps / mean rms in level-0 cells. "Largest": the 25 / 50 of largest
+ *    with 'details 65535'), against level 1 (CHAR_lod.blob's), max over the
+ *    steps / max over the held steps 25..48 / mean rms in level-0 cells. "Largest": the 25 / 50 of largest
  *    max-norm coefficient at step 48 of the run with every detail (ties by
  *    id), set at rest and kept. Every set must be nearer level 1 than the cut
- *    level at both measures (the details add level 1's functions: LEVELS.md
- *    §3's static table, 0.544 / 0.051 -> 0.076 / 0.0043 with every detail).
+ *    level in rms and at one of the maxima (the details add level 1's functions:
+ *    LEVELS.md §3's static table, 0.544 / 0.051 -> 0.076 / 0.0043 with every
+ *    detail); every detail at all three (see the check). DSTEP_WHERE=1 prints
+ *    where each run's max sits; DSTEP_SEL=K picks the largest at step K instead.
  * 3. No saturation; the state hash of a fixed set is reproducible (reset and
  *    the same run give the same hash; an sn_instance_init_shared instance
- *    stepped with a workspace gives it too) and is tests/expected_hashes.txt's. */
+ *    stepped with a workspace gives it too) and, for the cow's neck, is tests/expected_hashes.txt's. */
 #include "sinew.h"
 #include "sn_format.h"
 #include "sn_test.h"
@@ -52,6 +57,10 @@ static void dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, do
     *rms = sqrt(s / n) / cell;
 }
 
+static int g_sel = 48;        /* the every-detail run's step whose coefficients pick the largest (DSTEP_SEL, a study) */
+static double *g_selc;       /* their max-norms there, nD */
+static int g_axis = 1;      /* the ramp's axis: 0 x, 1 y, 2 z */
+static double g_deg = 90.0; /* and its angle */
 static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, double deg, int step, sn_xform *xf)
 {
     sn_quat *local = malloc(sizeof *local * nj);
@@ -59,7 +68,7 @@ static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, double de
     double a = deg * (step < 12 ? step / 12.0 : 1.0);
     for (j = 0; j < nj; j++) {
         sn_vec3 ax;
-        ax.x = R(0.0); ax.y = R(1.0); ax.z = R(0.0);
+        ax.x = R(g_axis == 0 ? 1.0 : 0.0); ax.y = R(g_axis == 1 ? 1.0 : 0.0); ax.z = R(g_axis == 2 ? 1.0 : 0.0);
         local[j] = sn_quat_axis_angle(ax, R((int32_t)j == joint ? a : 0.0));
     }
     sn_pose_from_local(blob, local, NULL, xf);
@@ -152,11 +161,11 @@ static const char *bpath(char *buf, size_t n, const char *name)
  * the figures are within 1% of 48's (--study). The cut level runs its own
  * default. */
 #define DIT 32u
-typedef struct { double mx, rms; uint32_t sat; uint64_t hash; } run_res;
+typedef struct { double mx, rms, mxh; uint32_t sat; uint64_t hash; } run_res; /* mxh: max over the held steps 25..48 */
 static run_res ramp(sn_instance *inst, const sn_blob *b, uint32_t nj, int32_t joint, const uint16_t *ids, uint32_t n, uint32_t iters,
                     const sn_vec3 *ref, uint32_t nS, double cell, sn_vec3 *s, sn_xform *xf, sn_vec3 *last)
 {
-    run_res r = {0, 0, 0, 0};
+    run_res r = {0, 0, 0, 0, 0};
     sn_stats st;
     int k;
     sn_reset(inst);
@@ -165,13 +174,28 @@ static run_res ramp(sn_instance *inst, const sn_blob *b, uint32_t nj, int32_t jo
     T_CHECK(sn_details_set(inst, ids, n) == SN_OK, "[%s] set %u details", FL, n);
     for (k = 1; k <= 48; k++) {
         double a, q;
-        ramp_pose(b, nj, joint, 90.0, k, xf);
+        ramp_pose(b, nj, joint, g_deg, k, xf);
         sn_set_pose(inst, xf, nj);
         sn_step(inst);
         sn_get_surface(inst, s, 0, nS);
+        if (g_selc && k == g_sel) {
+            uint32_t d;
+            for (d = 0; d < n; d++) g_selc[ids[d]] = coef_of(inst, ids[d]);
+        }
         if (ref) {
             dist(s, ref + (size_t)(k - 1) * nS, nS, cell, &a, &q);
+            if (getenv("DSTEP_WHERE") && a >= r.mx) { /* where the max is (LEVELS.md's beast elbow: the hand at step 14) */
+                uint32_t v, bv = 0;
+                double bd = -1, e, f;
+                for (v = 0; v < nS; v++) {
+                    dist(s + v, ref + (size_t)(k - 1) * nS + v, 1, cell, &e, &f);
+                    if (e > bd) { bd = e; bv = v; }
+                }
+                printf("  where: %u details, step %d, max %.6g cells at surface vertex %u (%.1f %.1f %.1f)\n", n, k, a, bv, D(s[bv].x),
+                       D(s[bv].y), D(s[bv].z));
+            }
             r.mx = fmax(r.mx, a);
+            if (k >= 25) r.mxh = fmax(r.mxh, a);
             r.rms += q / 48;
         }
     }
@@ -198,10 +222,27 @@ int main(int argc, char **argv)
     double cell;
     int study = argc > 1 && strcmp(argv[1], "--study") == 0;
     const char *dump = argc > 2 && strcmp(argv[1], "--dump") == 0 ? argv[2] : NULL;
-    const char *names[4] = {"cow_lod" SUF ".blob", "cow_cut" SUF ".blob", "cow_details" SUF ".blob", "cow_dall" SUF ".blob"};
+    int a0 = 1 + study + 2 * (dump != NULL);
+    const char *chr = "cow", *jname = "neck";
+    double deg = 90.0;
+    int cow_neck;
+    static const char *kinds[4] = {"lod", "cut", "details", "dall"};
     (void)t_seed; (void)pose_at; (void)tb_build;
+    if (argc >= a0 + 4) {
+        chr = argv[a0];
+        jname = argv[a0 + 1];
+        g_axis = argv[a0 + 2][0] == 'x' ? 0 : argv[a0 + 2][0] == 'z' ? 2 : 1;
+        deg = atof(argv[a0 + 3]);
+        g_deg = deg;
+    } else if (argc != a0) {
+        fprintf(stderr, "usage: %s [--study | --dump FILE] [CHAR JOINT AXIS DEG]\n", argv[0]);
+        return 2;
+    }
+    cow_neck = strcmp(chr, "cow") == 0 && strcmp(jname, "neck") == 0 && g_axis == 1 && deg == 90.0;
     for (k = 0; k < 4; k++) {
-        bb[k] = load(bpath(p[k], sizeof p[k], names[k]), &n[k]);
+        char name[200];
+        snprintf(name, sizeof name, "%s_%s%s.blob", chr, kinds[k], SUF);
+        bb[k] = load(bpath(p[k], sizeof p[k], name), &n[k]);
         if (!bb[k] || sn_blob_validate(bb[k], n[k], &bl[k]) != SN_OK) {
             T_CHECK(0, "cannot read/validate %s (tests/level.mk)", p[k]);
             return T_END();
@@ -211,7 +252,7 @@ int main(int argc, char **argv)
     nS = in[0].surface_vertices;
     nj = in[0].joints;
     cell = cell_of(bb[0]);
-    joint = sn_find_joint(bl[1], "neck");
+    joint = sn_find_joint(bl[1], jname);
     nd = tb_rd32(bb[3] + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_DETAIL + 8);
     T_CHECK(joint > 0 && nd > 50 && tb_rd32(bb[3] + tb_rd32(bb[3] + SN_H_SECTIONS + SN_SECTION_ENTRY * SN_SEC_DETAILS)) % 65536u == nd,
             "[%s] the every-detail blob: A_max = nD = %u", FL, nd);
@@ -225,8 +266,8 @@ int main(int argc, char **argv)
     ref = malloc(sizeof *ref * nS * 48);
     s = malloc(sizeof *s * nS);
     last = malloc(sizeof *last * nS);
-    T_FIGURE("[%s] cow: %u details, level-0 cell %.4g mesh units; instance bytes: cut %u, details A_max 50 %u, every detail (A_max %u) %u", FL,
-             nd, cell, in[1].instance_bytes, in[2].instance_bytes, nd, in[3].instance_bytes);
+    T_FIGURE("[%s] %s: %u details, level-0 cell %.4g mesh units; instance bytes: cut %u, details A_max 50 %u, every detail (A_max %u) %u", FL,
+             chr, nd, cell, in[1].instance_bytes, in[2].instance_bytes, nd, in[3].instance_bytes);
 
     /* 1. the contract */
     {
@@ -242,7 +283,7 @@ int main(int argc, char **argv)
         ids[7] = 21;
         T_CHECK(sn_details_set(cd, NULL, 3) == SN_ERR_NULL && sn_details_set(cd, NULL, 0) == SN_OK, "[%s] NULL ids", FL);
         for (k = 1; k <= 20; k++) { /* in motion, then details enter: the surface stays put (coefficient 0) */
-            ramp_pose(bl[2], nj, joint, 90.0, (int)k, xf);
+            ramp_pose(bl[2], nj, joint, deg, (int)k, xf);
             sn_set_pose(cd, xf, nj);
             sn_step(cd);
         }
@@ -263,18 +304,22 @@ int main(int argc, char **argv)
         uint64_t hs;
         sn_reset(lv1);
         for (k = 1; k <= 48; k++) {
-            ramp_pose(bl[0], nj, joint, 90.0, (int)k, xf);
+            ramp_pose(bl[0], nj, joint, deg, (int)k, xf);
             sn_set_pose(lv1, xf, nj);
             sn_step(lv1);
             sn_get_surface(lv1, ref + (size_t)(k - 1) * nS, 0, nS);
         }
         for (i = 0; i < nd; i++) all[i] = (uint16_t)i;
         r0 = ramp(ca, bl[3], nj, joint, NULL, 0, 0, ref, nS, cell, s, xf, NULL);
+        if (getenv("DSTEP_SEL")) g_sel = atoi(getenv("DSTEP_SEL"));
+        g_selc = calloc(nd, sizeof *g_selc);
         ra = ramp(ca, bl[3], nj, joint, all, nd, DIT, ref, nS, cell, s, xf, last);
         {   /* the largest coefficients at step 48 (max-norm; ties by id): selection sort on a copy */
             double *c = malloc(sizeof *c * nd);
             double c1 = 0, c25 = 0, c50 = 0;
-            for (i = 0; i < nd; i++) c[i] = coef_of(ca, i);
+            for (i = 0; i < nd; i++) c[i] = g_selc[i]; /* step 48's unless DSTEP_SEL */
+            free(g_selc);
+            g_selc = NULL;
             for (i = 0; i < 50; i++) {
                 uint32_t j, b = 0;
                 double bv = -1;
@@ -286,20 +331,27 @@ int main(int argc, char **argv)
                 if (i == 24) c25 = bv;
                 if (i == 49) c50 = bv;
             }
-            T_FIGURE("[%s] largest coefficients at step 48 (every detail active): %.3g (the 25th %.3g, the 50th %.3g) internal units", FL,
-                     c1, c25, c50);
+            T_FIGURE("[%s] largest coefficients at step %d (every detail active): %.3g (the 25th %.3g, the 50th %.3g) internal units", FL,
+                     g_sel, c1, c25, c50);
             free(c);
         }
         r25 = ramp(cd, bl[2], nj, joint, big, 25, DIT, ref, nS, cell, s, xf, NULL);
         r50 = ramp(cd, bl[2], nj, joint, big, 50, DIT, ref, nS, cell, s, xf, NULL);
         hs = r50.hash;
         rb = ramp(cd, bl[2], nj, joint, big, 50, DIT, ref, nS, cell, s, xf, NULL);
-        T_FIGURE("[%s] cow neck y 90, 48 steps, surface vs level 1, max over steps / mean rms (level-0 cells): cut level %.3g / %.3g; "
+        T_FIGURE("[%s] %s %s %c %g, 48 steps, surface vs level 1, max over steps / mean rms (level-0 cells): cut level %.3g / %.3g; "
                  "with details (" "32" " iterations): 25 largest %.3g / %.3g; 50 largest %.3g / %.3g; every detail (%u) %.3g / %.3g",
-                 FL, r0.mx, r0.rms, r25.mx, r25.rms, r50.mx, r50.rms, nd, ra.mx, ra.rms);
-        T_CHECK(r25.mx < r0.mx && r25.rms < r0.rms, "[%s] 25 details nearer level 1 than the cut level", FL);
-        T_CHECK(r50.mx < r0.mx && r50.rms < r0.rms, "[%s] 50 details nearer level 1 than the cut level", FL);
-        T_CHECK(ra.mx < r0.mx && ra.rms < r0.rms, "[%s] every detail nearer level 1 than the cut level", FL);
+                 FL, chr, jname, "xyz"[g_axis], deg, r0.mx, r0.rms, r25.mx, r25.rms, r50.mx, r50.rms, nd, ra.mx, ra.rms);
+        T_FIGURE("[%s] the same, max over the held steps 25..48: cut level %.3g; 25 largest %.3g; 50 largest %.3g; every detail %.3g", FL,
+                 r0.mxh, r25.mxh, r50.mxh, ra.mxh);
+        /* A partial set must be nearer in rms and at one of the two maxima at least: its largest error may sit
+         * where none of its details is. The beast's elbow: the whole run's max is the hand at step 14 (the ramp's
+         * transient), 0.171 cell with or without the 25 / 50 (chosen at step 48), which take the held max 0.147
+         * -> 0.12; the cow's head turn: the 25 take the run's max 0.999 -> 0.945 but the held max 0.725 -> 0.737.
+         * Every detail must be nearer at all three. */
+        T_CHECK(r25.rms < r0.rms && (r25.mx < r0.mx || r25.mxh < r0.mxh), "[%s] 25 details nearer level 1 than the cut level", FL);
+        T_CHECK(r50.rms < r0.rms && (r50.mx < r0.mx || r50.mxh < r0.mxh), "[%s] 50 details nearer level 1 than the cut level", FL);
+        T_CHECK(ra.mx < r0.mx && ra.mxh < r0.mxh && ra.rms < r0.rms, "[%s] every detail nearer level 1 than the cut level", FL);
         T_CHECK(r0.sat == 0 && r25.sat == 0 && r50.sat == 0 && ra.sat == 0, "[%s] saturations %u %u %u %u", FL, r0.sat, r25.sat, r50.sat,
                 ra.sat);
         T_CHECK(rb.hash == hs, "[%s] the 50's run again after sn_reset: the same hash %016llx", FL, (unsigned long long)hs);
@@ -318,7 +370,7 @@ int main(int argc, char **argv)
                 sn_set_iterations(si, DIT);
                 T_CHECK(sn_details_set(si, big, 50) == SN_OK, "[%s] shared: 50 set", FL);
                 for (k = 1; k <= 48; k++) {
-                    ramp_pose(bl[2], nj, joint, 90.0, (int)k, xf);
+                    ramp_pose(bl[2], nj, joint, deg, (int)k, xf);
                     sn_set_pose(si, xf, nj);
                     sn_step_with(si, ws, wb);
                 }
@@ -328,8 +380,12 @@ int main(int argc, char **argv)
                     (unsigned long long)hsh, (unsigned long long)hs);
             free(sm); free(ws);
         }
-        printf("  hash: details50%s %016llx\n", SUF[0] ? "_float" : "_fixed", (unsigned long long)hs);
-        {   /* tests/expected_hashes.txt's line (make update-hashes writes it) */
+        if (cow_neck) /* tests/scripts/update_hashes.sh reads this line */
+            printf("  hash: details50%s %016llx\n", SUF[0] ? "_float" : "_fixed", (unsigned long long)hs);
+        else /* not in tests/expected_hashes.txt: reproducibility is checked above */
+            printf("  hash (%s %s %c %g): details50%s %016llx\n", chr, jname, "xyz"[g_axis], deg, SUF[0] ? "_float" : "_fixed",
+                   (unsigned long long)hs);
+        if (cow_neck) {   /* tests/expected_hashes.txt's line (make update-hashes writes it) */
             FILE *f = fopen("tests/expected_hashes.txt", "r");
             char line[256], want[40] = "";
             while (f && fgets(line, sizeof line, f))
