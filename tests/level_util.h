@@ -1,7 +1,8 @@
 /* level_util.h -- what the level tests share (test_runtime_level.c,
- * test_runtime_adapt.c): the flavour's real <-> double conversions, a blob
- * loader (with 8 spare bytes, so a short read never overruns), the blob's cell
- * edge and the violent swing both drive. */
+ * test_runtime_adapt.c, test_runtime_cut.c, test_runtime_details.c,
+ * test_runtime_dstep.c): the flavour's real <-> double conversions, a blob
+ * loader (with 8 spare bytes, so a short read never overruns), the distance
+ * between two surfaces in cells, the blob's cell edge and the violent swing. */
 #ifndef SN_LEVEL_UTIL_H
 #define SN_LEVEL_UTIL_H
 #include <math.h>
@@ -24,6 +25,20 @@
 #endif
 
 static unsigned char *load(const char *path, size_t *n) { return (unsigned char *)t_read_file(path, n); }
+
+/* the largest and the rms distance between two surfaces of n points, in cells */
+static inline void surf_dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, double *mx, double *rms)
+{
+    double m = 0, s = 0;
+    uint32_t i;
+    for (i = 0; i < n; i++) {
+        double dx = D(a[i].x) - D(b[i].x), dy = D(a[i].y) - D(b[i].y), dz = D(a[i].z) - D(b[i].z), d2 = dx * dx + dy * dy + dz * dz;
+        m = fmax(m, sqrt(d2));
+        s += d2;
+    }
+    *mx = m / cell;
+    *rms = sqrt(s / n) / cell;
+}
 
 /* the blob's cell edge in mesh units (header real SN_R_CELL: internal Q22, unit 2^len_shift) */
 static double cell_of(const unsigned char *b)

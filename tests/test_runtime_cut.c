@@ -29,19 +29,6 @@
 
 static int b_flavour(const unsigned char *b) { return b[SN_H_FLAVOUR]; }
 
-static void dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, double *mx, double *rms)
-{
-    double m = 0, s = 0;
-    uint32_t i;
-    for (i = 0; i < n; i++) {
-        double dx = D(a[i].x) - D(b[i].x), dy = D(a[i].y) - D(b[i].y), dz = D(a[i].z) - D(b[i].z), d2 = dx * dx + dy * dy + dz * dz;
-        m = fmax(m, sqrt(d2));
-        s += d2;
-    }
-    *mx = m / cell;
-    *rms = sqrt(s / n) / cell;
-}
-
 /* JOINT's local rotation by deg * min(step / 12, 1) about axis, the rest at rest */
 static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, int axis, double deg, int step, sn_xform *xf)
 {
@@ -115,8 +102,8 @@ int main(int argc, char **argv)
         sn_step(c0); sn_step(l0); sn_step(l1);
         sn_get_surface(c0, sc, 0, ic.surface_vertices); sn_get_surface(l0, s0, 0, ic.surface_vertices);
         sn_get_surface(l1, s1, 0, ic.surface_vertices);
-        dist(sc, s1, ic.surface_vertices, cell, &a, &b); cmax = fmax(cmax, a); crms += b / 48;
-        dist(s0, s1, ic.surface_vertices, cell, &a, &b); bmax = fmax(bmax, a); brms += b / 48;
+        surf_dist(sc, s1, ic.surface_vertices, cell, &a, &b); cmax = fmax(cmax, a); crms += b / 48;
+        surf_dist(s0, s1, ic.surface_vertices, cell, &a, &b); bmax = fmax(bmax, a); brms += b / 48;
     }
     T_FIGURE("%s [%s]: %s %s %s deg, 48 steps: surface vs level 1, max over steps / mean rms (level-0 cells): cut %.3g / %.3g, "
              "baked level 0 %.3g / %.3g", name, FL, argv[3], argv[4], argv[5], cmax, crms, bmax, brms);
@@ -135,12 +122,12 @@ int main(int argc, char **argv)
                 sn_get_surface(c0, s0, 0, ic.surface_vertices);
                 T_CHECK(sn_set_lod(c0, lv) == SN_OK, "%s: sn_set_lod %u", name, lv);
                 sn_get_surface(c0, s1, 0, ic.surface_vertices);
-                dist(s0, s1, ic.surface_vertices, cell, &a, &b);
+                surf_dist(s0, s1, ic.surface_vertices, cell, &a, &b);
                 if (lv) up = a; else { down = a; down_rms = b; }
                 sn_get_surface(l0, s0, 0, ic.surface_vertices);
                 sn_set_lod(l0, lv);
                 sn_get_surface(l0, s1, 0, ic.surface_vertices);
-                dist(s0, s1, ic.surface_vertices, cell, &a, &b);
+                surf_dist(s0, s1, ic.surface_vertices, cell, &a, &b);
                 if (lv) lup = a; else { ldown = a; ldown_rms = b; }
             }
             sn_set_pose(c0, xf, ic.joints); sn_set_pose(l0, xf, ic.joints);

@@ -44,19 +44,6 @@
 #define SUF ""
 #endif
 
-static void dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, double *mx, double *rms)
-{
-    double m = 0, s = 0;
-    uint32_t i;
-    for (i = 0; i < n; i++) {
-        double dx = D(a[i].x) - D(b[i].x), dy = D(a[i].y) - D(b[i].y), dz = D(a[i].z) - D(b[i].z), d2 = dx * dx + dy * dy + dz * dz;
-        m = fmax(m, sqrt(d2));
-        s += d2;
-    }
-    *mx = m / cell;
-    *rms = sqrt(s / n) / cell;
-}
-
 static int g_sel = 48;        /* the every-detail run's step whose coefficients pick the largest (DSTEP_SEL, a study) */
 static double *g_selc;       /* their max-norms there, nD */
 static int g_axis = 1;      /* the ramp's axis: 0 x, 1 y, 2 z */
@@ -183,12 +170,12 @@ static run_res ramp(sn_instance *inst, const sn_blob *b, uint32_t nj, int32_t jo
             for (d = 0; d < n; d++) g_selc[ids[d]] = coef_of(inst, ids[d]);
         }
         if (ref) {
-            dist(s, ref + (size_t)(k - 1) * nS, nS, cell, &a, &q);
+            surf_dist(s, ref + (size_t)(k - 1) * nS, nS, cell, &a, &q);
             if (getenv("DSTEP_WHERE") && a >= r.mx) { /* where the max is (LEVELS.md's beast elbow: the hand at step 14) */
                 uint32_t v, bv = 0;
                 double bd = -1, e, f;
                 for (v = 0; v < nS; v++) {
-                    dist(s + v, ref + (size_t)(k - 1) * nS + v, 1, cell, &e, &f);
+                    surf_dist(s + v, ref + (size_t)(k - 1) * nS + v, 1, cell, &e, &f);
                     if (e > bd) { bd = e; bv = v; }
                 }
                 printf("  where: %u details, step %d, max %.6g cells at surface vertex %u (%.1f %.1f %.1f)\n", n, k, a, bv, D(s[bv].x),
@@ -417,7 +404,7 @@ int main(int argc, char **argv)
                         continue;
                     }
                     (void)ramp(in_, b_, nj, joint, q < 2 ? big : all, sz[q], its[i], NULL, nS, cell, s, xf, last);
-                    dist(last, conv, nS, cell, &a, &b2);
+                    surf_dist(last, conv, nS, cell, &a, &b2);
                     T_FIGURE("[%s] study: %u details, %u iterations: surface at step 48 vs %u iterations: max %.3g / rms %.3g cells", FL,
                              sz[q], its[i], in[q < 2 ? 2 : 3].cg_iters_max, a, b2);
                 }
