@@ -71,7 +71,7 @@ dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's
 [ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
 # the same blob on the trot (test_determinism.sh's details scenario, every platform): the
 # determinism driver, details 0..N-1 active from the first step (the players cannot set details)
-set -- $(make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
+set -- $(MAKEFLAGS= make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
 [ -n "$DT_ITERS" ] || { echo "update_hashes: print-bm-level gave no details run"; exit 1; }
 DT_ARGS="--steps $DT_STEPS --clip $CLIP --details $DT_N --iterations $DT_ITERS --main-only"
 # shellcheck disable=SC2086
@@ -132,9 +132,9 @@ cut_contact_float $cutcfloat
 # checked by test_runtime_dstep.
 details50_fixed $dfixed
 details50_float $dfloat
-# The same blob, details 0..$((DT_N - 1)) active from the first step, $DT_ITERS CG iterations, $DT_STEPS steps of the trot
-# (ports/cross det_main BLOB $DT_ARGS; no level switch), checked by
-# tests/scripts/test_determinism.sh on every platform and the Cortex-M4 (level_details.elf).
+# The same blob, details 0..$((DT_N - 1)) active from the first step, $DT_ITERS CG iterations, $DT_STEPS steps
+# of the trot, no level switch (ports/cross det_main BLOB $DT_ARGS),
+# checked by tests/scripts/test_determinism.sh on every platform and the Cortex-M4.
 details_trot_fixed $dtfixed
 details_trot_float $dtfloat
 EOT
