@@ -62,6 +62,6 @@ bm_level_check() {
     fi
     [ -z "${5:-}" ] || [ "$(_v details)" = "$5" ] || bad "$1: details '$(_v details)', want $5"
     if [ "$FAIL" -eq "$_fails" ]; then
-        ok "$1: $(_v steps) steps$( [ -n "${5:-}" ] && echo ", $5 details at $(_v iterations) iterations"), $_want level switches acted ($(grep '^switch: ' "$_lg" | awk '{printf "%s%s:%s=%s", s, $3, $5, $7; s=" "}') lattice vertices)$( [ "$4" = 1 ] && echo ", adaptation: $(_v adapt_refines) vertices in, $(_v adapt_coarsens) out"), no saturation, none refused, stack peak $_s B of 32768"
+        ok "$1: $(_v steps) steps$( [ -n "${5:-}" ] && echo ", $5 details at $(_v iterations) iterations"), $( [ -z "$3" ] && echo "no level switch" || echo "$_want level switches acted ($(grep '^switch: ' "$_lg" | awk '{printf "%s%s:%s=%s", s, $3, $5, $7; s=" "}') lattice vertices)")$( [ "$4" = 1 ] && echo ", adaptation: $(_v adapt_refines) vertices in, $(_v adapt_coarsens) out"), no saturation, none refused, stack peak $_s B of 32768"
     else sed 's/^/    /' "$_lg"; fi
 }

@@ -392,7 +392,7 @@ while read -r name target runner; do
 " ;;            lod-float-*) lodfloat="$lodfloat$name $h
 " ;;            lod-*) lodfixed="$lodfixed$name $h
 " ;;            cut-float-*) cutfloat="$cutfloat$name $h
- ;;            cut-*) cutfixed="$cutfixed$name $h
+" ;;            cut-*) cutfixed="$cutfixed$name $h
 " ;;            details-float-*) dtfloat="$dtfloat$name $h
 " ;;            details-*) dtfixed="$dtfixed$name $h
 " ;;            adapt-float-*) adfloat="$adfloat$name $h

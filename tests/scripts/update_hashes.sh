@@ -71,7 +71,8 @@ dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's
 [ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
 # the same blob on the trot (test_determinism.sh's details scenario, every platform): the
 # determinism driver, details 0..N-1 active from the first step (the players cannot set details)
-set -- $(MAKEFLAGS= make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
+# shellcheck disable=SC2046
+set -- $(MAKEFLAGS='' make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
 [ -n "$DT_ITERS" ] || { echo "update_hashes: print-bm-level gave no details run"; exit 1; }
 DT_ARGS="--steps $DT_STEPS --clip $CLIP --details $DT_N --iterations $DT_ITERS --main-only"
 # shellcheck disable=SC2086
@@ -80,7 +81,7 @@ dtfixed=$(hash_of "$T")
 # shellcheck disable=SC2086
 "$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
 dtfloat=$(hash_of "$T")
-[ -n "$dtfixed" ] && [ -n "$dtfloat" ] || { echo "update_hashes: the determinism driver printed no details hash"; exit 1; }
+if [ -z "$dtfixed" ] || [ -z "$dtfloat" ]; then echo "update_hashes: the determinism driver printed no details hash"; exit 1; fi
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
