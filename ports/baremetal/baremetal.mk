@@ -133,10 +133,20 @@ BM_SLICE_LOD   = 20:1,40:0,50:1
 # its slice has the level slice's steps and switches
 BM_CUT_STEPS   = 200
 BM_LEVEL_CUT   = 100:1,150:0
+# details on the cut level (cow_details, LEVELS.md §3 "Details on the cut
+# level"): details 0..BM_DETAILS_N-1 active from the first step at
+# BM_DETAILS_ITERS CG iterations (det_main --details/--iterations), no level
+# switch; the full run is test_determinism.sh's details scenario
+# (tests/expected_hashes.txt details_trot_fixed), the slice fewer steps
+BM_DETAILS_STEPS = 100
+BM_DETAILS_SLICE_STEPS = 30
+BM_DETAILS_N     = 50
+BM_DETAILS_ITERS = 32
 $(BM_DIR)/gen/cow_%_blob.c: $(BUILD)/level/cow/%.sinew $(BAKE)
 	@mkdir -p $(dir $@)
 	$(BAKE) $< --c-array $@ --name sinew_cow_$*_blob --quiet
-.SECONDARY: $(BM_DIR)/gen/cow_lod_blob.c $(BM_DIR)/gen/cow_adapt_blob.c $(BM_DIR)/gen/cow_cut_blob.c
+.SECONDARY: $(BM_DIR)/gen/cow_lod_blob.c $(BM_DIR)/gen/cow_adapt_blob.c $(BM_DIR)/gen/cow_cut_blob.c \
+            $(BM_DIR)/gen/cow_details_blob.c
 $(BM_DIR)/obj/cow_%_blob.o: $(BM_DIR)/gen/cow_%_blob.c
 	@mkdir -p $(dir $@)
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
@@ -149,14 +159,15 @@ $(BM_DIR)/gen/%_mem.h: $(BUILD)/level/%.blob $(BM_DIR)/mem_bytes
 	$(BM_DIR)/mem_bytes $< > $@.tmp || { rm -f $@.tmp; exit 1; }
 	mv $@.tmp $@
 # $(1) image, $(2) blob (cow_lod, cow_adapt), $(3) steps, $(4) name of the
-# switch variable (det_main's K:L list), $(5) shared 0/1, $(6) bench 0/1
+# switch variable (det_main's K:L list; empty: no switch), $(5) shared 0/1,
+# $(6) bench 0/1, $(7) more defines (SN_BM_DETAILS, SN_BM_ITERS)
 define bm_level_image
 $(BM_DIR)/obj/main_$(1).o: ports/baremetal/main_level.c $(PORT_HDRS) ports/baremetal/semihost.h \
         $(BM_DIR)/gen/$(2)_mem.h ports/baremetal/baremetal.mk
 	@mkdir -p $$(dir $$@)
 	$(BM_CC) $(BM_CFLAGS) -include $(BM_DIR)/gen/$(2)_mem.h -DSN_BM_BLOB=sinew_$(2)_blob \
-	    -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size -DSN_BM_STEPS=$(3) -DSN_BM_LOD=$(subst :,$(comma),$($(4))) \
-	    -DSN_BM_SHARED=$(5) -DSN_BM_BENCH=$(if $(6),$(6),0) -c $$< -o $$@
+	    -DSN_BM_BLOB_SIZE=sinew_$(2)_blob_size -DSN_BM_STEPS=$(3) $(if $(4),-DSN_BM_LOD=$(subst :,$(comma),$($(4)))) \
+	    -DSN_BM_SHARED=$(5) -DSN_BM_BENCH=$(if $(6),$(6),0) $(7) -c $$< -o $$@
 $(BM_DIR)/$(1).elf: $(BM_DIR)/obj/main_$(1).o $(BM_OBJS) $(BM_DIR)/obj/$(2)_blob.o \
         $(BM_DIR)/obj/cow_clip.o ports/baremetal/an386.ld
 	$(BM_CC) $(BM_LDFLAGS) -Wl,-Map,$$@.map -o $$@ $$(filter %.o,$$^)
@@ -167,25 +178,34 @@ $(eval $(call bm_level_image,level_lod_slice,cow_lod,$(BM_SLICE_STEPS),BM_SLICE_
 $(eval $(call bm_level_image,level_adapt_slice,cow_adapt,$(BM_SLICE_STEPS),BM_SLICE_LOD,1))
 $(eval $(call bm_level_image,level_cut,cow_cut,$(BM_CUT_STEPS),BM_LEVEL_CUT,0))
 $(eval $(call bm_level_image,level_cut_slice,cow_cut,$(BM_SLICE_STEPS),BM_SLICE_LOD,0))
+BM_DETAILS_DEFS = -DSN_BM_DETAILS=$(BM_DETAILS_N) -DSN_BM_ITERS=$(BM_DETAILS_ITERS)
+$(eval $(call bm_level_image,level_details,cow_details,$(BM_DETAILS_STEPS),,0,0,$(BM_DETAILS_DEFS)))
+$(eval $(call bm_level_image,level_details_slice,cow_details,$(BM_DETAILS_SLICE_STEPS),,0,0,$(BM_DETAILS_DEFS)))
 # timed (make bench-baremetal-level): instructions per step on each level
 $(eval $(call bm_level_image,bench_level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0,1))
 $(eval $(call bm_level_image,bench_level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1,1))
 $(eval $(call bm_level_image,bench_level_cut,cow_cut,$(BM_CUT_STEPS),BM_LEVEL_CUT,0,1))
+$(eval $(call bm_level_image,bench_level_details,cow_details,$(BM_DETAILS_STEPS),,0,1,$(BM_DETAILS_DEFS)))
 .PHONY: bench-baremetal-level
-bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf $(BM_DIR)/bench_level_cut.elf
+bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt.elf $(BM_DIR)/bench_level_cut.elf \
+                       $(BM_DIR)/bench_level_details.elf
 	for i in lod adapt; do echo "== level_$$i (1000 steps, switches $(BM_LEVEL_LOD), qemu -icount shift=0)"; \
 	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_$$i.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)' || exit 1; done
 	echo "== level_cut ($(BM_CUT_STEPS) steps, switches $(BM_LEVEL_CUT), qemu -icount shift=0)"; \
 	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_cut.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)'
-BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice level_cut level_cut_slice,$(BM_DIR)/$(i).elf)
+	echo "== level_details ($(BM_DETAILS_STEPS) steps, $(BM_DETAILS_N) details, $(BM_DETAILS_ITERS) iterations, qemu -icount shift=0)"; \
+	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_details.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)'
+BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice level_cut level_cut_slice \
+                    level_details level_details_slice,$(BM_DIR)/$(i).elf)
 BM_QEMU_ICOUNT = qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
                  -semihosting-config enable=on,target=native -icount shift=0,sleep=off
 .PHONY: print-bm-level determinism-m4
 determinism-m4:   # the full runs alone, against tests/expected_hashes.txt
 	BUILD=$(BUILD) sh ports/baremetal/determinism_m4.sh
 .PHONY: print-bm-level
-print-bm-level:   # for test_determinism.sh: steps and switches of the runs (full, slice, cut)
-	@echo $(BM_STEPS) $(BM_LEVEL_LOD) $(BM_SLICE_STEPS) $(BM_SLICE_LOD) $(BM_CUT_STEPS) $(BM_LEVEL_CUT)
+print-bm-level:   # for test_determinism.sh: steps and switches of the runs (full, slice, cut, details)
+	@echo $(BM_STEPS) $(BM_LEVEL_LOD) $(BM_SLICE_STEPS) $(BM_SLICE_LOD) $(BM_CUT_STEPS) $(BM_LEVEL_CUT) \
+	    $(BM_DETAILS_STEPS) $(BM_DETAILS_SLICE_STEPS) $(BM_DETAILS_N) $(BM_DETAILS_ITERS)
 
 BM_IMAGES = $(BM_DIR)/sinew_cow.elf $(BM_DIR)/bench_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bench_limb.elf
 ports-baremetal: $(BM_IMAGES) $(BM_LEVEL_IMAGES)
@@ -314,5 +334,5 @@ TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
 ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
 TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf $(BM_DIR)/test_kernels.elf \
              $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf $(BM_DIR)/level_cut_slice.elf \
-             $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
+             $(BM_DIR)/level_details_slice.elf $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
 endif

@@ -8,6 +8,10 @@
  *   SN_BM_BLOB, SN_BM_BLOB_SIZE  the tool's C-array symbols
  *   SN_BM_STEPS                  steps to play
  *   SN_BM_LOD                    switches K,L,K,L..: sn_set_lod(L) before step K
+ *                                (undefined: no switch)
+ *   SN_BM_DETAILS, SN_BM_ITERS   details 0..N-1 active on the cut level and
+ *                                the CG iterations from the first step, as
+ *                                det_main --details N --iterations K (0: none)
  *   SN_BM_SHARED                 1: shared instance stepped by sn_step_with
  *   SN_BM_BENCH                  1: also time each step with CMSDK timer 0 and
  *                                print instructions per step on each level;
@@ -21,8 +25,14 @@
 #include "semihost.h"
 #include "sn_det.h"
 
-#if !defined(SN_BM_STEPS) || !defined(SN_BM_LOD) || !defined(SN_BM_SHARED)
-#error "SN_BM_STEPS, SN_BM_LOD, SN_BM_SHARED: see baremetal.mk bm_level_image"
+#if !defined(SN_BM_STEPS) || !defined(SN_BM_SHARED)
+#error "SN_BM_STEPS, SN_BM_SHARED: see baremetal.mk bm_level_image"
+#endif
+#ifndef SN_BM_DETAILS
+#define SN_BM_DETAILS 0
+#endif
+#ifndef SN_BM_ITERS
+#define SN_BM_ITERS 0
 #endif
 #if !defined(SN_BM_INSTANCE_BYTES) || !defined(SN_BM_STATE_BYTES) || !defined(SN_BM_WS_BYTES)
 #error "SN_BM_*_BYTES: see ports/baremetal/mem_bytes.c"
@@ -38,8 +48,13 @@ uint32_t sn_bm_stack_used(void);
 #define SN_BM_BENCH 0
 #endif
 
+#ifdef SN_BM_LOD
 static const uint32_t lod_sw[] = { SN_BM_LOD };
 #define N_SW (sizeof lod_sw / sizeof lod_sw[0] / 2u)
+#endif
+#if SN_BM_DETAILS
+static uint16_t detail_ids[SN_BM_DETAILS];
+#endif
 
 static sn_det det;
 static sn_clip clip;
@@ -96,8 +111,18 @@ int main(void) {
     sn_bm_put_kv("instance_bytes: ", SN_BM_INSTANCE_BYTES);
     sn_bm_put_kv("shared: ", SN_BM_SHARED);
     sn_bm_put_kv("levels: ", sn_lod_levels(det.blob));
+#if SN_BM_DETAILS   /* ids 0..N-1, as det_main --details N */
+    for (j = 0; j < SN_BM_DETAILS; j++) detail_ids[j] = (uint16_t)j;
+    if (sn_details_set(det.inst, detail_ids, SN_BM_DETAILS) != SN_OK) return fail("sn_details_set refused");
+    sn_bm_put_kv("details: ", SN_BM_DETAILS);
+#endif
+#if SN_BM_ITERS
+    if (sn_set_iterations(det.inst, SN_BM_ITERS) != SN_OK) return fail("sn_set_iterations refused");
+    sn_bm_put_kv("iterations: ", SN_BM_ITERS);
+#endif
     for (k = 0; k < SN_BM_STEPS; k++) {
         sn_det_pose(&det);
+#ifdef SN_BM_LOD
         for (j = 0; j < N_SW; j++)   /* before step k + 1, as det_main --lod */
             if (lod_sw[2u * j] == k + 1u) {
                 if (sn_set_lod(det.inst, lod_sw[2u * j + 1u]) != SN_OK) return fail("sn_set_lod refused");
@@ -108,6 +133,7 @@ int main(void) {
                 sn_bm_puts("switch: step "); sn_bm_put_u64(k + 1u); sn_bm_puts(" level "); sn_bm_put_u64(st.lod);
                 sn_bm_puts(" lattice_vertices "); sn_bm_put_u64(st.lattice_vertices); sn_bm_puts("\n");
             }
+#endif
 #if SN_BM_BENCH
         t0 = sn_bm_timer_now();
         sn_det_step(&det);

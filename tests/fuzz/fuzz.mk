@@ -134,5 +134,6 @@ test-build: $(BUILD)/tests/blob_patch
 update-hashes: $(BUILD)/sinew-play $(BUILD)/sinew-play-float $(EX)/cow.blob $(EX)/cow_float.blob \
                $(BUILD)/cross/det_x86_64-gcc-O2 $(BUILD)/cross/det_float-gcc-O2 $(EX)/limb_crease.blob $(EX)/limb_crease_float.blob \
                $(LEVEL_EX)/cow_lod.blob $(LEVEL_EX)/cow_lod_float.blob $(LEVEL_EX)/cow_adapt.blob $(LEVEL_EX)/cow_adapt_float.blob \
-               $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float
+               $(LEVEL_EX)/cow_cut.blob $(LEVEL_EX)/cow_cut_float.blob $(BUILD)/tests/test_runtime_dstep $(BUILD)/tests/test_runtime_dstep_float \
+               $(LEVEL_EX)/cow_details.blob $(LEVEL_EX)/cow_details_float.blob
 	BUILD=$(BUILD) sh tests/scripts/update_hashes.sh

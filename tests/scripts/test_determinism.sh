@@ -13,7 +13,10 @@
 # the level-of-detail, adaptation and cut-level ones on the Cortex-M4 too (in
 # full under `make determinism`, a slice compared with x86-64 in `make test`;
 # big-endian MIPS's level-of-detail and adaptation runs likewise, and the
-# crease runs of big-endian MIPS and aarch64: CR_SHORT below).
+# crease runs of big-endian MIPS and aarch64: CR_SHORT below). Details on the
+# cut level (50 active, 32 iterations) run on every hosted platform and the
+# Cortex-M4 (full in `make determinism`; in `make test` x86-64's full runs
+# and short big-endian MIPS, aarch64 and Cortex-M4 runs: DT_SHORT below).
 # Every platform must also give the hash committed in tests/expected_hashes.txt
 # (update it on purpose with `make update-hashes`).
 # Prints "determinism: <platform> <hash>" per platform. A missing toolchain or
@@ -69,11 +72,13 @@ else add cortex-m4-qemu "$BUILD/baremetal/sinew_cow.elf" qemu-system-arm; m4=1; 
 # x86-64 det_main's of the same run, made here (a cross-platform identity).
 m4lvl=""
 if [ -n "${m4:-}" ] && [ -n "$clip_arg" ]; then
-    if [ "${DET_SET:-slice}" = full ]; then m4lvl="level_lod level_adapt level_cut"
-    else m4lvl="level_lod_slice level_adapt_slice level_cut_slice"; fi
+    if [ "${DET_SET:-slice}" = full ]; then m4lvl="level_lod level_adapt level_cut level_details"
+    else m4lvl="level_lod_slice level_adapt_slice level_cut_slice level_details_slice"; fi
 elif [ -n "${m4:-}" ]; then skip "cortex-m4 level of detail: the images play $COW_CLIP, which is missing"; fi
 # shellcheck disable=SC2046
 set -- $(pmake print-bm-level); M4_STEPS=$1; M4_SW=$2; M4_SLICE_STEPS=$3; M4_SLICE_SW=$4; M4_CUT_STEPS=$5; M4_CUT_SW=$6
+# the details run (baremetal.mk BM_DETAILS_*, one definition for the image and the hosted drivers)
+DT_STEPS=$7; DT_SLICE_STEPS=$8; DT_N=$9; DT_ITERS=${10}
 want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
 # clang cross: needs the cross gcc for headers, crt files and libgcc
 if have clang; then want mips-be-clang-O2 mips-linux-gnu-gcc qemu-mips; else skip "mips-be-clang-O2: no clang"; fi
@@ -246,13 +251,28 @@ CUT_STEPS=200; CUT_SW=100:1,150:0
 # checks the players' cut_contact_* lines against tests/expected_hashes.txt)
 pmake "$BUILD/level/cow_cut.blob" "$BUILD/level/cow_cut_float.blob" > "$L/build_cut.log" 2>&1 || \
     { bad "cut: blobs failed to bake"; tail -n 5 "$L/build_cut.log"; }
+# ---- details on the cut level (runtime/LEVELS.md §3 "Details on the cut
+# level"): cow_details.blob (the cut bake plus 'details 50 0.03 0.01'),
+# details 0..DT_N-1 active from the first step (sn_details_set) at DT_ITERS
+# CG iterations (above the 16 of the floor: accuracy wants 32 for 50),
+# DT_STEPS steps of the trot, no switch (details_trot_* hashes). The slice
+# runs big-endian MIPS and aarch64 short (DT_SHORT, DT_SLICE_STEPS), as the
+# Cortex-M4 slice, their hash equal to the x86-64 det_main's of the same run:
+# 100 steps cost 3.2 s (MIPS) and 2.2 s (aarch64) of qemu CPU, 30 steps a
+# third; the full runs everywhere in `make determinism`
+DT_SHORT=""; [ "${DET_SET:-slice}" = full ] || DT_SHORT="mips-be-gcc-O2 aarch64-gcc-O2"
+DT_ARGS="--details $DT_N --iterations $DT_ITERS --main-only"
+pmake "$BUILD/level/cow_details.blob" "$BUILD/level/cow_details_float.blob" > "$L/build_details.log" 2>&1 || \
+    { bad "details: blobs failed to bake"; tail -n 5 "$L/build_details.log"; }
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
     case $name in float-*) b=$BUILD/examples/limb_crease_float.blob; bl=$BUILD/level/cow_lod_float.blob
-                           ba=$BUILD/level/cow_adapt_float.blob; bc=$BUILD/level/cow_cut_float.blob ;;
+                           ba=$BUILD/level/cow_adapt_float.blob; bc=$BUILD/level/cow_cut_float.blob
+                           bd=$BUILD/level/cow_details_float.blob ;;
                         *) b=$BUILD/examples/limb_crease.blob; bl=$BUILD/level/cow_lod.blob
-                           ba=$BUILD/level/cow_adapt.blob; bc=$BUILD/level/cow_cut.blob ;; esac
+                           ba=$BUILD/level/cow_adapt.blob; bc=$BUILD/level/cow_cut.blob
+                           bd=$BUILD/level/cow_details.blob ;; esac
     case " $SCEN_SKIP " in *" $name "*) continue ;; esac
     r=""; [ "$runner" = - ] || r=$runner
     case $name in i686-*) "$target" --steps 0 >/dev/null 2>&1 || r=qemu-i386 ;; esac
@@ -265,6 +285,9 @@ while read -r name target runner; do
     case " $SCEN_SHORT " in *" $name "*) st=$M4_SLICE_STEPS; sw=$M4_SLICE_SW ;; esac
     launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $st $clip_arg --lod $sw --main-only
     launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW
+    dst=$DT_STEPS; case " $DT_SHORT " in *" $name "*) dst=$DT_SLICE_STEPS ;; esac
+    # shellcheck disable=SC2086
+    launch "$L/rc_details_$name" "$L/run_details_$name.log" $r "$target" "$bd" --steps $dst $clip_arg $DT_ARGS
     case " $ADAPT_SKIP " in *" $name "*) continue ;; esac
     launch "$L/rc_adapt_$name" "$L/run_adapt_$name.log" $r "$target" "$ba" --steps $st $clip_arg --lod $sw \
         --main-only --shared
@@ -274,7 +297,7 @@ EOF2
 # the x86-64 reference of the Cortex-M4 slice and of SCEN_SHORT: det_main on the same steps and switches
 m4ref=""; need_ref=""
 case $m4lvl in *_slice*) need_ref=1 ;; esac
-for _sn in $SCEN_SHORT $CR_SHORT; do case " $built " in *" $_sn "*) need_ref=1 ;; esac; done
+for _sn in $SCEN_SHORT $CR_SHORT $DT_SHORT; do case " $built " in *" $_sn "*) need_ref=1 ;; esac; done
 case $need_ref in 1)
     for c in x86_64-gcc-O2 x86_64-clang-O2 x86_64-gcc-O2-avx2 x86_64-gcc-O0; do
         case " $built " in *" $c "*) m4ref=$c; break ;; esac
@@ -286,9 +309,12 @@ case $need_ref in 1)
             --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only --shared
         launch "$L/rc_m4ref_cut" "$L/run_m4ref_cut.log" "$D/det_$m4ref" "$BUILD/level/cow_cut.blob" \
             --steps "$M4_SLICE_STEPS" $clip_arg --lod "$M4_SLICE_SW" --main-only
+        # shellcheck disable=SC2086
+        launch "$L/rc_m4ref_details" "$L/run_m4ref_details.log" "$D/det_$m4ref" "$BUILD/level/cow_details.blob" \
+            --steps "$DT_SLICE_STEPS" $clip_arg $DT_ARGS
         [ -z "$CR_SHORT" ] || launch "$L/rc_m4ref_crease" "$L/run_m4ref_crease.log" "$D/det_$m4ref" \
             "$BUILD/examples/limb_crease.blob" --steps "$CR_SLICE_STEPS" --clip "$CR_CLIP" --main-only
-    else bad "level and crease slices (cortex-m4, $SCEN_SHORT $CR_SHORT): no x86-64 det_main built to compare with"; fi ;;
+    else bad "level and crease slices (cortex-m4, $SCEN_SHORT $CR_SHORT $DT_SHORT): no x86-64 det_main built to compare with"; fi ;;
 esac
 # the desktop players: the crease and the cow (fixed: the blob file of the
 # same bake; float: against the float drivers)
@@ -335,12 +361,12 @@ short_eq() {
     if [ -n "$r" ] && [ "$3" = "$r" ]; then ok "$1 $2: hash $3 = $m4ref det_main's ($4)"
     else bad "$1 $2: hash $3, x86-64 det_main ${r:-none} ($4)"; fi
 }
-crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
+dtfixed=""; dtfloat=""; crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
     case " $SCEN_SKIP " in *" $name "*) continue ;; esac
-    for sc in crease lod adapt cut; do
+    for sc in crease lod adapt cut details; do
         case $sc:" $ADAPT_SKIP " in adapt:*" $name "*) continue ;; esac
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
             case "$sc: $SCEN_SHORT " in lod:*" $name "*|adapt:*" $name "*)
@@ -348,6 +374,9 @@ while read -r name target runner; do
             esac
             case "$sc: $CR_SHORT " in crease:*" $name "*)
                 short_eq crease "$name" "$h" "$CR_SLICE_STEPS steps"; continue ;;
+            esac
+            case "$sc: $DT_SHORT " in details:*" $name "*)
+                short_eq details "$name" "$h" "$DT_SLICE_STEPS steps, $DT_N details, $DT_ITERS iterations"; continue ;;
             esac
             echo "determinism: $sc $name $h"
             if [ $sc = cut ] && hc=$(hashc_of "$L/run_cut_$name.log") && [ -n "$hc" ]; then
@@ -364,6 +393,8 @@ while read -r name target runner; do
 " ;;            lod-*) lodfixed="$lodfixed$name $h
 " ;;            cut-float-*) cutfloat="$cutfloat$name $h
 " ;;            cut-*) cutfixed="$cutfixed$name $h
+" ;;            details-float-*) dtfloat="$dtfloat$name $h
+" ;;            details-*) dtfixed="$dtfixed$name $h
 " ;;            adapt-float-*) adfloat="$adfloat$name $h
 " ;;            *) adfixed="$adfixed$name $h
 " ;;        esac
@@ -378,19 +409,22 @@ case $m4lvl in level_lod*) [ "$M4_SW" = "$LOD_SW" ] || bad "cortex-m4: BM_LEVEL_
 case " $m4lvl " in *" level_cut "*) [ "$M4_CUT_SW" = "$CUT_SW" ] && [ "$M4_CUT_STEPS" = "$CUT_STEPS" ] || \
     bad "cortex-m4: BM_CUT_STEPS/BM_LEVEL_CUT $M4_CUT_STEPS $M4_CUT_SW (baremetal.mk) are not CUT_STEPS/CUT_SW $CUT_STEPS $CUT_SW" ;; esac
 for i in $m4lvl; do
-    case $i in level_adapt*) sc=adapt; ad=1; ;; level_cut*) sc=cut; ad=0 ;; *) sc=lod; ad=0 ;; esac
-    case $i in *_slice) sw=$M4_SLICE_SW; n=$M4_SLICE_STEPS ;; level_cut) sw=$M4_CUT_SW; n=$M4_CUT_STEPS ;; *) sw=$M4_SW; n=$M4_STEPS ;; esac
+    case $i in level_adapt*) sc=adapt; ad=1; ;; level_cut*) sc=cut; ad=0 ;; level_details*) sc=details; ad=0 ;; *) sc=lod; ad=0 ;; esac
+    case $i in level_details_slice) sw=""; n=$DT_SLICE_STEPS ;; level_details) sw=""; n=$DT_STEPS ;;
+               *_slice) sw=$M4_SLICE_SW; n=$M4_SLICE_STEPS ;; level_cut) sw=$M4_CUT_SW; n=$M4_CUT_STEPS ;; *) sw=$M4_SW; n=$M4_STEPS ;; esac
+    dn=""; [ $sc = details ] && dn=$DT_N
     [ -f "$L/rc_m4_$i" ] || continue   # build failed: reported above
     if rc_ok "$L/rc_m4_$i" && h=$(hash_of "$L/run_m4_$i.log") && [ -n "$h" ]; then
-        echo "determinism: $sc cortex-m4-qemu $h ($n steps, switches $sw, $(cut -d' ' -f2 "$L/rc_m4_$i")s)"
-        bm_level_check "cortex-m4 $i" "$L/run_m4_$i.log" "$sw" "$ad"
+        echo "determinism: $sc cortex-m4-qemu $h ($n steps, switches ${sw:-none}, $(cut -d' ' -f2 "$L/rc_m4_$i")s)"
+        bm_level_check "cortex-m4 $i" "$L/run_m4_$i.log" "$sw" "$ad" "$dn"
         case $i in
             level_lod) lodfixed="${lodfixed}cortex-m4-qemu $h
 " ;;        level_adapt) adfixed="${adfixed}cortex-m4-qemu $h
 " ;;        level_cut) cutfixed="${cutfixed}cortex-m4-qemu $h
+" ;;        level_details) dtfixed="${dtfixed}cortex-m4-qemu $h
 " ;;        *) if rc_ok "$L/rc_m4ref_$sc" && r=$(hash_of "$L/run_m4ref_$sc.log") && [ -n "$r" ]; then
-                   if [ "$h" = "$r" ]; then ok "cortex-m4 $i: hash $h = $m4ref det_main's ($n steps, switches $sw)"
-                   else bad "cortex-m4 $i: hash $h, $m4ref det_main $r ($n steps, switches $sw)"; fi
+                   if [ "$h" = "$r" ]; then ok "cortex-m4 $i: hash $h = $m4ref det_main's ($n steps, switches ${sw:-none})"
+                   else bad "cortex-m4 $i: hash $h, $m4ref det_main $r ($n steps, switches ${sw:-none})"; fi
                elif [ -n "$m4ref" ]; then bad "cortex-m4 $i: $m4ref det_main reference run failed"; tail -n 5 "$L/run_m4ref_$sc.log" | sed 's/^/    /'
                fi ;;
         esac
@@ -459,6 +493,8 @@ agree "cut level, fixed flavour" "$cutfixed" 2
 agree "cut level, float flavour" "$cutfloat" 2
 agree "cut level, contact/blended scenarios, fixed flavour" "$cutcfixed" 2
 agree "cut level, contact/blended scenarios, float flavour" "$cutcfloat" 2
+agree "details on the cut level, fixed flavour" "$dtfixed" 2
+agree "details on the cut level, float flavour" "$dtfloat" 2
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -486,6 +522,8 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "adaptation (shared workspace), float flavour" "$adfloat" adapt_float
     expect_hash "cut level, fixed flavour" "$cutfixed" cut_fixed
     expect_hash "cut level, float flavour" "$cutfloat" cut_float
+    expect_hash "details on the cut level, fixed flavour" "$dtfixed" details_trot_fixed
+    expect_hash "details on the cut level, float flavour" "$dtfloat" details_trot_float
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi

@@ -69,6 +69,19 @@ cutcfloat=$(hash_of "$T")
 dfixed=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" 2>&1 | sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p')
 dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p')
 [ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
+# the same blob on the trot (test_determinism.sh's details scenario, every platform): the
+# determinism driver, details 0..N-1 active from the first step (the players cannot set details)
+# shellcheck disable=SC2046
+set -- $(MAKEFLAGS='' make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
+[ -n "$DT_ITERS" ] || { echo "update_hashes: print-bm-level gave no details run"; exit 1; }
+DT_ARGS="--steps $DT_STEPS --clip $CLIP --details $DT_N --iterations $DT_ITERS --main-only"
+# shellcheck disable=SC2086
+"$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dtfixed=$(hash_of "$T")
+# shellcheck disable=SC2086
+"$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dtfloat=$(hash_of "$T")
+if [ -z "$dtfixed" ] || [ -z "$dtfloat" ]; then echo "update_hashes: the determinism driver printed no details hash"; exit 1; fi
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -120,5 +133,10 @@ cut_contact_float $cutcfloat
 # checked by test_runtime_dstep.
 details50_fixed $dfixed
 details50_float $dfloat
+# The same blob, details 0..$((DT_N - 1)) active from the first step, $DT_ITERS CG iterations, $DT_STEPS steps
+# of the trot, no level switch (ports/cross det_main BLOB $DT_ARGS),
+# checked by tests/scripts/test_determinism.sh on every platform and the Cortex-M4.
+details_trot_fixed $dtfixed
+details_trot_float $dtfloat
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"
