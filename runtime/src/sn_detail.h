@@ -67,7 +67,7 @@ void sn_detail_reset(sn_ihdr *h);
  * force, not the blended mode), else NULL */
 sn_dstate *sn_detail_live(const sn_ihdr *h);
 /* state hash: the seats' details, coefficients, velocities, x (none filled: unchanged) */
-uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh, uint64_t (*fnv)(uint64_t, uint32_t));
+uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh);
 /* the seats' preconditioner: z_s = P_s r_s (scalar block Jacobi: the seat's
  * own diagonal averaged, no frame), r and z the seat rows */
 void sn_detail_precond(const sn_ihdr *h, const sn_dstate *s, const sn_q *r, sn_q *z, uint32_t *sat);

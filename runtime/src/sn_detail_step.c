@@ -258,18 +258,18 @@ sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n) {
     return SN_OK;
 }
 
-uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh, uint64_t (*fnv)(uint64_t, uint32_t)) {
+uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh) {
     const sn_dstate *s;
     uint32_t i;
     if (!has_details(h) || st(h)->n == 0) return hsh;
     s = st(h);
-    for (i = 0; i < s->n; i++) hsh = fnv(hsh, DT(s, o_seat, const uint16_t)[i]);
+    for (i = 0; i < s->n; i++) hsh = sn_fnv_u32(hsh, DT(s, o_seat, const uint16_t)[i]);
     for (i = 0; i < 3u * s->n; i++) {
         uint32_t u[3];
         memcpy(&u[0], DT(s, o_coef, const sn_q) + i, 4);
         memcpy(&u[1], DT(s, o_vel, const sn_q) + i, 4);
         memcpy(&u[2], DT(s, o_x, const sn_q) + 3u * s->nF + i, 4);
-        hsh = fnv(fnv(fnv(hsh, u[0]), u[1]), u[2]);
+        hsh = sn_fnv_u32(sn_fnv_u32(sn_fnv_u32(hsh, u[0]), u[1]), u[2]);
     }
     return hsh;
 }

@@ -409,7 +409,7 @@ sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
 }
 
 /* ---- determinism hash: FNV-1a 64 over little-endian bytes ---- */
-static uint64_t fnv_u32(uint64_t hsh, uint32_t x) {
+uint64_t sn_fnv_u32(uint64_t hsh, uint32_t x) {
     int b;
     for (b = 0; b < 4; b++) {
         hsh ^= (x >> (8 * b)) & 0xFFu;
@@ -420,7 +420,7 @@ static uint64_t fnv_u32(uint64_t hsh, uint32_t x) {
 static uint64_t fnv_q(uint64_t hsh, sn_q x) {
     uint32_t u;
     memcpy(&u, &x, 4);
-    return fnv_u32(hsh, u);
+    return sn_fnv_u32(hsh, u);
 }
 
 uint64_t sn_state_hash(const sn_instance *inst) {
@@ -431,10 +431,10 @@ uint64_t sn_state_hash(const sn_instance *inst) {
     if (!inst || chdr_of(inst)->magic != SN_INST_MAGIC) return 0;
     h = chdr_of(inst);
     pos = CARR(h, o_pos, sn_q); vel = CARR(h, o_vel, sn_q); x = CARR(h, o_x, sn_q); pq = CARR(h, o_pq, sn_q);
-    hsh = fnv_u32(hsh, h->steps);
-    hsh = fnv_u32(hsh, h->saturations);
-    hsh = fnv_u32(hsh, h->bound_steps);
-    hsh = fnv_u32(hsh, h->limit_steps);
+    hsh = sn_fnv_u32(hsh, h->steps);
+    hsh = sn_fnv_u32(hsh, h->saturations);
+    hsh = sn_fnv_u32(hsh, h->bound_steps);
+    hsh = sn_fnv_u32(hsh, h->limit_steps);
     for (i = 0; i < 3; i++) hsh = fnv_q(hsh, h->origin[i]);
     hsh = fnv_q(hsh, h->energy);
     for (i = 0; i < 4 * h->v.nJ; i++) hsh = fnv_q(hsh, pq[i]); /* tracked hemispheres */
@@ -447,8 +447,8 @@ uint64_t sn_state_hash(const sn_instance *inst) {
         uint32_t na;
         const uint8_t *m = sn_adapt_mask_bytes(h, &na);
         for (i = 0; i < na; i++)
-            if (!m[i]) hsh = fnv_u32(hsh, i);
+            if (!m[i]) hsh = sn_fnv_u32(hsh, i);
     }
-    hsh = sn_detail_hash(h, hsh, fnv_u32); /* no seat filled: unchanged */
+    hsh = sn_detail_hash(h, hsh); /* no seat filled: unchanged */
     return sn_crease_hash(h, hsh);   /* no crease sections: unchanged */
 }

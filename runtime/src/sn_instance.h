@@ -231,6 +231,7 @@ void sn_segments_step(sn_ihdr *h, uint32_t *sat);   /* 8b: segment meshes after 
  * directions, velocities and pending impulses turned by M; expressed against h->origin */
 void sn_segments_teleport(sn_ihdr *h, const sn_q M[9], const sn_q T0[3], const sn_q T1[3], uint32_t *sat);
 uint64_t sn_segments_hash(const sn_ihdr *h, uint64_t hsh); /* segment state into the FNV-1a hash */
+uint64_t sn_fnv_u32(uint64_t hsh, uint32_t x);       /* one little-endian word into the FNV-1a 64 hash (sn_instance.c) */
 void sn_health(sn_ihdr *h, uint32_t step_clamps); /* 9: disp, bound steps (energy from sn_solve) */
 void sn_crease_step(sn_ihdr *h, uint32_t *sat);    /* 3b: crease list C: detect, drop, n_a, rows (sn_crease.c) */
 uint64_t sn_crease_hash(const sn_ihdr *h, uint64_t hsh); /* list C into the FNV-1a hash (unchanged without CREASE) */
