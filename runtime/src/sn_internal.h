@@ -17,6 +17,13 @@
 #include "sn_format.h"
 
 #define SN_INLINE static inline
+/* a function kept out of its caller: the details' per-cell work, so a step
+ * without details does not carry their arrays in its stack frame */
+#if defined(__GNUC__)
+#define SN_NOINLINE static __attribute__((noinline))
+#else
+#define SN_NOINLINE static
+#endif
 
 /* ---- endian-safe reads of the little-endian blob (aliasing-safe) ---- */
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && \

@@ -131,6 +131,23 @@ static void detail_rows_out(const sn_ihdr *h, const sn_dstate *dt, uint32_t on, 
         }
 }
 
+/* The active details' share of cell e's right-hand side (LEVELS.md §3): y_d =
+ * R^T (c_d + w_d), an offset (no corner-0 difference); the corner rows' part in
+ * lc, the seats' rows into sacc. */
+SN_NOINLINE void detail_cell_rhs(const sn_ihdr *h, const sn_dstate *dt, uint32_t e, uint32_t on, const sn_q *R, const sn_q d[24],
+                                 const sn_q uu[24], const sn_q (*yx)[3], sn_acc lc[24], sn_acc *sacc, uint32_t *sat) {
+    sn_q yc[24], yd[SN_CUT_MAXX][3];
+    sn_acc ldd[3 * SN_CUT_MAXX];
+    uint32_t sj[SN_CUT_MAXX], k;
+    for (k = 0; k < 24; k++) {
+        yc[k] = sn_add(d[k], uu[k], sat); /* the corners' d + u (ld + lu's operand) */
+        lc[k] = 0;
+    }
+    detail_ops(&h->v, dt, e, R, DT(dt, o_q, const sn_q) + 3 * dt->nF, sj, yd, sat);
+    sn_detail_cell_mul(&h->v, e, on, yc, yx, (const sn_q(*)[3])yd, lc, ldd, sat);
+    detail_rows_out(h, dt, on, sj, R, ldd, sacc, sat);
+}
+
 /* Per-cell elastic force plus the implicit stiffness/damping term (step 4-5):
  * acc_a = sum_e R_e S^_e (d_e + R_e^T (w - w_a0))_a over free corners, and twice
  * the elastic energy sum_e d_e . S^_e d_e into *e2 (Q32). u holds w per free vertex. */
@@ -172,18 +189,7 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) (void)sn_cut_terms(h, e, R, a0, w0, fr, yx, lx, sat); /* the cut level (sn_cut.c) */
-        if (on) { /* the active details (LEVELS.md §3): y_d = R^T (c_d + w_d), an offset (no corner-0 difference) */
-            sn_q yc[24], yd[SN_CUT_MAXX][3];
-            sn_acc ldd[3 * SN_CUT_MAXX];
-            uint32_t sj[SN_CUT_MAXX];
-            for (k = 0; k < 24; k++) {
-                yc[k] = sn_add(d[k], uu[k], sat); /* the corners' d + u (ld + lu's operand) */
-                lc[k] = 0;
-            }
-            detail_ops(v, dt, e, R, DT(dt, o_q, const sn_q) + 3 * dt->nF, sj, yd, sat);
-            sn_detail_cell_mul(v, e, on, yc, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ldd, sat);
-            detail_rows_out(h, dt, on, sj, R, ldd, sacc, sat);
-        }
+        if (on) detail_cell_rhs(h, dt, e, on, R, d, uu, (const sn_q(*)[3])yx, lc, sacc, sat);
         for (k = 3; k < 24; k++) ec += sn_mul(d[k], sn_out(ld[k], v->frac_S, &esat)); /* d_0 = 0: no term */
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
@@ -205,7 +211,7 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
  * rest shape, as a vertex's with its frame): folded in as y - g_E at the
  * corners and extras, which only the seats' rows read. bs: the seats' rows of
  * b, -= round(acc) at Q(19 + k_s). ua: a1 v per free vertex (or NULL). */
-static void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua, const sn_q *dsk, sn_acc *acc, sn_q *bs, uint32_t *sat) {
+SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua, const sn_q *dsk, sn_acc *acc, sn_q *bs, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS];
     const sn_q *vel = CARR(h, o_vel, sn_q), *cR = CARR(h, o_cR, sn_q);
@@ -419,7 +425,7 @@ void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned 
  * corners' product plus the details' columns (sn_detail_cell_mul, lc at the
  * corners' scale) before the rounding, and the details' rows into sacc. d's
  * seat rows follow its free rows. */
-static void cell_stiff_det(const sn_ihdr *h, const sn_dstate *dt, uint32_t e, uint32_t on, const unsigned char *K,
+SN_NOINLINE void cell_stiff_det(const sn_ihdr *h, const sn_dstate *dt, uint32_t e, uint32_t on, const unsigned char *K,
                            const unsigned char *cl, const sn_q *R, const sn_q *d, sn_acc *acc, sn_acc *sacc, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     uint32_t k, c, vi[8], nf = 0, nF = h->v.nF, sj[SN_CUT_MAXX];
@@ -449,7 +455,7 @@ static void cell_stiff_det(const sn_ihdr *h, const sn_dstate *dt, uint32_t e, ui
 
 /* The details' share of the mat-vec's mass pass: corner rows' detail columns
  * into acc (free corners), the seats' rows into sacc (zeroed here). */
-static void detail_mass_mv(const sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_acc *acc, sn_acc *sacc, uint32_t *sat) {
+SN_NOINLINE void detail_mass_mv(const sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_acc *acc, sn_acc *sacc, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cells = v->sec[SN_SEC_CELLS];
     const uint32_t *ons = DT(dt, o_on, const uint32_t);
