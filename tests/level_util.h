@@ -1,8 +1,8 @@
 /* level_util.h -- what the level tests share (test_runtime_level.c,
  * test_runtime_adapt.c, test_runtime_cut.c, test_runtime_details.c,
  * test_runtime_dstep.c): the flavour's real <-> double conversions, a blob
- * loader (with 8 spare bytes, so a short read never overruns), the distance
- * between two surfaces in cells, the blob's cell edge and the violent swing. */
+ * loader (with 8 spare bytes, so a short read never overruns), a joint's
+ * ramp, the distance between two surfaces in cells, the blob's cell edge and the violent swing. */
 #ifndef SN_LEVEL_UTIL_H
 #define SN_LEVEL_UTIL_H
 #include <math.h>
@@ -25,6 +25,21 @@
 #endif
 
 static unsigned char *load(const char *path, size_t *n) { return (unsigned char *)t_read_file(path, n); }
+
+/* the ramps of the cut-level tests: JOINT's local rotation by deg * min(step / 12, 1) about axis, the rest at rest */
+static inline void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, int axis, double deg, int step, sn_xform *xf)
+{
+    sn_quat *local = malloc(sizeof *local * nj);
+    uint32_t j;
+    double a = deg * (step < 12 ? step / 12.0 : 1.0);
+    for (j = 0; j < nj; j++) {
+        sn_vec3 ax;
+        ax.x = R(axis == 0 ? 1.0 : 0.0); ax.y = R(axis == 1 ? 1.0 : 0.0); ax.z = R(axis == 2 ? 1.0 : 0.0);
+        local[j] = sn_quat_axis_angle(ax, R((int32_t)j == joint ? a : 0.0));
+    }
+    sn_pose_from_local(blob, local, NULL, xf);
+    free(local);
+}
 
 /* the largest and the rms distance between two surfaces of n points, in cells */
 static inline void surf_dist(const sn_vec3 *a, const sn_vec3 *b, uint32_t n, double cell, double *mx, double *rms)

@@ -29,21 +29,6 @@
 
 static int b_flavour(const unsigned char *b) { return b[SN_H_FLAVOUR]; }
 
-/* JOINT's local rotation by deg * min(step / 12, 1) about axis, the rest at rest */
-static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, int axis, double deg, int step, sn_xform *xf)
-{
-    sn_quat *local = malloc(sizeof *local * nj);
-    uint32_t j;
-    double a = deg * (step < 12 ? step / 12.0 : 1.0);
-    for (j = 0; j < nj; j++) {
-        sn_vec3 ax;
-        ax.x = R(axis == 0 ? 1.0 : 0.0); ax.y = R(axis == 1 ? 1.0 : 0.0); ax.z = R(axis == 2 ? 1.0 : 0.0);
-        local[j] = sn_quat_axis_angle(ax, R((int32_t)j == joint ? a : 0.0));
-    }
-    sn_pose_from_local(blob, local, NULL, xf);
-    free(local);
-}
-
 int main(int argc, char **argv)
 {
     size_t nc, nl;

@@ -48,19 +48,6 @@ static int g_sel = 48;        /* the every-detail run's step whose coefficients 
 static double *g_selc;       /* their max-norms there, nD */
 static int g_axis = 1;      /* the ramp's axis: 0 x, 1 y, 2 z */
 static double g_deg = 90.0; /* and its angle */
-static void ramp_pose(const sn_blob *blob, uint32_t nj, int32_t joint, double deg, int step, sn_xform *xf)
-{
-    sn_quat *local = malloc(sizeof *local * nj);
-    uint32_t j;
-    double a = deg * (step < 12 ? step / 12.0 : 1.0);
-    for (j = 0; j < nj; j++) {
-        sn_vec3 ax;
-        ax.x = R(g_axis == 0 ? 1.0 : 0.0); ax.y = R(g_axis == 1 ? 1.0 : 0.0); ax.z = R(g_axis == 2 ? 1.0 : 0.0);
-        local[j] = sn_quat_axis_angle(ax, R((int32_t)j == joint ? a : 0.0));
-    }
-    sn_pose_from_local(blob, local, NULL, xf);
-    free(local);
-}
 
 /* detail id's coefficient, max-norm, in lattice cells' internal units (Q22; 0: no seat) */
 static double coef_of(const sn_instance *inst, uint32_t id)
@@ -161,7 +148,7 @@ static run_res ramp(sn_instance *inst, const sn_blob *b, uint32_t nj, int32_t jo
     T_CHECK(sn_details_set(inst, ids, n) == SN_OK, "[%s] set %u details", FL, n);
     for (k = 1; k <= 48; k++) {
         double a, q;
-        ramp_pose(b, nj, joint, g_deg, k, xf);
+        ramp_pose(b, nj, joint, g_axis, g_deg, k, xf);
         sn_set_pose(inst, xf, nj);
         sn_step(inst);
         sn_get_surface(inst, s, 0, nS);
@@ -270,7 +257,7 @@ int main(int argc, char **argv)
         ids[7] = 21;
         T_CHECK(sn_details_set(cd, NULL, 3) == SN_ERR_NULL && sn_details_set(cd, NULL, 0) == SN_OK, "[%s] NULL ids", FL);
         for (k = 1; k <= 20; k++) { /* in motion, then details enter: the surface stays put (coefficient 0) */
-            ramp_pose(bl[2], nj, joint, deg, (int)k, xf);
+            ramp_pose(bl[2], nj, joint, g_axis, deg, (int)k, xf);
             sn_set_pose(cd, xf, nj);
             sn_step(cd);
         }
@@ -291,7 +278,7 @@ int main(int argc, char **argv)
         uint64_t hs;
         sn_reset(lv1);
         for (k = 1; k <= 48; k++) {
-            ramp_pose(bl[0], nj, joint, deg, (int)k, xf);
+            ramp_pose(bl[0], nj, joint, g_axis, deg, (int)k, xf);
             sn_set_pose(lv1, xf, nj);
             sn_step(lv1);
             sn_get_surface(lv1, ref + (size_t)(k - 1) * nS, 0, nS);
@@ -357,7 +344,7 @@ int main(int argc, char **argv)
                 sn_set_iterations(si, DIT);
                 T_CHECK(sn_details_set(si, big, 50) == SN_OK, "[%s] shared: 50 set", FL);
                 for (k = 1; k <= 48; k++) {
-                    ramp_pose(bl[2], nj, joint, deg, (int)k, xf);
+                    ramp_pose(bl[2], nj, joint, g_axis, deg, (int)k, xf);
                     sn_set_pose(si, xf, nj);
                     sn_step_with(si, ws, wb);
                 }
