@@ -56,6 +56,8 @@ void sb_rt_tri_index_make(tri_index *x, const double *P, const int *tri, int nt)
 void sb_rt_tri_index_free(tri_index *x);
 /* the triangle of x closest to p and its barycentric weights */
 int sb_rt_tri_closest(const tri_index *x, const double p[3], double bw[3]);
+/* surface vertex k of o embedded in lattice positions P (its cell's trilinear weights) */
+void sb_rt_embed_point(const sb_model *o, const double *P, int k, double out[3]);
 /* mapped position of A's surface vertex k */
 void sb_rt_mapped_surface_point(const sb_retarget *rt, int k, double out[3]);
 #endif

@@ -143,17 +143,18 @@ int sb_rt_tri_closest(const tri_index *x, const double p[3], double bw[3])
     return bt;
 }
 
-/* mapped position of A's surface vertex k */
-void sb_rt_mapped_surface_point(const sb_retarget *rt, int k, double out[3])
+void sb_rt_embed_point(const sb_model *o, const double *P, int k, double out[3])
 {
-    const sb_model *A = rt->A;
     double N[8];
     int c, a;
-    sb_shape(A->emb_t + 3 * k, N, NULL);
+    sb_shape(o->emb_t + 3 * k, N, NULL);
     out[0] = out[1] = out[2] = 0;
     for (c = 0; c < 8; c++)
-        for (a = 0; a < 3; a++) out[a] += N[c] * rt->h[3 * A->cells[8 * A->emb_cell[k] + c] + a];
+        for (a = 0; a < 3; a++) out[a] += N[c] * P[3 * o->cells[8 * o->emb_cell[k] + c] + a];
 }
+
+/* mapped position of A's surface vertex k */
+void sb_rt_mapped_surface_point(const sb_retarget *rt, int k, double out[3]) { sb_rt_embed_point(rt->A, rt->h, k, out); }
 
 int sb_rt_update_surface(sb_retarget *rt)
 {

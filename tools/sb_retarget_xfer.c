@@ -80,15 +80,7 @@ double sb_rt_static(const sb_model *o, const double *Q, double *q)
 }
 
 /* rest position of o's surface vertex k from its embedding */
-static void sb_rt_surface_point(const sb_model *o, int k, double y[3])
-{
-    double N[8];
-    int c, a;
-    sb_shape(o->emb_t + 3 * k, N, NULL);
-    y[0] = y[1] = y[2] = 0;
-    for (c = 0; c < 8; c++)
-        for (a = 0; a < 3; a++) y[a] += N[c] * o->x[3 * o->cells[8 * o->emb_cell[k] + c] + a];
-}
+static void sb_rt_surface_point(const sb_model *o, int k, double y[3]) { sb_rt_embed_point(o, o->x, k, y); }
 
 void sb_rt_surface(const sb_model *o, const double *q, double *s)
 {

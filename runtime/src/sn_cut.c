@@ -56,8 +56,8 @@ sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk) {
  * the same order as extra-major loops would give them (x, then c), so float
  * keeps its bits; fixed sums a block row's 3 int16 mantissa products and
  * scales once by 2^e (m y = mant y 2^e, all exact in int64: same integers). */
-uint32_t sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
-                      sn_q y[SN_CUT_MAXX][3], sn_acc lx[24], uint32_t *sat) {
+void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
+                  sn_q y[SN_CUT_MAXX][3], sn_acc lx[24], uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX, *rest = v->sec[SN_SEC_REST];
     const unsigned char *K0 = sn_sec(v, SN_SEC_CELLXK) + (size_t)sn_rd_u32(cx + 40) * SN_ELEM_CELLXK(SN_FLAVOUR, SN_REAL_BYTES);
@@ -103,7 +103,6 @@ uint32_t sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const 
         lx[3 * a + 2] = s2;
         for (i = 3 * a; i < 3 * a + 3; i++) SN_RANGE(SN_WITHIN(lx[i], 61), "cut-level row beyond 19 * 3 * 2^55", lx[i]);
     }
-    return n;
 }
 
 /* The cut field (surface, sn_embed.c; level switch, sn_level.c): the field in a cell is

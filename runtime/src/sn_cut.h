@@ -15,9 +15,9 @@ sn_status sn_check_cut(const sn_view *v, uint32_t ncx, uint32_t nxk);
  * R the cell frame, a0 its corner 0, w0 w at a0. Only free corners' rows
  * are written (cell_forces reads no other). y: the extras' operands
  * d_x + u_x (cell frame, CELLX order compacted), which the details' rows
- * read too; returns their count. */
-uint32_t sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
-                      sn_q y[SN_CUT_MAXX][3], sn_acc lx[24], uint32_t *sat);
+ * read too. */
+void sn_cut_terms(sn_ihdr *h, uint32_t e, const sn_q *R, uint32_t a0, const sn_q w0[3], uint32_t fr,
+                  sn_q y[SN_CUT_MAXX][3], sn_acc lx[24], uint32_t *sat);
 
 /* Outputs and the level switch (sn_embed.c, sn_level.c): the correction to
  * the trilinear field in a cell at t (Q15); free vertices' values in vf,

@@ -140,7 +140,10 @@ size_t sn_workspace_size(const sn_blob *blob, sn_mode mode) {
 uint32_t sn_blend_offset(const sn_ihdr *h) {
     if (h->v.flags & SN_VIEW_SHARED) /* after the factor (shared_offsets' *ws) */
         return (h->o_L + 4u * (h->v.nRows * (h->v.nRows + 1u) / 2u) + 7u) & ~7u;
-    return h->v.instance_bytes + h->ad_bytes + (sn_detail_region(h) ? sn_detail_region(h)->bytes : 0u); /* past adaptation's mask and the details' seats (sn_instance_size_mode) */
+    {
+        const sn_dstate *ds = sn_detail_region(h); /* past adaptation's mask and the details' seats (sn_instance_size_mode) */
+        return h->v.instance_bytes + h->ad_bytes + (ds ? ds->bytes : 0u);
+    }
 }
 
 #if !defined(SN_FLOAT)
