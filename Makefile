@@ -8,6 +8,10 @@
 #   make ports    cross-built images (bare metal, other architectures)
 #   make clean
 BUILD   ?= build
+# an empty or root BUILD would write outputs under / and make clean remove it
+ifeq ($(filter-out /,$(strip $(BUILD))),)
+$(error BUILD must name a build directory (got '$(BUILD)'), e.g. BUILD=build)
+endif
 CC      ?= cc
 OPT     ?= -O2
 WARN     = -std=c99 -Wall -Wextra -Wpedantic -Wconversion -Werror
