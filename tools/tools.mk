@@ -175,13 +175,12 @@ $(EX)/beast_crease.blob: $(EX)/beast_crease/beast.sinew $(BAKE)
 $(EX)/beast_crease_float.blob: $(EX)/beast_crease/beast.sinew $(BAKE)
 	$(BAKE) $< -o $@ --flavour float --quiet
 TEST_DEPS += $(BEAST_BLOBS)
-# the humanoid's crease test (tests/test_runtime_crease.c) in make test: the
-# fixed flavour (the float one is left to `make crease-beast`: 35 CPU-s a bake)
-TEST_DEPS += $(EX)/beast_crease.blob
+# the humanoid's crease test (tests/test_runtime_crease.c, SN_CREASE_BEAST=1)
+# in both flavours: a campaign (tests/CAMPAIGNS.md; 32 CPU-s a bake, 4 a run)
 .PHONY: crease-beast
 crease-beast: $(EX)/beast_crease.blob $(EX)/beast_crease_float.blob $(BUILD)/tests/test_runtime_crease $(BUILD)/tests/test_runtime_crease_float
-	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_crease
-	BUILD=$(BUILD) $(BUILD)/tests/test_runtime_crease_float
+	SN_CREASE_BEAST=1 BUILD=$(BUILD) $(BUILD)/tests/test_runtime_crease
+	SN_CREASE_BEAST=1 BUILD=$(BUILD) $(BUILD)/tests/test_runtime_crease_float
 all: $(BEAST_BLOBS)
 
 # ---- glTF examples (tools/examples/*_gltf, issue 17): Blender exports, 'gltf' descriptions;

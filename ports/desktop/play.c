@@ -61,13 +61,16 @@ static void usage(FILE *f) {
         "  --iterations N     CG iterations per step (1..blob maximum; default: blob's)\n"
         "  --lod K:L[,K:L..]  level of detail L (0 coarse, 1 fine; sn_set_lod) from step K on (blob baked with 'levels 2')\n"
         "  --adapt on|off     adaptation on level 1 (sn_set_adapt; blob baked with 'adapt'): on by default\n"
+        "  --details N|all    details 0..N-1 active on the cut level from the first step (sn_details_set; blob baked\n"
+        "                     with 'levels 2 cut' and 'details'); all: as many as the blob's A_max allows\n"
         "  --unwarped         global linear FEM (all frames R = I), seed 000 fig. 5 (= --mode unwarped)\n"
         "  --mode M           warped (default), unwarped, or blended: blended local linearization, seed 000 sec. 4.5\n"
         "  --obj-dir DIR      write DIR/frame_NNNN.obj after every step (deformed surface)\n"
         "  --obj-frames LIST  with --obj-dir: only these frames, e.g. 0,10,20-30 (0: before the first step)\n"
         "  --png FILE         picture of the last frame\n"
         "  --sheet FILE       contact sheet: 12 frames over the run, 4x3 grid of 320x240 (or --size) cells\n"
-        "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n"
+        "  --compare FILE     rest | unwarped | warped at the last frame, side by side\n");
+    fprintf(f,
         "  --compare-hits FILE  rest | no hit | hit at the last frame: a second instance steps the clip without its\n"
         "                     impulse lines; with --heat D the hit panel is coloured by its distance from it\n"
         "  --compare-rigs FILE  rest | rigs off | rigs on at the last frame; rigs off = a second instance with\n"
@@ -75,6 +78,11 @@ static void usage(FILE *f) {
         "                     panel is coloured by its distance from the rigs-off one (red at D mesh units)\n"
         "  --rig-off-blob B   the same character baked without its rigs (same lattice and surface), for\n"
         "                     the rigs-off panel of --compare-rigs (pose-driven rigs cannot be switched off)\n"
+        "  --compare-details FILE  cut level | cut + details | level 1 at the last frame (with --details; two more\n"
+        "                     instances: no details, and level 1 from the first step); with --heat D the first two\n"
+        "                     panels are coloured by their distance from level 1 (red at D mesh units)\n"
+        "  --level1-blob B    the level-1 panel of --compare-details from blob B (same skeleton and surface; its\n"
+        "                     level 1 if it has two), for a blob that carries no level 1\n"
         "  --lattice          draw the control lattice (skeleton vertices in red)\n"
         "  --seg-impulse M:N:X,Y,Z[@K]  impulse (newton-seconds, world axes) at node N of segment mesh M\n"
         "                     during step K (default 1); repeatable (at most 16)\n"
@@ -503,6 +511,8 @@ static int render(scene *s, const sn_instance *inst, rs_image *out, const char *
 typedef struct {
     const char *blob_path, *clip_path, *obj_dir, *obj_frames, *png, *sheet, *compare, *title, *stats_csv, *plot;
     const char *compare_rigs, *rig_off_blob, *compare_hits;
+    const char *compare_details, *level1_blob;   /* issue 13's details: cut | cut + details | level 1 */
+    long details_n;     /* --details N; -1: all (up to A_max); 0: none */
     const char *gltf_anim, *clip_out, *out_gltf, *apng;   /* issue 17: glTF in and out */
     int gltf_noloop;
     const char *held[MAX_HELD];   /* --control NAME=VALUE, as given */
@@ -571,7 +581,8 @@ static int parse_args(int argc, char **argv, options *o) {
                                          "--frames", "--iterations", "--health", "--size", "--view", "--frame-box", "--heat",
                                          "--stats-csv", "--plot", "--control", "--rigs", "--compare-rigs", "--rig-off-blob", "--compare-hits",
                                          "--seg-impulse", "--seg-floor", "--segments", "--ground", "--sphere", "--pin", "--belt",
-                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", "--mode", "--adapt", NULL};
+                                         "--gltf-anim", "--gltf-loop", "--clip-out", "--out-gltf", "--apng", "--lod", "--mode", "--adapt",
+                                         "--details", "--compare-details", "--level1-blob", NULL};
     int i, j;
     memset(o, 0, sizeof *o);
     o->frames = -1; o->w = 640; o->h = 480; o->az = 30; o->el = 15;
@@ -607,6 +618,14 @@ static int parse_args(int argc, char **argv, options *o) {
         else if (!strcmp(a, "--compare-rigs")) o->compare_rigs = v;
         else if (!strcmp(a, "--compare-hits")) o->compare_hits = v;
         else if (!strcmp(a, "--rig-off-blob")) o->rig_off_blob = v;
+        else if (!strcmp(a, "--compare-details")) o->compare_details = v;
+        else if (!strcmp(a, "--level1-blob")) o->level1_blob = v;
+        else if (!strcmp(a, "--details")) {
+            long n = strtol(v, &end, 10);
+            if (!strcmp(v, "all")) o->details_n = -1;
+            else if (!*v || *end || n < 1 || n > 65535) { fprintf(stderr, PROG ": --details: want N (1..65535) or all, got '%s'\n", v); return 2; }
+            else o->details_n = n;
+        }
         else if (!strcmp(a, "--rigs")) {
             if (strcmp(v, "on") && strcmp(v, "off")) { fprintf(stderr, PROG ": --rigs: want on or off, got '%s'\n", v); return 2; }
             o->rigs_off = !strcmp(v, "off");
@@ -747,6 +766,12 @@ static int parse_args(int argc, char **argv, options *o) {
     if (o->compare && o->compare_rigs) { fprintf(stderr, PROG ": --compare and --compare-rigs: one at a time\n"); return 2; }
     if (o->compare_hits && (o->compare || o->compare_rigs)) { fprintf(stderr, PROG ": --compare-hits and --compare/--compare-rigs: one at a time\n"); return 2; }
     if (o->compare_hits && !o->clip_path) { fprintf(stderr, PROG ": --compare-hits needs a --clip with impulse lines\n"); return 2; }
+    if (o->compare_details && (o->compare || o->compare_rigs || o->compare_hits)) {
+        fprintf(stderr, PROG ": --compare-details and --compare/--compare-rigs/--compare-hits: one at a time\n"); return 2;
+    }
+    if (o->compare_details && !o->details_n) { fprintf(stderr, PROG ": --compare-details needs --details N|all (the middle panel)\n"); return 2; }
+    if (o->compare_details && o->n_lod) { fprintf(stderr, PROG ": --compare-details runs each panel on one level: not with --lod\n"); return 2; }
+    if (o->level1_blob && !o->compare_details) { fprintf(stderr, PROG ": --level1-blob needs --compare-details\n"); return 2; }
     if (o->compare_rigs && o->rigs_off) { fprintf(stderr, PROG ": --compare-rigs shows rigs off next to rigs on: not with --rigs off\n"); return 2; }
     if (o->sheet && o->have_size && (o->w > 2048 || o->h > 2048)) {
         fprintf(stderr, PROG ": --size: sheet cells are at most 2048x2048 (the sheet is 4x3 cells)\n"); return 2;
@@ -877,6 +902,88 @@ static void controls_step(sn_instance *in, const sn_blob *blob, const sn_clip *c
     for (i = 0; i < n_held; i++) sn_set_control(in, held[i].c, real_of_q16(held[i].q16));
 }
 
+/* --compare-details: cut level | cut + details | level 1 at the last frame
+ * (runtime/LEVELS.md §3 "Details on the cut level"). Each of the first two
+ * panels is labelled with its surface's distance from level 1's (largest
+ * and rms over the surface vertices, mesh units; also printed) and, with
+ * --heat, coloured by it. 0, or -1 after a message. */
+static int compare_details(scene *s, const options *o, const sn_instance *with, const sn_instance *cut,
+                           const sn_instance *l1, long n_details, double t_end, rs_image *cmp) {
+    const sn_instance *panel[2];
+    const uint8_t line[3] = {255, 255, 255};
+    rs_image pane;
+    float heat = s->heat, *ref;
+    uint32_t nv = s->info.surface_vertices, i;
+    int pw = o->w * 3 / 4 > 240 ? o->w * 3 / 4 : 240, ph = pw * 3 / 4, p;
+    char lab[64], title[64], dist[96], err[512];
+    panel[0] = cut; panel[1] = with;
+    memset(&pane, 0, sizeof pane);
+    ref = malloc(((size_t)nv + 1) * 3 * sizeof(float));
+    if (!ref || rs_image_alloc(cmp, 3 * pw, ph) || rs_image_alloc(&pane, pw, ph)) { free(ref); rs_image_free(&pane); die("out of memory"); return -1; }
+    snprintf(lab, sizeof lab, "t = %.2f s", t_end);
+    s->heat = 0; s->ref = NULL;
+    if (render(s, l1, &pane, "level 1", lab)) goto oom;
+    rs_blit(cmp, 2 * pw, 0, &pane);
+    memcpy(ref, s->pos, (size_t)nv * 3 * sizeof(float));   /* render fetched level 1's surface */
+    for (p = 0; p < 2; p++) {
+        double mx = 0, ss = 0;
+        fetch(s, panel[p]);
+        for (i = 0; i < nv; i++) {
+            double dx = s->pos[3 * i] - ref[3 * i], dy = s->pos[3 * i + 1] - ref[3 * i + 1], dz = s->pos[3 * i + 2] - ref[3 * i + 2];
+            double d2 = dx * dx + dy * dy + dz * dz;
+            ss += d2;
+            if (d2 > mx) mx = d2;
+        }
+        mx = sqrt(mx); ss = nv ? sqrt(ss / nv) : 0;
+        if (p == 0) snprintf(title, sizeof title, "cut level");
+        else snprintf(title, sizeof title, "cut + %ld details", n_details);
+        snprintf(dist, sizeof dist, "from level 1: max %.2f, rms %.3f", mx, ss);
+        if (!o->quiet) printf("compare-details: %s: surface from level 1 max %.4g rms %.4g mesh units (t = %.2f s)\n", title, mx, ss, t_end);
+        if (heat > 0) { s->ref = ref; s->heat = heat; }
+        if (render(s, panel[p], &pane, title, dist)) goto oom;
+        s->ref = NULL; s->heat = 0;
+        rs_blit(cmp, p * pw, 0, &pane);
+    }
+    s->heat = heat;
+    rs_fill(cmp, pw - 1, 0, 2, ph, line);
+    rs_fill(cmp, 2 * pw - 1, 0, 2, ph, line);
+    rs_image_free(&pane);
+    free(ref);
+    if (png_write(o->compare_details, cmp->rgb, cmp->w, cmp->h, err, sizeof err)) { die("%s", err); return -1; }
+    if (!o->quiet) printf("wrote %s\n", o->compare_details);
+    return 0;
+oom:
+    s->heat = heat; s->ref = NULL;
+    rs_image_free(&pane);
+    free(ref);
+    die("out of memory");
+    return -1;
+}
+
+/* --details: details 0..n-1 active (sn_details_set; runtime/LEVELS.md §3).
+ * n < 0: as many as the blob takes. The most it takes (A_max, at most its
+ * detail count) is not in sn_blob_info: found as the largest set
+ * sn_details_set accepts, then sn_reset empties the set again (keeping
+ * iterations and mode) and the chosen one is set on the state at rest.
+ * Returns the count set, or -1 with err. */
+static long details_apply(sn_instance *inst, long n, const char *blob_path, char *err, size_t errlen) {
+    uint16_t *ids = malloc(65536 * sizeof *ids);
+    long k, most = 0;
+    if (!ids) { snprintf(err, errlen, "out of memory"); return -1; }
+    for (k = 0; k < 65536; k++) ids[k] = (uint16_t)k;
+    while (most < 65535 && sn_details_set(inst, ids, (uint32_t)(most + 1)) == SN_OK) most++;
+    sn_reset(inst);
+    if (!most) snprintf(err, errlen, "--details: %s has no details (bake it with 'levels 2 cut' and 'details A_MAX REFINE COARSEN')", blob_path);
+    else if (n > most) snprintf(err, errlen, "--details %ld: %s takes at most %ld at once (its A_max, or its detail count)", n, blob_path, most);
+    else {
+        if (n < 0) n = most;
+        if (sn_details_set(inst, ids, (uint32_t)n) == SN_OK) { free(ids); return n; }
+        snprintf(err, errlen, "--details %ld: sn_details_set refused", n);
+    }
+    free(ids);
+    return -1;
+}
+
 int main(int argc, char **argv) {
     options o;
     scene s;
@@ -885,6 +992,9 @@ int main(int argc, char **argv) {
     size_t nbytes = 0, need;
     sn_status st;
     sn_instance *inst = NULL, *inst2 = NULL;
+    sn_instance *inst3 = NULL;       /* --compare-details: level 1 */
+    void *mem3 = NULL, *bytes3 = NULL;
+    long n_details = 0;              /* --details: active on inst */
     static sn_clip clip;
     char *gltf_clip = NULL;          /* --gltf-anim: the clip text */
     pg_out gout;                     /* --out-gltf */
@@ -1024,6 +1134,7 @@ int main(int argc, char **argv) {
     if (o.compare && probe_writable(o.compare, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare_rigs && probe_writable(o.compare_rigs, err, sizeof err)) { die("%s", err); goto done; }
     if (o.compare_hits && probe_writable(o.compare_hits, err, sizeof err)) { die("%s", err); goto done; }
+    if (o.compare_details && probe_writable(o.compare_details, err, sizeof err)) { die("%s", err); goto done; }
     if (o.obj_dir) {
         snprintf(path, sizeof path, "%s/frame_0000.obj", o.obj_dir);
         if (probe_writable(path, err, sizeof err)) { die("%s", err); goto done; }
@@ -1036,6 +1147,8 @@ int main(int argc, char **argv) {
     if ((st = sn_instance_init(mem, need, s.blob, &inst)) != SN_OK) {
         fprintf(stderr, PROG ": sn_instance_init: %s\n", sn_status_str(st)); goto done;
     }
+    if (o.details_n && (n_details = details_apply(inst, o.details_n, o.blob_path, err, sizeof err)) < 0) { die("%s", err); goto done; }
+    if (n_details && !o.quiet) printf("details: %ld active on the cut level (ids 0..%ld)\n", n_details, n_details - 1);
     if (o.iterations) sn_set_iterations(inst, (uint32_t)o.iterations);
     if (o.adapt_off) sn_set_adapt(inst, 0);
     if (o.unwarped && (st = sn_set_mode(inst, (sn_mode)o.unwarped)) != SN_OK) {
@@ -1085,6 +1198,45 @@ int main(int argc, char **argv) {
         controls_zero(inst2, b2, n_ctl2);
     }
 
+    if (o.compare_details) {   /* the cut level without details and level 1, stepped in lockstep */
+        const sn_blob *b3 = s.blob;
+        size_t need3 = need;
+        mem2 = malloc(need);
+        if (!mem2 || sn_instance_init(mem2, need, s.blob, &inst2) != SN_OK) { die("cannot create the cut-level instance"); goto done; }
+        if (o.iterations) sn_set_iterations(inst2, (uint32_t)o.iterations);
+        if (o.unwarped) sn_set_mode(inst2, (sn_mode)o.unwarped);
+        if (o.level1_blob) {
+            size_t n3 = 0;
+            sn_blob_info i3;
+            if (!(bytes3 = read_file(o.level1_blob, &n3, err, sizeof err))) { die("%s", err); goto done; }
+            if ((st = sn_blob_validate(bytes3, n3, &b3)) != SN_OK) {
+                fprintf(stderr, PROG ": %s: invalid blob: %s\n", o.level1_blob, sn_status_str(st)); goto done;
+            }
+            sn_blob_get_info(b3, &i3);
+            if (i3.joints != s.info.joints || i3.surface_vertices != s.info.surface_vertices ||
+                i3.triangles != s.info.triangles || i3.timestep != s.info.timestep) {
+                fprintf(stderr, PROG ": --level1-blob %s is not the character of %s: the skeleton, surface or timestep differ\n",
+                        o.level1_blob, o.blob_path);
+                goto done;
+            }
+            need3 = sn_instance_size_mode(b3, (sn_mode)o.unwarped);
+        } else if (sn_lod_levels(s.blob) < 2) {
+            fprintf(stderr, PROG ": --compare-details: %s carries one level; give the level-1 panel's blob with --level1-blob B\n", o.blob_path);
+            goto done;
+        }
+        mem3 = malloc(need3);
+        if (!mem3 || sn_instance_init(mem3, need3, b3, &inst3) != SN_OK) { die("cannot create the level-1 instance"); goto done; }
+        if (o.iterations) sn_set_iterations(inst3, (uint32_t)o.iterations);
+        if (o.unwarped) sn_set_mode(inst3, (sn_mode)o.unwarped);
+        if (sn_lod_levels(b3) >= 2 && sn_set_lod(inst3, 1) != SN_OK) { die("sn_set_lod(level 1) refused"); goto done; }
+        if (o.rigs_off) {
+            sn_blob_info i3;
+            sn_blob_get_info(b3, &i3);
+            controls_zero(inst2, s.blob, n_ctl);
+            controls_zero(inst3, b3, i3.controls);
+        }
+    }
+
     /* scratch */
     s.lattice = o.lattice; s.az = o.az; s.el = o.el; s.heat = o.heat; s.marks = o.marks;
     local = malloc(s.info.joints * sizeof *local);
@@ -1126,6 +1278,7 @@ int main(int argc, char **argv) {
         up.x = 0; up.y = R(1.0); up.z = 0;
         if (sn_set_segment_floor(inst, up, R(o.floor_y)) != SN_OK) { die("--seg-floor: refused"); goto done; }
         if (inst2) sn_set_segment_floor(inst2, up, R(o.floor_y));
+        if (inst3) sn_set_segment_floor(inst3, up, R(o.floor_y));
     }
     /* constraints and colliders: pins where the surface is before the first step */
     s.have_ground = o.have_ground;
@@ -1171,6 +1324,7 @@ int main(int argc, char **argv) {
         s.n_pins = nc;
         st = sn_set_constraints(inst, cs, nc);
         if (inst2) sn_set_constraints(inst2, cs, nc);
+        if (inst3) sn_set_constraints(inst3, cs, nc);
         flag_cs = cs; flag_nc = nc;   /* kept: set again with the clip's pins each step */
         if (st != SN_OK) { fprintf(stderr, PROG ": sn_set_constraints: %s\n", sn_status_str(st)); goto done; }
     }
@@ -1185,7 +1339,7 @@ int main(int argc, char **argv) {
     if (have_clip && clip.n_pins && !(all_cs = calloc((size_t)flag_nc + clip.n_pins + 1, sizeof *all_cs))) { die("out of memory"); goto done; }
     memset(clip_hold, 0, sizeof clip_hold);
     s.n_sph = o.n_sph;
-    pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits || o.apng;
+    pictures = o.png || o.sheet || o.compare || o.compare_rigs || o.compare_hits || o.compare_details || o.apng;
     if (o.lattice && lattice_edges(&s, bytes)) { die("out of memory"); goto done; }
     if ((pictures || o.heat > 0) && skin_setup(&s, bytes)) { die("out of memory"); goto done; }
     if (o.marks && !(s.cr_list = malloc(((size_t)s.info.surface_vertices + 1) * sizeof *s.cr_list))) { die("out of memory"); goto done; }
@@ -1306,6 +1460,7 @@ int main(int argc, char **argv) {
                 j.x = R(o.imp[i].j[0]); j.y = R(o.imp[i].j[1]); j.z = R(o.imp[i].j[2]);
                 if (sn_apply_segment_impulse(inst, o.imp[i].mesh, o.imp[i].node, j) != SN_OK) { die("--seg-impulse: refused"); goto done; }
                 if (inst2) sn_apply_segment_impulse(inst2, o.imp[i].mesh, o.imp[i].node, j);
+                if (inst3) sn_apply_segment_impulse(inst3, o.imp[i].mesh, o.imp[i].node, j);
             }
         if (o.have_ground || o.n_sph || (have_clip && clip.n_colliders)) {
             /* the colliders at the start of step k (spheres moved since step 1): the flags', then the clip's */
@@ -1328,6 +1483,7 @@ int main(int argc, char **argv) {
             if (have_clip) nq += (int)sn_clip_colliders(&clip, s.blob, (uint32_t)k, cl + nq, SN_CLIP_MAX_CHANNELS);
             if (sn_set_colliders(inst, cl, (uint32_t)nq) != SN_OK) { die("sn_set_colliders: refused (the blob's max_colliders is %u)", s.info.max_colliders); goto done; }
             if (inst2) sn_set_colliders(inst2, cl, (uint32_t)nq);
+            if (inst3) sn_set_colliders(inst3, cl, (uint32_t)nq);
         }
         if (all_cs) {   /* the clip's pins (targets at the end of step k) after --pin/--belt */
             uint32_t nc = flag_nc;
@@ -1335,6 +1491,7 @@ int main(int argc, char **argv) {
             nc += sn_clip_constraints(&clip, s.blob, (uint32_t)k, inst, clip_hold, all_cs + nc, clip.n_pins);
             if ((st = sn_set_constraints(inst, all_cs, nc)) != SN_OK) { die("sn_set_constraints (%s pins): %s", o.clip_path, sn_status_str(st)); goto done; }
             if (inst2) sn_set_constraints(inst2, all_cs, nc);
+            if (inst3) sn_set_constraints(inst3, all_cs, nc);
         }
         for (i = 0; i < (uint32_t)o.n_lod; i++)   /* level switches before this step */
             if (o.lod_step[i] == k && sn_set_lod(inst, o.lod_level[i]) != SN_OK) { die("--lod %ld:%u: sn_set_lod refused (the blob has %u level(s): bake with 'levels 2')", k, o.lod_level[i], sn_lod_levels(s.blob)); goto done; }
@@ -1353,10 +1510,15 @@ int main(int argc, char **argv) {
             }
         }
         if (inst2) {
-            if ((o.compare && !o.rigs_off) || o.compare_hits)
+            if ((o.compare && !o.rigs_off) || o.compare_hits || (o.compare_details && !o.rigs_off))
                 controls_step(inst2, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held, !o.compare_hits);
             sn_set_pose(inst2, xf, s.info.joints);
             sn_step(inst2);
+        }
+        if (inst3) {   /* level 1: the clip's controls only on the same blob (another blob's indices differ) */
+            if (!o.rigs_off && !o.level1_blob) controls_step(inst3, s.blob, have_clip ? &clip : NULL, (uint32_t)k, held, o.n_held, 1);
+            sn_set_pose(inst3, xf, s.info.joints);
+            sn_step(inst3);
         }
         if (fst || (o.health && k % o.health == 0)) {
             sn_stats hs;
@@ -1548,6 +1710,7 @@ int main(int argc, char **argv) {
         if (png_write(out_path, cmp.rgb, cmp.w, cmp.h, err, sizeof err)) { die("%s", err); goto done; }
         if (!o.quiet) printf("wrote %s\n", out_path);
     }
+    if (o.compare_details && compare_details(&s, &o, inst, inst2, inst3, n_details, (double)n_frames * h_s, &cmp)) goto done;
     if (o.hash) printf("hash: %016llx\n", (unsigned long long)sn_state_hash(inst));
     rc = 0;
 done:
@@ -1557,6 +1720,6 @@ done:
     free(s.surf); free(s.latt); free(s.pos); free(s.lpos); free(s.tri); free(s.edges); free(s.pins);
     free(s.sm); free(s.sm_first); free(s.snode); free(s.spos);
     free(s.rest); free(s.skin); free(s.dev); free(s.col); free(obj_sel); free(fst);
-    free(fctl); free(bytes2); free(refpos); free(s.cr_list); free(flag_cs); free(all_cs);
+    free(fctl); free(bytes2); free(mem3); free(bytes3); free(refpos); free(s.cr_list); free(flag_cs); free(all_cs);
     return rc;
 }

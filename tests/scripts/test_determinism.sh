@@ -12,8 +12,9 @@
 # platform too (adaptation as a shared instance: sn_step_with's workspace);
 # the level-of-detail, adaptation and cut-level ones on the Cortex-M4 too (in
 # full under `make determinism`, a slice compared with x86-64 in `make test`;
-# big-endian MIPS's level-of-detail and adaptation runs likewise, and the
-# crease runs of big-endian MIPS and aarch64: CR_SHORT below). Details on the
+# big-endian MIPS's and aarch64's level-of-detail and adaptation runs
+# likewise, the crease runs of big-endian MIPS and aarch64: CR_SHORT below,
+# and the float aarch64 trot: F_SHORT). Details on the
 # cut level (50 active, 32 iterations) run on every hosted platform and the
 # Cortex-M4 (full in `make determinism`; in `make test` x86-64's full runs
 # and short big-endian MIPS, aarch64 and Cortex-M4 runs: DT_SHORT below).
@@ -79,6 +80,13 @@ elif [ -n "${m4:-}" ]; then skip "cortex-m4 level of detail: the images play $CO
 set -- $(pmake print-bm-level); M4_STEPS=$1; M4_SW=$2; M4_SLICE_STEPS=$3; M4_SLICE_SW=$4; M4_CUT_STEPS=$5; M4_CUT_SW=$6
 # the details run (baremetal.mk BM_DETAILS_*, one definition for the image and the hosted drivers)
 DT_STEPS=$7; DT_SLICE_STEPS=$8; DT_N=$9; DT_ITERS=${10}
+# the slice's float aarch64 trot runs short (F_SHORT), its hash equal to an
+# x86-64 float det_main's of the same steps (the fref run below): 1000 steps
+# cost 7.1 s of qemu CPU (float NEON emulated), 250 steps 1.8 s; 1000 steps
+# against tests/expected_hashes.txt in `make determinism` (the x86-64 float
+# builds and sinew-play-float run 1000 here). Not the Cortex-M4 cow: its
+# contact and blended scenarios (fixed lengths) are most of its 8.8 s
+F_SHORT=""; F_SLICE_STEPS=250; [ "${DET_SET:-slice}" = full ] || F_SHORT="float-aarch64-gcc-O2"
 want mips-be-gcc-O2  mips-linux-gnu-gcc qemu-mips
 # clang cross: needs the cross gcc for headers, crt files and libgcc
 if have clang; then want mips-be-clang-O2 mips-linux-gnu-gcc qemu-mips; else skip "mips-be-clang-O2: no clang"; fi
@@ -144,8 +152,9 @@ pmake -k -j2 $targets > "$L/build.log" 2>&1 || true
 MAIN_ONLY=""; [ "${DET_SET:-slice}" = full ] || MAIN_ONLY="float-aarch64-gcc-O2 armhf-gcc-O2-neon"
 cmd_for() {  # name target runner -> command line
     _mo=""; case " $MAIN_ONLY " in *" $1 "*) _mo=" --main-only" ;; esac
+    _st=$STEPS; case " $F_SHORT " in *" $1 "*) _st=$F_SLICE_STEPS ;; esac
     case $1 in float-*) r=""; [ "$3" = - ] || r="$3 "
-                        echo "$r$2 $BUILD/examples/cow_float.blob --steps $STEPS $clip_arg$_mo"; return ;; esac
+                        echo "$r$2 $BUILD/examples/cow_float.blob --steps $_st $clip_arg$_mo"; return ;; esac
     case $3 in
         -) echo "$2 --steps $STEPS $clip_arg$_mo" ;;
         qemu-system-arm) echo "$BM_QEMU_RUN -kernel $2" ;;
@@ -239,12 +248,15 @@ SCEN_SKIP=""; [ "${DET_SET:-slice}" = full ] || SCEN_SKIP="float-aarch64-gcc-O2 
 # below): their 1000 steps cost 18 s and 33 s of qemu CPU; the full runs, with
 # tests/expected_hashes.txt, on x86-64 and aarch64 here and everywhere in
 # `make determinism`
-SCEN_SHORT=""; [ "${DET_SET:-slice}" = full ] || SCEN_SHORT="mips-be-gcc-O2"
+# aarch64 likewise (its 1000-step adaptation run cost 13.9 s of qemu CPU, level
+# of detail 5.9 s; their NEON kernels run 1000 steps in its trot)
+SCEN_SHORT=""; [ "${DET_SET:-slice}" = full ] || SCEN_SHORT="mips-be-gcc-O2 aarch64-gcc-O2"
 pmake "$BUILD/level/cow_adapt.blob" "$BUILD/level/cow_adapt_float.blob" > "$L/build_adapt.log" 2>&1 || \
     { bad "adapt: blobs failed to bake"; tail -n 5 "$L/build_adapt.log"; }
 # ---- the cut level (runtime/LEVELS.md §2 "The cut level"): the cow baked with
 # 'levels 2 cut', 200 steps of the trot, level 1 from 100 to 150 (cut_* hashes) ----
 CUT_STEPS=200; CUT_SW=100:1,150:0
+CUT_MAIN_ONLY=""; [ "${DET_SET:-slice}" = full ] || CUT_MAIN_ONLY="mips-be-gcc-O2"
 # the cut run also plays det_main's contact and blended scenarios on the cut
 # level (rows weigh points by the cut field, sn_point_weights): their hashes
 # must agree across platforms (about 3 s of CPU under qemu; test_level.sh
@@ -284,7 +296,10 @@ while read -r name target runner; do
     st=$STEPS; sw=$LOD_SW
     case " $SCEN_SHORT " in *" $name "*) st=$M4_SLICE_STEPS; sw=$M4_SLICE_SW ;; esac
     launch "$L/rc_lod_$name" "$L/run_lod_$name.log" $r "$target" "$bl" --steps $st $clip_arg --lod $sw --main-only
-    launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW
+    # the cut run's contact and blended scenarios: not on big-endian MIPS in the
+    # slice (3.8 s of its qemu CPU with them; aarch64 and x86-64 run them)
+    cmo=""; case " $CUT_MAIN_ONLY " in *" $name "*) cmo=--main-only ;; esac
+    launch "$L/rc_cut_$name" "$L/run_cut_$name.log" $r "$target" "$bc" --steps $CUT_STEPS $clip_arg --lod $CUT_SW $cmo
     dst=$DT_STEPS; case " $DT_SHORT " in *" $name "*) dst=$DT_SLICE_STEPS ;; esac
     # shellcheck disable=SC2086
     launch "$L/rc_details_$name" "$L/run_details_$name.log" $r "$target" "$bd" --steps $dst $clip_arg $DT_ARGS
@@ -298,6 +313,15 @@ EOF2
 m4ref=""; need_ref=""
 case $m4lvl in *_slice*) need_ref=1 ;; esac
 for _sn in $SCEN_SHORT $CR_SHORT $DT_SHORT; do case " $built " in *" $_sn "*) need_ref=1 ;; esac; done
+# the float aarch64 trot's slice against x86-64's float det_main
+fref=""
+for _sn in $F_SHORT; do case " $built " in *" $_sn "*)
+    for c in float-gcc-O2 float-clang-O2 float-gcc-O2-avx2; do case " $built " in *" $c "*) fref=$c; break ;; esac; done
+    if [ -n "$fref" ]; then
+        launch "$L/rc_m4ref_fmain" "$L/run_m4ref_fmain.log" "$D/det_$fref" "$BUILD/examples/cow_float.blob" \
+            --steps "$F_SLICE_STEPS" $clip_arg --main-only
+    else bad "$_sn: no x86-64 float det_main built to compare with"; fi ;; esac
+done
 case $need_ref in 1)
     for c in x86_64-gcc-O2 x86_64-clang-O2 x86_64-gcc-O2-avx2 x86_64-gcc-O0; do
         case " $built " in *" $c "*) m4ref=$c; break ;; esac
@@ -340,6 +364,13 @@ while read -r name target runner; do
         bad "$name: run failed (rc $rc)"; tail -n 5 "$L/run_$name.log" | sed 's/^/    /'; continue
     fi
     echo "determinism: $name $h contact ${hc:-none} blended ${hb:-none} (${secs}s)"
+    # the slice's short float run: equal to x86-64 det_main's same run, not in the 1000-step list
+    case " $F_SHORT " in *" $name "*)
+        r=$(hash_of "$L/run_m4ref_fmain.log")
+        if [ -n "$r" ] && [ "$h" = "$r" ]; then ok "$name: hash $h = $fref det_main's ($F_SLICE_STEPS steps)"
+        else bad "$name: hash $h, $fref det_main ${r:-none} ($F_SLICE_STEPS steps)"; fi
+        continue ;;
+    esac
     case $name in float-*) [ -n "$hb" ] && floatb="$floatb$name $hb
 " ;; *) [ -n "$hb" ] && fixedb="$fixedb$name $hb
 " ;; esac

@@ -55,8 +55,31 @@ reuse_float() {
     echo "  note: gcc float: make's objects ($BUILD/runtime/float, built with -Werror by '$line')"
 }
 reuse_float || compile_all gcc gcc-float "-DSN_FLOAT"
+# clang fixed: the determinism slice's x86_64-clang-O2 runtime objects
+# (ports/baremetal/baremetal.mk det_rt_rule, -Werror) when make's line is
+# this one plus the ports' include directories (no runtime source includes
+# from them: the objects are byte-identical, tests/CAMPAIGNS.md) with this
+# script's clang, and they are up to date; else a compile of our own
+reuse_clang_fixed() {
+    o1="$BUILD/cross/obj/x86_64-clang-O2/runtime/src/sn_math.o"
+    line=$(make -s --no-print-directory -n -B BUILD="$BUILD" "$o1" 2>/dev/null | tail -n 1) || return 1
+    set -- $line
+    c=$(command -v "$1" 2>/dev/null) && g=$(command -v clang 2>/dev/null) || return 1
+    [ "$(readlink -f "$c")" = "$(readlink -f "$g")" ] || return 1
+    shift
+    want=$(printf '%s\n' $WARN -O2 -Iruntime/include -Iports/common -Iports/cross -c runtime/src/sn_math.c -o "$o1" | sort | tr '\n' ' ')
+    [ "$(printf '%s\n' "$@" | sort | tr '\n' ' ')" = "$want" ] || return 1
+    # shellcheck disable=SC2046
+    make -s --no-print-directory -q BUILD="$BUILD" $(for s in $SRCS; do echo "$BUILD/cross/obj/x86_64-clang-O2/${s%.c}.o"; done) \
+        2>/dev/null || return 1
+    mkdir -p "$tmp/clang-fixed"
+    for s in $SRCS; do
+        b=$(basename "$s" .c); cp "$BUILD/cross/obj/x86_64-clang-O2/runtime/src/$b.o" "$tmp/clang-fixed/$b.o"; ok
+    done
+    echo "  note: clang fixed: make's objects ($BUILD/cross/obj/x86_64-clang-O2, built with -Werror by '$line')"
+}
 if command -v clang > /dev/null 2>&1; then
-    compile_all clang clang-fixed ""
+    reuse_clang_fixed || compile_all clang clang-fixed ""
     compile_all clang clang-float "-DSN_FLOAT"
 else
     echo "SKIPPED: install clang (clang warning check not run)"
