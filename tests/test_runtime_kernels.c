@@ -591,6 +591,54 @@ static void test_isqrt(void) {
     T_CHECK(bad == 0, "isqrt (this build's, Karatsuba, digits): %d of %d inputs not the exact floor", bad, n);
 }
 
+/* sn_k_cell_mul2 against the independent reference itself (not only
+ * against two sn_k_cell_mul calls: on the M4 both are assembly): 2000
+ * random records (every 8th at the bounds), corner 0's operands 0 (the
+ * contract), the others random, at +-2^28 (the state bound) or, every 4th
+ * record, INT32_MIN / INT32_MAX (beyond the contract, still exact: 21
+ * products < 2^27 2^31 sum below 2^62.4, and row_ok's halves stay exact);
+ * l1 every row, l2 the rows of a random corner set. Fixed: tolerance 0. */
+static void test_mul2_ref(void) {
+    static unsigned char K[REC];
+    double S[24][24];
+    int t, bad = 0, rows = 0;
+    for (t = 0; t < 2000; t++) {
+        sn_q u1[24], u2[24];
+        sn_acc l1[24], l2[24];
+        uint32_t k, mask = t % 5 == 0 ? 0xFFu : rnd32() & 0xFFu;
+        make_rec(K, S, t % 8 == 0);
+        for (k = 0; k < 24; k++) {
+#if defined(SN_FLOAT)
+            u1[k] = (float)rnd_in(1 << 20) / 256.0f;
+            u2[k] = (float)rnd_in(1 << 20) / 256.0f;
+#else
+            if (t % 4 == 1) {
+                u1[k] = rnd32() & 1 ? INT32_MAX : INT32_MIN;
+                u2[k] = rnd32() & 1 ? INT32_MAX : INT32_MIN;
+            } else if (t % 4 == 2) {
+                u1[k] = rnd32() & 1 ? (1 << 28) : -(1 << 28);
+                u2[k] = rnd32() & 1 ? (1 << 28) : -(1 << 28);
+            } else {
+                u1[k] = rnd_in(1 << 28);
+                u2[k] = rnd_in(1 << 28);
+            }
+#endif
+        }
+        u1[0] = u1[1] = u1[2] = u2[0] = u2[1] = u2[2] = 0;
+        sn_k_cell_mul2(K, u1, u2, l1, l2, mask);
+        for (k = 0; k < 24; k++) {
+            bad += !row_ok(S, u1, (int)k, l1[k]);
+            rows++;
+            if (mask >> (k / 3) & 1u) {
+                bad += !row_ok(S, u2, (int)k, l2[k]);
+                rows++;
+            }
+        }
+    }
+    T_CHECK(bad == 0, "sn_k_cell_mul2 (path %s): %d of %d rows off the reference", sn_kernels_name(), bad, rows);
+    T_FIGURE("sn_k_cell_mul2 against the reference: 2000 records, %d rows (operands at +-2^28 and INT32_MIN/MAX)", rows);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -664,6 +712,7 @@ int main(void) {
     (void)bad_order;
 #endif
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
+    test_mul2_ref();
     test_ic();
     test_rot();
     test_axpy();

@@ -1,7 +1,8 @@
 /* sn_kernels_m4.c -- Cortex-M4/M7 (ARMv7E-M, DSP extension) kernels of
  * sn_kernels.h, fixed flavour. sn_k_cell_mul's rows in Thumb-2 assembly
- * (GCC's C spilled the row sums); sn_k_cell_mul2 is sn_kernels.c's C; the
- * CG dot and axpy in C written for one SMLAL per multiply-add. The same
+ * (GCC's C spilled the row sums), sn_k_cell_mul2's too (one output
+ * component of both products at a time); the CG dot and axpy in C written
+ * for one SMLAL per multiply-add. The same
  * exact products as the scalar reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
@@ -171,6 +172,149 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
         sn_m4_cell_row(l + 3 * i, &c);
     }
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
+}
+
+/* The right-hand side's two products (sn_k_cell_mul2) in Thumb-2
+ * (sn_m4_cell_mul2), one output component at a time: l1[3a+r] and l2[3a+r]
+ * in r10:r11 and r12:lr, over the blocks b = 1..7 (corner 0's operands are
+ * 0, the contract): row r of block (a,b) (b > a), column r of block (b,a)
+ * (b < a) or row r of the diagonal block, its 3 entries decoded (LDRSH, LSL
+ * by the block's exponent) into r4-r6 and used for both vectors, u1_b and
+ * u2_b by LDM with writeback (r1, r2 walk the corners). Everything unrolled
+ * by the assembler (.macro, .if on a, b, r): the offsets are immediates,
+ * no loop or pointer arithmetic. An off-diagonal entry is decoded twice
+ * (once per direction) but no sum goes through memory: 15 instructions per
+ * 6 multiply-adds (GCC's C of sn_kernels.c: ~124 a block, 36). Rows a
+ * outside rows2 take the l1-only copy (l2's row unspecified, the contract).
+ * The same exact products as the reference, summed in another order
+ * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+void sn_m4_cell_mul2(const unsigned char *K, const sn_q *u1, const sn_q *u2, sn_acc *l1, sn_acc *l2, uint32_t rows2);
+#define SN_M4_S_(x) #x
+#define SN_M4_S(x) SN_M4_S_(x)
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_cell_mul2,\"ax\",%progbits\n"
+    ".set snm2_diag, " SN_M4_S(SN_CELLK_DIAG) "\n"
+    ".set snm2_off, " SN_M4_S(SN_CELLK_OFF) "\n"
+    ".set snm2_exp, " SN_M4_S(SN_CELLK_EXP) "\n"
+    /* one block's 3 entries for output (a, r) times u1_b [and u2_b] */
+    ".macro snm2_blk a, b, r, two, first\n"
+    ".if \\b == \\a\n"                      /* diagonal: xx yy zz xy xz yz */
+    ".if \\r == 0\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 0)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 12)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 16)]\n"
+    ".elseif \\r == 1\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 12)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 4)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 20)]\n"
+    ".else\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 16)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 20)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 8)]\n"
+    ".endif\n"
+    ".else\n"
+    ".if \\b > \\a\n"                       /* row r of block (a,b): m[3r..3r+2] */
+    ".set snm2_i, \\a * (13 - \\a) / 2 - 1 + \\b\n"
+    ".set snm2_m0, 6 * \\r\n"
+    ".set snm2_st, 2\n"
+    ".else\n"                               /* column r of block (b,a): m[r], m[3+r], m[6+r] */
+    ".set snm2_i, \\b * (13 - \\b) / 2 - 1 + \\a\n"
+    ".set snm2_m0, 2 * \\r\n"
+    ".set snm2_st, 6\n"
+    ".endif\n"
+    "ldrb  r7, [r0, #(snm2_exp + snm2_i)]\n"
+    "ldrsh r4, [r0, #(snm2_off + 18 * snm2_i + snm2_m0)]\n"
+    "ldrsh r5, [r0, #(snm2_off + 18 * snm2_i + snm2_m0 + snm2_st)]\n"
+    "ldrsh r6, [r0, #(snm2_off + 18 * snm2_i + snm2_m0 + 2 * snm2_st)]\n"
+    "lsl   r4, r4, r7\n"
+    "lsl   r5, r5, r7\n"
+    "lsl   r6, r6, r7\n"
+    ".endif\n"
+    "ldm   r1!, {r7, r8, r9}\n"
+    ".if \\first\n"
+    "smull r10, r11, r4, r7\n"
+    ".else\n"
+    "smlal r10, r11, r4, r7\n"
+    ".endif\n"
+    "smlal r10, r11, r5, r8\n"
+    "smlal r10, r11, r6, r9\n"
+    ".if \\two\n"
+    "ldm   r2!, {r7, r8, r9}\n"
+    ".if \\first\n"
+    "smull r12, lr, r4, r7\n"
+    ".else\n"
+    "smlal r12, lr, r4, r7\n"
+    ".endif\n"
+    "smlal r12, lr, r5, r8\n"
+    "smlal r12, lr, r6, r9\n"
+    ".endif\n"
+    ".endm\n"
+    /* output component (a, r): 7 blocks, the stores, the walks back */
+    ".macro snm2_out a, r, two\n"
+    "snm2_blk \\a, 1, \\r, \\two, 1\n"
+    "snm2_blk \\a, 2, \\r, \\two, 0\n"
+    "snm2_blk \\a, 3, \\r, \\two, 0\n"
+    "snm2_blk \\a, 4, \\r, \\two, 0\n"
+    "snm2_blk \\a, 5, \\r, \\two, 0\n"
+    "snm2_blk \\a, 6, \\r, \\two, 0\n"
+    "snm2_blk \\a, 7, \\r, \\two, 0\n"
+    "ldr   r7, [sp, #0]\n"                  /* l1 */
+    "strd  r10, r11, [r7, #(24 * \\a + 8 * \\r)]\n"
+    "sub   r1, r1, #84\n"
+    ".if \\two\n"
+    "ldr   r7, [sp, #40]\n"                 /* l2 */
+    "strd  r12, lr, [r7, #(24 * \\a + 8 * \\r)]\n"
+    "sub   r2, r2, #84\n"
+    ".endif\n"
+    ".endm\n"
+    /* row a: both products if bit a of rows2, else l1's */
+    ".macro snm2_row a\n"
+    "ldr   r7, [sp, #44]\n"                 /* rows2 */
+    "lsls  r7, r7, #(31 - \\a)\n"
+    "bpl   1f\n"
+    "snm2_out \\a, 0, 1\n"
+    "snm2_out \\a, 1, 1\n"
+    "snm2_out \\a, 2, 1\n"
+    "b     2f\n"
+    "1:\n"
+    "snm2_out \\a, 0, 0\n"
+    "snm2_out \\a, 1, 0\n"
+    "snm2_out \\a, 2, 0\n"
+    "2:\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_cell_mul2\n"
+    ".thumb_func\n"
+    ".type sn_m4_cell_mul2, %function\n"
+    "sn_m4_cell_mul2:\n"
+    "push  {r3-r11, lr}\n"                  /* [sp] l1; l2, rows2 at [sp, #40], [sp, #44] */
+    "add   r1, r1, #12\n"                   /* u1_1, u2_1: corner 0 skipped */
+    "add   r2, r2, #12\n"
+    "snm2_row 0\n"
+    "snm2_row 1\n"
+    "snm2_row 2\n"
+    "snm2_row 3\n"
+    "snm2_row 4\n"
+    "snm2_row 5\n"
+    "snm2_row 6\n"
+    "snm2_row 7\n"
+    "pop   {r3-r11, pc}\n"
+    ".size sn_m4_cell_mul2, .-sn_m4_cell_mul2\n"
+    ".purgem snm2_row\n"
+    ".purgem snm2_out\n"
+    ".purgem snm2_blk\n"
+    ".popsection\n");
+
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
+    uint32_t a;
+    sn_m4_cell_mul2(K, u1, u2, l1, l2, rows2);
+    for (a = 0; a < 24; a++)
+        SN_RANGE(SN_WITHIN(l1[a], 60) && (!(rows2 >> (a / 3) & 1u) || SN_WITHIN(l2[a], 60)), "cell row beyond 24 * 2^55",
+                 l1[a]);
+    (void)a;
 }
 
 /* The CG dot product (sn_kernels.c's reference): each product rounded alone,
