@@ -469,6 +469,21 @@ static void test_rshr(void) {
         bad += got != c || sat != (uint32_t)(c != w);
     }
     T_CHECK(bad == 0, "saturating add: %d of 200000 sums or counts off the clamped int64 sum", bad);
+    {   /* every pair of edge values (the M4's QADD saturation and its
+         * unsigned range compare at +-2^28 exactly) */
+        static const int32_t ed[] = {INT32_MIN, INT32_MIN + 1, -(1 << 28) - 1, -(1 << 28), -(1 << 28) + 1, -1, 0, 1,
+                                     (1 << 28) - 1, 1 << 28, (1 << 28) + 1, (1 << 29), INT32_MAX - 1, INT32_MAX};
+        unsigned i, j;
+        bad = 0;
+        for (i = 0; i < sizeof ed / sizeof ed[0]; i++)
+            for (j = 0; j < sizeof ed / sizeof ed[0]; j++) {
+                const int64_t w = (int64_t)ed[i] + ed[j], c = w > (1 << 28) ? (1 << 28) : (w < -(1 << 28) ? -(1 << 28) : w);
+                uint32_t sat = 0;
+                const sn_q got = sn_add(ed[i], ed[j], &sat);
+                bad += got != c || sat != (uint32_t)(c != w);
+            }
+        T_CHECK(bad == 0, "saturating add: %d of 196 edge pairs off the clamped int64 sum", bad);
+    }
 }
 #endif
 
