@@ -384,8 +384,96 @@ static void test_axpy(void) {
         bad += sat != sd;
         clamps += sd;
     }
+#if !defined(SN_FLOAT)
+    {   /* the clamps' edges: s x 2^-3 = +-(2^28 - 1), +-2^28, +-(2^28 + 1)
+         * exactly (x = 8, sh = 3) and INT32_MIN/MAX s, with a at 0 and
+         * +-SN_LIM, against the same floor-and-clamp reference */
+        static const int32_t es[] = {(1 << 28) - 1, 1 << 28, (1 << 28) + 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                                     INT32_MAX, INT32_MIN, 0};
+        static const int32_t ea[] = {0, 1 << 28, -(1 << 28), 1, -1};
+        unsigned i, j;
+        for (i = 0; i < sizeof es / sizeof es[0]; i++) {
+            sn_q a[5], x[5], o[5];
+            uint32_t sat = 0, sd = 0;
+            for (j = 0; j < 5; j++) { a[j] = ea[j]; x[j] = 8; }
+            sn_k_axpy(o, a, es[i], x, 5, 3, &sat);
+            for (j = 0; j < 5; j++) {
+                int64_t q = ((int64_t)es[i] * 8 + 4) >> 3; /* exact: a multiple of 8 plus 4, >= 0 or floor by >> */
+                if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                q += a[j];
+                if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                bad += o[j] != (sn_q)q;
+            }
+            bad += sat != sd;
+        }
+    }
+#endif
     T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);
+}
+
+/* sn_k_ic_rows (the backward sweep's row: on the M4 a Thumb-2 loop that
+ * hands blocks with frac 0 or >= 32 to the reference and resumes) against
+ * the loop of sn_k_ic_row_ref from 0 (bit for bit, both flavours) and, fixed,
+ * the double reference (each row floor(p 2^-frac + 1/2), |p| < 3 2^15 2^31
+ * < 2^48: exact; the int64 sum of up to 12 exact): 3000 runs of 0..12
+ * blocks of a 30-vertex z, fracs mostly 1..31, every 4th run with 0 or
+ * 32..62 anywhere (first, last, consecutive), z at +-2^28 or
+ * INT32_MIN/MAX in every 8th run. Tolerance 0. */
+static void test_ic_rows(void) {
+    static unsigned char L[12 * 20], cols[24];
+    int t, bad = 0, bad_ref = 0, odd = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q z[90];
+        sn_acc lp[4], lr[4];
+        double ref[3] = {0, 0, 0};
+        uint32_t nb = rnd32() % 13u, e, k, sat_p = 0, sat_r = 0;
+        int wild = t % 8 == 0;
+        for (k = 0; k < 90; k++) {
+#if defined(SN_FLOAT)
+            z[k] = (float)rnd_in(1 << 20) / 256.0f;
+#else
+            z[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? (1 << 28) : -(1 << 28)))
+                        : rnd_in(1 << 28);
+#endif
+        }
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            uint32_t col = rnd32() % 30u;
+            int frac = (int)(1u + rnd32() % 31u), r, c;
+            if (t % 4 == 1 && rnd32() % 3u == 0) { frac = rnd32() & 1 ? 0 : (int)(32u + rnd32() % 31u); odd++; }
+            for (k = 0; k < 9; k++) {
+                int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)frac;
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)col;
+            cols[2 * e + 1] = 0;
+            for (r = 0; r < 3; r++) {
+                double p = 0;
+                for (c = 0; c < 3; c++) {
+                    int32_t m = (int16_t)(uint16_t)(b[2 * (3 * r + c)] | b[2 * (3 * r + c) + 1] << 8);
+                    p += (double)m * (double)z[3 * col + (uint32_t)c];
+                }
+                ref[r] += SN_FLAVOUR ? 0.0 : floor(ldexp(p, -frac) + (frac > 0 ? 0.5 : 0.0));
+            }
+        }
+        sn_k_ic_rows(L, cols, nb, z, lp, &sat_p);
+        lr[0] = lr[1] = lr[2] = lr[3] = 0;
+        for (e = 0; e < nb; e++) sn_k_ic_row_ref(L + 20 * e, z + 3 * (cols[2 * e] | cols[2 * e + 1] << 8), lr, &sat_r);
+        bad += memcmp(lp, lr, 3 * sizeof lp[0]) != 0 || sat_p != sat_r;
+#if !defined(SN_FLOAT)
+        for (k = 0; k < 3; k++) bad_ref += (double)lr[k] != ref[k];
+#else
+        (void)ref;
+#endif
+    }
+    T_CHECK(bad == 0, "IC(0) backward rows (path %s): %d of 3000 runs differ from the reference loop", sn_kernels_name(), bad);
+    T_CHECK(bad_ref == 0, "IC(0) backward rows: %d sums off the double reference", bad_ref);
+    T_FIGURE("IC(0) backward rows: 3000 runs of 0..12 blocks, %d with frac 0 or >= 32", odd);
 }
 
 #if !defined(SN_FLOAT)
@@ -729,6 +817,7 @@ int main(void) {
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
     test_mul2_ref();
     test_ic();
+    test_ic_rows();
     test_rot();
     test_axpy();
     test_isqrt();

@@ -7,6 +7,7 @@
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
+#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 #if defined(SN_KERNELS_M4)
 
@@ -317,6 +318,104 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     (void)a;
 }
 
+/* The IC(0) backward sweep's block rows (sn_k_ic_rows, sn_kernels_ic.h) in
+ * Thumb-2: l = sum of round(U_b z_cols[b]) over consecutive blocks while
+ * their frac s is in 1..31 (the rounding term as the SMLAL chain's start,
+ * the shift on the two words, as sn_k_ic_m4); returns where it stopped
+ * (end, or a block for the reference). The sums live in the frame for the
+ * whole run (LDRD/ADDS/ADC/STRD), z_i by one LDM a block: 63 instructions
+ * a block against GCC's 81 (it kept l and its pointers on the stack and
+ * reloaded them). The same integers: each row's rounded term is the
+ * reference's, the sums exact. */
+typedef char sn_m4_ic_layout_[SN_ELEM_ICHOL == 20 ? 1 : -1]; /* the stride and frac's byte 18 below */
+const unsigned char *sn_m4_ic_rows(const unsigned char *b, const unsigned char *cols, const unsigned char *end,
+                                   const sn_q *z, sn_acc l[4]);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_ic_rows,\"ax\",%progbits\n"
+    /* row k: (2^(s-1) + U_k0 z0 + U_k1 z1 + U_k2 z2) >> s added to l_k */
+    ".macro snic_row k\n"
+    "mov   r9, r8\n"
+    "mov   r10, #0\n"
+    "ldrsh r11, [r0, #(6 * \\k)]\n"
+    "smlal r9, r10, r11, r3\n"
+    "ldrsh r11, [r0, #(6 * \\k + 2)]\n"
+    "smlal r9, r10, r11, r4\n"
+    "ldrsh r11, [r0, #(6 * \\k + 4)]\n"
+    "smlal r9, r10, r11, r5\n"
+    "lsr   r9, r9, r6\n"
+    "lsl   r11, r10, r7\n"
+    "orr   r9, r9, r11\n"
+    "asr   r10, r10, r6\n"
+    "ldrd  r12, lr, [sp, #(8 * \\k)]\n"
+    "adds  r12, r12, r9\n"
+    "adc   lr, lr, r10\n"
+    "strd  r12, lr, [sp, #(8 * \\k)]\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_ic_rows\n"
+    ".thumb_func\n"
+    ".type sn_m4_ic_rows, %function\n"
+    "sn_m4_ic_rows:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #36\n"               /* [sp] l0 l1 l2, end; the caller's l at [sp, #72] */
+    "str   r2, [sp, #24]\n"
+    "mov   r12, r2\n"
+    "mov   r2, r3\n"                    /* z */
+    "mov   r3, #0\n"
+    "mov   r4, #0\n"
+    "strd  r3, r4, [sp, #0]\n"
+    "strd  r3, r4, [sp, #8]\n"
+    "strd  r3, r4, [sp, #16]\n"
+    "cmp   r0, r12\n"
+    "beq   2f\n"
+    "1:\n"
+    "ldrh  r12, [r1], #2\n"             /* i */
+    "ldrb  r6, [r0, #18]\n"             /* s = frac */
+    "sub   lr, r6, #1\n"
+    "cmp   lr, #30\n"
+    "bhi   2f\n"                        /* s = 0 or s >= 32: the reference's block */
+    "mov   r8, #1\n"
+    "lsl   r8, r8, lr\n"                /* 2^(s-1) */
+    "rsb   r7, r6, #32\n"
+    "add   r12, r12, r12, lsl #1\n"
+    "add   r12, r2, r12, lsl #2\n"
+    "ldm   r12, {r3, r4, r5}\n"         /* z_i */
+    "snic_row 0\n"
+    "snic_row 1\n"
+    "snic_row 2\n"
+    "add   r0, r0, #20\n"
+    "ldr   r12, [sp, #24]\n"
+    "cmp   r0, r12\n"
+    "bne   1b\n"
+    "2:\n"
+    "ldm   sp, {r3-r8}\n"
+    "ldr   r12, [sp, #72]\n"
+    "stm   r12, {r3-r8}\n"
+    "add   sp, sp, #36\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_ic_rows, .-sn_m4_ic_rows\n"
+    ".purgem snic_row\n"
+    ".popsection\n");
+
+/* sn_k_ic_rows after a block the Thumb-2 loop left (s = 0 or s >= 32): that
+ * block by the reference, then the loop again from the next one */
+void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
+                        sn_acc l[4], uint32_t *sat) {
+    while (b != end) {
+        sn_acc t[4];
+        const unsigned char *p;
+        sn_k_ic_row_ref(b, z + 3 * sn_rd_u16(cols), l, sat);
+        b += SN_ELEM_ICHOL;
+        cols += 2;
+        p = sn_m4_ic_rows(b, cols, end, z, t);
+        l[0] += t[0]; l[1] += t[1]; l[2] += t[2];
+        cols += 2u * ((uint32_t)(p - b) / SN_ELEM_ICHOL);
+        b = p;
+    }
+}
+
 /* The CG dot product (sn_kernels.c's reference): each product rounded alone,
  * (a b + 2^(sh-1)) >> sh. Here the rounding term is the SMLAL's starting
  * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),
@@ -354,10 +453,12 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
         const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
         for (i = 0; i < n; i++) {
             const int64_t v = sn_shr64_w(bias + (int64_t)s * x[i], sh);
+            const uint32_t lo = (uint32_t)v;
             sn_q q;
-            if (v > SN_LIM) { (*sat)++; q = SN_LIM; }
-            else if (v < -SN_LIM) { (*sat)++; q = -SN_LIM; }
-            else q = (int32_t)v;
+            /* |v| <= SN_LIM: the low word within +-SN_LIM (one unsigned
+             * compare) and the high word its sign (not two 64-bit compares) */
+            if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && (int32_t)(v >> 32) == (int32_t)lo >> 31) q = (int32_t)lo;
+            else { (*sat)++; q = v > 0 ? SN_LIM : -SN_LIM; }
             out[i] = sn_add(a[i], q, sat);
         }
     } else {
