@@ -317,6 +317,31 @@ static void test_rot(void) {
 #endif
         clamps += sd;
     }
+#if !defined(SN_FLOAT)
+    {   /* the clamp's edges: R = 2^30 I (Q30 identity), v = +-(2^28 - 1),
+         * +-2^28, +-(2^28 + 1), INT32_MIN/MAX: the outputs are v clamped
+         * to +-2^28, counted; against sn_rot* and the formula */
+        static const int32_t ev[] = {(1 << 28) - 1, 1 << 28, (1 << 28) + 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                                     INT32_MAX, INT32_MIN};
+        sn_q R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30}, v[3], o1[3], o2[3], p1[3], p2[3];
+        unsigned i;
+        for (i = 0; i < sizeof ev / sizeof ev[0]; i++) {
+            uint32_t s1 = 0, s2 = 0, sd = 0, c;
+            v[0] = ev[i]; v[1] = ev[(i + 3) % 8]; v[2] = ev[(i + 5) % 8];
+            sn_k_rot_t(R, v, o1, &s1);
+            sn_rot_t(R, v, o2, &s2);
+            sn_k_rot(R, v, p1, &s1);
+            sn_rot(R, v, p2, &s2);
+            bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || s1 != s2;
+            for (c = 0; c < 3; c++) {
+                const int32_t w = v[c] > (1 << 28) ? (1 << 28) : v[c] < -(1 << 28) ? -(1 << 28) : v[c];
+                sd += 2u * (w != v[c]);
+                bad_ref += o2[c] != w || p2[c] != w;
+            }
+            bad_ref += s2 != sd;
+        }
+    }
+#endif
     T_CHECK(bad_path == 0, "frame rotations: %d differences between path %s and sn_rot*", bad_path, sn_kernels_name());
     T_CHECK(bad_ref == 0, "frame rotations: %d results or clamp counts off the double reference", bad_ref);
     T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", (unsigned)clamps);

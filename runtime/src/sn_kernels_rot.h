@@ -126,9 +126,9 @@ SN_INLINE sn_q sn_k_rot_out1(int64_t x, uint32_t *sat) {
     int32_t v;
     SN_RANGE(x < 3 * ((int64_t)1 << 58) && x > -3 * ((int64_t)1 << 58), "frame rotation sum beyond 3 2^58", x);
     v = (int32_t)sn_rshr64(x, SN_Q_ROT);
-    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
-    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
-    return v;
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v; /* |v| <= SN_LIM: one unsigned compare */
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
 }
 /* Written out, v in int32 registers (an empty asm: GCC otherwise kept
  * the int64 a clamped v came from, or hoisted v's sign extensions out of a
