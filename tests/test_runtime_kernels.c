@@ -20,6 +20,7 @@
 #include "sn_kernels.h"
 #include "sn_kernels_ic.h"
 #include "sn_kernels_rot.h"
+#include "sn_segment.h" /* seg_out, seg_lim */
 
 static uint32_t rng = 12345u;
 static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
@@ -502,6 +503,42 @@ static void test_ic_rows(void) {
 }
 
 #if !defined(SN_FLOAT)
+/* The segment sweep's clamps (sn_segment.h; on a Cortex-M one unsigned
+ * compare of the low word plus the high word's sign) against the compares
+ * written here: seg_out on int32 values (the edges +-2^28 +- 1, INT32_MIN/MAX,
+ * random), seg_lim on int64 values for m = 2^28 (ROT_MAX), 2^29, 1 and
+ * INT32_MAX (edges +-m +- 1, a high word with a small low word such as
+ * 2^32 + 5, +-2^62, random widths). Tolerance 0, counts included. */
+static void test_seg_clamps(void) {
+    static const int64_t m4[] = {(int64_t)1 << 28, (int64_t)1 << 29, 1, INT32_MAX};
+    int t, bad = 0, n = 0;
+    for (t = 0; t < 40000; t++) {
+        const int32_t e32[] = {(1 << 28) + 1, 1 << 28, (1 << 28) - 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                               INT32_MAX, INT32_MIN, INT32_MIN + 1, 0};
+        const int32_t v = t < 10 ? e32[t] : (int32_t)(rnd32() >> (rnd32() % 32u)) * (rnd32() & 1 ? 1 : -1);
+        const int32_t want = v > (1 << 28) ? (1 << 28) : v < -(1 << 28) ? -(1 << 28) : v;
+        const int64_t m = m4[t % 4];
+        int64_t a, wl;
+        uint32_t sat = 0;
+        const int32_t got = (int32_t)seg_out((seg_n)v, &sat);
+        bad += got != want || sat != (uint32_t)(want != v);
+        switch (t % 8) {
+        case 0: a = m + (int64_t)(t / 8 % 3) - 1; break;            /* m - 1, m, m + 1 */
+        case 1: a = -m + (int64_t)(t / 8 % 3) - 1; break;
+        case 2: a = ((int64_t)(rnd32() % 5u) - 2) * ((int64_t)1 << 32) + (int64_t)(rnd32() % 9u) - 4; break;
+        case 3: a = rnd32() & 1 ? ((int64_t)1 << 62) : -((int64_t)1 << 62); break;
+        default: a = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (1 + rnd32() % 63u)) * (rnd32() & 1 ? 1 : -1);
+        }
+        wl = a > m ? m : a < -m ? -m : a;
+        bad += seg_lim(a, m) != wl;
+        n += 2;
+    }
+    T_CHECK(bad == 0, "segment clamps: %d of %d results off the compares", bad, n);
+}
+
+#endif
+
+#if !defined(SN_FLOAT)
 /* ---- the rounding shift for run-time shifts (sn_rshr64_var: the Cortex-M
  * split over two words, sn_rshr64 elsewhere) against floor((x + 2^(s-1)) /
  * 2^s) by division, written here: random x with |x| up to 2^62 (the
@@ -849,6 +886,7 @@ int main(void) {
 #if !defined(SN_FLOAT)
     test_rshr();
     test_dot();
+    test_seg_clamps();
 #endif
     test_loops();
     return T_END();
