@@ -503,6 +503,31 @@ static void test_ic_rows(void) {
 }
 
 #if !defined(SN_FLOAT)
+/* sn_k_mul_out (d sn_out(l, s): the energy's term; on the M4 with the
+ * rounded value held as an int32) against sn_mul(d, sn_out(l, s)) and the
+ * clamp written here: l at +-2^62 (sn_out's precondition: < 2^62.5), at
+ * the clamp's edges (+-2^28 +- 1 after the shift, s 0..33) and random
+ * widths, s 0..40, d up to INT32_MIN/MAX. Tolerance 0, counts included. */
+static void test_mul_out(void) {
+    int t, bad = 0;
+    for (t = 0; t < 40000; t++) {
+        const int s = (int)(rnd32() % (t % 4 == 0 ? 34u : 41u)); /* (2^28 + 1) 2^33 < 2^62 */
+        const sn_q d = t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (sn_q)rnd32();
+        int64_t l, q;
+        uint32_t s1 = 0, s2 = 0, sd = 0;
+        switch (t % 4) {
+        case 0: l = (((int64_t)1 << 28) + (int64_t)(rnd32() % 3u) - 1) * ((int64_t)1 << s) * (rnd32() & 1 ? 1 : -1); break;
+        case 1: l = rnd32() & 1 ? ((int64_t)1 << 62) : -((int64_t)1 << 62); break;
+        default: l = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (2 + rnd32() % 62u)) * (rnd32() & 1 ? 1 : -1);
+        }
+        q = s > 0 ? (l + ((int64_t)1 << (s - 1))) >> s : l;
+        if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+        bad += sn_k_mul_out(d, l, s, &s1) != sn_mul(d, sn_out(l, s, &s2)) || s1 != s2;
+        bad += sn_k_mul_out(d, l, s, &s1) != (int64_t)d * q || s1 != 2 * sd;
+    }
+    T_CHECK(bad == 0, "energy term d sn_out(l, s) (path %s): %d of 40000 off", sn_kernels_name(), bad);
+}
+
 /* The segment sweep's clamps (sn_segment.h; on a Cortex-M one unsigned
  * compare of the low word plus the high word's sign) against the compares
  * written here: seg_out on int32 values (the edges +-2^28 +- 1, INT32_MIN/MAX,
@@ -887,6 +912,7 @@ int main(void) {
     test_rshr();
     test_dot();
     test_seg_clamps();
+    test_mul_out();
 #endif
     test_loops();
     return T_END();

@@ -339,4 +339,19 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
 #endif
 }
 
+/* d sn_out(l, s), a term of a cell's elastic energy (cell_forces): on the
+ * Cortex-M4 the rounded value held as an int32 (an empty asm, as SN_K_I32:
+ * GCC otherwise multiplied the clamped int64 as 64 x 64 bits, UMULL, MUL,
+ * MLA, not one SMLAL); elsewhere the reference expression itself (the same
+ * code as before). The same value. */
+#if defined(SN_KERNELS_M4)
+SN_INLINE sn_acc sn_k_mul_out(sn_q d, sn_acc l, int s, uint32_t *sat) {
+    int32_t t = sn_out(l, s, sat);
+    __asm__("" : "+r"(t));
+    return sn_mul(d, t);
+}
+#else
+#define sn_k_mul_out(d, l, s, sat) sn_mul((d), sn_out((l), (s), (sat)))
+#endif
+
 #endif /* SN_KERNELS_ROT_H */
