@@ -438,7 +438,7 @@ static void test_axpy(void) {
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);
 }
 
-/* sn_k_ic_rows (the backward sweep's row: on the M4 a Thumb-2 loop that
+/* sn_k_ic_bwd_row (the backward sweep's row: on the M4 a Thumb-2 loop that
  * hands blocks with frac 0 or >= 32 to the reference and resumes) against
  * the loop of sn_k_ic_row_ref from 0 (bit for bit, both flavours) and, fixed,
  * the double reference (each row floor(p 2^-frac + 1/2), |p| < 3 2^15 2^31
@@ -487,7 +487,7 @@ static void test_ic_rows(void) {
                 ref[r] += SN_FLAVOUR ? 0.0 : floor(ldexp(p, -frac) + (frac > 0 ? 0.5 : 0.0));
             }
         }
-        sn_k_ic_rows(L, cols, nb, z, lp, &sat_p);
+        sn_k_ic_bwd_row(L, cols, nb, z, lp, &sat_p);
         lr[0] = lr[1] = lr[2] = lr[3] = 0;
         for (e = 0; e < nb; e++) sn_k_ic_row_ref(L + 20 * e, z + 3 * (cols[2 * e] | cols[2 * e + 1] << 8), lr, &sat_r);
         bad += memcmp(lp, lr, 3 * sizeof lp[0]) != 0 || sat_p != sat_r;

@@ -7,9 +7,9 @@
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
-#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 #if defined(SN_KERNELS_M4)
+#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 /* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
  * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
@@ -318,7 +318,7 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     (void)a;
 }
 
-/* The IC(0) backward sweep's block rows (sn_k_ic_rows, sn_kernels_ic.h) in
+/* The IC(0) backward sweep's block rows (sn_k_ic_bwd_row, sn_kernels_ic.h) in
  * Thumb-2: l = sum of round(U_b z_cols[b]) over consecutive blocks while
  * their frac s is in 1..31 (the rounding term as the SMLAL chain's start,
  * the shift on the two words, as sn_k_ic_m4); returns where it stopped
@@ -399,7 +399,7 @@ __asm__(
     ".purgem snic_row\n"
     ".popsection\n");
 
-/* sn_k_ic_rows after a block the Thumb-2 loop left (s = 0 or s >= 32): that
+/* sn_k_ic_bwd_row after a block the Thumb-2 loop left (s = 0 or s >= 32): that
  * block by the reference, then the loop again from the next one */
 void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
                         sn_acc l[4], uint32_t *sat) {

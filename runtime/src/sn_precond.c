@@ -63,10 +63,10 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
     uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
-#if defined(SN_K_IC_ROWS) /* the M4's loop (sn_kernels_ic.h) */
+#if defined(SN_K_IC_BWD_ROW) /* the M4's loop (sn_kernels_ic.h) */
         sn_acc l[4];
         n -= f - b;
-        sn_k_ic_rows(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
+        sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
 #else
         sn_acc l[4] = {0, 0, 0, 0};
         const unsigned char *blk;
