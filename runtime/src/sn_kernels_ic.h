@@ -202,7 +202,7 @@ const unsigned char *sn_m4_ic_rows(const unsigned char *b, const unsigned char *
 void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
                         sn_acc l[4], uint32_t *sat);
 SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
-                            uint32_t *sat) {
+                               uint32_t *sat) {
     const unsigned char *end = b + (size_t)nb * SN_ELEM_ICHOL, *p = sn_m4_ic_rows(b, cols, end, z, l);
     if (p != end) sn_m4_ic_rows_rest(p, cols + 2u * ((uint32_t)(p - b) / SN_ELEM_ICHOL), end, z, l, sat);
 }
@@ -287,7 +287,7 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
  * before) */
 #if !defined(SN_K_IC_BWD_ROW)
 SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
-                            uint32_t *sat) {
+                               uint32_t *sat) {
     uint32_t e;
     l[0] = l[1] = l[2] = l[3] = 0;
     for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) sn_k_ic_row(b, z + 3 * sn_rd_u16(cols + 2 * e), l, sat);
