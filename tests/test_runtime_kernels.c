@@ -20,6 +20,7 @@
 #include "sn_kernels.h"
 #include "sn_kernels_ic.h"
 #include "sn_kernels_rot.h"
+#include "sn_segment.h" /* seg_out, seg_lim */
 
 static uint32_t rng = 12345u;
 static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (rng >> 15); }
@@ -317,6 +318,31 @@ static void test_rot(void) {
 #endif
         clamps += sd;
     }
+#if !defined(SN_FLOAT)
+    {   /* the clamp's edges: R = 2^30 I (Q30 identity), v = +-(2^28 - 1),
+         * +-2^28, +-(2^28 + 1), INT32_MIN/MAX: the outputs are v clamped
+         * to +-2^28, counted; against sn_rot* and the formula */
+        static const int32_t ev[] = {(1 << 28) - 1, 1 << 28, (1 << 28) + 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                                     INT32_MAX, INT32_MIN};
+        sn_q R[9] = {1 << 30, 0, 0, 0, 1 << 30, 0, 0, 0, 1 << 30}, v[3], o1[3], o2[3], p1[3], p2[3];
+        unsigned i;
+        for (i = 0; i < sizeof ev / sizeof ev[0]; i++) {
+            uint32_t s1 = 0, s2 = 0, sd = 0, c;
+            v[0] = ev[i]; v[1] = ev[(i + 3) % 8]; v[2] = ev[(i + 5) % 8];
+            sn_k_rot_t(R, v, o1, &s1);
+            sn_rot_t(R, v, o2, &s2);
+            sn_k_rot(R, v, p1, &s1);
+            sn_rot(R, v, p2, &s2);
+            bad_path += memcmp(o1, o2, sizeof o1) != 0 || memcmp(p1, p2, sizeof p1) != 0 || s1 != s2;
+            for (c = 0; c < 3; c++) {
+                const int32_t w = v[c] > (1 << 28) ? (1 << 28) : v[c] < -(1 << 28) ? -(1 << 28) : v[c];
+                sd += 2u * (w != v[c]);
+                bad_ref += o2[c] != w || p2[c] != w;
+            }
+            bad_ref += s2 != sd;
+        }
+    }
+#endif
     T_CHECK(bad_path == 0, "frame rotations: %d differences between path %s and sn_rot*", bad_path, sn_kernels_name());
     T_CHECK(bad_ref == 0, "frame rotations: %d results or clamp counts off the double reference", bad_ref);
     T_FIGURE("frame rotations: 20000 random matrices and vectors (every 16th at the bounds), %u clamped outputs", (unsigned)clamps);
@@ -384,9 +410,158 @@ static void test_axpy(void) {
         bad += sat != sd;
         clamps += sd;
     }
+#if !defined(SN_FLOAT)
+    {   /* the clamps' edges: s x 2^-3 = +-(2^28 - 1), +-2^28, +-(2^28 + 1)
+         * exactly (x = 8, sh = 3) and INT32_MIN/MAX s, with a at 0 and
+         * +-SN_LIM, against the same floor-and-clamp reference */
+        static const int32_t es[] = {(1 << 28) - 1, 1 << 28, (1 << 28) + 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                                     INT32_MAX, INT32_MIN, 0};
+        static const int32_t ea[] = {0, 1 << 28, -(1 << 28), 1, -1};
+        unsigned i, j;
+        for (i = 0; i < sizeof es / sizeof es[0]; i++) {
+            sn_q a[5], x[5], o[5];
+            uint32_t sat = 0, sd = 0;
+            for (j = 0; j < 5; j++) { a[j] = ea[j]; x[j] = 8; }
+            sn_k_axpy(o, a, es[i], x, 5, 3, &sat);
+            for (j = 0; j < 5; j++) {
+                int64_t q = ((int64_t)es[i] * 8 + 4) >> 3; /* exact: a multiple of 8 plus 4, >= 0 or floor by >> */
+                if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                q += a[j];
+                if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                bad += o[j] != (sn_q)q;
+            }
+            bad += sat != sd;
+        }
+    }
+#endif
     T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);
 }
+
+/* sn_k_ic_bwd_row (the backward sweep's row: on the M4 a Thumb-2 loop that
+ * hands blocks with frac 0 or >= 32 to the reference and resumes) against
+ * the loop of sn_k_ic_row_ref from 0 (bit for bit, both flavours) and, fixed,
+ * the double reference (each row floor(p 2^-frac + 1/2), |p| < 3 2^15 2^31
+ * < 2^48: exact; the int64 sum of up to 12 exact): 3000 runs of 0..12
+ * blocks of a 30-vertex z, fracs mostly 1..31, every 4th run with 0 or
+ * 32..62 anywhere (first, last, consecutive), z at +-2^28 or
+ * INT32_MIN/MAX in every 8th run. Tolerance 0. */
+static void test_ic_rows(void) {
+    static unsigned char L[12 * 20], cols[24];
+    int t, bad = 0, bad_ref = 0, odd = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q z[90];
+        sn_acc lp[4], lr[4];
+        double ref[3] = {0, 0, 0};
+        uint32_t nb = rnd32() % 13u, e, k, sat_p = 0, sat_r = 0;
+        int wild = t % 8 == 0;
+        for (k = 0; k < 90; k++) {
+#if defined(SN_FLOAT)
+            z[k] = (float)rnd_in(1 << 20) / 256.0f;
+#else
+            z[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? (1 << 28) : -(1 << 28)))
+                        : rnd_in(1 << 28);
+#endif
+        }
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            uint32_t col = rnd32() % 30u;
+            int frac = (int)(1u + rnd32() % 31u), r, c;
+            if (t % 4 == 1 && rnd32() % 3u == 0) { frac = rnd32() & 1 ? 0 : (int)(32u + rnd32() % 31u); odd++; }
+            for (k = 0; k < 9; k++) {
+                int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)frac;
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)col;
+            cols[2 * e + 1] = 0;
+            for (r = 0; r < 3; r++) {
+                double p = 0;
+                for (c = 0; c < 3; c++) {
+                    int32_t m = (int16_t)(uint16_t)(b[2 * (3 * r + c)] | b[2 * (3 * r + c) + 1] << 8);
+                    p += (double)m * (double)z[3 * col + (uint32_t)c];
+                }
+                ref[r] += SN_FLAVOUR ? 0.0 : floor(ldexp(p, -frac) + (frac > 0 ? 0.5 : 0.0));
+            }
+        }
+        sn_k_ic_bwd_row(L, cols, nb, z, lp, &sat_p);
+        lr[0] = lr[1] = lr[2] = lr[3] = 0;
+        for (e = 0; e < nb; e++) sn_k_ic_row_ref(L + 20 * e, z + 3 * (cols[2 * e] | cols[2 * e + 1] << 8), lr, &sat_r);
+        bad += memcmp(lp, lr, 3 * sizeof lp[0]) != 0 || sat_p != sat_r;
+#if !defined(SN_FLOAT)
+        for (k = 0; k < 3; k++) bad_ref += (double)lr[k] != ref[k];
+#else
+        (void)ref;
+#endif
+    }
+    T_CHECK(bad == 0, "IC(0) backward rows (path %s): %d of 3000 runs differ from the reference loop", sn_kernels_name(), bad);
+    T_CHECK(bad_ref == 0, "IC(0) backward rows: %d sums off the double reference", bad_ref);
+    T_FIGURE("IC(0) backward rows: 3000 runs of 0..12 blocks, %d with frac 0 or >= 32", odd);
+}
+
+#if !defined(SN_FLOAT)
+/* sn_k_mul_out (d sn_out(l, s): the energy's term; on the M4 with the
+ * rounded value held as an int32) against sn_mul(d, sn_out(l, s)) and the
+ * clamp written here: l at +-2^62 (sn_out's precondition: < 2^62.5), at
+ * the clamp's edges (+-2^28 +- 1 after the shift, s 0..33) and random
+ * widths, s 0..40, d up to INT32_MIN/MAX. Tolerance 0, counts included. */
+static void test_mul_out(void) {
+    int t, bad = 0;
+    for (t = 0; t < 40000; t++) {
+        const int s = (int)(rnd32() % (t % 4 == 0 ? 34u : 41u)); /* (2^28 + 1) 2^33 < 2^62 */
+        const sn_q d = t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (sn_q)rnd32();
+        int64_t l, q;
+        uint32_t s1 = 0, s2 = 0, sd = 0;
+        switch (t % 4) {
+        case 0: l = (((int64_t)1 << 28) + (int64_t)(rnd32() % 3u) - 1) * ((int64_t)1 << s) * (rnd32() & 1 ? 1 : -1); break;
+        case 1: l = rnd32() & 1 ? ((int64_t)1 << 62) : -((int64_t)1 << 62); break;
+        default: l = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (2 + rnd32() % 62u)) * (rnd32() & 1 ? 1 : -1);
+        }
+        q = s > 0 ? (l + ((int64_t)1 << (s - 1))) >> s : l;
+        if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+        bad += sn_k_mul_out(d, l, s, &s1) != sn_mul(d, sn_out(l, s, &s2)) || s1 != s2;
+        bad += sn_k_mul_out(d, l, s, &s1) != (int64_t)d * q || s1 != 2 * sd;
+    }
+    T_CHECK(bad == 0, "energy term d sn_out(l, s) (path %s): %d of 40000 off", sn_kernels_name(), bad);
+}
+
+/* The segment sweep's clamps (sn_segment.h; on a Cortex-M one unsigned
+ * compare of the low word plus the high word's sign) against the compares
+ * written here: seg_out on int32 values (the edges +-2^28 +- 1, INT32_MIN/MAX,
+ * random), seg_lim on int64 values for m = 2^28 (ROT_MAX), 2^29, 1 and
+ * INT32_MAX (edges +-m +- 1, a high word with a small low word such as
+ * 2^32 + 5, +-2^62, random widths). Tolerance 0, counts included. */
+static void test_seg_clamps(void) {
+    static const int64_t m4[] = {(int64_t)1 << 28, (int64_t)1 << 29, 1, INT32_MAX};
+    int t, bad = 0, n = 0;
+    for (t = 0; t < 40000; t++) {
+        const int32_t e32[] = {(1 << 28) + 1, 1 << 28, (1 << 28) - 1, -(1 << 28) + 1, -(1 << 28), -(1 << 28) - 1,
+                               INT32_MAX, INT32_MIN, INT32_MIN + 1, 0};
+        const int32_t v = t < 10 ? e32[t] : (int32_t)(rnd32() >> (rnd32() % 32u)) * (rnd32() & 1 ? 1 : -1);
+        const int32_t want = v > (1 << 28) ? (1 << 28) : v < -(1 << 28) ? -(1 << 28) : v;
+        const int64_t m = m4[t % 4];
+        int64_t a, wl;
+        uint32_t sat = 0;
+        const int32_t got = (int32_t)seg_out((seg_n)v, &sat);
+        bad += got != want || sat != (uint32_t)(want != v);
+        switch (t % 8) {
+        case 0: a = m + (int64_t)(t / 8 % 3) - 1; break;            /* m - 1, m, m + 1 */
+        case 1: a = -m + (int64_t)(t / 8 % 3) - 1; break;
+        case 2: a = ((int64_t)(rnd32() % 5u) - 2) * ((int64_t)1 << 32) + (int64_t)(rnd32() % 9u) - 4; break;
+        case 3: a = rnd32() & 1 ? ((int64_t)1 << 62) : -((int64_t)1 << 62); break;
+        default: a = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (1 + rnd32() % 63u)) * (rnd32() & 1 ? 1 : -1);
+        }
+        wl = a > m ? m : a < -m ? -m : a;
+        bad += seg_lim(a, m) != wl;
+        n += 2;
+    }
+    T_CHECK(bad == 0, "segment clamps: %d of %d results off the compares", bad, n);
+}
+
+#endif
 
 #if !defined(SN_FLOAT)
 /* ---- the rounding shift for run-time shifts (sn_rshr64_var: the Cortex-M
@@ -469,6 +644,21 @@ static void test_rshr(void) {
         bad += got != c || sat != (uint32_t)(c != w);
     }
     T_CHECK(bad == 0, "saturating add: %d of 200000 sums or counts off the clamped int64 sum", bad);
+    {   /* every pair of edge values (the M4's QADD saturation and its
+         * unsigned range compare at +-2^28 exactly) */
+        static const int32_t ed[] = {INT32_MIN, INT32_MIN + 1, -(1 << 28) - 1, -(1 << 28), -(1 << 28) + 1, -1, 0, 1,
+                                     (1 << 28) - 1, 1 << 28, (1 << 28) + 1, (1 << 29), INT32_MAX - 1, INT32_MAX};
+        unsigned i, j;
+        bad = 0;
+        for (i = 0; i < sizeof ed / sizeof ed[0]; i++)
+            for (j = 0; j < sizeof ed / sizeof ed[0]; j++) {
+                const int64_t w = (int64_t)ed[i] + ed[j], c = w > (1 << 28) ? (1 << 28) : (w < -(1 << 28) ? -(1 << 28) : w);
+                uint32_t sat = 0;
+                const sn_q got = sn_add(ed[i], ed[j], &sat);
+                bad += got != c || sat != (uint32_t)(c != w);
+            }
+        T_CHECK(bad == 0, "saturating add: %d of 196 edge pairs off the clamped int64 sum", bad);
+    }
 }
 #endif
 
@@ -591,6 +781,54 @@ static void test_isqrt(void) {
     T_CHECK(bad == 0, "isqrt (this build's, Karatsuba, digits): %d of %d inputs not the exact floor", bad, n);
 }
 
+/* sn_k_cell_mul2 against the independent reference itself (not only
+ * against two sn_k_cell_mul calls: on the M4 both are assembly): 2000
+ * random records (every 8th at the bounds), corner 0's operands 0 (the
+ * contract), the others random, at +-2^28 (the state bound) or, every 4th
+ * record, INT32_MIN / INT32_MAX (beyond the contract, still exact: 21
+ * products < 2^27 2^31 sum below 2^62.4, and row_ok's halves stay exact);
+ * l1 every row, l2 the rows of a random corner set. Fixed: tolerance 0. */
+static void test_mul2_ref(void) {
+    static unsigned char K[REC];
+    double S[24][24];
+    int t, bad = 0, rows = 0;
+    for (t = 0; t < 2000; t++) {
+        sn_q u1[24], u2[24];
+        sn_acc l1[24], l2[24];
+        uint32_t k, mask = t % 5 == 0 ? 0xFFu : rnd32() & 0xFFu;
+        make_rec(K, S, t % 8 == 0);
+        for (k = 0; k < 24; k++) {
+#if defined(SN_FLOAT)
+            u1[k] = (float)rnd_in(1 << 20) / 256.0f;
+            u2[k] = (float)rnd_in(1 << 20) / 256.0f;
+#else
+            if (t % 4 == 1) {
+                u1[k] = rnd32() & 1 ? INT32_MAX : INT32_MIN;
+                u2[k] = rnd32() & 1 ? INT32_MAX : INT32_MIN;
+            } else if (t % 4 == 2) {
+                u1[k] = rnd32() & 1 ? (1 << 28) : -(1 << 28);
+                u2[k] = rnd32() & 1 ? (1 << 28) : -(1 << 28);
+            } else {
+                u1[k] = rnd_in(1 << 28);
+                u2[k] = rnd_in(1 << 28);
+            }
+#endif
+        }
+        u1[0] = u1[1] = u1[2] = u2[0] = u2[1] = u2[2] = 0;
+        sn_k_cell_mul2(K, u1, u2, l1, l2, mask);
+        for (k = 0; k < 24; k++) {
+            bad += !row_ok(S, u1, (int)k, l1[k]);
+            rows++;
+            if (mask >> (k / 3) & 1u) {
+                bad += !row_ok(S, u2, (int)k, l2[k]);
+                rows++;
+            }
+        }
+    }
+    T_CHECK(bad == 0, "sn_k_cell_mul2 (path %s): %d of %d rows off the reference", sn_kernels_name(), bad, rows);
+    T_FIGURE("sn_k_cell_mul2 against the reference: 2000 records, %d rows (operands at +-2^28 and INT32_MIN/MAX)", rows);
+}
+
 int main(void) {
     static unsigned char K[REC];
     double S[24][24];
@@ -664,13 +902,17 @@ int main(void) {
     (void)bad_order;
 #endif
     T_FIGURE("4000 random cells (every 16th at the bounds), %d free-corner lists", lists);
+    test_mul2_ref();
     test_ic();
+    test_ic_rows();
     test_rot();
     test_axpy();
     test_isqrt();
 #if !defined(SN_FLOAT)
     test_rshr();
     test_dot();
+    test_seg_clamps();
+    test_mul_out();
 #endif
     test_loops();
     return T_END();

@@ -54,7 +54,7 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
 const char *sn_kernels_name(void) { return "scalar"; }
 #endif /* SN_KERNELS_SCALAR */
 
-#if defined(SN_KERNELS_SCALAR) || defined(SN_KERNELS_M4)
+#if defined(SN_KERNELS_SCALAR)
 /* First writes of BLK_ROW / BLK_MAC_T into an output: (sn_acc)0 + the
  * block term, the value the += had from a zeroed output (float: the same
  * sum, signed zeros included; fixed: the term), so the outputs need no
@@ -70,7 +70,7 @@ const char *sn_kernels_name(void) { return "scalar"; }
     (acc)[2] = (sn_acc)0 + (sn_mul(ENT(B, 2), (e)[0]) + sn_mul(ENT(B, 5), (e)[1]) + sn_mul(ENT(B, 8), (e)[2])); \
 } while (0)
 /* Both right-hand-side products, one decode per block; each output's
- * partial sums in sn_k_cell_mul's order (the M4 compiles this C to SMLAL).
+ * partial sums in sn_k_cell_mul's order (the M4's is sn_kernels_m4.c's).
  * Row 0: corner 0's operands are 0 (sn_kernels.h), so its diagonal block
  * and the transposed uses of its blocks add exact zeros (float: +-0 to a
  * +0 partial sum, which stays +0): only B u_b into row 0. So row 0's first

@@ -193,6 +193,19 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
     if (s <= 0 || s >= 32) sn_k_ic_row_ref(b, z, l, sat);
     else sn_k_ic_m4(b, z, s, 6, 2, l);
 }
+/* the backward sweep's row: sn_kernels_m4.c's Thumb-2 loop (sn_m4_ic_rows)
+ * over the blocks with 0 < s < 32, from the first other block on
+ * sn_m4_ic_rows_rest (the reference for such blocks) */
+#define SN_K_IC_BWD_ROW 1
+const unsigned char *sn_m4_ic_rows(const unsigned char *b, const unsigned char *cols, const unsigned char *end,
+                                   const sn_q *z, sn_acc l[4]);
+void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
+                        sn_acc l[4], uint32_t *sat);
+SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
+                               uint32_t *sat) {
+    const unsigned char *end = b + (size_t)nb * SN_ELEM_ICHOL, *p = sn_m4_ic_rows(b, cols, end, z, l);
+    if (p != end) sn_m4_ic_rows_rest(p, cols + 2u * ((uint32_t)(p - b) / SN_ELEM_ICHOL), end, z, l, sat);
+}
 
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
@@ -265,6 +278,20 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
 #else
 #define sn_k_ic_col sn_k_ic_col_ref
 #define sn_k_ic_row sn_k_ic_row_ref
+#endif
+
+/* l = sum of round(U_e z_cols[e]) over nb consecutive blocks (the backward
+ * sweep's row j, its free columns: cols the row's LE u16 column indices;
+ * l[3] scratch); every path but the M4's: the loop of sn_k_ic_row from 0
+ * (ic_backward keeps its own copy of that loop there: the x86-64 code as
+ * before) */
+#if !defined(SN_K_IC_BWD_ROW)
+SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
+                               uint32_t *sat) {
+    uint32_t e;
+    l[0] = l[1] = l[2] = l[3] = 0;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) sn_k_ic_row(b, z + 3 * sn_rd_u16(cols + 2 * e), l, sat);
+}
 #endif
 
 #endif /* SN_KERNELS_IC_H */

@@ -1,13 +1,15 @@
 /* sn_kernels_m4.c -- Cortex-M4/M7 (ARMv7E-M, DSP extension) kernels of
  * sn_kernels.h, fixed flavour. sn_k_cell_mul's rows in Thumb-2 assembly
- * (GCC's C spilled the row sums); sn_k_cell_mul2 is sn_kernels.c's C; the
- * CG dot and axpy in C written for one SMLAL per multiply-add. The same
+ * (GCC's C spilled the row sums), sn_k_cell_mul2's too (one output
+ * component of both products at a time); the CG dot and axpy in C written
+ * for one SMLAL per multiply-add. The same
  * exact products as the scalar reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 
 #if defined(SN_KERNELS_M4)
+#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 /* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
  * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
@@ -173,6 +175,247 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
 }
 
+/* The right-hand side's two products (sn_k_cell_mul2) in Thumb-2
+ * (sn_m4_cell_mul2), one output component at a time: l1[3a+r] and l2[3a+r]
+ * in r10:r11 and r12:lr, over the blocks b = 1..7 (corner 0's operands are
+ * 0, the contract): row r of block (a,b) (b > a), column r of block (b,a)
+ * (b < a) or row r of the diagonal block, its 3 entries decoded (LDRSH, LSL
+ * by the block's exponent) into r4-r6 and used for both vectors, u1_b and
+ * u2_b by LDM with writeback (r1, r2 walk the corners). Everything unrolled
+ * by the assembler (.macro, .if on a, b, r): the offsets are immediates,
+ * no loop or pointer arithmetic. An off-diagonal entry is decoded twice
+ * (once per direction) but no sum goes through memory: 15 instructions per
+ * 6 multiply-adds (GCC's C of sn_kernels.c: ~124 a block, 36). Rows a
+ * outside rows2 take the l1-only copy (l2's row unspecified, the contract).
+ * The same exact products as the reference, summed in another order
+ * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+void sn_m4_cell_mul2(const unsigned char *K, const sn_q *u1, const sn_q *u2, sn_acc *l1, sn_acc *l2, uint32_t rows2);
+#define SN_M4_S_(x) #x
+#define SN_M4_S(x) SN_M4_S_(x)
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_cell_mul2,\"ax\",%progbits\n"
+    ".set snm2_diag, " SN_M4_S(SN_CELLK_DIAG) "\n"
+    ".set snm2_off, " SN_M4_S(SN_CELLK_OFF) "\n"
+    ".set snm2_exp, " SN_M4_S(SN_CELLK_EXP) "\n"
+    /* one block's 3 entries for output (a, r) times u1_b [and u2_b] */
+    ".macro snm2_blk a, b, r, two, first\n"
+    ".if \\b == \\a\n"                      /* diagonal: xx yy zz xy xz yz */
+    ".if \\r == 0\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 0)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 12)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 16)]\n"
+    ".elseif \\r == 1\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 12)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 4)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 20)]\n"
+    ".else\n"
+    "ldr   r4, [r0, #(snm2_diag + 24 * \\a + 16)]\n"
+    "ldr   r5, [r0, #(snm2_diag + 24 * \\a + 20)]\n"
+    "ldr   r6, [r0, #(snm2_diag + 24 * \\a + 8)]\n"
+    ".endif\n"
+    ".else\n"
+    ".if \\b > \\a\n"                       /* row r of block (a,b): m[3r..3r+2] */
+    ".set snm2_i, \\a * (13 - \\a) / 2 - 1 + \\b\n"
+    ".set snm2_m0, 6 * \\r\n"
+    ".set snm2_st, 2\n"
+    ".else\n"                               /* column r of block (b,a): m[r], m[3+r], m[6+r] */
+    ".set snm2_i, \\b * (13 - \\b) / 2 - 1 + \\a\n"
+    ".set snm2_m0, 2 * \\r\n"
+    ".set snm2_st, 6\n"
+    ".endif\n"
+    "ldrb  r7, [r0, #(snm2_exp + snm2_i)]\n"
+    "ldrsh r4, [r0, #(snm2_off + 18 * snm2_i + snm2_m0)]\n"
+    "ldrsh r5, [r0, #(snm2_off + 18 * snm2_i + snm2_m0 + snm2_st)]\n"
+    "ldrsh r6, [r0, #(snm2_off + 18 * snm2_i + snm2_m0 + 2 * snm2_st)]\n"
+    "lsl   r4, r4, r7\n"
+    "lsl   r5, r5, r7\n"
+    "lsl   r6, r6, r7\n"
+    ".endif\n"
+    "ldm   r1!, {r7, r8, r9}\n"
+    ".if \\first\n"
+    "smull r10, r11, r4, r7\n"
+    ".else\n"
+    "smlal r10, r11, r4, r7\n"
+    ".endif\n"
+    "smlal r10, r11, r5, r8\n"
+    "smlal r10, r11, r6, r9\n"
+    ".if \\two\n"
+    "ldm   r2!, {r7, r8, r9}\n"
+    ".if \\first\n"
+    "smull r12, lr, r4, r7\n"
+    ".else\n"
+    "smlal r12, lr, r4, r7\n"
+    ".endif\n"
+    "smlal r12, lr, r5, r8\n"
+    "smlal r12, lr, r6, r9\n"
+    ".endif\n"
+    ".endm\n"
+    /* output component (a, r): 7 blocks, the stores, the walks back */
+    ".macro snm2_out a, r, two\n"
+    "snm2_blk \\a, 1, \\r, \\two, 1\n"
+    "snm2_blk \\a, 2, \\r, \\two, 0\n"
+    "snm2_blk \\a, 3, \\r, \\two, 0\n"
+    "snm2_blk \\a, 4, \\r, \\two, 0\n"
+    "snm2_blk \\a, 5, \\r, \\two, 0\n"
+    "snm2_blk \\a, 6, \\r, \\two, 0\n"
+    "snm2_blk \\a, 7, \\r, \\two, 0\n"
+    "ldr   r7, [sp, #0]\n"                  /* l1 */
+    "strd  r10, r11, [r7, #(24 * \\a + 8 * \\r)]\n"
+    "sub   r1, r1, #84\n"
+    ".if \\two\n"
+    "ldr   r7, [sp, #40]\n"                 /* l2 */
+    "strd  r12, lr, [r7, #(24 * \\a + 8 * \\r)]\n"
+    "sub   r2, r2, #84\n"
+    ".endif\n"
+    ".endm\n"
+    /* row a: both products if bit a of rows2, else l1's */
+    ".macro snm2_row a\n"
+    "ldr   r7, [sp, #44]\n"                 /* rows2 */
+    "lsls  r7, r7, #(31 - \\a)\n"
+    "bpl   1f\n"
+    "snm2_out \\a, 0, 1\n"
+    "snm2_out \\a, 1, 1\n"
+    "snm2_out \\a, 2, 1\n"
+    "b     2f\n"
+    "1:\n"
+    "snm2_out \\a, 0, 0\n"
+    "snm2_out \\a, 1, 0\n"
+    "snm2_out \\a, 2, 0\n"
+    "2:\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_cell_mul2\n"
+    ".thumb_func\n"
+    ".type sn_m4_cell_mul2, %function\n"
+    "sn_m4_cell_mul2:\n"
+    "push  {r3-r11, lr}\n"                  /* [sp] l1; l2, rows2 at [sp, #40], [sp, #44] */
+    "add   r1, r1, #12\n"                   /* u1_1, u2_1: corner 0 skipped */
+    "add   r2, r2, #12\n"
+    "snm2_row 0\n"
+    "snm2_row 1\n"
+    "snm2_row 2\n"
+    "snm2_row 3\n"
+    "snm2_row 4\n"
+    "snm2_row 5\n"
+    "snm2_row 6\n"
+    "snm2_row 7\n"
+    "pop   {r3-r11, pc}\n"
+    ".size sn_m4_cell_mul2, .-sn_m4_cell_mul2\n"
+    ".purgem snm2_row\n"
+    ".purgem snm2_out\n"
+    ".purgem snm2_blk\n"
+    ".popsection\n");
+
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
+    uint32_t a;
+    sn_m4_cell_mul2(K, u1, u2, l1, l2, rows2);
+    for (a = 0; a < 24; a++)
+        SN_RANGE(SN_WITHIN(l1[a], 60) && (!(rows2 >> (a / 3) & 1u) || SN_WITHIN(l2[a], 60)), "cell row beyond 24 * 2^55",
+                 l1[a]);
+    (void)a;
+}
+
+/* The IC(0) backward sweep's block rows (sn_k_ic_bwd_row, sn_kernels_ic.h) in
+ * Thumb-2: l = sum of round(U_b z_cols[b]) over consecutive blocks while
+ * their frac s is in 1..31 (the rounding term as the SMLAL chain's start,
+ * the shift on the two words, as sn_k_ic_m4); returns where it stopped
+ * (end, or a block for the reference). The sums live in the frame for the
+ * whole run (LDRD/ADDS/ADC/STRD), z_i by one LDM a block: 63 instructions
+ * a block against GCC's 81 (it kept l and its pointers on the stack and
+ * reloaded them). The same integers: each row's rounded term is the
+ * reference's, the sums exact. */
+typedef char sn_m4_ic_layout_[SN_ELEM_ICHOL == 20 ? 1 : -1]; /* the stride and frac's byte 18 below */
+const unsigned char *sn_m4_ic_rows(const unsigned char *b, const unsigned char *cols, const unsigned char *end,
+                                   const sn_q *z, sn_acc l[4]);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_ic_rows,\"ax\",%progbits\n"
+    /* row k: (2^(s-1) + U_k0 z0 + U_k1 z1 + U_k2 z2) >> s added to l_k */
+    ".macro snic_row k\n"
+    "mov   r9, r8\n"
+    "mov   r10, #0\n"
+    "ldrsh r11, [r0, #(6 * \\k)]\n"
+    "smlal r9, r10, r11, r3\n"
+    "ldrsh r11, [r0, #(6 * \\k + 2)]\n"
+    "smlal r9, r10, r11, r4\n"
+    "ldrsh r11, [r0, #(6 * \\k + 4)]\n"
+    "smlal r9, r10, r11, r5\n"
+    "lsr   r9, r9, r6\n"
+    "lsl   r11, r10, r7\n"
+    "orr   r9, r9, r11\n"
+    "asr   r10, r10, r6\n"
+    "ldrd  r12, lr, [sp, #(8 * \\k)]\n"
+    "adds  r12, r12, r9\n"
+    "adc   lr, lr, r10\n"
+    "strd  r12, lr, [sp, #(8 * \\k)]\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_ic_rows\n"
+    ".thumb_func\n"
+    ".type sn_m4_ic_rows, %function\n"
+    "sn_m4_ic_rows:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #36\n"               /* [sp] l0 l1 l2, end; the caller's l at [sp, #72] */
+    "str   r2, [sp, #24]\n"
+    "mov   r12, r2\n"
+    "mov   r2, r3\n"                    /* z */
+    "mov   r3, #0\n"
+    "mov   r4, #0\n"
+    "strd  r3, r4, [sp, #0]\n"
+    "strd  r3, r4, [sp, #8]\n"
+    "strd  r3, r4, [sp, #16]\n"
+    "cmp   r0, r12\n"
+    "beq   2f\n"
+    "1:\n"
+    "ldrh  r12, [r1], #2\n"             /* i */
+    "ldrb  r6, [r0, #18]\n"             /* s = frac */
+    "sub   lr, r6, #1\n"
+    "cmp   lr, #30\n"
+    "bhi   2f\n"                        /* s = 0 or s >= 32: the reference's block */
+    "mov   r8, #1\n"
+    "lsl   r8, r8, lr\n"                /* 2^(s-1) */
+    "rsb   r7, r6, #32\n"
+    "add   r12, r12, r12, lsl #1\n"
+    "add   r12, r2, r12, lsl #2\n"
+    "ldm   r12, {r3, r4, r5}\n"         /* z_i */
+    "snic_row 0\n"
+    "snic_row 1\n"
+    "snic_row 2\n"
+    "add   r0, r0, #20\n"
+    "ldr   r12, [sp, #24]\n"
+    "cmp   r0, r12\n"
+    "bne   1b\n"
+    "2:\n"
+    "ldm   sp, {r3-r8}\n"
+    "ldr   r12, [sp, #72]\n"
+    "stm   r12, {r3-r8}\n"
+    "add   sp, sp, #36\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_ic_rows, .-sn_m4_ic_rows\n"
+    ".purgem snic_row\n"
+    ".popsection\n");
+
+/* sn_k_ic_bwd_row after a block the Thumb-2 loop left (s = 0 or s >= 32): that
+ * block by the reference, then the loop again from the next one */
+void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
+                        sn_acc l[4], uint32_t *sat) {
+    while (b != end) {
+        sn_acc t[4];
+        const unsigned char *p;
+        sn_k_ic_row_ref(b, z + 3 * sn_rd_u16(cols), l, sat);
+        b += SN_ELEM_ICHOL;
+        cols += 2;
+        p = sn_m4_ic_rows(b, cols, end, z, t);
+        l[0] += t[0]; l[1] += t[1]; l[2] += t[2];
+        cols += 2u * ((uint32_t)(p - b) / SN_ELEM_ICHOL);
+        b = p;
+    }
+}
+
 /* The CG dot product (sn_kernels.c's reference): each product rounded alone,
  * (a b + 2^(sh-1)) >> sh. Here the rounding term is the SMLAL's starting
  * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),
@@ -210,10 +453,12 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
         const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
         for (i = 0; i < n; i++) {
             const int64_t v = sn_shr64_w(bias + (int64_t)s * x[i], sh);
+            const uint32_t lo = (uint32_t)v;
             sn_q q;
-            if (v > SN_LIM) { (*sat)++; q = SN_LIM; }
-            else if (v < -SN_LIM) { (*sat)++; q = -SN_LIM; }
-            else q = (int32_t)v;
+            /* |v| <= SN_LIM: the low word within +-SN_LIM (one unsigned
+             * compare) and the high word its sign (not two 64-bit compares) */
+            if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && (int32_t)(v >> 32) == (int32_t)lo >> 31) q = (int32_t)lo;
+            else { (*sat)++; q = v > 0 ? SN_LIM : -SN_LIM; }
             out[i] = sn_add(a[i], q, sat);
         }
     } else {

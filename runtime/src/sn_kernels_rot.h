@@ -126,9 +126,9 @@ SN_INLINE sn_q sn_k_rot_out1(int64_t x, uint32_t *sat) {
     int32_t v;
     SN_RANGE(x < 3 * ((int64_t)1 << 58) && x > -3 * ((int64_t)1 << 58), "frame rotation sum beyond 3 2^58", x);
     v = (int32_t)sn_rshr64(x, SN_Q_ROT);
-    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
-    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
-    return v;
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v; /* |v| <= SN_LIM: one unsigned compare */
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
 }
 /* Written out, v in int32 registers (an empty asm: GCC otherwise kept
  * the int64 a clamped v came from, or hoisted v's sign extensions out of a
@@ -338,5 +338,20 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
     }
 #endif
 }
+
+/* d sn_out(l, s), a term of a cell's elastic energy (cell_forces): on the
+ * Cortex-M4 the rounded value held as an int32 (an empty asm, as SN_K_I32:
+ * GCC otherwise multiplied the clamped int64 as 64 x 64 bits, UMULL, MUL,
+ * MLA, not one SMLAL); elsewhere the reference expression itself (the same
+ * code as before). The same value. */
+#if defined(SN_KERNELS_M4)
+SN_INLINE sn_acc sn_k_mul_out(sn_q d, sn_acc l, int s, uint32_t *sat) {
+    int32_t t = sn_out(l, s, sat);
+    __asm__("" : "+r"(t));
+    return sn_mul(d, t);
+}
+#else
+#define sn_k_mul_out(d, l, s, sat) sn_mul((d), sn_out((l), (s), (sat)))
+#endif
 
 #endif /* SN_KERNELS_ROT_H */

@@ -60,16 +60,23 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
 static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z, uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
-    uint32_t j = v->nF, e;
+    uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
+#if defined(SN_K_IC_BWD_ROW) /* the M4's loop (sn_kernels_ic.h) */
+        sn_acc l[4];
+        n -= f - b;
+        sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
+#else
         sn_acc l[4] = {0, 0, 0, 0};
         const unsigned char *blk;
+        uint32_t e;
         n -= f - b;
         blk = L + (size_t)n * SN_ELEM_ICHOL;
         for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
             sn_k_ic_row(blk, z + 3 * sn_rd_u16(cols + 2 * e), l, sat); /* l += round(U_ji z_i) */
         }
+#endif
         sn_k_sub3a(z + 3 * j, l, sat);
     }
 }

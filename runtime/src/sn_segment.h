@@ -150,10 +150,31 @@ SN_INLINE seg_n narrow(int64_t x) {
 #define SEG_OUT(v, sat) seg_out((v), (sat))
 SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
     SN_RANGE(v >= -INT32_MAX && v <= INT32_MAX, "segment sum beyond int32", v);
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    /* |v| <= SN_LIM as one unsigned compare (v within int32 here) */
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
+#else
     if (v > SN_LIM) { (*sat)++; return SN_LIM; }
     if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
     return v;
+#endif
 }
+#endif
+
+/* a clamped to +-m (0 < m < 2^31, fixed; float the same compares): the
+ * move's turn limiter and the star's last share */
+#if !defined(SN_FLOAT) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* Cortex-M: |a| <= m iff the low word is within +-m (one unsigned compare)
+ * and the high word its sign, not two 64-bit compares; the same value */
+SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
+    const uint32_t lo = (uint32_t)a, um = (uint32_t)m;
+    if (lo + um <= 2u * um && (int32_t)(a >> 32) == (int32_t)lo >> 31) return a;
+    return a > 0 ? m : -m;
+}
+#else
+SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
 #endif
 
 /* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,

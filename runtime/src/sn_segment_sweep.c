@@ -54,7 +54,6 @@ SN_INLINE sn_acc rsh(sn_acc a, int s) {
     return sn_rshr64_var(a, s);
 #endif
 }
-SN_INLINE sn_acc lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
 
 /* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
  * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
@@ -83,9 +82,9 @@ SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1,
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
-    e0 = NARROW(lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
-    e1 = NARROW(lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
-    e2 = NARROW(lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
+    e0 = NARROW(seg_lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
+    e1 = NARROW(seg_lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
+    e2 = NARROW(seg_lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
     eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
     x0 = NARROW(u0 + e0 - r30(MUL(eu, u0)));
     x1 = NARROW(u1 + e1 - r30(MUL(eu, u1)));
@@ -209,8 +208,8 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
             t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
             l0 -= t0; l1 -= t1; l2 -= t2;
         } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
-            t0 = NARROW(lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(lim(l1, (sn_acc)2 * SN_LIM));
-            t2 = NARROW(lim(l2, (sn_acc)2 * SN_LIM));
+            t0 = NARROW(seg_lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(seg_lim(l1, (sn_acc)2 * SN_LIM));
+            t2 = NARROW(seg_lim(l2, (sn_acc)2 * SN_LIM));
         }
         move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
     }
