@@ -478,14 +478,14 @@ for fl in "" _float; do
     else bad "$p: run failed"; tail -n 5 "$L/run_play$fl.log" | sed 's/^/    /'; fi
 done
 
-agree() {  # label list min
+agree() {  # label list min [run]: run names the steps where every build runs the same count
     n=$(printf '%s' "$2" | grep -c .)
     d=$(printf '%s' "$2" | awk '{print $2}' | sort -u | grep -c .)
-    if [ "$n" -ge "$3" ] && [ "$d" -eq 1 ]; then ok "$1: $n builds agree after $STEPS steps"
+    if [ "$n" -ge "$3" ] && [ "$d" -eq 1 ]; then ok "$1: $n builds agree${4:+ $4}"
     elif [ "$n" -lt "$3" ]; then bad "$1: only $n build(s) gave a hash"
     else bad "$1: hashes differ:"; printf '%s' "$2" | sed 's/^/    /'; fi
 }
-agree "fixed flavour" "$fixed" 2
+agree "fixed flavour" "$fixed" 2 "after $STEPS steps"
 # on a mismatch, locate it: the first step (traced every 10) where a hosted
 # build leaves the trace of a build with the most common hash
 major=$(printf '%s' "$fixed" | awk '{print $2}' | sort | uniq -c | sort -rn | awk 'NR==1 {print $2}')
