@@ -66,9 +66,14 @@ cutcfixed=$(hash_of "$T")
 cutcfloat=$(hash_of "$T")
 [ -n "$cutcfixed" ] && [ -n "$cutcfloat" ] || { echo "update_hashes: a player printed no cut-level contact hash"; exit 1; }
 # details on the cut level (tests/test_runtime_dstep.c): the ramp with the 50 largest details active
-dfixed=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" 2>&1 | sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p')
-dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p')
-[ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
+# and the runtime choosing them (stage 3, sn_set_detail_adapt), the same ramp
+BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" > "$T" 2>&1
+dfixed=$(sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p' "$T")
+dafixed=$(sed -n 's/^  hash: details_adapt_fixed \([0-9a-f]\{16\}\).*/\1/p' "$T")
+BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" > "$T" 2>&1
+dfloat=$(sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p' "$T")
+dafloat=$(sed -n 's/^  hash: details_adapt_float \([0-9a-f]\{16\}\).*/\1/p' "$T")
+[ -n "$dfixed" ] && [ -n "$dfloat" ] && [ -n "$dafixed" ] && [ -n "$dafloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
 # the same blob on the trot (test_determinism.sh's details scenario, every platform): the
 # determinism driver, details 0..N-1 active from the first step (the players cannot set details)
 # shellcheck disable=SC2046
@@ -133,6 +138,10 @@ cut_contact_float $cutcfloat
 # checked by test_runtime_dstep.
 details50_fixed $dfixed
 details50_float $dfloat
+# The same ramp with the runtime choosing the details from none (stage 3: sn_set_detail_adapt on,
+# the blob's A_max 50 and thresholds 0.03 / 0.01; 32 iterations), checked by test_runtime_dstep.
+details_adapt_fixed $dafixed
+details_adapt_float $dafloat
 # The same blob, details 0..$((DT_N - 1)) active from the first step, $DT_ITERS CG iterations, $DT_STEPS steps
 # of the trot, no level switch (ports/cross det_main BLOB $DT_ARGS),
 # checked by tests/scripts/test_determinism.sh on every platform and the Cortex-M4.
