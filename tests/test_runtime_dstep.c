@@ -599,7 +599,7 @@ int main(int argc, char **argv)
             double w, em;
             run_res rad, rad2, rcut, rbr;
             sn_stats sst;
-            uint32_t ev100 = 0, ev200 = 0;
+            uint32_t ev100 = 0, ev200 = 0, ait;
             /* the estimate against double: the 25 largest active, 20 steps into the ramp (the transient) */
             sn_reset(cd);
             sn_set_detail_adapt(cd, 0);
@@ -620,19 +620,20 @@ int main(int argc, char **argv)
             g_track = 1;
             g_act_sum = 0;
             g_act_max = 0;
-            rad = ramp(cd, bl[2], nj, joint, NULL, 0, DIT, ref, nS, cell, s, xf, NULL);
+            ait = getenv("DSTEP_AIT") ? (uint32_t)atoi(getenv("DSTEP_AIT")) : DIT; /* a study's override (0: the floor) */
+            rad = ramp(cd, bl[2], nj, joint, NULL, 0, ait, ref, nS, cell, s, xf, NULL);
             g_track = 0;
             sn_get_stats(cd, &sst);
-            T_FIGURE("[%s] stage 3: %s %s %c %g, adaptive (%u iterations): surface vs level 1 max %.3g / held %.3g / rms %.3g "
+            T_FIGURE("[%s] stage 3: %s %s %c %g, adaptive (%u iterations, 0: the floor): surface vs level 1 max %.3g / held %.3g / rms %.3g "
                      "(cut level %.3g / %.3g / %.3g; 50 largest %.3g / %.3g / %.3g; every detail %.3g / %.3g / %.3g); active mean %.1f "
-                     "max %u; refines %u, coarsens %u, overflow %u", FL, chr, jname, "xyz"[g_axis], deg, DIT, rad.mx, rad.mxh, rad.rms,
+                     "max %u; refines %u, coarsens %u, overflow %u", FL, chr, jname, "xyz"[g_axis], deg, ait, rad.mx, rad.mxh, rad.rms,
                      r0.mx, r0.mxh, r0.rms, r50.mx, r50.mxh, r50.rms, ra.mx, ra.mxh, ra.rms, g_act_sum / 48, g_act_max,
                      sst.adapt_refines, sst.adapt_coarsens, sst.adapt_overflow);
             T_CHECK(sst.adapt_on == 1 && g_act_max <= 50, "[%s] stage 3: stats on, at most A_max 50 active", FL);
             T_CHECK(rad.rms < r0.rms && (rad.mx < r0.mx || rad.mxh < r0.mxh), "[%s] stage 3: adaptive nearer level 1 than the cut level",
                     FL);
             T_CHECK(rad.sat == 0, "[%s] stage 3: no saturation (%u)", FL, rad.sat);
-            rad2 = ramp(cd, bl[2], nj, joint, NULL, 0, DIT, ref, nS, cell, s, xf, NULL);
+            rad2 = ramp(cd, bl[2], nj, joint, NULL, 0, ait, ref, nS, cell, s, xf, NULL);
             T_CHECK(rad2.hash == rad.hash, "[%s] stage 3: after sn_reset the same hash %016llx", FL, (unsigned long long)rad.hash);
             {   /* a shared instance */
                 size_t sb = sn_instance_state_size(bl[2]), wb = sn_workspace_size(bl[2], SN_MODE_WARPED);
@@ -640,7 +641,7 @@ int main(int argc, char **argv)
                 sn_instance *si;
                 uint64_t hsh = 0;
                 if (sm && ws && sn_instance_init_shared(sm, sb, bl[2], &si) == SN_OK) {
-                    sn_set_iterations(si, DIT);
+                    sn_set_iterations(si, ait);
                     sn_set_detail_adapt(si, 1);
                     for (k = 1; k <= 48; k++) {
                         ramp_pose(bl[2], nj, joint, g_axis, deg, (int)k, xf);

@@ -134,6 +134,11 @@ static int bench_blob(const char *path, int only_steps, int contact) {
         bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         for (k = 0; k < only_steps; k++) sn_step(inst);
+        if (g_dadapt) {
+            sn_stats st;
+            sn_get_stats(inst, &st);
+            fprintf(stderr, "sn_bench: details active %u, refines %u, coarsens %u\n", st.adapt_active, st.adapt_refines, st.adapt_coarsens);
+        }
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
         return 0;
     }

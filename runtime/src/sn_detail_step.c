@@ -186,7 +186,7 @@ static void detail_precond(const sn_view *v, const sn_dstate *s, uint32_t det, i
     e2 -= v->frac_M;
     ea = stat || e1 > e2 ? e1 : e2;
     t1 = ea - e1 > 62 ? 0 : t1 / ((int64_t)1 << (ea - e1));
-    t2 = ea - e2 > 62 ? 0 : t2 / ((int64_t)1 << (ea - e2));
+    t2 = stat || ea - e2 > 62 ? 0 : t2 / ((int64_t)1 << (ea - e2)); /* stat: no mass (and ea may be below e2) */
     A = t1 + t2; /* a = A 2^(ea - 24) */
     q = 0;
     if (A > 0) {
