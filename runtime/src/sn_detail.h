@@ -21,13 +21,14 @@ sn_status sn_check_details(const sn_view *v, uint32_t nhd, uint32_t nd, uint32_t
  * no unknown), yd the details' (CELLD order). lc += the corner rows' detail
  * columns at the corners' scale (fixed: Q(frac_S), shifted up by dshift, the
  * part clamped first, counted in *sat); ld = the details' rows (3 per detail,
- * 0 for inactive ones) at the details' scale (fixed Q(frac_S - dshift)). */
+ * 0 for inactive ones) at the details' scale (fixed Q(frac_S - dshift)).
+ * lc NULL: the details' rows only (stage 3's estimate). */
 void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                         sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat);
 
 /* The same for the Galerkin mass (CELLDK's masses, scalar: no frame): mc +=
  * the corner rows' detail columns, md = the details' rows, both at MOFF's
- * scale (fixed Q(frac_M)). */
+ * scale (fixed Q(frac_M)); mc NULL: the details' rows only. */
 void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                          sn_acc mc[24], sn_acc md[3 * SN_CUT_MAXX]);
 

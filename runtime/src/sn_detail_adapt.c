@@ -17,7 +17,8 @@
  * leavers drop theirs).
  *
  * Cost per step, fixed by the blob: the every-detail row product and mass of
- * every cell with details (sn_detail_cell_mul / _mass with every bit on), 3
+ * every cell with details (sn_detail_cell_mul / _mass with every bit on, the
+ * details' rows only), 3
  * rotations per cell and detail, the keys, at most 33 nD compares for the
  * selection, and (when the set changes) sn_details_apply (nC masks). The
  * estimate's clamps are not state clamps: counted nowhere (the keys only rank). */
@@ -43,58 +44,70 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
         uint32_t a0 = sn_rd_u16(cl), nd = cd[38], on, nx = 0, ids[SN_CUT_MAXX];
-        sn_q d[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], gx[SN_CUT_MAXX][3], gc[24], g[3], gr[3];
-        sn_acc lc[24], ld[3 * SN_CUT_MAXX], mc[24], md[3 * SN_CUT_MAXX];
+        sn_q d[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], g[3], gr[3];
+        sn_acc l[3 * SN_CUT_MAXX]; /* the mass rows, then the stiffness rows (one array: the stack, M4) */
         if (nd == 0) continue;
         on = nd >= 32u ? 0xFFFFFFFFu : (1u << nd) - 1u; /* nd <= 19 (validated) */
-        /* g_E: the step's gravity on a cell (sn_solve.c detail_mass_rhs) */
+        /* M g first: g_E (the step's gravity on a cell, sn_solve.c detail_mass_rhs) at corners and extras */
         sn_k_rot(R, v->grav, gr, &lsat);
         for (c = 0; c < 3; c++) g[c] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[c], -gr[c], &lsat) : v->grav[c];
-        for (k = 0; k < 8; k++) { /* the corners' displacement in the cell frame (cell_forces' d) */
-            uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], l[3], xr[3];
-            for (c = 0; c < 3; c++) gc[3 * k + c] = (sn_q)-g[c];
-            if (k == 0) { d[0] = d[1] = d[2] = 0; continue; }
-            sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, &lsat);
-            sn_k_rot_t(R, t, l, &lsat);
-            sn_k_sub3r(rest, 3 * a, 3 * a0, xr, &lsat);
-            sn_k_sub3(l, xr, d + 3 * k, &lsat);
-        }
-        for (k = 0; k < SN_CUT_MAXX; k++) { /* the extras' (sn_cut_terms' y without its velocity term) */
-            uint32_t x = sn_rd_u16(cx + 2 * k);
-            sn_q t[3], l[3], xr[3];
-            if (x == SN_CUT_NONE) continue;
-            sn_k_sub3(pos + 3 * x, pos + 3 * a0, t, &lsat);
-            sn_k_rot_t(R, t, l, &lsat);
-            sn_k_sub3r(rest, 3 * x, 3 * a0, xr, &lsat);
-            sn_k_sub3(l, xr, yx[nx], &lsat);
-            for (c = 0; c < 3; c++) gx[nx][c] = (sn_q)-g[c];
-            nx++;
-        }
-        for (k = 0, j = 0; k < SN_CUT_MAXX; k++) { /* the cell's details: active ones R^T c, others 0 */
+        for (k = 0; k < 24; k++) d[k] = (sn_q)-g[k % 3u];
+        for (k = 0; k < SN_CUT_MAXX; k++)
+            if (sn_rd_u16(cx + 2 * k) != SN_CUT_NONE) {
+                for (c = 0; c < 3; c++) yx[nx][c] = (sn_q)-g[c];
+                nx++;
+            }
+        for (k = 0, j = 0; k < SN_CUT_MAXX; k++) { /* the cell's details (ids), no operand for the mass */
             uint32_t id = sn_rd_u16(cd + 2 * k);
             if (id == SN_CUT_NONE) continue;
             ids[j] = id;
-            if (of[id] != SN_CUT_NONE) sn_k_rot_t(R, coef + 3 * (uint32_t)of[id], yd[j], &lsat);
-            else yd[j][0] = yd[j][1] = yd[j][2] = 0;
+            yd[j][0] = yd[j][1] = yd[j][2] = 0;
             j++;
         }
-        for (k = 0; k < 24; k++) lc[k] = mc[k] = 0;
-        sn_detail_cell_mul(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, lc, ld, &lsat);
-        for (k = 0; k < j; k++) yd[k][0] = yd[k][1] = yd[k][2] = 0; /* gravity: on corners and extras only */
-        sn_detail_cell_mass(v, e, on, gc, (const sn_q(*)[3])gx, (const sn_q(*)[3])yd, mc, md);
+        sn_detail_cell_mass(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l); /* the rows only */
+        for (k = 0; k < j; k++)
+            for (c = 0; c < 3; c++) { /* saturating at 2^61 as a seat's accumulator (a hostile blob's repeats) */
+#if defined(SN_FLOAT)
+                em[3 * ids[k] + c] += l[3 * k + c];
+#else
+                int64_t lim = (int64_t)1 << 61, b = em[3 * ids[k] + c] + l[3 * k + c];
+                em[3 * ids[k] + c] = b > lim ? lim : (b < -lim ? -lim : b);
+#endif
+            }
+        /* then S y: the corners' displacement in the cell frame (cell_forces' d), the extras' (sn_cut_terms' y
+         * without its velocity term), the active details' R^T c */
+        d[0] = d[1] = d[2] = 0;
+        for (k = 1; k < 8; k++) {
+            uint32_t a = sn_rd_u16(cl + 2 * k);
+            sn_q t[3], lr[3], xr[3];
+            sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, &lsat);
+            sn_k_rot_t(R, t, lr, &lsat);
+            sn_k_sub3r(rest, 3 * a, 3 * a0, xr, &lsat);
+            sn_k_sub3(lr, xr, d + 3 * k, &lsat);
+        }
+        for (k = 0, nx = 0; k < SN_CUT_MAXX; k++) {
+            uint32_t x = sn_rd_u16(cx + 2 * k);
+            sn_q t[3], lr[3], xr[3];
+            if (x == SN_CUT_NONE) continue;
+            sn_k_sub3(pos + 3 * x, pos + 3 * a0, t, &lsat);
+            sn_k_rot_t(R, t, lr, &lsat);
+            sn_k_sub3r(rest, 3 * x, 3 * a0, xr, &lsat);
+            sn_k_sub3(lr, xr, yx[nx], &lsat);
+            nx++;
+        }
+        for (k = 0; k < j; k++)
+            if (of[ids[k]] != SN_CUT_NONE) sn_k_rot_t(R, coef + 3 * (uint32_t)of[ids[k]], yd[k], &lsat);
+        sn_detail_cell_mul(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l, &lsat); /* the rows only */
         for (k = 0; k < j; k++) {
             sn_acc t[3] = {0, 0, 0};
             uint32_t id = ids[k];
-            sn_k_out_rot_acc(t, R, ld + 3 * k, sh - SN_KREL(sk[id]), &lsat); /* as a seat's row (detail_rows_out) */
-            for (c = 0; c < 3; c++) { /* saturating at 2^61 as a seat's accumulator (a hostile blob's repeats) */
+            sn_k_out_rot_acc(t, R, l + 3 * k, sh - SN_KREL(sk[id]), &lsat); /* as a seat's row (detail_rows_out) */
+            for (c = 0; c < 3; c++) {
 #if defined(SN_FLOAT)
                 es[3 * id + c] += t[c];
-                em[3 * id + c] += md[3 * k + c];
 #else
-                int64_t lim = (int64_t)1 << 61, a = es[3 * id + c] + t[c], b = em[3 * id + c] + md[3 * k + c];
+                int64_t lim = (int64_t)1 << 61, a = es[3 * id + c] + t[c];
                 es[3 * id + c] = a > lim ? lim : (a < -lim ? -lim : a);
-                em[3 * id + c] = b > lim ? lim : (b < -lim ? -lim : b);
 #endif
             }
         }
