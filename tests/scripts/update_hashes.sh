@@ -87,6 +87,15 @@ dtfixed=$(hash_of "$T")
 "$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
 dtfloat=$(hash_of "$T")
 if [ -z "$dtfixed" ] || [ -z "$dtfloat" ]; then echo "update_hashes: the determinism driver printed no details hash"; exit 1; fi
+# the same blob and trot with the runtime choosing the details from none (tests/scripts/test_details_adapt.sh)
+DA_ARGS="--steps 100 --clip $CLIP --detail-adapt --main-only"
+# shellcheck disable=SC2086
+"$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dafixed_t=$(hash_of "$T")
+# shellcheck disable=SC2086
+"$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dafloat_t=$(hash_of "$T")
+if [ -z "$dafixed_t" ] || [ -z "$dafloat_t" ]; then echo "update_hashes: the determinism driver printed no adaptive details hash"; exit 1; fi
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -147,5 +156,9 @@ details_adapt_float $dafloat
 # checked by tests/scripts/test_determinism.sh on every platform and the Cortex-M4.
 details_trot_fixed $dtfixed
 details_trot_float $dtfloat
+# The same blob and trot, 100 steps, the runtime choosing the details from none (det_main BLOB $DA_ARGS),
+# checked by tests/scripts/test_details_adapt.sh (x86-64, clang, float; MIPS and aarch64 on 30 steps).
+details_adapt_trot_fixed $dafixed_t
+details_adapt_trot_float $dafloat_t
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"
