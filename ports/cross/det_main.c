@@ -1,13 +1,14 @@
 /* det_main.c -- headless determinism driver, built by every compiler and
  * cross compiler of tests/scripts/test_determinism.sh.
  *   det_main [BLOB] [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]]
- *            [--shared] [--main-only] [--details N] [--iterations K]
+ *            [--shared] [--main-only] [--details N] [--iterations K] [--detail-adapt]
  * --lod: sn_set_lod(L) before step K (a blob baked with 'levels 2', runtime/LEVELS.md).
  * --shared: a shared instance stepped by sn_step_with on a separate workspace
  * (sinew.h "Shared workspace"); its hash must equal the own-scratch one.
  * --main-only: leave out the contact and blended scenarios after the run.
  * --details N: details 0..N-1 active on the cut level (sn_details_set, runtime/LEVELS.md §3);
  * --iterations K: K CG iterations (sn_set_iterations) from the first step.
+ * --detail-adapt: the runtime chooses the details after each step (sn_set_detail_adapt, stage 3).
  * Without BLOB it uses the array linked in with -DSN_DET_BLOB=sym
  * -DSN_DET_BLOB_SIZE=sym (the host tool's C-array output), copied to
  * malloc memory because the runtime wants 8-byte alignment.
@@ -50,7 +51,7 @@ int main(int argc, char **argv) {
     unsigned lod_l[16];
     void *mem, *ws = NULL;
     size_t ws_n = 0;
-    int i, n_lod = 0, j, shared = 0, main_only = 0;
+    int i, n_lod = 0, j, shared = 0, main_only = 0, dadapt = 0;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--clip") && i + 1 < argc) clip_path = argv[++i];
         else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = strtoul(argv[++i], NULL, 10);
@@ -73,8 +74,9 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[i], "--main-only")) main_only = 1;
         else if (!strcmp(argv[i], "--details") && i + 1 < argc) n_det = strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--iterations") && i + 1 < argc) iters = strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--detail-adapt")) dadapt = 1;
         else if (argv[i][0] != '-' && !blob_path) blob_path = argv[i];
-        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]] [--shared] [--main-only] [--details N] [--iterations K]\n"); return 2; }
+        else { fprintf(stderr, "usage: det_main BLOB [--clip CLIP] [--steps N] [--trace K] [--lod K:L[,K:L..]] [--shared] [--main-only] [--details N] [--iterations K] [--detail-adapt]\n"); return 2; }
     }
     if (blob_path) {
         blob = slurp(blob_path, &blob_n);
@@ -119,6 +121,7 @@ int main(int argc, char **argv) {
         if (n_det > 65535u || !ids || sn_details_set(det.inst, ids, (uint32_t)n_det) != SN_OK) { fprintf(stderr, "det_main: --details %lu refused\n", n_det); return 1; }
         free(ids);
     }
+    if (dadapt && sn_set_detail_adapt(det.inst, 1) != SN_OK) { fprintf(stderr, "det_main: --detail-adapt refused\n"); return 1; }
     if (iters && sn_set_iterations(det.inst, (uint32_t)iters) != SN_OK) { fprintf(stderr, "det_main: --iterations %lu refused\n", iters); return 1; }
     for (k = 0; k < steps; k++) {
         sn_det_pose(&det);

@@ -14,7 +14,9 @@
  *   sn_bench --details N [--iterations K] --steps S blob
  *                              details on the cut level (runtime/LEVELS.md
  *                              §3): ids 0..N-1 active (N <= the blob's
- *                              A_max), K CG iterations (0: the blob's)
+ *                              A_max), K CG iterations (0: the blob's);
+ *                              --detail-adapt: the runtime re-chooses them
+ *                              after each step (sn_set_detail_adapt)
  *   sn_bench --lod L --steps S blob   level L of a 'levels 2' blob
  *
  * Built against the shipping library (libsinew.a / libsinew_float.a).
@@ -70,7 +72,7 @@ static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static int g_details, g_iters, g_lod; /* --details N, --iterations K, --lod L (--steps only) */
+static int g_details, g_iters, g_lod, g_dadapt; /* --details N, --iterations K, --lod L, --detail-adapt (--steps only) */
 
 static int bench_blob(const char *path, int only_steps, int contact) {
     size_t size, need;
@@ -126,11 +128,17 @@ static int bench_blob(const char *path, int only_steps, int contact) {
             }
             free(ids);
         }
+        if (g_dadapt && sn_set_detail_adapt(inst, 1) != SN_OK) return 1;
         if (g_iters > 0 && sn_set_iterations(inst, (uint32_t)g_iters) != SN_OK) return 1;
         if (g_lod > 0 && sn_set_lod(inst, (uint32_t)g_lod) != SN_OK) return 1;
         bench_pose(blob, info.joints, 7 / 60.0, local, xf);
         sn_set_pose(inst, xf, info.joints);
         for (k = 0; k < only_steps; k++) sn_step(inst);
+        if (g_dadapt) {
+            sn_stats st;
+            sn_get_stats(inst, &st);
+            fprintf(stderr, "sn_bench: details active %u, refines %u, coarsens %u\n", st.adapt_active, st.adapt_refines, st.adapt_coarsens);
+        }
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
         return 0;
     }
@@ -194,6 +202,7 @@ int main(int argc, char **argv) {
         if (strcmp(argv[i], "--details") == 0 && i + 1 < argc) { g_details = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--iterations") == 0 && i + 1 < argc) { g_iters = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--lod") == 0 && i + 1 < argc) { g_lod = atoi(argv[++i]); continue; }
+        if (strcmp(argv[i], "--detail-adapt") == 0) { g_dadapt = 1; continue; }
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) { steps = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--contact") == 0) { contact = 1; continue; }
         rc |= bench_blob(argv[i], steps, contact);

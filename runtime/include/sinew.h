@@ -347,7 +347,7 @@ typedef struct sn_stats {
     uint32_t constraint_clamps;  ///< row targets clamped since init/reset: a constraint to one lattice cell per step (a far or fast target is approached at that speed), a contact to its yield bound (runtime/NUMERICS.md "Contacts")
     uint32_t lod;                ///< level of detail in force (sn_set_lod): 0 the baked lattice, 1 the finer one
     uint32_t lattice_vertices;   ///< lattice vertices of that level (free and skeleton): sn_get_lattice's range
-    uint32_t adapt_on;           ///< 1 while adaptation runs (blob with 'adapt', level 1, sn_set_adapt on; runtime/LEVELS.md §3)
+    uint32_t adapt_on;           ///< 1 while adaptation runs (blob with 'adapt', level 1, sn_set_adapt on; or a details blob on the cut level with sn_set_detail_adapt on: the adapt_* fields then count its details; runtime/LEVELS.md §3)
     uint32_t adapt_active;       ///< level-1 detail vertices in the last step's solve (at most the blob's max_active)
     uint32_t adapt_refines;      ///< detail vertices that joined the solve since init/reset (detail estimate >= refine)
     uint32_t adapt_coarsens;     ///< detail vertices that left it since init/reset (detail < coarsen, or pushed out by larger ones)
@@ -400,11 +400,14 @@ sn_status sn_set_adapt(sn_instance *inst, int on);
 /// set. SN_ERR_ARG (nothing changes) for n > A_max, an id out of range or
 /// repeated, or n > 0 on a blob without details; SN_ERR_NULL for ids NULL with n > 0.
 /// The details' rows are preconditioned by their own diagonal only (for now):
-/// they need more CG iterations than the cut level: while a detail is active
-/// the step runs at least 16 (within the blob's maximum; below that the cow's
-/// runs drift, LEVELS.md §3), and accuracy wants 32 for 50 details
-/// (sn_set_iterations).
+/// they need more CG iterations than the cut level: while at most 25 details
+/// are active the step runs at least 8 CG iterations, above that at least 32
+/// (within the blob's maximum; below these the runs drift from the converged
+/// ones by more than 0.01 cell, LEVELS.md §3 "The floor, measured").
 sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n);
+
+/// Details chosen by the runtime (stage 3, runtime/LEVELS.md §3; off by default): after each step on the cut level an active detail stays while |c| >= coarsen, an inactive one joins when its static estimate >= refine, at most A_max (the blob's `details A_MAX REFINE COARSEN`); sn_stats' adapt_* fields report it; SN_ERR_ARG turning it on in a blob without details.
+sn_status sn_set_detail_adapt(sn_instance *inst, int on);
 
 /// 64-bit FNV-1a hash of a little-endian serialization of the simulation state
 /// (free positions, velocities, warm start, skeleton state, step count, control

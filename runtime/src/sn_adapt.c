@@ -64,23 +64,12 @@ static uint8_t *mask_of(const sn_ihdr *h) { return (uint8_t *)(sn_ad(h) + 1); }
 /* the preconditioner's scales per level-1 free vertex, after the mask (4-aligned) */
 static sn_q *scales_of(const sn_ihdr *h) { return (sn_q *)(void *)(mask_of(h) + ((sn_ad(h)->n + 3u) & ~3u)); }
 
-/* an ordered 32-bit key of a non-negative length (fixed: the integer; float:
- * its bits, which order as the values do) */
-SN_INLINE uint32_t key_of(sn_q x) {
-#if defined(SN_FLOAT)
-    uint32_t u;
-    memcpy(&u, &x, 4);
-    return u & 0x7FFFFFFFu; /* |x| */
-#else
-    return x < 0 ? (uint32_t)(-(int64_t)x) : (uint32_t)x;
-#endif
-}
 /* max-norm of a - b (fixed: |a|, |b| <= 2^31: the difference in int64, < 2^32) */
 SN_INLINE uint32_t dist_key(const sn_q *a, const sn_q *b) {
     uint32_t k, m = 0;
     for (k = 0; k < 3; k++) {
 #if defined(SN_FLOAT)
-        uint32_t u = key_of(a[k] - b[k]);
+        uint32_t u = sn_key_of(a[k] - b[k]);
 #else
         int64_t d = (int64_t)a[k] - b[k];
         uint32_t u = (uint32_t)(d < 0 ? -d : d);
@@ -100,8 +89,8 @@ void sn_adapt_init(sn_ihdr *h) {
     sn_ad(h)->on = 1;
     r = t.sec[SN_SEC_ADAPT];
     sn_ad(h)->max = sn_rd_u16(r);
-    sn_ad(h)->refine = key_of(SN_RD_REAL(r + 8));
-    sn_ad(h)->coarsen = key_of(SN_RD_REAL(r + 8 + RB));
+    sn_ad(h)->refine = sn_key_of(SN_RD_REAL(r + 8));
+    sn_ad(h)->coarsen = sn_key_of(SN_RD_REAL(r + 8 + RB));
     {
         sn_view f;
         sn_view_init(&f, (const sn_blob *)(const void *)t.sec[SN_SEC_LEVEL_BLOB]);
@@ -263,6 +252,19 @@ static void scales(sn_ihdr *h, const sn_view *t) {
 
 const sn_q *sn_adapt_scales(const sn_ihdr *h) { return scales_of(h); }
 
+/* The smallest T with at most max of the wanted entries (bit 1 of m[i]) keyed
+ * above it: 32 halvings of [0, 2^32), each one pass (key NULL: all 0). Shared
+ * by level 1's adaptation (choose) and the details' (sn_detail_adapt.c). */
+uint32_t sn_select_threshold(const uint8_t *m, const uint32_t *key, uint32_t n, uint32_t max) {
+    uint32_t lo = 0, hi = 0xFFFFFFFFu, i;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2u, c = 0;
+        for (i = 0; i < n; i++) c += (m[i] >> 1) & (uint32_t)((key ? key[i] : 0u) > mid);
+        if (c <= max) hi = mid; else lo = mid + 1u;
+    }
+    return lo;
+}
+
 static void choose(sn_ihdr *h, uint32_t *key, int fresh) {
     uint8_t *m = mask_of(h);
     uint32_t i, n = sn_ad(h)->n, want = 0, above, room, act = 0, T = 0;
@@ -276,15 +278,9 @@ static void choose(sn_ihdr *h, uint32_t *key, int fresh) {
          * it an estimate and a measured detail would trade seats every step (a pop each time) */
         if (key && was) key[i] |= 0x80000000u;
     }
-    if (want > sn_ad(h)->max) { /* the smallest T with at most A_max wanted keys above it: 32 halvings */
-        uint32_t lo = 0, hi = 0xFFFFFFFFu;
+    if (want > sn_ad(h)->max) { /* the smallest T with at most A_max wanted keys above it */
         sn_ad(h)->overflow = sn_count(sn_ad(h)->overflow, want - sn_ad(h)->max);
-        while (lo < hi) {
-            uint32_t mid = lo + (hi - lo) / 2u, c = 0;
-            for (i = 0; i < n; i++) c += (m[i] >> 1) & (uint32_t)((key ? key[i] : 0u) > mid);
-            if (c <= sn_ad(h)->max) hi = mid; else lo = mid + 1u;
-        }
-        T = lo;
+        T = sn_select_threshold(m, key, n, sn_ad(h)->max);
     }
     for (i = 0, above = 0; i < n; i++) above += (m[i] >> 1) & (uint32_t)((key ? key[i] : 0u) > T);
     room = sn_ad(h)->max - (above < sn_ad(h)->max ? above : sn_ad(h)->max);
@@ -418,7 +414,7 @@ uint32_t sn_adapt_iterations(const sn_ihdr *h) {
 
 void sn_adapt_keys(sn_ihdr *h, const uint8_t *mask, const sn_q *x) {
     uint32_t *key = WARR(h, o_acc, uint32_t), w;
-    for (w = 0; w < sn_ad(h)->n; w++) key[w] = mask[w] ? 0u : key_of(x[3 * w]);
+    for (w = 0; w < sn_ad(h)->n; w++) key[w] = mask[w] ? 0u : sn_key_of(x[3 * w]);
     sn_ad(h)->keyed = 1;
 }
 

@@ -6,6 +6,21 @@
 
 #include "sn_instance.h"
 
+/* an ordered 32-bit key of a non-negative length (fixed: the integer; float:
+ * its bits, which order as the values do) */
+SN_INLINE uint32_t sn_key_of(sn_q x) {
+#if defined(SN_FLOAT)
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    return u & 0x7FFFFFFFu; /* |x| */
+#else
+    return x < 0 ? (uint32_t)(-(int64_t)x) : (uint32_t)x;
+#endif
+}
+/* The selection's threshold (sn_adapt.c): the smallest T with at most max of
+ * the wanted entries (bit 1 of m[i]) keyed above T (key NULL: all 0). */
+uint32_t sn_select_threshold(const uint8_t *m, const uint32_t *key, uint32_t n, uint32_t max);
+
 /* ADAPT record against the pair (validator): A_max <= nF of level 1, 0 <=
  * coarsen <= refine <= SN_ADAPT_MAX, reserved 0, only in a two-level blob. */
 sn_status sn_check_adapt(const sn_view *top, const sn_view *fine);

@@ -137,10 +137,9 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
         Kj = run[j];
         l[0] = l[1] = l[2] = 0;
         if (!(on >> j & 1u)) continue;
-        for (c = 0; c < 8; c++) {
-            blk_mac(Kj + (size_t)c * KB, yc + 3 * c, 0, l);
-            blk_mac(Kj + (size_t)c * KB, yd[j], 1, dc + 3 * c); /* corner c's row: block (j, c) transposed */
-        }
+        for (c = 0; c < 8; c++) blk_mac(Kj + (size_t)c * KB, yc + 3 * c, 0, l);
+        if (lc)
+            for (c = 0; c < 8; c++) blk_mac(Kj + (size_t)c * KB, yd[j], 1, dc + 3 * c); /* corner c's row: block (j, c) transposed */
         if (yx)
             for (c = 0; c < nx; c++) blk_mac(Kj + (size_t)(8u + c) * KB, yx[c], 0, l);
         for (k = 0; k < nd; k++) { /* k < j: block (k, j) transposed, in k's run at column 8 + nx + (j - k) */
@@ -150,7 +149,7 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
         }
         for (c = 0; c < 3; c++) SN_RANGE(SN_WITHIN(l[c], 62), "detail row beyond 27 * 3 * 2^55 (2^61.4)", l[c]);
     }
-    for (c = 0; c < 24; c++) {
+    for (c = 0; lc && c < 24; c++) {
 #if defined(SN_FLOAT)
         lc[c] += dc[c];
 #else
@@ -189,10 +188,9 @@ void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q y
         if (!(on >> j & 1u)) continue;
         for (c = 0; c < 8; c++) {
             sn_q m = blk_mass(Kj + (size_t)c * KB);
-            for (q = 0; q < 3; q++) {
-                l[q] += sn_mul(m, yc[3 * c + q]);
-                mc[3 * c + q] += sn_mul(m, yd[j][q]);
-            }
+            for (q = 0; q < 3; q++) l[q] += sn_mul(m, yc[3 * c + q]);
+            if (mc)
+                for (q = 0; q < 3; q++) mc[3 * c + q] += sn_mul(m, yd[j][q]);
         }
         if (yx)
             for (c = 0; c < nx; c++) {

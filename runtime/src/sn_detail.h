@@ -8,6 +8,7 @@
 #define SN_DETAIL_H
 
 #include "sn_instance.h"
+#include "sn_adapt.h" /* sn_key_of, sn_select_threshold: stage 3 shares level 1's selection */
 
 /* Validator (sn_blob.c): the table's counts of DETAILS, DETAIL, CELLD,
  * CELLDK and CELLX (the details live on the cut level only). */
@@ -20,13 +21,14 @@ sn_status sn_check_details(const sn_view *v, uint32_t nhd, uint32_t nd, uint32_t
  * no unknown), yd the details' (CELLD order). lc += the corner rows' detail
  * columns at the corners' scale (fixed: Q(frac_S), shifted up by dshift, the
  * part clamped first, counted in *sat); ld = the details' rows (3 per detail,
- * 0 for inactive ones) at the details' scale (fixed Q(frac_S - dshift)). */
+ * 0 for inactive ones) at the details' scale (fixed Q(frac_S - dshift)).
+ * lc NULL: the details' rows only (stage 3's estimate). */
 void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                         sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat);
 
 /* The same for the Galerkin mass (CELLDK's masses, scalar: no frame): mc +=
  * the corner rows' detail columns, md = the details' rows, both at MOFF's
- * scale (fixed Q(frac_M)). */
+ * scale (fixed Q(frac_M)); mc NULL: the details' rows only. */
 void sn_detail_cell_mass(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                          sn_acc mc[24], sn_acc md[3 * SN_CUT_MAXX]);
 
@@ -50,8 +52,12 @@ void sn_detail_interp(const sn_view *v, uint32_t cell, const uint32_t t[3], cons
 typedef struct sn_dstate {
     uint32_t bytes, amax, nd, n, nF, nC, bmin, pad; /* n: seats filled (the active set, <= amax); bmin: the k table's */
     uint32_t o_acc, o_coef, o_vel, o_x, o_r, o_d, o_q, o_P, o_on, o_seat, o_of, o_kk; /* from the region's start */
+    /* per detail (nD): its seat's preconditioner and k (computed once at init, sn_details_set copies them), the
+     * static denominator's inverse and k (stage 3's estimate), the estimate's sums, keys and flags */
+    uint32_t o_dP, o_dk, o_sP, o_sk, o_es, o_em, o_key, o_fl;
+    uint32_t on, refine, coarsen, refines, coarsens, overflow; /* stage 3 (sn_detail_adapt.c): on, thresholds as keys, events */
 } sn_dstate;
-#define SN_DSTATE_BYTES 80u
+#define SN_DSTATE_BYTES 136u
 typedef char sn_dstate_fits_[sizeof(sn_dstate) == SN_DSTATE_BYTES ? 1 : -1];
 #define DT(s, off, T) ((T *)(void *)((unsigned char *)(s) + (s)->off))
 
@@ -71,15 +77,34 @@ uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh);
 /* the seats' preconditioner: z_s = P_s r_s (scalar block Jacobi: the seat's
  * own diagonal averaged, no frame), r and z the seat rows */
 void sn_detail_precond(const sn_ihdr *h, const sn_dstate *s, const sn_q *r, sn_q *z, uint32_t *sat);
-/* CG iterations with a seat filled: at least SN_DETAIL_MIN_ITERATIONS (within
- * the blob's cg_max). With the seats' block Jacobi the cow's ramp
- * (LEVELS.md §3, test_runtime_dstep --study) at the cut level's 4 drifts
- * from the converged run: 1.32 cells with 50 details, 11.8 with every one;
- * at 16: 0.085 and 0.378 (32: 0.0006, 0.034). A floor against the drift,
- * as adaptation's SN_ADAPT_MIN_ITERATIONS; accuracy wants 32 (sn_set_iterations). */
+/* CG iterations with a seat filled: at least SN_DETAIL_MIN_ITERATIONS while
+ * at most SN_DETAIL_FEW seats are filled, SN_DETAIL_MIN_ITERATIONS_MANY above
+ * (within the blob's cg_max; the cost bound at init is A_max's). With the
+ * seats' block Jacobi the ramps of LEVELS.md §3 "The floor, measured" (cow
+ * neck, beast elbow and neck, fixed and float, against 64 iterations): 25
+ * details are within 0.003 cell over the hold at 8 (4: up to 0.83 cell); 50
+ * need 32 (the cow, fixed: 0.051 / 0.055 / 0.10 cell at 8 / 12 / 16, 0.0008
+ * at 32; the beast's elbow, fixed: 0.31 at 8, 0.036 at 12); every detail 32
+ * (0.01-0.03). A floor against the drift, as adaptation's SN_ADAPT_MIN_ITERATIONS. */
 #ifndef SN_DETAIL_MIN_ITERATIONS
-#define SN_DETAIL_MIN_ITERATIONS 16u
+#define SN_DETAIL_MIN_ITERATIONS 8u
 #endif
+#ifndef SN_DETAIL_MIN_ITERATIONS_MANY
+#define SN_DETAIL_MIN_ITERATIONS_MANY 32u
+#endif
+#define SN_DETAIL_FEW 25u
 uint32_t sn_detail_iterations(const sn_ihdr *h);
+/* the active set replaced by ids[0..n) (validated: distinct, < nD, n <= A_max):
+ * sn_details_set's path (incumbents keep their state, entrants start at 0) */
+void sn_details_apply(sn_ihdr *h, sn_dstate *s, const uint16_t *ids, uint32_t n);
+
+/* ---- stage 3: adaptation on the seats (sn_detail_adapt.c; LEVELS.md §3) ----
+ * After the step, when on (sn_set_detail_adapt) and the cut level steps
+ * warped: every detail's key (an active one: |c|_inf; an inactive one: the
+ * static coefficient it would take, |(M g - S y)_d| / (tr sum_E S_dd / 3),
+ * y the cut field's displacement and the active details), then the set:
+ * incumbents while >= coarsen, entrants when >= refine, at most A_max,
+ * incumbents first, then by key, ties by id (sn_select_threshold). */
+void sn_detail_adapt_step(sn_ihdr *h);
 
 #endif /* SN_DETAIL_H */

@@ -14,7 +14,8 @@ static uint32_t top_details(const sn_view *top, uint32_t *amax, uint32_t *nd) {
 
 /* Layout from the region's start (8-aligned pieces first): header | acc 3A x 8 |
  * coef, vel 3A | x, r, d, q 3(nF + A) each | P A | on nC (u32) | seat A,
- * of nD (u16) | kk nF + A (u8). Counts are validated (nF, nC, nD, A <= 65535). */
+ * of nD (u16) | kk nF + A (u8) | stage 3, per detail: es, em 3 x 8 | dP, sP,
+ * key (4) | dk, sk, fl (u8). Counts are validated (nF, nC, nD, A <= 65535). */
 static uint32_t dt_layout(uint32_t amax, uint32_t nd, uint32_t nF, uint32_t nC, sn_dstate *s) {
     uint32_t o = SN_DSTATE_BYTES, n = nF + amax;
     s->o_acc = o; o += 24u * amax;
@@ -29,8 +30,19 @@ static uint32_t dt_layout(uint32_t amax, uint32_t nd, uint32_t nF, uint32_t nC, 
     s->o_seat = o; o += 2u * amax;
     s->o_of = o; o += 2u * nd;
     s->o_kk = o; o += n;
+    o = (o + 7u) & ~7u;
+    s->o_es = o; o += 24u * nd; /* stage 3: the estimate's sums (stiffness, mass) */
+    s->o_em = o; o += 24u * nd;
+    s->o_dP = o; o += 4u * nd;
+    s->o_sP = o; o += 4u * nd;
+    s->o_key = o; o += 4u * nd;
+    s->o_dk = o; o += nd;
+    s->o_sk = o; o += nd;
+    s->o_fl = o; o += nd;
     return (o + 7u) & ~7u;
 }
+
+static void detail_precond(const sn_view *v, const sn_dstate *s, uint32_t det, int stat, sn_q *P, uint8_t *kd);
 
 uint32_t sn_detail_bytes(const sn_view *top) {
     sn_dstate s;
@@ -71,6 +83,13 @@ void sn_detail_init(sn_ihdr *h) {
 #else
     (void)i;
 #endif
+    s->on = 0;
+    s->refine = sn_key_of(SN_RD_REAL(sn_sec(&top, SN_SEC_DETAILS) + 8));
+    s->coarsen = sn_key_of(SN_RD_REAL(sn_sec(&top, SN_SEC_DETAILS) + 8 + RB));
+    for (i = 0; i < nd; i++) { /* per detail, once: a seat's preconditioner and the estimate's denominator */
+        detail_precond(&top, s, i, 0, DT(s, o_dP, sn_q) + i, DT(s, o_dk, uint8_t) + i);
+        detail_precond(&top, s, i, 1, DT(s, o_sP, sn_q) + i, DT(s, o_sk, uint8_t) + i);
+    }
     sn_detail_reset(h);
 }
 
@@ -80,6 +99,7 @@ void sn_detail_reset(sn_ihdr *h) {
     if (!has_details(h)) return;
     s = st(h);
     s->n = 0;
+    s->refines = s->coarsens = s->overflow = 0;
     for (i = 0; i < s->nd; i++) DT(s, o_of, uint16_t)[i] = SN_CUT_NONE;
     for (i = 0; i < s->nC; i++) DT(s, o_on, uint32_t)[i] = 0;
     for (i = 0; i < 3u * (s->nF + s->amax); i++) DT(s, o_x, sn_q)[i] = 0;
@@ -116,17 +136,21 @@ static int64_t norm35(int64_t x, int *e) {
  * int64 (<= 65535 cells x 3 x 2^27.6 stiffness, x 2^27 mass), each term brought
  * below 2^35 before its Q24 coefficient (< 2^61), the two aligned (< 2^62) and
  * brought below 2^31 (relative error < 2^-30), P = (2^63 - 1) / a (>= 32 bits)
- * shifted to frac_P: P within 2^-29 of 1/a, plus its rounding (test_runtime_dstep). */
-static void seat_precond(const sn_view *v, sn_dstate *s, uint32_t seat, uint32_t det) {
+ * shifted to frac_P: P within 2^-29 of 1/a, plus its rounding (test_runtime_dstep).
+ * stat: the static denominator of stage 3's estimate instead, a = tr(sum_E S_dd)/3
+ * (no b1, no mass), at frac_P - x (*kd = x, fixed; float 0): a hat's own
+ * stiffness alone may be soft enough that 1/a exceeds 2^27 at frac_P (the
+ * cow: 1/a ~ 2^12.2, clamped before x; x < frac_P - 3 keeps the estimate's
+ * shift frac_P - x + k - 3 >= 0). Per detail, once at init (nD x nC x
+ * 19 reads). */
+static void detail_precond(const sn_view *v, const sn_dstate *s, uint32_t det, int stat, sn_q *P, uint8_t *kd) {
     const unsigned char *cd = sn_sec(v, SN_SEC_CELLD);
     uint32_t e, k;
-    sn_q *P = DT(s, o_P, sn_q);
-    uint8_t *kk = DT(s, o_kk, uint8_t);
 #if defined(SN_FLOAT)
     float ssum = 0.0f, msum = 0.0f, a;
 #else
     int64_t ssum = 0, msum = 0, t1, t2, A, q;
-    int e1 = 0, e2 = 0, ea, sh, ds = sn_sec(v, SN_SEC_DETAILS)[2];
+    int e1 = 0, e2 = 0, ea, sh, x = 0, ds = sn_sec(v, SN_SEC_DETAILS)[2];
 #endif
     for (e = 0; e < s->nC; e++) {
         const unsigned char *c = cd + (size_t)e * SN_ELEM_CELLD;
@@ -151,32 +175,38 @@ static void seat_precond(const sn_view *v, sn_dstate *s, uint32_t seat, uint32_t
         }
     }
 #if defined(SN_FLOAT)
-    a = (1.0f + v->b1) * ssum / 3.0f + (1.0f + v->a1) * msum;
-    P[seat] = a > 1.0f / 134217728.0f ? 1.0f / a : 0.0f;
-    kk[s->nF + seat] = 0;
+    a = stat ? ssum / 3.0f : (1.0f + v->b1) * ssum / 3.0f + (1.0f + v->a1) * msum;
+    *P = a > 1.0f / 134217728.0f ? 1.0f / a : 0.0f;
+    *kd = 0;
 #else
     /* a = t1 2^(e1 - (frac_S - ds) - 24) + t2 2^(e2 - frac_M - 24) */
-    t1 = norm35(ssum, &e1) * (ONE_COEF + (int64_t)v->b1) / 3;
-    t2 = norm35(msum, &e2) * (ONE_COEF + (int64_t)v->a1);
+    t1 = norm35(ssum, &e1) * (ONE_COEF + (stat ? 0 : (int64_t)v->b1)) / 3;
+    t2 = stat ? 0 : norm35(msum, &e2) * (ONE_COEF + (int64_t)v->a1);
     e1 -= v->frac_S - ds;
     e2 -= v->frac_M;
-    ea = e1 > e2 ? e1 : e2;
+    ea = stat || e1 > e2 ? e1 : e2;
     t1 = ea - e1 > 62 ? 0 : t1 / ((int64_t)1 << (ea - e1));
-    t2 = ea - e2 > 62 ? 0 : t2 / ((int64_t)1 << (ea - e2));
+    t2 = stat || ea - e2 > 62 ? 0 : t2 / ((int64_t)1 << (ea - e2)); /* stat: no mass (and ea may be below e2) */
     A = t1 + t2; /* a = A 2^(ea - 24) */
     q = 0;
     if (A > 0) {
         while (A >= ((int64_t)1 << 31)) { A /= 2; ea++; } /* below 2^31: the quotient keeps >= 32 bits */
         q = INT64_MAX / A; /* ~2^63 / A */
         sh = v->frac_P - (ea - 24) - 63; /* P = q 2^sh */
+        if (stat) /* the static inverse at frac_P - x, x the smallest that keeps it <= 2^27 (a soft hat's 1/a exceeds it) */
+            while (x < 40 && x < v->frac_P - 3 && (sh - x > 30 || (sh - x >= 0 && q > ((int64_t)1 << 27) >> (sh - x)) ||
+                              (sh - x < 0 && -(sh - x) <= 62 && sn_rshr64(q, x - sh) > ((int64_t)1 << 27))))
+                x++;
+        sh -= x;
         if (sh >= 0) q = (sh > 30 || q > ((int64_t)1 << 27) >> sh) ? (int64_t)1 << 27 : q << sh;
         else q = -sh > 62 ? 0 : sn_rshr64(q, -sh);
         if (q > ((int64_t)1 << 27)) q = (int64_t)1 << 27;
     }
-    P[seat] = (sn_q)q;
-    {
+    *P = (sn_q)q;
+    if (stat) *kd = (uint8_t)x; /* the static inverse's scale: frac_P - x */
+    else {
         int kb = bitlen64((uint64_t)(3 * q)) - (int)s->bmin;
-        kk[s->nF + seat] = (uint8_t)(kb < 0 ? 0 : (kb > SN_KMAX ? SN_KMAX : kb));
+        *kd = (uint8_t)(kb < 0 ? 0 : (kb > SN_KMAX ? SN_KMAX : kb));
     }
 #endif
 }
@@ -190,17 +220,16 @@ void sn_detail_precond(const sn_ihdr *h, const sn_dstate *s, const sn_q *r, sn_q
 }
 
 uint32_t sn_detail_iterations(const sn_ihdr *h) {
-    uint32_t it = h->iterations < SN_DETAIL_MIN_ITERATIONS ? SN_DETAIL_MIN_ITERATIONS : h->iterations;
+    uint32_t fl = st(h)->n <= SN_DETAIL_FEW ? SN_DETAIL_MIN_ITERATIONS : SN_DETAIL_MIN_ITERATIONS_MANY;
+    uint32_t it = h->iterations < fl ? fl : h->iterations;
     return it > h->v.cg_max ? h->v.cg_max : it;
 }
 
 sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n) {
     sn_ihdr *h;
     sn_dstate *s;
-    uint16_t *of, *seat, *old;
-    sn_q *coef, *vel, *x, *tc, *tv, *tx;
-    uint32_t i, e, k, n0;
-    sn_view top;
+    uint8_t *fl;
+    uint32_t i;
     SN_CHECK_INST(inst);
     h = hdr_of(inst);
     if (n > 0 && !ids) return SN_ERR_NULL;
@@ -209,17 +238,28 @@ sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n) {
     if (n > s->amax) return SN_ERR_ARG;
     for (i = 0; i < n; i++)
         if (ids[i] >= s->nd) return SN_ERR_ARG;
+    fl = DT(s, o_fl, uint8_t); /* stage 3's flags: scratch between steps */
+    for (i = 0; i < s->nd; i++) fl[i] = 0;
+    for (i = 0; i < n; i++) { /* a repeat: refused, nothing changed */
+        if (fl[ids[i]]) return SN_ERR_ARG;
+        fl[ids[i]] = 1;
+    }
+    sn_details_apply(h, s, ids, n);
+    return SN_OK;
+}
+
+void sn_details_apply(sn_ihdr *h, sn_dstate *s, const uint16_t *ids, uint32_t n) {
+    uint16_t *of, *seat, *old;
+    sn_q *coef, *vel, *x, *tc, *tv, *tx;
+    uint32_t i, e, k, n0;
+    sn_view top;
     of = DT(s, o_of, uint16_t);
     seat = DT(s, o_seat, uint16_t);
     coef = DT(s, o_coef, sn_q);
     vel = DT(s, o_vel, sn_q);
     x = DT(s, o_x, sn_q) + 3u * s->nF;
     old = (uint16_t *)(void *)DT(s, o_P, sn_q); /* the new seats' old ones (P is rebuilt below) */
-    for (i = 0; i < n; i++) { /* mark; a repeat undoes the marks */
-        if (of[ids[i]] == 0xFFFEu) {
-            while (i-- > 0) of[ids[i]] = old[i];
-            return SN_ERR_ARG;
-        }
+    for (i = 0; i < n; i++) { /* mark (distinct: checked by the caller) */
         old[i] = of[ids[i]];
         of[ids[i]] = 0xFFFEu;
     }
@@ -254,8 +294,10 @@ sn_status sn_details_set(sn_instance *inst, const uint16_t *ids, uint32_t n) {
         }
         DT(s, o_on, uint32_t)[e] = on;
     }
-    for (i = 0; i < n; i++) seat_precond(&top, s, i, seat[i]);
-    return SN_OK;
+    for (i = 0; i < n; i++) { /* the seats' preconditioners: the details' (init) */
+        DT(s, o_P, sn_q)[i] = DT(s, o_dP, const sn_q)[seat[i]];
+        DT(s, o_kk, uint8_t)[s->nF + i] = DT(s, o_dk, const uint8_t)[seat[i]];
+    }
 }
 
 uint64_t sn_detail_hash(const sn_ihdr *h, uint64_t hsh) {

@@ -408,6 +408,16 @@ sn_status sn_get_stats(const sn_instance *inst, sn_stats *out) {
         out->adapt_overflow = a->overflow;
         out->adapt_on = a->on && h->lod == 1u;
     }
+    {
+        const sn_dstate *d = sn_detail_region(h);
+        if (d && d->on && h->lod == 0u) { /* the details' adaptation on the cut level (sn_detail_adapt.c) */
+            out->adapt_on = 1;
+            out->adapt_active = d->n;
+            out->adapt_refines = d->refines;
+            out->adapt_coarsens = d->coarsens;
+            out->adapt_overflow = d->overflow;
+        }
+    }
     return SN_OK;
 }
 

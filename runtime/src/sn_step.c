@@ -9,6 +9,7 @@
  */
 #include "sn_blended.h"
 #include "sn_adapt.h"
+#include "sn_detail.h"
 
 static void step(sn_ihdr *h) {
     uint32_t sat = 0;
@@ -19,6 +20,7 @@ static void step(sn_ihdr *h) {
     else sn_solve(h, &sat);
     sn_limits(h, &sat);
     sn_adapt_step(h, &sat); /* level 1's active set for the next step (seed 000 §4.7, sn_adapt.c) */
+    sn_detail_adapt_step(h); /* the cut level's active details for the next step (stage 3, sn_detail_adapt.c) */
     sn_segments_step(h, &sat);
     sn_forces_clear(h);
     sn_health(h, sat);

@@ -138,7 +138,8 @@ static void *grow(void *p, size_t *have, size_t need) {
 }
 
 /* Details on the cut level (stage 2, sn_detail_step.c): every detail up to
- * A_max active, so the steps on level 0 run the details' rows. */
+ * A_max active, so the steps on level 0 run the details' rows; stage 3's
+ * adaptation on. */
 static void set_details(sn_instance *inst, const sn_blob *blob) {
     static uint16_t ids[65536];
     sn_view v;
@@ -148,6 +149,9 @@ static void set_details(sn_instance *inst, const sn_blob *blob) {
     a = sn_rd_u16(sn_sec(&v, SN_SEC_DETAILS)); /* <= nD (validated) */
     for (i = 0; i < a; i++) ids[i] = (uint16_t)i;
     if (sn_details_set(inst, ids, a) != SN_OK) { printf("FAIL: sn_details_set refused A_max details (%s)\n", g_case); exit(1); }
+    /* stage 3 (sn_detail_adapt.c): after each step on the cut level the runtime re-chooses the set (the estimate over
+     * every detail, the selection, sn_details_apply); the first step still runs every seat filled */
+    if (sn_set_detail_adapt(inst, 1) != SN_OK) { printf("FAIL: sn_set_detail_adapt refused on a details blob (%s)\n", g_case); exit(1); }
 }
 
 /* The blob as an sn_instance_init_shared instance, stepped with a workspace

@@ -66,9 +66,14 @@ cutcfixed=$(hash_of "$T")
 cutcfloat=$(hash_of "$T")
 [ -n "$cutcfixed" ] && [ -n "$cutcfloat" ] || { echo "update_hashes: a player printed no cut-level contact hash"; exit 1; }
 # details on the cut level (tests/test_runtime_dstep.c): the ramp with the 50 largest details active
-dfixed=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" 2>&1 | sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p')
-dfloat=$(BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" 2>&1 | sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p')
-[ -n "$dfixed" ] && [ -n "$dfloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
+# and the runtime choosing them (stage 3, sn_set_detail_adapt), the same ramp
+BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep" > "$T" 2>&1
+dfixed=$(sed -n 's/^  hash: details50_fixed \([0-9a-f]\{16\}\).*/\1/p' "$T")
+dafixed=$(sed -n 's/^  hash: details_adapt_fixed \([0-9a-f]\{16\}\).*/\1/p' "$T")
+BUILD="$BUILD" "$BUILD/tests/test_runtime_dstep_float" > "$T" 2>&1
+dfloat=$(sed -n 's/^  hash: details50_float \([0-9a-f]\{16\}\).*/\1/p' "$T")
+dafloat=$(sed -n 's/^  hash: details_adapt_float \([0-9a-f]\{16\}\).*/\1/p' "$T")
+[ -n "$dfixed" ] && [ -n "$dfloat" ] && [ -n "$dafixed" ] && [ -n "$dafloat" ] || { echo "update_hashes: test_runtime_dstep printed no hash"; exit 1; }
 # the same blob on the trot (test_determinism.sh's details scenario, every platform): the
 # determinism driver, details 0..N-1 active from the first step (the players cannot set details)
 # shellcheck disable=SC2046
@@ -82,6 +87,15 @@ dtfixed=$(hash_of "$T")
 "$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
 dtfloat=$(hash_of "$T")
 if [ -z "$dtfixed" ] || [ -z "$dtfloat" ]; then echo "update_hashes: the determinism driver printed no details hash"; exit 1; fi
+# the same blob and trot with the runtime choosing the details from none (tests/scripts/test_details_adapt.sh)
+DA_ARGS="--steps 100 --clip $CLIP --detail-adapt --main-only"
+# shellcheck disable=SC2086
+"$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dafixed_t=$(hash_of "$T")
+# shellcheck disable=SC2086
+"$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
+dafloat_t=$(hash_of "$T")
+if [ -z "$dafixed_t" ] || [ -z "$dafloat_t" ]; then echo "update_hashes: the determinism driver printed no adaptive details hash"; exit 1; fi
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
@@ -133,10 +147,18 @@ cut_contact_float $cutcfloat
 # checked by test_runtime_dstep.
 details50_fixed $dfixed
 details50_float $dfloat
+# The same ramp with the runtime choosing the details from none (stage 3: sn_set_detail_adapt on,
+# the blob's A_max 50 and thresholds 0.03 / 0.01; 32 iterations), checked by test_runtime_dstep.
+details_adapt_fixed $dafixed
+details_adapt_float $dafloat
 # The same blob, details 0..$((DT_N - 1)) active from the first step, $DT_ITERS CG iterations, $DT_STEPS steps
 # of the trot, no level switch (ports/cross det_main BLOB $DT_ARGS),
 # checked by tests/scripts/test_determinism.sh on every platform and the Cortex-M4.
 details_trot_fixed $dtfixed
 details_trot_float $dtfloat
+# The same blob and trot, 100 steps, the runtime choosing the details from none (det_main BLOB $DA_ARGS),
+# checked by tests/scripts/test_details_adapt.sh (x86-64, clang, float; MIPS and aarch64 on 30 steps).
+details_adapt_trot_fixed $dafixed_t
+details_adapt_trot_float $dafloat_t
 EOT
 echo "update_hashes: fixed ${old_fixed:-none} -> $fixed, float ${old_float:-none} -> $float, contact $fixedc / $floatc ($OUT)"
