@@ -274,6 +274,7 @@ pmake "$BUILD/level/cow_cut.blob" "$BUILD/level/cow_cut_float.blob" > "$L/build_
 # third; the full runs everywhere in `make determinism`
 DT_SHORT=""; [ "${DET_SET:-slice}" = full ] || DT_SHORT="mips-be-gcc-O2 aarch64-gcc-O2"
 DT_ARGS="--details $DT_N --iterations $DT_ITERS --main-only"
+DA_RUN=0; [ "${DET_SET:-slice}" = full ] && DA_RUN=1
 pmake "$BUILD/level/cow_details.blob" "$BUILD/level/cow_details_float.blob" > "$L/build_details.log" 2>&1 || \
     { bad "details: blobs failed to bake"; tail -n 5 "$L/build_details.log"; }
 while read -r name target runner; do
@@ -303,6 +304,10 @@ while read -r name target runner; do
     dst=$DT_STEPS; case " $DT_SHORT " in *" $name "*) dst=$DT_SLICE_STEPS ;; esac
     # shellcheck disable=SC2086
     launch "$L/rc_details_$name" "$L/run_details_$name.log" $r "$target" "$bd" --steps $dst $clip_arg $DT_ARGS
+    # the details chosen by the runtime (stage 3, sn_set_detail_adapt), the set
+    # from none: the full matrix only (make test: tests/scripts/test_details_adapt.sh)
+    [ "$DA_RUN" = 1 ] && launch "$L/rc_dadapt_$name" "$L/run_dadapt_$name.log" $r "$target" "$bd" --steps $DT_STEPS \
+        $clip_arg --detail-adapt --main-only
     case " $ADAPT_SKIP " in *" $name "*) continue ;; esac
     launch "$L/rc_adapt_$name" "$L/run_adapt_$name.log" $r "$target" "$ba" --steps $st $clip_arg --lod $sw \
         --main-only --shared
@@ -392,13 +397,14 @@ short_eq() {
     if [ -n "$r" ] && [ "$3" = "$r" ]; then ok "$1 $2: hash $3 = $m4ref det_main's ($4)"
     else bad "$1 $2: hash $3, x86-64 det_main ${r:-none} ($4)"; fi
 }
-dtfixed=""; dtfloat=""; crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
+dtfixed=""; dtfloat=""; dafixed=""; dafloat=""; crfixed=""; crfloat=""; lodfixed=""; lodfloat=""; adfixed=""; adfloat=""; cutfixed=""; cutfloat=""; cutcfixed=""; cutcfloat=""
 while read -r name target runner; do
     case $name in cortex-*|"") continue ;; esac
     case " $built " in *" $name "*) ;; *) continue ;; esac
     case " $SCEN_SKIP " in *" $name "*) continue ;; esac
-    for sc in crease lod adapt cut details; do
+    for sc in crease lod adapt cut details dadapt; do
         case $sc:" $ADAPT_SKIP " in adapt:*" $name "*) continue ;; esac
+        [ $sc != dadapt ] || [ "$DA_RUN" = 1 ] || continue
         if rc_ok "$L/rc_${sc}_$name" && h=$(hash_of "$L/run_${sc}_$name.log") && [ -n "$h" ]; then
             case "$sc: $SCEN_SHORT " in lod:*" $name "*|adapt:*" $name "*)
                 short_eq "$sc" "$name" "$h" "$M4_SLICE_STEPS steps, switches $M4_SLICE_SW"; continue ;;
@@ -424,6 +430,8 @@ while read -r name target runner; do
 " ;;            lod-*) lodfixed="$lodfixed$name $h
 " ;;            cut-float-*) cutfloat="$cutfloat$name $h
 " ;;            cut-*) cutfixed="$cutfixed$name $h
+" ;;            dadapt-float-*) dafloat="$dafloat$name $h
+" ;;            dadapt-*) dafixed="$dafixed$name $h
 " ;;            details-float-*) dtfloat="$dtfloat$name $h
 " ;;            details-*) dtfixed="$dtfixed$name $h
 " ;;            adapt-float-*) adfloat="$adfloat$name $h
@@ -526,6 +534,10 @@ agree "cut level, contact/blended scenarios, fixed flavour" "$cutcfixed" 2
 agree "cut level, contact/blended scenarios, float flavour" "$cutcfloat" 2
 agree "details on the cut level, fixed flavour" "$dtfixed" 2
 agree "details on the cut level, float flavour" "$dtfloat" 2
+if [ "$DA_RUN" = 1 ]; then
+    agree "details chosen by the runtime, fixed flavour" "$dafixed" 2
+    agree "details chosen by the runtime, float flavour" "$dafloat" 2
+fi
 
 # ---- the committed hashes (tests/expected_hashes.txt): platforms agreeing
 # with each other is not enough; a change that alters every platform alike
@@ -555,6 +567,10 @@ if [ "$COW_CLIP" = tools/examples/cow/trot.clip ] && [ -n "$clip_arg" ]; then
     expect_hash "cut level, float flavour" "$cutfloat" cut_float
     expect_hash "details on the cut level, fixed flavour" "$dtfixed" details_trot_fixed
     expect_hash "details on the cut level, float flavour" "$dtfloat" details_trot_float
+    if [ "$DA_RUN" = 1 ]; then
+        expect_hash "details chosen by the runtime, fixed flavour" "$dafixed" details_adapt_trot_fixed
+        expect_hash "details chosen by the runtime, float flavour" "$dafloat" details_adapt_trot_float
+    fi
 else
     echo "note: COW_CLIP=$COW_CLIP: the committed hashes are for tools/examples/cow/trot.clip; not compared"
 fi
