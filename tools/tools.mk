@@ -45,11 +45,12 @@ $(BAKE): $(BUILD)/tools/sinew_bake.o $(TOOLS_LIB) $(STATIC_OBJ)
 # sinew-rig (issue 11): rig fitting on the double-precision reference model,
 # tools/sb_fit.c (costs, adjoint, pose fit) over L-BFGS-B (tools/sb_lbfgsb.c).
 RIGTOOL = $(BUILD)/sinew-rig
-RIG_SRC = tools/sb_fit.c tools/sinew_rig.c tools/sb_retarget_cli.c   # + TOOLS_LIB_SRC and STATIC_SRC (the CMake build reads this list)
+RIG_SRC = tools/sb_fit.c tools/sinew_rig.c tools/sinew_rig_args.c tools/sinew_rig_report.c tools/sinew_rig_export.c tools/sinew_rig_pose.c tools/sinew_rig_surface.c tools/sinew_rig_points.c tools/sb_retarget_cli.c   # + TOOLS_LIB_SRC and STATIC_SRC (the CMake build reads this list)
 FIT_OBJ = $(BUILD)/tools/static/sb_fit.o
-$(FIT_OBJ) $(BUILD)/tools/static/sinew_rig.o: tools/sb_fit.h
-$(RIGTOOL): $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
-	$(CC) $(HOST_CFLAGS) -o $@ $(BUILD)/tools/static/sinew_rig.o $(BUILD)/tools/static/sb_retarget_cli.o $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
+RIG_CLI_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/static/%.o,$(filter tools/sinew_rig%.c,$(RIG_SRC))) $(BUILD)/tools/static/sb_retarget_cli.o
+$(FIT_OBJ) $(RIG_CLI_OBJ): tools/sb_fit.h tools/sinew_rig_int.h
+$(RIGTOOL): $(RIG_CLI_OBJ) $(FIT_OBJ) $(TOOLS_LIB) $(STATIC_OBJ)
+	$(CC) $(HOST_CFLAGS) -o $@ $(RIG_CLI_OBJ) $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) -lm
 all: $(RIGTOOL)
 $(BUILD)/tests/test_rigfit: tests/test_rigfit.c $(FIT_OBJ) $(STATIC_OBJ) $(TOOLS_LIB) tools/sb_fit.h tests/sn_test.h
 	@mkdir -p $(dir $@)
