@@ -1,170 +1,21 @@
 /* sb_blob.c -- baked units (runtime/NUMERICS.md) and the byte layout
  * (runtime/src/sn_format.h, prose in runtime/BLOB.md). */
-#include "sb.h"
-#include "sb_cut.h"
-#include "../runtime/src/sn_format.h"
+#include "sb_blob_int.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct {
-    unsigned char *p;
-    int flavour, rs;   /* real size */
-    int err;
-} wr_t;
-
-static void put_u8(wr_t *w, size_t at, unsigned v) { w->p[at] = (unsigned char)v; }
-static void put_u16(wr_t *w, size_t at, unsigned v) { w->p[at] = (unsigned char)(v & 255u); w->p[at + 1] = (unsigned char)((v >> 8) & 255u); }
-static void put_u32(wr_t *w, size_t at, uint32_t v)
-{
-    int k;
-    for (k = 0; k < 4; k++) w->p[at + (size_t)k] = (unsigned char)((v >> (8 * k)) & 255u);
-}
-static void put_u64(wr_t *w, size_t at, uint64_t v)
-{
-    int k;
-    for (k = 0; k < 8; k++) w->p[at + (size_t)k] = (unsigned char)((v >> (8 * k)) & 255u);
-}
-
-/* round to nearest, ties away from zero */
-static double rnd(double x) { return x < 0 ? -floor(-x + 0.5) : floor(x + 0.5); }
-
 uint16_t sb_frame_w(double w) { return (uint16_t)rnd(w * 32768.0); }
-
-/* one real: fixed = round(x * 2^frac) as int32, float32, or float64 */
-static void put_real(wr_t *w, size_t at, double x, int frac)
-{
-    if (w->flavour == SB_FIXED) {
-        double q = rnd(ldexp(x, frac));
-        if (!(q >= -2147483648.0 && q <= 2147483647.0)) { w->err = 1; q = 0; }
-        put_u32(w, at, (uint32_t)(int32_t)q);
-    } else if (w->flavour == SB_FLOAT) {
-        float f = (float)x;
-        uint32_t u;
-        memcpy(&u, &f, 4);
-        put_u32(w, at, u);
-    } else {
-        uint64_t u;
-        memcpy(&u, &x, 8);
-        put_u64(w, at, u);
-    }
-}
 
 /* symmetric 3x3 storage order of PRECOND: xx yy zz xy xz yz */
 /* health bound on the distance from the skinned position, cells */
 #define SB_DISP_BOUND 2.0
 static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
-/* Cell e's stiffness S^_e = h^2 S_e / m0, quantized for the flavour into
- * out (36 upper blocks a <= b, 9 entries each, block (a,b)[3i+j] =
- * S^_e[3a+i][3b+j]). Fixed flavour (format 6.0 CELLK, sn_format.h): each
- * off-diagonal block is rounded on its own to an int16 mantissa times 2^e,
- * e the smallest exponent (0..12) whose mantissas fit |m| <= 2^15 - 1 (into
- * exps[], by the block's index among the 28); each diagonal block (int32)
- * is set so that the integer block row sums equal the rounded exact ones
- * (zero for the translation null space): rounding every entry alone breaks
- * that null space, which moved a slender beam's static tip by 1.4%
- * (tests/reference/README.md, finding 2); then symmetrized (<= 1 LSB).
- * out holds the integer entries m 2^e / the diagonal's. Returns 0, or -1 if
- * an entry does not fit. */
-/* The cut level's blocks [corner a x extra k] of cell ci (sb_cut.h), scaled as
- * cell_blocks' and, fixed, rounded each to int16 mantissas times 2^e (xe[]):
- * out[9 (8 k + a) + 3i + j]. Returns the extras, or -1 if an entry does not fit. */
-static int cut_blocks(const sb_model *o, int ci, double sc, int flavour, int frac, double *out, int *xe)
-{
-    const sb_cut *cut = o->cut;
-    const int N3 = 3 * SB_CUT_NL;
-    const double *KE;
-    int nx, k, a, i, j;
-    if (!cut) return 0;
-    nx = cut->cnx[ci];
-    KE = cut->K + (size_t)(N3 * N3) * (size_t)ci;
-    for (k = 0; k < nx; k++)
-        for (a = 0; a < 8; a++) {
-            double *B = out + 9 * (8 * k + a), mx = 0;
-            int e = 0;
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) {
-                    double x = sc * KE[(size_t)N3 * (size_t)(3 * a + i) + (size_t)(3 * (8 + k) + j)];
-                    B[3 * i + j] = flavour == SB_FIXED ? ldexp(x, frac) : x;
-                    mx = fmax(mx, fabs(B[3 * i + j]));
-                }
-            if (!(mx <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
-            if (flavour != SB_FIXED) continue;
-            while (e < SN_CELLK_EXP_MAX && rnd(ldexp(mx, -e)) > (double)SN_CELLK_M_MAX) e++;
-            for (i = 0; i < 9; i++) B[i] = ldexp(fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(B[i], -e)))), e);
-            xe[8 * k + a] = e;
-        }
-    return nx;
-}
-
 /* CELLDK elements of a cell with nd details and nx extras (sn_format.h) */
 static uint32_t detail_blocks(int nd, int nx) { return (uint32_t)(nd * (8 + nx) + nd * (nd + 1) / 2); }
-
-static int cell_blocks(const sb_model *o, int ci, double h, double m0, int flavour, int frac, double out[36 * 9],
-                       int exps[28])
-{
-    const double *Se = o->Se + (size_t)ci * 576;
-    double sc = h * h / m0, xb[8 * SB_CUT_MAXX * 9];
-    int a, b, i, j, n = 0, no = 0, nx = 0, xe[8 * SB_CUT_MAXX];
-    for (a = 0; a < 8; a++)
-        for (b = a; b < 8; b++, n++)
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) {
-                    double x = sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
-                    out[9 * n + 3 * i + j] = flavour == SB_FIXED ? ldexp(x, frac) : x;
-                }
-    if (flavour != SB_FIXED) return 0;
-    for (a = 0, n = 0; a < 8; a++)
-        for (b = a; b < 8; b++, n++) {
-            double mx = 0;
-            int k, e = 0;
-            if (b == a) continue;
-            for (k = 0; k < 9; k++) mx = fmax(mx, fabs(out[9 * n + k]));
-            while (e < SN_CELLK_EXP_MAX && rnd(ldexp(mx, -e)) > (double)SN_CELLK_M_MAX) e++;
-            if (!(mx <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
-            for (k = 0; k < 9; k++) /* at e = 12 an entry within 2^11 of 2^27 takes the largest mantissa */
-                out[9 * n + k] = ldexp(fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(out[9 * n + k], -e)))), e);
-            exps[no++] = e;
-        }
-    if (o->cut && (nx = cut_blocks(o, ci, sc, SB_FIXED, frac, xb, xe)) < 0) return -1;
-    for (a = 0; a < 8; a++) {
-        double exact[9] = {0}, D[9], xsum[9] = {0};
-        int k, na = 0;
-        for (k = 0; k < a; k++) na += 8 - k; /* index of block (a,a) */
-        for (b = 0; b < 8; b++)
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) exact[3 * i + j] += sc * Se[(size_t)(3 * a + i) * 24 + (size_t)(3 * b + j)];
-        if (o->cut) { /* the cut element: its rows' null space runs over the extras too (their rounded blocks) */
-            const int N3 = 3 * SB_CUT_NL;
-            const double *KE = o->cut->K + (size_t)(N3 * N3) * (size_t)ci;
-            for (k = 0; k < nx; k++)
-                for (i = 0; i < 3; i++)
-                    for (j = 0; j < 3; j++) {
-                        exact[3 * i + j] += sc * KE[(size_t)N3 * (size_t)(3 * a + i) + (size_t)(3 * (8 + k) + j)];
-                        xsum[3 * i + j] += xb[9 * (8 * k + a) + 3 * i + j];
-                    }
-        }
-        for (k = 0; k < 9; k++) D[k] = rnd(ldexp(exact[k], frac)) - xsum[k];
-        for (b = 0; b < 8; b++) {
-            int lo = a < b ? a : b, hi = a < b ? b : a, nb = 0;
-            if (b == a) continue;
-            for (k = 0; k < lo; k++) nb += 8 - k;
-            nb += hi - lo;
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) /* block (a,b) = stored (lo,hi), transposed when a > b */
-                    D[3 * i + j] -= a < b ? out[9 * nb + 3 * i + j] : out[9 * nb + 3 * j + i];
-        }
-        for (i = 0; i < 3; i++)
-            for (j = 0; j < 3; j++)
-                out[9 * na + 3 * i + j] = i == j ? D[3 * i + j] : rnd(0.5 * (D[3 * i + j] + D[3 * j + i]));
-    }
-    for (n = 0; n < 36 * 9; n++)
-        if (!(fabs(out[n]) <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
-    return 0;
-}
 
 /* fractional bits so that the largest |entry| lands in [2^26, 2^27] */
 static int pick_frac(double maxabs)
@@ -184,85 +35,6 @@ static void inv3sym(const double A[3][3], double R[3][3])
     R[1][1] = (A[0][0] * A[2][2] - A[0][2] * A[2][0]) / D; R[1][2] = (A[0][2] * A[1][0] - A[0][0] * A[1][2]) / D;
     R[2][0] = R[0][2]; R[2][1] = R[1][2];
     R[2][2] = (A[0][0] * A[1][1] - A[0][1] * A[1][0]) / D;
-}
-
-/* Rig sections (format 3.0, sn_format.h). Forces in the units of the right-hand
- * side b (NUMERICS.md): Q^ = h^2 Q / (m0 Um), Q in newtons, Um = U * unit metres,
- * exactly as gravity is baked (m^ g^ = (m/m0) h^2 g / Um = h^2 (m g) / (m0 Um)).
- * The eta samples are normalized to max |eta| = 1 and the scale folded into Q^.
- * Fixed: per rig frac so that the largest |Q^ component| * 2^frac is in
- * [2^29, 2^30) (error below SN_RIG_FRAC_MIN: an absurd force; clamped to
- * SN_RIG_FRAC_MAX with a warning when tiny); gamma Q16.16, eta Q30, axis Q30,
- * abstract default Q16.16. Float32: |Q^| <= SN_RIG_FLOAT_MAX. */
-static int write_rigs(const sb_model *o, wr_t *w, const uint32_t *off, double Um, double m0, sb_blob *b)
-{
-    int a, k, i;
-    uint32_t fs = 0, fe = 0;
-    double sc = o->h * o->h / (m0 * Um);
-    int rs = w->rs;
-    b->rig_frac = sb_alloc(sizeof(int) * (size_t)(o->nrig ? o->nrig : 1));
-    for (a = 0; a < o->nctl; a++) {
-        const sb_control *c = &o->ctl[a];
-        size_t at = off[SN_SEC_CONTROLS] + (size_t)a * (size_t)SN_ELEM_CONTROLS(rs);
-        memcpy(w->p + at, c->name, strlen(c->name));
-        put_u8(w, at + 32, c->kind == SB_CTL_ABSTRACT ? SN_CTL_ABSTRACT : SN_CTL_ANGLE);
-        put_u8(w, at + 33, c->kind == SB_CTL_ABSTRACT ? 0u : (unsigned)c->joint);
-        for (k = 0; k < 3; k++) put_real(w, at + 40 + (size_t)(k * rs), c->kind == SB_CTL_ABSTRACT ? 0.0 : c->axis[k], SN_Q_ROT);
-        put_real(w, at + 40 + (size_t)(3 * rs), c->kind == SB_CTL_ABSTRACT ? c->value0 : 0.0, 16);
-    }
-    for (a = 0; a < o->nrig; a++) {
-        const sb_rig *r = &o->rig[a];
-        size_t at = off[SN_SEC_RIGS] + (size_t)a * SN_ELEM_RIGS;
-        double emax = 0, maxc = 0, fold;
-        int frac = 0;
-        for (k = 0; k < r->def.ntau; k++) emax = fmax(emax, fabs(r->def.tau_e[k]));
-        if (!(emax > 0)) return sb_fail("rig '%s': every tau eta is 0", r->def.name);
-        fold = sc * emax;
-        for (i = 0; i < 3 * r->n; i++) maxc = fmax(maxc, fabs(fold * r->Q[i]));
-        if (w->flavour == SB_FIXED) {
-            int e;
-            frexp(maxc, &e);   /* maxc in [2^(e-1), 2^e) */
-            frac = 30 - e;
-            if (frac < SN_RIG_FRAC_MIN)
-                return sb_fail("rig '%s' (line %d): force out of range (largest generalized force %g N = %g internal units, needs < 2^%d): "
-                               "lower its strength", r->def.name, r->def.line, r->qmax * emax, maxc, 30 - SN_RIG_FRAC_MIN);
-            if (frac > SN_RIG_FRAC_MAX) {
-                fprintf(stderr, "sinew-bake: warning: rig '%s' (line %d) is tiny (largest generalized force %g N): its forces are stored with %d "
-                                "fractional bits, the largest as %.3g (%.1f significant bits instead of 30)\n", r->def.name, r->def.line, r->qmax * emax,
-                        SN_RIG_FRAC_MAX, ldexp(maxc, SN_RIG_FRAC_MAX), log2(ldexp(maxc, SN_RIG_FRAC_MAX)));
-                frac = SN_RIG_FRAC_MAX;
-            }
-        } else if (w->flavour == SB_FLOAT && !(maxc <= SN_RIG_FLOAT_MAX)) {
-            return sb_fail("rig '%s' (line %d): force out of range for float32 (largest %g internal units, at most %g): lower its strength",
-                           r->def.name, r->def.line, maxc, (double)SN_RIG_FLOAT_MAX);
-        }
-        b->rig_frac[a] = frac;
-        put_u16(w, at, (unsigned)r->def.control);
-        put_u8(w, at + 2, (unsigned)r->def.ntau);
-        put_u8(w, at + 3, (unsigned)(frac & 255));
-        put_u32(w, at + 4, fs);
-        put_u32(w, at + 8, fe);
-        put_u32(w, at + 12, (uint32_t)r->n);
-        for (k = 0; k < r->def.ntau; k++) {
-            size_t sat = off[SN_SEC_RIG_SAMPLES] + (size_t)(fs + (uint32_t)k) * (size_t)SN_ELEM_RIG_SAMPLES(rs);
-            double g = r->def.tau_g[k];
-            if (k > 0) {   /* strictly increasing as stored */
-                double g0 = r->def.tau_g[k - 1];
-                int same = w->flavour == SB_FIXED ? rnd(ldexp(g, 16)) <= rnd(ldexp(g0, 16)) : w->flavour == SB_FLOAT ? !((float)g > (float)g0) : 0;
-                if (same) return sb_fail("rig '%s' (line %d): tau gammas %.9g and %.9g are equal in the blob's precision", r->def.name, r->def.line, g0, g);
-            }
-            put_real(w, sat, g, 16);
-            put_real(w, sat + (size_t)rs, r->def.tau_e[k] / emax, 30);
-        }
-        for (i = 0; i < r->n; i++) {
-            put_u16(w, off[SN_SEC_RIG_VERTS] + 2 * (size_t)(fe + (uint32_t)i), (unsigned)r->vert[i]);
-            for (k = 0; k < 3; k++)
-                put_real(w, off[SN_SEC_RIG_FORCES] + (size_t)(3 * (fe + (uint32_t)i) + (uint32_t)k) * (size_t)rs, fold * r->Q[3 * i + k], frac);
-        }
-        fs += (uint32_t)r->def.ntau;
-        fe += (uint32_t)r->n;
-    }
-    return 0;
 }
 
 int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
@@ -559,7 +331,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         put_u8(&w, at, (unsigned)o->cfb1[i]);
         put_u8(&w, at + 1, (unsigned)o->cfb2[i]);
         put_u16(&w, at + 2, sb_frame_w(o->cfw[i]));
-        if (cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w.err = 1;
+        if (sb_blob_cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w.err = 1;
         if (flavour == SB_FIXED) { /* int32 diagonal (6 symmetric), int16 mantissas, exponents */
             size_t c0 = off[SN_SEC_CELLK] + (size_t)i * SN_CELLK_FIXED_BYTES;
             int a, bb, n = 0, no = 0;
@@ -587,7 +359,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
             size_t at = off[SN_SEC_CELLX] + (size_t)i * SN_ELEM_CELLX;
             double xb[8 * SB_CUT_MAXX * 9];
             int xe[8 * SB_CUT_MAXX], nx, q, m = 0;
-            nx = cut_blocks(o, i, h * h / m0, flavour, b->frac_S, xb, xe);
+            nx = sb_blob_cut_blocks(o, i, h * h / m0, flavour, b->frac_S, xb, xe);
             if (nx < 0) { w.err = 1; continue; }
             for (q = 0; q < 27; q++) {
                 int id;
@@ -704,7 +476,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (i = 0; i < o->nt; i++)
         for (k = 0; k < 3; k++) put_u16(&w, off[SN_SEC_TRIS] + 6 * (size_t)i + 2 * (size_t)k, (unsigned)o->tri[3 * i + k]);
     free(P); free(lump);
-    if (!w.err && write_rigs(o, &w, off, U * o->unit, m0, b) != 0) { sb_blob_free(b); return -1; }
+    if (!w.err && sb_blob_write_rigs(o, &w, off, U * o->unit, m0, b) != 0) { sb_blob_free(b); return -1; }
     for (i = 0; i < o->nprof; i++)   /* share profiles: Q30, the fine share takes the rounding so each sums to 2^30 */
         for (k = 0; k < SN_LEVELS; k++) {
             size_t at = off[SN_SEC_SHARES] + ((size_t)i * SN_LEVELS + (size_t)k) * (size_t)rs;
@@ -765,43 +537,4 @@ void sb_blob_free(sb_blob *b)
     free(b->bytes);
     free(b->rig_frac);
     memset(b, 0, sizeof *b);
-}
-
-/* Write to PATH.tmp in the same directory, then rename: no partial output. */
-static int write_via_tmp(const char *path, const unsigned char *p, size_t n, const char *text)
-{
-    char tmp[4200];
-    FILE *f;
-    int ok;
-    if (strlen(path) > 4000) return sb_fail("%s: path too long", path);
-    sprintf(tmp, "%s.tmp", path);
-    f = fopen(tmp, "wb");
-    if (!f) return sb_fail("%s: cannot create: %s", tmp, strerror(errno));
-    ok = text ? fputs(text, f) >= 0 : fwrite(p, 1, n, f) == n;
-    if (fclose(f) != 0) ok = 0;
-    if (!ok) { remove(tmp); return sb_fail("%s: write failed", tmp); }
-    if (rename(tmp, path) != 0) { remove(tmp); return sb_fail("%s: cannot rename to %s: %s", tmp, path, strerror(errno)); }
-    return 0;
-}
-
-int sb_write_file(const char *path, const unsigned char *p, size_t n) { return write_via_tmp(path, p, n, NULL); }
-
-int sb_write_c_array(const char *path, const char *sym, const unsigned char *p, size_t n)
-{
-    size_t i, cap = 600 + 6 * n + 3 * strlen(sym), len = 0;
-    char *t = sb_alloc(cap);
-    int rc;
-    const char *c;
-    for (c = sym; *c; c++)
-        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || *c == '_' || (c != sym && *c >= '0' && *c <= '9'))) {
-            free(t);
-            return sb_fail("'%s' is not a C identifier", sym);
-        }
-    len += (size_t)sprintf(t + len, "/* Sinew blob, generated by sinew-bake; do not edit. */\n#include <stdint.h>\n\n"
-                                    "const union { uint64_t align_; unsigned char bytes[%lu]; } %s = { .bytes = {", (unsigned long)n, sym);
-    for (i = 0; i < n; i++) len += (size_t)sprintf(t + len, "%s%u,", i % 20 == 0 ? "\n    " : "", (unsigned)p[i]);
-    len += (size_t)sprintf(t + len, "\n} };\nconst unsigned long %s_size = %lu;\n", sym, (unsigned long)n);
-    rc = write_via_tmp(path, NULL, 0, t);
-    free(t);
-    return rc;
 }

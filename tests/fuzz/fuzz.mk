@@ -53,7 +53,7 @@ $(FUZZ_DIR)/fuzz_clip: tests/fuzz/lf_clip.c tests/fuzz/lf_common.h ports/common/
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) $(LF_RT_INC) -Iports/common -o $@ $< ports/common/sn_clip.c ports/common/sn_clip_pose.c $(call lf_rt,fixed) -lm
 # the description reader reads `gltf FILE` lines through the glTF bake (and its mesh checks)
-LF_DESC_SRC = tools/sb_desc.c tools/sb_util.c tools/sb_mesh.c tools/sb_gltf_bake.c tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_gltf_anim.c tools/sb_json.c
+LF_DESC_SRC = tools/sb_desc.c tools/sb_desc_args.c tools/sb_desc_body.c tools/sb_desc_sim.c tools/sb_desc_rig.c tools/sb_desc_seg.c tools/sb_util.c tools/sb_mesh.c tools/sb_gltf_bake.c tools/sb_gltf.c tools/sb_gltf_data.c tools/sb_gltf_anim.c tools/sb_json.c
 $(FUZZ_DIR)/fuzz_desc: tests/fuzz/lf_desc.c tests/fuzz/lf_common.h $(LF_DESC_SRC) tools/sb.h $(GLTF_HDR)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(LF_CFLAGS) -Itools -o $@ $< $(LF_DESC_SRC) -lm
