@@ -106,5 +106,7 @@ void sn_details_apply(sn_ihdr *h, sn_dstate *s, const uint16_t *ids, uint32_t n)
  * incumbents while >= coarsen, entrants when >= refine, at most A_max,
  * incumbents first, then by key, ties by id (sn_select_threshold). */
 void sn_detail_adapt_step(sn_ihdr *h);
+/* init: the estimate's M g per detail, once when the rest shape is not modelled */
+void sn_detail_adapt_init(sn_ihdr *h);
 
 #endif /* SN_DETAIL_H */
