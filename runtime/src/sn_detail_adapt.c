@@ -17,8 +17,8 @@
  * leavers drop theirs).
  *
  * Cost per step, fixed by the blob: the every-detail row product of every
- * cell with details (sn_detail_cell_mul with every bit on, the details' rows
- * only), its mass rows too only with a modelled rest shape (else M g is
+ * cell with details (sn_detail_cell_rows: every row, the active details'
+ * columns only; at most A_max of them), its mass rows too only with a modelled rest shape (else M g is
  * constant: summed once at init, sn_detail_adapt_init), 3
  * rotations per cell and detail, the keys, at most 33 nD compares for the
  * selection, and (when the set changes) sn_details_apply (nC masks). The
@@ -93,7 +93,7 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
         const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
-        uint32_t a0 = sn_rd_u16(cl), nd = cd[38], on, nx = 0, ids[SN_CUT_MAXX];
+        uint32_t a0 = sn_rd_u16(cl), nd = cd[38], on, nx = 0, act, ids[SN_CUT_MAXX];
         sn_q d[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], g[3], gr[3];
         sn_acc l[3 * SN_CUT_MAXX]; /* the mass rows, then the stiffness rows (one array: the stack, M4) */
         if (nd == 0) continue;
@@ -131,9 +131,13 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
             sn_k_sub3(lr, xr, yx[nx], &lsat);
             nx++;
         }
-        for (k = 0; k < j; k++)
-            if (of[ids[k]] != SN_CUT_NONE) sn_k_rot_t(R, coef + 3 * (uint32_t)of[ids[k]], yd[k], &lsat);
-        sn_detail_cell_mul(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l, &lsat); /* the rows only */
+        for (k = 0, act = 0; k < j; k++)
+            if (of[ids[k]] != SN_CUT_NONE) {
+                sn_k_rot_t(R, coef + 3 * (uint32_t)of[ids[k]], yd[k], &lsat);
+                act |= 1u << k;
+            }
+        /* the rows only, the active details' columns only (the others' yd are 0: the same sums) */
+        sn_detail_cell_rows(v, e, on, act, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, l, &lsat);
         for (k = 0; k < j; k++) {
             sn_acc t[3] = {0, 0, 0};
             uint32_t id = ids[k];
