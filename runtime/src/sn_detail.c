@@ -119,8 +119,8 @@ static uint32_t cell_runs(const sn_view *v, uint32_t e, const unsigned char *run
  * the details' scale, clamped to 2^(61 - dshift) (counted) and shifted up by
  * dshift to the corners' scale: with the corner rows' own < 2^61.6 (cell_forces:
  * ld + lu + lx) the sum stays < 2^62.3, below sn_out's 2^62.5. */
-void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
-                        sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
+static void cell_mul(const sn_view *v, uint32_t e, uint32_t on, uint32_t con, const sn_q yc[24], const sn_q (*yx)[3],
+                     const sn_q (*yd)[3], sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
     const size_t KB = SN_ELEM_CELLDK(SN_FLAVOUR, SN_REAL_BYTES);
     const unsigned char *run[SN_CUT_MAXX], *Kj;
     uint32_t nx;
@@ -143,7 +143,7 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
         if (yx)
             for (c = 0; c < nx; c++) blk_mac(Kj + (size_t)(8u + c) * KB, yx[c], 0, l);
         for (k = 0; k < nd; k++) { /* k < j: block (k, j) transposed, in k's run at column 8 + nx + (j - k) */
-            if (!(on >> k & 1u)) continue;
+            if (!(con >> k & 1u)) continue;
             if (k >= j) blk_mac(Kj + (size_t)(8u + nx + k - j) * KB, yd[k], 0, l);
             else blk_mac(run[k] + (size_t)(8u + nx + j - k) * KB, yd[k], 1, l);
         }
@@ -160,6 +160,14 @@ void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc
 #endif
     }
     (void)sat;
+}
+void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
+                        sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
+    cell_mul(v, e, on, on, yc, yx, yd, lc, ld, sat);
+}
+void sn_detail_cell_rows(const sn_view *v, uint32_t e, uint32_t on, uint32_t con, const sn_q yc[24], const sn_q (*yx)[3],
+                         const sn_q (*yd)[3], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat) {
+    cell_mul(v, e, on, con, yc, yx, yd, NULL, ld, sat);
 }
 
 /* A CELLDK element's mass M_E[d][col] / m0 (Q frac_M, as MOFF). */

@@ -25,6 +25,11 @@ sn_status sn_check_details(const sn_view *v, uint32_t nhd, uint32_t nd, uint32_t
  * lc NULL: the details' rows only (stage 3's estimate). */
 void sn_detail_cell_mul(const sn_view *v, uint32_t e, uint32_t on, const sn_q yc[24], const sn_q (*yx)[3], const sn_q (*yd)[3],
                         sn_acc lc[24], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat);
+/* The details' rows only (stage 3's estimate): the rows of on, the detail
+ * columns of con only (the others' yd zero: skipping them changes no bit in
+ * fixed; in float at most a zero's sign) */
+void sn_detail_cell_rows(const sn_view *v, uint32_t e, uint32_t on, uint32_t con, const sn_q yc[24], const sn_q (*yx)[3],
+                         const sn_q (*yd)[3], sn_acc ld[3 * SN_CUT_MAXX], uint32_t *sat);
 
 /* The same for the Galerkin mass (CELLDK's masses, scalar: no frame): mc +=
  * the corner rows' detail columns, md = the details' rows, both at MOFF's
@@ -106,5 +111,7 @@ void sn_details_apply(sn_ihdr *h, sn_dstate *s, const uint16_t *ids, uint32_t n)
  * incumbents while >= coarsen, entrants when >= refine, at most A_max,
  * incumbents first, then by key, ties by id (sn_select_threshold). */
 void sn_detail_adapt_step(sn_ihdr *h);
+/* init: the estimate's M g per detail, once when the rest shape is not modelled */
+void sn_detail_adapt_init(sn_ihdr *h);
 
 #endif /* SN_DETAIL_H */

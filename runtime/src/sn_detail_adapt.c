@@ -16,14 +16,62 @@
  * sn_details_set's path (incumbents keep their state, entrants start at 0,
  * leavers drop theirs).
  *
- * Cost per step, fixed by the blob: the every-detail row product and mass of
- * every cell with details (sn_detail_cell_mul / _mass with every bit on, the
- * details' rows only), 3
+ * Cost per step, fixed by the blob: the every-detail row product of every
+ * cell with details (sn_detail_cell_rows: every row, the active details'
+ * columns only; at most A_max of them), its mass rows too only with a modelled rest shape (else M g is
+ * constant: summed once at init, sn_detail_adapt_init), 3
  * rotations per cell and detail, the keys, at most 33 nD compares for the
  * selection, and (when the set changes) sn_details_apply (nC masks). The
  * estimate's clamps are not state clamps: counted nowhere (the keys only rank). */
 #include "sn_detail.h"
 #include "sn_kernels_rot.h" /* the frame rotations, as the step's */
+
+/* cell e's Galerkin mass rows against g at corners and extras (no detail
+ * operand: yd zero on entry), summed into em per detail (ids in cell order) */
+static void cell_mass(const sn_view *v, uint32_t e, const sn_q g[3], sn_q d[24], sn_q (*yx)[3], sn_q (*yd)[3], sn_acc *l,
+                      sn_acc *em) {
+    const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
+    const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
+    uint32_t nd = cd[38], on = nd >= 32u ? 0xFFFFFFFFu : (1u << nd) - 1u, k, c, j, nx = 0; /* nd <= 19 (validated) */
+    for (k = 0; k < 24; k++) d[k] = (sn_q)-g[k % 3u];
+    for (k = 0; k < SN_CUT_MAXX; k++)
+        if (sn_rd_u16(cx + 2 * k) != SN_CUT_NONE) {
+            for (c = 0; c < 3; c++) yx[nx][c] = (sn_q)-g[c];
+            nx++;
+        }
+    sn_detail_cell_mass(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l); /* the rows only */
+    for (k = 0, j = 0; k < SN_CUT_MAXX; k++) {
+        uint32_t id = sn_rd_u16(cd + 2 * k);
+        if (id == SN_CUT_NONE) continue;
+        for (c = 0; c < 3; c++) { /* saturating at 2^61 as a seat's accumulator (a hostile blob's repeats) */
+#if defined(SN_FLOAT)
+            em[3 * id + c] += l[3 * j + c];
+#else
+            int64_t lim = (int64_t)1 << 61, b = em[3 * id + c] + l[3 * j + c];
+            em[3 * id + c] = b > lim ? lim : (b < -lim ? -lim : b);
+#endif
+        }
+        j++;
+    }
+}
+
+/* M g per detail at init when the rest shape is not modelled: g_E = g in
+ * every cell, so the sums are constant (the same calls, the same order: the
+ * bits the estimate summed per step before) */
+void sn_detail_adapt_init(sn_ihdr *h) {
+    const sn_view *v = &h->v;
+    sn_dstate *s = sn_detail_region(h);
+    sn_acc *em, l[3 * SN_CUT_MAXX];
+    sn_q d[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3];
+    uint32_t e, i;
+    if (!s) return;
+    em = DT(s, o_em, sn_acc);
+    for (i = 0; i < 3u * s->nd; i++) em[i] = 0;
+    for (i = 0; i < SN_CUT_MAXX; i++) yd[i][0] = yd[i][1] = yd[i][2] = 0;
+    if (v->flags & SN_FLAG_REST_MODELLED) return; /* per step (estimate) */
+    for (e = 0; e < v->nC; e++)
+        if (sn_sec(v, SN_SEC_CELLD)[(size_t)e * SN_ELEM_CELLD + 38]) cell_mass(v, e, v->grav, d, yx, yd, l, em);
+}
 
 /* the keys into s->o_key (their sums in o_es, o_em) */
 static void estimate(const sn_ihdr *h, sn_dstate *s) {
@@ -37,43 +85,31 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
     uint32_t *key = DT(s, o_key, uint32_t);
     const int sh = v->frac_S - (SN_FLAVOUR == SN_FLAVOUR_FIXED ? sn_sec(v, SN_SEC_DETAILS)[2] : 0);
     uint32_t e, i, k, c, j, lsat = 0;
-    for (i = 0; i < 3u * s->nd; i++) es[i] = em[i] = 0;
+    for (i = 0; i < 3u * s->nd; i++) es[i] = 0;
+    if (v->flags & SN_FLAG_REST_MODELLED)
+        for (i = 0; i < 3u * s->nd; i++) em[i] = 0; /* else the constant sums of sn_detail_adapt_init */
     for (e = 0; e < v->nC; e++) {
         const unsigned char *cd = sn_sec(v, SN_SEC_CELLD) + (size_t)e * SN_ELEM_CELLD;
         const unsigned char *cx = sn_sec(v, SN_SEC_CELLX) + (size_t)e * SN_ELEM_CELLX;
         const unsigned char *cl = cells + (size_t)e * SN_ELEM_CELLS;
         const sn_q *R = cR + 9 * e;
-        uint32_t a0 = sn_rd_u16(cl), nd = cd[38], on, nx = 0, ids[SN_CUT_MAXX];
+        uint32_t a0 = sn_rd_u16(cl), nd = cd[38], on, nx = 0, act, ids[SN_CUT_MAXX];
         sn_q d[24], yx[SN_CUT_MAXX][3], yd[SN_CUT_MAXX][3], g[3], gr[3];
         sn_acc l[3 * SN_CUT_MAXX]; /* the mass rows, then the stiffness rows (one array: the stack, M4) */
         if (nd == 0) continue;
         on = nd >= 32u ? 0xFFFFFFFFu : (1u << nd) - 1u; /* nd <= 19 (validated) */
-        /* M g first: g_E (the step's gravity on a cell, sn_solve.c detail_mass_rhs) at corners and extras */
-        sn_k_rot(R, v->grav, gr, &lsat);
-        for (c = 0; c < 3; c++) g[c] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[c], -gr[c], &lsat) : v->grav[c];
-        for (k = 0; k < 24; k++) d[k] = (sn_q)-g[k % 3u];
-        for (k = 0; k < SN_CUT_MAXX; k++)
-            if (sn_rd_u16(cx + 2 * k) != SN_CUT_NONE) {
-                for (c = 0; c < 3; c++) yx[nx][c] = (sn_q)-g[c];
-                nx++;
-            }
-        for (k = 0, j = 0; k < SN_CUT_MAXX; k++) { /* the cell's details (ids), no operand for the mass */
+        for (k = 0, j = 0; k < SN_CUT_MAXX; k++) { /* the cell's details (ids) */
             uint32_t id = sn_rd_u16(cd + 2 * k);
             if (id == SN_CUT_NONE) continue;
             ids[j] = id;
             yd[j][0] = yd[j][1] = yd[j][2] = 0;
             j++;
         }
-        sn_detail_cell_mass(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l); /* the rows only */
-        for (k = 0; k < j; k++)
-            for (c = 0; c < 3; c++) { /* saturating at 2^61 as a seat's accumulator (a hostile blob's repeats) */
-#if defined(SN_FLOAT)
-                em[3 * ids[k] + c] += l[3 * k + c];
-#else
-                int64_t lim = (int64_t)1 << 61, b = em[3 * ids[k] + c] + l[3 * k + c];
-                em[3 * ids[k] + c] = b > lim ? lim : (b < -lim ? -lim : b);
-#endif
-            }
+        if (v->flags & SN_FLAG_REST_MODELLED) { /* M g first: g_E = g - R_E^T g (sn_solve.c detail_mass_rhs) */
+            sn_k_rot(R, v->grav, gr, &lsat);
+            for (c = 0; c < 3; c++) g[c] = sn_add(v->grav[c], -gr[c], &lsat);
+            cell_mass(v, e, g, d, yx, yd, l, em);
+        }
         /* then S y: the corners' displacement in the cell frame (cell_forces' d), the extras' (sn_cut_terms' y
          * without its velocity term), the active details' R^T c */
         d[0] = d[1] = d[2] = 0;
@@ -95,9 +131,13 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
             sn_k_sub3(lr, xr, yx[nx], &lsat);
             nx++;
         }
-        for (k = 0; k < j; k++)
-            if (of[ids[k]] != SN_CUT_NONE) sn_k_rot_t(R, coef + 3 * (uint32_t)of[ids[k]], yd[k], &lsat);
-        sn_detail_cell_mul(v, e, on, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, NULL, l, &lsat); /* the rows only */
+        for (k = 0, act = 0; k < j; k++)
+            if (of[ids[k]] != SN_CUT_NONE) {
+                sn_k_rot_t(R, coef + 3 * (uint32_t)of[ids[k]], yd[k], &lsat);
+                act |= 1u << k;
+            }
+        /* the rows only, the active details' columns only (the others' yd are 0: the same sums) */
+        sn_detail_cell_rows(v, e, on, act, d, (const sn_q(*)[3])yx, (const sn_q(*)[3])yd, l, &lsat);
         for (k = 0; k < j; k++) {
             sn_acc t[3] = {0, 0, 0};
             uint32_t id = ids[k];

@@ -90,6 +90,7 @@ void sn_detail_init(sn_ihdr *h) {
         detail_precond(&top, s, i, 0, DT(s, o_dP, sn_q) + i, DT(s, o_dk, uint8_t) + i);
         detail_precond(&top, s, i, 1, DT(s, o_sP, sn_q) + i, DT(s, o_sk, uint8_t) + i);
     }
+    sn_detail_adapt_init(h);
     sn_detail_reset(h);
 }
 
