@@ -181,6 +181,11 @@ $(eval $(call bm_level_image,level_cut_slice,cow_cut,$(BM_SLICE_STEPS),BM_SLICE_
 BM_DETAILS_DEFS = -DSN_BM_DETAILS=$(BM_DETAILS_N) -DSN_BM_ITERS=$(BM_DETAILS_ITERS)
 $(eval $(call bm_level_image,level_details,cow_details,$(BM_DETAILS_STEPS),,0,0,$(BM_DETAILS_DEFS)))
 $(eval $(call bm_level_image,level_details_slice,cow_details,$(BM_DETAILS_SLICE_STEPS),,0,0,$(BM_DETAILS_DEFS)))
+# the details chosen by the runtime (stage 3, det_main --detail-adapt): the
+# full run against details_adapt_trot_fixed (make determinism-m4), the slice
+# against x86-64 det_main's same steps (tests/scripts/test_details_adapt.sh)
+$(eval $(call bm_level_image,level_dadapt,cow_details,$(BM_DETAILS_STEPS),,0,0,-DSN_BM_DETAIL_ADAPT=1))
+$(eval $(call bm_level_image,level_dadapt_slice,cow_details,$(BM_DETAILS_SLICE_STEPS),,0,0,-DSN_BM_DETAIL_ADAPT=1))
 # timed (make bench-baremetal-level): instructions per step on each level
 $(eval $(call bm_level_image,bench_level_lod,cow_lod,$(BM_STEPS),BM_LEVEL_LOD,0,1))
 $(eval $(call bm_level_image,bench_level_adapt,cow_adapt,$(BM_STEPS),BM_LEVEL_LOD,1,1))
@@ -196,7 +201,7 @@ bench-baremetal-level: $(BM_DIR)/bench_level_lod.elf $(BM_DIR)/bench_level_adapt
 	echo "== level_details ($(BM_DETAILS_STEPS) steps, $(BM_DETAILS_N) details, $(BM_DETAILS_ITERS) iterations, qemu -icount shift=0)"; \
 	    timeout 900 $(BM_QEMU_ICOUNT) -kernel $(BM_DIR)/bench_level_details.elf < /dev/null 2>&1 | grep -E '^(insns|hash|saturations)'
 BM_LEVEL_IMAGES = $(foreach i,level_lod level_adapt level_lod_slice level_adapt_slice level_cut level_cut_slice \
-                    level_details level_details_slice,$(BM_DIR)/$(i).elf)
+                    level_details level_details_slice level_dadapt level_dadapt_slice,$(BM_DIR)/$(i).elf)
 BM_QEMU_ICOUNT = qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
                  -semihosting-config enable=on,target=native -icount shift=0,sleep=off
 .PHONY: print-bm-level determinism-m4
@@ -334,5 +339,5 @@ TEST_DEPS += $(foreach d,$(filter-out cortex-m4-qemu,$(DET_SLICE)),\
 ifneq ($(shell command -v $(BM_CC) 2>/dev/null),)
 TEST_DEPS += $(BM_DIR)/sinew_cow.elf $(BM_DIR)/sinew_limb.elf $(BM_DIR)/bad_blob.elf $(BM_DIR)/test_kernels.elf \
              $(BM_DIR)/level_lod_slice.elf $(BM_DIR)/level_adapt_slice.elf $(BM_DIR)/level_cut_slice.elf \
-             $(BM_DIR)/level_details_slice.elf $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
+             $(BM_DIR)/level_details_slice.elf $(BM_DIR)/level_dadapt_slice.elf $(patsubst %.c,$(BM_DIR)/obj-float/%.o,$(BM_FLOAT_CONTROL))
 endif

@@ -6,7 +6,8 @@
 # adapt_fixed, and level_cut.elf, the cut level's BM_CUT_STEPS with switches
 # BM_LEVEL_CUT, its cut_fixed, and level_details.elf, BM_DETAILS_STEPS with
 # BM_DETAILS_N details active at BM_DETAILS_ITERS iterations, details_trot_fixed
-# (the desktop player's and det_main's hashes; `make
+# (the desktop player's and det_main's hashes), and level_dadapt.elf, the same
+# steps with the details chosen by the runtime, details_adapt_trot_fixed (`make
 # determinism` also compares them with every other platform). Prints each
 # run's QEMU wall time.
 # Not part of make test (about a minute of QEMU); make test runs a slice.
@@ -18,7 +19,7 @@ B=$BUILD/baremetal
 mkdir -p "$B"
 # shellcheck disable=SC2046
 set -- $(pmake print-bm-level); steps=$1; sw=$2; cut_steps=$5; cut_sw=$6; dt_steps=$7; dt_n=$9
-pmake -j2 "$B/level_lod.elf" "$B/level_adapt.elf" "$B/level_cut.elf" "$B/level_details.elf" > "$B/determinism_m4_build.log" 2>&1 || {
+pmake -j2 "$B/level_lod.elf" "$B/level_adapt.elf" "$B/level_cut.elf" "$B/level_details.elf" "$B/level_dadapt.elf" > "$B/determinism_m4_build.log" 2>&1 || {
     bad "determinism-m4: build failed"; tail -n 20 "$B/determinism_m4_build.log"; finish; exit $?; }
 run() {  # i: level_$i.elf, its log and "rc seconds"
     # shellcheck disable=SC2086
@@ -27,11 +28,12 @@ run() {  # i: level_$i.elf, its log and "rc seconds"
 }
 # two at once (2 cores): the cut (~2 s) and details (~6 s) runs after the lod one (~16 s)
 ( run lod; run cut; run details ) &
-run adapt &
+( run adapt; run dadapt ) &
 wait
-for i in lod adapt cut details; do
+for i in lod adapt cut details dadapt; do
     dn=""; key=$i
-    case $i in cut) n=$cut_steps; isw=$cut_sw ;; details) n=$dt_steps; isw=""; dn=$dt_n; key=details_trot ;; *) n=$steps; isw=$sw ;; esac
+    case $i in cut) n=$cut_steps; isw=$cut_sw ;; details) n=$dt_steps; isw=""; dn=$dt_n; key=details_trot ;;
+             dadapt) n=$dt_steps; isw=""; key=details_adapt_trot ;; *) n=$steps; isw=$sw ;; esac
     read -r rc secs < "$B/determinism_m4_$i.rc"
     h=$(hash_of "$B/determinism_m4_$i.log")
     want=$(sed -n "s/^${key}_fixed \([0-9a-f]\{16\}\).*/\1/p" tests/expected_hashes.txt)

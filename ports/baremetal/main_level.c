@@ -12,6 +12,9 @@
  *   SN_BM_DETAILS, SN_BM_ITERS   details 0..N-1 active on the cut level and
  *                                the CG iterations from the first step, as
  *                                det_main --details N --iterations K (0: none)
+ *   SN_BM_DETAIL_ADAPT           1: the details chosen by the runtime from the
+ *                                first step (sn_set_detail_adapt), as det_main
+ *                                --detail-adapt
  *   SN_BM_SHARED                 1: shared instance stepped by sn_step_with
  *   SN_BM_BENCH                  1: also time each step with CMSDK timer 0 and
  *                                print instructions per step on each level;
@@ -33,6 +36,9 @@
 #endif
 #ifndef SN_BM_ITERS
 #define SN_BM_ITERS 0
+#endif
+#ifndef SN_BM_DETAIL_ADAPT
+#define SN_BM_DETAIL_ADAPT 0
 #endif
 #if !defined(SN_BM_INSTANCE_BYTES) || !defined(SN_BM_STATE_BYTES) || !defined(SN_BM_WS_BYTES)
 #error "SN_BM_*_BYTES: see ports/baremetal/mem_bytes.c"
@@ -92,6 +98,7 @@ int main(void) {
     t0 = sn_bm_timer_now(); overhead = t0 - sn_bm_timer_now();
     if (cal_ticks == 0) return fail("timer does not run");
 #endif
+    (void)j;   /* unused in an image with neither switches nor a detail list */
     /* the host's sizes must be the target's: the figures below are exact */
     if (sn_blob_validate(SN_BM_BLOB, SN_BM_BLOB_SIZE, &b) != SN_OK) return fail("blob does not validate");
     if (sn_instance_size(b) != SN_BM_INSTANCE_BYTES || sn_instance_state_size(b) != SN_BM_STATE_BYTES ||
@@ -115,6 +122,10 @@ int main(void) {
     for (j = 0; j < SN_BM_DETAILS; j++) detail_ids[j] = (uint16_t)j;
     if (sn_details_set(det.inst, detail_ids, SN_BM_DETAILS) != SN_OK) return fail("sn_details_set refused");
     sn_bm_put_kv("details: ", SN_BM_DETAILS);
+#endif
+#if SN_BM_DETAIL_ADAPT
+    if (sn_set_detail_adapt(det.inst, 1) != SN_OK) return fail("sn_set_detail_adapt refused");
+    sn_bm_put_kv("detail_adapt: ", 1);
 #endif
 #if SN_BM_ITERS
     if (sn_set_iterations(det.inst, SN_BM_ITERS) != SN_OK) return fail("sn_set_iterations refused");

@@ -5,7 +5,8 @@
 # (det_main --detail-adapt --main-only), x86-64 gcc own and shared instances
 # and the float build against tests/expected_hashes.txt's details_adapt_trot_*
 # (make update-hashes writes them), clang -O2 too, and big-endian MIPS and
-# aarch64 under qemu on DA_SLICE_STEPS steps against x86-64's same run. Uses
+# aarch64 under qemu and the Cortex-M4 image (level_dadapt_slice.elf) on
+# DA_SLICE_STEPS steps against x86-64's same run. Uses
 # the drivers `make test-build` built (nothing is built here: the suites run
 # in parallel); a missing one is skipped. About 4 s of CPU.
 B=${BUILD:-build}
@@ -45,6 +46,20 @@ if [ -n "$X" ] && [ -f "$BD" ]; then
             [ -n "$h" ] && [ "$h" = "$ref" ] && ok "$n $DA_SLICE_STEPS steps $h" || bad "$n $DA_SLICE_STEPS steps $h, x86-64 $ref"
         else echo "  skip: $n (no driver or $q)"; fi
     done
+    # the Cortex-M4 (main_level.c SN_BM_DETAIL_ADAPT, the slice image make test-build builds)
+    M=$B/baremetal/level_dadapt_slice.elf
+    if [ -f "$M" ] && command -v qemu-system-arm > /dev/null 2>&1; then
+        q=$(sed -n 's/^BM_QEMU_RUN="\(.*\)"$/\1/p' ports/cross/port_lib.sh)   # the one QEMU command line
+        # shellcheck disable=SC2086
+        timeout 300 $q -kernel "$M" < /dev/null > "$B/baremetal/test_dadapt_slice.log" 2>&1
+        h=$(hash_of < "$B/baremetal/test_dadapt_slice.log")
+        a=$(sed -n 's/^adapt_on: //p' "$B/baremetal/test_dadapt_slice.log")
+        r=$(sed -n 's/^adapt_refines: //p' "$B/baremetal/test_dadapt_slice.log")
+        s=$(sed -n 's/^saturations: //p' "$B/baremetal/test_dadapt_slice.log")
+        if [ -n "$h" ] && [ "$h" = "$ref" ] && [ "$a" = 1 ] && [ "${r:-0}" -gt 0 ] && [ "$s" = 0 ]; then
+            ok "cortex-m4 $DA_SLICE_STEPS steps $h (adapt_on $a, refines $r)"
+        else bad "cortex-m4 $DA_SLICE_STEPS steps '$h', x86-64 $ref (adapt_on '$a', refines '$r', saturations '$s')"; fi
+    else echo "  skip: cortex-m4 (no $M or qemu-system-arm)"; fi
 else bad "no x86-64 driver or no $BD (make test-build)"; fi
 if [ -x "$FL" ] && [ -f "$BF" ]; then
     h=$(run "$FL" "$BF" $DA_STEPS); [ "$h" = "$wl" ] && ok "float-gcc-O2 $h" || bad "float-gcc-O2 $h, expected $wl"
