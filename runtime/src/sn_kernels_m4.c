@@ -7,9 +7,11 @@
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
+/* outside the #if: tools/amalgamate.sh inlines a header at its first
+ * include only, so under a false #if it would be lost to sn_precond.c */
+#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 #if defined(SN_KERNELS_M4)
-#include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
 
 /* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
  * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
