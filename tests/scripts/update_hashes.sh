@@ -79,23 +79,23 @@ dafloat=$(sed -n 's/^  hash: details_adapt_float \([0-9a-f]\{16\}\).*/\1/p' "$T"
 # shellcheck disable=SC2046
 set -- $(MAKEFLAGS='' make -s --no-print-directory BUILD="$BUILD" print-bm-level); DT_STEPS=$7; DT_N=$9; DT_ITERS=${10}
 [ -n "$DT_ITERS" ] || { echo "update_hashes: print-bm-level gave no details run"; exit 1; }
+details_pair() {  # ARGS...: "FIXED FLOAT", det_main's hashes on the cow's details blobs (both flavours)
+    "$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" "$@" > "$T" 2>&1 || { cat "$T" >&2; return 1; }
+    _fx=$(hash_of "$T")
+    "$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" "$@" > "$T" 2>&1 || { cat "$T" >&2; return 1; }
+    _fl=$(hash_of "$T")
+    [ -n "$_fx" ] && [ -n "$_fl" ] || { echo "update_hashes: the determinism driver printed no details hash ($*)" >&2; return 1; }
+    echo "$_fx $_fl"
+}
 DT_ARGS="--steps $DT_STEPS --clip $CLIP --details $DT_N --iterations $DT_ITERS --main-only"
 # shellcheck disable=SC2086
-"$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
-dtfixed=$(hash_of "$T")
-# shellcheck disable=SC2086
-"$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DT_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
-dtfloat=$(hash_of "$T")
-if [ -z "$dtfixed" ] || [ -z "$dtfloat" ]; then echo "update_hashes: the determinism driver printed no details hash"; exit 1; fi
+r=$(details_pair $DT_ARGS) || exit 1
+dtfixed=${r% *}; dtfloat=${r#* }
 # the same blob and trot with the runtime choosing the details from none (tests/scripts/test_details_adapt.sh)
 DA_ARGS="--steps 100 --clip $CLIP --detail-adapt --main-only"
 # shellcheck disable=SC2086
-"$BUILD/cross/det_x86_64-gcc-O2" "$BUILD/level/cow_details.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
-dafixed_t=$(hash_of "$T")
-# shellcheck disable=SC2086
-"$BUILD/cross/det_float-gcc-O2" "$BUILD/level/cow_details_float.blob" $DA_ARGS > "$T" 2>&1 || { cat "$T"; exit 1; }
-dafloat_t=$(hash_of "$T")
-if [ -z "$dafixed_t" ] || [ -z "$dafloat_t" ]; then echo "update_hashes: the determinism driver printed no adaptive details hash"; exit 1; fi
+r=$(details_pair $DA_ARGS) || exit 1
+dafixed_t=${r% *}; dafloat_t=${r#* }
 old_fixed=$(sed -n 's/^fixed \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 old_float=$(sed -n 's/^float \([0-9a-f]*\).*/\1/p' "$OUT" 2>/dev/null)
 cat > "$OUT" <<EOT
