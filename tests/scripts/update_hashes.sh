@@ -157,7 +157,8 @@ details_adapt_float $dafloat
 details_trot_fixed $dtfixed
 details_trot_float $dtfloat
 # The same blob and trot, 100 steps, the runtime choosing the details from none (det_main BLOB $DA_ARGS),
-# checked by tests/scripts/test_details_adapt.sh (x86-64, clang, float; MIPS and aarch64 on 30 steps).
+# checked by tests/scripts/test_details_adapt.sh (x86-64, clang, float; MIPS, aarch64, Cortex-M4 on 30 steps),
+# make determinism on every hosted build and make determinism-m4.
 details_adapt_trot_fixed $dafixed_t
 details_adapt_trot_float $dafloat_t
 EOT
