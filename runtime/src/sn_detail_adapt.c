@@ -73,6 +73,17 @@ void sn_detail_adapt_init(sn_ihdr *h) {
         if (sn_sec(v, SN_SEC_CELLD)[(size_t)e * SN_ELEM_CELLD + 38]) cell_mass(v, e, v->grav, d, yx, yd, l, em);
 }
 
+/* vertex a's displacement from a0 in the cell frame, less the rest
+ * difference: cell_forces' d (sn_solve.c) without its velocity term */
+static void frame_disp(const sn_q *R, const sn_q *pos, const unsigned char *rest, uint32_t a, uint32_t a0, sn_q out[3],
+                       uint32_t *sat) {
+    sn_q t[3], lr[3], xr[3];
+    sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat);
+    sn_k_rot_t(R, t, lr, sat);
+    sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
+    sn_k_sub3(lr, xr, out, sat);
+}
+
 /* the keys into s->o_key (their sums in o_es, o_em) */
 static void estimate(const sn_ihdr *h, sn_dstate *s) {
     const sn_view *v = &h->v;
@@ -113,23 +124,10 @@ static void estimate(const sn_ihdr *h, sn_dstate *s) {
         /* then S y: the corners' displacement in the cell frame (cell_forces' d), the extras' (sn_cut_terms' y
          * without its velocity term), the active details' R^T c */
         d[0] = d[1] = d[2] = 0;
-        for (k = 1; k < 8; k++) {
-            uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], lr[3], xr[3];
-            sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, &lsat);
-            sn_k_rot_t(R, t, lr, &lsat);
-            sn_k_sub3r(rest, 3 * a, 3 * a0, xr, &lsat);
-            sn_k_sub3(lr, xr, d + 3 * k, &lsat);
-        }
+        for (k = 1; k < 8; k++) frame_disp(R, pos, rest, sn_rd_u16(cl + 2 * k), a0, d + 3 * k, &lsat);
         for (k = 0, nx = 0; k < SN_CUT_MAXX; k++) {
             uint32_t x = sn_rd_u16(cx + 2 * k);
-            sn_q t[3], lr[3], xr[3];
-            if (x == SN_CUT_NONE) continue;
-            sn_k_sub3(pos + 3 * x, pos + 3 * a0, t, &lsat);
-            sn_k_rot_t(R, t, lr, &lsat);
-            sn_k_sub3r(rest, 3 * x, 3 * a0, xr, &lsat);
-            sn_k_sub3(lr, xr, yx[nx], &lsat);
-            nx++;
+            if (x != SN_CUT_NONE) frame_disp(R, pos, rest, x, a0, yx[nx++], &lsat);
         }
         for (k = 0, act = 0; k < j; k++)
             if (of[ids[k]] != SN_CUT_NONE) {
