@@ -155,7 +155,7 @@ typedef struct sb_desc {
     int mesh_line;
     struct sb_gltf *gltf;   /* 'gltf FILE [MESH]': the loaded file (joints and surface come from it), else NULL */
     char gltf_mesh[256];    /* its MESH argument ("" for the first skinned mesh) */
-    int skin_frames;        /* 'frames skin': lattice frames from the glTF's skin weights (sb_lattice.c) */
+    int skin_frames;        /* 'frames skin': lattice frames from the glTF's skin weights (sb_frames.c) */
     int skin_frames_line;
     double unit;            /* metres per mesh unit */
     double cell;            /* lattice cell edge, mesh units */
@@ -230,7 +230,7 @@ void sb_srcmap_free(sb_srcmap *s);
 /* text sidecar (format in tools/DESCRIPTION.md, 'gltf'); 0 or -1 (sb_fail) */
 int sb_srcmap_write(const char *path, const sb_srcmap *s);
 
-/* ---- lattice + integration (sb_lattice.c, sb_integrate.c) ---- */
+/* ---- lattice + integration (sb_lattice.c and its steps in sb_lattice_geom.c, sb_lattice_fill.c, sb_frames.c; sb_integrate.c) ---- */
 typedef struct sb_model {
     /* skeleton, sorted so parents precede children */
     int nj;
@@ -348,7 +348,7 @@ int sb_integrate(const sb_desc *d, sb_model *o, const unsigned char *inbits);
  * frac[k * npt + q] is the inside fraction of quadrature point q's box */
 int sb_integrate_frac(const sb_desc *d, sb_model *o, const double *frac, const int *fidx);
 /* inside fractions of the quadrature boxes (subdivision n) of the grid cells with
- * slot[gc] >= 0, added into frac[slot * 8n^3 + q] (sb_lattice.c; t0 >= 0 prints progress) */
+ * slot[gc] >= 0, added into frac[slot * 8n^3 + q] (sb_lattice_fill.c; t0 >= 0 prints progress) */
 void sb_box_fractions(const sb_model *o, const sb_mesh *m, const sb_inside *in, int n, const int *slot, double *frac, double t0);
 /* checks of a built model (sinew-bake --check, tests): interior volume vs mesh
  * volume (= mass vs rho*V at uniform density), embedding error, null space of S */

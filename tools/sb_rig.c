@@ -7,7 +7,7 @@
  * rest frame: the runtime turns it by R_i). The quadrature is the one of
  * sb_integrate_frac: each kept cell split into subdiv^3 sub-boxes with 2x2x2
  * Gauss points, point q weighted w0 * frac_q where frac_q is the inside
- * fraction of the point's box (sb_lattice.c step 3, recomputed here the same
+ * fraction of the point's box (sb_lattice_fill.c, the build's step 3, recomputed here the same
  * way for the partially inside cells a rig touches); points outside weigh 0
  * (no `air`: a force field acts on flesh, not on the padding).
  *
@@ -307,7 +307,7 @@ int sb_rig_build(const sb_desc *d, const sb_mesh *m, sb_model *o)
                 double wq = w0 * (fr ? fr[q] : 1.0), bl[3], mw;
                 int sx = q / 8 % n, sy = q / 8 / n % n, sz = q / 8 / (n * n), gp = q % 8, mx, my, mz, g;
                 if (wq == 0) continue;
-                /* the box of point q: the octant of its sub-box holding it (sb_lattice.c step 3) */
+                /* the box of point q: the octant of its sub-box holding it (sb_lattice_fill.c, step 3) */
                 bl[0] = (sx + 0.5 * (gp & 1)) / n; bl[1] = (sy + 0.5 * ((gp >> 1) & 1)) / n; bl[2] = (sz + 0.5 * ((gp >> 2) & 1)) / n;
                 hit = 1;
                 for (k = 0; k < 3; k++) if (x0[k] + bl[k] * o->c > rg->hi[k] || x0[k] + (bl[k] + 0.5 / n) * o->c < rg->lo[k]) hit = 0;

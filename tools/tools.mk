@@ -1,12 +1,12 @@
 # tools build fragment: the host tool sinew-bake (library + main) and the baked examples.
 BAKE = $(BUILD)/sinew-bake
-TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_desc_args.c tools/sb_desc_body.c tools/sb_desc_sim.c tools/sb_desc_rig.c tools/sb_desc_seg.c tools/sb_lattice.c tools/sb_integrate.c tools/sb_level.c tools/sb_cut.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_ichol.c tools/sb_frefs.c tools/sb_blob.c tools/sb_blob_cells.c tools/sb_blob_rigs.c tools/sb_blob_file.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c tools/sb_retarget.c tools/sb_retarget_surf.c tools/sb_retarget_xfer.c
+TOOLS_LIB_SRC = tools/sb_util.c tools/sb_mesh.c tools/sb_desc.c tools/sb_desc_args.c tools/sb_desc_body.c tools/sb_desc_sim.c tools/sb_desc_rig.c tools/sb_desc_seg.c tools/sb_lattice.c tools/sb_lattice_geom.c tools/sb_lattice_fill.c tools/sb_frames.c tools/sb_integrate.c tools/sb_level.c tools/sb_cut.c tools/sb_rig.c tools/sb_force.c tools/sb_segment.c tools/sb_crease.c tools/ref/snref.c tools/sb_ichol.c tools/sb_frefs.c tools/sb_blob.c tools/sb_blob_cells.c tools/sb_blob_rigs.c tools/sb_blob_file.c tools/sb_bake.c tools/sb_json.c tools/sb_gltf_data.c tools/sb_gltf.c tools/sb_lbfgsb.c tools/sb_rigfile.c tools/sb_gltf_bake.c tools/sb_gltf_anim.c tools/sb_retarget.c tools/sb_retarget_surf.c tools/sb_retarget_xfer.c
 TOOLS_LIB_OBJ = $(patsubst tools/%.c,$(BUILD)/tools/%.o,$(TOOLS_LIB_SRC))
 TOOLS_LIB = $(BUILD)/tools/libsinewbake.a
 TOOLS_HDR = tools/sb.h tools/sb_desc_int.h tools/sb_blob_int.h tools/sb_level.h tools/sb_cut.h tools/sb_lbfgsb.h tools/sb_retarget.h tools/sb_retarget_int.h runtime/src/sn_format.h tools/ref/snref.h
 # the glTF reader (issue 17): its own headers
 GLTF_HDR = tools/sb_json.h tools/sb_gltf.h tools/sb_gltf_int.h
-$(BUILD)/tools/sb_json.o $(BUILD)/tools/sb_gltf_data.o $(BUILD)/tools/sb_gltf.o $(BUILD)/tools/sb_gltf_bake.o $(BUILD)/tools/sb_gltf_anim.o $(BUILD)/tools/sb_desc.o $(BUILD)/tools/sb_lattice.o $(BUILD)/tests/test_bake_gltf: $(GLTF_HDR)
+$(BUILD)/tools/sb_json.o $(BUILD)/tools/sb_gltf_data.o $(BUILD)/tools/sb_gltf.o $(BUILD)/tools/sb_gltf_bake.o $(BUILD)/tools/sb_gltf_anim.o $(BUILD)/tools/sb_desc.o $(BUILD)/tools/sb_frames.o $(BUILD)/tests/test_bake_gltf: $(GLTF_HDR)
 
 $(BUILD)/tools/%.o: tools/%.c $(TOOLS_HDR)
 	@mkdir -p $(dir $@)
