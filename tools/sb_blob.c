@@ -15,7 +15,6 @@ uint16_t sb_frame_w(double w) { return (uint16_t)rnd(w * 32768.0); }
 static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
 /* CELLDK elements of a cell with nd details and nx extras (sn_format.h) */
-static uint32_t detail_blocks(int nd, int nx) { return (uint32_t)(nd * (8 + nx) + nd * (nd + 1) / 2); }
 
 /* fractional bits so that the largest |entry| lands in [2^26, 2^27] */
 static int pick_frac(double maxabs)
@@ -112,89 +111,14 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         if (b->frac_M < 0 || b->frac_M > 60 || b->frac_P < 0 || b->frac_P > 60) { free(P); free(lump); return sb_fail("mass/preconditioner out of fixed-point range"); }
     }
 
-    /* section table */
-    cnt[SN_SEC_JOINTS] = (uint32_t)nJ;        esz[SN_SEC_JOINTS] = SN_ELEM_JOINTS(rs);
-    cnt[SN_SEC_JOINT_NAMES] = (uint32_t)nJ;   esz[SN_SEC_JOINT_NAMES] = SN_ELEM_JOINT_NAMES;
-    cnt[SN_SEC_REST] = (uint32_t)nV;          esz[SN_SEC_REST] = SN_ELEM_REST(rs);
-    cnt[SN_SEC_FRAMES] = (uint32_t)nV;        esz[SN_SEC_FRAMES] = SN_ELEM_FRAMES;
-    cnt[SN_SEC_MDIAG] = (uint32_t)nF;         esz[SN_SEC_MDIAG] = SN_ELEM_MDIAG(rs);
-    cnt[SN_SEC_PRECOND] = (uint32_t)nF;       esz[SN_SEC_PRECOND] = SN_ELEM_PRECOND(rs);
-    cnt[SN_SEC_MLUMP] = (uint32_t)nF;         esz[SN_SEC_MLUMP] = SN_ELEM_MLUMP(rs);
-    cnt[SN_SEC_ROWPTR] = (uint32_t)nF + 1;    esz[SN_SEC_ROWPTR] = SN_ELEM_ROWPTR;
-    cnt[SN_SEC_COLS] = (uint32_t)nnz;         esz[SN_SEC_COLS] = SN_ELEM_COLS;
-    cnt[SN_SEC_MOFF] = (uint32_t)nnz;         esz[SN_SEC_MOFF] = SN_ELEM_MOFF(rs);
-    cnt[SN_SEC_CELLS] = (uint32_t)o->nc;      esz[SN_SEC_CELLS] = SN_ELEM_CELLS;
-    cnt[SN_SEC_CFRAMES] = (uint32_t)o->nc;    esz[SN_SEC_CFRAMES] = SN_ELEM_CFRAMES;
-    cnt[SN_SEC_CELLK] = (uint32_t)o->nc;      esz[SN_SEC_CELLK] = SN_ELEM_CELLK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
-    cnt[SN_SEC_LIMIT] = (uint32_t)nlim;       esz[SN_SEC_LIMIT] = SN_ELEM_LIMIT(rs);
-    cnt[SN_SEC_EMBED] = (uint32_t)o->ns;      esz[SN_SEC_EMBED] = SN_ELEM_EMBED;
-    cnt[SN_SEC_TRIS] = (uint32_t)o->nt;       esz[SN_SEC_TRIS] = SN_ELEM_TRIS;
-    {   /* rig sections: counts (running sums of samples and entries) */
-        uint32_t nsamp = 0, nent = 0;
-        for (k = 0; k < o->nrig; k++) { nsamp += (uint32_t)o->rig[k].def.ntau; nent += (uint32_t)o->rig[k].n; }
-        cnt[SN_SEC_CONTROLS] = (uint32_t)o->nctl;  esz[SN_SEC_CONTROLS] = SN_ELEM_CONTROLS(rs);
-        cnt[SN_SEC_RIGS] = (uint32_t)o->nrig;      esz[SN_SEC_RIGS] = SN_ELEM_RIGS;
-        cnt[SN_SEC_RIG_SAMPLES] = nsamp;           esz[SN_SEC_RIG_SAMPLES] = SN_ELEM_RIG_SAMPLES(rs);
-        cnt[SN_SEC_RIG_VERTS] = nent;              esz[SN_SEC_RIG_VERTS] = SN_ELEM_RIG_VERTS;
-        cnt[SN_SEC_RIG_FORCES] = nent;             esz[SN_SEC_RIG_FORCES] = SN_ELEM_RIG_FORCES(rs);
-        if (o->nctl > (int)SN_MAX_CONTROLS || o->nrig > (int)SN_MAX_RIGS) { free(P); free(lump); return sb_fail("%d controls, %d rigs: at most %u and %u", o->nctl, o->nrig, SN_MAX_CONTROLS, SN_MAX_RIGS); }
-    }
-    {   /* external forces: share profiles, per-vertex profiles */
-        if (o->nprof > (int)SN_MAX_PROFILES || o->max_forces < 0 || o->max_forces > (int)SN_MAX_FORCES) { free(P); free(lump); return sb_fail("%d force profiles, %d force slots: at most %u and %u", o->nprof, o->max_forces, SN_MAX_PROFILES, SN_MAX_FORCES); }
-        cnt[SN_SEC_SHARES] = (uint32_t)o->nprof;                 esz[SN_SEC_SHARES] = SN_ELEM_SHARES(rs);
-        cnt[SN_SEC_VSHARE] = o->vprof ? (uint32_t)nF : 0u;       esz[SN_SEC_VSHARE] = SN_ELEM_VSHARE;
-    }
-    {   /* segment meshes (sb_segment.c) */
-        uint32_t nodes = 0, natt = 0;
-        sb_segment_blob_counts(o, &nodes, &natt);
-        cnt[SN_SEC_SEGMESH] = (uint32_t)o->nsm;    esz[SN_SEC_SEGMESH] = SN_ELEM_SEGMESH(rs);
-        cnt[SN_SEC_SEGNODES] = nodes;              esz[SN_SEC_SEGNODES] = SN_ELEM_SEGNODES(rs);
-        cnt[SN_SEC_SEGATTACH] = natt;              esz[SN_SEC_SEGATTACH] = SN_ELEM_SEGATTACH(rs);
-    }
-    {   /* constraints and contact: one record of maxima, or none */
-        int any = o->max_cons || o->max_cols || o->max_contacts;
-        if (o->max_cons < 0 || o->max_cons > (int)SN_MAX_CONSTRAINTS || o->max_cols < 0 || o->max_cols > (int)SN_MAX_COLLIDERS ||
-            o->max_contacts < 0 || o->max_contacts > (int)SN_MAX_CONTACTS ||
-            SN_ROWS_CAP(o->max_cons, o->max_contacts, o->crease ? o->cr_active : 0) > SN_MAX_ROWS || (o->max_cols > 0 && o->max_contacts == 0)) {
-            free(P); free(lump);
-            return sb_fail("constraints %d, colliders %d, contacts %d: at most %u, %u, %u, 3 constraints + contacts + crease rows <= %u, contacts >= 1 with colliders",
-                           o->max_cons, o->max_cols, o->max_contacts, SN_MAX_CONSTRAINTS, SN_MAX_COLLIDERS, SN_MAX_CONTACTS, SN_MAX_ROWS);
-        }
-        cnt[SN_SEC_CONSTRAINTS] = any ? 1u : 0u;   esz[SN_SEC_CONSTRAINTS] = SN_ELEM_CONSTRAINTS;
-    }
-    {   /* self-collision near creases (sb_crease.c) */
-        uint32_t on = o->crease ? 1u : 0u;
-        cnt[SN_SEC_CREASE] = on;                                   esz[SN_SEC_CREASE] = SN_ELEM_CREASE(rs);
-        cnt[SN_SEC_CREASE_PAIRS] = on ? (uint32_t)o->cr_nD : 0u;   esz[SN_SEC_CREASE_PAIRS] = SN_ELEM_CREASE_PAIRS;
-        cnt[SN_SEC_CREASE_VNBR] = on ? (uint32_t)(o->cr_nq * o->cr_kv) : 0u; esz[SN_SEC_CREASE_VNBR] = SN_ELEM_CREASE_VNBR;
-        cnt[SN_SEC_CREASE_TNBR] = on ? (uint32_t)(o->cr_nq * o->cr_kt) : 0u; esz[SN_SEC_CREASE_TNBR] = SN_ELEM_CREASE_TNBR;
-    }
-    /* level of detail (sb_level.c) */
-    cnt[SN_SEC_LEVEL_BLOB] = o->lod_size;                      esz[SN_SEC_LEVEL_BLOB] = SN_ELEM_LEVEL_BLOB;
-    cnt[SN_SEC_LEVEL_UP] = o->lod_size ? o->lod_nv1 : 0u;      esz[SN_SEC_LEVEL_UP] = SN_ELEM_LEVEL_MAP;
-    cnt[SN_SEC_LEVEL_DOWN] = o->lod_size ? (uint32_t)nV : 0u;  esz[SN_SEC_LEVEL_DOWN] = SN_ELEM_LEVEL_MAP;
-    cnt[SN_SEC_ICHOL] = (uint32_t)ic.n;           esz[SN_SEC_ICHOL] = SN_ELEM_ICHOL;
-    cnt[SN_SEC_ADAPT] = o->lod_size && o->ad_on ? 1u : 0u;   esz[SN_SEC_ADAPT] = SN_ELEM_ADAPT(rs);
-    {
-        uint32_t nxb = 0;
-        if (o->cut) for (i = 0; i < o->nc; i++) nxb += 8u * (uint32_t)o->cut->cnx[i];
-        cnt[SN_SEC_CELLX] = o->cut ? (uint32_t)o->nc : 0u;   esz[SN_SEC_CELLX] = SN_ELEM_CELLX;
-        cnt[SN_SEC_CELLXK] = nxb;   esz[SN_SEC_CELLXK] = SN_ELEM_CELLXK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
-    }
+    /* section table (sb_blob_table.c), the frames' references (format 6.4) */
+    if (sb_blob_table(o, flavour, rs, nnz, ic.n, nlim, cnt, esz) != 0) { sb_ichol_free(&ic); free(P); free(lump); return -1; }
     /* the frames' references (format 6.4): every entry's, and the distinct pairs */
     frefs = sb_alloc(sizeof(uint32_t) * (size_t)(nF + o->nc));
     fpairs = sb_alloc(sizeof(uint16_t) * (size_t)(nF + o->nc));
     nfp = sb_frame_refs(o, frefs, fpairs);
     cnt[SN_SEC_FPAIRS] = (uint32_t)nfp;              esz[SN_SEC_FPAIRS] = SN_ELEM_FPAIRS;
     cnt[SN_SEC_FREFS] = (uint32_t)(nF + o->nc);      esz[SN_SEC_FREFS] = SN_ELEM_FREFS;
-    {   /* the cut level's details (sb_cut.h): per cell nd (8 + nx) + nd (nd + 1) / 2 blocks */
-        uint32_t ndb = 0, on = o->cut && o->det_on ? 1u : 0u;
-        if (on) for (i = 0; i < o->nc; i++) ndb += detail_blocks(o->cut->cnd[i], o->cut->cnx[i]);
-        cnt[SN_SEC_DETAILS] = on;   esz[SN_SEC_DETAILS] = SN_ELEM_DETAILS(rs);
-        cnt[SN_SEC_DETAIL] = on ? (uint32_t)o->cut->nd : 0u;   esz[SN_SEC_DETAIL] = SN_ELEM_DETAIL(rs);
-        cnt[SN_SEC_CELLD] = on ? (uint32_t)o->nc : 0u;   esz[SN_SEC_CELLD] = SN_ELEM_CELLD;
-        cnt[SN_SEC_CELLDK] = ndb;   esz[SN_SEC_CELLDK] = SN_ELEM_CELLDK(flavour == SB_FIXED ? SN_FLAVOUR_FIXED : SN_FLAVOUR_FLOAT32, rs);
-    }
     total = SN_HEADER_BYTES;
     for (k = 0; k < SN_SEC_COUNT; k++) {
         total = (total + 7u) & ~7u;
@@ -323,64 +247,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         }
         sb_ichol_free(&ic);
     }
-    for (i = 0; i < o->nc; i++) {
-        double blk[36 * 9];
-        int exps[28];
-        size_t at = off[SN_SEC_CFRAMES] + 4 * (size_t)i;
-        for (k = 0; k < 8; k++) put_u16(&w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
-        put_u8(&w, at, (unsigned)o->cfb1[i]);
-        put_u8(&w, at + 1, (unsigned)o->cfb2[i]);
-        put_u16(&w, at + 2, sb_frame_w(o->cfw[i]));
-        if (sb_blob_cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w.err = 1;
-        if (flavour == SB_FIXED) { /* int32 diagonal (6 symmetric), int16 mantissas, exponents */
-            size_t c0 = off[SN_SEC_CELLK] + (size_t)i * SN_CELLK_FIXED_BYTES;
-            int a, bb, n = 0, no = 0;
-            for (a = 0; a < 8; a++)
-                for (bb = a; bb < 8; bb++, n++) {
-                    if (bb == a) {
-                        for (k = 0; k < 6; k++)
-                            put_u32(&w, c0 + SN_CELLK_DIAG + 24 * (size_t)a + 4 * (size_t)k,
-                                    (uint32_t)(int32_t)blk[9 * n + 3 * sym6[k][0] + sym6[k][1]]);
-                    } else {
-                        for (k = 0; k < 9; k++)
-                            put_u16(&w, c0 + SN_CELLK_OFF + 18 * (size_t)no + 2 * (size_t)k,
-                                    (unsigned)(uint16_t)(int16_t)ldexp(blk[9 * n + k], -exps[no]));
-                        put_u8(&w, c0 + SN_CELLK_EXP + (size_t)no, (unsigned)exps[no]);
-                        no++;
-                    }
-                }
-        } else
-            for (k = 0; k < 36 * 9; k++)
-                put_real(&w, off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs, blk[k], 0);
-    }
-    if (o->cut) { /* the cut level: each cell's extras and their blocks (sb_cut.h) */
-        uint32_t first = 0;
-        for (i = 0; i < o->nc; i++) {
-            size_t at = off[SN_SEC_CELLX] + (size_t)i * SN_ELEM_CELLX;
-            double xb[8 * SB_CUT_MAXX * 9];
-            int xe[8 * SB_CUT_MAXX], nx, q, m = 0;
-            nx = sb_blob_cut_blocks(o, i, h * h / m0, flavour, b->frac_S, xb, xe);
-            if (nx < 0) { w.err = 1; continue; }
-            for (q = 0; q < 27; q++) {
-                int id;
-                if (!((q % 3) & 1) && !((q / 3 % 3) & 1) && !((q / 9) & 1)) continue; /* a corner */
-                id = o->cut->csub[27 * i + q];
-                put_u16(&w, at + 2 * (size_t)m++, id < 0 ? SN_CUT_NONE : (unsigned)(o->cut_nv0 + id));
-            }
-            put_u8(&w, at + 38, (unsigned)nx);
-            put_u32(&w, at + 40, first);
-            for (k = 0; k < 8 * nx; k++) {
-                size_t bt = off[SN_SEC_CELLXK] + (size_t)(first + (uint32_t)k) * esz[SN_SEC_CELLXK];
-                int l;
-                if (flavour == SB_FIXED) {
-                    for (l = 0; l < 9; l++) put_u16(&w, bt + 2 * (size_t)l, (unsigned)(uint16_t)(int16_t)ldexp(xb[9 * k + l], -xe[k]));
-                    put_u8(&w, bt + 18, (unsigned)xe[k]);
-                } else
-                    for (l = 0; l < 9; l++) put_real(&w, bt + (size_t)l * (size_t)rs, xb[9 * k + l], 0);
-            }
-            first += 8u * (uint32_t)nx;
-        }
-    }
+    sb_blob_write_cells(o, &w, off, esz, h, m0, b);
     for (k = 0; k < nfp; k++) {
         put_u8(&w, off[SN_SEC_FPAIRS] + 2 * (size_t)k, (unsigned)(fpairs[k] >> 8));
         put_u8(&w, off[SN_SEC_FPAIRS] + 2 * (size_t)k + 1, (unsigned)(fpairs[k] & 255u));
@@ -388,75 +255,9 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
     for (i = 0; i < nF + o->nc; i++) put_u32(&w, off[SN_SEC_FREFS] + 4 * (size_t)i, frefs[i]);
     free(frefs);
     free(fpairs);
-    if (cnt[SN_SEC_DETAILS]) { /* the details: record, rest points, per-cell lists, blocks with their mass (sn_format.h) */
-        const sb_cut *cut = o->cut;
-        const int N3 = 3 * SB_CUT_NL, NL = SB_CUT_NL;
-        uint32_t first = 0;
-        size_t at = off[SN_SEC_DETAILS];
-        int dshift = 0;
-        if (flavour == SB_FIXED) { /* a detail's own block can exceed the corners' (a cell-centre hat spans 8 children):
-                                    * its blocks in Q(frac_S - dshift), the smallest shift keeping |entry| <= 2^27 */
-            double mx = 0;
-            for (i = 0; i < o->nc; i++) {
-                const double *KE = cut->K + (size_t)(N3 * N3) * (size_t)i;
-                int r, c2, l;
-                for (r = 8 + cut->cnx[i]; r < 8 + cut->cnx[i] + cut->cnd[i]; r++)
-                    for (c2 = 0; c2 < 8 + cut->cnx[i] + cut->cnd[i]; c2++)
-                        for (l = 0; l < 9; l++) mx = fmax(mx, fabs(KE[(size_t)N3 * (size_t)(3 * r + l / 3) + (size_t)(3 * c2 + l % 3)]));
-            }
-            mx = ldexp(h * h / m0 * mx, b->frac_S);
-            while (dshift < SN_DETAIL_SHIFT_MAX && rnd(ldexp(mx, -dshift)) > 134217728.0) dshift++;
-        }
-        if (o->det_refine / U * 4194304.0 > (double)SN_ADAPT_MAX) { sb_blob_free(b); return sb_fail("details refine %g mesh units out of range (0..%g)", o->det_refine, U * 256); }
-        put_u16(&w, at, (unsigned)o->det_max);
-        put_u8(&w, at + 2, (unsigned)dshift);
-        put_real(&w, at + 8, o->det_refine / U, SN_Q_LEN);
-        put_real(&w, at + 8 + (size_t)rs, fmin(o->det_coarsen, o->det_refine) / U, SN_Q_LEN);
-        for (i = 0; i < cut->nd; i++) {
-            size_t dt = off[SN_SEC_DETAIL] + (size_t)i * esz[SN_SEC_DETAIL];
-            put_u16(&w, dt, (unsigned)cut->dcell[i]);
-            put_u8(&w, dt + 2, (unsigned)cut->dpoint[i]);
-            for (k = 0; k < 3; k++) put_real(&w, dt + 4 + (size_t)(k * rs), (cut->dx[3 * i + k] - root[k]) / U, SN_Q_LEN);
-        }
-        for (i = 0; i < o->nc; i++) {
-            const double *KE = cut->K + (size_t)(N3 * N3) * (size_t)i, *ME = cut->M + (size_t)(NL * NL) * (size_t)i;
-            size_t ct = off[SN_SEC_CELLD] + (size_t)i * SN_ELEM_CELLD;
-            int q, m = 0, nx = cut->cnx[i], nd = cut->cnd[i], j, c;
-            for (q = 0; q < 27; q++) {
-                int id;
-                if (!((q % 3) & 1) && !((q / 3 % 3) & 1) && !((q / 9) & 1)) continue; /* a corner */
-                id = cut->dsub[27 * i + q];
-                put_u16(&w, ct + 2 * (size_t)m++, id < 0 ? SN_CUT_NONE : (unsigned)id);
-            }
-            put_u8(&w, ct + 38, (unsigned)nd);
-            put_u32(&w, ct + 40, first);
-            for (j = 0; j < nd; j++)
-                for (c = 0; c < 8 + nx + nd; c++) { /* columns: corners, extras, details from j on (locals 8 + nx + ..) */
-                    int r = 8 + nx + j, l, e = 0;
-                    size_t bt = off[SN_SEC_CELLDK] + (size_t)first * esz[SN_SEC_CELLDK];
-                    double B[9], mx = 0, mass = ME[NL * r + c] / m0;
-                    if (c >= 8 + nx && c < r) continue;
-                    for (l = 0; l < 9; l++) {
-                        B[l] = h * h / m0 * KE[(size_t)N3 * (size_t)(3 * r + l / 3) + (size_t)(3 * c + l % 3)];
-                        if (flavour == SB_FIXED) B[l] = ldexp(B[l], b->frac_S - dshift);
-                        mx = fmax(mx, fabs(B[l]));
-                    }
-                    if (!(mx <= 134217728.0)) w.err = 1; /* 2^27: the runtime's entry bound */
-                    if (flavour == SB_FIXED) {
-                        while (e < SN_CELLK_EXP_MAX && rnd(ldexp(mx, -e)) > (double)SN_CELLK_M_MAX) e++;
-                        for (l = 0; l < 9; l++)
-                            put_u16(&w, bt + 2 * (size_t)l, (unsigned)(uint16_t)(int16_t)fmax(-SN_CELLK_M_MAX, fmin(SN_CELLK_M_MAX, rnd(ldexp(B[l], -e)))));
-                        put_u8(&w, bt + 18, (unsigned)e);
-                        put_real(&w, bt + 20, mass, b->frac_M);
-                        if (!(fabs(ldexp(mass, b->frac_M)) <= 134217728.0) || (c == r && !(rnd(ldexp(mass, b->frac_M)) > 0))) w.err = 1;
-                    } else {
-                        for (l = 0; l < 9; l++) put_real(&w, bt + (size_t)l * (size_t)rs, B[l], 0);
-                        put_real(&w, bt + 9 * (size_t)rs, mass, 0);
-                        if (!(fabs(mass) <= 134217728.0) || (c == r && !(mass > 0))) w.err = 1;
-                    }
-                    first++;
-                }
-        }
+    if (cnt[SN_SEC_DETAILS] && sb_blob_write_details(o, &w, off, esz, h, m0, U, root, b) != 0) {
+        free(P); free(lump); sb_blob_free(b);
+        return -1;
     }
     {   /* beyond 64 internal units the state clamps anyway (NUMERICS.md): say so once */
         int beyond = 0;
@@ -477,55 +278,8 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         for (k = 0; k < 3; k++) put_u16(&w, off[SN_SEC_TRIS] + 6 * (size_t)i + 2 * (size_t)k, (unsigned)o->tri[3 * i + k]);
     free(P); free(lump);
     if (!w.err && sb_blob_write_rigs(o, &w, off, U * o->unit, m0, b) != 0) { sb_blob_free(b); return -1; }
-    for (i = 0; i < o->nprof; i++)   /* share profiles: Q30, the fine share takes the rounding so each sums to 2^30 */
-        for (k = 0; k < SN_LEVELS; k++) {
-            size_t at = off[SN_SEC_SHARES] + ((size_t)i * SN_LEVELS + (size_t)k) * (size_t)rs;
-            if (flavour == SB_FIXED) {
-                int32_t q = 0, rest = (int32_t)1 << 30;
-                int kk;
-                for (kk = 1; kk < SN_LEVELS; kk++) rest -= (int32_t)rnd(o->prof[i][kk] * 1073741824.0);
-                q = k == 0 ? rest : (int32_t)rnd(o->prof[i][k] * 1073741824.0);
-                put_u32(&w, at, (uint32_t)q);
-            } else put_real(&w, at, o->prof[i][k], 0);
-        }
-    if (o->vprof) for (i = 0; i < nF; i++) put_u8(&w, off[SN_SEC_VSHARE] + (size_t)i, o->vprof[i]);
-    if (cnt[SN_SEC_CONSTRAINTS]) {
-        put_u8(&w, off[SN_SEC_CONSTRAINTS], (unsigned)o->max_cons);
-        put_u8(&w, off[SN_SEC_CONSTRAINTS] + 1, (unsigned)o->max_cols);
-        put_u16(&w, off[SN_SEC_CONSTRAINTS] + 2, (unsigned)o->max_contacts);
-    }
     if (!w.err && sb_segment_blob_write(o, b->bytes, off, flavour, rs, s, m0) != 0) { sb_blob_free(b); return -1; }
-    if (cnt[SN_SEC_ADAPT]) {   /* ADAPT record (sn_adapt.c): A_max, refine, coarsen (internal units, Q22) */
-        size_t at = off[SN_SEC_ADAPT];
-        if (o->ad_refine / U * 4194304.0 > (double)SN_ADAPT_MAX) { sb_blob_free(b); return sb_fail("adapt refine %g mesh units out of range (0..%g)", o->ad_refine, U * 256); }
-        put_u16(&w, at, (unsigned)o->ad_max);
-        put_real(&w, at + 8, o->ad_refine / U, SN_Q_LEN);
-        put_real(&w, at + 8 + (size_t)rs, fmin(o->ad_coarsen, o->ad_refine) / U, SN_Q_LEN);
-    }
-    if (o->crease) {   /* CREASE record, seed pairs, neighbourhood rows (SN_CREASE_NONE for -1) */
-        size_t at = off[SN_SEC_CREASE];
-        double dep = o->cr_depth / U, push = o->cr_push / U;
-        if (dep * 4194304.0 < 1 || dep * 4194304.0 > (double)SN_CREASE_DEPTH_MAX) { sb_blob_free(b); return sb_fail("crease depth %g mesh units out of range (%g..%g)", o->cr_depth, U / 4194304.0, U * 16); }
-        put_u16(&w, at, (unsigned)o->cr_list); put_u16(&w, at + 2, (unsigned)o->cr_active);
-        put_u8(&w, at + 4, (unsigned)o->cr_kv); put_u8(&w, at + 5, (unsigned)o->cr_kt); put_u16(&w, at + 6, (unsigned)o->cr_nq);
-        put_real(&w, at + 12, dep, SN_Q_LEN);
-        put_real(&w, at + 12 + (size_t)rs, fmin(push, dep), SN_Q_LEN);
-        if (o->cr_exclude / U * 4194304.0 > (double)SN_CREASE_EXCLUDE_MAX) { sb_blob_free(b); return sb_fail("crease exclude %g mesh units out of range (0..%g)", o->cr_exclude, U * 64); }
-        put_real(&w, at + 12 + 2 * (size_t)rs, o->cr_exclude / U, SN_Q_LEN);
-        for (i = 0; i < o->cr_nD; i++) {
-            put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i, (unsigned)o->cr_pairs[2 * i]);
-            put_u16(&w, off[SN_SEC_CREASE_PAIRS] + 4 * (size_t)i + 2, (unsigned)o->cr_pairs[2 * i + 1]);
-        }
-        for (i = 0; i < o->cr_nq * o->cr_kv; i++)
-            put_u16(&w, off[SN_SEC_CREASE_VNBR] + 2 * (size_t)i, o->cr_vnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_vnbr[i]);
-        for (i = 0; i < o->cr_nq * o->cr_kt; i++)
-            put_u16(&w, off[SN_SEC_CREASE_TNBR] + 2 * (size_t)i, o->cr_tnbr[i] < 0 ? SN_CREASE_NONE : (unsigned)o->cr_tnbr[i]);
-    }
-    if (o->lod_size) {   /* the finer level verbatim, then the two maps */
-        memcpy(b->bytes + off[SN_SEC_LEVEL_BLOB], o->lod_blob, o->lod_size);
-        for (i = 0; i < 4 * (int)o->lod_nv1; i++) put_u16(&w, off[SN_SEC_LEVEL_UP] + 2 * (size_t)i, o->lod_up[i]);
-        for (i = 0; i < 4 * nV; i++) put_u16(&w, off[SN_SEC_LEVEL_DOWN] + 2 * (size_t)i, o->lod_down[i]);
-    }
+    if (sb_blob_write_records(o, &w, off, cnt, U) != 0) { sb_blob_free(b); return -1; }
     if (w.err) { sb_blob_free(b); return sb_fail("a baked value does not fit its fixed-point format (check timestep, gravity, damping)"); }
     if (o->nc > 65535) { sb_blob_free(b); return sb_fail("%d cells: at most 65535", o->nc); }
     put_u32(&w, SN_H_CRC32, sb_crc32(b->bytes + 16, total - 16));

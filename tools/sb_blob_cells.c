@@ -109,3 +109,71 @@ int sb_blob_cell_blocks(const sb_model *o, int ci, double h, double m0, int flav
         if (!(fabs(out[n]) <= 134217728.0)) return -1; /* 2^27: the runtime's entry bound */
     return 0;
 }
+
+/* CELLS, CFRAMES, CELLK and the cut level's CELLX / CELLXK (sn_format.h); a
+ * block beyond its format sets w->err */
+void sb_blob_write_cells(const sb_model *o, wr_t *w, const uint32_t *off, const uint32_t *esz, double h, double m0,
+                         const sb_blob *b)
+{
+    static const int sym6[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    const int flavour = w->flavour, rs = w->rs;
+    int i, k;
+    for (i = 0; i < o->nc; i++) {
+        double blk[36 * 9];
+        int exps[28];
+        size_t at = off[SN_SEC_CFRAMES] + 4 * (size_t)i;
+        for (k = 0; k < 8; k++) put_u16(w, off[SN_SEC_CELLS] + 16 * (size_t)i + 2 * (size_t)k, (unsigned)o->cells[8 * i + k]);
+        put_u8(w, at, (unsigned)o->cfb1[i]);
+        put_u8(w, at + 1, (unsigned)o->cfb2[i]);
+        put_u16(w, at + 2, sb_frame_w(o->cfw[i]));
+        if (sb_blob_cell_blocks(o, i, h, m0, flavour, b->frac_S, blk, exps) != 0) w->err = 1;
+        if (flavour == SB_FIXED) { /* int32 diagonal (6 symmetric), int16 mantissas, exponents */
+            size_t c0 = off[SN_SEC_CELLK] + (size_t)i * SN_CELLK_FIXED_BYTES;
+            int a, bb, n = 0, no = 0;
+            for (a = 0; a < 8; a++)
+                for (bb = a; bb < 8; bb++, n++) {
+                    if (bb == a) {
+                        for (k = 0; k < 6; k++)
+                            put_u32(w, c0 + SN_CELLK_DIAG + 24 * (size_t)a + 4 * (size_t)k,
+                                    (uint32_t)(int32_t)blk[9 * n + 3 * sym6[k][0] + sym6[k][1]]);
+                    } else {
+                        for (k = 0; k < 9; k++)
+                            put_u16(w, c0 + SN_CELLK_OFF + 18 * (size_t)no + 2 * (size_t)k,
+                                    (unsigned)(uint16_t)(int16_t)ldexp(blk[9 * n + k], -exps[no]));
+                        put_u8(w, c0 + SN_CELLK_EXP + (size_t)no, (unsigned)exps[no]);
+                        no++;
+                    }
+                }
+        } else
+            for (k = 0; k < 36 * 9; k++)
+                put_real(w, off[SN_SEC_CELLK] + ((size_t)i * 36 * 9 + (size_t)k) * (size_t)rs, blk[k], 0);
+    }
+    if (o->cut) { /* the cut level: each cell's extras and their blocks (sb_cut.h) */
+        uint32_t first = 0;
+        for (i = 0; i < o->nc; i++) {
+            size_t at = off[SN_SEC_CELLX] + (size_t)i * SN_ELEM_CELLX;
+            double xb[8 * SB_CUT_MAXX * 9];
+            int xe[8 * SB_CUT_MAXX], nx, q, m = 0;
+            nx = sb_blob_cut_blocks(o, i, h * h / m0, flavour, b->frac_S, xb, xe);
+            if (nx < 0) { w->err = 1; continue; }
+            for (q = 0; q < 27; q++) {
+                int id;
+                if (!((q % 3) & 1) && !((q / 3 % 3) & 1) && !((q / 9) & 1)) continue; /* a corner */
+                id = o->cut->csub[27 * i + q];
+                put_u16(w, at + 2 * (size_t)m++, id < 0 ? SN_CUT_NONE : (unsigned)(o->cut_nv0 + id));
+            }
+            put_u8(w, at + 38, (unsigned)nx);
+            put_u32(w, at + 40, first);
+            for (k = 0; k < 8 * nx; k++) {
+                size_t bt = off[SN_SEC_CELLXK] + (size_t)(first + (uint32_t)k) * esz[SN_SEC_CELLXK];
+                int l;
+                if (flavour == SB_FIXED) {
+                    for (l = 0; l < 9; l++) put_u16(w, bt + 2 * (size_t)l, (unsigned)(uint16_t)(int16_t)ldexp(xb[9 * k + l], -xe[k]));
+                    put_u8(w, bt + 18, (unsigned)xe[k]);
+                } else
+                    for (l = 0; l < 9; l++) put_real(w, bt + (size_t)l * (size_t)rs, xb[9 * k + l], 0);
+            }
+            first += 8u * (uint32_t)nx;
+        }
+    }
+}

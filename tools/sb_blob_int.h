@@ -57,4 +57,14 @@ int sb_blob_cell_blocks(const sb_model *o, int ci, double h, double m0, int flav
 int sb_blob_cut_blocks(const sb_model *o, int ci, double sc, int flavour, int frac, double *out, int *xe);
 /* sb_blob_rigs.c: the rig sections (format 3.0) */
 int sb_blob_write_rigs(const sb_model *o, wr_t *w, const uint32_t *off, double Um, double m0, sb_blob *b);
+/* sb_blob_cells.c: CELLS, CFRAMES, CELLK, CELLX, CELLXK written */
+void sb_blob_write_cells(const sb_model *o, wr_t *w, const uint32_t *off, const uint32_t *esz, double h, double m0,
+                         const sb_blob *b);
+/* sb_blob_table.c: every section's count and element size but FPAIRS / FREFS */
+int sb_blob_table(const sb_model *o, int flavour, int rs, int nnz, int nic, int nlim, uint32_t *cnt, uint32_t *esz);
+/* sb_blob_details.c: the cut level's details (format 6.5) */
+int sb_blob_write_details(const sb_model *o, wr_t *w, const uint32_t *off, const uint32_t *esz, double h, double m0,
+                          double U, const double *root, const sb_blob *b);
+/* sb_blob_records.c: shares, constraints, adaptation, crease records, the level maps */
+int sb_blob_write_records(const sb_model *o, wr_t *w, const uint32_t *off, const uint32_t *cnt, double U);
 #endif
