@@ -111,7 +111,7 @@ int sb_blob_make(const sb_model *o, int flavour, sb_blob *b)
         if (b->frac_M < 0 || b->frac_M > 60 || b->frac_P < 0 || b->frac_P > 60) { free(P); free(lump); return sb_fail("mass/preconditioner out of fixed-point range"); }
     }
 
-    /* section table (sb_blob_table.c), the frames' references (format 6.4) */
+    /* section table (sb_blob_table.c) */
     if (sb_blob_table(o, flavour, rs, nnz, ic.n, nlim, cnt, esz) != 0) { sb_ichol_free(&ic); free(P); free(lump); return -1; }
     /* the frames' references (format 6.4): every entry's, and the distinct pairs */
     frefs = sb_alloc(sizeof(uint32_t) * (size_t)(nF + o->nc));
