@@ -43,6 +43,23 @@ for flav in fixed float; do
             printf "  figure: %s callgrind: %.0f instructions per step ((%d-step run - 0-step run) / %d), %.1f per block multiply-add\n", f, per, n, n, per / m }' \
             | tee "$tmp/cgline"
         sed -n 's/.*callgrind: \([0-9]*\) instructions per step.*/\1/p' "$tmp/cgline" > "$tmp/c_${a}_$flav"
+        if command -v callgrind_annotate > /dev/null 2>&1; then # per stage, inclusive (issue 15 item 6)
+            for n in 0 "$STEPS"; do
+                callgrind_annotate --inclusive=yes --threshold=100 "$tmp/cg.$n" 2> /dev/null | grep ' \[' > "$tmp/ann.$n"
+            done
+            printf '  figure: %s callgrind per step by stage (inclusive):' "$flav"
+            for fn in sn_skeleton sn_frames sn_solve sn_rhs matvec sn_precond sn_k_dot sn_k_axpy sn_segments_step sn_health; do
+                awk -v fn="$fn" -v n="$STEPS" -v f0="$tmp/ann.0" -v f1="$tmp/ann.$STEPS" '
+                    function sum(file,   t, line, name) { t = 0
+                        while ((getline line < file) > 0) { k = split(line, w, " "); name = ""
+                            for (i = 2; i < k; i++) if (w[i + 1] ~ /^\[/) name = w[i]
+                            sub(/^.*:/, "", name)
+                            sub(/\..*$/, "", name); if (name == fn) { gsub(",", "", w[1]); t += w[1] } }
+                        close(file); return t }
+                    BEGIN { d = (sum(f1) - sum(f0)) / n; if (d > 0) printf " %s %.0f", fn, d }'
+            done
+            echo
+        fi
     else
         echo "  SKIPPED: valgrind not installed (no instruction counts)"
     fi
