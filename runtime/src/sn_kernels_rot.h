@@ -249,6 +249,17 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
  * table of the 4-bit mask). |x| < 2^62.5 (sn_out's contract): no overflow.
  * The same integers and counts as the reference loops below. */
 SN_INLINE uint32_t sn_k_cnt4(int m) { return (uint32_t)(0x4332322132212110ull >> (4 * m) & 15u); }
+#if defined(__AVX512F__) && defined(__AVX512VL__) /* compares into mask registers, VPMINSQ/VPMAXSQ, VPSRAVQ */
+SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
+    const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
+    *sat += sn_k_cnt4((int)(_mm256_cmpgt_epi64_mask(y, lim) | _mm256_cmpgt_epi64_mask(nlim, y)));
+    return _mm256_max_epi64(_mm256_min_epi64(y, lim), nlim);
+}
+SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
+    const __m256i one = _mm256_set1_epi64x(1);
+    return sn_k_clamp4(_mm256_srav_epi64(_mm256_add_epi64(x, _mm256_sllv_epi64(one, _mm256_sub_epi64(s, one))), s), sat);
+}
+#else
 SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
@@ -261,6 +272,7 @@ SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
     const __m256i m = _mm256_cmpgt_epi64(_mm256_setzero_si256(), y);
     return sn_k_clamp4(_mm256_xor_si256(_mm256_srlv_epi64(_mm256_xor_si256(y, m), s), m), sat);
 }
+#endif
 SN_INLINE __m256i sn_k_sh4(int sh) { return _mm256_set1_epi64x(sh < 0 ? 0 : sh); }
 /* 3 int32 as int64 lanes (lane 3: 0), and back (lanes 0..2; no masked moves, as sn_k_st3q) */
 SN_INLINE __m256i sn_k_ld3d(const void *p) {
