@@ -303,7 +303,7 @@ SN_INLINE __m256i clamp4(__m256i q, uint32_t *c) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     const __m256i hi = _mm256_cmpgt_epi64(q, lim), lo = _mm256_cmpgt_epi64(nlim, q);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
-    *c += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3));
+    if (m) *c += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3)); /* rare */
     return _mm256_blendv_epi8(_mm256_blendv_epi8(q, lim, hi), nlim, lo);
 }
 

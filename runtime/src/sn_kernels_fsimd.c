@@ -184,8 +184,8 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
         sn_fv q = fv_clamp(FV_MUL(vs, FV_LD4(x + i)), &m1);
         q = fv_clamp(FV_ADD(FV_LD4(a + i), q), &m2);
         FV_ST4(out + i, q);
-        c += (uint32_t)((m1 & 1) + (m1 >> 1 & 1) + (m1 >> 2 & 1) + (m1 >> 3 & 1));
-        c += (uint32_t)((m2 & 1) + (m2 >> 1 & 1) + (m2 >> 2 & 1) + (m2 >> 3 & 1));
+        if (m1 | m2) /* rare: the counts of the 4-bit masks from a nibble table */
+            c += (uint32_t)((0x4332322132212110ull >> (4 * m1) & 15u) + (0x4332322132212110ull >> (4 * m2) & 15u));
     }
     *sat += c;
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);

@@ -52,7 +52,7 @@ SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
     const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
-    *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2));
+    if (m) *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2)); /* rare */
     {
         const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
         const int32_t o2 = _mm_extract_epi32(o, 2);
@@ -252,7 +252,8 @@ SN_INLINE uint32_t sn_k_cnt4(int m) { return (uint32_t)(0x4332322132212110ull >>
 #if defined(__AVX512F__) && defined(__AVX512VL__) /* compares into mask registers, VPMINSQ/VPMAXSQ, VPSRAVQ */
 SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
-    *sat += sn_k_cnt4((int)(_mm256_cmpgt_epi64_mask(y, lim) | _mm256_cmpgt_epi64_mask(nlim, y)));
+    const int m = (int)(_mm256_cmpgt_epi64_mask(y, lim) | _mm256_cmpgt_epi64_mask(nlim, y));
+    if (m) *sat += sn_k_cnt4(m); /* rare */
     return _mm256_max_epi64(_mm256_min_epi64(y, lim), nlim);
 }
 SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
@@ -263,7 +264,8 @@ SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
 SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
-    *sat += sn_k_cnt4(_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))));
+    const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
+    if (m) *sat += sn_k_cnt4(m); /* rare */
     return _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
 }
 SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
@@ -377,7 +379,7 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
  * Float SIMD paths: 4 entries per iteration (each entry alone: the same
  * floats and counts), the tail as the reference. */
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
-SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3 & 1)); }
+SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)(0x4332322132212110ull >> (4 * m) & 15u); } /* 4-bit mask's count */
 #endif
 SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_t *sat) {
     uint32_t i = 0;
@@ -392,7 +394,7 @@ SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_
     for (; i + 4 <= n; i += 4) {
         int m;
         FV_ST4(out + i, fv_clamp(FV_LD4(in + i), &m));
-        c += sn_k_bits4(m);
+        if (m) c += sn_k_bits4(m); /* rare */
     }
     *sat += c;
 #endif
@@ -439,7 +441,7 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         int m1, m2;
         const sn_fv mk = fv_clamp(FV_LD4(acc + i), &m1);
         FV_ST4(q + i, fv_clamp(FV_ADD(FV_MUL(FV_LD4(q + i), vk), FV_MUL(mk, vm)), &m2));
-        c += sn_k_bits4(m1) + sn_k_bits4(m2);
+        if (m1 | m2) c += sn_k_bits4(m1) + sn_k_bits4(m2); /* rare */
     }
     *sat += c;
     for (; i < n; i++) {
