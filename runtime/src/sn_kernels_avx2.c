@@ -1,5 +1,6 @@
 /* sn_kernels_avx2.c -- x86-64 AVX2 (and AVX-512VL: the same code, EVEX
- * encoded) kernels of sn_kernels.h, fixed flavour.
+ * encoded, but for the cell products' zmm forms below) kernels of
+ * sn_kernels.h, fixed flavour.
  *
  * cell_mul: one 3x3 block as 4 int64 lanes (the 4th unused) per column or
  * row: the block decoded into two int32 vectors (B0..B7, B1..B8; blk_ld), VPERMD puts a

@@ -6,7 +6,8 @@
  * each as ((p0 + p1) + p2) added to the accumulator, and the blocks come in
  * the reference's order (rows ascending; a corner's row takes the
  * transposed blocks of the rows above it, then its own row): every output
- * is the scalar reference's float, bit for bit. */
+ * is the scalar reference's float, bit for bit. AVX2 uses 8 lanes for the
+ * cell products (two 3-vector halves: below). */
 #include "sn_kernels_fsimd.h"
 
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)

@@ -185,7 +185,8 @@ SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
  *   sn_k_sym_out(b, e, out, sh, sat): out = sn_out(0 + D e, sh), D the
  *     symmetric block of 6 reals at b (xx yy zz xy xz yz; sn_precond.c)
  * Float SIMD paths: lanes as in sn_kernels_fsimd.h (the same floats and
- * counts); every other path: the reference loops. */
+ * counts); fixed AVX2 / AVX-512: int64 lanes (sn_k_out4, the same integers
+ * and counts); every other path: the reference loops. */
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #if defined(SN_KERNELS_FAVX2)
 #define SN_K_LANE(v, k) _mm_permute_ps((v), _MM_SHUFFLE(k, k, k, k))
@@ -377,7 +378,8 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
  *   sn_k_mix(q, acc, kk, n, fm, ck, cm, sat): q[i] = sn_out(q[i] ck +
  *     sn_out(acc[i], fm - SN_KREL(k of i's vertex)) cm, SN_Q_COEF)
  * Float SIMD paths: 4 entries per iteration (each entry alone: the same
- * floats and counts), the tail as the reference. */
+ * floats and counts), the tail as the reference; fixed AVX2 / AVX-512: 4
+ * int64 lanes by sn_k_out4 (sn_k_mix 4 vertices at a time). */
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)(0x4332322132212110ull >> (4 * m) & 15u); } /* 4-bit mask's count */
 #endif
