@@ -18,6 +18,8 @@ $(KP_DIR)/$(1): $(KP_DEPS) $(call det_rt_objs,$(4))
 endef
 $(eval $(call kp_rule,kernels_avx2,$(CC),-mavx2,x86_64-gcc-O2-avx2))
 $(eval $(call kp_rule,kernels_avx2_float,$(CC),-mavx2 -DSN_FLOAT,float-gcc-O2-avx2))
+$(eval $(call kp_rule,kernels_avx512,$(CC),-mavx2 -mavx512f -mavx512vl,x86_64-gcc-O2-avx512))
+$(eval $(call kp_rule,kernels_avx512_float,$(CC),-mavx2 -mavx512f -mavx512vl -DSN_FLOAT,float-gcc-O2-avx512))
 $(eval $(call kp_rule,kernels_aarch64,aarch64-linux-gnu-gcc,-static,aarch64-gcc-O2))
 $(eval $(call kp_rule,kernels_aarch64_float,aarch64-linux-gnu-gcc,-static -DSN_FLOAT,float-aarch64-gcc-O2))
 TEST_DEPS += $(KP_DIR)/kernels_avx2 $(KP_DIR)/kernels_avx2_float \

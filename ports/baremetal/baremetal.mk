@@ -306,10 +306,12 @@ $(eval $(call det_float,float-clang-O2,clang,-O2))
 # the float SIMD kernels (AVX2, aarch64 NEON: sn_kernels_fsimd.c) compute the
 # scalar reference's floats, so every path gives the one float hash (clang's
 # -mavx512f implies FMA: -ffp-contract=off, as above, keeps the scalar code
-# unfused; the kernels' intrinsics never fuse)
+# unfused; the kernels' intrinsics never fuse; GCC 12's SLP fused sn_qmul's
+# float sums even so, sn_math.c)
 $(eval $(call det_float,float-gcc-O2-avx2,gcc,-O2 -mavx2))
 $(eval $(call det_float,float-clang-O2-avx2,clang,-O2 -mavx2))
 $(eval $(call det_float,float-clang-O2-avx512,clang,-O2 -mavx2 -mavx512f -mavx512vl))
+$(eval $(call det_float,float-gcc-O2-avx512,gcc,-O2 -mavx2 -mavx512f -mavx512vl))
 $(eval $(call det_float,float-aarch64-gcc-O2,aarch64-linux-gnu-gcc,-O2 -static))
 $(eval $(call det_float,float-aarch64-gcc-O2-scalar,aarch64-linux-gnu-gcc,-O2 -DSN_SIMD_SCALAR -static))
 $(eval $(call det_float,float-aarch64-clang-O2,clang --target=aarch64-linux-gnu,-O2 -static))

@@ -1,5 +1,6 @@
 /* sn_kernels_avx2.c -- x86-64 AVX2 (and AVX-512VL: the same code, EVEX
- * encoded) kernels of sn_kernels.h, fixed flavour.
+ * encoded, but for the cell products' zmm forms below) kernels of
+ * sn_kernels.h, fixed flavour.
  *
  * cell_mul: one 3x3 block as 4 int64 lanes (the 4th unused) per column or
  * row: the block decoded into two int32 vectors (B0..B7, B1..B8; blk_ld), VPERMD puts a
@@ -41,6 +42,95 @@ SN_INLINE void blk_ld(const unsigned char *K, uint32_t a, uint32_t b, __m256i *v
     }
 }
 
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+/* AVX-512: 8 int64 lanes hold two 3-vectors (the 4th lane of each half
+ * unused). cell_mul: a block's two terms side by side, [B u_b | B^T u_a]
+ * (one VPERMD puts column c in the low half and row c in the high half;
+ * the operand [u_b[c] | u_a[c]] by one merge-masked broadcast); cell_mul2:
+ * the two products side by side, [l1 row | l2 row], operands [u1_b[c] |
+ * u2_b[c]] built once per cell. Exact int64 sums, any order (above). */
+#define Z_IDX(a, b, c, d, e, f) _mm512_setr_epi32(a, 0, b, 0, c, 0, a, 0, d, 0, e, 0, f, 0, d, 0)
+#define Z_PERM(v, idx) _mm512_permutexvar_epi32((idx), _mm512_castsi256_si512(v))
+#define Z_MAC3(p0, p1, p2, x0, x1, x2) \
+    _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epi32((p0), (x0)), _mm512_mul_epi32((p1), (x1))), _mm512_mul_epi32((p2), (x2)))
+SN_INLINE void st3x2(sn_acc *lo, sn_acc *hi, __m512i v) { /* lanes 0..2 -> lo, 4..6 -> hi */
+    int64_t t[8];
+    _mm512_storeu_si512((void *)t, v);
+    lo[0] = t[0]; lo[1] = t[1]; lo[2] = t[2];
+    hi[0] = t[4]; hi[1] = t[5]; hi[2] = t[6];
+    SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60), "cell row beyond 24 * 2^55", t[0]);
+}
+
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0), ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0);
+    const __m512i z0 = Z_IDX(0, 3, 6, 0, 1, 2); /* v0: column 0 | row 0 */
+    const __m512i z1 = Z_IDX(1, 4, 7, 3, 4, 5); /* v0: column 1 | row 1 */
+    const __m512i z2 = Z_IDX(1, 4, 7, 5, 6, 7); /* v1: column 2 | row 2 */
+    __m256i L[8];
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) L[i] = _mm256_setzero_si256();
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        const __m512i wa0 = _mm512_set1_epi32(u[3 * i]), wa1 = _mm512_set1_epi32(u[3 * i + 1]);
+        const __m512i wa2 = _mm512_set1_epi32(u[3 * i + 2]);
+        __m256i v0, v1, la;
+        blk_ld(K, a, a, &v0, &v1);
+        la = _mm256_add_epi64(L[i], _mm256_add_epi64(_mm256_add_epi64(MUL(v0, ic0, _mm512_castsi512_si256(wa0)),
+                                                                      MUL(v0, ic1, _mm512_castsi512_si256(wa1))),
+                                                     MUL(v1, ic1, _mm512_castsi512_si256(wa2))));
+        for (j = i + 1; j < nf; j++) {
+            __m512i t;
+            blk_ld(K, a, fc[j], &v0, &v1);
+            t = Z_MAC3(Z_PERM(v0, z0), Z_PERM(v0, z1), Z_PERM(v1, z2), _mm512_mask_set1_epi32(wa0, 0x00FF, u[3 * j]),
+                       _mm512_mask_set1_epi32(wa1, 0x00FF, u[3 * j + 1]), _mm512_mask_set1_epi32(wa2, 0x00FF, u[3 * j + 2]));
+            la = _mm256_add_epi64(la, _mm512_castsi512_si256(t));
+            L[j] = _mm256_add_epi64(L[j], _mm512_extracti64x4_epi64(t, 1));
+        }
+        L[i] = la;
+    }
+    for (i = 0; i < nf; i++) {
+        int64_t t[4];
+        _mm256_storeu_si256((__m256i *)(void *)t, L[i]);
+        l[3 * i] = t[0];
+        l[3 * i + 1] = t[1];
+        l[3 * i + 2] = t[2];
+        SN_RANGE(SN_WITHIN(t[0], 60) && SN_WITHIN(t[1], 60) && SN_WITHIN(t[2], 60), "cell row beyond 24 * 2^55", t[0]);
+    }
+}
+
+/* l2 at every row (rows outside rows2 unspecified: exact sums, unread) */
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
+    const __m512i c0 = Z_IDX(0, 3, 6, 0, 3, 6), c1 = Z_IDX(1, 4, 7, 1, 4, 7); /* c1 also column 2 of v1 */
+    const __m512i r0 = Z_IDX(0, 1, 2, 0, 1, 2), r1 = Z_IDX(3, 4, 5, 3, 4, 5), r2 = Z_IDX(5, 6, 7, 5, 6, 7);
+    __m512i L[8], W[24];
+    uint32_t a, b;
+    (void)rows2;
+    for (a = 3; a < 24; a++) W[a] = _mm512_mask_set1_epi32(_mm512_set1_epi32(u1[a]), 0xFF00, u2[a]); /* corner 0's unread */
+    for (a = 0; a < 8; a++) L[a] = _mm512_setzero_si512();
+    for (a = 0; a < 8; a++) {
+        __m512i la = L[a];
+        __m256i v0, v1;
+        if (a) { /* the diagonal block (a,a); corner 0's is a product with 0 */
+            blk_ld(K, a, a, &v0, &v1);
+            la = _mm512_add_epi64(la, Z_MAC3(Z_PERM(v0, c0), Z_PERM(v0, c1), Z_PERM(v1, c1), W[3 * a], W[3 * a + 1], W[3 * a + 2]));
+        }
+        for (b = a + 1; b < 8; b++) {
+            blk_ld(K, a, b, &v0, &v1);
+            la = _mm512_add_epi64(la, Z_MAC3(Z_PERM(v0, c0), Z_PERM(v0, c1), Z_PERM(v1, c1), W[3 * b], W[3 * b + 1], W[3 * b + 2]));
+            if (a) /* B^T u_0 = 0 */
+                L[b] = _mm512_add_epi64(L[b], Z_MAC3(Z_PERM(v0, r0), Z_PERM(v0, r1), Z_PERM(v1, r2), W[3 * a], W[3 * a + 1],
+                                                     W[3 * a + 2]));
+        }
+        L[a] = la;
+    }
+    for (a = 0; a < 8; a++) st3x2(l1 + 3 * a, l2 + 3 * a, L[a]);
+}
+#undef Z_IDX
+#undef Z_PERM
+#undef Z_MAC3
+
+#else
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     /* the 4th lane of each index vector reads B0 (a harmless product, never stored) */
     const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0); /* col 0 from B0..B7 */
@@ -149,6 +239,8 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     }
 }
 
+#endif
+
 /* Block-floating dot product: magnitudes ORed 8 lanes at a time (VPABSD of
  * a clamped int32 has the bits of the scalar's uint32 magnitude); then 4
  * vertices = 12 products per iteration in three 4-lane groups, each lane
@@ -212,7 +304,7 @@ SN_INLINE __m256i clamp4(__m256i q, uint32_t *c) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     const __m256i hi = _mm256_cmpgt_epi64(q, lim), lo = _mm256_cmpgt_epi64(nlim, q);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
-    *c += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3));
+    if (m) *c += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3)); /* rare */
     return _mm256_blendv_epi8(_mm256_blendv_epi8(q, lim, hi), nlim, lo);
 }
 

@@ -6,7 +6,8 @@
  * each as ((p0 + p1) + p2) added to the accumulator, and the blocks come in
  * the reference's order (rows ascending; a corner's row takes the
  * transposed blocks of the rows above it, then its own row): every output
- * is the scalar reference's float, bit for bit. */
+ * is the scalar reference's float, bit for bit. AVX2 uses 8 lanes for the
+ * cell products (two 3-vector halves: below). */
 #include "sn_kernels_fsimd.h"
 
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
@@ -21,6 +22,40 @@ SN_INLINE void store_rows(sn_acc *l, const sn_fv *L, uint32_t nf) {
     if (nf) fv_st3(l + 3 * (nf - 1), L[nf - 1]);
 }
 
+#if defined(SN_KERNELS_FAVX2)
+/* AVX2: a block's two terms side by side in 8 lanes, [B u_b | B^T u_a]:
+ * one VPERMPS puts column c in the low half and row c in the high half,
+ * times [u_b[c] x4 | u_a[c] x4]; the low half is added to L_a, the high
+ * half to L_b, in the order of the 4-lane code (each half's lane k is the
+ * same ((p0 + p1) + p2) of output k): the same floats. */
+#define F8_PERM(v, a, b, c, d, e, f) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, d, e, f, f))
+void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
+    sn_fv L[8], c[3];
+    uint32_t i, j;
+    for (i = 0; i < nf; i++) L[i] = FV_SET1(0.0f);
+    for (i = 0; i < nf; i++) {
+        const uint32_t a = fc[i];
+        const __m256 wa0 = _mm256_set1_ps(u[3 * i]), wa1 = _mm256_set1_ps(u[3 * i + 1]), wa2 = _mm256_set1_ps(u[3 * i + 2]);
+        sn_fv la;
+        fv_cols(BLKP(K, a, a), c);
+        la = FV_ADD(L[i], FV_MAC3(c, _mm256_castps256_ps128(wa0), _mm256_castps256_ps128(wa1),
+                                  _mm256_castps256_ps128(wa2))); /* diagonal block (a,a) */
+        for (j = i + 1; j < nf; j++) {
+            const unsigned char *B = BLKP(K, a, fc[j]);
+            const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+            const __m256 t = _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(u[3 * j]), wa0, 0xF0)),
+                              _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(u[3 * j + 1]), wa1, 0xF0))),
+                _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(u[3 * j + 2]), wa2, 0xF0)));
+            la = FV_ADD(la, _mm256_castps256_ps128(t));
+            L[j] = FV_ADD(L[j], _mm256_extractf128_ps(t, 1));
+        }
+        L[i] = la;
+    }
+    store_rows(l, L, nf);
+}
+#undef F8_PERM
+#else
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     sn_fv L[8], r[3], c[3];
     uint32_t i, j;
@@ -42,6 +77,65 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     store_rows(l, L, nf);
 }
 
+#endif
+
+#if defined(SN_KERNELS_FAVX2)
+/* AVX2: the two products side by side in 8 lanes, [l1 row | l2 row]: a
+ * block's row or column in both halves (one VPERMPS), times [u1_b[c] x4 |
+ * u2_b[c] x4] (built once per cell), the rows accumulated in the
+ * reference's order as before. Lanes never mix (lane k of a half is output
+ * k of that product), so the floats are the 4-lane code's. l2 is computed
+ * at every row (rows outside rows2 are unspecified: finite, unread). */
+#define F8_PERM(v, a, b, c) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, a, b, c, c))
+#define F8_MAC3(c, x) _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps((c)[0], (x)[0]), _mm256_mul_ps((c)[1], (x)[1])), \
+                                    _mm256_mul_ps((c)[2], (x)[2]))
+SN_INLINE void f8_cols(const unsigned char *B, __m256 c[3]) {
+    const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+    c[0] = F8_PERM(v0, 0, 3, 6);
+    c[1] = F8_PERM(v0, 1, 4, 7);
+    c[2] = F8_PERM(v1, 1, 4, 7);
+}
+SN_INLINE void f8_blk(const unsigned char *B, __m256 r[3], __m256 c[3]) {
+    const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+    r[0] = F8_PERM(v0, 0, 1, 2);
+    r[1] = F8_PERM(v0, 3, 4, 5);
+    r[2] = F8_PERM(v1, 5, 6, 7);
+    c[0] = F8_PERM(v0, 0, 3, 6);
+    c[1] = F8_PERM(v0, 1, 4, 7);
+    c[2] = F8_PERM(v1, 1, 4, 7);
+}
+void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24], sn_acc l1[24], sn_acc l2[24],
+                    uint32_t rows2) {
+    __m256 L[8], W[24], r[3], c[3];
+    uint32_t a, b;
+    (void)rows2;
+    for (a = 3; a < 24; a++) /* corner 0's operands are never read */
+        W[a] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(u1 + a)), _mm_broadcast_ss(u2 + a), 1);
+    for (a = 0; a < 8; a++) L[a] = _mm256_setzero_ps();
+    for (a = 0; a < 8; a++) {
+        __m256 la = L[a];
+        if (a) { /* the diagonal block; corner 0's is a product with 0 */
+            f8_cols(BLKP(K, a, a), c);
+            la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * a));
+        }
+        for (b = a + 1; b < 8; b++) {
+            f8_blk(BLKP(K, a, b), r, c);
+            la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * b));
+            if (a) L[b] = _mm256_add_ps(L[b], F8_MAC3(r, W + 3 * a)); /* B^T u_0 = 0 */
+        }
+        L[a] = la;
+    }
+    for (a = 0; a < 7; a++) {
+        FV_ST4(l1 + 3 * a, _mm256_castps256_ps128(L[a]));
+        FV_ST4(l2 + 3 * a, _mm256_extractf128_ps(L[a], 1));
+    }
+    fv_st3(l1 + 21, _mm256_castps256_ps128(L[7]));
+    fv_st3(l2 + 21, _mm256_extractf128_ps(L[7], 1));
+}
+#undef F8_PERM
+#undef F8_MAC3
+
+#else /* aarch64: 4 lanes */
 /* Both right-hand-side products, one block load for both: row 0 takes B
  * u_b only (corner 0's operands are 0, sn_kernels.h: the skipped terms are
  * +-0 added to a +0 partial sum, which stays +0), l1 every row, l2 the
@@ -78,6 +172,8 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     store_rows(l2, L2, 8);
 }
 
+#endif
+
 /* out[i] = sn_add(a[i], sn_mulq(s, x[i])): s x clamped and counted, added to
  * a[i], clamped and counted again; 4 entries per iteration, the tail in
  * scalar (each entry alone: the same floats and counts) */
@@ -89,8 +185,8 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
         sn_fv q = fv_clamp(FV_MUL(vs, FV_LD4(x + i)), &m1);
         q = fv_clamp(FV_ADD(FV_LD4(a + i), q), &m2);
         FV_ST4(out + i, q);
-        c += (uint32_t)((m1 & 1) + (m1 >> 1 & 1) + (m1 >> 2 & 1) + (m1 >> 3 & 1));
-        c += (uint32_t)((m2 & 1) + (m2 >> 1 & 1) + (m2 >> 2 & 1) + (m2 >> 3 & 1));
+        if (m1 | m2) /* rare: the counts of the 4-bit masks from a nibble table */
+            c += (uint32_t)((0x4332322132212110ull >> (4 * m1) & 15u) + (0x4332322132212110ull >> (4 * m2) & 15u));
     }
     *sat += c;
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);

@@ -125,7 +125,7 @@ SN_INLINE sn_fv fv_clamp(sn_fv a, int *m) {
 SN_INLINE sn_fv fv_out3(sn_fv a, uint32_t *sat) {
     int m;
     a = fv_clamp(a, &m);
-    *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1));
+    if (m) *sat += (uint32_t)(0x32212110u >> (4 * (m & 7)) & 15u); /* clamps are rare: a branch, then lanes 0..2's count */
     return a;
 }
 /* ((c0 x0 + c1 x1) + c2 x2), the reference's order */

@@ -84,11 +84,21 @@ SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l
  * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
  * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
  * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s). */
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+/* AVX-512VL has the 64-bit arithmetic shift (VPSRAQ): p + 2^(s-1) (1 << s
+ * >> 1: 0 for s = 0), shifted by s, the same floor (no overflow: |p| < 2^44.6) */
+SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
+    const __m128i c = _mm_cvtsi32_si128(s);
+    const __m256i half = _mm256_srli_epi64(_mm256_sll_epi64(_mm256_set1_epi64x(1), c), 1);
+    return _mm256_sra_epi64(_mm256_add_epi64(p, half), c);
+}
+#else
 SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
     const int64_t bias = ((int64_t)1 << 62) + (s > 0 ? (int64_t)1 << (s - 1) : 0);
     return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_set1_epi64x(bias)), _mm_cvtsi32_si128(s)),
                             _mm256_set1_epi64x(((int64_t)1 << 62) >> s));
 }
+#endif
 #define SN_K_IC_W(p) _mm256_cvtepi16_epi64(_mm_loadl_epi64((const __m128i *)(const void *)(p)))
 
 /* columns of U as lanes: U0..U3, U3..U6, U6..U9 (8-byte loads, inside the

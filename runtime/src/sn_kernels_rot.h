@@ -52,7 +52,7 @@ SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
     const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
-    *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2));
+    if (m) *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2)); /* rare */
     {
         const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
         const int32_t o2 = _mm_extract_epi32(o, 2);
@@ -185,7 +185,8 @@ SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
  *   sn_k_sym_out(b, e, out, sh, sat): out = sn_out(0 + D e, sh), D the
  *     symmetric block of 6 reals at b (xx yy zz xy xz yz; sn_precond.c)
  * Float SIMD paths: lanes as in sn_kernels_fsimd.h (the same floats and
- * counts); every other path: the reference loops. */
+ * counts); fixed AVX2 / AVX-512: int64 lanes (sn_k_out4, the same integers
+ * and counts); every other path: the reference loops. */
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #if defined(SN_KERNELS_FAVX2)
 #define SN_K_LANE(v, k) _mm_permute_ps((v), _MM_SHUFFLE(k, k, k, k))
@@ -239,6 +240,95 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     sn_k_sym_cols(b, c);
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
+#elif defined(SN_KERNELS_AVX2)
+/* Fixed AVX2 (and AVX-512): the helpers on int64 lanes (the 4th lane 0 or
+ * unused, never stored). sn_k_out4 is sn_out per lane with shift s (0..62
+ * per int64 lane; a negative shift is passed as 0, sn_rshr64's "s <= 0:
+ * x"): y = x + 2^(s-1) (VPSLLVQ of 1 by s - 1: s = 0 wraps to a count >= 64,
+ * 0), floor(y / 2^s) as (y ^ m) >> s ^ m with m y's sign (AVX2 has no
+ * 64-bit arithmetic shift), the clamp to +-SN_LIM and its count (a nibble
+ * table of the 4-bit mask). |x| < 2^62.5 (sn_out's contract): no overflow.
+ * The same integers and counts as the reference loops below. */
+SN_INLINE uint32_t sn_k_cnt4(int m) { return (uint32_t)(0x4332322132212110ull >> (4 * m) & 15u); }
+#if defined(__AVX512F__) && defined(__AVX512VL__) /* compares into mask registers, VPMINSQ/VPMAXSQ, VPSRAVQ */
+SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
+    const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
+    const int m = (int)(_mm256_cmpgt_epi64_mask(y, lim) | _mm256_cmpgt_epi64_mask(nlim, y));
+    if (m) *sat += sn_k_cnt4(m); /* rare */
+    return _mm256_max_epi64(_mm256_min_epi64(y, lim), nlim);
+}
+SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
+    const __m256i one = _mm256_set1_epi64x(1);
+    return sn_k_clamp4(_mm256_srav_epi64(_mm256_add_epi64(x, _mm256_sllv_epi64(one, _mm256_sub_epi64(s, one))), s), sat);
+}
+#else
+SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
+    const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
+    const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
+    const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
+    if (m) *sat += sn_k_cnt4(m); /* rare */
+    return _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
+}
+SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
+    const __m256i one = _mm256_set1_epi64x(1);
+    const __m256i y = _mm256_add_epi64(x, _mm256_sllv_epi64(one, _mm256_sub_epi64(s, one)));
+    const __m256i m = _mm256_cmpgt_epi64(_mm256_setzero_si256(), y);
+    return sn_k_clamp4(_mm256_xor_si256(_mm256_srlv_epi64(_mm256_xor_si256(y, m), s), m), sat);
+}
+#endif
+SN_INLINE __m256i sn_k_sh4(int sh) { return _mm256_set1_epi64x(sh < 0 ? 0 : sh); }
+/* 3 int32 as int64 lanes (lane 3: 0), and back (lanes 0..2; no masked moves, as sn_k_st3q) */
+SN_INLINE __m256i sn_k_ld3d(const void *p) {
+    int32_t z;
+    memcpy(&z, (const unsigned char *)p + 8, 4);
+    return _mm256_cvtepi32_epi64(_mm_insert_epi32(_mm_loadl_epi64((const __m128i *)p), z, 2));
+}
+SN_INLINE __m128i sn_k_pack4(__m256i v) {
+    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
+}
+SN_INLINE void sn_k_st3d(sn_q *p, __m256i v) {
+    const __m128i o = sn_k_pack4(v);
+    const int32_t o2 = _mm_extract_epi32(o, 2);
+    _mm_storel_epi64((__m128i *)(void *)p, o);
+    memcpy(p + 2, &o2, 4);
+}
+SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    const __m256i t = sn_k_out4(sn_k_ld3q(l), sn_k_sh4(sh), sat); /* lane 3: 0 */
+    const __m256i r0 = _mm256_loadu_si256((const __m256i *)(const void *)R);
+    const __m256i r1 = _mm256_loadu_si256((const __m256i *)(const void *)(R + 1));
+    const __m256i ic0 = _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0), ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0);
+    const __m256i x = _mm256_add_epi64(
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, ic0), _mm256_permute4x64_epi64(t, 0x00)),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, ic1), _mm256_permute4x64_epi64(t, 0x55))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, ic1), _mm256_permute4x64_epi64(t, 0xAA)));
+    sn_k_st3q(acc, _mm256_add_epi64(sn_k_ld3q(acc), x)); /* acc += R t */
+}
+SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    sn_k_st3d(out, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(x), sn_k_ld3d(y)), sat));
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    /* fixed blob reals: little-endian int32 (x86) */
+    sn_k_st3d(out, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(sec + 4u * ia), sn_k_ld3d(sec + 4u * ib)), sat));
+}
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    sn_k_st3d(out, sn_k_clamp4(_mm256_add_epi64(sn_k_ld3d(x), sn_k_ld3d(y)), sat));
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    sn_k_st3d(out, sn_k_out4(_mm256_mul_epi32(sn_k_ld3d(x), _mm256_set1_epi64x(c)), _mm256_set1_epi64x(SN_Q_COEF), sat));
+}
+SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
+    sn_k_st3d(x, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(x), sn_k_ld3q(y)), sat));
+}
+/* l = D e (D: xx yy zz xy xz yz, 6 int32 at b), out = sn_out(l, sh) */
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
+                                              _mm_loadl_epi64((const __m128i *)(const void *)(b + 16)), 1); /* xx yy zz xy xz yz 0 0 */
+    const __m256i x = _mm256_add_epi64(
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi64x(e[0])),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi64x(e[1]))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi64x(e[2])));
+    sn_k_st3d(out, sn_k_out4(x, sn_k_sh4(sh), sat)); /* lane 3: 0 * e */
+}
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     sn_q t[3];
@@ -288,18 +378,25 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
  *   sn_k_mix(q, acc, kk, n, fm, ck, cm, sat): q[i] = sn_out(q[i] ck +
  *     sn_out(acc[i], fm - SN_KREL(k of i's vertex)) cm, SN_Q_COEF)
  * Float SIMD paths: 4 entries per iteration (each entry alone: the same
- * floats and counts), the tail as the reference. */
+ * floats and counts), the tail as the reference; fixed AVX2 / AVX-512: 4
+ * int64 lanes by sn_k_out4 (sn_k_mix 4 vertices at a time). */
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
-SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2 & 1) + (m >> 3 & 1)); }
+SN_INLINE uint32_t sn_k_bits4(int m) { return (uint32_t)(0x4332322132212110ull >> (4 * m) & 15u); } /* 4-bit mask's count */
 #endif
 SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_t *sat) {
     uint32_t i = 0;
-#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#if defined(SN_KERNELS_AVX2)
+    const __m256i sv = sn_k_sh4(s);
+    uint32_t c = 0;
+    for (; i + 4 <= n; i += 4)
+        _mm_storeu_si128((__m128i *)(void *)(out + i), sn_k_pack4(sn_k_out4(_mm256_loadu_si256((const __m256i *)(const void *)(in + i)), sv, &c)));
+    *sat += c;
+#elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
     uint32_t c = 0;
     for (; i + 4 <= n; i += 4) {
         int m;
         FV_ST4(out + i, fv_clamp(FV_LD4(in + i), &m));
-        c += sn_k_bits4(m);
+        if (m) c += sn_k_bits4(m); /* rare */
     }
     *sat += c;
 #endif
@@ -307,14 +404,46 @@ SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_
 }
 SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t n, int fm, sn_q ck, sn_q cm, uint32_t *sat) {
     uint32_t i = 0;
-#if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
+#if defined(SN_KERNELS_AVX2)
+    /* 4 vertices (12 values) per iteration: the per-vertex shifts as lanes
+     * (as sn_k_dot: VPERMQ of the 4), the tail per vertex as the reference */
+    const __m256i vk = _mm256_set1_epi64x(ck), vm = _mm256_set1_epi64x(cm), sq = _mm256_set1_epi64x(SN_Q_COEF);
+    const __m128i base = _mm_set1_epi32(fm - SN_KREL(0));
+    uint32_t c = 0, g;
+    for (; i + 12 <= n; i += 12) {
+        uint32_t k4;
+        __m256i sv, sg[3];
+        memcpy(&k4, kk + i / 3, 4);
+        sv = _mm256_cvtepi32_epi64(_mm_max_epi32(_mm_sub_epi32(base, _mm_cvtepu8_epi32(_mm_cvtsi32_si128((int)k4))),
+                                                 _mm_setzero_si128())); /* sh per vertex, s <= 0 as 0 */
+        sg[0] = _mm256_permute4x64_epi64(sv, 0x40); /* v0 v0 v0 v1 */
+        sg[1] = _mm256_permute4x64_epi64(sv, 0xA5); /* v1 v1 v2 v2 */
+        sg[2] = _mm256_permute4x64_epi64(sv, 0xFE); /* v2 v3 v3 v3 */
+        for (g = 0; g < 3; g++) {
+            const __m256i mk = sn_k_out4(_mm256_loadu_si256((const __m256i *)(const void *)(acc + i + 4 * g)), sg[g], &c);
+            const __m256i qv = _mm256_cvtepi32_epi64(_mm_loadu_si128((const __m128i *)(const void *)(q + i + 4 * g)));
+            const __m256i sum = _mm256_add_epi64(_mm256_mul_epi32(qv, vk), _mm256_mul_epi32(mk, vm));
+            _mm_storeu_si128((__m128i *)(void *)(q + i + 4 * g), sn_k_pack4(sn_k_out4(sum, sq, &c)));
+        }
+    }
+    *sat += c;
+    for (i /= 3; i < n / 3; i++) {
+        int sh = fm - SN_KREL(kk[i]);
+        uint32_t k;
+        for (k = 0; k < 3; k++) {
+            sn_q mk = sn_out(acc[3 * i + k], sh, sat);
+            sn_acc s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
+            q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
+        }
+    }
+#elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
     const sn_fv vk = FV_SET1(ck), vm = FV_SET1(cm);
     uint32_t c = 0;
     for (; i + 4 <= n; i += 4) {
         int m1, m2;
         const sn_fv mk = fv_clamp(FV_LD4(acc + i), &m1);
         FV_ST4(q + i, fv_clamp(FV_ADD(FV_MUL(FV_LD4(q + i), vk), FV_MUL(mk, vm)), &m2));
-        c += sn_k_bits4(m1) + sn_k_bits4(m2);
+        if (m1 | m2) c += sn_k_bits4(m1) + sn_k_bits4(m2); /* rare */
     }
     *sat += c;
     for (; i < n; i++) {

@@ -549,6 +549,13 @@ void sn_qtomat(const sn_q q[4], sn_q R[9]) {
     R[8] = 1.0f - 2.0f * (x * x + y * y);
 }
 
+/* GCC 12 with FMA (-mavx512f, -mfma) SLP-vectorizes these four sums into
+ * one VFMSUBADD, a fused rounding even under -std=c99 / -ffp-contract=off:
+ * the float AVX-512 hash moved. No SLP here under GCC (the reference's
+ * roundings on every target; four sums, nothing to gain). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-slp-vectorize")))
+#endif
 void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]) {
     float o0 = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
     float o1 = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];

@@ -122,6 +122,7 @@ if have clang; then
     want_cpu float-clang-O2-avx512 clang avx512f avx512vl
 fi
 want_cpu float-gcc-O2-avx2 gcc avx2
+want_cpu float-gcc-O2-avx512 gcc avx512f avx512vl
 if have clang; then want_cpu float-clang-O2-avx2 clang avx2; fi
 # the float flavour's NEON kernels (aarch64 only) and its scalar reference there
 want float-aarch64-gcc-O2 aarch64-linux-gnu-gcc qemu-aarch64

@@ -1,6 +1,6 @@
 #!/bin/sh
 # The kernel test on the SIMD paths make test's default build does not
-# compile (tests/kernels.mk): x86-64 AVX2 and aarch64 NEON, fixed and float.
+# compile (tests/kernels.mk): x86-64 AVX2, AVX-512 and aarch64 NEON, fixed and float.
 # Each must pass its bit-for-bit checks against the portable references
 # (fixed: the same integers; float: the reference order's floats).
 . ports/cross/port_lib.sh
@@ -18,6 +18,14 @@ if grep -qw avx2 /proc/cpuinfo 2>/dev/null; then
     run avx2_float - "$K/kernels_avx2_float"
 else
     SKIPS=$((SKIPS + 1)); echo "SKIPPED: avx2 kernels: this CPU has no avx2"
+fi
+# AVX-512 (sn_kernels_avx2.c's 512-bit cell products): built here, where run
+# (not a make test-build dependency: the runner's CPU decides; ~1 min of CPU)
+if grep -qw avx512f /proc/cpuinfo 2>/dev/null && grep -qw avx512vl /proc/cpuinfo 2>/dev/null; then
+    run avx512 - "$K/kernels_avx512"
+    run avx512_float - "$K/kernels_avx512_float"
+else
+    SKIPS=$((SKIPS + 1)); echo "SKIPPED: avx512 kernels: this CPU has no avx512f/avx512vl"
 fi
 if ! have aarch64-linux-gnu-gcc; then skip "aarch64 kernels: no aarch64-linux-gnu-gcc (make deps)"
 elif ! have qemu-aarch64; then skip "aarch64 kernels: no qemu-aarch64 (make deps)"
