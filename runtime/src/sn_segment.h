@@ -115,8 +115,10 @@ typedef float seg_n;
 #else
 #if UINTPTR_MAX > 0xFFFFFFFFu
 typedef int64_t seg_n;
+typedef uint64_t seg_u;
 #else
 typedef int32_t seg_n;
+typedef uint32_t seg_u;
 #endif
 #define MUL(a, b) ((int64_t)(a) * (b))
 #endif
@@ -150,16 +152,11 @@ SN_INLINE seg_n narrow(int64_t x) {
 #define SEG_OUT(v, sat) seg_out((v), (sat))
 SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
     SN_RANGE(v >= -INT32_MAX && v <= INT32_MAX, "segment sum beyond int32", v);
-#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
-    /* |v| <= SN_LIM as one unsigned compare (v within int32 here) */
-    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    /* |v| <= SN_LIM as one unsigned compare in seg_n's width (exact for
+     * every value of that width), the clamp out of the straight path */
+    if ((seg_u)v + (seg_u)SN_LIM <= 2u * (seg_u)SN_LIM) return v;
     (*sat)++;
     return v > 0 ? SN_LIM : -SN_LIM;
-#else
-    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
-    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
-    return v;
-#endif
 }
 #endif
 
@@ -171,6 +168,14 @@ SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
 SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
     const uint32_t lo = (uint32_t)a, um = (uint32_t)m;
     if (lo + um <= 2u * um && (int32_t)(a >> 32) == (int32_t)lo >> 31) return a;
+    return a > 0 ? m : -m;
+}
+#elif !defined(SN_FLOAT)
+/* |a| <= m as one unsigned compare of the 64-bit value (exact for every
+ * int64 a and 0 < m < 2^62), the clamp out of the straight path: the same
+ * value as the two compares */
+SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
+    if ((uint64_t)a + (uint64_t)m <= 2u * (uint64_t)m) return a;
     return a > 0 ? m : -m;
 }
 #else
@@ -249,6 +254,7 @@ typedef struct seg_ctx {
     sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
     seg_n kf0, kf1;     /* level 0's turn factors rf2/half, rf1/half (seg_kf), set by sweep */
     seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
+    sn_acc bias0;       /* level 0's turn rounding bias 2^(sh-1) (seg_bias), set by sweep_prep */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
     sn_len2 gap2;        /* the measuring pass's largest |d|^2 */

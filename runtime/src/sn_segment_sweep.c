@@ -46,12 +46,58 @@ SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its opera
     return sn_rshr64(a, SN_Q_ROT);
 #endif
 }
-SN_INLINE sn_acc rsh(sn_acc a, int s) {
+/* r30(x b) for a factor |x| < 2^29 (fixed; the bound stated at each use):
+ * on a Cortex-M with the DSP extension one SMMULR of 4x and b,
+ * (4 x b + 2^31) >> 32 = (x b + 2^29) >> 30 = sn_rshr64(x b, 30) exactly
+ * (4x within int32), instead of SMULL or SMLAL on a bias pair and a
+ * 64-bit shift (5 instructions); elsewhere that expression */
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP)
+#define SEG_SMMULR 1
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    int32_t r;
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(x * 4), "r"(b));
+    return r;
+}
+#else
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    return NARROW(r30(MUL(x, b)));
+}
+#endif
+
+/* the turn's rounding shift by sh in [0, 29] (recip's b - 1, half < 2^30)
+ * with its bias 2^(sh-1) (0 at sh = 0) formed once per level or segment
+ * (seg_bias), not per component: sn_rshr64(a, sh)'s value. Cortex-M: on
+ * the two words, hi << (32 - sh) as (hi << (31 - sh)) << 1 (0 at sh = 0,
+ * every shift < 32) */
+SN_INLINE sn_acc seg_bias(int sh) {
 #if defined(SN_FLOAT)
-    (void)s;
+    (void)sh;
+    return 0;
+#else
+    SN_RANGE(sh >= 0 && sh <= 29, "segment turn shift beyond [0, 29]", sh);
+    return ((sn_acc)1 << sh) >> 1;
+#endif
+}
+SN_INLINE sn_acc rsh(sn_acc a, int sh, sn_acc bias) {
+#if defined(SN_FLOAT)
+    (void)sh;
+    (void)bias;
     return a;
 #else
-    return sn_rshr64_var(a, s);
+    SN_RANGE(a <= INT64_MAX - bias, "rounding add overflows int64", a);
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    {   /* a + bias as one 64-bit sum (an SMLAL on the bias when a is a product) */
+        const int64_t y = a + bias;
+        const uint32_t lo = (uint32_t)y;
+        const int32_t hi = (int32_t)(y >> 32);
+        return (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | (((uint32_t)hi << (31 - sh)) << 1));
+    }
+#else
+    return (a + bias) >> sh;
+#endif
 #endif
 }
 
@@ -78,17 +124,17 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
 #define SEG_HOT static inline
 #endif
 SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
-                        int sh, uint32_t *sat) {
+                        int sh, sn_acc bias, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
-    e0 = NARROW(seg_lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
-    e1 = NARROW(seg_lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
-    e2 = NARROW(seg_lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
+    e0 = NARROW(seg_lim(rsh(MUL(NARROW(d0 - r30s(du, u0)), kf), sh, bias), ROT_MAX));
+    e1 = NARROW(seg_lim(rsh(MUL(NARROW(d1 - r30s(du, u1)), kf), sh, bias), ROT_MAX));
+    e2 = NARROW(seg_lim(rsh(MUL(NARROW(d2 - r30s(du, u2)), kf), sh, bias), ROT_MAX));
     eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
-    x0 = NARROW(u0 + e0 - r30(MUL(eu, u0)));
-    x1 = NARROW(u1 + e1 - r30(MUL(eu, u1)));
-    x2 = NARROW(u2 + e2 - r30(MUL(eu, u2)));
+    x0 = NARROW(u0 + e0 - r30s(eu, u0));
+    x1 = NARROW(u1 + e1 - r30s(eu, u1));
+    x2 = NARROW(u2 + e2 - r30s(eu, u2));
 #if defined(SN_FLOAT)
     f = 1.5f - 0.5f * (x0 * x0 + x1 * x1 + x2 * x2);
 #else
@@ -108,7 +154,7 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
                      uint32_t *sat) {
     int sh;
     seg_n kf = seg_kf(L, i, s, rf, &sh);
-    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
+    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
 }
 
 /* The measuring pass keeps the largest |d|^2 and converts it once (seg_gap):
@@ -135,13 +181,16 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
     int sha, shb;
+    sn_acc ba, bb;
     if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
         ha = hb = L->half;
         sha = shb = L->sh;
+        ba = bb = C->bias0;
         ka = kb = C->kf0;
     } else {
         ha = A[12]; hb = B[12];
         sha = (int)A[14]; shb = (int)B[14];
+        ba = seg_bias(sha); bb = seg_bias(shb);
         ka = NARROW(r30(MUL(C->rf2, A[13])));
         kb = NARROW(r30(MUL(C->rf2, B[13])));
     }
@@ -149,20 +198,20 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     hb = sb > 0 ? hb : -hb;
     /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
      * t = omega gamma d / 2: |.| < 2^28 (components written out) */
-    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30(MUL(B[3], hb))) - NARROW(A[0] + r30(MUL(A[3], ha))), &ls);
-    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30(MUL(B[4], hb))) - NARROW(A[1] + r30(MUL(A[4], ha))), &ls);
-    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30(MUL(B[5], hb))) - NARROW(A[2] + r30(MUL(A[5], ha))), &ls);
-    t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
-    t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
-    t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
+    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30s(hb, B[3])) - NARROW(A[0] + r30s(ha, A[3])), &ls);
+    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30s(hb, B[4])) - NARROW(A[1] + r30s(ha, A[4])), &ls);
+    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30s(hb, B[5])) - NARROW(A[2] + r30s(ha, A[5])), &ls);
+    t[0] = r30s(d[0], C->gh);
+    t[1] = r30s(d[1], C->gh);
+    t[2] = r30s(d[2], C->gh);
     if (measure) {
         sn_len2 g = sn_norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
     } else {
         ka = sa > 0 ? ka : -ka;
         kb = sb > 0 ? kb : -kb;
-        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
-        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
+        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, ba, &ls);
+        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, bb, &ls);
     }
     *sat += ls;
 }
@@ -181,37 +230,43 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
  * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
 SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                   uint32_t *sat) {
-    seg_n P[5][3], kf[5], h0 = L->half, k0 = C->kf1;
-    int sh[5];
+    seg_n P[5][3];
     sn_acc s0 = 0, s1 = 0, s2 = 0, l0 = 0, l1 = 0, l2 = 0;
     sn_q m0, m1, m2;
     uint32_t ls = 0;
     unsigned j;
+    const int coarse = L->l != 0;
     for (j = 0; j < k; j++) { /* components written out: compilers kept the loop */
         const sn_q *S = L->S + SEG_W * seg[j];
-        seg_n h = h0, f = k0;
-        sh[j] = L->sh;
-        if (L->l != 0) { h = S[12]; sh[j] = (int)S[14]; f = NARROW(r30(MUL(C->rf1, S[13]))); }
-        if (sgn[j] < 0) { h = -h; f = -f; }
-        kf[j] = f;
-        P[j][0] = NARROW(S[0] + r30(MUL(S[3], h)));
-        P[j][1] = NARROW(S[1] + r30(MUL(S[4], h)));
-        P[j][2] = NARROW(S[2] + r30(MUL(S[5], h)));
+        seg_n h = coarse ? S[12] : L->half;
+        if (sgn[j] < 0) h = -h;
+        P[j][0] = NARROW(S[0] + r30s(h, S[3]));
+        P[j][1] = NARROW(S[1] + r30s(h, S[4]));
+        P[j][2] = NARROW(S[2] + r30s(h, S[5]));
         s0 += P[j][0]; s1 += P[j][1]; s2 += P[j][2];
     }
     m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
     for (j = 0; j < k; j++) {
+        /* the turn factor, shift and bias of the end (seg_kf; a move writes
+         * words 0-5 only, so the coarse words 12-14 read here are the
+         * first loop's): no arrays of them across the loops */
+        sn_q *S = L->S + SEG_W * seg[j];
+        seg_n f = C->kf1;
+        int sh = L->sh;
+        sn_acc bias = C->bias0;
         /* |m| <= 2^28, |P| < 2^30: the difference within int32 */
         seg_n d0 = SEG_OUT((seg_n)m0 - P[j][0], &ls), d1 = SEG_OUT((seg_n)m1 - P[j][1], &ls),
               d2 = SEG_OUT((seg_n)m2 - P[j][2], &ls), t0, t1, t2;
+        if (coarse) { sh = (int)S[14]; bias = seg_bias(sh); f = NARROW(r30(MUL(C->rf1, S[13]))); }
+        if (sgn[j] < 0) f = -f;
         if (j + 1 < k) {
-            t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
+            t0 = r30s(d0, C->g1n); t1 = r30s(d1, C->g1n); t2 = r30s(d2, C->g1n);
             l0 -= t0; l1 -= t1; l2 -= t2;
         } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
             t0 = NARROW(seg_lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(seg_lim(l1, (sn_acc)2 * SN_LIM));
             t2 = NARROW(seg_lim(l2, (sn_acc)2 * SN_LIM));
         }
-        move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
+        move_seg(S, d0, d1, d2, t0, t1, t2, f, sh, bias, &ls);
     }
     *sat += ls;
 }
@@ -223,6 +278,7 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
      * each clamped and counted */
     sn_q *S = L->S + SEG_W * a, P[3], d[3], t0, t1, t2;
     int sh;
+    sn_acc bias;
     seg_n kf;
     uint32_t ls = 0;
     end_of(L, a, sa, P, &ls);
@@ -243,10 +299,12 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     if (L->l == 0) { /* level 0: the sweep's turn factor (seg_kf of the level's half) */
         kf = sa > 0 ? C->kf1 : -C->kf1;
         sh = L->sh;
+        bias = C->bias0;
     } else {
         kf = seg_kf(L, a, sa, C->rf1, &sh);
+        bias = seg_bias(sh);
     }
-    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
+    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, bias, &ls);
     *sat += ls;
 }
 
@@ -311,6 +369,7 @@ void seg_sweep_prep(seg_ctx *C, const seg_lvl *L) {
     int sh;
     C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
     C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
+    C->bias0 = seg_bias(L->sh);
     for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
