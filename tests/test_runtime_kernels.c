@@ -660,6 +660,46 @@ static void test_rshr(void) {
         T_CHECK(bad == 0, "saturating add: %d of 196 edge pairs off the clamped int64 sum", bad);
     }
 }
+
+/* ---- the segment move's products and turn shift (sn_segment.h) against
+ * rshr_ref, the division written above: r30s(x, b) (a Cortex-M4's SMMULR of
+ * 4x and b) = round(x b / 2^30) for x in [-2^29, 2^29) (its precondition)
+ * and any int32 b: the edges -2^29, -2^29 + 1, 2^29 - 1, 0, +-1, +-3 times
+ * INT32_MIN, INT32_MAX, +-2^30, 2^30 - 1, 0, +-1, then random widths;
+ * seg_rsh(a, sh, seg_bias(sh)) (the Cortex-M4's two words of an SMLAL sum) =
+ * round(a / 2^sh) for sh 0..29 and |a| <= 2^61: a at the rounding edges
+ * k 2^sh - 2^(sh-1) + {-1, 0, 1} and k 2^sh + {-1, 0, 1} with k near 0,
+ * near the low word's edge (k 2^sh ~ +-2^32) and random, and random
+ * products p kf (|p| < 2^29.6, |kf| <= 2^30, the move's). Tolerance 0. */
+static void test_seg_move_ops(void) {
+    static const int32_t ex[8] = {-(1 << 29), -(1 << 29) + 1, (1 << 29) - 1, 0, 1, -1, 3, -3};
+    static const int32_t eb[8] = {INT32_MIN, INT32_MAX, 1 << 30, -(1 << 30), (1 << 30) - 1, 0, 1, -1};
+    int t, bad_m = 0, bad_s = 0;
+    for (t = 0; t < 60000; t++) {
+        const int32_t sx = rnd32() & 1 ? 1 : -1, sb = rnd32() & 1 ? 1 : -1;
+        const int32_t x = t < 64 ? ex[t % 8] : sx * (int32_t)(rnd32() >> (3 + rnd32() % 29u));
+        const int32_t b = t < 64 ? eb[t / 8] : sb * (int32_t)(rnd32() >> (1 + rnd32() % 31u));
+        const int sh = t % 30;
+        const int64_t h = sh > 0 ? (int64_t)1 << (sh - 1) : 0, one = (int64_t)1 << sh;
+        int64_t a, k;
+        bad_m += (int64_t)r30s((seg_n)x, (seg_n)b) != rshr_ref((int64_t)x * b, 30);
+        switch (t % 4) {
+        case 0: k = (int64_t)(rnd32() % 9u) - 4; break;
+        case 1: k = (((int64_t)1 << 32) >> sh) * (rnd32() & 1 ? 1 : -1) + (int64_t)(rnd32() % 5u) - 2; break;
+        case 2: k = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (3 + sh + rnd32() % 8u)) * (rnd32() & 1 ? 1 : -1); break;
+        default: k = 0;
+        }
+        if (t % 4 == 3) { /* a move's product p kf */
+            a = (int64_t)(sx * (int32_t)(rnd32() >> (2 + rnd32() % 30u))) * (sb * (int32_t)(rnd32() >> (2 + rnd32() % 30u)));
+        } else {
+            static const int64_t off[3] = {-1, 0, 1};
+            a = k * one + off[rnd32() % 3u] - (rnd32() & 1 ? h : 0);
+        }
+        bad_s += seg_rsh(a, sh, seg_bias(sh)) != rshr_ref(a, sh);
+    }
+    T_CHECK(bad_m == 0, "segment r30s (path %s): %d of 60000 products off the rounded division", sn_kernels_name(), bad_m);
+    T_CHECK(bad_s == 0, "segment turn shift seg_rsh: %d of 60000 values off the rounded division", bad_s);
+}
 #endif
 
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
@@ -912,6 +952,7 @@ int main(void) {
     test_rshr();
     test_dot();
     test_seg_clamps();
+    test_seg_move_ops();
     test_mul_out();
 #endif
     test_loops();

@@ -182,6 +182,70 @@ SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
 SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
 #endif
 
+/* ---- the move's multiplies and shifts (sn_segment_sweep.c; tested bit for bit
+ * against a rounded division in test_runtime_kernels, on the Cortex-M4 too) ---- */
+SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+/* r30(x b) for a factor |x| < 2^29 (fixed; the bound stated at each use):
+ * on a Cortex-M with the DSP extension one SMMULR of 4x and b,
+ * (4 x b + 2^31) >> 32 = (x b + 2^29) >> 30 = sn_rshr64(x b, 30) exactly
+ * (4x within int32), instead of SMULL or SMLAL on a bias pair and a
+ * 64-bit shift (5 instructions); elsewhere that expression */
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP)
+#define SEG_SMMULR 1
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    int32_t r;
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(x * 4), "r"(b));
+    return r;
+}
+#else
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    return NARROW(r30(MUL(x, b)));
+}
+#endif
+
+/* the turn's rounding shift by sh in [0, 29] (recip's b - 1, half < 2^30)
+ * with its bias 2^(sh-1) (0 at sh = 0) formed once per level or segment
+ * (seg_bias), not per component: sn_rshr64(a, sh)'s value. Cortex-M: on
+ * the two words, hi << (32 - sh) as (hi << (31 - sh)) << 1 (0 at sh = 0,
+ * every shift < 32) */
+SN_INLINE sn_acc seg_bias(int sh) {
+#if defined(SN_FLOAT)
+    (void)sh;
+    return 0;
+#else
+    SN_RANGE(sh >= 0 && sh <= 29, "segment turn shift beyond [0, 29]", sh);
+    return ((sn_acc)1 << sh) >> 1;
+#endif
+}
+SN_INLINE sn_acc seg_rsh(sn_acc a, int sh, sn_acc bias) {
+#if defined(SN_FLOAT)
+    (void)sh;
+    (void)bias;
+    return a;
+#else
+    SN_RANGE(a <= INT64_MAX - bias, "rounding add overflows int64", a);
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    {   /* a + bias as one 64-bit sum (an SMLAL on the bias when a is a product) */
+        const int64_t y = a + bias;
+        const uint32_t lo = (uint32_t)y;
+        const int32_t hi = (int32_t)(y >> 32);
+        return (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | (((uint32_t)hi << (31 - sh)) << 1));
+    }
+#else
+    return (a + bias) >> sh;
+#endif
+#endif
+}
+
 /* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,
  * one clamp of the sum (fixed); float the same expression */
 SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *sat) {

@@ -39,68 +39,6 @@ void seg_renormalize(const seg_lvl *L) {
  * Fixed: kf = s rf r / 2^30 (|kf| <= 2^30) with r the half length's
  * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: see
  * move_seg; d_perp kf <= 2^59.6; e.u <= 2^58.8 in Q60. */
-SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
-#if defined(SN_FLOAT)
-    return a;
-#else
-    return sn_rshr64(a, SN_Q_ROT);
-#endif
-}
-/* r30(x b) for a factor |x| < 2^29 (fixed; the bound stated at each use):
- * on a Cortex-M with the DSP extension one SMMULR of 4x and b,
- * (4 x b + 2^31) >> 32 = (x b + 2^29) >> 30 = sn_rshr64(x b, 30) exactly
- * (4x within int32), instead of SMULL or SMLAL on a bias pair and a
- * 64-bit shift (5 instructions); elsewhere that expression */
-#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
-    defined(__ARM_FEATURE_DSP)
-#define SEG_SMMULR 1
-SN_INLINE seg_n r30s(seg_n x, seg_n b) {
-    int32_t r;
-    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
-    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(x * 4), "r"(b));
-    return r;
-}
-#else
-SN_INLINE seg_n r30s(seg_n x, seg_n b) {
-    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
-    return NARROW(r30(MUL(x, b)));
-}
-#endif
-
-/* the turn's rounding shift by sh in [0, 29] (recip's b - 1, half < 2^30)
- * with its bias 2^(sh-1) (0 at sh = 0) formed once per level or segment
- * (seg_bias), not per component: sn_rshr64(a, sh)'s value. Cortex-M: on
- * the two words, hi << (32 - sh) as (hi << (31 - sh)) << 1 (0 at sh = 0,
- * every shift < 32) */
-SN_INLINE sn_acc seg_bias(int sh) {
-#if defined(SN_FLOAT)
-    (void)sh;
-    return 0;
-#else
-    SN_RANGE(sh >= 0 && sh <= 29, "segment turn shift beyond [0, 29]", sh);
-    return ((sn_acc)1 << sh) >> 1;
-#endif
-}
-SN_INLINE sn_acc rsh(sn_acc a, int sh, sn_acc bias) {
-#if defined(SN_FLOAT)
-    (void)sh;
-    (void)bias;
-    return a;
-#else
-    SN_RANGE(a <= INT64_MAX - bias, "rounding add overflows int64", a);
-#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
-    {   /* a + bias as one 64-bit sum (an SMLAL on the bias when a is a product) */
-        const int64_t y = a + bias;
-        const uint32_t lo = (uint32_t)y;
-        const int32_t hi = (int32_t)(y >> 32);
-        return (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | (((uint32_t)hi << (31 - sh)) << 1));
-    }
-#else
-    return (a + bias) >> sh;
-#endif
-#endif
-}
-
 /* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
  * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
 SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
@@ -128,9 +66,9 @@ SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1,
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
-    e0 = NARROW(seg_lim(rsh(MUL(NARROW(d0 - r30s(du, u0)), kf), sh, bias), ROT_MAX));
-    e1 = NARROW(seg_lim(rsh(MUL(NARROW(d1 - r30s(du, u1)), kf), sh, bias), ROT_MAX));
-    e2 = NARROW(seg_lim(rsh(MUL(NARROW(d2 - r30s(du, u2)), kf), sh, bias), ROT_MAX));
+    e0 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d0 - r30s(du, u0)), kf), sh, bias), ROT_MAX));
+    e1 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d1 - r30s(du, u1)), kf), sh, bias), ROT_MAX));
+    e2 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d2 - r30s(du, u2)), kf), sh, bias), ROT_MAX));
     eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
     x0 = NARROW(u0 + e0 - r30s(eu, u0));
     x1 = NARROW(u1 + e1 - r30s(eu, u1));
