@@ -6,6 +6,7 @@
  * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
  */
 #include "sn_segment.h"
+#include "sn_kernels.h" /* the SIMD path (float AVX2: star_fv) */
 
 /* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
 
@@ -209,6 +210,135 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     *sat += ls;
 }
 
+#if defined(SN_KERNELS_FAVX2)
+/* Float, x86-64 AVX2 builds (sn_kernels.h's float path): star() with its
+ * k = 3 or 4 ends in the lanes of SSE vectors (lane 3 at k = 3 repeats end
+ * 0 and is never counted or stored). Every lane computes star()'s float
+ * expressions in its order (((a + b) + c), separate multiplies and adds, no
+ * FMA: NUMERICS.md "SIMD kernels", float flavour), the sums over the ends
+ * (the mean's, the last end's share) run end by end as in star() on the
+ * transposed vectors, the clamps are star()'s compares (blends, NaN kept),
+ * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
+ * scalar star's floats and counts. */
+#include <immintrin.h>
+/* seg_lim: a > m ? m : (a < -m ? -m : a) (-m by the sign bit, as negation) */
+SN_INLINE __m128 fv_lim(__m128 a, __m128 m) {
+    const __m128 nm = _mm_xor_ps(m, _mm_set1_ps(-0.0f));
+    return _mm_blendv_ps(_mm_blendv_ps(a, nm, _mm_cmplt_ps(a, nm)), m, _mm_cmpgt_ps(a, m));
+}
+/* sn_out(v, 0) in the lanes of km: unchanged unless beyond +-SN_FLIM or NaN */
+SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
+    const __m128 lim = _mm_set1_ps(SN_FLIM), nlim = _mm_set1_ps(-SN_FLIM);
+    const int f = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(v, lim), _mm_cmplt_ps(v, nlim)),
+                                            _mm_cmpunord_ps(v, v))) & km;
+    if (f) {
+        float x[4];
+        unsigned j;
+        _mm_storeu_ps(x, v);
+        for (j = 0; j < 4; j++)
+            if (f >> j & 1) x[j] = sn_out(x[j], 0, sat);
+        v = _mm_loadu_ps(x);
+    }
+    return v;
+}
+static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
+    sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const int km = k == 4u ? 0xF : 0x7;
+    const __m128 z = _mm_setzero_ps();
+    /* the ends' signs as sign bits (negation = the scalar's -h, -kf) */
+    const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(
+                                      _mm_setr_epi32(sgn[0], sgn[1], sgn[2], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128())),
+                                  _mm_set1_ps(-0.0f));
+    __m128 G0, G1, G2, u0, u1, u2, P0, P1, P2, R0, R1, R2, R3, m, d0, d1, d2, t0, t1, t2, last, kv, hv;
+    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    uint32_t ls = 0;
+    /* words 0-3 of the four segments transposed to G0, G1, G2, u0; words 4-5 by pairs */
+    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
+    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
+    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
+    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
+    if (L->l != 0) {
+        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
+        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
+    } else {
+        hv = _mm_set1_ps(L->half);
+        kv = _mm_set1_ps(C->kf1);
+    }
+    hv = _mm_xor_ps(hv, neg);
+    kv = _mm_xor_ps(kv, neg);
+    P0 = _mm_add_ps(G0, _mm_mul_ps(hv, u0));
+    P1 = _mm_add_ps(G1, _mm_mul_ps(hv, u1));
+    P2 = _mm_add_ps(G2, _mm_mul_ps(hv, u2));
+    /* the mean: per end (P_j0, P_j1, P_j2, 0), summed end by end from 0 */
+    R0 = P0; R1 = P1; R2 = P2; R3 = z;
+    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
+    m = _mm_add_ps(_mm_add_ps(_mm_add_ps(z, R0), R1), R2);
+    if (k == 4u) m = _mm_add_ps(m, R3);
+    m = fv_out(_mm_div_ps(m, _mm_set1_ps((float)k)), 0x7, &ls);
+    d0 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x00), P0), km, &ls);
+    d1 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x55), P1), km, &ls);
+    d2 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0xAA), P2), km, &ls);
+    /* t = D omega gamma; the last end's: minus the others', end by end from 0 */
+    hv = _mm_set1_ps(C->g1n);
+    t0 = _mm_mul_ps(d0, hv); t1 = _mm_mul_ps(d1, hv); t2 = _mm_mul_ps(d2, hv);
+    R0 = t0; R1 = t1; R2 = t2; R3 = z;
+    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
+    last = _mm_sub_ps(_mm_sub_ps(z, R0), R1);
+    if (k == 4u) last = _mm_sub_ps(last, R2);
+    last = fv_lim(last, _mm_set1_ps((sn_acc)2 * SN_LIM));
+    {
+        const __m128 lm = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32((int)k - 1)));
+        t0 = _mm_blendv_ps(t0, _mm_shuffle_ps(last, last, 0x00), lm);
+        t1 = _mm_blendv_ps(t1, _mm_shuffle_ps(last, last, 0x55), lm);
+        t2 = _mm_blendv_ps(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
+    }
+    /* move_seg per lane (kv: the ends' turn factors) */
+    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
+    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
+    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
+    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
+    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
+    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
+    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
+    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
+    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
+                    _mm_mul_ps(_mm_set1_ps(0.5f),
+                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
+    /* back: G0, G1, G2, u0 transposed to words 0-3, u1 u2 by pairs (not lane 3 at k = 3) */
+    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
+    G0 = fv_out(_mm_add_ps(G0, t0), km, &ls);
+    G1 = fv_out(_mm_add_ps(G1, t1), km, &ls);
+    G2 = fv_out(_mm_add_ps(G2, t2), km, &ls);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_unpacklo_ps(u1, u2);
+    R1 = _mm_unpackhi_ps(u1, u2);
+    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
+    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
+    _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1);
+    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    *sat += ls;
+}
+#endif
+
+#if defined(SN_FLOAT)
+/* star() (simd 0) or the step's form of it (star_fv where built, else
+ * star) as a call: test_runtime_kernels compares the two bit for bit. Not
+ * called by the step. */
+void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
+                   uint32_t *sat) {
+#if defined(SN_KERNELS_FAVX2)
+    if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
+#else
+    (void)simd;
+#endif
+    if (k == 4) star(C, L, seg, sgn, 4u, sat);
+    else star(C, L, seg, sgn, 3u, sat);
+}
+#endif
+
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
 SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[3], int measure, uint32_t *sat) {
@@ -294,8 +424,12 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
 SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                          int measure, uint32_t *sat) {
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
+#if defined(SN_KERNELS_FAVX2)
+    else star_fv(C, L, seg, sgn, k, sat);
+#else
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
+#endif
 }
 
 /* What every sweep of level L reads and no sweep changes, once per level:
