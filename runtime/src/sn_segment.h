@@ -253,12 +253,13 @@ SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *
     sn_q r;
     int sh;
     sn_q hl = seg_half(L, i, &r, &sh);
-    /* components written out: compilers kept the loop (it runs per end per sweep) */
+    /* components written out: compilers kept the loop (it runs per end per
+     * sweep); hl < 2^28 (a coarse half is half the clamped nodes' distance,
+     * |d_k| <= 2^28: < 2^27.8), so r30s (one SMMULR on the M4) */
 #if defined(SN_FLOAT)
     sn_q o0 = S[3] * hl, o1 = S[4] * hl, o2 = S[5] * hl;
 #else
-    int64_t o0 = sn_rshr64((int64_t)S[3] * hl, SN_Q_ROT), o1 = sn_rshr64((int64_t)S[4] * hl, SN_Q_ROT),
-            o2 = sn_rshr64((int64_t)S[5] * hl, SN_Q_ROT);
+    seg_n o0 = r30s(hl, S[3]), o1 = r30s(hl, S[4]), o2 = r30s(hl, S[5]);
 #endif
     /* |G| <= 2^28, offset <= 2^29: the end within int32, clamped as one (seg_out) */
     P[0] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[0] + o0 : S[0] - o0), sat);

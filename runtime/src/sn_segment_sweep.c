@@ -361,9 +361,10 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     }
     /* omega gamma < 2^31 as its int32 copy g1n: one 32x32 product (the same
      * product as with the int64 g1) */
-    t0 = sn_out(MUL(d[0], C->g1n), SN_Q_ROT, &ls);
-    t1 = sn_out(MUL(d[1], C->g1n), SN_Q_ROT, &ls);
-    t2 = sn_out(MUL(d[2], C->g1n), SN_Q_ROT, &ls);
+    /* |d| <= 2^28 (sn_add's clamp): r30s, then sn_out's clamp and count */
+    t0 = (sn_q)SEG_OUT(r30s(d[0], C->g1n), &ls);
+    t1 = (sn_q)SEG_OUT(r30s(d[1], C->g1n), &ls);
+    t2 = (sn_q)SEG_OUT(r30s(d[2], C->g1n), &ls);
     if (L->l == 0) { /* level 0: the sweep's turn factor (seg_kf of the level's half) */
         kf = sa > 0 ? C->kf1 : -C->kf1;
         sh = L->sh;
