@@ -704,7 +704,7 @@ static void test_seg_move_ops(void) {
 
 #if defined(SN_FLOAT)
 /* ---- the float star projection of a sheet node (sn_segment_sweep.c): the
- * step's form (path avx2: star_fv, the ends in SSE lanes) against star()
+ * step's form (x86-64: star_fv, the ends in SSE lanes) against star()
  * itself, bit for bit with the saturation counts: 20000 random nodes of 3
  * or 4 ends (distinct segments of 6, random signs) on level 0 and on a
  * coarse level (the segments' own half lengths and turn factors), random

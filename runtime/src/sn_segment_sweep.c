@@ -6,7 +6,7 @@
  * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
  */
 #include "sn_segment.h"
-#include "sn_kernels.h" /* the SIMD path (float AVX2: star_fv) */
+#include "sn_kernels.h" /* SN_SIMD_SCALAR, the float x86-64 star (star_fv) */
 
 /* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
 
@@ -210,8 +210,12 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     *sat += ls;
 }
 
-#if defined(SN_KERNELS_FAVX2)
-/* Float, x86-64 AVX2 builds (sn_kernels.h's float path): star() with its
+#if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
+#define SEG_STAR_SSE 1
+#endif
+#if defined(SEG_STAR_SSE)
+/* Float, x86-64 (SSE2, the baseline; AVX2 builds the same code VEX-encoded;
+ * not under SN_SIMD_SCALAR): star() with its
  * k = 3 or 4 ends in the lanes of SSE vectors (lane 3 at k = 3 repeats end
  * 0 and is never counted or stored). Every lane computes star()'s float
  * expressions in its order (((a + b) + c), separate multiplies and adds, no
@@ -221,10 +225,12 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
  * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
  * scalar star's floats and counts. */
 #include <immintrin.h>
+/* mask ? b : a per lane (bitwise, SSE2) */
+SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) { return _mm_or_ps(_mm_and_ps(mask, b), _mm_andnot_ps(mask, a)); }
 /* seg_lim: a > m ? m : (a < -m ? -m : a) (-m by the sign bit, as negation) */
 SN_INLINE __m128 fv_lim(__m128 a, __m128 m) {
     const __m128 nm = _mm_xor_ps(m, _mm_set1_ps(-0.0f));
-    return _mm_blendv_ps(_mm_blendv_ps(a, nm, _mm_cmplt_ps(a, nm)), m, _mm_cmpgt_ps(a, m));
+    return fv_sel(fv_sel(a, nm, _mm_cmplt_ps(a, nm)), m, _mm_cmpgt_ps(a, m));
 }
 /* sn_out(v, 0) in the lanes of km: unchanged unless beyond +-SN_FLIM or NaN */
 SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
@@ -291,9 +297,9 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     last = fv_lim(last, _mm_set1_ps((sn_acc)2 * SN_LIM));
     {
         const __m128 lm = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32((int)k - 1)));
-        t0 = _mm_blendv_ps(t0, _mm_shuffle_ps(last, last, 0x00), lm);
-        t1 = _mm_blendv_ps(t1, _mm_shuffle_ps(last, last, 0x55), lm);
-        t2 = _mm_blendv_ps(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
+        t0 = fv_sel(t0, _mm_shuffle_ps(last, last, 0x00), lm);
+        t1 = fv_sel(t1, _mm_shuffle_ps(last, last, 0x55), lm);
+        t2 = fv_sel(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
     }
     /* move_seg per lane (kv: the ends' turn factors) */
     du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
@@ -329,7 +335,7 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
  * called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
-#if defined(SN_KERNELS_FAVX2)
+#if defined(SEG_STAR_SSE)
     if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
 #else
     (void)simd;
@@ -425,7 +431,7 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
 SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                          int measure, uint32_t *sat) {
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
-#if defined(SN_KERNELS_FAVX2)
+#if defined(SEG_STAR_SSE)
     else star_fv(C, L, seg, sgn, k, sat);
 #else
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
