@@ -225,8 +225,15 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
  * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
  * scalar star's floats and counts. */
 #include <immintrin.h>
-/* mask ? b : a per lane (bitwise, SSE2) */
-SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) { return _mm_or_ps(_mm_and_ps(mask, b), _mm_andnot_ps(mask, a)); }
+/* mask ? b : a per lane, mask all ones or zeros (a compare's): BLENDVPS
+ * where built (SSE4.1, AVX2 builds), else bitwise (SSE2) */
+SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) {
+#if defined(__SSE4_1__)
+    return _mm_blendv_ps(a, b, mask);
+#else
+    return _mm_or_ps(_mm_and_ps(mask, b), _mm_andnot_ps(mask, a));
+#endif
+}
 /* seg_lim: a > m ? m : (a < -m ? -m : a) (-m by the sign bit, as negation) */
 SN_INLINE __m128 fv_lim(__m128 a, __m128 m) {
     const __m128 nm = _mm_xor_ps(m, _mm_set1_ps(-0.0f));
