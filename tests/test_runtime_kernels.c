@@ -660,6 +660,110 @@ static void test_rshr(void) {
         T_CHECK(bad == 0, "saturating add: %d of 196 edge pairs off the clamped int64 sum", bad);
     }
 }
+
+/* ---- the segment move's products and turn shift (sn_segment.h) against
+ * rshr_ref, the division written above: r30s(x, b) (a Cortex-M4's SMMULR of
+ * 4x and b) = round(x b / 2^30) for x in [-2^29, 2^29) (its precondition)
+ * and any int32 b: the edges -2^29, -2^29 + 1, 2^29 - 1, 0, +-1, +-3 times
+ * INT32_MIN, INT32_MAX, +-2^30, 2^30 - 1, 0, +-1, then random widths;
+ * seg_rsh(a, sh, seg_bias(sh)) (the Cortex-M4's two words of an SMLAL sum) =
+ * round(a / 2^sh) for sh 0..29 and |a| <= 2^61: a at the rounding edges
+ * k 2^sh - 2^(sh-1) + {-1, 0, 1} and k 2^sh + {-1, 0, 1} with k near 0,
+ * near the low word's edge (k 2^sh ~ +-2^32) and random, and random
+ * products p kf (|p| < 2^29.6, |kf| <= 2^30, the move's). Tolerance 0. */
+static void test_seg_move_ops(void) {
+    static const int32_t ex[8] = {-(1 << 29), -(1 << 29) + 1, (1 << 29) - 1, 0, 1, -1, 3, -3};
+    static const int32_t eb[8] = {INT32_MIN, INT32_MAX, 1 << 30, -(1 << 30), (1 << 30) - 1, 0, 1, -1};
+    int t, bad_m = 0, bad_s = 0;
+    for (t = 0; t < 60000; t++) {
+        const int32_t sx = rnd32() & 1 ? 1 : -1, sb = rnd32() & 1 ? 1 : -1;
+        const int32_t x = t < 64 ? ex[t % 8] : sx * (int32_t)(rnd32() >> (3 + rnd32() % 29u));
+        const int32_t b = t < 64 ? eb[t / 8] : sb * (int32_t)(rnd32() >> (1 + rnd32() % 31u));
+        const int sh = t % 30;
+        const int64_t h = sh > 0 ? (int64_t)1 << (sh - 1) : 0, one = (int64_t)1 << sh;
+        int64_t a, k;
+        bad_m += (int64_t)r30s((seg_n)x, (seg_n)b) != rshr_ref((int64_t)x * b, 30);
+        switch (t % 4) {
+        case 0: k = (int64_t)(rnd32() % 9u) - 4; break;
+        case 1: k = (((int64_t)1 << 32) >> sh) * (rnd32() & 1 ? 1 : -1) + (int64_t)(rnd32() % 5u) - 2; break;
+        case 2: k = (int64_t)(((uint64_t)rnd32() << 32 | rnd32()) >> (3 + sh + rnd32() % 8u)) * (rnd32() & 1 ? 1 : -1); break;
+        default: k = 0;
+        }
+        if (t % 4 == 3) { /* a move's product p kf */
+            a = (int64_t)(sx * (int32_t)(rnd32() >> (2 + rnd32() % 30u))) * (sb * (int32_t)(rnd32() >> (2 + rnd32() % 30u)));
+        } else {
+            static const int64_t off[3] = {-1, 0, 1};
+            a = k * one + off[rnd32() % 3u] - (rnd32() & 1 ? h : 0);
+        }
+        bad_s += seg_rsh(a, sh, seg_bias(sh)) != rshr_ref(a, sh);
+    }
+    T_CHECK(bad_m == 0, "segment r30s (path %s): %d of 60000 products off the rounded division", sn_kernels_name(), bad_m);
+    T_CHECK(bad_s == 0, "segment turn shift seg_rsh: %d of 60000 values off the rounded division", bad_s);
+}
+#endif
+
+#if defined(SN_FLOAT)
+/* ---- the float star projection of a sheet node (sn_segment_sweep.c): the
+ * step's form (x86-64: star_fv, the ends in SSE lanes) against star()
+ * itself, bit for bit with the saturation counts: 20000 random nodes of 3
+ * or 4 ends (distinct segments of 6, random signs) on level 0 and on a
+ * coarse level (the segments' own half lengths and turn factors), random
+ * centres and unit directions; every 8th segment pushed to the clamps
+ * (centre at +-(SN_FLIM - 0.5): the mean, the gaps and G + t clamp; half
+ * lengths to 3 and turn factors to 40: the turn limiter), -0.0 components,
+ * and every 64th node with a NaN centre (sn_out's replacement). Tolerance 0. */
+static float rnd_f(float a) { return a * ((float)(rnd32() % 2000001u) / 1000000.0f - 1.0f); }
+static void test_seg_star(void) {
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W];
+    seg_ctx C;
+    seg_lvl L;
+    int t, bad = 0;
+    unsigned long sats = 0;
+    memset(&C, 0, sizeof C);
+    memset(&L, 0, sizeof L);
+    for (t = 0; t < 20000; t++) {
+        const unsigned k = 3u + (unsigned)(t & 1);
+        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, j, w;
+        int sgn[5];
+        float rf = (float)(rnd32() % 1001u) / 1000.0f;
+        for (j = 5; j > 0; j--) { /* distinct segments in a random order */
+            const uint32_t r = rnd32() % (j + 1u), x = perm[j];
+            perm[j] = perm[r]; perm[r] = x;
+        }
+        for (j = 0; j < 5; j++) seg[j] = perm[j];
+        for (j = 0; j < 5; j++) sgn[j] = rnd32() & 1 ? 1 : -1;
+        L.l = (unsigned)(t >> 1 & 1);
+        L.half = 0.05f + (float)(rnd32() % 1000u) / 1000.0f;
+        C.rf1 = rf;
+        C.kf1 = rf * (1.0f / L.half) * (t % 16 == 3 ? 40.0f : 1.0f);
+        C.g1n = (float)(rnd32() % 1001u) / 500.0f;
+        for (j = 0; j < 6; j++) {
+            sn_q *S = SA + SEG_W * j;
+            const int edge = rnd32() % 8u == 0;
+            float n2;
+            for (w = 0; w < 3; w++) S[w] = edge ? (rnd32() & 1 ? 1.0f : -1.0f) * (SN_FLIM - 0.5f) : rnd_f(8.0f);
+            do {
+                for (w = 3; w < 6; w++) S[w] = rnd_f(1.0f);
+                n2 = S[3] * S[3] + S[4] * S[4] + S[5] * S[5];
+            } while (n2 < 0.01f);
+            for (w = 3; w < 6; w++) S[w] /= sqrtf(n2);
+            if (rnd32() % 16u == 0) S[rnd32() % 6u] = -0.0f;
+            for (w = 6; w < SEG_W; w++) S[w] = 0.0f;
+            S[12] = edge ? 3.0f : 0.05f + (float)(rnd32() % 1000u) / 1000.0f;
+            S[13] = 1.0f / S[12];
+        }
+        if (t % 64 == 5) SA[SEG_W * seg[0]] = NAN;
+        memcpy(SB, SA, sizeof SA);
+        L.S = SA;
+        seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
+        L.S = SB;
+        seg_star_test(&C, &L, seg, sgn, k, 1, &sb);
+        bad += memcmp(SA, SB, sizeof SA) != 0 || sa != sb;
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "float star (path %s): %d of 20000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
+    T_FIGURE("float star: 20000 random nodes, %lu clamps and NaN replacements counted", sats);
+}
 #endif
 
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
@@ -919,7 +1023,11 @@ int main(void) {
     test_rshr();
     test_dot();
     test_seg_clamps();
+    test_seg_move_ops();
     test_mul_out();
+#endif
+#if defined(SN_FLOAT)
+    test_seg_star();
 #endif
     test_loops();
     return T_END();

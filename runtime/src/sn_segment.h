@@ -115,8 +115,10 @@ typedef float seg_n;
 #else
 #if UINTPTR_MAX > 0xFFFFFFFFu
 typedef int64_t seg_n;
+typedef uint64_t seg_u;
 #else
 typedef int32_t seg_n;
+typedef uint32_t seg_u;
 #endif
 #define MUL(a, b) ((int64_t)(a) * (b))
 #endif
@@ -150,16 +152,11 @@ SN_INLINE seg_n narrow(int64_t x) {
 #define SEG_OUT(v, sat) seg_out((v), (sat))
 SN_INLINE seg_n seg_out(seg_n v, uint32_t *sat) {
     SN_RANGE(v >= -INT32_MAX && v <= INT32_MAX, "segment sum beyond int32", v);
-#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
-    /* |v| <= SN_LIM as one unsigned compare (v within int32 here) */
-    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    /* |v| <= SN_LIM as one unsigned compare in seg_n's width (exact for
+     * every value of that width), the clamp out of the straight path */
+    if ((seg_u)v + (seg_u)SN_LIM <= 2u * (seg_u)SN_LIM) return v;
     (*sat)++;
     return v > 0 ? SN_LIM : -SN_LIM;
-#else
-    if (v > SN_LIM) { (*sat)++; return SN_LIM; }
-    if (v < -SN_LIM) { (*sat)++; return -SN_LIM; }
-    return v;
-#endif
 }
 #endif
 
@@ -173,9 +170,81 @@ SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
     if (lo + um <= 2u * um && (int32_t)(a >> 32) == (int32_t)lo >> 31) return a;
     return a > 0 ? m : -m;
 }
+#elif !defined(SN_FLOAT)
+/* |a| <= m as one unsigned compare of the 64-bit value (exact for every
+ * int64 a and 0 < m < 2^62), the clamp out of the straight path: the same
+ * value as the two compares */
+SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) {
+    if ((uint64_t)a + (uint64_t)m <= 2u * (uint64_t)m) return a;
+    return a > 0 ? m : -m;
+}
 #else
 SN_INLINE sn_acc seg_lim(sn_acc a, sn_acc m) { return a > m ? m : (a < -m ? -m : a); }
 #endif
+
+/* ---- the move's multiplies and shifts (sn_segment_sweep.c; tested bit for bit
+ * against a rounded division in test_runtime_kernels, on the Cortex-M4 too) ---- */
+SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
+#if defined(SN_FLOAT)
+    return a;
+#else
+    return sn_rshr64(a, SN_Q_ROT);
+#endif
+}
+/* r30(x b) for a factor |x| < 2^29 (fixed; the bound stated at each use):
+ * on a Cortex-M with the DSP extension one SMMULR of 4x and b,
+ * (4 x b + 2^31) >> 32 = (x b + 2^29) >> 30 = sn_rshr64(x b, 30) exactly
+ * (4x within int32), instead of SMULL or SMLAL on a bias pair and a
+ * 64-bit shift (5 instructions); elsewhere that expression */
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP)
+#define SEG_SMMULR 1
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    int32_t r;
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(x * 4), "r"(b));
+    return r;
+}
+#else
+SN_INLINE seg_n r30s(seg_n x, seg_n b) {
+    SN_RANGE(x >= -((int32_t)1 << 29) && x < ((int32_t)1 << 29), "segment SMMULR factor beyond 2^29", x);
+    return NARROW(r30(MUL(x, b)));
+}
+#endif
+
+/* the turn's rounding shift by sh in [0, 29] (recip's b - 1, half < 2^30)
+ * with its bias 2^(sh-1) (0 at sh = 0) formed once per level or segment
+ * (seg_bias), not per component: sn_rshr64(a, sh)'s value. Cortex-M: on
+ * the two words, hi << (32 - sh) as (hi << (31 - sh)) << 1 (0 at sh = 0,
+ * every shift < 32) */
+SN_INLINE sn_acc seg_bias(int sh) {
+#if defined(SN_FLOAT)
+    (void)sh;
+    return 0;
+#else
+    SN_RANGE(sh >= 0 && sh <= 29, "segment turn shift beyond [0, 29]", sh);
+    return ((sn_acc)1 << sh) >> 1;
+#endif
+}
+SN_INLINE sn_acc seg_rsh(sn_acc a, int sh, sn_acc bias) {
+#if defined(SN_FLOAT)
+    (void)sh;
+    (void)bias;
+    return a;
+#else
+    SN_RANGE(a <= INT64_MAX - bias, "rounding add overflows int64", a);
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    {   /* a + bias as one 64-bit sum (an SMLAL on the bias when a is a product) */
+        const int64_t y = a + bias;
+        const uint32_t lo = (uint32_t)y;
+        const int32_t hi = (int32_t)(y >> 32);
+        return (int64_t)(hi >> sh) * ((int64_t)1 << 32) + (int64_t)((lo >> sh) | (((uint32_t)hi << (31 - sh)) << 1));
+    }
+#else
+    return (a + bias) >> sh;
+#endif
+#endif
+}
 
 /* P = G +- half u: the offset (|u| <= 1, half <= 2^29: <= 2^29) in int64,
  * one clamp of the sum (fixed); float the same expression */
@@ -184,12 +253,13 @@ SN_INLINE void end_of(const seg_lvl *L, uint32_t i, int s, sn_q P[3], uint32_t *
     sn_q r;
     int sh;
     sn_q hl = seg_half(L, i, &r, &sh);
-    /* components written out: compilers kept the loop (it runs per end per sweep) */
+    /* components written out: compilers kept the loop (it runs per end per
+     * sweep); hl < 2^28 (a coarse half is half the clamped nodes' distance,
+     * |d_k| <= 2^28: < 2^27.8), so r30s (one SMMULR on the M4) */
 #if defined(SN_FLOAT)
     sn_q o0 = S[3] * hl, o1 = S[4] * hl, o2 = S[5] * hl;
 #else
-    int64_t o0 = sn_rshr64((int64_t)S[3] * hl, SN_Q_ROT), o1 = sn_rshr64((int64_t)S[4] * hl, SN_Q_ROT),
-            o2 = sn_rshr64((int64_t)S[5] * hl, SN_Q_ROT);
+    seg_n o0 = r30s(hl, S[3]), o1 = r30s(hl, S[4]), o2 = r30s(hl, S[5]);
 #endif
     /* |G| <= 2^28, offset <= 2^29: the end within int32, clamped as one (seg_out) */
     P[0] = (sn_q)SEG_OUT(NARROW(s > 0 ? S[0] + o0 : S[0] - o0), sat);
@@ -249,6 +319,7 @@ typedef struct seg_ctx {
     sn_q gb, rfu;       /* gamma/2, 1-gamma: braces and floor, not relaxed */
     seg_n kf0, kf1;     /* level 0's turn factors rf2/half, rf1/half (seg_kf), set by sweep */
     seg_n g1n;          /* omega gamma: < 2^31 (relax <= 63), int32 */
+    sn_acc bias0;       /* level 0's turn rounding bias 2^(sh-1) (seg_bias), set by sweep_prep */
     sn_q fn[3], foff;   /* floor in the internal frame */
     int floor_on;
     sn_len2 gap2;        /* the measuring pass's largest |d|^2 */
@@ -272,6 +343,12 @@ void seg_attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3], ui
 void seg_sweep_prep(seg_ctx *C, const seg_lvl *L);
 /* one sweep in direction dir (0 up / row-major, 1 back), or (measure) the gaps it would close */
 void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat);
+#if defined(SN_FLOAT)
+/* a sheet node's star projection (k = 3, 4 ends): the scalar one (simd 0)
+ * or the step's (SIMD where built), for the kernel test only */
+void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
+                   uint32_t *sat);
+#endif
 /* every segment's u of level L to unit length (three Newton steps) */
 void seg_renormalize(const seg_lvl *L);
 /* the measuring pass's largest |d|^2 as a length in public Q16.16 segment lengths (or float) */

@@ -6,6 +6,7 @@
  * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
  */
 #include "sn_segment.h"
+#include "sn_kernels.h" /* SN_SIMD_SCALAR, the float x86-64 star (star_fv) */
 
 /* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
 
@@ -39,22 +40,6 @@ void seg_renormalize(const seg_lvl *L) {
  * Fixed: kf = s rf r / 2^30 (|kf| <= 2^30) with r the half length's
  * reciprocal 2^(29+b)/half, e = d_perp kf >> (b - 1) (Q30). Bounds: see
  * move_seg; d_perp kf <= 2^59.6; e.u <= 2^58.8 in Q60. */
-SN_INLINE sn_acc r30(sn_acc a) { /* fixed: a Q30 product (sum) back to its operand's Q, rounded */
-#if defined(SN_FLOAT)
-    return a;
-#else
-    return sn_rshr64(a, SN_Q_ROT);
-#endif
-}
-SN_INLINE sn_acc rsh(sn_acc a, int s) {
-#if defined(SN_FLOAT)
-    (void)s;
-    return a;
-#else
-    return sn_rshr64_var(a, s);
-#endif
-}
-
 /* the turn factor of segment i's end s: s rf / half (fixed: s rf r >> 30,
  * |.| <= 2^30, with the shift of r in *sh, see seg_move) */
 SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
@@ -78,17 +63,17 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
 #define SEG_HOT static inline
 #endif
 SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
-                        int sh, uint32_t *sat) {
+                        int sh, sn_acc bias, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
-    e0 = NARROW(seg_lim(rsh(MUL(NARROW(d0 - r30(MUL(du, u0))), kf), sh), ROT_MAX));
-    e1 = NARROW(seg_lim(rsh(MUL(NARROW(d1 - r30(MUL(du, u1))), kf), sh), ROT_MAX));
-    e2 = NARROW(seg_lim(rsh(MUL(NARROW(d2 - r30(MUL(du, u2))), kf), sh), ROT_MAX));
+    e0 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d0 - r30s(du, u0)), kf), sh, bias), ROT_MAX));
+    e1 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d1 - r30s(du, u1)), kf), sh, bias), ROT_MAX));
+    e2 = NARROW(seg_lim(seg_rsh(MUL(NARROW(d2 - r30s(du, u2)), kf), sh, bias), ROT_MAX));
     eu = NARROW(r30(MUL(e0, u0) + MUL(e1, u1) + MUL(e2, u2)));
-    x0 = NARROW(u0 + e0 - r30(MUL(eu, u0)));
-    x1 = NARROW(u1 + e1 - r30(MUL(eu, u1)));
-    x2 = NARROW(u2 + e2 - r30(MUL(eu, u2)));
+    x0 = NARROW(u0 + e0 - r30s(eu, u0));
+    x1 = NARROW(u1 + e1 - r30s(eu, u1));
+    x2 = NARROW(u2 + e2 - r30s(eu, u2));
 #if defined(SN_FLOAT)
     f = 1.5f - 0.5f * (x0 * x0 + x1 * x1 + x2 * x2);
 #else
@@ -108,7 +93,7 @@ static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const
                      uint32_t *sat) {
     int sh;
     seg_n kf = seg_kf(L, i, s, rf, &sh);
-    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, sat);
+    move_seg(L->S + SEG_W * i, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
 }
 
 /* The measuring pass keeps the largest |d|^2 and converts it once (seg_gap):
@@ -135,13 +120,16 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
     int sha, shb;
+    sn_acc ba, bb;
     if (L->l == 0) { /* seg_half, seg_kf: the level's half length and turn factor */
         ha = hb = L->half;
         sha = shb = L->sh;
+        ba = bb = C->bias0;
         ka = kb = C->kf0;
     } else {
         ha = A[12]; hb = B[12];
         sha = (int)A[14]; shb = (int)B[14];
+        ba = seg_bias(sha); bb = seg_bias(shb);
         ka = NARROW(r30(MUL(C->rf2, A[13])));
         kb = NARROW(r30(MUL(C->rf2, B[13])));
     }
@@ -149,20 +137,20 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     hb = sb > 0 ? hb : -hb;
     /* endpoints G +- half u (|.| < 2^30) and their difference, clamped;
      * t = omega gamma d / 2: |.| < 2^28 (components written out) */
-    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30(MUL(B[3], hb))) - NARROW(A[0] + r30(MUL(A[3], ha))), &ls);
-    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30(MUL(B[4], hb))) - NARROW(A[1] + r30(MUL(A[4], ha))), &ls);
-    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30(MUL(B[5], hb))) - NARROW(A[2] + r30(MUL(A[5], ha))), &ls);
-    t[0] = NARROW(r30(MUL(NARROW(d[0]), C->gh)));
-    t[1] = NARROW(r30(MUL(NARROW(d[1]), C->gh)));
-    t[2] = NARROW(r30(MUL(NARROW(d[2]), C->gh)));
+    d[0] = (sn_q)SEG_OUT(NARROW(B[0] + r30s(hb, B[3])) - NARROW(A[0] + r30s(ha, A[3])), &ls);
+    d[1] = (sn_q)SEG_OUT(NARROW(B[1] + r30s(hb, B[4])) - NARROW(A[1] + r30s(ha, A[4])), &ls);
+    d[2] = (sn_q)SEG_OUT(NARROW(B[2] + r30s(hb, B[5])) - NARROW(A[2] + r30s(ha, A[5])), &ls);
+    t[0] = r30s(d[0], C->gh);
+    t[1] = r30s(d[1], C->gh);
+    t[2] = r30s(d[2], C->gh);
     if (measure) {
         sn_len2 g = sn_norm2(d);
         C->gap2 = g > C->gap2 ? g : C->gap2;
     } else {
         ka = sa > 0 ? ka : -ka;
         kb = sb > 0 ? kb : -kb;
-        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, &ls);
-        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, &ls);
+        move_seg(A, d[0], d[1], d[2], t[0], t[1], t[2], ka, sha, ba, &ls);
+        move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, bb, &ls);
     }
     *sat += ls;
 }
@@ -179,42 +167,200 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
  * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
  * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the
  * state range as pair's d; t = D omega gamma (< 2^31) < 2^59 -> Q22 < 2^29. */
+/* star()'s two loops over its k = 3 or 4 ends unrolled (GCC, Clang): per
+ * cow step x86-64 fixed segments 785,010 -> 755,135 instructions, Cortex-M4
+ * step 3,821,450 -> 3,757,556 for 4.6 kB of flash */
+#if defined(__GNUC__)
+#define SEG_UNROLL4 _Pragma("GCC unroll 4")
+#else
+#define SEG_UNROLL4
+#endif
 SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                   uint32_t *sat) {
-    seg_n P[5][3], kf[5], h0 = L->half, k0 = C->kf1;
-    int sh[5];
+    seg_n P[5][3];
     sn_acc s0 = 0, s1 = 0, s2 = 0, l0 = 0, l1 = 0, l2 = 0;
     sn_q m0, m1, m2;
     uint32_t ls = 0;
     unsigned j;
+    const int coarse = L->l != 0;
+    SEG_UNROLL4
     for (j = 0; j < k; j++) { /* components written out: compilers kept the loop */
         const sn_q *S = L->S + SEG_W * seg[j];
-        seg_n h = h0, f = k0;
-        sh[j] = L->sh;
-        if (L->l != 0) { h = S[12]; sh[j] = (int)S[14]; f = NARROW(r30(MUL(C->rf1, S[13]))); }
-        if (sgn[j] < 0) { h = -h; f = -f; }
-        kf[j] = f;
-        P[j][0] = NARROW(S[0] + r30(MUL(S[3], h)));
-        P[j][1] = NARROW(S[1] + r30(MUL(S[4], h)));
-        P[j][2] = NARROW(S[2] + r30(MUL(S[5], h)));
+        seg_n h = coarse ? S[12] : L->half;
+        if (sgn[j] < 0) h = -h;
+        P[j][0] = NARROW(S[0] + r30s(h, S[3]));
+        P[j][1] = NARROW(S[1] + r30s(h, S[4]));
+        P[j][2] = NARROW(S[2] + r30s(h, S[5]));
         s0 += P[j][0]; s1 += P[j][1]; s2 += P[j][2];
     }
     m0 = mean_k(s0, k, &ls); m1 = mean_k(s1, k, &ls); m2 = mean_k(s2, k, &ls);
+    SEG_UNROLL4
     for (j = 0; j < k; j++) {
+        /* the turn factor, shift and bias of the end (seg_kf; a move writes
+         * words 0-5 only, so the coarse words 12-14 read here are the
+         * first loop's): no arrays of them across the loops */
+        sn_q *S = L->S + SEG_W * seg[j];
+        seg_n f = C->kf1;
+        int sh = L->sh;
+        sn_acc bias = C->bias0;
         /* |m| <= 2^28, |P| < 2^30: the difference within int32 */
         seg_n d0 = SEG_OUT((seg_n)m0 - P[j][0], &ls), d1 = SEG_OUT((seg_n)m1 - P[j][1], &ls),
               d2 = SEG_OUT((seg_n)m2 - P[j][2], &ls), t0, t1, t2;
+        if (coarse) { sh = (int)S[14]; bias = seg_bias(sh); f = NARROW(r30(MUL(C->rf1, S[13]))); }
+        if (sgn[j] < 0) f = -f;
         if (j + 1 < k) {
-            t0 = NARROW(r30(MUL(d0, C->g1n))); t1 = NARROW(r30(MUL(d1, C->g1n))); t2 = NARROW(r30(MUL(d2, C->g1n)));
+            t0 = r30s(d0, C->g1n); t1 = r30s(d1, C->g1n); t2 = r30s(d2, C->g1n);
             l0 -= t0; l1 -= t1; l2 -= t2;
         } else { /* the others' sum: |.| <= 2^29 unless a D was clamped */
             t0 = NARROW(seg_lim(l0, (sn_acc)2 * SN_LIM)); t1 = NARROW(seg_lim(l1, (sn_acc)2 * SN_LIM));
             t2 = NARROW(seg_lim(l2, (sn_acc)2 * SN_LIM));
         }
-        move_seg(L->S + SEG_W * seg[j], d0, d1, d2, t0, t1, t2, kf[j], sh[j], &ls);
+        move_seg(S, d0, d1, d2, t0, t1, t2, f, sh, bias, &ls);
     }
     *sat += ls;
 }
+
+#if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
+#define SEG_STAR_SSE 1
+#endif
+#if defined(SEG_STAR_SSE)
+/* Float, x86-64 (SSE2, the baseline; AVX2 builds the same code VEX-encoded;
+ * not under SN_SIMD_SCALAR): star() with its
+ * k = 3 or 4 ends in the lanes of SSE vectors (lane 3 at k = 3 repeats end
+ * 0 and is never counted or stored). Every lane computes star()'s float
+ * expressions in its order (((a + b) + c), separate multiplies and adds, no
+ * FMA: NUMERICS.md "SIMD kernels", float flavour), the sums over the ends
+ * (the mean's, the last end's share) run end by end as in star() on the
+ * transposed vectors, the clamps are star()'s compares (blends, NaN kept),
+ * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
+ * scalar star's floats and counts. */
+#include <immintrin.h>
+/* mask ? b : a per lane, mask all ones or zeros (a compare's): BLENDVPS
+ * where built (SSE4.1, AVX2 builds), else bitwise (SSE2) */
+SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) {
+#if defined(__SSE4_1__)
+    return _mm_blendv_ps(a, b, mask);
+#else
+    return _mm_or_ps(_mm_and_ps(mask, b), _mm_andnot_ps(mask, a));
+#endif
+}
+/* seg_lim: a > m ? m : (a < -m ? -m : a) (-m by the sign bit, as negation) */
+SN_INLINE __m128 fv_lim(__m128 a, __m128 m) {
+    const __m128 nm = _mm_xor_ps(m, _mm_set1_ps(-0.0f));
+    return fv_sel(fv_sel(a, nm, _mm_cmplt_ps(a, nm)), m, _mm_cmpgt_ps(a, m));
+}
+/* sn_out(v, 0) in the lanes of km: unchanged unless beyond +-SN_FLIM or NaN */
+SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
+    const __m128 lim = _mm_set1_ps(SN_FLIM), nlim = _mm_set1_ps(-SN_FLIM);
+    const int f = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(v, lim), _mm_cmplt_ps(v, nlim)),
+                                            _mm_cmpunord_ps(v, v))) & km;
+    if (f) {
+        float x[4];
+        unsigned j;
+        _mm_storeu_ps(x, v);
+        for (j = 0; j < 4; j++)
+            if (f >> j & 1) x[j] = sn_out(x[j], 0, sat);
+        v = _mm_loadu_ps(x);
+    }
+    return v;
+}
+static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
+    sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const int km = k == 4u ? 0xF : 0x7;
+    const __m128 z = _mm_setzero_ps();
+    /* the ends' signs as sign bits (negation = the scalar's -h, -kf) */
+    const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(
+                                      _mm_setr_epi32(sgn[0], sgn[1], sgn[2], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128())),
+                                  _mm_set1_ps(-0.0f));
+    __m128 G0, G1, G2, u0, u1, u2, P0, P1, P2, R0, R1, R2, R3, m, d0, d1, d2, t0, t1, t2, last, kv, hv;
+    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    uint32_t ls = 0;
+    /* words 0-3 of the four segments transposed to G0, G1, G2, u0; words 4-5 by pairs */
+    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
+    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
+    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
+    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
+    if (L->l != 0) {
+        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
+        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
+    } else {
+        hv = _mm_set1_ps(L->half);
+        kv = _mm_set1_ps(C->kf1);
+    }
+    hv = _mm_xor_ps(hv, neg);
+    kv = _mm_xor_ps(kv, neg);
+    P0 = _mm_add_ps(G0, _mm_mul_ps(hv, u0));
+    P1 = _mm_add_ps(G1, _mm_mul_ps(hv, u1));
+    P2 = _mm_add_ps(G2, _mm_mul_ps(hv, u2));
+    /* the mean: per end (P_j0, P_j1, P_j2, 0), summed end by end from 0 */
+    R0 = P0; R1 = P1; R2 = P2; R3 = z;
+    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
+    m = _mm_add_ps(_mm_add_ps(_mm_add_ps(z, R0), R1), R2);
+    if (k == 4u) m = _mm_add_ps(m, R3);
+    m = fv_out(_mm_div_ps(m, _mm_set1_ps((float)k)), 0x7, &ls);
+    d0 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x00), P0), km, &ls);
+    d1 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x55), P1), km, &ls);
+    d2 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0xAA), P2), km, &ls);
+    /* t = D omega gamma; the last end's: minus the others', end by end from 0 */
+    hv = _mm_set1_ps(C->g1n);
+    t0 = _mm_mul_ps(d0, hv); t1 = _mm_mul_ps(d1, hv); t2 = _mm_mul_ps(d2, hv);
+    R0 = t0; R1 = t1; R2 = t2; R3 = z;
+    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
+    last = _mm_sub_ps(_mm_sub_ps(z, R0), R1);
+    if (k == 4u) last = _mm_sub_ps(last, R2);
+    last = fv_lim(last, _mm_set1_ps((sn_acc)2 * SN_LIM));
+    {
+        const __m128 lm = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32((int)k - 1)));
+        t0 = fv_sel(t0, _mm_shuffle_ps(last, last, 0x00), lm);
+        t1 = fv_sel(t1, _mm_shuffle_ps(last, last, 0x55), lm);
+        t2 = fv_sel(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
+    }
+    /* move_seg per lane (kv: the ends' turn factors) */
+    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
+    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
+    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
+    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
+    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
+    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
+    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
+    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
+    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
+                    _mm_mul_ps(_mm_set1_ps(0.5f),
+                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
+    /* back: G0, G1, G2, u0 transposed to words 0-3, u1 u2 by pairs (not lane 3 at k = 3) */
+    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
+    G0 = fv_out(_mm_add_ps(G0, t0), km, &ls);
+    G1 = fv_out(_mm_add_ps(G1, t1), km, &ls);
+    G2 = fv_out(_mm_add_ps(G2, t2), km, &ls);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_unpacklo_ps(u1, u2);
+    R1 = _mm_unpackhi_ps(u1, u2);
+    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
+    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
+    _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1);
+    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    *sat += ls;
+}
+#endif
+
+#if defined(SN_FLOAT)
+/* star() (simd 0) or the step's form of it (star_fv where built, else
+ * star) as a call: test_runtime_kernels compares the two bit for bit. Not
+ * called by the step. */
+void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
+                   uint32_t *sat) {
+#if defined(SEG_STAR_SSE)
+    if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
+#else
+    (void)simd;
+#endif
+    if (k == 4) star(C, L, seg, sgn, 4u, sat);
+    else star(C, L, seg, sgn, 3u, sat);
+}
+#endif
 
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
@@ -223,6 +369,7 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
      * each clamped and counted */
     sn_q *S = L->S + SEG_W * a, P[3], d[3], t0, t1, t2;
     int sh;
+    sn_acc bias;
     seg_n kf;
     uint32_t ls = 0;
     end_of(L, a, sa, P, &ls);
@@ -237,16 +384,19 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     }
     /* omega gamma < 2^31 as its int32 copy g1n: one 32x32 product (the same
      * product as with the int64 g1) */
-    t0 = sn_out(MUL(d[0], C->g1n), SN_Q_ROT, &ls);
-    t1 = sn_out(MUL(d[1], C->g1n), SN_Q_ROT, &ls);
-    t2 = sn_out(MUL(d[2], C->g1n), SN_Q_ROT, &ls);
+    /* |d| <= 2^28 (sn_add's clamp): r30s, then sn_out's clamp and count */
+    t0 = (sn_q)SEG_OUT(r30s(d[0], C->g1n), &ls);
+    t1 = (sn_q)SEG_OUT(r30s(d[1], C->g1n), &ls);
+    t2 = (sn_q)SEG_OUT(r30s(d[2], C->g1n), &ls);
     if (L->l == 0) { /* level 0: the sweep's turn factor (seg_kf of the level's half) */
         kf = sa > 0 ? C->kf1 : -C->kf1;
         sh = L->sh;
+        bias = C->bias0;
     } else {
         kf = seg_kf(L, a, sa, C->rf1, &sh);
+        bias = seg_bias(sh);
     }
-    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, &ls);
+    move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, bias, &ls);
     *sat += ls;
 }
 
@@ -298,8 +448,12 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
 SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                          int measure, uint32_t *sat) {
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
+#if defined(SEG_STAR_SSE)
+    else star_fv(C, L, seg, sgn, k, sat);
+#else
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
+#endif
 }
 
 /* What every sweep of level L reads and no sweep changes, once per level:
@@ -311,6 +465,7 @@ void seg_sweep_prep(seg_ctx *C, const seg_lvl *L) {
     int sh;
     C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
     C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
+    C->bias0 = seg_bias(L->sh);
     for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
