@@ -150,6 +150,21 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
     out[2] = sn_k_rot_out1(sn_mul(R[6], v0) + sn_mul(R[7], v1) + sn_mul(R[8], v2), sat);
 }
 #define sn_k_rot_acc sn_rot_acc
+/* sn_out(l, s) for 0 < s < 32, bit = 2^(s-1): the rounding add's carry and
+ * the shift on the two words (sn_rshr64_var's form), the clamp as the low
+ * word within +-SN_LIM and the high word its sign (sn_k_axpy's test); an
+ * int32 result without 64-bit compares. The same value and count. */
+SN_INLINE int32_t sn_k_out_w(sn_acc l, int s, uint32_t bit, uint32_t *sat) {
+    const uint32_t lo0 = (uint32_t)l + bit;
+    const int32_t hi0 = (int32_t)(l >> 32) + (int32_t)(lo0 < bit);
+    const uint32_t lo = (lo0 >> s) | ((uint32_t)hi0 << (32 - s));
+    const int32_t hi = hi0 >> s;
+    SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", l);
+    if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && hi == (int32_t)lo >> 31) return (int32_t)lo;
+    (*sat)++;
+    return hi < 0 ? -SN_LIM : SN_LIM;
+}
 
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
@@ -240,12 +255,36 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
+#if defined(SN_KERNELS_M4)
+/* t = sn_out(l, sh) as int32 (sn_k_out_w for 0 < sh < 32), then each acc
+ * entry as the start of its SMLAL chain (GCC's sn_rot_acc: SMULL, SMLAL x 2
+ * and a 64-bit add a row); exact int64 sums, the same integers. */
+SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    int32_t t0, t1, t2;
+    int64_t x;
+    if (sh > 0 && sh < 32) {
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        t0 = sn_k_out_w(l[0], sh, bit, sat);
+        t1 = sn_k_out_w(l[1], sh, bit, sat);
+        t2 = sn_k_out_w(l[2], sh, bit, sat);
+    } else {
+        t0 = sn_out(l[0], sh, sat);
+        t1 = sn_out(l[1], sh, sat);
+        t2 = sn_out(l[2], sh, sat);
+    }
+    SN_K_I32(t0, t1, t2);
+    x = acc[0]; x += sn_mul(R[0], t0); x += sn_mul(R[1], t1); x += sn_mul(R[2], t2); acc[0] = x;
+    x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
+    x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
+}
+#else
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     sn_q t[3];
     int c;
     for (c = 0; c < 3; c++) t[c] = sn_out(l[c], sh, sat);
     sn_k_rot_acc(acc, R, t);
 }
+#endif
 SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], -y[c], sat);
@@ -302,6 +341,11 @@ SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_
         c += sn_k_bits4(m);
     }
     *sat += c;
+#elif defined(SN_KERNELS_M4)
+    if (s > 0 && s < 32) {
+        const uint32_t bit = (uint32_t)1 << (s - 1);
+        for (; i < n; i++) out[i] = sn_k_out_w(in[i], s, bit, sat);
+    }
 #endif
     for (; i < n; i++) out[i] = sn_out(in[i], s, sat);
 }
@@ -322,6 +366,17 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         sn_acc s = sn_mul(q[i], ck) + sn_mul(mk, cm);
         q[i] = sn_out(s, SN_Q_COEF, sat);
     }
+#elif defined(SN_KERNELS_M4) /* sn_k_out_w for both roundings; a vertex's shift outside 1..31: the reference's */
+    for (; i < n / 3; i++) {
+        const int sh = fm - SN_KREL(kk[i]);
+        uint32_t k;
+        for (k = 0; k < 3; k++) {
+            int32_t mk = sh > 0 && sh < 32 ? sn_k_out_w(acc[3 * i + k], sh, (uint32_t)1 << (sh - 1), sat)
+                                           : sn_out(acc[3 * i + k], sh, sat);
+            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
+            q[3 * i + k] = sn_k_out_w(sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm), SN_Q_COEF, (uint32_t)1 << (SN_Q_COEF - 1), sat);
+        }
+    }
 #else /* per vertex, its shift once (the loop the mat-vec had) */
     for (; i < n / 3; i++) {
         int sh = fm - SN_KREL(kk[i]);
@@ -329,9 +384,6 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         for (k = 0; k < 3; k++) {
             sn_q mk = sn_out(acc[3 * i + k], sh, sat);
             sn_acc s;
-#if defined(SN_KERNELS_M4)
-            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
-#endif
             s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
             q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
         }
