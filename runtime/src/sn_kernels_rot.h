@@ -165,6 +165,18 @@ SN_INLINE int32_t sn_k_out_w(sn_acc l, int s, uint32_t bit, uint32_t *sat) {
     (*sat)++;
     return hi < 0 ? -SN_LIM : SN_LIM;
 }
+/* the same for 32 <= s <= 62, 2^(s-1) = bhi 2^32 + blo: the value is the
+ * high word after the rounding add, shifted by s - 32 (the low word only
+ * carries), an int32 (|l| < 2^62.5) */
+SN_INLINE int32_t sn_k_out_hw(sn_acc l, int s, uint32_t blo, int32_t bhi, uint32_t *sat) {
+    const uint32_t lo0 = (uint32_t)l + blo;
+    const int32_t v = ((int32_t)(l >> 32) + bhi + (int32_t)(lo0 < blo)) >> (s - 32);
+    SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", l);
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
+}
 
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
@@ -262,11 +274,17 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     int32_t t0, t1, t2;
     int64_t x;
-    if (sh > 0 && sh < 32) {
+    if ((uint32_t)(sh - 1) < 31u) {
         const uint32_t bit = (uint32_t)1 << (sh - 1);
         t0 = sn_k_out_w(l[0], sh, bit, sat);
         t1 = sn_k_out_w(l[1], sh, bit, sat);
         t2 = sn_k_out_w(l[2], sh, bit, sat);
+    } else if ((uint32_t)(sh - 32) < 31u) { /* 32..62: some vertices' stiffness rows */
+        const uint32_t blo = sh == 32 ? (uint32_t)1 << 31 : 0;
+        const int32_t bhi = sh == 32 ? 0 : (int32_t)1 << ((sh - 33) & 31);
+        t0 = sn_k_out_hw(l[0], sh, blo, bhi, sat);
+        t1 = sn_k_out_hw(l[1], sh, blo, bhi, sat);
+        t2 = sn_k_out_hw(l[2], sh, blo, bhi, sat);
     } else {
         t0 = sn_out(l[0], sh, sat);
         t1 = sn_out(l[1], sh, sat);
