@@ -295,6 +295,29 @@ SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3],
     x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
     x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
 }
+/* l = D e in int32 registers (e read first: out may be e), then sn_k_out_w
+ * (0 < sh < 32) or sn_out; exact sums, the same integers */
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    const sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    const sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    int32_t e0 = e[0], e1 = e[1], e2 = e[2];
+    sn_acc l0, l1, l2;
+    SN_K_I32(e0, e1, e2);
+    l0 = sn_mul(xx, e0) + sn_mul(xy, e1) + sn_mul(xz, e2);
+    l1 = sn_mul(xy, e0) + sn_mul(yy, e1) + sn_mul(yz, e2);
+    l2 = sn_mul(xz, e0) + sn_mul(yz, e1) + sn_mul(zz, e2);
+    if ((uint32_t)(sh - 1) < 31u) {
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        out[0] = sn_k_out_w(l0, sh, bit, sat);
+        out[1] = sn_k_out_w(l1, sh, bit, sat);
+        out[2] = sn_k_out_w(l2, sh, bit, sat);
+    } else {
+        out[0] = sn_out(l0, sh, sat);
+        out[1] = sn_out(l1, sh, sat);
+        out[2] = sn_out(l2, sh, sat);
+    }
+}
+#define SN_K_SYM_OUT_M4 1
 #else
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     sn_q t[3];
@@ -326,6 +349,7 @@ SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
 }
 /* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
  * block Jacobi of format 5 did: float keeps its signed zeros); out = sn_out(l, sh) */
+#if !defined(SN_K_SYM_OUT_M4)
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
     sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
     sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
@@ -338,6 +362,7 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     out[1] = sn_out(l[1], sh, sat);
     out[2] = sn_out(l[2], sh, sat);
 }
+#endif
 #endif
 
 /* The mat-vec's last passes (sn_solve.c matvec), over n = 3 nF values:
@@ -416,7 +441,7 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
  * code as before). The same value. */
 #if defined(SN_KERNELS_M4)
 SN_INLINE sn_acc sn_k_mul_out(sn_q d, sn_acc l, int s, uint32_t *sat) {
-    int32_t t = sn_out(l, s, sat);
+    int32_t t = (uint32_t)(s - 1) < 31u ? sn_k_out_w(l, s, (uint32_t)1 << (s - 1), sat) : sn_out(l, s, sat);
     __asm__("" : "+r"(t));
     return sn_mul(d, t);
 }
