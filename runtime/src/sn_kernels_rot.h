@@ -155,8 +155,9 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
  * word within +-SN_LIM and the high word its sign (sn_k_axpy's test); an
  * int32 result without 64-bit compares. The same value and count. */
 SN_INLINE int32_t sn_k_out_w(sn_acc l, int s, uint32_t bit, uint32_t *sat) {
-    const uint32_t lo0 = (uint32_t)l + bit;
-    const int32_t hi0 = (int32_t)(l >> 32) + (int32_t)(lo0 < bit);
+    const int64_t r = l + (int64_t)bit; /* ADDS, ADC (a carry by compare cost GCC 4) */
+    const uint32_t lo0 = (uint32_t)r;
+    const int32_t hi0 = (int32_t)(r >> 32);
     const uint32_t lo = (lo0 >> s) | ((uint32_t)hi0 << (32 - s));
     const int32_t hi = hi0 >> s;
     SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
@@ -169,8 +170,7 @@ SN_INLINE int32_t sn_k_out_w(sn_acc l, int s, uint32_t bit, uint32_t *sat) {
  * high word after the rounding add, shifted by s - 32 (the low word only
  * carries), an int32 (|l| < 2^62.5) */
 SN_INLINE int32_t sn_k_out_hw(sn_acc l, int s, uint32_t blo, int32_t bhi, uint32_t *sat) {
-    const uint32_t lo0 = (uint32_t)l + blo;
-    const int32_t v = ((int32_t)(l >> 32) + bhi + (int32_t)(lo0 < blo)) >> (s - 32);
+    const int32_t v = (int32_t)((l + (int64_t)(((uint64_t)(uint32_t)bhi << 32) | blo)) >> 32) >> (s - 32);
     SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
              "accumulator beyond 2^62.5 reaches sn_out", l);
     if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
