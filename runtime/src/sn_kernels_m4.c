@@ -401,6 +401,110 @@ __asm__(
     ".purgem snic_row\n"
     ".popsection\n");
 
+/* The IC(0) forward sweep's column (sn_k_ic_fwd_col, sn_kernels_ic.h) in
+ * Thumb-2: for the blocks of column j while their row i < nF and their
+ * shift s = frac + k_j - k_i is in 1..31: acc_i += round(U^T y_j), each of
+ * the three sums from the rounding term 2^(s-1) through three SMLAL, the
+ * shift on the two words (sn_k_ic_m4's value), added to acc_i by
+ * LDRD/ADDS/ADC/STRD. y_j stays in r0-r2 for the column (GCC's inlined
+ * sn_k_ic_col reloaded it and the loop's bounds: 91 instructions a block,
+ * here 70). Leaves in c (blk, cols) where it stopped: the column's end
+ * or a skeleton row (returns 0), or a block for the reference (returns 1). */
+typedef char sn_m4_icc_layout_[sizeof(struct sn_m4_icc) == 32 && SN_ELEM_ICHOL == 20 ? 1 : -1];
+
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_ic_cols,\"ax\",%progbits\n"
+    /* row k of U^T (column k of U: entries k, 3 + k, 6 + k) */
+    ".macro snicc_row k\n"
+    "mov   r8, r11\n"
+    "mov   r9, #0\n"
+    "ldrsh r10, [r3, #(2 * \\k)]\n"
+    "smlal r8, r9, r10, r0\n"
+    "ldrsh r10, [r3, #(2 * \\k + 6)]\n"
+    "smlal r8, r9, r10, r1\n"
+    "ldrsh r10, [r3, #(2 * \\k + 12)]\n"
+    "smlal r8, r9, r10, r2\n"
+    "lsr   r8, r8, r5\n"
+    "lsl   r10, r9, r6\n"
+    "orr   r8, r8, r10\n"
+    "asr   r9, r9, r5\n"
+    "ldrd  r10, r12, [r7, #(8 * \\k)]\n"
+    "adds  r10, r10, r8\n"
+    "adc   r12, r12, r9\n"
+    "strd  r10, r12, [r7, #(8 * \\k)]\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_ic_cols\n"
+    ".thumb_func\n"
+    ".type sn_m4_ic_cols, %function\n"
+    "sn_m4_ic_cols:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #4\n"               /* [sp] c */
+    "str   r0, [sp]\n"
+    "ldr   r3, [r0, #0]\n"            /* blk */
+    "ldr   r4, [r0, #4]\n"            /* cols */
+    "ldr   r12, [r0, #28]\n"
+    "ldm   r12, {r0, r1, r2}\n"        /* y_j */
+    "1:\n"
+    "ldr   r12, [sp]\n"
+    "ldr   lr, [r12, #8]\n"
+    "cmp   r4, lr\n"
+    "beq   9f\n"                       /* the column's end */
+    "ldrh  r7, [r4]\n"                 /* i */
+    "ldr   lr, [r12, #20]\n"
+    "cmp   r7, lr\n"
+    "bhs   9f\n"                       /* a skeleton row: the column's free blocks are done */
+    "ldr   lr, [r12, #12]\n"
+    "ldrb  lr, [lr, r7]\n"             /* k_i */
+    "ldrb  r5, [r3, #18]\n"            /* frac */
+    "ldr   r6, [r12, #24]\n"
+    "add   r5, r5, r6\n"
+    "sub   r5, r5, lr\n"               /* s */
+    "sub   lr, r5, #1\n"
+    "cmp   lr, #30\n"
+    "bhi   8f\n"                       /* s <= 0 or s >= 32: the reference's block */
+    "mov   r11, #1\n"
+    "lsl   r11, r11, lr\n"             /* 2^(s-1) */
+    "rsb   r6, r5, #32\n"
+    "ldr   lr, [r12, #16]\n"
+    "add   r7, r7, r7, lsl #1\n"
+    "add   r7, lr, r7, lsl #3\n"       /* acc + 3 i */
+    "snicc_row 0\n"
+    "snicc_row 1\n"
+    "snicc_row 2\n"
+    "add   r3, r3, #20\n"
+    "add   r4, r4, #2\n"
+    "b     1b\n"
+    "8:\n"
+    "mov   r0, #1\n"                   /* returns 1: a block for the reference */
+    "b     7f\n"
+    "9:\n"
+    "mov   r0, #0\n"
+    "7:\n"
+    "str   r3, [r12, #0]\n"
+    "str   r4, [r12, #4]\n"
+    "add   sp, sp, #4\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_ic_cols, .-sn_m4_ic_cols\n"
+    ".purgem snicc_row\n"
+    ".popsection\n");
+
+/* the forward sweep's column after a block sn_m4_ic_cols left: that
+ * block by the reference, then the loop again, until the column's end or a
+ * skeleton row */
+void sn_m4_ic_cols_rest(struct sn_m4_icc *c, uint32_t *sat) {
+    while (c->cols != c->cend) {
+        const uint32_t i = sn_rd_u16(c->cols);
+        if (i >= c->nF) break;
+        sn_k_ic_col_ref(c->blk, c->y, (int)c->blk[18] + c->kj - (int)c->kk[i], c->acc + 3 * i, sat);
+        c->blk += SN_ELEM_ICHOL;
+        c->cols += 2;
+        if (!sn_m4_ic_cols(c)) break;
+    }
+}
+
 /* sn_k_ic_bwd_row after a block the Thumb-2 loop left (s = 0 or s >= 32): that
  * block by the reference, then the loop again from the next one */
 void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
