@@ -758,6 +758,130 @@ static void test_loops(void) {
     T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", (unsigned)clamps);
 }
 
+#if !defined(SN_FLOAT)
+/* The rounding-and-clamp helpers at their edges (every path; on the M4 they
+ * run sn_k_out_w / sn_k_out_hw, "M4 round 3"): accumulators l = v 2^s + d
+ * with v at 0, +-1, +-(SN_LIM - 1), +-SN_LIM, +-(SN_LIM + 1), +-2^30 and d at
+ * 0, +-1, +-2^(s-1) and its neighbours (the rounding's ties), plus +-(2^62 -
+ * 1) and random values, for every shift 0..62: sn_k_out_rot_acc, sn_k_outv,
+ * sn_k_mix, sn_k_mul_out against sn_out (sn_internal.h, the reference),
+ * bit for bit with the same clamp counts; on the M4 sn_k_out_w (s < 32) and
+ * sn_k_out_hw (32..62) themselves too. */
+static int edge_ls(int s, sn_acc *l) {
+    static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1),
+                                 1 << 30, -(1 << 30)};
+    const int64_t h = s > 0 ? (int64_t)1 << (s - 1) : 0;
+    const int64_t ds[] = {0, 1, -1, h, -h, h - 1, -h - 1, h + 1, -h + 1};
+    int n = 0;
+    uint32_t a, b;
+    for (a = 0; a < sizeof vs / sizeof vs[0]; a++) {
+        const int64_t v = vs[a];
+        if ((v < 0 ? -v : v) >= ((int64_t)1 << (62 - s))) continue; /* |v 2^s| < 2^62 */
+        for (b = 0; b < sizeof ds / sizeof ds[0]; b++) l[n++] = v * ((int64_t)1 << s) + ds[b];
+    }
+    l[n++] = ((int64_t)1 << 62) - 1;
+    l[n++] = -(((int64_t)1 << 62) - 1);
+    for (a = 0; a < 6; a++) l[n++] = (int64_t)rnd_in(1 << 30) * ((int64_t)1 << (rnd32() % 32u));
+    return n;
+}
+static void test_out_edges(void) {
+    int s, bad = 0, cases = 0;
+    uint32_t clamps = 0;
+    for (s = 0; s <= 62; s++) {
+        sn_acc l[128];
+        const int n = edge_ls(s, l);
+        int i, k;
+        for (i = 0; i < n; i++) {
+            sn_q R[9], q1[3], q2[3], ck = rnd_in(1 << 24), cm = rnd_in(1 << 24);
+            sn_acc a1[3], a2[3], lv[3] = {l[i], l[(i + 1) % n], l[(i + 7) % n]};
+            uint8_t kk[1] = {(uint8_t)(rnd32() % 4u)};
+            uint32_t s1 = 0, s2 = 0;
+            for (k = 0; k < 9; k++) R[k] = rnd_in(1 << 30);
+            for (k = 0; k < 3; k++) a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 20;
+            sn_k_out_rot_acc(a1, R, lv, s, &s1);
+            for (k = 0; k < 3; k++) q2[k] = sn_out(lv[k], s, &s2);
+            sn_rot_acc(a2, R, q2);
+            bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+            sn_k_outv(q1, lv, 3, s, &s1);
+            for (k = 0; k < 3; k++) q2[k] = sn_out(lv[k], s, &s2);
+            bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+            bad += sn_k_mul_out(ck, lv[0], s, &s1) != sn_mul(ck, sn_out(lv[0], s, &s2)) || s1 != s2;
+            if (s >= SN_KREL(kk[0])) {
+                const int fm = s + SN_KREL(kk[0]);
+                for (k = 0; k < 3; k++) q1[k] = q2[k] = rnd_in(SN_LIM);
+                sn_k_mix(q1, lv, kk, 3, fm, ck, cm, &s1);
+                for (k = 0; k < 3; k++) q2[k] = sn_out(sn_mul(q2[k], ck) + sn_mul(sn_out(lv[k], s, &s2), cm), SN_Q_COEF, &s2);
+                bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+            }
+#if defined(SN_KERNELS_M4)
+            if (s > 0 && s < 32) bad += sn_k_out_w(l[i], s, (uint32_t)1 << (s - 1), &s1) != sn_out(l[i], s, &s2) || s1 != s2;
+            if (s >= 32) bad += sn_k_out_hw(l[i], s, s == 32 ? (uint32_t)1 << 31 : 0, s == 32 ? 0 : (int32_t)1 << (s - 33), &s1) !=
+                                    sn_out(l[i], s, &s2) || s1 != s2;
+#endif
+            clamps += s2;
+            cases++;
+        }
+    }
+    T_CHECK(bad == 0, "rounding helpers at their edges (path %s): %d results or clamp counts off sn_out", sn_kernels_name(), bad);
+    T_FIGURE("rounding helpers: %d edge accumulators over shifts 0..62, %u clamps", cases, (unsigned)clamps);
+}
+#endif
+
+#if defined(SN_K_IC_FWD_COL)
+/* The M4's forward-sweep column (sn_k_ic_fwd_col: sn_m4_ic_cols and its
+ * reference fallback) against ic_forward's loop on the portable reference
+ * (sn_k_ic_col_ref per block, stopping at the first row >= nF): random
+ * columns of 0..12 blocks, row indices sometimes past nF, vertex exponents
+ * 0..3 and fracs 0..40 (shifts below 1 and past 31 included), y at the
+ * state bound and INT32_MIN/MAX; the accumulators, the clamp count and the
+ * blocks read must match exactly. */
+static void test_ic_fwd(void) {
+    static unsigned char L[12 * 20], cols[24];
+    static sn_acc a1[90], a2[90];
+    int t, bad = 0, odd = 0, stops = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q y[3];
+        uint8_t kk[30];
+        const uint32_t nF = 20u + rnd32() % 10u, nb = rnd32() % 13u;
+        const int kj = (int)(rnd32() % 4u), wild = t % 8 == 0;
+        uint32_t e, k, n1, n2 = 0, s1 = 0, s2 = 0;
+        struct sn_m4_icc c;
+        for (k = 0; k < 3; k++)
+            y[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? SN_LIM : -SN_LIM)) : rnd_in(SN_LIM);
+        for (k = 0; k < 30; k++) kk[k] = (uint8_t)(rnd32() % 4u);
+        for (k = 0; k < 90; k++) a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12;
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            const uint32_t row = rnd32() % 16u == 0 ? nF + rnd32() % 3u : rnd32() % nF;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 8u == 0 ? rnd32() % 41u : 1u + rnd32() % 28u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)row;
+            cols[2 * e + 1] = 0;
+        }
+        sn_k_ic_fwd_init(&c, kk, a1, nF);
+        n1 = nb ? sn_k_ic_fwd_col(&c, L, cols, cols + 2 * nb, y, kj, &s1) : 0;
+        for (e = 0; e < nb; e++) {
+            const uint32_t i = cols[2 * e];
+            int s;
+            if (i >= nF) { stops++; break; }
+            s = (int)L[20 * e + 18] + kj - (int)kk[i];
+            odd += s <= 0 || s >= 32;
+            sn_k_ic_col_ref(L + 20 * e, y, s, a2 + 3 * i, &s2);
+            n2++;
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2 || n1 != n2;
+    }
+    T_CHECK(bad == 0, "IC(0) forward columns (path %s): %d of 3000 columns differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("IC(0) forward columns: 3000 columns of 0..12 blocks, %d blocks with shift outside 1..31, %d stopped at a row >= nF", odd, stops);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -905,6 +1029,12 @@ int main(void) {
     test_mul2_ref();
     test_ic();
     test_ic_rows();
+#if defined(SN_K_IC_FWD_COL)
+    test_ic_fwd();
+#endif
+#if !defined(SN_FLOAT)
+    test_out_edges();
+#endif
     test_rot();
     test_axpy();
     test_isqrt();
