@@ -882,6 +882,55 @@ static void test_ic_fwd(void) {
 }
 #endif
 
+#if defined(SN_K_MASS_FF)
+/* The M4's mass pass (sn_k_mass_ff) against pass_M_ff's loop written here
+ * with sn_mul (exact int64 sums: tolerance 0): random row structures of
+ * 1..40 free rows, 0..8 blocks a row, columns past nF (the row stops there)
+ * and operands at the bounds (y +-2^28 and INT32_MIN/MAX; |M| <= 2^23, so
+ * the <= 330 products of <= 2^54 a sum gets stay below 2^63). */
+static void test_mass_ff(void) {
+    static unsigned char rp[4 * 41], cols[2 * 400], md[4 * 40], mo[4 * 400];
+    static sn_q y[3 * 48];
+    static sn_acc a1[3 * 40], a2[3 * 40];
+    int t, bad = 0, stops = 0;
+    for (t = 0; t < 500; t++) {
+        const uint32_t nF = 1u + rnd32() % 40u;
+        const int wild = t % 8 == 0;
+        uint32_t i, e = 0, k;
+        for (i = 0; i < 3 * 48; i++) y[i] = wild ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : rnd32() & 1 ? rnd_in(SN_LIM) : (rnd32() & 1 ? SN_LIM : -SN_LIM);
+        for (i = 0; i < nF; i++) {
+            const uint32_t nb = rnd32() % 9u;
+            put32(rp + 4 * i, e);
+            put32(md + 4 * i, wild ? 0x007FFFFFu : (uint32_t)rnd_in(1 << 23));
+            for (k = 0; k < nb; k++, e++) {
+                const uint32_t j = rnd32() % 12u == 0 ? nF + rnd32() % 8u : rnd32() % nF;
+                cols[2 * e] = (unsigned char)j;
+                cols[2 * e + 1] = (unsigned char)(j >> 8);
+                put32(mo + 4 * e, wild ? 0xFF800000u : (uint32_t)rnd_in(1 << 23));
+            }
+        }
+        put32(rp + 4 * nF, e);
+        for (i = 0; i < 3 * nF; i++) a1[i] = a2[i] = 0;
+        sn_k_mass_ff(rp, cols, md, mo, y, a1, nF);
+        for (i = 0; i < nF; i++) {
+            uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+            sn_acc l[3];
+            for (k = 0; k < 3; k++) l[k] = sn_mul(sn_rd_i32(md + 4 * i), y[3 * i + k]);
+            for (; b < end; b++) {
+                const uint32_t j = sn_rd_u16(cols + 2 * b);
+                const sn_q m = sn_rd_i32(mo + 4 * b);
+                if (j >= nF) { stops++; break; }
+                for (k = 0; k < 3; k++) { l[k] += sn_mul(m, y[3 * j + k]); a2[3 * j + k] += sn_mul(m, y[3 * i + k]); }
+            }
+            for (k = 0; k < 3; k++) a2[3 * i + k] += l[k];
+        }
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0;
+    }
+    T_CHECK(bad == 0, "mass pass (path %s): %d of 500 structures differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("mass pass: 500 random row structures, %d rows stopped at a column >= nF", stops);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -1034,6 +1083,9 @@ int main(void) {
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();
+#endif
+#if defined(SN_K_MASS_FF)
+    test_mass_ff();
 #endif
     test_rot();
     test_axpy();
