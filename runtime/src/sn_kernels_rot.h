@@ -326,6 +326,27 @@ SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3],
     sn_k_rot_acc(acc, R, t);
 }
 #endif
+#if defined(SN_KERNELS_M4)
+/* sn_add(x, -y) as QSUB (sn_add's QADD with the negation folded in: the
+ * same saturated difference for every y the reference can negate) and its
+ * one-compare clamp; written out (the loop's counter and NEG cost 4 of 11
+ * instructions an entry) */
+SN_INLINE sn_q sn_k_qsub(sn_q x, sn_q y, uint32_t *sat) {
+    const int32_t v = __qsub(x, y);
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
+}
+SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    const sn_q a0 = sn_k_qsub(x[0], y[0], sat), a1 = sn_k_qsub(x[1], y[1], sat), a2 = sn_k_qsub(x[2], y[2], sat);
+    out[0] = a0; out[1] = a1; out[2] = a2; /* out may be x or y */
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    out[0] = sn_k_qsub(rd_real(sec, ia), rd_real(sec, ib), sat);
+    out[1] = sn_k_qsub(rd_real(sec, ia + 1), rd_real(sec, ib + 1), sat);
+    out[2] = sn_k_qsub(rd_real(sec, ia + 2), rd_real(sec, ib + 2), sat);
+}
+#else
 SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], -y[c], sat);
@@ -334,6 +355,7 @@ SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn
     uint32_t c;
     for (c = 0; c < 3; c++) out[c] = sn_add(rd_real(sec, ia + c), -rd_real(sec, ib + c), sat);
 }
+#endif
 SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], y[c], sat);
