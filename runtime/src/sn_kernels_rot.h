@@ -356,6 +356,35 @@ SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn
     for (c = 0; c < 3; c++) out[c] = sn_add(rd_real(sec, ia + c), -rd_real(sec, ib + c), sat);
 }
 #endif
+#if defined(SN_KERNELS_M4)
+/* written out, sn_add by QADD; coef's rounding by sn_k_out_w; x - y's
+ * clamp (sn_out at shift 0) on the two words (sn_k_out_w's test) */
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    const sn_q a0 = sn_add(x[0], y[0], sat), a1 = sn_add(x[1], y[1], sat), a2 = sn_add(x[2], y[2], sat);
+    out[0] = a0; out[1] = a1; out[2] = a2; /* out may be x or y */
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+    const sn_q a0 = sn_k_out_w(sn_mul(x[0], c), SN_Q_COEF, bit, sat), a1 = sn_k_out_w(sn_mul(x[1], c), SN_Q_COEF, bit, sat);
+    const sn_q a2 = sn_k_out_w(sn_mul(x[2], c), SN_Q_COEF, bit, sat);
+    out[0] = a0; out[1] = a1; out[2] = a2;
+}
+SN_INLINE sn_q sn_k_sub_w(sn_q x, sn_acc y, uint32_t *sat) {
+    const int64_t d = (int64_t)x - y;
+    const uint32_t lo = (uint32_t)d;
+    const int32_t hi = (int32_t)(d >> 32);
+    SN_RANGE(d <= (int64_t)6521908912666391106 && d >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", d);
+    if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && hi == (int32_t)lo >> 31) return (int32_t)lo;
+    (*sat)++;
+    return hi < 0 ? -SN_LIM : SN_LIM;
+}
+SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
+    x[0] = sn_k_sub_w(x[0], y[0], sat);
+    x[1] = sn_k_sub_w(x[1], y[1], sat);
+    x[2] = sn_k_sub_w(x[2], y[2], sat);
+}
+#else
 SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], y[c], sat);
@@ -369,6 +398,7 @@ SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     x[1] = sn_out((sn_acc)x[1] - y[1], 0, sat);
     x[2] = sn_out((sn_acc)x[2] - y[2], 0, sat);
 }
+#endif
 /* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
  * block Jacobi of format 5 did: float keeps its signed zeros); out = sn_out(l, sh) */
 #if !defined(SN_K_SYM_OUT_M4)
