@@ -251,11 +251,26 @@ void sn_qnormalize(sn_q q[4]) {
  * Components are clamped to +-2^30 (a unit quaternion's range), so every
  * product is <= 2^60 and no sum overflows; entries are rounded from Q60
  * (error <= 0.5 LSB for the given q) and clamped to +-2^30. */
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* Cortex-M: the clamp in int32 and the products 32 x 32 -> 64 (one SMULL
+ * each; GCC multiplied the clamped int64 as 64 x 64 bits, three
+ * multiplies): the same products */
+static int32_t sn_clamp30(int32_t v) {
+    return v > (int32_t)SN_Q30 ? (int32_t)SN_Q30 : (v < -(int32_t)SN_Q30 ? -(int32_t)SN_Q30 : v);
+}
+#define SN_QC_(v) sn_clamp30(v)
+#define SN_QM_(a, b) sn_mul((a), (b))
+typedef int32_t sn_qc_t_;
+#else
+#define SN_QC_(v) sn_clamp64((v), SN_Q30)
+#define SN_QM_(a, b) ((a) * (b))
+typedef int64_t sn_qc_t_;
+#endif
 void sn_qtomat(const sn_q q[4], sn_q R[9]) {
-    int64_t x = sn_clamp64(q[0], SN_Q30), y = sn_clamp64(q[1], SN_Q30);
-    int64_t z = sn_clamp64(q[2], SN_Q30), w = sn_clamp64(q[3], SN_Q30);
-    int64_t xx = x * x, yy = y * y, zz = z * z, xy = x * y, xz = x * z, yz = y * z;
-    int64_t xw = x * w, yw = y * w, zw = z * w;
+    sn_qc_t_ x = SN_QC_(q[0]), y = SN_QC_(q[1]);
+    sn_qc_t_ z = SN_QC_(q[2]), w = SN_QC_(q[3]);
+    int64_t xx = SN_QM_(x, x), yy = SN_QM_(y, y), zz = SN_QM_(z, z), xy = SN_QM_(x, y), xz = SN_QM_(x, z), yz = SN_QM_(y, z);
+    int64_t xw = SN_QM_(x, w), yw = SN_QM_(y, w), zw = SN_QM_(z, w);
     int64_t e[9];
     int k;
     e[0] = SN_Q30 - sn_rshr64(yy + zz, 29);
