@@ -203,6 +203,44 @@ static int sn_bitlen64(uint64_t x) {
  * so the sum of squares fits uint64; |c| = isqrt rounded to nearest;
  * one division 2^62/|c|, then a multiply per component.
  * Error: <= 1.5 LSB per component (test: <= 2). |out_i| <= 2^30. */
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* Cortex-M: the same arithmetic in 32-bit words where the values fit: the
+ * bit length of the OR of the magnitudes (that of their maximum, no 64-bit
+ * compares), the scaled magnitudes (< 2^31) as uint32, so the squares are
+ * UMULL/UMLAL and a r a UMULL (r = 2^32 exactly gives a itself). The same
+ * integers. */
+static int sn_unit(const int64_t *c, int n, int32_t *out) {
+    uint64_t a64[4], m = 0, n2 = 0, N, r;
+    uint32_t a[4];
+    int i, b;
+    for (i = 0; i < n; i++) {
+        a64[i] = c[i] < 0 ? (uint64_t)0 - (uint64_t)c[i] : (uint64_t)c[i];
+        m |= a64[i];
+    }
+    if (m == 0) return 0;
+    b = sn_bitlen64(m);
+    for (i = 0; i < n; i++) {
+        a[i] = b > 31 ? (uint32_t)(a64[i] >> (b - 31)) : (uint32_t)a64[i] << (31 - b); /* < 2^31 */
+        n2 += (uint64_t)a[i] * a[i];
+    }
+    N = sn_isqrt64(n2);
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) {
+        for (i = 0; i < n; i++) out[i] = c[i] < 0 ? -(int32_t)a[i] : (int32_t)a[i]; /* r = 2^32 */
+        return 1;
+    }
+    if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else {
+        int s = N < ((uint64_t)1 << 31) ? 1 : 0;
+        r = sn_div64n((((uint64_t)1 << 62) + (N >> 1)) << s, (uint32_t)(N << s));
+    }
+    for (i = 0; i < n; i++) {
+        const uint32_t v = (uint32_t)(((uint64_t)a[i] * (uint32_t)r + ((uint64_t)1 << 31)) >> 32); /* r < 2^32 */
+        out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+    return 1;
+}
+#else
 static int sn_unit(const int64_t *c, int n, int32_t *out) {
     uint64_t a[4], m = 0, n2 = 0, N, r;
     int i, b;
@@ -234,6 +272,7 @@ static int sn_unit(const int64_t *c, int n, int32_t *out) {
     }
     return 1;
 }
+#endif
 
 /* Normalize q in place (Q30). Zero quaternion -> identity (0,0,0,1).
  * Any int32 input; error <= 1.5 LSB per component. */
