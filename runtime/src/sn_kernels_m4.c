@@ -651,9 +651,19 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * the shift is done on the two words: the same rounded terms (sn_rshr64_var's
  * identity), summed in the same order. */
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
-    uint32_t i, k, nv = n / 3;
-    const int s = sn_k_dot_scale(a, b, 0, n, 0, 0);
+    uint32_t i, k, nv = n / 3, oa = 0, ob = 0;
+    int s;
     int64_t sum = 0;
+    /* the ORs of |a|, |b| (sn_k_dot_scale's head): a vertex's 3 values at a
+     * time, |x| as (x ^ m) - m with m = x >> 31 (EOR, SUB with shifted
+     * operands; GCC's compare and conditional negate took 3) */
+#define SN_K_ABS(x) (((uint32_t)(x) ^ (uint32_t)((x) >> 31)) - (uint32_t)((x) >> 31))
+    for (i = 0; i < 3 * nv; i += 3) {
+        oa |= SN_K_ABS(a[i]) | SN_K_ABS(a[i + 1]) | SN_K_ABS(a[i + 2]);
+        ob |= SN_K_ABS(b[i]) | SN_K_ABS(b[i + 1]) | SN_K_ABS(b[i + 2]);
+    }
+#undef SN_K_ABS
+    s = sn_k_dot_scale(a, b, 3 * nv, n, oa, ob);
     for (i = 0; i < nv; i++) {
         const int sh = s + kk[i];
         if (sh > 0 && sh < 32) {
