@@ -10,6 +10,7 @@
 /* outside the #if: tools/amalgamate.sh inlines a header at its first
  * include only, so under a false #if it would be lost to sn_precond.c */
 #include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
+#include "sn_kernels_rot.h" /* sn_k_out_w */
 
 #if defined(SN_KERNELS_M4)
 
@@ -689,16 +690,14 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
     uint32_t i;
     if (sh > 0 && sh < 32) {
-        const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
-        for (i = 0; i < n; i++) {
-            const int64_t v = sn_shr64_w(bias + (int64_t)s * x[i], sh);
-            const uint32_t lo = (uint32_t)v;
-            sn_q q;
-            /* |v| <= SN_LIM: the low word within +-SN_LIM (one unsigned
-             * compare) and the high word its sign (not two 64-bit compares) */
-            if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && (int32_t)(v >> 32) == (int32_t)lo >> 31) q = (int32_t)lo;
-            else { (*sat)++; q = v > 0 ? SN_LIM : -SN_LIM; }
-            out[i] = sn_add(a[i], q, sat);
+        /* sn_k_out_w (sn_kernels_rot.h): the rounding add, the shift on the
+         * two words and |v| <= SN_LIM as the low word within +-SN_LIM and
+         * the high word its sign (not two 64-bit compares) */
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        sn_q *const end = out + n;
+        while (out != end) {
+            const sn_q q = sn_k_out_w(sn_mul(s, *x++), sh, bit, sat);
+            *out++ = sn_add(*a++, q, sat);
         }
     } else {
         for (i = 0; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
