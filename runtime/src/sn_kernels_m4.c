@@ -13,48 +13,82 @@
 #include "sn_kernels_rot.h" /* sn_k_out_w */
 
 #if defined(SN_KERNELS_M4)
+#define SN_M4_S_(x) #x
+#define SN_M4_S(x) SN_M4_S_(x)
 
-/* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
- * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
- * sums of the rows above): the diagonal block (a,a), then each block (i,j),
+/* The cell product (sn_k_cell_mul) in Thumb-2, sn_m4_cell_mul: l zeroed by
+ * STRD, then row i = 0..nf-1 of the listed corners: row i's three int64
+ * sums stay in r0..r5 for the whole row (from l[3i..], the transposed sums
+ * of the rows above): the diagonal block (a,a), then each block (i,j),
  * j > i, decoded once (LDRSH, LSL by its exponent: m 2^e, |.| < 2^27, exact
  * in int32) and used both ways, column c at a time: s_r += B_rc b_c (SMLAL)
  * and corner j's sum t_c += B_rc a_r in r6:r7, loaded and stored once
- * (LDRD/STRD). a, the pointers and the end live on the stack (GCC's C
- * spilled the sums: ~100 instructions a block, here 72). The same exact
+ * (LDRD/STRD). a, the pointers and the ends live on the stack (GCC's C
+ * spilled the sums: ~100 instructions a block, here 72); each row's
+ * pointers (SN_CELLK_OFFIDX's base a (13 - a) / 2 - 1) are formed here, not
+ * by a C loop around a call per row ("M4 round 3"). The same exact
  * products as the reference, another order (NUMERICS.md "SIMD kernels"). */
-struct sn_m4_row {
-    const sn_q *ua;         /* 0: u + 3 i (corner j's operand follows) */
-    const uint8_t *fcp;     /* 4: fc + i + 1 */
-    uint32_t m0, e0;        /* 8, 12: block (a,b)'s mantissas at m0 + 18 b, exponent at e0 + b */
-    const unsigned char *d; /* 16: diagonal block (a,a) */
-    sn_acc *lend;           /* 20: l + 3 nf */
-};
-typedef char sn_m4_row_layout_[sizeof(struct sn_m4_row) == 24 ? 1 : -1];
-void sn_m4_cell_row(sn_acc s[3], const struct sn_m4_row *c);
+void sn_m4_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
 __asm__(
     ".syntax unified\n"
     ".thumb\n"
-    ".pushsection .text.sn_m4_cell_row,\"ax\",%progbits\n"
+    ".pushsection .text.sn_m4_cell_mul,\"ax\",%progbits\n"
+    ".set snm1_diag, " SN_M4_S(SN_CELLK_DIAG) "\n"
+    ".set snm1_off, " SN_M4_S(SN_CELLK_OFF) "\n"
+    ".set snm1_exp, " SN_M4_S(SN_CELLK_EXP) "\n"
     ".align 2\n"
-    ".global sn_m4_cell_row\n"
+    ".global sn_m4_cell_mul\n"
     ".thumb_func\n"
-    ".type sn_m4_cell_row, %function\n"
-    "sn_m4_cell_row:\n"
+    ".type sn_m4_cell_mul, %function\n"
+    "sn_m4_cell_mul:\n"
     "push  {r4-r11, lr}\n"
-    "sub   sp, sp, #40\n"           /* [sp] a0 a1 a2 fcp ub m0 e0 lend s */
-    "str   r0, [sp, #32]\n"
-    "add   lr, r0, #24\n"           /* lb = l + 3 (i + 1) */
-    "ldm   r1, {r2-r7}\n"           /* ua fcp m0 e0 d lend */
-    "str   r3, [sp, #12]\n"
-    "str   r4, [sp, #20]\n"
-    "str   r5, [sp, #24]\n"
-    "str   r7, [sp, #28]\n"
+    "sub   sp, sp, #48\n"          /* [sp] a0 a1 a2 fcp ub m0 e0 lend s K fci ua; l at [sp, #84] */
+    "ldr   r12, [sp, #84]\n"
+    "str   r0, [sp, #36]\n"
+    "str   r1, [sp, #40]\n"
+    "str   r3, [sp, #44]\n"
+    "str   r12, [sp, #32]\n"
+    "add   r4, r2, r2, lsl #1\n"
+    "add   r4, r12, r4, lsl #3\n"  /* lend = l + 3 nf */
+    "str   r4, [sp, #28]\n"
+    "mov   r5, #0\n"
+    "mov   r6, #0\n"
+    "0:\n"                          /* l = 0, a corner at a time (nf >= 1) */
+    "strd  r5, r6, [r12], #8\n"
+    "strd  r5, r6, [r12], #8\n"
+    "strd  r5, r6, [r12], #8\n"
+    "cmp   r12, r4\n"
+    "bne   0b\n"
+    "3:\n"                          /* row i */
+    "ldr   r1, [sp, #40]\n"
+    "ldrb  r2, [r1], #1\n"          /* a = fc[i] */
+    "str   r1, [sp, #40]\n"
+    "str   r1, [sp, #12]\n"         /* fcp = fc + i + 1 */
+    "ldr   r0, [sp, #36]\n"
+    "rsb   r3, r2, #13\n"
+    "mul   r3, r3, r2\n"
+    "lsr   r3, r3, #1\n"
+    "sub   r3, r3, #1\n"            /* base: SN_CELLK_OFFIDX(a, b) = base + b */
+    "add   r4, r0, r3, lsl #4\n"
+    "add   r4, r4, r3, lsl #1\n"
+    "add   r4, r4, #snm1_off\n"
+    "str   r4, [sp, #20]\n"         /* m0 = K + OFF + 18 base */
+    "add   r4, r0, r3\n"
+    "addw  r4, r4, #snm1_exp\n"
+    "str   r4, [sp, #24]\n"         /* e0 = K + EXP + base */
+    "add   r10, r2, r2, lsl #1\n"
+    "add   r10, r0, r10, lsl #3\n"
+    ".if snm1_diag\n"
+    "add   r10, r10, #snm1_diag\n"
+    ".endif\n"                      /* d = K + DIAG + 24 a */
+    "ldr   r2, [sp, #44]\n"         /* ua */
     "add   r3, r2, #12\n"
     "str   r3, [sp, #16]\n"         /* ub = ua + 3 */
-    "mov   r10, r6\n"               /* d */
+    "str   r3, [sp, #44]\n"         /* the next row's ua */
     "ldm   r2, {r6-r8}\n"           /* a0 a1 a2 */
     "stm   sp, {r6-r8}\n"
+    "ldr   r0, [sp, #32]\n"
+    "add   lr, r0, #24\n"           /* lb = l + 3 (i + 1) */
     "ldm   r0, {r0-r5}\n"           /* s0 s1 s2, lo:hi */
     "ldr   r12, [r10]\n"            /* diagonal: xx yy zz xy xz yz */
     "smlal r0, r1, r12, r6\n"
@@ -149,33 +183,21 @@ __asm__(
     "bne   1b\n"
     "2:\n"
     "ldr   r12, [sp, #32]\n"
-    "stm   r12, {r0-r5}\n"
-    "add   sp, sp, #40\n"
+    "stm   r12!, {r0-r5}\n"
+    "str   r12, [sp, #32]\n"
+    "ldr   r11, [sp, #28]\n"
+    "cmp   r12, r11\n"
+    "bne   3b\n"
+    "add   sp, sp, #48\n"
     "pop   {r4-r11, pc}\n"
-    ".size sn_m4_cell_row, .-sn_m4_cell_row\n"
+    ".size sn_m4_cell_mul, .-sn_m4_cell_mul\n"
     ".popsection\n");
 
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
-    const uint32_t k0 = (uint32_t)(uintptr_t)K;
-    struct sn_m4_row c;
     uint32_t i;
-    for (i = 0; i < 3 * nf; i++) {
-        l[i] = 0;
-        __asm__("" : : : "memory"); /* a store a word, not GCC's memset call (newlib-nano's is a byte loop) */
-    }
-    c.lend = l + 3 * nf;
-    for (i = 0; i < nf; i++) {
-        const uint32_t a = fc[i];
-        /* SN_CELLK_OFFIDX(a, b) = base + b = a (13 - a) / 2 - 1 + b >= 0 (b > a) */
-        const uint32_t base = a * (13u - a) / 2u - 1u;
-        c.ua = u + 3 * i;
-        c.fcp = fc + i + 1;
-        c.m0 = k0 + SN_CELLK_OFF + 18u * base;
-        c.e0 = k0 + SN_CELLK_EXP + base;
-        c.d = K + SN_CELLK_DIAG + 24u * a;
-        sn_m4_cell_row(l + 3 * i, &c);
-    }
+    if (nf) sn_m4_cell_mul(K, fc, nf, u, l);
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
+    (void)i;
 }
 
 /* The right-hand side's two products (sn_k_cell_mul2) in Thumb-2
@@ -193,8 +215,6 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * The same exact products as the reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 void sn_m4_cell_mul2(const unsigned char *K, const sn_q *u1, const sn_q *u2, sn_acc *l1, sn_acc *l2, uint32_t rows2);
-#define SN_M4_S_(x) #x
-#define SN_M4_S(x) SN_M4_S_(x)
 __asm__(
     ".syntax unified\n"
     ".thumb\n"
