@@ -827,6 +827,123 @@ static void test_out_edges(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+/* The 3-vector helpers at the clamp edges (sn_k_sub3, sn_k_sub3r, sn_k_add3,
+ * sn_k_coef3, sn_k_sub3a; the M4 writes them out on QSUB/QADD, sn_k_out_w
+ * and the two-word clamp, "M4 round 3"): every pair of values from an edge
+ * set (0, +-1, +-SN_LIM and one past, +-2^30, INT32_MAX, INT32_MIN + 1)
+ * against sn_add / sn_out, bit for bit with the same counts. */
+static void test_vec_edges(void) {
+    static const int32_t ev[] = {0, 1, -1, SN_LIM, -SN_LIM, SN_LIM + 1, -SN_LIM - 1, 1 << 30, -(1 << 30), INT32_MAX,
+                                 INT32_MIN + 1};
+    static const int64_t ea[] = {0, 1, -1, SN_LIM, -(int64_t)SN_LIM, SN_LIM + 1, -(int64_t)SN_LIM - 1,
+                                 (int64_t)1 << 40, -((int64_t)1 << 40), ((int64_t)1 << 62) - ((int64_t)1 << 31),
+                                 -((int64_t)1 << 62) + ((int64_t)1 << 31)};
+    const uint32_t ne = sizeof ev / sizeof ev[0];
+    uint32_t i, j, k, c;
+    int bad = 0;
+    for (i = 0; i < ne; i++)
+        for (j = 0; j < ne; j++) {
+            sn_q x[3], y[3], o1[3], o2[3];
+            sn_acc ya[3];
+            unsigned char sec[24];
+            uint32_t s1 = 0, s2 = 0;
+            for (k = 0; k < 3; k++) { x[k] = ev[(i + k) % ne]; y[k] = ev[(j + 2 * k) % ne]; ya[k] = ea[(j + k) % ne]; }
+            sn_k_sub3(x, y, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            sn_k_add3(x, y, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            for (k = 0; k < 3; k++) { put32(sec + 4 * k, (uint32_t)x[k]); put32(sec + 12 + 4 * k, (uint32_t)y[k]); }
+            sn_k_sub3r(sec, 0, 3, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            for (c = 0; c < ne; c++) {
+                sn_k_coef3(x, ev[c], o1, &s1);
+                for (k = 0; k < 3; k++) o2[k] = sn_out(sn_mul(x[k], ev[c]), SN_Q_COEF, &s2);
+                bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            }
+            memcpy(o1, x, sizeof x);
+            sn_k_sub3a(o1, ya, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        }
+    T_CHECK(bad == 0, "3-vector helpers at the clamp edges (path %s): %d results or counts off sn_add/sn_out", sn_kernels_name(), bad);
+}
+
+/* sn_qtomat and sn_qnormalize (sn_math.c; the M4 clamps in int32,
+ * multiplies 32 x 32 and normalizes in 32-bit words, "M4 round 3")
+ * against the portable formulas written here in int64 (qtomat: the clamp
+ * to +-2^30, Q60 products, round by 2^29, clamp) and, for the unit vector,
+ * the scaled magnitudes, the rounded root (a double estimate corrected to
+ * floor(sqrt)) and r = (2^62 + N/2) / N by uint64 division: bit for bit,
+ * on quaternions with components at +-2^30 and one past, INT32_MIN/MAX,
+ * 0 and random widths. */
+static int64_t ref_c30(int64_t v) { return v > (1 << 30) ? (1 << 30) : (v < -(1 << 30) ? -(1 << 30) : v); }
+static void ref_qtomat(const sn_q q[4], sn_q R[9]) {
+    const int64_t x = ref_c30(q[0]), y = ref_c30(q[1]), z = ref_c30(q[2]), w = ref_c30(q[3]), one = (int64_t)1 << 30;
+    int64_t e[9];
+    int k;
+    e[0] = one - sn_rshr64(y * y + z * z, 29);
+    e[1] = sn_rshr64(x * y - z * w, 29);
+    e[2] = sn_rshr64(x * z + y * w, 29);
+    e[3] = sn_rshr64(x * y + z * w, 29);
+    e[4] = one - sn_rshr64(x * x + z * z, 29);
+    e[5] = sn_rshr64(y * z - x * w, 29);
+    e[6] = sn_rshr64(x * z - y * w, 29);
+    e[7] = sn_rshr64(y * z + x * w, 29);
+    e[8] = one - sn_rshr64(x * x + y * y, 29);
+    for (k = 0; k < 9; k++) R[k] = (int32_t)ref_c30(e[k]);
+}
+static void ref_qnormalize(sn_q q[4]) {
+    uint64_t a[4], m = 0, n2 = 0, N, r;
+    int i, b = 0;
+    for (i = 0; i < 4; i++) {
+        a[i] = q[i] < 0 ? (uint64_t)0 - (uint64_t)(int64_t)q[i] : (uint64_t)q[i];
+        if (a[i] > m) m = a[i];
+    }
+    if (m == 0) { q[0] = q[1] = q[2] = 0; q[3] = 1 << 30; return; }
+    while (b < 64 && m >> b) b++;
+    for (i = 0; i < 4; i++) {
+        a[i] = b > 31 ? a[i] >> (b - 31) : a[i] << (31 - b);
+        n2 += a[i] * a[i];
+    }
+    N = (uint64_t)sqrt((double)n2);
+    while (N * N > n2) N--;
+    while ((N + 1) * (N + 1) <= n2) N++;
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else r = (((uint64_t)1 << 62) + (N >> 1)) / N;
+    for (i = 0; i < 4; i++) {
+        const uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32;
+        q[i] = q[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+}
+static void test_quat_words(void) {
+    static const int32_t eq[] = {0, 1, -1, 1 << 30, -(1 << 30), (1 << 30) + 1, -(1 << 30) - 1, INT32_MAX, INT32_MIN, 1 << 29,
+                                 759250125, -759250125};
+    int t, bad_m = 0, bad_n = 0;
+    for (t = 0; t < 6000; t++) {
+        sn_q q[4], q1[4], q2[4], R1[9], R2[9];
+        int k;
+        for (k = 0; k < 4; k++)
+            q[k] = t % 3 == 0 ? eq[rnd32() % (sizeof eq / sizeof eq[0])] : (int32_t)(rnd32() >> (rnd32() % 32u)) * (rnd32() & 1 ? 1 : -1);
+        sn_qtomat(q, R1);
+        ref_qtomat(q, R2);
+        bad_m += memcmp(R1, R2, sizeof R1) != 0;
+        memcpy(q1, q, sizeof q);
+        memcpy(q2, q, sizeof q);
+        sn_qnormalize(q1);
+        ref_qnormalize(q2);
+        bad_n += memcmp(q1, q2, sizeof q1) != 0;
+    }
+    T_CHECK(bad_m == 0, "sn_qtomat: %d of 6000 quaternions off the int64 formula", bad_m);
+    T_CHECK(bad_n == 0, "sn_qnormalize: %d of 6000 quaternions off the portable unit-vector arithmetic", bad_n);
+}
+#endif
+
 #if defined(SN_K_IC_FWD_COL)
 /* The M4's forward-sweep column (sn_k_ic_fwd_col: sn_m4_ic_cols and its
  * reference fallback) against ic_forward's loop on the portable reference
@@ -1083,6 +1200,8 @@ int main(void) {
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();
+    test_vec_edges();
+    test_quat_words();
 #endif
 #if defined(SN_K_MASS_FF)
     test_mass_ff();
