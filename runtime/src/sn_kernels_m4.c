@@ -671,6 +671,13 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),
  * the shift is done on the two words: the same rounded terms (sn_rshr64_var's
  * identity), summed in the same order. */
+/* sn_shr64_w's value with the words joined by OR (GCC added the zero
+ * high word of the low part: one ADDS #0 a term) */
+SN_INLINE int64_t sn_m4_shr_or(int64_t x, int s) {
+    const uint32_t lo = (uint32_t)x;
+    const int32_t hi = (int32_t)(x >> 32);
+    return (int64_t)(((uint64_t)(uint32_t)(hi >> s) << 32) | (lo >> s | (uint32_t)hi << (32 - s)));
+}
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
     uint32_t i, k, nv = n / 3, oa = 0, ob = 0;
     int s;
@@ -691,9 +698,9 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
             const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
             const sn_q *ai = a + 3 * i, *bi = b + 3 * i;
             /* written out: GCC kept a loop of 3 (15 instructions a term) */
-            sum += sn_shr64_w(bias + (int64_t)ai[0] * bi[0], sh);
-            sum += sn_shr64_w(bias + (int64_t)ai[1] * bi[1], sh);
-            sum += sn_shr64_w(bias + (int64_t)ai[2] * bi[2], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[0] * bi[0], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[1] * bi[1], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[2] * bi[2], sh);
         } else {
             const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
             for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
