@@ -35,7 +35,11 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
     struct sn_m4_icc c;
     sn_k_ic_fwd_init(&c, kk, acc, nF);
 #endif
+#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+    sn_k_zero(acc, 3 * nF);
+#else
     for (j = 0; j < 3 * nF; j++) acc[j] = 0;
+#endif
     for (j = 0; j < nF; j++) {
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
