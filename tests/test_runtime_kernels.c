@@ -869,6 +869,296 @@ static void test_loops(void) {
     T_FIGURE("loop helpers: 4000 random cases of each (every 4th with clamps%s), %u clamps", SN_FLAVOUR ? " and NaNs" : "", (unsigned)clamps);
 }
 
+#if !defined(SN_FLOAT)
+/* The rounding-and-clamp helpers at their edges (every path; on the M4 they
+ * run sn_k_out_w / sn_k_out_hw, "M4 round 3"): accumulators l = v 2^s + d
+ * with v at 0, +-1, +-(SN_LIM - 1), +-SN_LIM, +-(SN_LIM + 1), +-2^30 and d at
+ * 0, +-1, +-2^(s-1) and its neighbours (the rounding's ties), plus +-(2^62 -
+ * 1) and random values, for every shift 0..62: sn_k_out_rot_acc, sn_k_outv,
+ * sn_k_mix, sn_k_mul_out against sn_out (sn_internal.h, the reference),
+ * bit for bit with the same clamp counts; on the M4 sn_k_out_w (s < 32) and
+ * sn_k_out_hw (32..62) themselves too. */
+static int edge_ls(int s, sn_acc *l) {
+    static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1),
+                                 1 << 30, -(1 << 30)};
+    const int64_t h = s > 0 ? (int64_t)1 << (s - 1) : 0;
+    const int64_t ds[] = {0, 1, -1, h, -h, h - 1, -h - 1, h + 1, -h + 1};
+    int n = 0;
+    uint32_t a, b;
+    for (a = 0; a < sizeof vs / sizeof vs[0]; a++) {
+        const int64_t v = vs[a];
+        if ((v < 0 ? -v : v) >= ((int64_t)1 << (62 - s))) continue; /* |v 2^s| < 2^62 */
+        for (b = 0; b < sizeof ds / sizeof ds[0]; b++) l[n++] = v * ((int64_t)1 << s) + ds[b];
+    }
+    l[n++] = ((int64_t)1 << 62) - 1;
+    l[n++] = -(((int64_t)1 << 62) - 1);
+    for (a = 0; a < 6; a++) l[n++] = (int64_t)rnd_in(1 << 30) * ((int64_t)1 << (rnd32() % 32u));
+    return n;
+}
+static void test_out_edges(void) {
+    int s, bad = 0, cases = 0;
+    uint32_t clamps = 0;
+    for (s = 0; s <= 62; s++) {
+        sn_acc l[128];
+        const int n = edge_ls(s, l);
+        int i, k;
+        for (i = 0; i < n; i++) {
+            sn_q R[9], q1[3], q2[3], ck = rnd_in(1 << 24), cm = rnd_in(1 << 24);
+            sn_acc a1[3], a2[3], lv[3] = {l[i], l[(i + 1) % n], l[(i + 7) % n]};
+            uint8_t kk[1] = {(uint8_t)(rnd32() % 4u)};
+            uint32_t s1 = 0, s2 = 0;
+            for (k = 0; k < 9; k++) R[k] = rnd_in(1 << 30);
+            for (k = 0; k < 3; k++) a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 20;
+            sn_k_out_rot_acc(a1, R, lv, s, &s1);
+            for (k = 0; k < 3; k++) q2[k] = sn_out(lv[k], s, &s2);
+            sn_rot_acc(a2, R, q2);
+            bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+            sn_k_outv(q1, lv, 3, s, &s1);
+            for (k = 0; k < 3; k++) q2[k] = sn_out(lv[k], s, &s2);
+            bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+            bad += sn_k_mul_out(ck, lv[0], s, &s1) != sn_mul(ck, sn_out(lv[0], s, &s2)) || s1 != s2;
+            if (s >= SN_KREL(kk[0])) {
+                const int fm = s + SN_KREL(kk[0]);
+                for (k = 0; k < 3; k++) q1[k] = q2[k] = rnd_in(SN_LIM);
+                sn_k_mix(q1, lv, kk, 3, fm, ck, cm, &s1);
+                for (k = 0; k < 3; k++) q2[k] = sn_out(sn_mul(q2[k], ck) + sn_mul(sn_out(lv[k], s, &s2), cm), SN_Q_COEF, &s2);
+                bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+            }
+#if defined(SN_KERNELS_M4)
+            if (s > 0 && s < 32) bad += sn_k_out_w(l[i], s, (uint32_t)1 << (s - 1), &s1) != sn_out(l[i], s, &s2) || s1 != s2;
+            if (s >= 32) bad += sn_k_out_hw(l[i], s, s == 32 ? (uint32_t)1 << 31 : 0, s == 32 ? 0 : (int32_t)1 << (s - 33), &s1) !=
+                                    sn_out(l[i], s, &s2) || s1 != s2;
+#endif
+            clamps += s2;
+            cases++;
+        }
+    }
+    T_CHECK(bad == 0, "rounding helpers at their edges (path %s): %d results or clamp counts off sn_out", sn_kernels_name(), bad);
+    T_FIGURE("rounding helpers: %d edge accumulators over shifts 0..62, %u clamps", cases, (unsigned)clamps);
+}
+#endif
+
+#if !defined(SN_FLOAT)
+/* The 3-vector helpers at the clamp edges (sn_k_sub3, sn_k_sub3r, sn_k_add3,
+ * sn_k_coef3, sn_k_sub3a; the M4 writes them out on QSUB/QADD, sn_k_out_w
+ * and the two-word clamp, "M4 round 3"): every pair of values from an edge
+ * set (0, +-1, +-SN_LIM and one past, +-2^30, INT32_MAX, INT32_MIN + 1)
+ * against sn_add / sn_out, bit for bit with the same counts. */
+static void test_vec_edges(void) {
+    static const int32_t ev[] = {0, 1, -1, SN_LIM, -SN_LIM, SN_LIM + 1, -SN_LIM - 1, 1 << 30, -(1 << 30), INT32_MAX,
+                                 INT32_MIN + 1};
+    static const int64_t ea[] = {0, 1, -1, SN_LIM, -(int64_t)SN_LIM, SN_LIM + 1, -(int64_t)SN_LIM - 1,
+                                 (int64_t)1 << 40, -((int64_t)1 << 40), ((int64_t)1 << 62) - ((int64_t)1 << 31),
+                                 -((int64_t)1 << 62) + ((int64_t)1 << 31)};
+    const uint32_t ne = sizeof ev / sizeof ev[0];
+    uint32_t i, j, k, c;
+    int bad = 0;
+    for (i = 0; i < ne; i++)
+        for (j = 0; j < ne; j++) {
+            sn_q x[3], y[3], o1[3], o2[3];
+            sn_acc ya[3];
+            unsigned char sec[24];
+            uint32_t s1 = 0, s2 = 0;
+            for (k = 0; k < 3; k++) { x[k] = ev[(i + k) % ne]; y[k] = ev[(j + 2 * k) % ne]; ya[k] = ea[(j + k) % ne]; }
+            sn_k_sub3(x, y, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            sn_k_add3(x, y, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            for (k = 0; k < 3; k++) { put32(sec + 4 * k, (uint32_t)x[k]); put32(sec + 12 + 4 * k, (uint32_t)y[k]); }
+            sn_k_sub3r(sec, 0, 3, o1, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            for (c = 0; c < ne; c++) {
+                sn_k_coef3(x, ev[c], o1, &s1);
+                for (k = 0; k < 3; k++) o2[k] = sn_out(sn_mul(x[k], ev[c]), SN_Q_COEF, &s2);
+                bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            }
+            memcpy(o1, x, sizeof x);
+            sn_k_sub3a(o1, ya, &s1);
+            for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
+            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        }
+    T_CHECK(bad == 0, "3-vector helpers at the clamp edges (path %s): %d results or counts off sn_add/sn_out", sn_kernels_name(), bad);
+}
+
+/* sn_qtomat and sn_qnormalize (sn_math.c; the M4 clamps in int32,
+ * multiplies 32 x 32 and normalizes in 32-bit words, "M4 round 3")
+ * against the portable formulas written here in int64 (qtomat: the clamp
+ * to +-2^30, Q60 products, round by 2^29, clamp) and, for the unit vector,
+ * the scaled magnitudes, the rounded root (a double estimate corrected to
+ * floor(sqrt)) and r = (2^62 + N/2) / N by uint64 division: bit for bit,
+ * on quaternions with components at +-2^30 and one past, INT32_MIN/MAX,
+ * 0 and random widths. */
+static int64_t ref_c30(int64_t v) { return v > (1 << 30) ? (1 << 30) : (v < -(1 << 30) ? -(1 << 30) : v); }
+static void ref_qtomat(const sn_q q[4], sn_q R[9]) {
+    const int64_t x = ref_c30(q[0]), y = ref_c30(q[1]), z = ref_c30(q[2]), w = ref_c30(q[3]), one = (int64_t)1 << 30;
+    int64_t e[9];
+    int k;
+    e[0] = one - sn_rshr64(y * y + z * z, 29);
+    e[1] = sn_rshr64(x * y - z * w, 29);
+    e[2] = sn_rshr64(x * z + y * w, 29);
+    e[3] = sn_rshr64(x * y + z * w, 29);
+    e[4] = one - sn_rshr64(x * x + z * z, 29);
+    e[5] = sn_rshr64(y * z - x * w, 29);
+    e[6] = sn_rshr64(x * z - y * w, 29);
+    e[7] = sn_rshr64(y * z + x * w, 29);
+    e[8] = one - sn_rshr64(x * x + y * y, 29);
+    for (k = 0; k < 9; k++) R[k] = (int32_t)ref_c30(e[k]);
+}
+static void ref_qnormalize(sn_q q[4]) {
+    uint64_t a[4], m = 0, n2 = 0, N, r;
+    int i, b = 0;
+    for (i = 0; i < 4; i++) {
+        a[i] = q[i] < 0 ? (uint64_t)0 - (uint64_t)(int64_t)q[i] : (uint64_t)q[i];
+        if (a[i] > m) m = a[i];
+    }
+    if (m == 0) { q[0] = q[1] = q[2] = 0; q[3] = 1 << 30; return; }
+    while (b < 64 && m >> b) b++;
+    for (i = 0; i < 4; i++) {
+        a[i] = b > 31 ? a[i] >> (b - 31) : a[i] << (31 - b);
+        n2 += a[i] * a[i];
+    }
+    N = (uint64_t)sqrt((double)n2);
+    while (N * N > n2) N--;
+    while ((N + 1) * (N + 1) <= n2) N++;
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else r = (((uint64_t)1 << 62) + (N >> 1)) / N;
+    for (i = 0; i < 4; i++) {
+        const uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32;
+        q[i] = q[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+}
+static void test_quat_words(void) {
+    static const int32_t eq[] = {0, 1, -1, 1 << 30, -(1 << 30), (1 << 30) + 1, -(1 << 30) - 1, INT32_MAX, INT32_MIN, 1 << 29,
+                                 759250125, -759250125};
+    int t, bad_m = 0, bad_n = 0;
+    for (t = 0; t < 6000; t++) {
+        sn_q q[4], q1[4], q2[4], R1[9], R2[9];
+        int k;
+        for (k = 0; k < 4; k++)
+            q[k] = t % 3 == 0 ? eq[rnd32() % (sizeof eq / sizeof eq[0])] : (int32_t)(rnd32() >> (rnd32() % 32u)) * (rnd32() & 1 ? 1 : -1);
+        sn_qtomat(q, R1);
+        ref_qtomat(q, R2);
+        bad_m += memcmp(R1, R2, sizeof R1) != 0;
+        memcpy(q1, q, sizeof q);
+        memcpy(q2, q, sizeof q);
+        sn_qnormalize(q1);
+        ref_qnormalize(q2);
+        bad_n += memcmp(q1, q2, sizeof q1) != 0;
+    }
+    T_CHECK(bad_m == 0, "sn_qtomat: %d of 6000 quaternions off the int64 formula", bad_m);
+    T_CHECK(bad_n == 0, "sn_qnormalize: %d of 6000 quaternions off the portable unit-vector arithmetic", bad_n);
+}
+#endif
+
+#if defined(SN_K_IC_FWD_COL)
+/* The M4's forward-sweep column (sn_k_ic_fwd_col: sn_m4_ic_cols and its
+ * reference fallback) against ic_forward's loop on the portable reference
+ * (sn_k_ic_col_ref per block, stopping at the first row >= nF): random
+ * columns of 0..12 blocks, row indices sometimes past nF, vertex exponents
+ * 0..3 and fracs 0..40 (shifts below 1 and past 31 included), y at the
+ * state bound and INT32_MIN/MAX; the accumulators, the clamp count and the
+ * blocks read must match exactly. */
+static void test_ic_fwd(void) {
+    static unsigned char L[12 * 20], cols[24];
+    static sn_acc a1[90], a2[90];
+    int t, bad = 0, odd = 0, stops = 0;
+    for (t = 0; t < 3000; t++) {
+        sn_q y[3];
+        uint8_t kk[30];
+        const uint32_t nF = 20u + rnd32() % 10u, nb = rnd32() % 13u;
+        const int kj = (int)(rnd32() % 4u), wild = t % 8 == 0;
+        uint32_t e, k, n1, n2 = 0, s1 = 0, s2 = 0;
+        struct sn_m4_icc c;
+        for (k = 0; k < 3; k++)
+            y[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? SN_LIM : -SN_LIM)) : rnd_in(SN_LIM);
+        for (k = 0; k < 30; k++) kk[k] = (uint8_t)(rnd32() % 4u);
+        for (k = 0; k < 90; k++) a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12;
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            const uint32_t row = rnd32() % 16u == 0 ? nF + rnd32() % 3u : rnd32() % nF;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 8u == 0 ? rnd32() % 41u : 1u + rnd32() % 28u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)row;
+            cols[2 * e + 1] = 0;
+        }
+        sn_k_ic_fwd_init(&c, kk, a1, nF);
+        n1 = nb ? sn_k_ic_fwd_col(&c, L, cols, cols + 2 * nb, y, kj, &s1) : 0;
+        for (e = 0; e < nb; e++) {
+            const uint32_t i = cols[2 * e];
+            int s;
+            if (i >= nF) { stops++; break; }
+            s = (int)L[20 * e + 18] + kj - (int)kk[i];
+            odd += s <= 0 || s >= 32;
+            sn_k_ic_col_ref(L + 20 * e, y, s, a2 + 3 * i, &s2);
+            n2++;
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2 || n1 != n2;
+    }
+    T_CHECK(bad == 0, "IC(0) forward columns (path %s): %d of 3000 columns differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("IC(0) forward columns: 3000 columns of 0..12 blocks, %d blocks with shift outside 1..31, %d stopped at a row >= nF", odd, stops);
+}
+#endif
+
+#if defined(SN_K_MASS_FF)
+/* The M4's mass pass (sn_k_mass_ff) against pass_M_ff's loop written here
+ * with sn_mul (exact int64 sums: tolerance 0): random row structures of
+ * 1..40 free rows, 0..8 blocks a row, columns past nF (the row stops there)
+ * and operands at the bounds (y +-2^28 and INT32_MIN/MAX; |M| <= 2^23, so
+ * the <= 330 products of <= 2^54 a sum gets stay below 2^63). */
+static void test_mass_ff(void) {
+    static unsigned char rp[4 * 41], cols[2 * 400], md[4 * 40], mo[4 * 400];
+    static sn_q y[3 * 48];
+    static sn_acc a1[3 * 40], a2[3 * 40];
+    int t, bad = 0, stops = 0;
+    for (t = 0; t < 500; t++) {
+        const uint32_t nF = 1u + rnd32() % 40u;
+        const int wild = t % 8 == 0;
+        uint32_t i, e = 0, k;
+        for (i = 0; i < 3 * 48; i++) y[i] = wild ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : rnd32() & 1 ? rnd_in(SN_LIM) : (rnd32() & 1 ? SN_LIM : -SN_LIM);
+        for (i = 0; i < nF; i++) {
+            const uint32_t nb = rnd32() % 9u;
+            put32(rp + 4 * i, e);
+            put32(md + 4 * i, wild ? 0x007FFFFFu : (uint32_t)rnd_in(1 << 23));
+            for (k = 0; k < nb; k++, e++) {
+                const uint32_t j = rnd32() % 12u == 0 ? nF + rnd32() % 8u : rnd32() % nF;
+                cols[2 * e] = (unsigned char)j;
+                cols[2 * e + 1] = (unsigned char)(j >> 8);
+                put32(mo + 4 * e, wild ? 0xFF800000u : (uint32_t)rnd_in(1 << 23));
+            }
+        }
+        put32(rp + 4 * nF, e);
+        for (i = 0; i < 3 * nF; i++) a1[i] = a2[i] = 0;
+        sn_k_mass_ff(rp, cols, md, mo, y, a1, nF);
+        for (i = 0; i < nF; i++) {
+            uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+            sn_acc l[3];
+            for (k = 0; k < 3; k++) l[k] = sn_mul(sn_rd_i32(md + 4 * i), y[3 * i + k]);
+            for (; b < end; b++) {
+                const uint32_t j = sn_rd_u16(cols + 2 * b);
+                const sn_q m = sn_rd_i32(mo + 4 * b);
+                if (j >= nF) { stops++; break; }
+                for (k = 0; k < 3; k++) { l[k] += sn_mul(m, y[3 * j + k]); a2[3 * j + k] += sn_mul(m, y[3 * i + k]); }
+            }
+            for (k = 0; k < 3; k++) a2[3 * i + k] += l[k];
+        }
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0;
+    }
+    T_CHECK(bad == 0, "mass pass (path %s): %d of 500 structures differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("mass pass: 500 random row structures, %d rows stopped at a column >= nF", stops);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -1016,6 +1306,17 @@ int main(void) {
     test_mul2_ref();
     test_ic();
     test_ic_rows();
+#if defined(SN_K_IC_FWD_COL)
+    test_ic_fwd();
+#endif
+#if !defined(SN_FLOAT)
+    test_out_edges();
+    test_vec_edges();
+    test_quat_words();
+#endif
+#if defined(SN_K_MASS_FF)
+    test_mass_ff();
+#endif
     test_rot();
     test_axpy();
     test_isqrt();

@@ -151,6 +151,33 @@ SN_INLINE void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32
 }
 #endif
 
+#if defined(SN_KERNELS_M4)
+/* acc[0..n) = 0 (n = 3 nF: accumulators), a vertex's 24 bytes at a time
+ * by STRD: the empty asm keeps GCC from turning the loop into a call of
+ * newlib-nano's memset, a byte loop (~1 instruction a byte). */
+SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
+    uint32_t i = 0;
+    for (; i + 3 <= n; i += 3) {
+        acc[i] = 0; acc[i + 1] = 0; acc[i + 2] = 0;
+        __asm__("" : : : "memory");
+    }
+    for (; i < n; i++) {
+        acc[i] = 0;
+        __asm__("" : : : "memory");
+    }
+}
+#define SN_K_ZERO 1
+
+/* The mat-vec's mass pass without a mask (sn_solve.c pass_M_ff), acc
+ * zeroed by the caller: per free row i, acc_i += M_ii y_i + sum over the
+ * row's blocks (i,j) up to the first j >= nF of M_ij y_j, and acc_j +=
+ * M_ij y_i (rp: ROWPTR, cols: COLS, md: MDIAG, mo: MOFF). Cortex-M4:
+ * Thumb-2 (sn_kernels_m4.c); other paths keep pass_M_ff's loop. */
+#define SN_K_MASS_FF 1
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF);
+#endif
+
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */
 const char *sn_kernels_name(void);
 

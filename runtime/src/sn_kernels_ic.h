@@ -217,6 +217,37 @@ SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols
     if (p != end) sn_m4_ic_rows_rest(p, cols + 2u * ((uint32_t)(p - b) / SN_ELEM_ICHOL), end, z, l, sat);
 }
 
+/* the forward sweep's column j (ic_forward): sn_kernels_m4.c's Thumb-2 loop
+ * (sn_m4_ic_cols) over blk, cols < cend while the row i < nF, from the
+ * first block with s = frac + kj - kk[i] outside 1..31 on
+ * sn_m4_ic_cols_rest (the reference for such blocks). The struct is set
+ * once per sweep (sn_k_ic_fwd_init), blk, cols, cend, kj and y per column;
+ * sn_k_ic_fwd_col returns the blocks read (ic_forward's loop's count). */
+#define SN_K_IC_FWD_COL 1
+struct sn_m4_icc {
+    const unsigned char *blk;  /* 0: the next block */
+    const unsigned char *cols; /* 4: its row index (u16) */
+    const unsigned char *cend; /* 8: the column's end in cols */
+    const uint8_t *kk;         /* 12 */
+    sn_acc *acc;               /* 16 */
+    uint32_t nF;               /* 20 */
+    int32_t kj;                /* 24: k_j */
+    const sn_q *y;             /* 28: y_j */
+};
+int sn_m4_ic_cols(struct sn_m4_icc *c); /* 1: stopped at a block for the reference */
+void sn_m4_ic_cols_rest(struct sn_m4_icc *c, uint32_t *sat);
+SN_INLINE void sn_k_ic_fwd_init(struct sn_m4_icc *c, const uint8_t *kk, sn_acc *acc, uint32_t nF) {
+    c->kk = kk;
+    c->acc = acc;
+    c->nF = nF;
+}
+SN_INLINE uint32_t sn_k_ic_fwd_col(struct sn_m4_icc *c, const unsigned char *blk, const unsigned char *cols,
+                                   const unsigned char *cend, const sn_q y[3], int kj, uint32_t *sat) {
+    c->blk = blk; c->cols = cols; c->cend = cend; c->kj = kj; c->y = y;
+    if (sn_m4_ic_cols(c)) sn_m4_ic_cols_rest(c, sat);
+    return (uint32_t)(c->cols - cols) / 2u;
+}
+
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
 /* Float: U's rows (col) or columns (row) in lanes, decoded exactly as the

@@ -10,50 +10,85 @@
 /* outside the #if: tools/amalgamate.sh inlines a header at its first
  * include only, so under a false #if it would be lost to sn_precond.c */
 #include "sn_kernels_ic.h" /* sn_k_ic_row_ref */
+#include "sn_kernels_rot.h" /* sn_k_out_w */
 
 #if defined(SN_KERNELS_M4)
+#define SN_M4_S_(x) #x
+#define SN_M4_S(x) SN_M4_S_(x)
 
-/* Row i of the cell product in Thumb-2 (sn_m4_cell_row): row i's three
- * int64 sums stay in r0..r5 for the whole row (from l[3i..], the transposed
- * sums of the rows above): the diagonal block (a,a), then each block (i,j),
+/* The cell product (sn_k_cell_mul) in Thumb-2, sn_m4_cell_mul: l zeroed by
+ * STRD, then row i = 0..nf-1 of the listed corners: row i's three int64
+ * sums stay in r0..r5 for the whole row (from l[3i..], the transposed sums
+ * of the rows above): the diagonal block (a,a), then each block (i,j),
  * j > i, decoded once (LDRSH, LSL by its exponent: m 2^e, |.| < 2^27, exact
  * in int32) and used both ways, column c at a time: s_r += B_rc b_c (SMLAL)
  * and corner j's sum t_c += B_rc a_r in r6:r7, loaded and stored once
- * (LDRD/STRD). a, the pointers and the end live on the stack (GCC's C
- * spilled the sums: ~100 instructions a block, here 72). The same exact
+ * (LDRD/STRD). a, the pointers and the ends live on the stack (GCC's C
+ * spilled the sums: ~100 instructions a block, here 72); each row's
+ * pointers (SN_CELLK_OFFIDX's base a (13 - a) / 2 - 1) are formed here, not
+ * by a C loop around a call per row ("M4 round 3"). The same exact
  * products as the reference, another order (NUMERICS.md "SIMD kernels"). */
-struct sn_m4_row {
-    const sn_q *ua;         /* 0: u + 3 i (corner j's operand follows) */
-    const uint8_t *fcp;     /* 4: fc + i + 1 */
-    uint32_t m0, e0;        /* 8, 12: block (a,b)'s mantissas at m0 + 18 b, exponent at e0 + b */
-    const unsigned char *d; /* 16: diagonal block (a,a) */
-    sn_acc *lend;           /* 20: l + 3 nf */
-};
-typedef char sn_m4_row_layout_[sizeof(struct sn_m4_row) == 24 ? 1 : -1];
-void sn_m4_cell_row(sn_acc s[3], const struct sn_m4_row *c);
+void sn_m4_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
 __asm__(
     ".syntax unified\n"
     ".thumb\n"
-    ".pushsection .text.sn_m4_cell_row,\"ax\",%progbits\n"
+    ".pushsection .text.sn_m4_cell_mul,\"ax\",%progbits\n"
+    ".set snm1_diag, " SN_M4_S(SN_CELLK_DIAG) "\n"
+    ".set snm1_off, " SN_M4_S(SN_CELLK_OFF) "\n"
+    ".set snm1_exp, " SN_M4_S(SN_CELLK_EXP) "\n"
     ".align 2\n"
-    ".global sn_m4_cell_row\n"
+    ".global sn_m4_cell_mul\n"
     ".thumb_func\n"
-    ".type sn_m4_cell_row, %function\n"
-    "sn_m4_cell_row:\n"
+    ".type sn_m4_cell_mul, %function\n"
+    "sn_m4_cell_mul:\n"
     "push  {r4-r11, lr}\n"
-    "sub   sp, sp, #40\n"           /* [sp] a0 a1 a2 fcp ub m0 e0 lend s */
-    "str   r0, [sp, #32]\n"
-    "add   lr, r0, #24\n"           /* lb = l + 3 (i + 1) */
-    "ldm   r1, {r2-r7}\n"           /* ua fcp m0 e0 d lend */
-    "str   r3, [sp, #12]\n"
-    "str   r4, [sp, #20]\n"
-    "str   r5, [sp, #24]\n"
-    "str   r7, [sp, #28]\n"
+    "sub   sp, sp, #48\n"          /* [sp] a0 a1 a2 fcp ub m0 e0 lend s K fci ua; l at [sp, #84] */
+    "ldr   r12, [sp, #84]\n"
+    "str   r0, [sp, #36]\n"
+    "str   r1, [sp, #40]\n"
+    "str   r3, [sp, #44]\n"
+    "str   r12, [sp, #32]\n"
+    "add   r4, r2, r2, lsl #1\n"
+    "add   r4, r12, r4, lsl #3\n"  /* lend = l + 3 nf */
+    "str   r4, [sp, #28]\n"
+    "mov   r5, #0\n"
+    "mov   r6, #0\n"
+    "0:\n"                          /* l = 0, a corner at a time (nf >= 1) */
+    "strd  r5, r6, [r12], #8\n"
+    "strd  r5, r6, [r12], #8\n"
+    "strd  r5, r6, [r12], #8\n"
+    "cmp   r12, r4\n"
+    "bne   0b\n"
+    "3:\n"                          /* row i */
+    "ldr   r1, [sp, #40]\n"
+    "ldrb  r2, [r1], #1\n"          /* a = fc[i] */
+    "str   r1, [sp, #40]\n"
+    "str   r1, [sp, #12]\n"         /* fcp = fc + i + 1 */
+    "ldr   r0, [sp, #36]\n"
+    "rsb   r3, r2, #13\n"
+    "mul   r3, r3, r2\n"
+    "lsr   r3, r3, #1\n"
+    "sub   r3, r3, #1\n"            /* base: SN_CELLK_OFFIDX(a, b) = base + b */
+    "add   r4, r0, r3, lsl #4\n"
+    "add   r4, r4, r3, lsl #1\n"
+    "add   r4, r4, #snm1_off\n"
+    "str   r4, [sp, #20]\n"         /* m0 = K + OFF + 18 base */
+    "add   r4, r0, r3\n"
+    "addw  r4, r4, #snm1_exp\n"
+    "str   r4, [sp, #24]\n"         /* e0 = K + EXP + base */
+    "add   r10, r2, r2, lsl #1\n"
+    "add   r10, r0, r10, lsl #3\n"
+    ".if snm1_diag\n"
+    "add   r10, r10, #snm1_diag\n"
+    ".endif\n"                      /* d = K + DIAG + 24 a */
+    "ldr   r2, [sp, #44]\n"         /* ua */
     "add   r3, r2, #12\n"
     "str   r3, [sp, #16]\n"         /* ub = ua + 3 */
-    "mov   r10, r6\n"               /* d */
+    "str   r3, [sp, #44]\n"         /* the next row's ua */
     "ldm   r2, {r6-r8}\n"           /* a0 a1 a2 */
     "stm   sp, {r6-r8}\n"
+    "ldr   r0, [sp, #32]\n"
+    "add   lr, r0, #24\n"           /* lb = l + 3 (i + 1) */
     "ldm   r0, {r0-r5}\n"           /* s0 s1 s2, lo:hi */
     "ldr   r12, [r10]\n"            /* diagonal: xx yy zz xy xz yz */
     "smlal r0, r1, r12, r6\n"
@@ -148,33 +183,21 @@ __asm__(
     "bne   1b\n"
     "2:\n"
     "ldr   r12, [sp, #32]\n"
-    "stm   r12, {r0-r5}\n"
-    "add   sp, sp, #40\n"
+    "stm   r12!, {r0-r5}\n"
+    "str   r12, [sp, #32]\n"
+    "ldr   r11, [sp, #28]\n"
+    "cmp   r12, r11\n"
+    "bne   3b\n"
+    "add   sp, sp, #48\n"
     "pop   {r4-r11, pc}\n"
-    ".size sn_m4_cell_row, .-sn_m4_cell_row\n"
+    ".size sn_m4_cell_mul, .-sn_m4_cell_mul\n"
     ".popsection\n");
 
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
-    const uint32_t k0 = (uint32_t)(uintptr_t)K;
-    struct sn_m4_row c;
     uint32_t i;
-    for (i = 0; i < 3 * nf; i++) {
-        l[i] = 0;
-        __asm__("" : : : "memory"); /* a store a word, not GCC's memset call (newlib-nano's is a byte loop) */
-    }
-    c.lend = l + 3 * nf;
-    for (i = 0; i < nf; i++) {
-        const uint32_t a = fc[i];
-        /* SN_CELLK_OFFIDX(a, b) = base + b = a (13 - a) / 2 - 1 + b >= 0 (b > a) */
-        const uint32_t base = a * (13u - a) / 2u - 1u;
-        c.ua = u + 3 * i;
-        c.fcp = fc + i + 1;
-        c.m0 = k0 + SN_CELLK_OFF + 18u * base;
-        c.e0 = k0 + SN_CELLK_EXP + base;
-        c.d = K + SN_CELLK_DIAG + 24u * a;
-        sn_m4_cell_row(l + 3 * i, &c);
-    }
+    if (nf) sn_m4_cell_mul(K, fc, nf, u, l);
     for (i = 0; i < 3 * nf; i++) SN_RANGE(SN_WITHIN(l[i], 60), "cell row beyond 24 * 2^55", l[i]);
+    (void)i;
 }
 
 /* The right-hand side's two products (sn_k_cell_mul2) in Thumb-2
@@ -192,8 +215,6 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * The same exact products as the reference, summed in another order
  * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 void sn_m4_cell_mul2(const unsigned char *K, const sn_q *u1, const sn_q *u2, sn_acc *l1, sn_acc *l2, uint32_t rows2);
-#define SN_M4_S_(x) #x
-#define SN_M4_S(x) SN_M4_S_(x)
 __asm__(
     ".syntax unified\n"
     ".thumb\n"
@@ -401,6 +422,110 @@ __asm__(
     ".purgem snic_row\n"
     ".popsection\n");
 
+/* The IC(0) forward sweep's column (sn_k_ic_fwd_col, sn_kernels_ic.h) in
+ * Thumb-2: for the blocks of column j while their row i < nF and their
+ * shift s = frac + k_j - k_i is in 1..31: acc_i += round(U^T y_j), each of
+ * the three sums from the rounding term 2^(s-1) through three SMLAL, the
+ * shift on the two words (sn_k_ic_m4's value), added to acc_i by
+ * LDRD/ADDS/ADC/STRD. y_j stays in r0-r2 for the column (GCC's inlined
+ * sn_k_ic_col reloaded it and the loop's bounds: 91 instructions a block,
+ * here 70). Leaves in c (blk, cols) where it stopped: the column's end
+ * or a skeleton row (returns 0), or a block for the reference (returns 1). */
+typedef char sn_m4_icc_layout_[sizeof(struct sn_m4_icc) == 32 && SN_ELEM_ICHOL == 20 ? 1 : -1];
+
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_ic_cols,\"ax\",%progbits\n"
+    /* row k of U^T (column k of U: entries k, 3 + k, 6 + k) */
+    ".macro snicc_row k\n"
+    "mov   r8, r11\n"
+    "mov   r9, #0\n"
+    "ldrsh r10, [r3, #(2 * \\k)]\n"
+    "smlal r8, r9, r10, r0\n"
+    "ldrsh r10, [r3, #(2 * \\k + 6)]\n"
+    "smlal r8, r9, r10, r1\n"
+    "ldrsh r10, [r3, #(2 * \\k + 12)]\n"
+    "smlal r8, r9, r10, r2\n"
+    "lsr   r8, r8, r5\n"
+    "lsl   r10, r9, r6\n"
+    "orr   r8, r8, r10\n"
+    "asr   r9, r9, r5\n"
+    "ldrd  r10, r12, [r7, #(8 * \\k)]\n"
+    "adds  r10, r10, r8\n"
+    "adc   r12, r12, r9\n"
+    "strd  r10, r12, [r7, #(8 * \\k)]\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_ic_cols\n"
+    ".thumb_func\n"
+    ".type sn_m4_ic_cols, %function\n"
+    "sn_m4_ic_cols:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #4\n"               /* [sp] c */
+    "str   r0, [sp]\n"
+    "ldr   r3, [r0, #0]\n"            /* blk */
+    "ldr   r4, [r0, #4]\n"            /* cols */
+    "ldr   r12, [r0, #28]\n"
+    "ldm   r12, {r0, r1, r2}\n"        /* y_j */
+    "1:\n"
+    "ldr   r12, [sp]\n"
+    "ldr   lr, [r12, #8]\n"
+    "cmp   r4, lr\n"
+    "beq   9f\n"                       /* the column's end */
+    "ldrh  r7, [r4]\n"                 /* i */
+    "ldr   lr, [r12, #20]\n"
+    "cmp   r7, lr\n"
+    "bhs   9f\n"                       /* a skeleton row: the column's free blocks are done */
+    "ldr   lr, [r12, #12]\n"
+    "ldrb  lr, [lr, r7]\n"             /* k_i */
+    "ldrb  r5, [r3, #18]\n"            /* frac */
+    "ldr   r6, [r12, #24]\n"
+    "add   r5, r5, r6\n"
+    "sub   r5, r5, lr\n"               /* s */
+    "sub   lr, r5, #1\n"
+    "cmp   lr, #30\n"
+    "bhi   8f\n"                       /* s <= 0 or s >= 32: the reference's block */
+    "mov   r11, #1\n"
+    "lsl   r11, r11, lr\n"             /* 2^(s-1) */
+    "rsb   r6, r5, #32\n"
+    "ldr   lr, [r12, #16]\n"
+    "add   r7, r7, r7, lsl #1\n"
+    "add   r7, lr, r7, lsl #3\n"       /* acc + 3 i */
+    "snicc_row 0\n"
+    "snicc_row 1\n"
+    "snicc_row 2\n"
+    "add   r3, r3, #20\n"
+    "add   r4, r4, #2\n"
+    "b     1b\n"
+    "8:\n"
+    "mov   r0, #1\n"                   /* returns 1: a block for the reference */
+    "b     7f\n"
+    "9:\n"
+    "mov   r0, #0\n"
+    "7:\n"
+    "str   r3, [r12, #0]\n"
+    "str   r4, [r12, #4]\n"
+    "add   sp, sp, #4\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_ic_cols, .-sn_m4_ic_cols\n"
+    ".purgem snicc_row\n"
+    ".popsection\n");
+
+/* the forward sweep's column after a block sn_m4_ic_cols left: that
+ * block by the reference, then the loop again, until the column's end or a
+ * skeleton row */
+void sn_m4_ic_cols_rest(struct sn_m4_icc *c, uint32_t *sat) {
+    while (c->cols != c->cend) {
+        const uint32_t i = sn_rd_u16(c->cols);
+        if (i >= c->nF) break;
+        sn_k_ic_col_ref(c->blk, c->y, (int)c->blk[18] + c->kj - (int)c->kk[i], c->acc + 3 * i, sat);
+        c->blk += SN_ELEM_ICHOL;
+        c->cols += 2;
+        if (!sn_m4_ic_cols(c)) break;
+    }
+}
+
 /* sn_k_ic_bwd_row after a block the Thumb-2 loop left (s = 0 or s >= 32): that
  * block by the reference, then the loop again from the next one */
 void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const unsigned char *end, const sn_q *z,
@@ -418,24 +543,164 @@ void sn_m4_ic_rows_rest(const unsigned char *b, const unsigned char *cols, const
     }
 }
 
+/* The mat-vec's mass pass over free-free blocks (sn_solve.c pass_M_ff
+ * without a mask) in Thumb-2: row i's three sums l in r0-r5 from the
+ * diagonal's SMULL, each block (i,j), j < nF, by m y_j into l and m y_i into
+ * acc_j (LDRD/SMLAL/STRD), the row's end into acc_i. y_i on the stack,
+ * y_j by pointer (GCC spilled l: ~45 instructions a block, here 30). The
+ * same exact products added to the same int64 sums. */
+struct sn_m4_mff {
+    const unsigned char *rp, *cols, *md, *mo; /* 0, 4, 8, 12 */
+    const sn_q *y;                            /* 16 */
+    sn_acc *acc;                              /* 20 */
+    uint32_t nF;                              /* 24 */
+};
+typedef char sn_m4_mff_layout_[sizeof(struct sn_m4_mff) == 28 && SN_REAL_BYTES == 4 ? 1 : -1];
+void sn_m4_mass_ff(const struct sn_m4_mff *c);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_mass_ff,\"ax\",%progbits\n"
+    ".align 2\n"
+    ".global sn_m4_mass_ff\n"
+    ".thumb_func\n"
+    ".type sn_m4_mass_ff, %function\n"
+    "sn_m4_mass_ff:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #48\n"      /* [sp] yi0 yi1 yi2, 12 end, 16 nF, 20 i, 24 rp, 28 md, 32 y, 36 cols, 40 mo */
+    "ldm   r0, {r1-r7}\n"      /* rp cols md mo y acc nF */
+    "str   r1, [sp, #24]\n"
+    "str   r2, [sp, #36]\n"
+    "str   r3, [sp, #28]\n"
+    "str   r4, [sp, #40]\n"
+    "str   r5, [sp, #32]\n"
+    "str   r7, [sp, #16]\n"
+    "mov   lr, r6\n"           /* acc */
+    "mov   r0, #0\n"
+    "str   r0, [sp, #20]\n"    /* i = 0 */
+    "1:\n"
+    "ldr   r6, [sp, #24]\n"
+    "ldr   r7, [r6], #4\n"     /* e = rp[i] */
+    "ldr   r8, [r6]\n"         /* end = rp[i + 1] */
+    "str   r6, [sp, #24]\n"
+    "ldr   r9, [sp, #36]\n"
+    "add   r10, r9, r7, lsl #1\n"  /* cols + 2 e */
+    "add   r8, r9, r8, lsl #1\n"
+    "str   r8, [sp, #12]\n"    /* cols + 2 end */
+    "ldr   r9, [sp, #40]\n"
+    "add   r11, r9, r7, lsl #2\n"  /* mo + 4 e */
+    "ldr   r6, [sp, #28]\n"
+    "ldr   r12, [r6], #4\n"    /* md[i] */
+    "str   r6, [sp, #28]\n"
+    "ldr   r6, [sp, #20]\n"
+    "add   r6, r6, r6, lsl #1\n"
+    "ldr   r7, [sp, #32]\n"
+    "add   r6, r7, r6, lsl #2\n"
+    "ldm   r6, {r7, r8, r9}\n" /* y_i */
+    "stm   sp, {r7, r8, r9}\n"
+    "smull r0, r1, r12, r7\n"
+    "smull r2, r3, r12, r8\n"
+    "smull r4, r5, r12, r9\n"
+    "2:\n"
+    "ldr   r6, [sp, #12]\n"
+    "cmp   r10, r6\n"
+    "beq   3f\n"               /* the row's end */
+    "ldrh  r7, [r10], #2\n"    /* j */
+    "ldr   r6, [sp, #16]\n"
+    "cmp   r7, r6\n"
+    "bhs   3f\n"               /* a skeleton column: the row's free blocks are done */
+    "ldr   r6, [r11], #4\n"    /* m */
+    "add   r7, r7, r7, lsl #1\n"
+    "ldr   r8, [sp, #32]\n"
+    "add   r8, r8, r7, lsl #2\n"   /* y_j */
+    "ldr   r9, [r8]\n"
+    "smlal r0, r1, r6, r9\n"
+    "ldr   r9, [r8, #4]\n"
+    "smlal r2, r3, r6, r9\n"
+    "ldr   r9, [r8, #8]\n"
+    "smlal r4, r5, r6, r9\n"
+    "add   r7, lr, r7, lsl #3\n"   /* acc_j */
+    "ldr   r12, [sp, #0]\n"
+    "ldrd  r8, r9, [r7, #0]\n"
+    "smlal r8, r9, r6, r12\n"
+    "strd  r8, r9, [r7, #0]\n"
+    "ldr   r12, [sp, #4]\n"
+    "ldrd  r8, r9, [r7, #8]\n"
+    "smlal r8, r9, r6, r12\n"
+    "strd  r8, r9, [r7, #8]\n"
+    "ldr   r12, [sp, #8]\n"
+    "ldrd  r8, r9, [r7, #16]\n"
+    "smlal r8, r9, r6, r12\n"
+    "strd  r8, r9, [r7, #16]\n"
+    "b     2b\n"
+    "3:\n"
+    "ldr   r6, [sp, #20]\n"
+    "add   r7, r6, r6, lsl #1\n"
+    "add   r7, lr, r7, lsl #3\n"   /* acc_i */
+    "ldrd  r8, r9, [r7, #0]\n"
+    "adds  r8, r8, r0\n"
+    "adc   r9, r9, r1\n"
+    "strd  r8, r9, [r7, #0]\n"
+    "ldrd  r8, r9, [r7, #8]\n"
+    "adds  r8, r8, r2\n"
+    "adc   r9, r9, r3\n"
+    "strd  r8, r9, [r7, #8]\n"
+    "ldrd  r8, r9, [r7, #16]\n"
+    "adds  r8, r8, r4\n"
+    "adc   r9, r9, r5\n"
+    "strd  r8, r9, [r7, #16]\n"
+    "add   r6, r6, #1\n"
+    "str   r6, [sp, #20]\n"
+    "ldr   r7, [sp, #16]\n"
+    "cmp   r6, r7\n"
+    "blo   1b\n"
+    "add   sp, sp, #48\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_mass_ff, .-sn_m4_mass_ff\n"
+    ".popsection\n");
+
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF) {
+    struct sn_m4_mff c;
+    c.rp = rp; c.cols = cols; c.md = md; c.mo = mo; c.y = y; c.acc = acc; c.nF = nF;
+    if (nF) sn_m4_mass_ff(&c);
+}
+
 /* The CG dot product (sn_kernels.c's reference): each product rounded alone,
  * (a b + 2^(sh-1)) >> sh. Here the rounding term is the SMLAL's starting
  * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),
  * the shift is done on the two words: the same rounded terms (sn_rshr64_var's
  * identity), summed in the same order. */
+/* sn_shr64_w's value with the words joined by OR (GCC added the zero
+ * high word of the low part: one ADDS #0 a term) */
+SN_INLINE int64_t sn_m4_shr_or(int64_t x, int s) {
+    const uint32_t lo = (uint32_t)x;
+    const int32_t hi = (int32_t)(x >> 32);
+    return (int64_t)(((uint64_t)(uint32_t)(hi >> s) << 32) | (lo >> s | (uint32_t)hi << (32 - s)));
+}
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
-    uint32_t i, k, nv = n / 3;
-    const int s = sn_k_dot_scale(a, b, 0, n, 0, 0);
+    uint32_t i, k, nv = n / 3, oa = 0, ob = 0;
+    int s;
     int64_t sum = 0;
+    /* the ORs of |a|, |b| (sn_k_dot_scale's head): a vertex's 3 values at a
+     * time, |x| as (x ^ m) - m with m = x >> 31 (EOR, SUB with shifted
+     * operands; GCC's compare and conditional negate took 3) */
+#define SN_K_ABS(x) (((uint32_t)(x) ^ (uint32_t)((x) >> 31)) - (uint32_t)((x) >> 31))
+    for (i = 0; i < 3 * nv; i += 3) {
+        oa |= SN_K_ABS(a[i]) | SN_K_ABS(a[i + 1]) | SN_K_ABS(a[i + 2]);
+        ob |= SN_K_ABS(b[i]) | SN_K_ABS(b[i + 1]) | SN_K_ABS(b[i + 2]);
+    }
+#undef SN_K_ABS
+    s = sn_k_dot_scale(a, b, 3 * nv, n, oa, ob);
     for (i = 0; i < nv; i++) {
         const int sh = s + kk[i];
         if (sh > 0 && sh < 32) {
             const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
             const sn_q *ai = a + 3 * i, *bi = b + 3 * i;
             /* written out: GCC kept a loop of 3 (15 instructions a term) */
-            sum += sn_shr64_w(bias + (int64_t)ai[0] * bi[0], sh);
-            sum += sn_shr64_w(bias + (int64_t)ai[1] * bi[1], sh);
-            sum += sn_shr64_w(bias + (int64_t)ai[2] * bi[2], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[0] * bi[0], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[1] * bi[1], sh);
+            sum += sn_m4_shr_or(bias + (int64_t)ai[2] * bi[2], sh);
         } else {
             const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
             for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
@@ -452,16 +717,14 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
     uint32_t i;
     if (sh > 0 && sh < 32) {
-        const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
-        for (i = 0; i < n; i++) {
-            const int64_t v = sn_shr64_w(bias + (int64_t)s * x[i], sh);
-            const uint32_t lo = (uint32_t)v;
-            sn_q q;
-            /* |v| <= SN_LIM: the low word within +-SN_LIM (one unsigned
-             * compare) and the high word its sign (not two 64-bit compares) */
-            if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && (int32_t)(v >> 32) == (int32_t)lo >> 31) q = (int32_t)lo;
-            else { (*sat)++; q = v > 0 ? SN_LIM : -SN_LIM; }
-            out[i] = sn_add(a[i], q, sat);
+        /* sn_k_out_w (sn_kernels_rot.h): the rounding add, the shift on the
+         * two words and |v| <= SN_LIM as the low word within +-SN_LIM and
+         * the high word its sign (not two 64-bit compares) */
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        sn_q *const end = out + n;
+        while (out != end) {
+            const sn_q q = sn_k_out_w(sn_mul(s, *x++), sh, bit, sat);
+            *out++ = sn_add(*a++, q, sat);
         }
     } else {
         for (i = 0; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);

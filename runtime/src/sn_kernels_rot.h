@@ -150,6 +150,33 @@ SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t 
     out[2] = sn_k_rot_out1(sn_mul(R[6], v0) + sn_mul(R[7], v1) + sn_mul(R[8], v2), sat);
 }
 #define sn_k_rot_acc sn_rot_acc
+/* sn_out(l, s) for 0 < s < 32, bit = 2^(s-1): the rounding add's carry and
+ * the shift on the two words (sn_rshr64_var's form), the clamp as the low
+ * word within +-SN_LIM and the high word its sign (sn_k_axpy's test); an
+ * int32 result without 64-bit compares. The same value and count. */
+SN_INLINE int32_t sn_k_out_w(sn_acc l, int s, uint32_t bit, uint32_t *sat) {
+    const int64_t r = l + (int64_t)bit; /* ADDS, ADC (a carry by compare cost GCC 4) */
+    const uint32_t lo0 = (uint32_t)r;
+    const int32_t hi0 = (int32_t)(r >> 32);
+    const uint32_t lo = (lo0 >> s) | ((uint32_t)hi0 << (32 - s));
+    const int32_t hi = hi0 >> s;
+    SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", l);
+    if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && hi == (int32_t)lo >> 31) return (int32_t)lo;
+    (*sat)++;
+    return hi < 0 ? -SN_LIM : SN_LIM;
+}
+/* the same for 32 <= s <= 62, 2^(s-1) = bhi 2^32 + blo: the value is the
+ * high word after the rounding add, shifted by s - 32 (the low word only
+ * carries), an int32 (|l| < 2^62.5) */
+SN_INLINE int32_t sn_k_out_hw(sn_acc l, int s, uint32_t blo, int32_t bhi, uint32_t *sat) {
+    const int32_t v = (int32_t)((l + (int64_t)(((uint64_t)(uint32_t)bhi << 32) | blo)) >> 32) >> (s - 32);
+    SN_RANGE(l <= (int64_t)6521908912666391106 && l >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", l);
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
+}
 
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
@@ -330,12 +357,86 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     sn_k_st3d(out, sn_k_out4(x, sn_k_sh4(sh), sat)); /* lane 3: 0 * e */
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
+#if defined(SN_KERNELS_M4)
+/* t = sn_out(l, sh) as int32 (sn_k_out_w for 0 < sh < 32), then each acc
+ * entry as the start of its SMLAL chain (GCC's sn_rot_acc: SMULL, SMLAL x 2
+ * and a 64-bit add a row); exact int64 sums, the same integers. */
+SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    int32_t t0, t1, t2;
+    int64_t x;
+    if ((uint32_t)(sh - 1) < 31u) {
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        t0 = sn_k_out_w(l[0], sh, bit, sat);
+        t1 = sn_k_out_w(l[1], sh, bit, sat);
+        t2 = sn_k_out_w(l[2], sh, bit, sat);
+    } else if ((uint32_t)(sh - 32) < 31u) { /* 32..62: some vertices' stiffness rows */
+        const uint32_t blo = sh == 32 ? (uint32_t)1 << 31 : 0;
+        const int32_t bhi = sh == 32 ? 0 : (int32_t)1 << ((sh - 33) & 31);
+        t0 = sn_k_out_hw(l[0], sh, blo, bhi, sat);
+        t1 = sn_k_out_hw(l[1], sh, blo, bhi, sat);
+        t2 = sn_k_out_hw(l[2], sh, blo, bhi, sat);
+    } else {
+        t0 = sn_out(l[0], sh, sat);
+        t1 = sn_out(l[1], sh, sat);
+        t2 = sn_out(l[2], sh, sat);
+    }
+    SN_K_I32(t0, t1, t2);
+    x = acc[0]; x += sn_mul(R[0], t0); x += sn_mul(R[1], t1); x += sn_mul(R[2], t2); acc[0] = x;
+    x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
+    x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
+}
+/* l = D e in int32 registers (e read first: out may be e), then sn_k_out_w
+ * (0 < sh < 32) or sn_out; exact sums, the same integers */
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    const sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
+    const sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
+    int32_t e0 = e[0], e1 = e[1], e2 = e[2];
+    sn_acc l0, l1, l2;
+    SN_K_I32(e0, e1, e2);
+    l0 = sn_mul(xx, e0) + sn_mul(xy, e1) + sn_mul(xz, e2);
+    l1 = sn_mul(xy, e0) + sn_mul(yy, e1) + sn_mul(yz, e2);
+    l2 = sn_mul(xz, e0) + sn_mul(yz, e1) + sn_mul(zz, e2);
+    if ((uint32_t)(sh - 1) < 31u) {
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        out[0] = sn_k_out_w(l0, sh, bit, sat);
+        out[1] = sn_k_out_w(l1, sh, bit, sat);
+        out[2] = sn_k_out_w(l2, sh, bit, sat);
+    } else {
+        out[0] = sn_out(l0, sh, sat);
+        out[1] = sn_out(l1, sh, sat);
+        out[2] = sn_out(l2, sh, sat);
+    }
+}
+#define SN_K_SYM_OUT_M4 1
+#else
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
     sn_q t[3];
     int c;
     for (c = 0; c < 3; c++) t[c] = sn_out(l[c], sh, sat);
     sn_k_rot_acc(acc, R, t);
 }
+#endif
+#if defined(SN_KERNELS_M4)
+/* sn_add(x, -y) as QSUB (sn_add's QADD with the negation folded in: the
+ * same saturated difference for every y the reference can negate) and its
+ * one-compare clamp; written out (the loop's counter and NEG cost 4 of 11
+ * instructions an entry) */
+SN_INLINE sn_q sn_k_qsub(sn_q x, sn_q y, uint32_t *sat) {
+    const int32_t v = __qsub(x, y);
+    if ((uint32_t)v + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM) return v;
+    (*sat)++;
+    return v > 0 ? SN_LIM : -SN_LIM;
+}
+SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    const sn_q a0 = sn_k_qsub(x[0], y[0], sat), a1 = sn_k_qsub(x[1], y[1], sat), a2 = sn_k_qsub(x[2], y[2], sat);
+    out[0] = a0; out[1] = a1; out[2] = a2; /* out may be x or y */
+}
+SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn_q out[3], uint32_t *sat) {
+    out[0] = sn_k_qsub(rd_real(sec, ia), rd_real(sec, ib), sat);
+    out[1] = sn_k_qsub(rd_real(sec, ia + 1), rd_real(sec, ib + 1), sat);
+    out[2] = sn_k_qsub(rd_real(sec, ia + 2), rd_real(sec, ib + 2), sat);
+}
+#else
 SN_INLINE void sn_k_sub3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], -y[c], sat);
@@ -344,6 +445,36 @@ SN_INLINE void sn_k_sub3r(const unsigned char *sec, uint32_t ia, uint32_t ib, sn
     uint32_t c;
     for (c = 0; c < 3; c++) out[c] = sn_add(rd_real(sec, ia + c), -rd_real(sec, ib + c), sat);
 }
+#endif
+#if defined(SN_KERNELS_M4)
+/* written out, sn_add by QADD; coef's rounding by sn_k_out_w; x - y's
+ * clamp (sn_out at shift 0) on the two words (sn_k_out_w's test) */
+SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
+    const sn_q a0 = sn_add(x[0], y[0], sat), a1 = sn_add(x[1], y[1], sat), a2 = sn_add(x[2], y[2], sat);
+    out[0] = a0; out[1] = a1; out[2] = a2; /* out may be x or y */
+}
+SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
+    const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+    const sn_q a0 = sn_k_out_w(sn_mul(x[0], c), SN_Q_COEF, bit, sat), a1 = sn_k_out_w(sn_mul(x[1], c), SN_Q_COEF, bit, sat);
+    const sn_q a2 = sn_k_out_w(sn_mul(x[2], c), SN_Q_COEF, bit, sat);
+    out[0] = a0; out[1] = a1; out[2] = a2;
+}
+SN_INLINE sn_q sn_k_sub_w(sn_q x, sn_acc y, uint32_t *sat) {
+    const int64_t d = (int64_t)x - y;
+    const uint32_t lo = (uint32_t)d;
+    const int32_t hi = (int32_t)(d >> 32);
+    SN_RANGE(d <= (int64_t)6521908912666391106 && d >= -(int64_t)6521908912666391106, /* 2^62.5, as sn_out */
+             "accumulator beyond 2^62.5 reaches sn_out", d);
+    if (lo + (uint32_t)SN_LIM <= 2u * (uint32_t)SN_LIM && hi == (int32_t)lo >> 31) return (int32_t)lo;
+    (*sat)++;
+    return hi < 0 ? -SN_LIM : SN_LIM;
+}
+SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
+    x[0] = sn_k_sub_w(x[0], y[0], sat);
+    x[1] = sn_k_sub_w(x[1], y[1], sat);
+    x[2] = sn_k_sub_w(x[2], y[2], sat);
+}
+#else
 SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t *sat) {
     int c;
     for (c = 0; c < 3; c++) out[c] = sn_add(x[c], y[c], sat);
@@ -357,8 +488,10 @@ SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     x[1] = sn_out((sn_acc)x[1] - y[1], 0, sat);
     x[2] = sn_out((sn_acc)x[2] - y[2], 0, sat);
 }
+#endif
 /* l = 0 + D e, D symmetric stored xx yy zz xy xz yz (the sum from 0 as the
  * block Jacobi of format 5 did: float keeps its signed zeros); out = sn_out(l, sh) */
+#if !defined(SN_K_SYM_OUT_M4)
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
     sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
     sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
@@ -371,6 +504,7 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     out[1] = sn_out(l[1], sh, sat);
     out[2] = sn_out(l[2], sh, sat);
 }
+#endif
 #endif
 
 /* The mat-vec's last passes (sn_solve.c matvec), over n = 3 nF values:
@@ -399,6 +533,11 @@ SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_
         if (m) c += sn_k_bits4(m); /* rare */
     }
     *sat += c;
+#elif defined(SN_KERNELS_M4)
+    if (s > 0 && s < 32) {
+        const uint32_t bit = (uint32_t)1 << (s - 1);
+        for (; i < n; i++) out[i] = sn_k_out_w(in[i], s, bit, sat);
+    }
 #endif
     for (; i < n; i++) out[i] = sn_out(in[i], s, sat);
 }
@@ -451,6 +590,17 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         sn_acc s = sn_mul(q[i], ck) + sn_mul(mk, cm);
         q[i] = sn_out(s, SN_Q_COEF, sat);
     }
+#elif defined(SN_KERNELS_M4) /* sn_k_out_w for both roundings; a vertex's shift outside 1..31: the reference's */
+    for (; i < n / 3; i++) {
+        const int sh = fm - SN_KREL(kk[i]);
+        uint32_t k;
+        for (k = 0; k < 3; k++) {
+            int32_t mk = sh > 0 && sh < 32 ? sn_k_out_w(acc[3 * i + k], sh, (uint32_t)1 << (sh - 1), sat)
+                                           : sn_out(acc[3 * i + k], sh, sat);
+            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
+            q[3 * i + k] = sn_k_out_w(sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm), SN_Q_COEF, (uint32_t)1 << (SN_Q_COEF - 1), sat);
+        }
+    }
 #else /* per vertex, its shift once (the loop the mat-vec had) */
     for (; i < n / 3; i++) {
         int sh = fm - SN_KREL(kk[i]);
@@ -458,9 +608,6 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         for (k = 0; k < 3; k++) {
             sn_q mk = sn_out(acc[3 * i + k], sh, sat);
             sn_acc s;
-#if defined(SN_KERNELS_M4)
-            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
-#endif
             s = sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm);
             q[3 * i + k] = sn_out(s, SN_Q_COEF, sat);
         }
@@ -475,7 +622,7 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
  * code as before). The same value. */
 #if defined(SN_KERNELS_M4)
 SN_INLINE sn_acc sn_k_mul_out(sn_q d, sn_acc l, int s, uint32_t *sat) {
-    int32_t t = sn_out(l, s, sat);
+    int32_t t = (uint32_t)(s - 1) < 31u ? sn_k_out_w(l, s, (uint32_t)1 << (s - 1), sat) : sn_out(l, s, sat);
     __asm__("" : "+r"(t));
     return sn_mul(d, t);
 }

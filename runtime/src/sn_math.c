@@ -203,6 +203,44 @@ static int sn_bitlen64(uint64_t x) {
  * so the sum of squares fits uint64; |c| = isqrt rounded to nearest;
  * one division 2^62/|c|, then a multiply per component.
  * Error: <= 1.5 LSB per component (test: <= 2). |out_i| <= 2^30. */
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* Cortex-M: the same arithmetic in 32-bit words where the values fit: the
+ * bit length of the OR of the magnitudes (that of their maximum, no 64-bit
+ * compares), the scaled magnitudes (< 2^31) as uint32, so the squares are
+ * UMULL/UMLAL and a r a UMULL (r = 2^32 exactly gives a itself). The same
+ * integers. */
+static int sn_unit(const int64_t *c, int n, int32_t *out) {
+    uint64_t a64[4], m = 0, n2 = 0, N, r;
+    uint32_t a[4];
+    int i, b;
+    for (i = 0; i < n; i++) {
+        a64[i] = c[i] < 0 ? (uint64_t)0 - (uint64_t)c[i] : (uint64_t)c[i];
+        m |= a64[i];
+    }
+    if (m == 0) return 0;
+    b = sn_bitlen64(m);
+    for (i = 0; i < n; i++) {
+        a[i] = b > 31 ? (uint32_t)(a64[i] >> (b - 31)) : (uint32_t)a64[i] << (31 - b); /* < 2^31 */
+        n2 += (uint64_t)a[i] * a[i];
+    }
+    N = sn_isqrt64(n2);
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) {
+        for (i = 0; i < n; i++) out[i] = c[i] < 0 ? -(int32_t)a[i] : (int32_t)a[i]; /* r = 2^32 */
+        return 1;
+    }
+    if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else {
+        int s = N < ((uint64_t)1 << 31) ? 1 : 0;
+        r = sn_div64n((((uint64_t)1 << 62) + (N >> 1)) << s, (uint32_t)(N << s));
+    }
+    for (i = 0; i < n; i++) {
+        const uint32_t v = (uint32_t)(((uint64_t)a[i] * (uint32_t)r + ((uint64_t)1 << 31)) >> 32); /* r < 2^32 */
+        out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+    return 1;
+}
+#else
 static int sn_unit(const int64_t *c, int n, int32_t *out) {
     uint64_t a[4], m = 0, n2 = 0, N, r;
     int i, b;
@@ -234,6 +272,7 @@ static int sn_unit(const int64_t *c, int n, int32_t *out) {
     }
     return 1;
 }
+#endif
 
 /* Normalize q in place (Q30). Zero quaternion -> identity (0,0,0,1).
  * Any int32 input; error <= 1.5 LSB per component. */
@@ -251,11 +290,26 @@ void sn_qnormalize(sn_q q[4]) {
  * Components are clamped to +-2^30 (a unit quaternion's range), so every
  * product is <= 2^60 and no sum overflows; entries are rounded from Q60
  * (error <= 0.5 LSB for the given q) and clamped to +-2^30. */
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* Cortex-M: the clamp in int32 and the products 32 x 32 -> 64 (one SMULL
+ * each; GCC multiplied the clamped int64 as 64 x 64 bits, three
+ * multiplies): the same products */
+static int32_t sn_clamp30(int32_t v) {
+    return v > (int32_t)SN_Q30 ? (int32_t)SN_Q30 : (v < -(int32_t)SN_Q30 ? -(int32_t)SN_Q30 : v);
+}
+#define SN_QC_(v) sn_clamp30(v)
+#define SN_QM_(a, b) sn_mul((a), (b))
+typedef int32_t sn_qc_t_;
+#else
+#define SN_QC_(v) sn_clamp64((v), SN_Q30)
+#define SN_QM_(a, b) ((a) * (b))
+typedef int64_t sn_qc_t_;
+#endif
 void sn_qtomat(const sn_q q[4], sn_q R[9]) {
-    int64_t x = sn_clamp64(q[0], SN_Q30), y = sn_clamp64(q[1], SN_Q30);
-    int64_t z = sn_clamp64(q[2], SN_Q30), w = sn_clamp64(q[3], SN_Q30);
-    int64_t xx = x * x, yy = y * y, zz = z * z, xy = x * y, xz = x * z, yz = y * z;
-    int64_t xw = x * w, yw = y * w, zw = z * w;
+    sn_qc_t_ x = SN_QC_(q[0]), y = SN_QC_(q[1]);
+    sn_qc_t_ z = SN_QC_(q[2]), w = SN_QC_(q[3]);
+    int64_t xx = SN_QM_(x, x), yy = SN_QM_(y, y), zz = SN_QM_(z, z), xy = SN_QM_(x, y), xz = SN_QM_(x, z), yz = SN_QM_(y, z);
+    int64_t xw = SN_QM_(x, w), yw = SN_QM_(y, w), zw = SN_QM_(z, w);
     int64_t e[9];
     int k;
     e[0] = SN_Q30 - sn_rshr64(yy + zz, 29);

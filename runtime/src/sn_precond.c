@@ -31,12 +31,25 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
     uint32_t j, e, n = 0, nF = v->nF;
+#if defined(SN_K_IC_FWD_COL)
+    struct sn_m4_icc c;
+    sn_k_ic_fwd_init(&c, kk, acc, nF);
+#endif
+#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+    sn_k_zero(acc, 3 * nF);
+#else
     for (j = 0; j < 3 * nF; j++) acc[j] = 0;
+#endif
     for (j = 0; j < nF; j++) {
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
         const uint32_t n0 = n;
         sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
+#if defined(SN_K_IC_FWD_COL) /* the M4's loop (sn_kernels_ic.h) */
+        e = sn_rd_u32(rp + 4 * j);
+        if (e < end)
+            n += sn_k_ic_fwd_col(&c, L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, yj, kk[j], sat);
+#else
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
             const unsigned char *blk = L + (size_t)n * SN_ELEM_ICHOL;
@@ -48,6 +61,7 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
 #endif
             sn_k_ic_col(blk, yj, s, acc + 3 * i, sat); /* acc_i += round(U_ji^T y_j) */
         }
+#endif
         acc[3 * j] = (sn_acc)(n - n0); /* acc_j is consumed: row j's free column count, for ic_backward */
     }
     (void)kk;

@@ -37,8 +37,12 @@ SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
 }
 
 static void acc_zero(sn_acc *acc, uint32_t n3) {
+#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+    sn_k_zero(acc, n3);
+#else
     uint32_t i;
     for (i = 0; i < n3; i++) acc[i] = 0;
+#endif
 }
 
 
@@ -371,6 +375,9 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
     uint32_t i, nF = v->nF;
     acc_zero(acc, 3 * nF);
+#if defined(SN_K_MASS_FF)
+    if (!mask) { sn_k_mass_ff(rp, cols, md, mo, y, acc, nF); return; } /* the M4's loop (sn_kernels.h) */
+#endif
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_acc l[3] = {0, 0, 0};
