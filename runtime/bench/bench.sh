@@ -1,9 +1,9 @@
 #!/bin/sh
 # make bench (runtime part): step time, memory, callgrind instructions per
-# step and per block multiply-add, for the cow, the cow without its segment
-# meshes (cow_fem: the model issue 15's goals were set on, before the tail and
-# the blanket) and the beast (humanoid), fixed and float; the herd; then the issue 15 figure table (cow, beast),
-# with the Cortex-M4 figures of `make bench-baremetal` (run before this by
+# step, per stage and per block multiply-add, for the cow, the cow without its
+# segment meshes (cow_fem: the model issue 15's goals were set on, before the
+# tail and the blanket) and the beast (humanoid), fixed and float; the herd;
+# then the issue 15 figure table (every asset), with the Cortex-M4 figures of `make bench-baremetal` (run before this by
 # `make bench`) where its log exists.
 # Never fails on speed; a missing valgrind is reported, not fatal.
 BUILD=${1:-build}
