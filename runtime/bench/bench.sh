@@ -3,8 +3,9 @@
 # step, per stage and per block multiply-add, for the cow, the cow without its
 # segment meshes (cow_fem: the model issue 15's goals were set on, before the
 # tail and the blanket) and the beast (humanoid), fixed and float; the herd;
-# then the issue 15 figure table (every asset), with the Cortex-M4 figures of `make bench-baremetal` (run before this by
-# `make bench`) where its log exists.
+# then the issue 15 figure table (every asset), with the Cortex-M4 figures
+# of `make bench-baremetal` (run before this by `make bench`) where its log
+# exists.
 # Never fails on speed; a missing valgrind is reported, not fatal.
 BUILD=${1:-build}
 STEPS=${BENCH_STEPS:-20}
