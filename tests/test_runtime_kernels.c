@@ -790,6 +790,24 @@ static sn_acc rnd_acc(int wild) {
     return (int64_t)rnd_in(1 << 30) * (wild ? (1 << 26) : (1 << 12));
 #endif
 }
+/* sn_k_sub3, sn_k_add3 and sn_k_sub3a against sn_add / sn_out, bit for bit
+ * with the same clamp counts: the number of results or counts off (0..3) */
+static int vec3_off(const sn_q x[3], const sn_q y[3], const sn_acc ya[3]) {
+    sn_q o1[3], o2[3];
+    uint32_t s1 = 0, s2 = 0, k;
+    int bad = 0;
+    sn_k_sub3(x, y, o1, &s1);
+    for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
+    bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+    sn_k_add3(x, y, o1, &s1);
+    for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
+    bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+    memcpy(o1, x, sizeof o1);
+    sn_k_sub3a(o1, ya, &s1);
+    for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
+    bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+    return bad;
+}
 static void test_loops(void) {
     int t, bad = 0;
     uint32_t clamps = 0;
@@ -816,12 +834,7 @@ static void test_loops(void) {
         }
         for (k = 0; k < 14; k++) kk[k] = (uint8_t)(rnd32() % 4u);
         for (i = 0; i < n; i++) { in[i] = rnd_acc(wild); q1[i] = q2[i] = rnd_val(wild); }
-        sn_k_sub3(x, y, o1, &s1);
-        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
-        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
-        sn_k_add3(x, y, o1, &s1);
-        for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
-        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+        bad += vec3_off(x, y, ya);
         sn_k_coef3(x, ck, o1, &s1);
         for (k = 0; k < 3; k++) o2[k] = sn_mulq(x[k], ck, SN_Q_COEF, &s2);
         bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
@@ -833,10 +846,6 @@ static void test_loops(void) {
             for (k = 0; k < 3; k++) o2[k] = sn_add(rd_real(sec, (uint32_t)k), -rd_real(sec, 3u + (uint32_t)k), &s2);
             bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
         }
-        memcpy(o1, x, sizeof x);
-        sn_k_sub3a(o1, ya, &s1);
-        for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
-        bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
         sn_k_sym_out(D, x, o1, sh, &s1);
         {
             sn_q xx = rd_real(D, 0), yy = rd_real(D, 1), zz = rd_real(D, 2), xy = rd_real(D, 3), xz = rd_real(D, 4), yz = rd_real(D, 5);
@@ -960,12 +969,7 @@ static void test_vec_edges(void) {
             unsigned char sec[24];
             uint32_t s1 = 0, s2 = 0;
             for (k = 0; k < 3; k++) { x[k] = ev[(i + k) % ne]; y[k] = ev[(j + 2 * k) % ne]; ya[k] = ea[(j + k) % ne]; }
-            sn_k_sub3(x, y, o1, &s1);
-            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
-            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
-            sn_k_add3(x, y, o1, &s1);
-            for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], y[k], &s2);
-            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
+            bad += vec3_off(x, y, ya);
             for (k = 0; k < 3; k++) { put32(sec + 4 * k, (uint32_t)x[k]); put32(sec + 12 + 4 * k, (uint32_t)y[k]); }
             sn_k_sub3r(sec, 0, 3, o1, &s1);
             for (k = 0; k < 3; k++) o2[k] = sn_add(x[k], -y[k], &s2);
@@ -975,10 +979,6 @@ static void test_vec_edges(void) {
                 for (k = 0; k < 3; k++) o2[k] = sn_out(sn_mul(x[k], ev[c]), SN_Q_COEF, &s2);
                 bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
             }
-            memcpy(o1, x, sizeof x);
-            sn_k_sub3a(o1, ya, &s1);
-            for (k = 0; k < 3; k++) o2[k] = sn_out((sn_acc)x[k] - ya[k], 0, &s2);
-            bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2;
         }
     T_CHECK(bad == 0, "3-vector helpers at the clamp edges (path %s): %d results or counts off sn_add/sn_out", sn_kernels_name(), bad);
 }
