@@ -64,6 +64,29 @@ $(BM_DIR)/limb_clip.c: $(LIMB_CLIP) ports/baremetal/bin2c.sh
 $(BM_DIR)/obj/%_clip.o: $(BM_DIR)/%_clip.c
 	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
 
+# cow_fem: the cow without its segment meshes (the model issue 15's goals were
+# set on), baked in the build tree as runtime/bench/bench.sh bakes it: cow.sinew
+# without its chain, sheet and attach lines, mesh path made absolute; the trot
+COW_FEM_BLOB_C = $(BM_DIR)/gen/cow_fem_blob.c
+$(BM_DIR)/gen/cow_fem.sinew: tools/examples/cow/cow.sinew
+	@mkdir -p $(dir $@)
+	grep -v -E '^(chain|sheet|attach) ' $< | sed "s#^mesh #mesh $(CURDIR)/tools/examples/cow/#" > $@
+$(COW_FEM_BLOB_C): $(BM_DIR)/gen/cow_fem.sinew tools/examples/cow/cow.obj $(BAKE)
+	$(BAKE) $< --c-array $@ --name sinew_cow_fem_blob --quiet
+$(BM_DIR)/gen/cow_fem.blob: $(BM_DIR)/gen/cow_fem.sinew tools/examples/cow/cow.obj $(BAKE)
+	$(BAKE) $< -o $@ --quiet
+$(BM_DIR)/obj/cow_fem_blob.o: $(COW_FEM_BLOB_C)
+	@mkdir -p $(dir $@)
+	$(BM_CC) $(BM_CFLAGS) -c $< -o $@
+$(BM_DIR)/gen/cow_fem_inst.h: $(COW_FEM_BLOB_C) ports/baremetal/inst_bytes.sh
+	sh ports/baremetal/inst_bytes.sh $< > $@
+$(BM_DIR)/cow_fem_clip.c: $(COW_CLIP) ports/baremetal/bin2c.sh
+	@mkdir -p $(dir $@)
+	sh ports/baremetal/bin2c.sh sn_bm_clip $(COW_CLIP) > $@
+.PHONY: print-blob-cow_fem
+print-blob-cow_fem:
+	@echo $(BM_DIR)/gen/cow_fem.blob
+
 # the instance size of each blob, for main.c's static instance buffer
 $(BM_DIR)/gen/%_inst.h: $(BUILD)/examples/%_blob.c ports/baremetal/inst_bytes.sh
 	@mkdir -p $(dir $@)
@@ -93,6 +116,10 @@ $(eval $(call bm_image,bench_limb,limb,$(BM_BENCH_STEPS),1,$(LIMB_CLIP)))
 PROF_M4_STEPS ?= 2 10
 $(eval $(call bm_image,prof_cow_a,cow,$(word 1,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,prof_cow_b,cow,$(word 2,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,sinew_cow_fem,cow_fem,$(BM_STEPS),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,bench_cow_fem,cow_fem,$(BM_BENCH_STEPS),1,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,prof_cow_fem_a,cow_fem,$(word 1,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
+$(eval $(call bm_image,prof_cow_fem_b,cow_fem,$(word 2,$(PROF_M4_STEPS)),0,$(wildcard $(COW_CLIP))))
 $(eval $(call bm_image,prof_limb_a,limb,$(word 1,$(PROF_M4_STEPS)),0,$(LIMB_CLIP)))
 $(eval $(call bm_image,prof_limb_b,limb,$(word 2,$(PROF_M4_STEPS)),0,$(LIMB_CLIP)))
 # the QEMU TCG plugin that counts instructions per address (host code)
