@@ -176,6 +176,13 @@ SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
 #define SN_K_MASS_FF 1
 void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
                   const sn_q *y, sn_acc *acc, uint32_t nF);
+/* The right-hand side's mass pass (sn_solve.c sn_rhs) at the skeleton
+ * columns, after sn_k_mass_ff did the free ones with y = a1 v: acc_i +=
+ * M_ij sn_add(coef(vel_j, a1), ds_{j-nF}) over row i's blocks with j >= nF,
+ * y formed per block (the reference's values and clamp counts); requires
+ * |a1| <= ONE_COEF (sn_rhs's pre). */
+void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
+                  const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

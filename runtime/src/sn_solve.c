@@ -325,7 +325,19 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     pre = v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF;
     if (pre)
         for (i = 0; i < nF; i++) sn_k_coef3(vel + 3 * i, v->a1, u + 3 * i, sat);
+#if defined(SN_K_MASS_FF)
+    /* the M4: the free blocks by the mat-vec's loop, then the skeleton
+     * columns (sn_kernels.h); exact int64 sums of the same products, each
+     * partial sum within the pass's bound in any order (NUMERICS.md "M4
+     * round 4") */
+    if (pre) {
+        sn_k_mass_ff(rp, cols, md, mo, u, acc, nF);
+        sn_k_mass_sk(rp, cols, mo, vel, ds, v->a1, acc, nF, sat);
+    }
+    for (i = pre ? nF : 0; i < nF; i++) {
+#else
     for (i = 0; i < nF; i++) {
+#endif
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
         sn_q yis[3], yjs[3];
         const sn_q *yi = u + 3 * i;
