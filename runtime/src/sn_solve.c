@@ -303,7 +303,11 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     cell_forces(h, dt, u, acc, &e2, sat);
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
+#if defined(SN_KERNELS_M4)
+        b[i] = elastic ? (sn_q)-sn_k_out_w(acc[i], SN_Q_ROT, (uint32_t)1 << (SN_Q_ROT - 1), sat) : 0; /* sn_out in words */
+#else
         b[i] = elastic ? (sn_q)-sn_out(acc[i], SN_Q_ROT, sat) : 0; /* |.| <= SN_LIM */
+#endif
     }
     if (dt)
         for (i = 0; i < 3 * dt->n; i++) b[3 * nF + i] = (sn_q)-sn_out(DT(dt, o_acc, sn_acc)[i], SN_Q_ROT, sat);
@@ -311,6 +315,12 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i);
         sn_acc ek = 0;
+#if defined(SN_KERNELS_M4)
+        if ((uint32_t)(v->frac_M - 1) < 31u) { /* sn_out in 32-bit words: the same values and counts */
+            const uint32_t bit = (uint32_t)1 << (v->frac_M - 1);
+            for (k = 0; k < 3; k++) ek += sn_mul(vel[3 * i + k], sn_k_out_w(sn_mul(mi, vel[3 * i + k]), v->frac_M, bit, &esat));
+        } else
+#endif
         for (k = 0; k < 3; k++) ek += sn_mul(vel[3 * i + k], sn_mulq(mi, vel[3 * i + k], v->frac_M, &esat));
         e2 = energy_add(e2, E_Q32(ek));
     }
@@ -368,6 +378,21 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         sn_k_rot(R + 9 * i, v->grav, gr, sat);
         for (k = 0; k < 3; k++)
             gi[k] = (v->flags & SN_FLAG_REST_MODELLED) ? sn_add(v->grav[k], -gr[k], sat) : v->grav[k];
+#if defined(SN_KERNELS_M4)
+        { /* sn_out for 0 < s < 32 in 32-bit words (sn_k_out_w), the sum by QADD / QSUB (|ma| <= SN_LIM):
+           * the same values and counts */
+            const int s = v->frac_M - SN_KREL(kk[i]);
+            if ((uint32_t)(s - 1) < 31u) {
+                const uint32_t bit = (uint32_t)1 << (s - 1);
+                for (k = 0; k < 3; k++) {
+                    sn_q g = sn_k_out_w(sn_mul(mi, gi[k]), s, bit, sat);
+                    sn_q ma = sn_k_out_w(acc[3 * i + k], s, bit, sat);
+                    b[3 * i + k] = sn_k_qsub(sn_add(b[3 * i + k], g, sat), ma, sat);
+                }
+                continue;
+            }
+        }
+#endif
         for (k = 0; k < 3; k++) {
             sn_q g = sn_mulq(mi, gi[k], v->frac_M - SN_KREL(kk[i]), sat);
             sn_q ma = sn_out(acc[3 * i + k], v->frac_M - SN_KREL(kk[i]), sat);
