@@ -591,15 +591,28 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         q[i] = sn_out(s, SN_Q_COEF, sat);
     }
 #elif defined(SN_KERNELS_M4) /* sn_k_out_w for both roundings; a vertex's shift outside 1..31: the reference's */
+    /* a vertex's 3 values written out, its shift tested once (the loop of 3
+     * tested it per value and reloaded its operands: cow_fem step -17 k) */
+    const uint32_t cb = (uint32_t)1 << (SN_Q_COEF - 1);
     for (; i < n / 3; i++) {
         const int sh = fm - SN_KREL(kk[i]);
-        uint32_t k;
-        for (k = 0; k < 3; k++) {
-            int32_t mk = sh > 0 && sh < 32 ? sn_k_out_w(acc[3 * i + k], sh, (uint32_t)1 << (sh - 1), sat)
-                                           : sn_out(acc[3 * i + k], sh, sat);
-            __asm__("" : "+r"(mk)); /* an int32 (sn_k_rot's SN_K_I32) */
-            q[3 * i + k] = sn_k_out_w(sn_mul(q[3 * i + k], ck) + sn_mul(mk, cm), SN_Q_COEF, (uint32_t)1 << (SN_Q_COEF - 1), sat);
+        sn_q *qi = q + 3 * i;
+        const sn_acc *ai = acc + 3 * i;
+        int32_t m0, m1, m2;
+        if ((uint32_t)(sh - 1) < 31u) {
+            const uint32_t bit = (uint32_t)1 << (sh - 1);
+            m0 = sn_k_out_w(ai[0], sh, bit, sat);
+            m1 = sn_k_out_w(ai[1], sh, bit, sat);
+            m2 = sn_k_out_w(ai[2], sh, bit, sat);
+        } else {
+            m0 = sn_out(ai[0], sh, sat);
+            m1 = sn_out(ai[1], sh, sat);
+            m2 = sn_out(ai[2], sh, sat);
         }
+        SN_K_I32(m0, m1, m2); /* int32 operands: SMULL, SMLAL */
+        qi[0] = sn_k_out_w(sn_mul(qi[0], ck) + sn_mul(m0, cm), SN_Q_COEF, cb, sat);
+        qi[1] = sn_k_out_w(sn_mul(qi[1], ck) + sn_mul(m1, cm), SN_Q_COEF, cb, sat);
+        qi[2] = sn_k_out_w(sn_mul(qi[2], ck) + sn_mul(m2, cm), SN_Q_COEF, cb, sat);
     }
 #else /* per vertex, its shift once (the loop the mat-vec had) */
     for (; i < n / 3; i++) {
