@@ -292,7 +292,11 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
      * Stored over free vertices; the skeleton's, computed in cell_forces
      * (w_of), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
     for (i = 0; i < nF; i++)
+#if defined(SN_KERNELS_M4)
+        sn_k_coef3(vel + 3 * i, ck, u + 3 * i, sat); /* coef per entry, in 32-bit words */
+#else
         for (k = 0; k < 3; k++) u[3 * i + k] = coef(vel[3 * i + k], ck, sat);
+#endif
     if (v->b1 > ONE_COEF)
         for (i = 3 * nF; i < 3 * nV; i++) (void)coef(vel[i], v->b1, sat);
     if (dt) { /* the seats' operands: c + (1+b1) v for the stiffness (in q's seat rows, dead until the PCG) */
@@ -318,7 +322,11 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
 #if defined(SN_KERNELS_M4)
         if ((uint32_t)(v->frac_M - 1) < 31u) { /* sn_out in 32-bit words: the same values and counts */
             const uint32_t bit = (uint32_t)1 << (v->frac_M - 1);
-            for (k = 0; k < 3; k++) ek += sn_mul(vel[3 * i + k], sn_k_out_w(sn_mul(mi, vel[3 * i + k]), v->frac_M, bit, &esat));
+            for (k = 0; k < 3; k++) {
+                int32_t t = sn_k_out_w(sn_mul(mi, vel[3 * i + k]), v->frac_M, bit, &esat);
+                __asm__("" : "+r"(t)); /* an int32: SMLAL (SN_K_I32) */
+                ek += sn_mul(vel[3 * i + k], t);
+            }
         } else
 #endif
         for (k = 0; k < 3; k++) ek += sn_mul(vel[3 * i + k], sn_mulq(mi, vel[3 * i + k], v->frac_M, &esat));
