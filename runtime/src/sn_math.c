@@ -372,6 +372,11 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
     int64_t X = x * 256, Y = y * 256, Z = 0;
     int i;
     if (x == 0 && y == 0) return 0;
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__GNUC__) && !defined(__clang__) && !defined(SN_FLOAT)
+    /* Cortex-M: unrolled, each shift a constant (5 instructions on the two
+     * words, not sn_rshr64_var's 10 for a variable one); the same values */
+#pragma GCC unroll 32
+#endif
     for (i = 0; i < 32; i++) {
         int64_t dx = sn_rshr64_var(Y, i), dy = sn_rshr64_var(X, i); /* Cortex-M: the shift on two words */
         if (Y > 0) {
