@@ -1159,6 +1159,61 @@ static void test_mass_ff(void) {
 }
 #endif
 
+#if defined(SN_K_MASS_FF)
+/* The M4's right-hand-side mass pass at the skeleton columns (sn_k_mass_sk)
+ * against sn_rhs's loop written here with the reference helpers (coef =
+ * sn_mulq, sn_add, sn_mul; exact int64 sums and the clamp count: tolerance
+ * 0): random ascending rows of 1..40 free rows over nF + 1..16 vertices
+ * (free columns first, as the validator's order gives), v' at and inside
+ * +-SN_LIM, a1 at and inside +-ONE_COEF (the kernel's contract: sn_rhs's
+ * pre) and at +-ONE_COEF / 2 (odd v' gives the rounding's ties), ds making y clamp at SN_LIM, starting accumulators random. */
+static void test_mass_sk(void) {
+    static unsigned char rp[4 * 41], cols[2 * 400], mo[4 * 400];
+    static sn_q vel[3 * 56], ds[3 * 16];
+    static sn_acc a1[3 * 40], a2[3 * 40];
+    int t, bad = 0, blocks = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 500; t++) {
+        const uint32_t nF = 1u + rnd32() % 40u, nS = 1u + rnd32() % 16u, nV = nF + nS;
+        const int wild = t % 4 == 0;
+        const sn_q a = t % 8 == 0 ? ONE_COEF : t % 8 == 1 ? -ONE_COEF : t % 8 == 2 ? ONE_COEF / 2 : t % 8 == 3 ? -ONE_COEF / 2 : rnd_in(ONE_COEF);
+        uint32_t i, e = 0, k, s1 = 0, s2 = 0;
+        for (i = 0; i < 3 * nV; i++) vel[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+        for (i = 0; i < 3 * nS; i++) ds[i] = wild ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+        for (i = 0; i < nF; i++) {
+            uint32_t j;
+            put32(rp + 4 * i, e);
+            for (j = i + 1; j < nV && e < 400; j++) /* ascending, > i: about 8 a row */
+                if (rnd32() % nV < 8u) {
+                    cols[2 * e] = (unsigned char)j;
+                    cols[2 * e + 1] = (unsigned char)(j >> 8);
+                    put32(mo + 4 * e, wild && rnd32() & 1 ? 0x007FFFFFu : (uint32_t)rnd_in(1 << 23));
+                    e++;
+                }
+        }
+        put32(rp + 4 * nF, e);
+        for (i = 0; i < 3 * nF; i++) a1[i] = a2[i] = (sn_acc)rnd_in(1 << 30) * 4096;
+        sn_k_mass_sk(rp, cols, mo, vel, ds, a, a1, nF, &s1);
+        for (i = 0; i < nF; i++) {
+            uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+            for (; b < end; b++) {
+                const uint32_t j = sn_rd_u16(cols + 2 * b);
+                const sn_q m = sn_rd_i32(mo + 4 * b);
+                if (j < nF) continue;
+                blocks++;
+                for (k = 0; k < 3; k++)
+                    a2[3 * i + k] += sn_mul(m, sn_add(sn_mulq(vel[3 * j + k], a, SN_Q_COEF, &s2), ds[3 * (j - nF) + k], &s2));
+            }
+        }
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "rhs mass pass, skeleton columns (path %s): %d of 500 structures differ from the reference loop",
+            sn_kernels_name(), bad);
+    T_FIGURE("rhs mass pass, skeleton columns: 500 random row structures, %d skeleton blocks, %u clamps", blocks, (unsigned)clamps);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -1316,6 +1371,7 @@ int main(void) {
 #endif
 #if defined(SN_K_MASS_FF)
     test_mass_ff();
+    test_mass_sk();
 #endif
     test_rot();
     test_axpy();
