@@ -433,6 +433,32 @@ static void test_axpy(void) {
             bad += sat != sd;
         }
     }
+    {   /* the product's bound |s x| <= 2^31 2^28 at the CG's shifts 28..31
+         * (the M4's word form there): s at INT32_MIN/MAX, +-1, 0, +-2^30, x at
+         * +-2^28, +-(2^28 - 1), +-2^27, +-1, 0 (INT32_MIN x -2^28 rounds to
+         * 2^31: clamped to +SN_LIM), against the same reference formula */
+        static const int32_t es[] = {INT32_MIN, INT32_MAX, -INT32_MAX, 1, -1, 0, 1 << 30, -(1 << 30)};
+        static const int32_t ex[] = {1 << 28, -(1 << 28), (1 << 28) - 1, -(1 << 28) + 1, 1 << 27, -(1 << 27), 1, -1, 0};
+        static const int32_t ea[] = {0, 1 << 28, -(1 << 28), 1, -1};
+        unsigned i, j, k;
+        int sh;
+        for (sh = 28; sh < 32; sh++)
+            for (i = 0; i < sizeof es / sizeof es[0]; i++)
+                for (k = 0; k < 5; k++) {
+                    sn_q a[9], x[9], o[9];
+                    uint32_t sat = 0, sd = 0;
+                    for (j = 0; j < 9; j++) { a[j] = ea[(j + k) % 5]; x[j] = ex[j]; }
+                    sn_k_axpy(o, a, es[i], x, 9, sh, &sat);
+                    for (j = 0; j < 9; j++) {
+                        int64_t q = ((int64_t)es[i] * x[j] + ((int64_t)1 << (sh - 1))) >> sh; /* floor: arithmetic shift */
+                        if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                        q += a[j];
+                        if (q > (1 << 28) || q < -(1 << 28)) { sd++; q = q > 0 ? (1 << 28) : -(1 << 28); }
+                        bad += o[j] != (sn_q)q;
+                    }
+                    bad += sat != sd;
+                }
+    }
 #endif
     T_CHECK(bad == 0, "CG vector update (path %s): %d values or clamp counts off the reference", sn_kernels_name(), bad);
     T_FIGURE("CG vector update: 3000 random vectors of 0..40 values (shifts 28 and 0..62, both aliasings), %u clamps", (unsigned)clamps);

@@ -140,7 +140,8 @@ SN_INLINE int sn_k_dot_scale(const sn_q *a, const sn_q *b, uint32_t i, uint32_t 
  * out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat); out may be a or x
  * (each entry is read before it is written). Fixed: |s x| <= 2^31 2^28,
  * |a| <= SN_LIM (a state vector) and 0 <= sh <= 62, every product rounded
- * and clamped alone (order-free);
+ * and clamped alone (order-free; the M4's word form for sh >= 28 relies
+ * on the product's bound);
  * float: out = sn_out(a + sn_out(s x)) per entry on every path (the same bits). */
 #if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_NEON) || defined(SN_KERNELS_M4) || defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat);
