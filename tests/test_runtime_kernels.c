@@ -1240,6 +1240,71 @@ static void test_mass_sk(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+/* sn_math.c's reduced sine / cosine and CORDIC atan2 (on the M4 image
+ * their Cortex-M forms: int32 Horner operands, the CORDIC unrolled, "M4
+ * round 4") against their int64 reference written here (the other paths'
+ * code), tolerance 0: r over [-pi/4, pi/4] (Q30) in steps of 2^12 plus
+ * the ends and 0, every quadrant; atan2 on edges (0, 1, 2^30, 2^31 - 1,
+ * 2^40) and random magnitudes of random widths, x or y 0 included. */
+static void ref_sincos(int64_t r, int quad, int64_t *s, int64_t *c) {
+    static const int64_t ks[6] = {1 << 30, -178956971, 8947849, -213044, 2959, -27};
+    static const int64_t kc[7] = {1 << 30, -536870912, 44739243, -1491308, 26630, -296, 2};
+    int64_t u = sn_rshr64(r * r, 30), ps = ks[5], pc = kc[6], sv;
+    int k;
+    for (k = 4; k >= 0; k--) ps = ks[k] + sn_rshr64(ps * u, 30);
+    for (k = 5; k >= 0; k--) pc = kc[k] + sn_rshr64(pc * u, 30);
+    sv = sn_rshr64(ps * r, 30);
+    switch (quad & 3) {
+    case 0: *s = sv; *c = pc; break;
+    case 1: *s = pc; *c = -sv; break;
+    case 2: *s = -sv; *c = -pc; break;
+    default: *s = -pc; *c = sv; break;
+    }
+}
+static int64_t ref_atan2(int64_t y, int64_t x) {
+    static const int64_t tab[32] = {
+        863554413089, 509785937287, 269356888665, 136729762476, 68630207382,
+        34348560106, 17178471287, 8589759836, 4294945451, 2147480917,
+        1073741483, 536870869, 268435451, 134217727, 67108864, 33554432,
+        16777216, 8388608, 4194304, 2097152, 1048576, 524288, 262144, 131072,
+        65536, 32768, 16384, 8192, 4096, 2048, 1024, 512};
+    int64_t X = x * 256, Y = y * 256, Z = 0;
+    int i;
+    if (x == 0 && y == 0) return 0;
+    for (i = 0; i < 32; i++) {
+        int64_t dx = sn_rshr64(Y, i), dy = sn_rshr64(X, i);
+        if (Y > 0) { X += dx; Y -= dy; Z += tab[i]; }
+        else { X -= dx; Y += dy; Z -= tab[i]; }
+    }
+    return sn_rshr64(Z, 10);
+}
+static void test_trig(void) {
+    static const int64_t edge[] = {0, 1, 2, 3, 1 << 30, (1 << 30) + 1, INT32_MAX, (int64_t)1 << 32, (int64_t)1 << 40};
+    const int64_t lim = 843314857; /* pi/4 2^30 */
+    int64_t r;
+    int bad = 0, n = 0, quad, t;
+    unsigned i, j;
+    for (r = -lim; r <= lim; r += r < lim - 4096 ? 4096 : (lim - r > 0 ? lim - r : 1))
+        for (quad = 0; quad < 4; quad++) {
+            int64_t s1, c1, s2, c2;
+            sn_sincos_q30(r, quad, &s1, &c1);
+            ref_sincos(r, quad, &s2, &c2);
+            bad += s1 != s2 || c1 != c2;
+            n++;
+        }
+    for (i = 0; i < sizeof edge / sizeof edge[0]; i++)
+        for (j = 0; j < sizeof edge / sizeof edge[0]; j++, n++) bad += sn_atan2_q30(edge[i], edge[j]) != ref_atan2(edge[i], edge[j]);
+    for (t = 0; t < 20000; t++, n++) {
+        const int64_t y = t % 7 == 0 ? 0 : (int64_t)(rnd32() >> (rnd32() % 32u)) << (rnd32() % 9u);
+        const int64_t x = t % 11 == 0 ? 0 : (int64_t)(rnd32() >> (rnd32() % 32u)) << (rnd32() % 9u);
+        bad += sn_atan2_q30(y, x) != ref_atan2(y, x);
+    }
+    T_CHECK(bad == 0, "sincos / atan2 (path %s): %d of %d results off the int64 reference", sn_kernels_name(), bad, n);
+    T_FIGURE("sincos / atan2: %d cases", n);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -1404,6 +1469,7 @@ int main(void) {
     test_isqrt();
 #if !defined(SN_FLOAT)
     test_rshr();
+    test_trig();
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();

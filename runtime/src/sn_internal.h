@@ -290,6 +290,10 @@ void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q
 sn_real sn_twist_deg(const sn_q q[4], const sn_q a[3]);
 /* floor(n / D), 0 < D <= 2^62, constant time (both flavours link it; fixed uses it). */
 uint64_t sn_udiv64(uint64_t n, uint64_t D);
+/* sin, cos of (quad pi/2 + r), |r| <= pi/4 (Q30), and atan2(y, x) for x, y
+ * >= 0 (Q30 radians): sn_math.c's helpers, exported for the kernel test */
+void sn_sincos_q30(int64_t r, int quad, int64_t *s, int64_t *c);
+int64_t sn_atan2_q30(int64_t y, int64_t x);
 /* Integer square root: floor(sqrt(x)). */
 uint32_t sn_isqrt64(uint64_t x);
 /* the same by two-bit digits in 32-bit words (sn_isqrt64 on a 32-bit target) */

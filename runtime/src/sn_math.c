@@ -343,6 +343,29 @@ void sn_qmul(const sn_q a[4], const sn_q b[4], sn_q out[4]) {
  * Taylor polynomials to r^11 / r^12 (truncation < 1e-11), Horner in Q30
  * with rounding: error <= ~1.5 LSB (Q30). */
 static void sn_sincos_red(int64_t r, int quad, int64_t *s, int64_t *c) {
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    /* Cortex-M: the same integers in int32 operands (SMULL, not GCC's
+     * 64 x 64 multiply): |r| <= pi/4 2^30 (both callers reduce to it), so
+     * u < 2^30 and every Horner value (sin r / r, cos r, partial sums of
+     * the alternating series) stays below 2^31 */
+    static const int32_t ks[6] = {SN_Q30, -178956971, 8947849, -213044, 2959, -27};
+    static const int32_t kc[7] = {SN_Q30, -536870912, 44739243, -1491308, 26630, -296, 2};
+    const int32_t r32 = (int32_t)r;
+    const int32_t u = (int32_t)sn_rshr64(sn_mul(r32, r32), 30);
+    int32_t ps = ks[5], pc = kc[6];
+    int64_t sv, cv;
+    int k;
+    SN_RANGE(r <= 843314857 && r >= -843314857, "sincos argument beyond pi/4", r);
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 6
+#endif
+    for (k = 4; k >= 0; k--) ps = ks[k] + (int32_t)sn_rshr64(sn_mul(ps, u), 30);
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 6
+#endif
+    for (k = 5; k >= 0; k--) pc = kc[k] + (int32_t)sn_rshr64(sn_mul(pc, u), 30);
+    sv = sn_rshr64(sn_mul(ps, r32), 30);
+#else
     static const int64_t ks[6] = {SN_Q30, -178956971, 8947849, -213044, 2959, -27};
     static const int64_t kc[7] = {SN_Q30, -536870912, 44739243, -1491308, 26630, -296, 2};
     int64_t u = sn_rshr64(r * r, 30), ps = ks[5], pc = kc[6], sv, cv;
@@ -350,6 +373,7 @@ static void sn_sincos_red(int64_t r, int quad, int64_t *s, int64_t *c) {
     for (k = 4; k >= 0; k--) ps = ks[k] + sn_rshr64(ps * u, 30);
     for (k = 5; k >= 0; k--) pc = kc[k] + sn_rshr64(pc * u, 30);
     sv = sn_rshr64(ps * r, 30);
+#endif
     cv = pc;
     switch (quad & 3) {
     case 0: *s = sv; *c = cv; break;
@@ -391,6 +415,11 @@ static int64_t sn_atan2_pos(int64_t y, int64_t x) {
     }
     return sn_rshr64(Z, 10);
 }
+
+/* sn_sincos_red and sn_atan2_pos for the kernel test (their Cortex-M
+ * forms against the int64 reference, tests/test_runtime_kernels.c) */
+void sn_sincos_q30(int64_t r, int quad, int64_t *s, int64_t *c) { sn_sincos_red(r, quad, s, c); }
+int64_t sn_atan2_q30(int64_t y, int64_t x) { return sn_atan2_pos(y, x); }
 
 /* Slerp along the shorter arc, Q30 in and out, t in [0, 2^30] (clamped).
  * Method (stable for tiny angles): d = a.b (b negated if d < 0),
