@@ -1060,7 +1060,7 @@ static void ref_qnormalize(sn_q q[4]) {
 }
 static void test_quat_words(void) {
     static const int32_t eq[] = {0, 1, -1, 1 << 30, -(1 << 30), (1 << 30) + 1, -(1 << 30) - 1, INT32_MAX, INT32_MIN, 1 << 29,
-                                 759250125, -759250125};
+                                 759250125, -759250125, 1 << 14, -(1 << 14), 3 << 14}; /* 2^14, 3 2^14: products at the rounding's ties */
     int t, bad_m = 0, bad_n = 0;
     for (t = 0; t < 6000; t++) {
         sn_q q[4], q1[4], q2[4], R1[9], R2[9];

@@ -305,6 +305,35 @@ typedef int32_t sn_qc_t_;
 #define SN_QM_(a, b) ((a) * (b))
 typedef int64_t sn_qc_t_;
 #endif
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+/* clamp(s >> 29, +-2^30) in 32-bit words, s holding the rounding term
+ * (|s| < 2^62): the low word of the shifted value and, for the clamp's
+ * test, its high word (sn_k_out_w's form) */
+SN_INLINE int32_t sn_r29c(int64_t s) {
+    const int32_t hi0 = (int32_t)(s >> 32);
+    const uint32_t lo = ((uint32_t)s >> 29) | ((uint32_t)hi0 << 3);
+    const int32_t hi = hi0 >> 29;
+    if (lo + (uint32_t)SN_Q30 <= 2u * (uint32_t)SN_Q30 && hi == (int32_t)lo >> 31) return (int32_t)lo;
+    return hi < 0 ? -(int32_t)SN_Q30 : (int32_t)SN_Q30;
+}
+/* Cortex-M: each entry one SMLAL chain from its rounding term (the
+ * diagonal's 2^30 - round(a / 2^29) as -round((a - 2^59) / 2^29): 2^59 is a
+ * multiple of 2^29, the clamp symmetric), clamped in words: the same
+ * integers as below */
+void sn_qtomat(const sn_q q[4], sn_q R[9]) {
+    const int32_t x = sn_clamp30(q[0]), y = sn_clamp30(q[1]), z = sn_clamp30(q[2]), w = sn_clamp30(q[3]);
+    const int64_t b = (int64_t)1 << 28, bd = b - ((int64_t)1 << 59);
+    R[0] = -sn_r29c(bd + sn_mul(y, y) + sn_mul(z, z));
+    R[1] = sn_r29c(b + sn_mul(x, y) + sn_mul(-z, w));
+    R[2] = sn_r29c(b + sn_mul(x, z) + sn_mul(y, w));
+    R[3] = sn_r29c(b + sn_mul(x, y) + sn_mul(z, w));
+    R[4] = -sn_r29c(bd + sn_mul(x, x) + sn_mul(z, z));
+    R[5] = sn_r29c(b + sn_mul(y, z) + sn_mul(-x, w));
+    R[6] = sn_r29c(b + sn_mul(x, z) + sn_mul(-y, w));
+    R[7] = sn_r29c(b + sn_mul(y, z) + sn_mul(x, w));
+    R[8] = -sn_r29c(bd + sn_mul(x, x) + sn_mul(y, y));
+}
+#else
 void sn_qtomat(const sn_q q[4], sn_q R[9]) {
     sn_qc_t_ x = SN_QC_(q[0]), y = SN_QC_(q[1]);
     sn_qc_t_ z = SN_QC_(q[2]), w = SN_QC_(q[3]);
@@ -323,6 +352,7 @@ void sn_qtomat(const sn_q q[4], sn_q R[9]) {
     e[8] = SN_Q30 - sn_rshr64(xx + yy, 29);
     for (k = 0; k < 9; k++) R[k] = (int32_t)sn_clamp64(e[k], SN_Q30);
 }
+#endif
 
 /* Hamilton product out = a*b, Q30. Inputs clamped to +-2^30 (sums of four
  * Q60 products <= 2^62), each output rounded (<= 0.5 LSB for the clamped
