@@ -495,7 +495,11 @@ void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q
     int64_t A[4], o[4], tt, ph, sp, cp, k;
     uint64_t s = p->s;
     int i;
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    for (i = 0; i < 4; i++) A[i] = sn_clamp30(a[i]); /* int32 compares; the same values */
+#else
     for (i = 0; i < 4; i++) A[i] = sn_clamp64(a[i], SN_Q30);
+#endif
     tt = t < 0 ? 0 : (t > SN_Q30 ? SN_Q30 : t);
     if (tt == 0 || tt == SN_Q30) { /* t is the blob's frame weight: not a pose-dependent branch */
         for (i = 0; i < 4; i++) {
@@ -511,7 +515,17 @@ void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q
     if (s == 0) k = tt;
     else k = (sp * SN_Q30 + (int64_t)(s >> 1)) / (int64_t)s;
     k = k < 0 ? 0 : (k > SN_Q30 ? SN_Q30 : k);
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+    { /* Cortex-M: int32 operands, SMULL / SMLAL (GCC multiplied 64 x 64):
+       * |A| <= 2^30, 0 <= k <= 2^30, |cp| < 2^31 (sn_sincos_red's int32
+       * Horner value or its rounded product with |r| < 2^30) */
+        const int32_t c32 = (int32_t)cp, k32 = (int32_t)k;
+        SN_RANGE(cp <= INT32_MAX && cp >= -INT32_MAX, "slerp cosine beyond int32", cp);
+        for (i = 0; i < 4; i++) o[i] = sn_rshr64(sn_mul((int32_t)A[i], c32) + sn_mul(p->v[i], k32), 30);
+    }
+#else
     for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + (int64_t)p->v[i] * k, 30);
+#endif
     if (!sn_unit(o, 4, out)) {
         for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
     }
