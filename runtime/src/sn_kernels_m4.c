@@ -677,13 +677,6 @@ SN_INLINE uint32_t sn_m4_rd_u16(const unsigned char *p) {
     memcpy(&v, p, 2); /* LDRH: little-endian, unaligned allowed */
     return v;
 }
-/* coef(v, c) when it cannot clamp, |v| <= SN_LIM and |c| <= ONE_COEF
- * (|v c| + 2^23 < (SN_LIM + 1) 2^24): the rounded high bits, no test */
-SN_INLINE int32_t sn_m4_coef_nc(sn_q v, sn_q c, uint32_t bit) {
-    const int64_t x = sn_mul(v, c) + (int64_t)bit; /* SMLAL from the rounding term */
-    SN_RANGE(v <= SN_LIM && v >= -SN_LIM && c <= ONE_COEF && c >= -ONE_COEF, "coef beyond its no-clamp bound", v);
-    return (int32_t)(((uint32_t)(x >> 32) << (32 - SN_Q_COEF)) | ((uint32_t)x >> SN_Q_COEF));
-}
 void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
                   const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
     const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
@@ -697,9 +690,9 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
         for (; e < end; e++) {
             const uint32_t j = sn_m4_rd_u16(cols + 2 * e);
             const sn_q m = rd_real(mo, e), *vj = vel + 3 * j, *dj = ds + 3 * (j - nF);
-            int32_t y0 = sn_add(sn_m4_coef_nc(vj[0], a1, bit), dj[0], &ns);
-            int32_t y1 = sn_add(sn_m4_coef_nc(vj[1], a1, bit), dj[1], &ns);
-            int32_t y2 = sn_add(sn_m4_coef_nc(vj[2], a1, bit), dj[2], &ns);
+            int32_t y0 = sn_add(sn_k_coef_nc(vj[0], a1, bit), dj[0], &ns);
+            int32_t y1 = sn_add(sn_k_coef_nc(vj[1], a1, bit), dj[1], &ns);
+            int32_t y2 = sn_add(sn_k_coef_nc(vj[2], a1, bit), dj[2], &ns);
             SN_K_I32(y0, y1, y2);
             l0 += sn_mul(m, y0);
             l1 += sn_mul(m, y1);

@@ -459,6 +459,15 @@ SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
     const sn_q a2 = sn_k_out_w(sn_mul(x[2], c), SN_Q_COEF, bit, sat);
     out[0] = a0; out[1] = a1; out[2] = a2;
 }
+/* coef(v, c) when it cannot clamp, |v| <= SN_LIM and |c| <= ONE_COEF
+ * (|v c| + 2^23 < (SN_LIM + 1) 2^24): the rounded high bits, no test
+ * (bit = 2^(SN_Q_COEF - 1)) */
+SN_INLINE int32_t sn_k_coef_nc(sn_q v, sn_q c, uint32_t bit) {
+    const int64_t x = sn_mul(v, c) + (int64_t)bit; /* SMLAL from the rounding term */
+    SN_RANGE(v <= SN_LIM && v >= -SN_LIM && c <= ((int32_t)1 << SN_Q_COEF) && c >= -((int32_t)1 << SN_Q_COEF),
+             "coef beyond its no-clamp bound", v);
+    return (int32_t)(((uint32_t)(x >> 32) << (32 - SN_Q_COEF)) | ((uint32_t)x >> SN_Q_COEF));
+}
 SN_INLINE sn_q sn_k_sub_w(sn_q x, sn_acc y, uint32_t *sat) {
     const int64_t d = (int64_t)x - y;
     const uint32_t lo = (uint32_t)d;

@@ -70,6 +70,15 @@ SN_INLINE sn_acc energy_add(sn_acc e, sn_acc x) {
 SN_INLINE const sn_q *w_of(const sn_ihdr *h, const sn_q *w, const sn_q *vel, uint32_t a, sn_q tmp[3]) {
     uint32_t counted = 0;
     if (a < h->v.nF) return w + 3 * a;
+#if defined(SN_KERNELS_M4)
+    if (h->v.b1 <= ONE_COEF && h->v.b1 >= -ONE_COEF) { /* |v'| <= SN_LIM: no clamp, no test (sn_kernels_rot.h) */
+        const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+        tmp[0] = sn_k_coef_nc(vel[3 * a], h->v.b1, bit);
+        tmp[1] = sn_k_coef_nc(vel[3 * a + 1], h->v.b1, bit);
+        tmp[2] = sn_k_coef_nc(vel[3 * a + 2], h->v.b1, bit);
+        return tmp;
+    }
+#endif
     sn_k_coef3(vel + 3 * a, h->v.b1, tmp, &counted);
     return tmp;
 }
