@@ -1240,6 +1240,72 @@ static void test_mass_sk(void) {
 }
 #endif
 
+#if defined(SN_K_CORNERS)
+/* The M4's cell_forces corners (sn_k_corners, Thumb-2 sn_m4_corners)
+ * against cell_forces' loop written here with the reference helpers
+ * (sn_add, sn_rot_t, coef = sn_mulq; w_of's skeleton w uncounted),
+ * tolerance 0 on d, uu, the free-corner bits and the clamp count: 3000
+ * random cells over 24 vertices (nF 0..24), R entries within +-2^30 (at
+ * the bounds in every 4th), positions, w, v' and rest values within
+ * +-SN_LIM (at the bounds in every 4th: the differences and rotations
+ * clamp), b1 at +-1, inside and beyond (the counted coef path). */
+static void test_corners(void) {
+    static sn_q pos[3 * 24], w[3 * 24], vel[3 * 24];
+    static unsigned char rest[4 * 3 * 24], cl[16];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        const uint32_t nF = rnd32() % 25u;
+        const int wild = t % 4 == 0;
+        const sn_q b1 = t % 6 == 0 ? ONE_COEF : t % 6 == 1 ? -ONE_COEF : t % 6 == 2 ? 3 * ONE_COEF + rnd_in(ONE_COEF) : rnd_in(ONE_COEF);
+        sn_q R[9], d1[24], u1[24], d2[24], u2[24], w0s[3], ws[3];
+        const sn_q *w0, *wa;
+        uint32_t i, k, c, a0, s1 = 0, s2 = 0, dummy = 0, f1, f2 = 0;
+        for (i = 0; i < 9; i++) R[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? 1 << 30 : -(1 << 30)) : rnd_in(1 << 30);
+        for (i = 0; i < 3 * 24; i++) {
+            pos[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            w[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            vel[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            put32(rest + 4 * i, (uint32_t)(wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM)));
+        }
+        for (k = 0; k < 8; k++) {
+            const uint32_t a = rnd32() % 24u;
+            cl[2 * k] = (unsigned char)a;
+            cl[2 * k + 1] = 0;
+        }
+        for (i = 0; i < 24; i++) d1[i] = u1[i] = d2[i] = u2[i] = 0;
+        a0 = cl[0];
+        if (a0 < nF) w0 = w + 3 * a0;
+        else {
+            for (c = 0; c < 3; c++) w0s[c] = sn_mulq(vel[3 * a0 + c], b1, SN_Q_COEF, &dummy);
+            w0 = w0s;
+        }
+        f1 = sn_k_corners(cl, pos, w, vel, nF, b1, rest, R, w0, d1, u1, &s1);
+        for (k = 1; k < 8; k++) {
+            const uint32_t a = cl[2 * k];
+            sn_q tt[3], ss[3], l[3], xr[3];
+            if (a < nF) { wa = w + 3 * a; f2 |= 1u << k; }
+            else {
+                for (c = 0; c < 3; c++) ws[c] = sn_mulq(vel[3 * a + c], b1, SN_Q_COEF, &dummy);
+                wa = ws;
+            }
+            for (c = 0; c < 3; c++) {
+                tt[c] = sn_add(pos[3 * a + c], -pos[3 * a0 + c], &s2);
+                ss[c] = sn_add(wa[c], -w0[c], &s2);
+                xr[c] = sn_add(rd_real(rest, 3 * a + c), -rd_real(rest, 3 * a0 + c), &s2);
+            }
+            sn_rot_t(R, tt, l, &s2);
+            sn_rot_t(R, ss, u2 + 3 * k, &s2);
+            for (c = 0; c < 3; c++) d2[3 * k + c] = sn_add(l[c], -xr[c], &s2);
+        }
+        bad += memcmp(d1, d2, sizeof d1) != 0 || memcmp(u1, u2, sizeof u1) != 0 || f1 != f2 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "cell_forces corners (path %s): %d of 3000 cells differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("cell_forces corners: 3000 random cells (every 4th at the bounds), %u clamps", (unsigned)clamps);
+}
+#endif
+
 #if !defined(SN_FLOAT)
 /* sn_math.c's reduced sine / cosine and CORDIC atan2 (on the M4 image
  * their Cortex-M forms: int32 Horner operands, the CORDIC unrolled, "M4
@@ -1463,6 +1529,9 @@ int main(void) {
 #if defined(SN_K_MASS_FF)
     test_mass_ff();
     test_mass_sk();
+#endif
+#if defined(SN_K_CORNERS)
+    test_corners();
 #endif
     test_rot();
     test_axpy();

@@ -184,6 +184,14 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * |a1| <= ONE_COEF (sn_rhs's pre). */
 void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
                   const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat);
+/* cell_forces' corners 1..7 (sn_solve.c): for k = 1..7, a = cl[k], a0 =
+ * cl[0], w_a = w + 3a (a < nF) or coef(v'_a, b1) (w_of, uncounted): d_k =
+ * sn_k_sub3(sn_k_rot_t(R, sn_k_sub3(pos_a, pos_a0)), sn_k_sub3r(rest, 3a,
+ * 3a0)), uu_k = sn_k_rot_t(R, sn_k_sub3(w_a, w0)); the reference's values
+ * and clamp count. Returns the free corners' bits 1..7 (a < nF). */
+#define SN_K_CORNERS 1
+uint32_t sn_k_corners(const unsigned char *cl, const sn_q *pos, const sn_q *w, const sn_q *vel, uint32_t nF, sn_q b1,
+                      const unsigned char *rest, const sn_q *R, const sn_q *w0, sn_q *d, sn_q *uu, uint32_t *sat);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

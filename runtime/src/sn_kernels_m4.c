@@ -703,6 +703,170 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
     *sat += ns; /* a count: the same total */
 }
 
+/* cell_forces' corners 1..7 (sn_solve.c) in Thumb-2, sn_m4_corners: per
+ * corner a (cl[k]) t = pos_a - pos_a0, s = w_a - w_a0 (QSUB), row i of
+ * d_k = R^T t - (rest_a - rest_a0) and of uu_k = R^T s (R^T's row i from
+ * the rounding term 2^29 by three SMLAL, >> 30 on the two words), each
+ * difference and rotated value clamped to +-SN_LIM by one unsigned compare
+ * (the clamp inline, branched over) and counted in lr. The 7 corners
+ * unrolled by the assembler (.irp): offsets immediates, the pointers of a0
+ * and w_a (wp[k]: w + 3a or the caller's b1 v') in the frame. The
+ * reference's sn_k_sub3 / sn_k_rot_t / sn_k_sub3r values and count (GCC's
+ * loop: ~210 instructions a corner, here ~160). */
+struct sn_m4_cor {
+    const unsigned char *cl;          /* 0: the cell's 8 corners (u16) */
+    const sn_q *pos;                  /* 4 */
+    const unsigned char *rest;        /* 8: REST section (int32 reals) */
+    const sn_q *R;                    /* 12: the cell frame */
+    const sn_q *w0;                   /* 16: w at corner 0 */
+    sn_q *d, *uu;                     /* 20, 24: rows 3..23 written */
+    uint32_t sat;                     /* 28: clamp count, in and out */
+    const sn_q *wp[8];                /* 32: w at corner k (1..7) */
+};
+typedef char sn_m4_cor_layout_[sizeof(struct sn_m4_cor) == 64 && SN_REAL_BYTES == 4 ? 1 : -1];
+void sn_m4_corners(struct sn_m4_cor *c);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_corners,\"ax\",%progbits\n"
+    /* v clamped to +-SN_LIM (2^28), counted; t a scratch register */
+    ".macro snc_cl v, t\n"
+    "add   \\t, \\v, #0x10000000\n"
+    "cmp   \\t, #0x20000000\n"
+    "bls   .Lsnc\\@\n"
+    "add   lr, lr, #1\n"
+    "cmp   \\v, #0\n"
+    "ite   gt\n"
+    "movgt \\v, #0x10000000\n"
+    "movle \\v, #0xF0000000\n"
+    ".Lsnc\\@:\n"
+    ".endm\n"
+    /* r3 = row i of R^T (r0, r1, r2), rounded >> 30, clamped */
+    ".macro snc_rot i\n"
+    "mov   r3, #0x20000000\n"
+    "mov   r4, #0\n"
+    "ldr   r5, [r8, #(4 * \\i)]\n"
+    "smlal r3, r4, r5, r0\n"
+    "ldr   r5, [r8, #(12 + 4 * \\i)]\n"
+    "smlal r3, r4, r5, r1\n"
+    "ldr   r5, [r8, #(24 + 4 * \\i)]\n"
+    "smlal r3, r4, r5, r2\n"
+    "lsrs  r3, r3, #30\n"
+    "orr   r3, r3, r4, lsl #2\n"
+    "snc_cl r3, r4\n"
+    ".endm\n"
+    /* r0..r2 = [\\p] - [\\q] per entry, clamped */
+    ".macro snc_sub3 p, q\n"
+    "ldr   r0, [\\p]\n"
+    "ldr   r3, [\\q]\n"
+    "qsub  r0, r0, r3\n"
+    "snc_cl r0, r3\n"
+    "ldr   r1, [\\p, #4]\n"
+    "ldr   r3, [\\q, #4]\n"
+    "qsub  r1, r1, r3\n"
+    "snc_cl r1, r3\n"
+    "ldr   r2, [\\p, #8]\n"
+    "ldr   r3, [\\q, #8]\n"
+    "qsub  r2, r2, r3\n"
+    "snc_cl r2, r3\n"
+    ".endm\n"
+    ".macro snc_corner k\n"
+    "ldrh  r7, [r11, #(2 * \\k)]\n"
+    "add   r7, r7, r7, lsl #1\n"   /* 3 a */
+    "ldr   r6, [sp, #0]\n"
+    "add   r6, r6, r7, lsl #2\n"   /* pos_a */
+    "ldr   r5, [sp, #12]\n"        /* pos_a0 */
+    "snc_sub3 r6, r5\n"            /* t */
+    "ldr   r6, [sp, #4]\n"
+    "add   r6, r6, r7, lsl #2\n"   /* rest_a */
+    ".irp i, 0, 1, 2\n"
+    "snc_rot \\i\n"
+    "ldr   r4, [r6, #(4 * \\i)]\n"
+    "ldr   r5, [r12, #(4 * \\i)]\n"
+    "qsub  r4, r4, r5\n"
+    "snc_cl r4, r5\n"              /* xr_i */
+    "qsub  r3, r3, r4\n"
+    "snc_cl r3, r5\n"
+    "str   r3, [r9, #(12 * \\k + 4 * \\i)]\n"   /* d */
+    ".endr\n"
+    "ldr   r6, [sp, #(16 + 4 * \\k)]\n"         /* w_a */
+    "ldr   r7, [sp, #8]\n"                      /* w_a0 */
+    "snc_sub3 r6, r7\n"            /* s */
+    ".irp i, 0, 1, 2\n"
+    "snc_rot \\i\n"
+    "str   r3, [r10, #(12 * \\k + 4 * \\i)]\n"  /* uu */
+    ".endr\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_corners\n"
+    ".thumb_func\n"
+    ".type sn_m4_corners, %function\n"
+    "sn_m4_corners:\n"
+    "push  {r4-r11, lr}\n"
+    "sub   sp, sp, #56\n"          /* 0 pos, 4 rest, 8 w0, 12 pos_a0, 16 wp[0..7], 48 c */
+    "str   r0, [sp, #48]\n"
+    "ldr   r11, [r0, #0]\n"
+    "ldr   r1, [r0, #4]\n"
+    "str   r1, [sp, #0]\n"
+    "ldr   r2, [r0, #8]\n"
+    "str   r2, [sp, #4]\n"
+    "ldr   r3, [r0, #16]\n"
+    "str   r3, [sp, #8]\n"
+    "ldrh  r7, [r11]\n"
+    "add   r7, r7, r7, lsl #1\n"   /* 3 a0 */
+    "add   r1, r1, r7, lsl #2\n"
+    "str   r1, [sp, #12]\n"        /* pos_a0 */
+    "add   r12, r2, r7, lsl #2\n"  /* rest_a0 */
+    "ldr   r8, [r0, #12]\n"
+    "ldr   r9, [r0, #20]\n"
+    "ldr   r10, [r0, #24]\n"
+    "ldr   lr, [r0, #28]\n"
+    "add   r1, r0, #32\n"
+    "add   r6, sp, #16\n"
+    "ldmia r1!, {r2-r5}\n"
+    "stmia r6!, {r2-r5}\n"
+    "ldmia r1, {r2-r5}\n"
+    "stmia r6, {r2-r5}\n"
+    ".irp k, 1, 2, 3, 4, 5, 6, 7\n"
+    "snc_corner \\k\n"
+    ".endr\n"
+    "ldr   r0, [sp, #48]\n"
+    "str   lr, [r0, #28]\n"
+    "add   sp, sp, #56\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_corners, .-sn_m4_corners\n"
+    ".popsection\n");
+
+uint32_t sn_k_corners(const unsigned char *cl, const sn_q *pos, const sn_q *w, const sn_q *vel, uint32_t nF, sn_q b1,
+                      const unsigned char *rest, const sn_q *R, const sn_q *w0, sn_q *d, sn_q *uu, uint32_t *sat) {
+    struct sn_m4_cor c;
+    sn_q ws[24];
+    uint32_t k, fr = 0, dummy = 0;
+    const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+    const int nc = b1 <= ONE_COEF && b1 >= -ONE_COEF;
+    for (k = 1; k < 8; k++) {
+        const uint32_t a = sn_m4_rd_u16(cl + 2 * k);
+        if (a < nF) {
+            c.wp[k] = w + 3 * a;
+            fr |= (uint32_t)1 << k;
+        } else { /* w_of's b1 v' (its clamps counted once in sn_rhs) */
+            sn_q *t = ws + 3 * k;
+            if (nc) {
+                t[0] = sn_k_coef_nc(vel[3 * a], b1, bit);
+                t[1] = sn_k_coef_nc(vel[3 * a + 1], b1, bit);
+                t[2] = sn_k_coef_nc(vel[3 * a + 2], b1, bit);
+            } else
+                sn_k_coef3(vel + 3 * a, b1, t, &dummy);
+            c.wp[k] = t;
+        }
+    }
+    c.wp[0] = w0;
+    c.cl = cl; c.pos = pos; c.rest = rest; c.R = R; c.w0 = w0; c.d = d; c.uu = uu; c.sat = 0;
+    sn_m4_corners(&c);
+    *sat += c.sat;
+    return fr;
+}
+
 /* The CG dot product (sn_kernels.c's reference): each product rounded alone,
  * (a b + 2^(sh-1)) >> sh. Here the rounding term is the SMLAL's starting
  * value and, for 0 < sh < 32 (sh = s + k_i, shared by a vertex's 3 terms),

@@ -189,6 +189,9 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
          * exactly (no clamp), without its two rotations */
         for (c = 0; c < 3; c++) d[c] = uu[c] = 0;
         fr = (uint32_t)(a0 < nF);
+#if defined(SN_K_CORNERS) /* the M4's Thumb-2 (sn_kernels.h) */
+        fr |= sn_k_corners(cl, pos, w, vel, nF, v->b1, rest, R, w0, d, uu, sat);
+#else
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_q t[3], s[3], l[3], wa[3], xr[3];
@@ -200,6 +203,7 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
             sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
             sn_k_sub3(l, xr, d + 3 * k, sat);
         }
+#endif
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, yx, lx, sat); /* the cut level (sn_cut.c) */
         if (on) detail_cell_rhs(h, dt, e, on, R, d, uu, (const sn_q(*)[3])yx, lc, sacc, sat);
