@@ -1240,6 +1240,33 @@ static void test_mass_sk(void) {
 }
 #endif
 
+#if defined(SN_K_ENERGY)
+/* The M4's energy sum of cell_forces (sn_k_energy) against its loop of
+ * sn_mul(d, sn_out(l, s)), tolerance 0 with the clamp count: every shift
+ * 0..62, the 24 accumulators from edge_ls' rounding ties and clamp edges
+ * (and random), d at +-SN_LIM, 0 and random */
+static void test_energy(void) {
+    int s, bad = 0, cases = 0;
+    for (s = 0; s <= 62; s++) {
+        sn_acc l[128], lc[24];
+        sn_q d[24];
+        const int n = edge_ls(s, l);
+        int r;
+        for (r = 0; r < 12; r++, cases++) {
+            uint32_t k, s1 = 0, s2 = 0;
+            sn_acc e2 = 0;
+            for (k = 0; k < 24; k++) {
+                lc[k] = l[(uint32_t)(r * 24 + (int)k) % (uint32_t)n];
+                d[k] = r % 3 == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : r % 3 == 1 ? 0 : rnd_in(SN_LIM);
+            }
+            for (k = 3; k < 24; k++) e2 += sn_mul(d[k], sn_out(lc[k], s, &s2));
+            bad += sn_k_energy(d, lc, s, &s1) != e2 || s1 != s2;
+        }
+    }
+    T_CHECK(bad == 0, "cell energy sum (path %s): %d of %d cases off the reference loop", sn_kernels_name(), bad, cases);
+}
+#endif
+
 #if defined(SN_K_CORNERS)
 /* The M4's cell_forces corners (sn_k_corners, Thumb-2 sn_m4_corners)
  * against cell_forces' loop written here with the reference helpers
@@ -1532,6 +1559,9 @@ int main(void) {
 #endif
 #if defined(SN_K_CORNERS)
     test_corners();
+#endif
+#if defined(SN_K_ENERGY)
+    test_energy();
 #endif
     test_rot();
     test_axpy();

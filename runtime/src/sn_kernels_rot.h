@@ -648,6 +648,26 @@ SN_INLINE sn_acc sn_k_mul_out(sn_q d, sn_acc l, int s, uint32_t *sat) {
     __asm__("" : "+r"(t));
     return sn_mul(d, t);
 }
+/* sum over k = 3..23 of d[k] sn_out(l[k], s) (cell_forces' energy term,
+ * corners 1..7): the test of s once, a corner's 3 values written out (the
+ * loop tested s per value); exact int64 sums (|term| <= 2^56), the same
+ * value and count */
+#define SN_K_ENERGY 1
+SN_INLINE sn_acc sn_k_energy(const sn_q *d, const sn_acc *l, int s, uint32_t *sat) {
+    sn_acc e = 0;
+    uint32_t k;
+    if ((uint32_t)(s - 1) < 31u) {
+        const uint32_t bit = (uint32_t)1 << (s - 1);
+        for (k = 3; k < 24; k += 3) {
+            int32_t t0 = sn_k_out_w(l[k], s, bit, sat), t1 = sn_k_out_w(l[k + 1], s, bit, sat);
+            int32_t t2 = sn_k_out_w(l[k + 2], s, bit, sat);
+            SN_K_I32(t0, t1, t2);
+            e += sn_mul(d[k], t0) + sn_mul(d[k + 1], t1) + sn_mul(d[k + 2], t2);
+        }
+    } else
+        for (k = 3; k < 24; k++) e += sn_mul(d[k], sn_out(l[k], s, sat));
+    return e;
+}
 #else
 #define sn_k_mul_out(d, l, s, sat) sn_mul((d), sn_out((l), (s), (sat)))
 #endif
