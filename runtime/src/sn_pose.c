@@ -3,6 +3,7 @@
  * (seed 003 §3.3, per cell as its closing remark suggests), skeleton vertices
  * (runtime/NUMERICS.md "One step"). */
 #include "sn_instance.h"
+#include "sn_kernels_rot.h" /* the M4's sn_k_rot */
 
 /* A usable joint transform: a quaternion whose largest component is at least
  * 2^-10 (a shorter one has no reliable direction: normalizing it would turn a
@@ -453,7 +454,11 @@ void sn_skeleton(sn_ihdr *h, uint32_t *sat) {
         uint32_t b = fr[4 * i];
         sn_q x[3], p[3];
         for (k = 0; k < 3; k++) x[k] = rd_real(rest, 3 * i + k);
+#if defined(SN_KERNELS_M4)
+        sn_k_rot(jR + 9 * b, x, p, sat); /* one-compare clamps: sn_rot's values and counts */
+#else
         sn_rot(jR + 9 * b, x, p, sat);
+#endif
         for (k = 0; k < 3; k++) {
             sn_q pn = sn_add(p[k], jT[3 * b + k], sat);
             sn_q vn = h->have_prev ? sn_add(pn, -pos[3 * i + k], sat) : 0;

@@ -7,6 +7,7 @@
  * on values, so the cost is a function of the blob's counts.
  */
 #include "sn_instance.h"
+#include "sn_kernels_rot.h" /* the M4's sn_k_out_w, sn_k_rot */
 
 #define CTL_ELEM SN_ELEM_CONTROLS(SN_REAL_BYTES)
 #define SMP_ELEM SN_ELEM_RIG_SAMPLES(SN_REAL_BYTES)
@@ -90,6 +91,20 @@ void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
         for (e = first; e < first + cnt; e++) {
             uint32_t i = sn_rd_u16(vx + 2 * e);
             sn_q t[3], f[3];
+#if defined(SN_KERNELS_M4)
+            { /* the shift's test once, sn_out in 32-bit words (sn_k_out_w), the rotation with
+               * one-compare clamps (sn_k_rot): the same values and counts */
+                const int sh = 30 + frac - SN_Q_FORCE - (int)kk[i];
+                if ((uint32_t)(sh - 1) < 31u) {
+                    const uint32_t bit = (uint32_t)1 << (sh - 1);
+                    for (c = 0; c < 3; c++) t[c] = sn_k_out_w(sn_mul(eta, rd_real(F, 3 * e + c)), sh, bit, sat);
+                } else
+                    for (c = 0; c < 3; c++) t[c] = sn_out(sn_mul(eta, rd_real(F, 3 * e + c)), sh, sat);
+            }
+            sn_k_rot(R + 9 * i, t, f, sat);
+            for (c = 0; c < 3; c++) b[3 * i + c] = sn_add(b[3 * i + c], f[c], sat);
+            continue;
+#endif
             for (c = 0; c < 3; c++) {
                 sn_q q = rd_real(F, 3 * e + c);
 #if defined(SN_FLOAT)
