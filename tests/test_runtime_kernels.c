@@ -610,7 +610,8 @@ static int64_t rshr_ref(int64_t x, int s) {
  * bitlen(OR|b|) + bitlen(n) - 62), each product a_k b_k rounded alone by
  * rshr_ref at s + k_i, summed exactly. Random lengths 0..600 (whole
  * vertices), values at scales 2^0..2^28 (every 8th vector at +-2^28),
- * k_i 0..15. Tolerance 0: the result is an exact integer. */
+ * k_i 0..15 (0..45 in every 4th: shifts beyond 31). Tolerance 0: the result
+ * is an exact integer. */
 static int bitlen_ref(uint64_t x) { int n = 0; while (x) { n++; x /= 2; } return n; }
 static void test_dot(void) {
     static sn_q a[600], b[600];
@@ -621,12 +622,14 @@ static void test_dot(void) {
         int sa = (int)(rnd32() % 29u), sb = (int)(rnd32() % 29u), s, e = -1;
         int64_t ref = 0, got;
         for (i = 0; i < n; i++) {
-            a[i] = t % 8 == 0 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sa);
-            b[i] = t % 8 == 1 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sb);
+            a[i] = t % 8 == 0 || t % 16 == 2 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sa);
+            /* every 16th: b all -2^28 (|b|'s bit length from a negative power of two alone) */
+            b[i] = t % 16 == 2 ? -(1 << 28) : t % 8 == 1 ? (rnd32() & 1 ? (1 << 28) : -(1 << 28)) : rnd_in((int32_t)1 << sb);
             oa |= (uint32_t)(a[i] < 0 ? -a[i] : a[i]);
             ob |= (uint32_t)(b[i] < 0 ? -b[i] : b[i]);
         }
-        for (i = 0; i < nv; i++) kk[i] = (uint8_t)(rnd32() % 16u);
+        /* k up to 45 in every 4th run: shifts s + k beyond 31 too (the M4's C fallback) */
+        for (i = 0; i < nv; i++) kk[i] = (uint8_t)(rnd32() % (t % 4 == 3 ? 46u : 16u));
         s = bitlen_ref(oa) + bitlen_ref(ob) + bitlen_ref(n) - 62;
         s = s < 0 ? 0 : s;
         for (i = 0; i < n; i++) ref += rshr_ref((int64_t)a[i] * b[i], s + kk[i / 3]);

@@ -879,36 +879,129 @@ SN_INLINE int64_t sn_m4_shr_or(int64_t x, int s) {
     const int32_t hi = (int32_t)(x >> 32);
     return (int64_t)(((uint64_t)(uint32_t)(hi >> s) << 32) | (lo >> s | (uint32_t)hi << (32 - s)));
 }
+/* Thumb-2 (sn_m4_absor, sn_m4_dot): the ORs of |a|, |b| a vertex at a
+ * time (LDM, |x| as (x ^ m) - m with m = x >> 31), then per vertex sh = s
+ * + k_i and each of its 3 terms from the rounding term 2^(sh-1) by SMLAL,
+ * shifted on the two words (sn_m4_shr_or's value) and added to the sum in
+ * r10:r11 (sh = 0 too: register shifts by 32 or more give 0, so the
+ * rounding term is 0 and the high word adds nothing to the low); a vertex
+ * with sh > 31 hands back to the C loop, which
+ * does it as the reference and resumes (GCC's loops: 28 + 56 instructions
+ * a vertex, here 22 + 43). The same rounded terms, summed exactly. */
+struct sn_m4_dotc {
+    const sn_q *a, *b;      /* 0, 4: the next vertex */
+    const uint8_t *kk;      /* 8 */
+    const sn_q *aend;       /* 12 */
+    int32_t s, pad;         /* 16 */
+    int64_t sum;            /* 24 */
+};
+typedef char sn_m4_dotc_layout_[sizeof(struct sn_m4_dotc) == 32 ? 1 : -1];
+int sn_m4_dot(struct sn_m4_dotc *c);
+void sn_m4_absor(const sn_q *a, const sn_q *b, uint32_t nv, uint32_t o[2]);
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_dot,\"ax\",%progbits\n"
+    ".macro snd_term\n"
+    "ldr   r12, [r0], #4\n"
+    "ldr   lr, [r1], #4\n"
+    "mov   r8, r6\n"
+    "mov   r9, #0\n"
+    "smlal r8, r9, r12, lr\n"
+    "lsr   r8, r8, r5\n"
+    "lsl   r12, r9, r7\n"
+    "orr   r8, r8, r12\n"
+    "asr   r9, r9, r5\n"
+    "adds  r10, r10, r8\n"
+    "adc   r11, r11, r9\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_dot\n"
+    ".thumb_func\n"
+    ".type sn_m4_dot, %function\n"
+    "sn_m4_dot:\n"
+    "push  {r0, r4-r11, lr}\n"
+    "mov   r12, r0\n"
+    "ldm   r12, {r0-r4}\n"           /* a b kk aend s */
+    "ldrd  r10, r11, [r12, #24]\n"
+    "cmp   r0, r3\n"
+    "beq   3f\n"
+    "1:\n"
+    "ldrb  r5, [r2], #1\n"
+    "add   r5, r5, r4\n"             /* sh */
+    "cmp   r5, #31\n"
+    "bhi   2f\n"
+    "sub   r12, r5, #1\n"
+    "mov   r6, #1\n"
+    "lsl   r6, r6, r12\n"            /* 2^(sh-1); sh = 0: a shift by 255 (the low byte of -1), 0 */
+    "rsb   r7, r5, #32\n"            /* sh = 0: the high word shifted by 32, 0 */
+    "snd_term\n"
+    "snd_term\n"
+    "snd_term\n"
+    "cmp   r0, r3\n"
+    "bne   1b\n"
+    "3:\n"
+    "movs  r5, #0\n"                 /* done */
+    "b     4f\n"
+    "2:\n"
+    "sub   r2, r2, #1\n"             /* this vertex: the C loop's */
+    "movs  r5, #1\n"
+    "4:\n"
+    "ldr   r12, [sp]\n"
+    "stm   r12, {r0-r2}\n"
+    "strd  r10, r11, [r12, #24]\n"
+    "mov   r0, r5\n"
+    "add   sp, sp, #4\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_dot, .-sn_m4_dot\n"
+    ".align 2\n"
+    ".global sn_m4_absor\n"
+    ".thumb_func\n"
+    ".type sn_m4_absor, %function\n"
+    "sn_m4_absor:\n"                 /* r0 a, r1 b, r2 nv > 0, r3 o */
+    "push  {r3-r10, lr}\n"
+    "add   r2, r2, r2, lsl #1\n"
+    "add   r2, r0, r2, lsl #2\n"     /* a end */
+    "movs  r3, #0\n"                 /* |a| OR */
+    "mov   r12, #0\n"                /* |b| OR */
+    "5:\n"
+    "ldm   r0!, {r4-r6}\n"
+    "ldm   r1!, {r7-r9}\n"
+    ".irp x, r4, r5, r6\n"
+    "eor   r10, \\x, \\x, asr #31\n"
+    "sub   r10, r10, \\x, asr #31\n"
+    "orr   r3, r3, r10\n"
+    ".endr\n"
+    ".irp x, r7, r8, r9\n"
+    "eor   r10, \\x, \\x, asr #31\n"
+    "sub   r10, r10, \\x, asr #31\n"
+    "orr   r12, r12, r10\n"
+    ".endr\n"
+    "cmp   r0, r2\n"
+    "bne   5b\n"
+    "ldr   r4, [sp]\n"
+    "str   r3, [r4]\n"
+    "str   r12, [r4, #4]\n"
+    "add   sp, sp, #4\n"
+    "pop   {r4-r10, pc}\n"
+    ".size sn_m4_absor, .-sn_m4_absor\n"
+    ".popsection\n");
+
 int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, int *e) {
-    uint32_t i, k, nv = n / 3, oa = 0, ob = 0;
+    uint32_t k, nv = n / 3, o[2] = {0, 0};
+    struct sn_m4_dotc c;
     int s;
-    int64_t sum = 0;
-    /* the ORs of |a|, |b| (sn_k_dot_scale's head): a vertex's 3 values at a
-     * time, |x| as (x ^ m) - m with m = x >> 31 (EOR, SUB with shifted
-     * operands; GCC's compare and conditional negate took 3) */
-#define SN_K_ABS(x) (((uint32_t)(x) ^ (uint32_t)((x) >> 31)) - (uint32_t)((x) >> 31))
-    for (i = 0; i < 3 * nv; i += 3) {
-        oa |= SN_K_ABS(a[i]) | SN_K_ABS(a[i + 1]) | SN_K_ABS(a[i + 2]);
-        ob |= SN_K_ABS(b[i]) | SN_K_ABS(b[i + 1]) | SN_K_ABS(b[i + 2]);
-    }
-#undef SN_K_ABS
-    s = sn_k_dot_scale(a, b, 3 * nv, n, oa, ob);
-    for (i = 0; i < nv; i++) {
-        const int sh = s + kk[i];
-        if (sh > 0 && sh < 32) {
-            const int64_t bias = (int64_t)((uint32_t)1 << (sh - 1));
-            const sn_q *ai = a + 3 * i, *bi = b + 3 * i;
-            /* written out: GCC kept a loop of 3 (15 instructions a term) */
-            sum += sn_m4_shr_or(bias + (int64_t)ai[0] * bi[0], sh);
-            sum += sn_m4_shr_or(bias + (int64_t)ai[1] * bi[1], sh);
-            sum += sn_m4_shr_or(bias + (int64_t)ai[2] * bi[2], sh);
-        } else {
-            const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
-            for (k = 3 * i; k < 3 * i + 3; k++) sum += ((int64_t)a[k] * b[k] + half) >> sh;
-        }
+    if (nv) sn_m4_absor(a, b, nv, o);
+    s = sn_k_dot_scale(a, b, 3 * nv, n, o[0], o[1]);
+    c.a = a; c.b = b; c.kk = kk; c.aend = a + 3 * nv; c.s = s; c.pad = 0; c.sum = 0;
+    while (c.a != c.aend && sn_m4_dot(&c)) { /* a vertex with sh > 31: the reference's terms */
+        const int sh = s + *c.kk;
+        const int64_t half = sh > 0 ? (int64_t)1 << (sh - 1) : 0;
+        for (k = 0; k < 3; k++) c.sum += ((int64_t)c.a[k] * c.b[k] + half) >> sh;
+        c.a += 3; c.b += 3; c.kk++;
     }
     *e = s;
-    return sum;
+    return c.sum;
 }
 
 /* The CG vector updates (sn_kernels.h's reference, sn_mulq then sn_add per
