@@ -1008,9 +1008,28 @@ int64_t sn_k_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n, in
  * value): for 0 < sh < 32 the product starts from the rounding term and is
  * shifted on the two words, the test hoisted out of the loop (inside
  * sn_out it cost the solve +6%); the same clamps and counts. */
+/* the loop below for one shift sh in 28..31 (a constant: immediate shifts) */
+SN_INLINE void sn_m4_axpy_hi(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, const int sh, uint32_t *sat) {
+    const uint32_t bit = (uint32_t)1 << (sh - 1);
+    sn_q *const end = out + n;
+    while (out != end) {
+        const sn_q xi = *x++;
+        const int64_t p = sn_mul(s, xi) + (int64_t)bit; /* SMLAL from the rounding term */
+        const int32_t hi = (int32_t)(p >> 32);
+        int32_t q = (int32_t)(((uint32_t)p >> sh) | ((uint32_t)hi << (32 - sh)));
+        SN_RANGE(SN_WITHIN(sn_mul(s, xi), 59), "CG update product beyond 2^59", xi);
+        if ((uint32_t)q + (uint32_t)SN_LIM > 2u * (uint32_t)SN_LIM) {
+            (*sat)++;
+            q = hi < 0 ? -SN_LIM : SN_LIM;
+        }
+        *out++ = sn_add(*a++, q, sat);
+    }
+}
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
     uint32_t i;
-    if (sh >= 28 && sh < 32) {
+    if (sh == 28) {
+        sn_m4_axpy_hi(out, a, s, x, n, 28, sat); /* the CG's SN_Q_SCAL: immediate shifts */
+    } else if (sh >= 28 && sh < 32) {
         /* the CG's shift (28): with the contract's |s x| <= 2^31 2^28
          * (sn_kernels.h), the rounded value lies in [-2^31, 2^31], so its low
          * word is it (2^31 reads as INT32_MIN: outside +-SN_LIM, clamped by
