@@ -1064,6 +1064,93 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     }
 }
 
+/* sn_k_out_rot_acc (sn_kernels_rot.h) for 0 < sh < 32 in Thumb-2: t_c =
+ * sn_k_out_w(l_c, sh) (the rounding add, the shift on the two words, the
+ * clamp's two tests, the count in memory on the rare clamp), then acc_r +=
+ * R_r0 t0 + R_r1 t1 + R_r2 t2 as one SMLAL chain from acc_r, R's row by
+ * LDM (GCC: 77 instructions a call, here 60) */
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_out_rot_acc,\"ax\",%progbits\n"
+    ".macro snr_out c, t\n"
+    "ldrd  r4, r5, [r2, #(8 * \\c)]\n"
+    "adds  r4, r4, lr\n"
+    "adc   r5, r5, #0\n"
+    "lsr   r4, r4, r3\n"
+    "lsl   r6, r5, r12\n"
+    "orr   \\t, r4, r6\n"
+    "asr   r5, r5, r3\n"
+    "add   r6, \\t, #0x10000000\n"
+    "cmp   r6, #0x20000000\n"
+    "bhi   .Lsnr1\\@\n"
+    "cmp   r5, \\t, asr #31\n"
+    "beq   .Lsnr2\\@\n"
+    ".Lsnr1\\@:\n"
+    "ldr   r6, [sp, #36]\n"
+    "ldr   r4, [r6]\n"
+    "add   r4, r4, #1\n"
+    "str   r4, [r6]\n"
+    "cmp   r5, #0\n"
+    "ite   lt\n"
+    "movlt \\t, #0xF0000000\n"
+    "movge \\t, #0x10000000\n"
+    ".Lsnr2\\@:\n"
+    ".endm\n"
+    ".macro snr_row r\n"
+    "ldrd  r4, r5, [r0, #(8 * \\r)]\n"
+    "ldm   r1!, {r10, r11, r12}\n"
+    "smlal r4, r5, r10, r7\n"
+    "smlal r4, r5, r11, r8\n"
+    "smlal r4, r5, r12, r9\n"
+    "strd  r4, r5, [r0, #(8 * \\r)]\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_out_rot_acc\n"
+    ".thumb_func\n"
+    ".type sn_m4_out_rot_acc, %function\n"
+    "sn_m4_out_rot_acc:\n"         /* r0 acc, r1 R, r2 l, r3 sh (1..31), [sp] sat */
+    "push  {r4-r11, lr}\n"
+    "rsb   r12, r3, #32\n"
+    "sub   r6, r3, #1\n"
+    "mov   lr, #1\n"
+    "lsl   lr, lr, r6\n"           /* 2^(sh-1) */
+    "snr_out 0, r7\n"
+    "snr_out 1, r8\n"
+    "snr_out 2, r9\n"
+    "snr_row 0\n"
+    "snr_row 1\n"
+    "snr_row 2\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_out_rot_acc, .-sn_m4_out_rot_acc\n"
+    ".popsection\n");
+
+/* the other shifts (sn_kernels_rot.h's sn_k_out_rot_acc) */
+void sn_k_out_rot_acc_c(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
+    int32_t t0, t1, t2;
+    int64_t x;
+    if ((uint32_t)(sh - 1) < 31u) {
+        const uint32_t bit = (uint32_t)1 << (sh - 1);
+        t0 = sn_k_out_w(l[0], sh, bit, sat);
+        t1 = sn_k_out_w(l[1], sh, bit, sat);
+        t2 = sn_k_out_w(l[2], sh, bit, sat);
+    } else if ((uint32_t)(sh - 32) < 31u) { /* 32..62: some vertices' stiffness rows */
+        const uint32_t blo = sh == 32 ? (uint32_t)1 << 31 : 0;
+        const int32_t bhi = sh == 32 ? 0 : (int32_t)1 << ((sh - 33) & 31);
+        t0 = sn_k_out_hw(l[0], sh, blo, bhi, sat);
+        t1 = sn_k_out_hw(l[1], sh, blo, bhi, sat);
+        t2 = sn_k_out_hw(l[2], sh, blo, bhi, sat);
+    } else {
+        t0 = sn_out(l[0], sh, sat);
+        t1 = sn_out(l[1], sh, sat);
+        t2 = sn_out(l[2], sh, sat);
+    }
+    SN_K_I32(t0, t1, t2);
+    x = acc[0]; x += sn_mul(R[0], t0); x += sn_mul(R[1], t1); x += sn_mul(R[2], t2); acc[0] = x;
+    x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
+    x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
+}
+
 const char *sn_kernels_name(void) { return "m4"; }
 
 #else

@@ -358,32 +358,15 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)
-/* t = sn_out(l, sh) as int32 (sn_k_out_w for 0 < sh < 32), then each acc
- * entry as the start of its SMLAL chain (GCC's sn_rot_acc: SMULL, SMLAL x 2
- * and a 64-bit add a row); exact int64 sums, the same integers. */
+/* t = sn_out(l, sh) per entry, acc += R t: for 0 < sh < 32 Thumb-2
+ * (sn_m4_out_rot_acc, sn_kernels_m4.c: sn_k_out_w's rounding and clamp,
+ * R's rows by LDM into SMLAL chains from acc), other shifts in C
+ * (sn_k_out_rot_acc_c); exact int64 sums, the same integers and counts */
+void sn_m4_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat);
+void sn_k_out_rot_acc_c(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat);
 SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh, uint32_t *sat) {
-    int32_t t0, t1, t2;
-    int64_t x;
-    if ((uint32_t)(sh - 1) < 31u) {
-        const uint32_t bit = (uint32_t)1 << (sh - 1);
-        t0 = sn_k_out_w(l[0], sh, bit, sat);
-        t1 = sn_k_out_w(l[1], sh, bit, sat);
-        t2 = sn_k_out_w(l[2], sh, bit, sat);
-    } else if ((uint32_t)(sh - 32) < 31u) { /* 32..62: some vertices' stiffness rows */
-        const uint32_t blo = sh == 32 ? (uint32_t)1 << 31 : 0;
-        const int32_t bhi = sh == 32 ? 0 : (int32_t)1 << ((sh - 33) & 31);
-        t0 = sn_k_out_hw(l[0], sh, blo, bhi, sat);
-        t1 = sn_k_out_hw(l[1], sh, blo, bhi, sat);
-        t2 = sn_k_out_hw(l[2], sh, blo, bhi, sat);
-    } else {
-        t0 = sn_out(l[0], sh, sat);
-        t1 = sn_out(l[1], sh, sat);
-        t2 = sn_out(l[2], sh, sat);
-    }
-    SN_K_I32(t0, t1, t2);
-    x = acc[0]; x += sn_mul(R[0], t0); x += sn_mul(R[1], t1); x += sn_mul(R[2], t2); acc[0] = x;
-    x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
-    x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
+    if ((uint32_t)(sh - 1) < 31u) sn_m4_out_rot_acc(acc, R, l, sh, sat);
+    else sn_k_out_rot_acc_c(acc, R, l, sh, sat);
 }
 /* l = D e in int32 registers (e read first: out may be e), then sn_k_out_w
  * (0 < sh < 32) or sn_out; exact sums, the same integers */
