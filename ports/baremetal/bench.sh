@@ -52,6 +52,6 @@ for a in $assets; do
         # one CG iteration = matvec + preconditioner + dots/axpys
         echo "bench-baremetal: cortex-m4 $a: $ipc instructions per CG iteration (slope $it -> $(v cg_iterations_more) iterations: $(v insns_per_step_more) per step)"
     fi
-    echo "bench-baremetal: cortex-m4 $a: hash $(v hash) after $(v bench_steps) steps (contact $(v hash-contact))"
+    echo "bench-baremetal: cortex-m4 $a: hash $(v hash) after $(v bench_steps) steps$( [ -n "$(v hash-contact)" ] && echo " (contact $(v hash-contact))")"
     echo "bench-baremetal: cortex-m4 $a: flash $((text + data)) B (runtime code $rt B, blob $blob B), RAM $((data + bss + stack)) B (.data+.bss $((data + bss)) B: instance $inst B$( [ "$(v clip)" = 1 ] && echo ", parsed clip $(arm-none-eabi-nm -S "$B/sinew_$a.elf" | awk '$4 == "clip" {print 0 + ("0x" $2)}') B"), pose scratch; stack peak $stack B)"
 done
