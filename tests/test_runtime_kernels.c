@@ -1110,6 +1110,72 @@ static void test_ic_fwd(void) {
 }
 #endif
 
+#if defined(SN_K_IC_FWD_RUN)
+/* x86-64's forward-sweep column (sn_k_ic_fwd_run) against ic_forward's
+ * loop on the portable reference (sn_k_ic_col_ref per block, stopping at
+ * the first row >= nF) and, per block, a double reference of the rounded
+ * row (exact below 2^53): random columns of 0..12 blocks, rows sometimes
+ * past nF, vertex exponents 0..15 and fracs 0..47 (shifts -15..62: the
+ * scale-up below 0, the table's ends 0 and 62), y at the state bound and
+ * INT32_MIN/MAX; accumulators, clamp count and blocks read must match. */
+static void test_ic_fwd_run(void) {
+    static unsigned char L[12 * 20], cols[24];
+    static sn_acc a1[90], a2[90];
+    static double a3[90];
+    int t, bad = 0, bad_d = 0, lo = 0, hi = 0, neg = 0, stops = 0;
+    for (t = 0; t < 6000; t++) {
+        sn_q y[3];
+        uint8_t kk[30];
+        const uint32_t nF = 20u + rnd32() % 10u, nb = rnd32() % 13u;
+        const int kj = (int)(rnd32() % 16u), wild = t % 8 == 0;
+        uint32_t e, k, n1, n2 = 0, s1 = 0, s2 = 0;
+        for (k = 0; k < 3; k++)
+            y[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? SN_LIM : -SN_LIM)) : rnd_in(SN_LIM);
+        for (k = 0; k < 30; k++) kk[k] = (uint8_t)(rnd32() % 16u);
+        for (k = 0; k < 90; k++) a3[k] = (double)(a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12);
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            const uint32_t row = rnd32() % 16u == 0 ? nF + rnd32() % 3u : rnd32() % nF;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 4u == 0 ? (rnd32() & 1 ? 47u : 0u) : rnd32() % 48u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)row;
+            cols[2 * e + 1] = 0;
+        }
+        n1 = sn_k_ic_fwd_run(L, cols, cols + 2 * nb, y, kj, kk, nF, a1, &s1);
+        for (e = 0; e < nb; e++) {
+            const uint32_t i = cols[2 * e];
+            const unsigned char *b = L + 20 * e;
+            int s, c, r;
+            if (i >= nF) { stops++; break; }
+            s = (int)b[18] + kj - (int)kk[i];
+            lo += s == 0;
+            hi += s == 62;
+            neg += s < 0;
+            sn_k_ic_col_ref(b, y, s, a2 + 3 * i, &s2);
+            for (c = 0; c < 3; c++) { /* round half up (s >= 0), or scaled up and clamped */
+                double p = 0;
+                for (r = 0; r < 3; r++) p += (double)(int16_t)(uint16_t)(b[6 * r + 2 * c] | b[6 * r + 2 * c + 1] << 8) * (double)y[r];
+                p = s >= 0 ? floor(ldexp(p, -s) + (s > 0 ? 0.5 : 0.0)) : ldexp(p, -s);
+                a3[3 * i + (uint32_t)c] += p > SN_LIM && s < 0 ? SN_LIM : p < -SN_LIM && s < 0 ? -SN_LIM : p;
+            }
+            n2++;
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2 || n1 != n2;
+        for (k = 0; k < 90; k++) bad_d += (double)a1[k] != a3[k];
+    }
+    T_CHECK(bad == 0, "IC(0) forward columns (path %s): %d of 6000 columns differ from the reference loop", sn_kernels_name(), bad);
+    T_CHECK(bad_d == 0, "IC(0) forward columns (path %s): %d accumulators off the double reference", sn_kernels_name(), bad_d);
+    T_FIGURE("IC(0) forward columns (x86): 6000 columns of 0..12 blocks, %d blocks at shift 0, %d at 62, %d below 0, %d stopped at a row >= nF",
+             lo, hi, neg, stops);
+}
+#endif
+
 #if defined(SN_K_MASS_FF)
 /* The M4's mass pass (sn_k_mass_ff) against pass_M_ff's loop written here
  * with sn_mul (exact int64 sums: tolerance 0): random row structures of
@@ -1308,6 +1374,9 @@ int main(void) {
     test_ic_rows();
 #if defined(SN_K_IC_FWD_COL)
     test_ic_fwd();
+#endif
+#if defined(SN_K_IC_FWD_RUN)
+    test_ic_fwd_run();
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();

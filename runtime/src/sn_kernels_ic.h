@@ -83,51 +83,89 @@ SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l
 /* 4 int64 lanes (the 4th unused). Round half up for 0 <= s <= 62 without an
  * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
  * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
- * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s). */
-#if defined(__AVX512F__) && defined(__AVX512VL__)
-/* AVX-512VL has the 64-bit arithmetic shift (VPSRAQ): p + 2^(s-1) (1 << s
- * >> 1: 0 for s = 0), shifted by s, the same floor (no overflow: |p| < 2^44.6) */
+ * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s).
+ * The two constants per s come from a table (sn_kernels_avx2.c: row s =
+ * [2^62 + 2^(s-1) x4 | 2^(62-s) x4]), one folded load each: the sweeps
+ * round every block at its own s, and building them cost ~10 instructions. */
+#define SN_K_IC_RT_N 63 /* s = 0..62: the forward shift's range (SN_ICHOL_FRAC_MAX + 15) */
+extern const int64_t sn_k_ic_rtab[SN_K_IC_RT_N][8];
 SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
-    const __m128i c = _mm_cvtsi32_si128(s);
-    const __m256i half = _mm256_srli_epi64(_mm256_sll_epi64(_mm256_set1_epi64x(1), c), 1);
-    return _mm256_sra_epi64(_mm256_add_epi64(p, half), c);
+    const int64_t *t = sn_k_ic_rtab[s];
+    return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_loadu_si256((const __m256i *)(const void *)t)),
+                                             _mm_cvtsi32_si128(s)),
+                            _mm256_loadu_si256((const __m256i *)(const void *)(t + 4)));
 }
-#else
-SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
-    const int64_t bias = ((int64_t)1 << 62) + (s > 0 ? (int64_t)1 << (s - 1) : 0);
-    return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_set1_epi64x(bias)), _mm_cvtsi32_si128(s)),
-                            _mm256_set1_epi64x(((int64_t)1 << 62) >> s));
-}
-#endif
 #define SN_K_IC_W(p) _mm256_cvtepi16_epi64(_mm_loadl_epi64((const __m128i *)(const void *)(p)))
-
-/* columns of U as lanes: U0..U3, U3..U6, U6..U9 (8-byte loads, inside the
- * 20-byte block); lane c = sum_r U[3r+c] y[r]. s < 0 (scale-up and clamp,
- * a rare blob): the reference. */
-SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
-    __m256i p;
-    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
-    p = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), _mm256_set1_epi64x(y[0])),
-                                          _mm256_mul_epi32(SN_K_IC_W(b + 6), _mm256_set1_epi64x(y[1]))),
-                         _mm256_mul_epi32(SN_K_IC_W(b + 12), _mm256_set1_epi64x(y[2])));
-    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(p, s))); /* sn_kernels_rot.h: no masked moves */
+/* U^T y in lanes 0..2 (lane 3 junk): columns of U as lanes, U0..U3, U3..U6,
+ * U6..U9 (8-byte loads, inside the 20-byte block); y as VPMULDQ operands
+ * (the even int32 slots: y[c] in every slot) */
+SN_INLINE __m256i sn_k_ic_colp(const unsigned char *b, __m256i y0, __m256i y1, __m256i y2) {
+    return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), y0), _mm256_mul_epi32(SN_K_IC_W(b + 6), y1)),
+                            _mm256_mul_epi32(SN_K_IC_W(b + 12), y2));
 }
-
-/* rows of U as lanes: (U0,U3,U6) (U1,U4,U7) from bytes 0..15, (U2,U5,U8)
- * from bytes 4..19 by the same byte shuffle; frac = b[18] >= 0. */
-SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
+/* U z in lanes 0..2: rows of U as lanes, (U0,U3,U6) (U1,U4,U7) from bytes
+ * 0..15, (U2,U5,U8) from bytes 4..19 by the same byte shuffle */
+SN_INLINE __m256i sn_k_ic_rowp(const unsigned char *b, __m256i z0, __m256i z1, __m256i z2) {
     const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, 0, 1, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
     const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
-    __m256i p;
+    return _mm256_add_epi64(
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh0)), z0),
+                         _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh1)), z1)),
+        _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(w, sh0)), z2));
+}
+
+/* s < 0 (scale-up and clamp, a rare blob): the reference. */
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
+    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(sn_k_ic_colp(b, _mm256_set1_epi32(y[0]), _mm256_set1_epi32(y[1]),
+                                                                           _mm256_set1_epi32(y[2])), s))); /* no masked moves */
+}
+/* frac = b[18] >= 0 */
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
     (void)sat;
-    p = _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh0)), _mm256_set1_epi64x(z[0])),
-                         _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh1)), _mm256_set1_epi64x(z[1]))),
-        _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(w, sh0)), _mm256_set1_epi64x(z[2])));
-    p = _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)(const void *)l), sn_k_ic_rshr(p, b[18]));
-    _mm256_storeu_si256((__m256i *)(void *)l, p);
+    _mm256_storeu_si256((__m256i *)(void *)l,
+                        _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)(const void *)l),
+                                         sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi32(z[0]), _mm256_set1_epi32(z[1]),
+                                                                   _mm256_set1_epi32(z[2])), b[18])));
+}
+
+/* The sweeps' loops (sn_precond.c ic_forward / ic_backward), x86-64 round
+ * 2: y_j's operands built once per column, the row's sum kept in a
+ * register; the same integers as the per-block calls above. */
+/* ic_forward's column j: acc_i += round(U_ji^T y_j, frac + k_j - k_i) over
+ * the blocks at blk, their row indices at cols < cend, up to the first
+ * i >= nF; returns the blocks read. */
+#define SN_K_IC_FWD_RUN 1
+SN_INLINE uint32_t sn_k_ic_fwd_run(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend,
+                                   const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc, uint32_t *sat) {
+    const __m256i y0 = _mm256_set1_epi32(y[0]), y1 = _mm256_set1_epi32(y[1]), y2 = _mm256_set1_epi32(y[2]);
+    const unsigned char *c = cols;
+    for (; c < cend; c += 2, blk += SN_ELEM_ICHOL) {
+        const uint32_t i = sn_rd_u16(c);
+        int s;
+        if (i >= nF) break; /* skeleton columns: not in ICHOL */
+        s = (int)blk[18] + kj - (int)kk[i];
+        if (s < 0) sn_k_ic_col_ref(blk, y, s, acc + 3 * i, sat);
+        else sn_k_st3q(acc + 3 * i, _mm256_add_epi64(sn_k_ld3q(acc + 3 * i), sn_k_ic_rshr(sn_k_ic_colp(blk, y0, y1, y2), s)));
+    }
+    return (uint32_t)(c - cols) / 2u;
+}
+/* ic_backward's row: l = sum of round(U_e z_cols[e], frac_e) over nb blocks
+ * (l[3] scratch) */
+#define SN_K_IC_BWD_ROW 1
+SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
+                               uint32_t *sat) {
+    __m256i a = _mm256_setzero_si256();
+    uint32_t e;
+    (void)sat;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_q *zi = z + 3 * sn_rd_u16(cols + 2 * e);
+        a = _mm256_add_epi64(a, sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi32(zi[0]), _mm256_set1_epi32(zi[1]),
+                                                          _mm256_set1_epi32(zi[2])), b[18]));
+    }
+    _mm256_storeu_si256((__m256i *)(void *)l, a);
 }
 #undef SN_K_IC_W
 

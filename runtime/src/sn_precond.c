@@ -49,6 +49,9 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
         e = sn_rd_u32(rp + 4 * j);
         if (e < end)
             n += sn_k_ic_fwd_col(&c, L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, yj, kk[j], sat);
+#elif defined(SN_K_IC_FWD_RUN) /* x86-64 AVX2's loop (sn_kernels_ic.h) */
+        e = sn_rd_u32(rp + 4 * j);
+        n += sn_k_ic_fwd_run(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, yj, kk[j], kk, nF, acc, sat);
 #else
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
@@ -77,7 +80,7 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
     uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
-#if defined(SN_K_IC_BWD_ROW) /* the M4's loop (sn_kernels_ic.h) */
+#if defined(SN_K_IC_BWD_ROW) /* the M4's and x86-64 AVX2's loops (sn_kernels_ic.h) */
         sn_acc l[4];
         n -= f - b;
         sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
