@@ -103,11 +103,11 @@ SN_INLINE __m256i sn_k_ic_colp(const unsigned char *b, __m256i y0, __m256i y1, _
     return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), y0), _mm256_mul_epi32(SN_K_IC_W(b + 6), y1)),
                             _mm256_mul_epi32(SN_K_IC_W(b + 12), y2));
 }
-/* U z in lanes 0..2: rows of U as lanes, (U0,U3,U6) (U1,U4,U7) from bytes
+/* U z in lanes 0..2 (lane 3: 0): rows of U as lanes, (U0,U3,U6) (U1,U4,U7) from bytes
  * 0..15, (U2,U5,U8) from bytes 4..19 by the same byte shuffle */
 SN_INLINE __m256i sn_k_ic_rowp(const unsigned char *b, __m256i z0, __m256i z1, __m256i z2) {
-    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, 0, 1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1); /* lane 3: 0 */
+    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
     const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
     return _mm256_add_epi64(
@@ -138,9 +138,10 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
  * the blocks at blk, their row indices at cols < cend, up to the first
  * i >= nF; returns the blocks read. */
 #define SN_K_IC_FWD_RUN 1
-SN_INLINE uint32_t sn_k_ic_fwd_run(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend,
-                                   const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc, uint32_t *sat) {
-    const __m256i y0 = _mm256_set1_epi32(y[0]), y1 = _mm256_set1_epi32(y[1]), y2 = _mm256_set1_epi32(y[2]);
+/* y0..y2: y's entries as VPMULDQ operands */
+SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend, __m256i y0,
+                                   __m256i y1, __m256i y2, const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc,
+                                   uint32_t *sat) {
     const unsigned char *c = cols;
     for (; c < cend; c += 2, blk += SN_ELEM_ICHOL) {
         const uint32_t i = sn_rd_u16(c);
@@ -151,6 +152,11 @@ SN_INLINE uint32_t sn_k_ic_fwd_run(const unsigned char *blk, const unsigned char
         else sn_k_st3q(acc + 3 * i, _mm256_add_epi64(sn_k_ld3q(acc + 3 * i), sn_k_ic_rshr(sn_k_ic_colp(blk, y0, y1, y2), s)));
     }
     return (uint32_t)(c - cols) / 2u;
+}
+SN_INLINE uint32_t sn_k_ic_fwd_run(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend,
+                                   const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc, uint32_t *sat) {
+    return sn_k_ic_fwd_ops(blk, cols, cend, _mm256_set1_epi32(y[0]), _mm256_set1_epi32(y[1]), _mm256_set1_epi32(y[2]), y, kj,
+                           kk, nF, acc, sat);
 }
 /* ic_backward's row: l = sum of round(U_e z_cols[e], frac_e) over nb blocks
  * (l[3] scratch) */
@@ -166,6 +172,18 @@ SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols
                                                           _mm256_set1_epi32(zi[2])), b[18]));
     }
     _mm256_storeu_si256((__m256i *)(void *)l, a);
+}
+/* the same sum as lanes (lane 3: 0), z_i read as the int64 zq[3 i..3 i+2]
+ * (|z_i| <= SN_LIM: VPMULDQ's low halves are the values) */
+SN_INLINE __m256i sn_k_ic_bwd_rowq(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
+    __m256i a = _mm256_setzero_si256();
+    uint32_t e;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_acc *zi = zq + 3 * sn_rd_u16(cols + 2 * e);
+        a = _mm256_add_epi64(a, sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi64x(zi[0]), _mm256_set1_epi64x(zi[1]),
+                                                          _mm256_set1_epi64x(zi[2])), b[18]));
+    }
+    return a;
 }
 #undef SN_K_IC_W
 

@@ -43,8 +43,8 @@ SN_INLINE __m256i sn_k_rot3(const sn_q *R, const sn_q v[3], __m256i i0, __m256i 
                          _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi64x(v[1]))),
         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi64x(v[2])));
 }
-/* lanes 0..2 -> out: sn_out(x, SN_Q_ROT) each */
-SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
+/* sn_out(x, SN_Q_ROT) per lane (lanes 0..2 counted; lane 3 clamped, uncounted) */
+SN_INLINE __m256i sn_k_rot_rnd(__m256i x, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     __m256i y = _mm256_sub_epi64(
         _mm256_srli_epi64(_mm256_add_epi64(x, _mm256_set1_epi64x(((int64_t)1 << 62) + ((int64_t)1 << (SN_Q_ROT - 1)))), SN_Q_ROT),
@@ -53,12 +53,15 @@ SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
     if (m) *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2)); /* rare */
-    {
-        const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
-        const int32_t o2 = _mm_extract_epi32(o, 2);
-        _mm_storel_epi64((__m128i *)(void *)out, o); /* no VPMASKMOVD (see sn_k_st3q) */
-        memcpy(out + 2, &o2, 4);
-    }
+    return y;
+}
+/* lanes 0..2 -> out: sn_out(x, SN_Q_ROT) each */
+SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
+    const __m256i y = sn_k_rot_rnd(x, sat);
+    const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
+    const int32_t o2 = _mm_extract_epi32(o, 2);
+    _mm_storel_epi64((__m128i *)(void *)out, o); /* no VPMASKMOVD (see sn_k_st3q) */
+    memcpy(out + 2, &o2, 4);
 }
 /* out = R^T v: lane k = R[k] v0 + R[3+k] v1 + R[6+k] v2 */
 SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
@@ -73,6 +76,26 @@ SN_INLINE __m256i sn_k_rot_x(const sn_q R[9], const sn_q v[3]) {
 }
 SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
     sn_k_rot_out(sn_k_rot_x(R, v), out, sat);
+}
+/* R^T v and R v from v's int64 lanes (x86-64 round 2: the IC(0) sweeps
+ * rotate a vertex's value where they form it, sn_precond.c) */
+SN_INLINE __m256i sn_k_rot3v(const sn_q *R, __m256i v, __m256i i0, __m256i i1, __m256i i2) {
+    const __m256i r0 = SN_K_R8(R), r1 = SN_K_R8(R + 1);
+    return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_permute4x64_epi64(v, 0x00)),
+                                             _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_permute4x64_epi64(v, 0x55))),
+                            _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_permute4x64_epi64(v, 0xAA)));
+}
+/* sn_out(R^T v, SN_Q_ROT) as lanes (v in memory) */
+SN_INLINE __m256i sn_k_rot_t4(const sn_q R[9], const sn_q v[3], uint32_t *sat) {
+    return sn_k_rot_rnd(sn_k_rot3(R, v, _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0), _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0),
+                                  _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0)),
+                        sat);
+}
+/* out = sn_out(R v, SN_Q_ROT), v as lanes */
+SN_INLINE void sn_k_rot4(const sn_q R[9], __m256i v, sn_q out[3], uint32_t *sat) {
+    sn_k_rot_out(sn_k_rot3v(R, v, _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0), _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0),
+                            _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0)),
+                 out, sat);
 }
 /* acc += R t (int64, masked to the 3 entries) */
 SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
@@ -347,14 +370,19 @@ SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     sn_k_st3d(x, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(x), sn_k_ld3q(y)), sat));
 }
 /* l = D e (D: xx yy zz xy xz yz, 6 int32 at b), out = sn_out(l, sh) */
+SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh, uint32_t *sat);
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
+}
+/* the same as lanes (lane 3: 0) */
+SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh, uint32_t *sat) {
     const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
                                               _mm_loadl_epi64((const __m128i *)(const void *)(b + 16)), 1); /* xx yy zz xy xz yz 0 0 */
     const __m256i x = _mm256_add_epi64(
         _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi64x(e[0])),
                          _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi64x(e[1]))),
         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi64x(e[2])));
-    sn_k_st3d(out, sn_k_out4(x, sn_k_sh4(sh), sat)); /* lane 3: 0 * e */
+    return sn_k_out4(x, sn_k_sh4(sh), sat); /* lane 3: 0 * e */
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)

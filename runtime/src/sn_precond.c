@@ -98,6 +98,45 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
     }
 }
 
+#if defined(SN_KERNELS_AVX2)
+/* x86-64 round 2 (AVX2, fixed; NUMERICS.md "x86-64 solve, round 2"): IC(0)
+ * without mask or scale, the per-vertex passes fused into the sweeps, the
+ * same integers and clamp counts as precond_core's passes: the forward
+ * sweep forms t_j = R_j^T r_j where it reaches j (y_j = sn_out(t_j - acc_j)),
+ * the backward sweep w_j = D^-1 y_j and z'_j = sn_out(w_j - l_j) where it
+ * reaches j, keeps z'_j in acc_j (int64; row j's count, read first, is its
+ * last use) for the rows above, and writes z_j = R_j z'_j. One pass over
+ * the vertices each way instead of five. */
+static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
+                     uint32_t *sat) {
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
+    const uint32_t nF = v->nF;
+    uint32_t j, n = 0;
+    for (j = 0; j + 4 <= 3 * nF; j += 4) _mm256_storeu_si256((__m256i *)(void *)(acc + j), _mm256_setzero_si256());
+    for (; j < 3 * nF; j++) acc[j] = 0;
+    for (j = 0; j < nF; j++) {
+        const uint32_t e = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4);
+        const __m256i y = sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_t4(R + rs * j, r + 3 * j, sat), sn_k_ld3q(acc + 3 * j)), sat);
+        uint32_t m;
+        sn_k_st3d(z + 3 * j, y);
+        m = sn_k_ic_fwd_ops(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, _mm256_permute4x64_epi64(y, 0x00),
+                            _mm256_permute4x64_epi64(y, 0x55), _mm256_permute4x64_epi64(y, 0xAA), z + 3 * j, kk[j], kk, nF, acc, sat);
+        acc[3 * j] = (sn_acc)m; /* acc_j is consumed: row j's free column count */
+        n += m;
+    }
+    j = nF;
+    while (j-- > 0) {
+        const uint32_t m = (uint32_t)acc[3 * j], b = sn_rd_u32(rp + 4 * j);
+        __m256i w = sn_k_sym_out4(P + (size_t)j * 6 * SN_REAL_BYTES, z + 3 * j, v->frac_P + SN_KREL(kk[j]), sat);
+        n -= m;
+        w = sn_k_clamp4(_mm256_sub_epi64(w, sn_k_ic_bwd_rowq(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc)), sat);
+        sn_k_st3q(acc + 3 * j, w); /* z'_j, for the rows above */
+        sn_k_rot4(R + rs * j, w, z + 3 * j, sat);
+    }
+}
+#endif
+
 /* t = s t, s a Q30 scale in (0, 1] (adaptation's source rows): no clamp */
 SN_INLINE void scale3(sn_q t[3], sn_q s, uint32_t *sat) {
     t[0] = sn_out(sn_mul(s, t[0]), SN_Q_ROT, sat);
@@ -130,6 +169,9 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
         }
         return;
     }
+#if defined(SN_KERNELS_AVX2)
+    if (!mask && !sc) { ic_fused(v, kk, R, rs, r, z, WARR(h, o_acc, sn_acc), sat); return; }
+#endif
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i] == !inv) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
         else {
