@@ -371,6 +371,35 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
     sn_k_ic_cols(b, c);
     FV_ST4(l, FV_ADD(FV_LD4(l), FV_MAC3(c, FV_SET1(z[0]), FV_SET1(z[1]), FV_SET1(z[2]))));
 }
+#if defined(SN_KERNELS_FAVX2)
+/* x86-64 round 2 (sn_precond.c ic_fused): ic_forward's column j with y_j's
+ * lanes broadcast once (y0..y2), and ic_backward's row sum as lanes, z_i
+ * read from zq (3 floats per vertex); each lane the reference's
+ * ((p0 + p1) + p2) added to its accumulator in the reference's order. */
+SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend, sn_fv y0,
+                                   sn_fv y1, sn_fv y2, uint32_t nF, sn_acc *acc) {
+    const unsigned char *c = cols;
+    for (; c < cend; c += 2, blk += SN_ELEM_ICHOL) {
+        const uint32_t i = sn_rd_u16(c);
+        sn_fv r[3];
+        if (i >= nF) break; /* skeleton columns: not in ICHOL */
+        sn_k_ic_rows(blk, r);
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), FV_MAC3(r, y0, y1, y2)));
+    }
+    return (uint32_t)(c - cols) / 2u;
+}
+SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
+    sn_fv a = FV_SET1(0.0f); /* the reference's l = 0, then l += each block's row sums */
+    uint32_t e;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_acc *zi = zq + 3 * sn_rd_u16(cols + 2 * e);
+        sn_fv c[3];
+        sn_k_ic_cols(b, c);
+        a = FV_ADD(a, FV_MAC3(c, FV_SET1(zi[0]), FV_SET1(zi[1]), FV_SET1(zi[2])));
+    }
+    return a;
+}
+#endif
 
 #else
 #define sn_k_ic_col sn_k_ic_col_ref

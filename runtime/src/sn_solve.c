@@ -37,7 +37,7 @@ SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
 }
 
 static void acc_zero(sn_acc *acc, uint32_t n3) {
-#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+#if defined(SN_K_ZERO) /* the M4's and x86-64 AVX2's (sn_kernels.h) */
     sn_k_zero(acc, n3);
 #else
     uint32_t i;
