@@ -138,7 +138,11 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
  * the blocks at blk, their row indices at cols < cend, up to the first
  * i >= nF; returns the blocks read. */
 #define SN_K_IC_FWD_RUN 1
-/* y0..y2: y's entries as VPMULDQ operands */
+/* y0..y2: y's entries as VPMULDQ operands. Always inlined: GCC kept it a
+ * call from sn_precond.c's fused sweep (~40 instructions a vertex). */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
 SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend, __m256i y0,
                                    __m256i y1, __m256i y2, const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc,
                                    uint32_t *sat) {

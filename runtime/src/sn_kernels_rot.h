@@ -39,9 +39,9 @@ SN_INLINE void sn_k_st3q(int64_t *p, __m256i v) {
 SN_INLINE __m256i sn_k_rot3(const sn_q *R, const sn_q v[3], __m256i i0, __m256i i1, __m256i i2) {
     const __m256i r0 = SN_K_R8(R), r1 = SN_K_R8(R + 1);
     return _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_set1_epi64x(v[0])),
-                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi64x(v[1]))),
-        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi64x(v[2])));
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_set1_epi32(v[0])),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi32(v[1]))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi32(v[2])));
 }
 /* sn_out(x, SN_Q_ROT) per lane (lanes 0..2 counted; lane 3 clamped, uncounted) */
 SN_INLINE __m256i sn_k_rot_rnd(__m256i x, uint32_t *sat) {
@@ -364,25 +364,23 @@ SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t
     sn_k_st3d(out, sn_k_clamp4(_mm256_add_epi64(sn_k_ld3d(x), sn_k_ld3d(y)), sat));
 }
 SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
-    sn_k_st3d(out, sn_k_out4(_mm256_mul_epi32(sn_k_ld3d(x), _mm256_set1_epi64x(c)), _mm256_set1_epi64x(SN_Q_COEF), sat));
+    sn_k_st3d(out, sn_k_out4(_mm256_mul_epi32(sn_k_ld3d(x), _mm256_set1_epi32(c)), _mm256_set1_epi64x(SN_Q_COEF), sat));
 }
 SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     sn_k_st3d(x, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(x), sn_k_ld3q(y)), sat));
 }
-/* l = D e (D: xx yy zz xy xz yz, 6 int32 at b), out = sn_out(l, sh) */
-SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh, uint32_t *sat);
-SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
-    sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
-}
-/* the same as lanes (lane 3: 0) */
+/* l = D e (D: xx yy zz xy xz yz, 6 int32 at b) rounded: sn_out(l, sh) as lanes (lane 3: 0) */
 SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh, uint32_t *sat) {
     const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
                                               _mm_loadl_epi64((const __m128i *)(const void *)(b + 16)), 1); /* xx yy zz xy xz yz 0 0 */
     const __m256i x = _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi64x(e[0])),
-                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi64x(e[1]))),
-        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi64x(e[2])));
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi32(e[0])),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi32(e[1]))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi32(e[2])));
     return sn_k_out4(x, sn_k_sh4(sh), sat); /* lane 3: 0 * e */
+}
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)
