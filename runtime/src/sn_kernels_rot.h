@@ -290,6 +290,25 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     sn_k_sym_cols(b, c);
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
+#if defined(SN_KERNELS_FAVX2)
+/* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
+ * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
+ * in registers between the steps; the reference's floats and counts. */
+#define SN_K_CORNER 1
+SN_INLINE void sn_k_corner(const sn_q *R, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+                           uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
+    sn_fv r[3], t, x;
+    fv_rows(R, r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 (sn_k_rot_t) */
+    t = fv_out3(FV_ADD(fv_ld3(wa), SN_K_NEG(fv_ld3(w0))), sat);
+    fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
+    t = fv_out3(FV_ADD(fv_ld3(pa), SN_K_NEG(fv_ld3(p0))), sat);
+    t = fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat);
+    x = fv_out3(FV_ADD(fv_ld3(f + ia), SN_K_NEG(fv_ld3(f + ib))), sat);
+    fv_st3(d, fv_out3(FV_ADD(t, SN_K_NEG(x)), sat));
+}
+#endif
 #elif defined(SN_KERNELS_AVX2)
 /* Fixed AVX2 (and AVX-512): the helpers on int64 lanes (the 4th lane 0 or
  * unused, never stored). sn_k_out4 is sn_out per lane with shift s (0..62
@@ -381,6 +400,21 @@ SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh,
 }
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
     sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
+}
+/* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
+ * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
+ * in int64 lanes between the steps; the same integers and counts. */
+#define SN_K_CORNER 1
+SN_INLINE void sn_k_corner(const sn_q *R, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+                           uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const __m256i i0 = _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0), i1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0);
+    const __m256i i2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0); /* R^T v (sn_k_rot_t) */
+    const __m256i t = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(pa), sn_k_ld3d(p0)), sat);
+    const __m256i s = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(wa), sn_k_ld3d(w0)), sat);
+    const __m256i x = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(rest + 4u * ia), sn_k_ld3d(rest + 4u * ib)), sat);
+    sn_k_st3d(uu, sn_k_rot_rnd(sn_k_rot3v(R, s, i0, i1, i2), sat));
+    sn_k_st3d(d, sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_rnd(sn_k_rot3v(R, t, i0, i1, i2), sat), x), sat)); /* lane 3: in range */
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)

@@ -182,14 +182,19 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         fr = (uint32_t)(a0 < nF);
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
-            sn_q t[3], s[3], l[3], wa[3], xr[3];
+            sn_q wa[3];
             fr |= (uint32_t)(a < nF) << k;
+#if defined(SN_K_CORNER) /* x86-64 AVX2: the steps below in registers (sn_kernels_rot.h) */
+            sn_k_corner(R, pos + 3 * a, pos + 3 * a0, w_of(h, w, vel, a, wa), w0, rest, 3 * a, 3 * a0, d + 3 * k, uu + 3 * k, sat);
+#else
+            sn_q t[3], s[3], l[3], xr[3];
             sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
             sn_k_sub3(w_of(h, w, vel, a, wa), w0, s, sat);
             sn_k_rot_t(R, t, l, sat);
             sn_k_rot_t(R, s, uu + 3 * k, sat);
             sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
             sn_k_sub3(l, xr, d + 3 * k, sat);
+#endif
         }
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, yx, lx, sat); /* the cut level (sn_cut.c) */
