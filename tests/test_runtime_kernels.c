@@ -1176,6 +1176,32 @@ static void test_ic_fwd_run(void) {
 }
 #endif
 
+#if defined(SN_K_ENERGY24)
+/* x86-64's cell energy sum (sn_k_energy24) against the reference loop,
+ * sum over k = 3..23 of sn_mul(d[k], sn_out(l[k], s)) (sn_internal.h):
+ * d at and inside +-2^28, l up to +-2^62 (clamps on both sides), shifts
+ * -3..61; the int64 and the clamp count must match. */
+static void test_energy24(void) {
+    int t, bad = 0, clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        sn_q d[24];
+        sn_acc l[24], ref = 0, got;
+        uint32_t k, s1 = 0, s2 = 0;
+        const int s = (int)(rnd32() % 65u) - 3;
+        for (k = 0; k < 24; k++) {
+            d[k] = t % 8 == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            l[k] = (int64_t)rnd_in(1 << 30) * ((int64_t)1 << (rnd32() % 33u));
+        }
+        for (k = 3; k < 24; k++) ref += sn_mul(d[k], sn_out(l[k], s, &s2));
+        got = sn_k_energy24(d, l, s, &s1);
+        clamps += (int)s2;
+        bad += got != ref || s1 != s2;
+    }
+    T_CHECK(bad == 0, "cell energy sum (path %s): %d of 4000 cells differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("cell energy sums: 4000 cells, shifts -3..61, %d clamped terms", clamps);
+}
+#endif
+
 #if defined(SN_K_MASS_FF)
 /* The M4's mass pass (sn_k_mass_ff) against pass_M_ff's loop written here
  * with sn_mul (exact int64 sums: tolerance 0): random row structures of
@@ -1377,6 +1403,9 @@ int main(void) {
 #endif
 #if defined(SN_K_IC_FWD_RUN)
     test_ic_fwd_run();
+#endif
+#if defined(SN_K_ENERGY24)
+    test_energy24();
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();

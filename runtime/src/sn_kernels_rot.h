@@ -401,6 +401,25 @@ SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh,
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
     sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
 }
+/* cell_forces' elastic energy term: sum over k = 3..23 of d[k] sn_out(l[k], s)
+ * (x86-64 round 2), 4 terms a vector (lanes 0..2 of the first masked to 0:
+ * no term, no clamp). |d|, |sn_out| <= 2^28: each product < 2^56, the sum
+ * of 21 < 2^61, exact in any order: the reference loop's int64. */
+#define SN_K_ENERGY24 1
+SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint32_t *sat) {
+    const __m256i sv = sn_k_sh4(s);
+    __m256i a = _mm256_setzero_si256();
+    int64_t t[4];
+    uint32_t k;
+    for (k = 0; k < 24; k += 4) {
+        __m256i x = _mm256_loadu_si256((const __m256i *)(const void *)(l + k));
+        if (k == 0) x = _mm256_blend_epi32(x, _mm256_setzero_si256(), 0x3F); /* k = 0..2: d_0 = 0 */
+        a = _mm256_add_epi64(a, _mm256_mul_epi32(sn_k_out4(x, sv, sat),
+                                                 _mm256_cvtepi32_epi64(_mm_loadu_si128((const __m128i *)(const void *)(d + k)))));
+    }
+    _mm256_storeu_si256((__m256i *)(void *)t, a);
+    return t[0] + t[1] + t[2] + t[3];
+}
 /* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
  * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
  * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept

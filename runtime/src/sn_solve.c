@@ -199,7 +199,11 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
         if (v->cut) sn_cut_terms(h, e, R, a0, w0, fr, yx, lx, sat); /* the cut level (sn_cut.c) */
         if (on) detail_cell_rhs(h, dt, e, on, R, d, uu, (const sn_q(*)[3])yx, lc, sacc, sat);
+#if defined(SN_K_ENERGY24) /* x86-64 AVX2 (sn_kernels_rot.h) */
+        ec = sn_k_energy24(d, ld, v->frac_S, &esat);
+#else
         for (k = 3; k < 24; k++) ec += sn_k_mul_out(d[k], ld[k], v->frac_S, &esat); /* d_0 = 0: no term */
+#endif
         *e2 = energy_add(*e2, E_Q32(ec));
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
