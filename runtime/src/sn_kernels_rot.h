@@ -43,14 +43,25 @@ SN_INLINE __m256i sn_k_rot3(const sn_q *R, const sn_q v[3], __m256i i0, __m256i 
                          _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi32(v[1]))),
         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi32(v[2])));
 }
-/* sn_out(x, SN_Q_ROT) per lane (lanes 0..2 counted; lane 3 clamped, uncounted) */
+/* nonzero where a lane may lie outside +-SN_LIM: (y + 2^28) >> 29 (logical)
+ * is 0 exactly for y in [-2^28, 2^28) (y = 2^28 only takes the full path);
+ * the full compares and blends run only then (x86-64 round 2) */
+#define SN_K_INLIM(y) _mm256_testz_si256(_mm256_srli_epi64(_mm256_add_epi64((y), _mm256_set1_epi64x(SN_LIM)), 29), \
+                                         _mm256_set1_epi64x(-1))
+/* sn_out(x, SN_Q_ROT) per lane, lanes 0..2 (lane 3: 0, so that callers'
+ * clamps of sums with it count nothing there) */
 SN_INLINE __m256i sn_k_rot_rnd(__m256i x, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     __m256i y = _mm256_sub_epi64(
         _mm256_srli_epi64(_mm256_add_epi64(x, _mm256_set1_epi64x(((int64_t)1 << 62) + ((int64_t)1 << (SN_Q_ROT - 1)))), SN_Q_ROT),
         _mm256_set1_epi64x((int64_t)1 << (62 - SN_Q_ROT)));
-    const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
-    const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
+    __m256i hi, lo;
+    int m;
+    y = _mm256_blend_epi32(y, _mm256_setzero_si256(), 0xC0);
+    if (SN_K_INLIM(y)) return y;
+    hi = _mm256_cmpgt_epi64(y, lim);
+    lo = _mm256_cmpgt_epi64(nlim, y);
+    m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
     if (m) *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2)); /* rare */
     return y;
@@ -333,7 +344,10 @@ SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
 #else
 SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
-    const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
+    __m256i hi, lo;
+    if (SN_K_INLIM(y)) return y;
+    hi = _mm256_cmpgt_epi64(y, lim);
+    lo = _mm256_cmpgt_epi64(nlim, y);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
     if (m) *sat += sn_k_cnt4(m); /* rare */
     return _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
