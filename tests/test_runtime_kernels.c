@@ -1179,8 +1179,9 @@ static void test_ic_fwd_run(void) {
 #if defined(SN_K_ENERGY24)
 /* x86-64's cell energy sum (sn_k_energy24) against the reference loop,
  * sum over k = 3..23 of sn_mul(d[k], sn_out(l[k], s)) (sn_internal.h):
- * d at and inside +-2^28, l up to +-2^62 (clamps on both sides), shifts
- * -3..61; the int64 and the clamp count must match. */
+ * d at and inside +-2^28, l up to +-2^62 (clamps on both sides; float:
+ * also +-inf and NaN), shifts -3..61; the value (fixed: the int64; float:
+ * the reference order's float) and the clamp count must match. */
 static void test_energy24(void) {
     int t, bad = 0, clamps = 0;
     for (t = 0; t < 4000; t++) {
@@ -1190,7 +1191,16 @@ static void test_energy24(void) {
         const int s = (int)(rnd32() % 65u) - 3;
         for (k = 0; k < 24; k++) {
             d[k] = t % 8 == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+#if defined(SN_FLOAT)
+            d[k] = (float)rnd_in(1 << 20) / 1024.0f;
+            l[k] = (float)rnd_in(1 << 24) / 2048.0f; /* +-8192: about a quarter beyond SN_FLIM */
+            if (t % 16 == 1 && rnd32() % 4u == 0) { /* sn_out's other float cases: +-inf, NaN */
+                const uint32_t u = rnd32() % 3u;
+                l[k] = u == 0 ? (sn_acc)HUGE_VAL : u == 1 ? (sn_acc)-HUGE_VAL : (sn_acc)NAN;
+            }
+#else
             l[k] = (int64_t)rnd_in(1 << 30) * ((int64_t)1 << (rnd32() % 33u));
+#endif
         }
         for (k = 3; k < 24; k++) ref += sn_mul(d[k], sn_out(l[k], s, &s2));
         got = sn_k_energy24(d, l, s, &s1);

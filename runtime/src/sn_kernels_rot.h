@@ -302,6 +302,29 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
 #if defined(SN_KERNELS_FAVX2)
+/* cell_forces' elastic energy term: ec = sum over k = 3..23 of
+ * d[k] sn_out(l[k]) added in k order (x86-64 round 2): the clamps and
+ * products 8 at a time (the same floats; lanes 0..2 neither counted nor
+ * summed), the sum in the reference's order. */
+#define SN_K_ENERGY24 1
+SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint32_t *sat) {
+    const __m256 lim = _mm256_set1_ps(SN_FLIM), nlim = _mm256_set1_ps(-SN_FLIM);
+    float p[24];
+    sn_acc ec = 0;
+    uint32_t k;
+    (void)s;
+    for (k = 0; k < 24; k += 8) {
+        const __m256 x = _mm256_loadu_ps(l + k);
+        const __m256 hi = _mm256_cmp_ps(x, lim, _CMP_GT_OQ), lo = _mm256_cmp_ps(x, nlim, _CMP_LT_OQ);
+        const __m256 nan = _mm256_cmp_ps(x, x, _CMP_UNORD_Q);
+        const int m = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(hi, lo), nan)) & (k ? 0xFF : 0xF8);
+        if (m) *sat += (uint32_t)((0x4332322132212110ull >> (4 * (m & 15)) & 15u) + (0x4332322132212110ull >> (4 * (m >> 4)) & 15u)); /* rare */
+        _mm256_storeu_ps(p + k, _mm256_mul_ps(_mm256_loadu_ps(d + k),
+                                              _mm256_andnot_ps(nan, _mm256_blendv_ps(_mm256_blendv_ps(x, lim, hi), nlim, lo))));
+    }
+    for (k = 3; k < 24; k++) ec += p[k];
+    return ec;
+}
 /* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
  * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
  * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
