@@ -329,12 +329,28 @@ SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint
  * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
  * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
  * in registers between the steps; the reference's floats and counts. */
+/* A cell's frame as rows (R^T v, sn_k_rot_t) and columns (R v,
+ * sn_k_out_rot_acc) once for its corners (x86-64 round 2): the same floats. */
+#define SN_K_ROTM 1
+typedef struct { sn_fv r[3], c[3]; } sn_k_rotm;
+SN_INLINE void sn_k_rotm_ld(sn_k_rotm *m, const sn_q *R) {
+    fv_rows(R, m->r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 */
+    fv_cols(R, m->c); /* lane k: R[3k] v0 + R[3k+1] v1 + R[3k+2] v2 */
+}
+SN_INLINE void sn_k_rot_t_m(const sn_k_rotm *m, const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc l[3], int sh, uint32_t *sat) {
+    const sn_fv t = fv_out3(fv_ld3(l), sat);
+    (void)sh;
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
 #define SN_K_CORNER 1
-SN_INLINE void sn_k_corner(const sn_q *R, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
                            uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
     const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
-    sn_fv r[3], t, x;
-    fv_rows(R, r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 (sn_k_rot_t) */
+    const sn_fv *r = m->r;
+    sn_fv t, x;
     t = fv_out3(FV_ADD(fv_ld3(wa), SN_K_NEG(fv_ld3(w0))), sat);
     fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
     t = fv_out3(FV_ADD(fv_ld3(pa), SN_K_NEG(fv_ld3(p0))), sat);
@@ -438,6 +454,42 @@ SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh,
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
     sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
 }
+/* A cell's frame permuted once for its corners (x86-64 round 2: cell_stiff,
+ * cell_forces): t0..t2 for R^T v (sn_k_rot_t's lanes), c0..c2 for R v
+ * (sn_k_out_rot_acc's); sn_k_rot_t_m / sn_k_out_rot_acc_m are those two
+ * with the permutes done, the same integers. */
+#define SN_K_ROTM 1
+typedef struct { __m256i t0, t1, t2, c0, c1, c2; } sn_k_rotm;
+SN_INLINE void sn_k_rotm_ld(sn_k_rotm *m, const sn_q *R) {
+    const __m256i r0 = _mm256_loadu_si256((const __m256i *)(const void *)R);
+    const __m256i r1 = _mm256_loadu_si256((const __m256i *)(const void *)(R + 1));
+    const __m256i ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0);
+    m->t0 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0));
+    m->t1 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0));
+    m->t2 = _mm256_permutevar8x32_epi32(r1, _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0));
+    m->c0 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0));
+    m->c1 = _mm256_permutevar8x32_epi32(r0, ic1);
+    m->c2 = _mm256_permutevar8x32_epi32(r1, ic1);
+}
+SN_INLINE __m256i sn_k_rot_t_mv(const sn_k_rotm *m, __m256i v, uint32_t *sat) { /* v as lanes */
+    return sn_k_rot_rnd(_mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->t0, _mm256_permute4x64_epi64(v, 0x00)),
+                                                          _mm256_mul_epi32(m->t1, _mm256_permute4x64_epi64(v, 0x55))),
+                                         _mm256_mul_epi32(m->t2, _mm256_permute4x64_epi64(v, 0xAA))),
+                        sat);
+}
+SN_INLINE void sn_k_rot_t_m(const sn_k_rotm *m, const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_k_rot_out(_mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->t0, _mm256_set1_epi32(v[0])),
+                                                   _mm256_mul_epi32(m->t1, _mm256_set1_epi32(v[1]))),
+                                  _mm256_mul_epi32(m->t2, _mm256_set1_epi32(v[2]))),
+                 out, sat);
+}
+SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc l[3], int sh, uint32_t *sat) {
+    const __m256i t = sn_k_out4(sn_k_ld3q(l), sn_k_sh4(sh), sat); /* lane 3: 0 */
+    const __m256i x = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->c0, _mm256_permute4x64_epi64(t, 0x00)),
+                                                        _mm256_mul_epi32(m->c1, _mm256_permute4x64_epi64(t, 0x55))),
+                                       _mm256_mul_epi32(m->c2, _mm256_permute4x64_epi64(t, 0xAA)));
+    sn_k_st3q(acc, _mm256_add_epi64(sn_k_ld3q(acc), x)); /* acc += R t */
+}
 /* cell_forces' elastic energy term: sum over k = 3..23 of d[k] sn_out(l[k], s)
  * (x86-64 round 2), 4 terms a vector (lanes 0..2 of the first masked to 0:
  * no term, no clamp). |d|, |sn_out| <= 2^28: each product < 2^56, the sum
@@ -462,15 +514,13 @@ SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint
  * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
  * in int64 lanes between the steps; the same integers and counts. */
 #define SN_K_CORNER 1
-SN_INLINE void sn_k_corner(const sn_q *R, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
                            uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
-    const __m256i i0 = _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0), i1 = _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0);
-    const __m256i i2 = _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0); /* R^T v (sn_k_rot_t) */
     const __m256i t = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(pa), sn_k_ld3d(p0)), sat);
     const __m256i s = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(wa), sn_k_ld3d(w0)), sat);
     const __m256i x = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(rest + 4u * ia), sn_k_ld3d(rest + 4u * ib)), sat);
-    sn_k_st3d(uu, sn_k_rot_rnd(sn_k_rot3v(R, s, i0, i1, i2), sat));
-    sn_k_st3d(d, sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_rnd(sn_k_rot3v(R, t, i0, i1, i2), sat), x), sat)); /* lane 3: in range */
+    sn_k_st3d(uu, sn_k_rot_t_mv(m, s, sat));
+    sn_k_st3d(d, sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_t_mv(m, t, sat), x), sat)); /* lane 3: 0 */
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)

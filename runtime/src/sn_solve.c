@@ -176,6 +176,10 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         uint32_t fr = 0; /* the free corners: lu's rows read below */
         uint32_t on = dt ? DT(dt, o_on, const uint32_t)[e] : 0;
         const sn_q *w0 = w_of(h, w, vel, a0, w0s);
+#if defined(SN_K_ROTM) /* x86-64 AVX2: R permuted once for the corners (sn_kernels_rot.h) */
+        sn_k_rotm rm;
+        sn_k_rotm_ld(&rm, R);
+#endif
         /* corner 0 is a0: its t, s and rest difference are 0, so d_0 = uu_0 = 0
          * exactly (no clamp), without its two rotations */
         for (c = 0; c < 3; c++) d[c] = uu[c] = 0;
@@ -185,7 +189,7 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
             sn_q wa[3];
             fr |= (uint32_t)(a < nF) << k;
 #if defined(SN_K_CORNER) /* x86-64 AVX2: the steps below in registers (sn_kernels_rot.h) */
-            sn_k_corner(R, pos + 3 * a, pos + 3 * a0, w_of(h, w, vel, a, wa), w0, rest, 3 * a, 3 * a0, d + 3 * k, uu + 3 * k, sat);
+            sn_k_corner(&rm, pos + 3 * a, pos + 3 * a0, w_of(h, w, vel, a, wa), w0, rest, 3 * a, 3 * a0, d + 3 * k, uu + 3 * k, sat);
 #else
             sn_q t[3], s[3], l[3], xr[3];
             sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
@@ -210,7 +214,11 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
             sn_acc ls[3];
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
             for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0) + (on ? lc[3 * k + c] : 0);
+#if defined(SN_K_ROTM)
+            sn_k_out_rot_acc_m(acc + 3 * a, &rm, ls, v->frac_S - SN_KREL(kk[a]), sat);
+#else
             sn_k_out_rot_acc(acc + 3 * a, R, ls, v->frac_S - SN_KREL(kk[a]), sat); /* R round(ld + lu [+ lx]) */
+#endif
         }
     }
 }
@@ -417,10 +425,19 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_q u[24];
     sn_acc l[24];
     uint8_t fc[8];
+#if defined(SN_K_ROTM) /* x86-64 AVX2: R permuted once for the corners (sn_kernels_rot.h) */
+    sn_k_rotm rm;
+    sn_k_rotm_ld(&rm, R);
+#define SN_ROT_T(v, o) sn_k_rot_t_m(&rm, (v), (o), sat)
+#define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc_m((x), &rm, (l), (sh), sat)
+#else
+#define SN_ROT_T(v, o) sn_k_rot_t(R, (v), (o), sat)
+#define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc((x), R, (l), (sh), sat)
+#endif
     for (k = 0; k < 8; k++) {
         uint32_t a = sn_rd_u16(cl + 2 * k);
         if (a >= nF || (mask && !mask[a])) continue;
-        sn_k_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+        SN_ROT_T(d + 3 * a, u + 3 * nf);
         fc[nf] = (uint8_t)k;
         vi[nf++] = a;
     }
@@ -428,8 +445,10 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_k_cell_mul(K, fc, nf, u, l);
     for (k = 0; k < nf; k++) {
         uint32_t a = vi[k];
-        sn_k_out_rot_acc(acc + 3 * a, R, l + 3 * k, h->v.frac_S - SN_KREL(kk[a]), sat); /* R round(l) */
+        SN_OUT_ROT_ACC(acc + 3 * a, l + 3 * k, h->v.frac_S - SN_KREL(kk[a])); /* R round(l) */
     }
+#undef SN_ROT_T
+#undef SN_OUT_ROT_ACC
 }
 
 void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
