@@ -1176,6 +1176,79 @@ static void test_ic_fwd_run(void) {
 }
 #endif
 
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+/* x86-64's fused IC(0) sweep loops (sn_precond.c ic_fused) against the
+ * reference per block (sn_k_ic_col_ref / sn_k_ic_row_ref, the portable
+ * loops' order): the backward row with z read from the accumulators
+ * (fixed: sn_k_ic_bwd_rowq, int64 z_i; float: sn_k_ic_bwd_rowv, two
+ * blocks a step and the odd one) over 0..13 blocks with fracs 0..47 (the
+ * float scale's range), and the float forward column (sn_k_ic_fwd_ops;
+ * fixed: test_ic_fwd_run). Exact: the same integers / floats. */
+static void test_ic_fused(void) {
+    static unsigned char L[13 * 20], cols[26];
+    static sn_acc zq[90], a1[90], a2[90];
+    int t, bad_r = 0, bad_c = 0;
+    for (t = 0; t < 4000; t++) {
+        const uint32_t nb = rnd32() % 14u, nF = 24u;
+        uint32_t e, k;
+        sn_q y[3], z[90];
+        sn_acc lr[4] = {0, 0, 0, 0}, lv[4];
+        uint32_t s1 = 0;
+        const int wild = t % 8 == 0;
+        for (k = 0; k < 90; k++) {
+#if defined(SN_FLOAT)
+            z[k] = (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 24u));
+#else
+            z[k] = wild ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+#endif
+            zq[k] = (sn_acc)z[k];
+#if defined(SN_FLOAT)
+            a1[k] = a2[k] = (float)rnd_in(1 << 20) / 64.0f;
+#else
+            a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12;
+#endif
+        }
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 4u == 0 ? (rnd32() & 1 ? 47u : 0u) : rnd32() % 48u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)(rnd32() % (nF + 3u)); /* rows past nF: the forward column stops there */
+            cols[2 * e + 1] = 0;
+        }
+        for (e = 0; e < nb; e++) sn_k_ic_row_ref(L + 20 * e, z + 3 * (cols[2 * e] % 30u), lr, &s1);
+        for (e = 0; e < nb; e++) cols[2 * e] = (unsigned char)(cols[2 * e] % 30u);
+#if defined(SN_FLOAT)
+        {
+            const sn_fv r = sn_k_ic_bwd_rowv(L, cols, nb, zq);
+            FV_ST4(lv, r);
+        }
+#else
+        _mm256_storeu_si256((__m256i *)(void *)lv, sn_k_ic_bwd_rowq(L, cols, nb, zq));
+#endif
+        bad_r += memcmp(lv, lr, 3 * sizeof lv[0]) != 0;
+#if defined(SN_FLOAT)
+        {
+            uint32_t n1, n2 = 0;
+            for (k = 0; k < 3; k++) y[k] = z[k];
+            n1 = sn_k_ic_fwd_ops(L, cols, cols + 2 * nb, FV_SET1(y[0]), FV_SET1(y[1]), FV_SET1(y[2]), nF, a1);
+            for (e = 0; e < nb && cols[2 * e] < nF; e++, n2++) sn_k_ic_col_ref(L + 20 * e, y, 0, a2 + 3 * cols[2 * e], &s1);
+            bad_c += memcmp(a1, a2, sizeof a1) != 0 || n1 != n2;
+        }
+#else
+        (void)y; (void)a1; (void)a2;
+#endif
+    }
+    T_CHECK(bad_r == 0, "fused IC(0) backward rows (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_r);
+    T_CHECK(bad_c == 0, "fused IC(0) forward columns (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_c);
+}
+#endif
+
 #if defined(SN_K_ENERGY24)
 /* x86-64's cell energy sum (sn_k_energy24) against the reference loop,
  * sum over k = 3..23 of sn_mul(d[k], sn_out(l[k], s)) (sn_internal.h):
@@ -1416,6 +1489,9 @@ int main(void) {
 #endif
 #if defined(SN_K_ENERGY24)
     test_energy24();
+#endif
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+    test_ic_fused();
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();

@@ -392,10 +392,43 @@ SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char
     }
     return (uint32_t)(c - cols) / 2u;
 }
+/* Two blocks at once in 8 lanes, [block e | block e+1]: each column by one
+ * VPSHUFB putting the int16 in the high half of a 32-bit slot (VPSRAD 16
+ * sign-extends: the VPMOVSXWD value) and the two scales 2^-frac from the
+ * frac bytes (127 - frac) << 23, the same floats as sn_k_ic_cols; the two
+ * row sums then added to l one after the other (l + A) + B, the
+ * reference's order. */
+SN_INLINE __m256 sn_k_ic_cols2(const unsigned char *b, __m256 c[3]) {
+    const __m256i m0 = _mm256_setr_epi8(-1, -1, 0, 1, -1, -1, 6, 7, -1, -1, 12, 13, -1, -1, -1, -1,
+                                        -1, -1, 0, 1, -1, -1, 6, 7, -1, -1, 12, 13, -1, -1, -1, -1);
+    const __m256i m1 = _mm256_setr_epi8(-1, -1, 2, 3, -1, -1, 8, 9, -1, -1, 14, 15, -1, -1, -1, -1,
+                                        -1, -1, 2, 3, -1, -1, 8, 9, -1, -1, 14, 15, -1, -1, -1, -1);
+    const __m256i mf = _mm256_setr_epi8(14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1,
+                                        14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1);
+    const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
+                                              _mm_loadu_si128((const __m128i *)(const void *)(b + SN_ELEM_ICHOL)), 1);
+    const __m256i w = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)(b + 4))),
+                                              _mm_loadu_si128((const __m128i *)(const void *)(b + SN_ELEM_ICHOL + 4)), 1);
+    const __m256 sc = _mm256_castsi256_ps(
+        _mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), _mm256_shuffle_epi8(w, mf)), 23)); /* b[18]: w's byte 14 */
+    c[0] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(v, m0), 16)), sc);
+    c[1] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(v, m1), 16)), sc);
+    c[2] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(w, m0), 16)), sc);
+    return sc;
+}
+#define SN_K_ZZ(p, q) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(p)), _mm_broadcast_ss(q), 1)
 SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
     sn_fv a = FV_SET1(0.0f); /* the reference's l = 0, then l += each block's row sums */
-    uint32_t e;
-    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+    uint32_t e = 0;
+    for (; e + 2 <= nb; e += 2, b += 2 * SN_ELEM_ICHOL) {
+        const sn_acc *z1 = zq + 3 * sn_rd_u16(cols + 2 * e), *z2 = zq + 3 * sn_rd_u16(cols + 2 * e + 2);
+        __m256 c[3], p;
+        (void)sn_k_ic_cols2(b, c);
+        p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(c[0], SN_K_ZZ(z1, z2)), _mm256_mul_ps(c[1], SN_K_ZZ(z1 + 1, z2 + 1))),
+                          _mm256_mul_ps(c[2], SN_K_ZZ(z1 + 2, z2 + 2)));
+        a = FV_ADD(FV_ADD(a, _mm256_castps256_ps128(p)), _mm256_extractf128_ps(p, 1));
+    }
+    for (; e < nb; e++, b += SN_ELEM_ICHOL) {
         const sn_acc *zi = zq + 3 * sn_rd_u16(cols + 2 * e);
         sn_fv c[3];
         sn_k_ic_cols(b, c);
@@ -403,6 +436,7 @@ SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *co
     }
     return a;
 }
+#undef SN_K_ZZ
 #endif
 
 #else
