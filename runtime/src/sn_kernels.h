@@ -191,6 +191,13 @@ SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
     for (; i < n; i++) acc[i] = 0;
 }
 #define SN_K_ZERO 1
+
+/* The mat-vec's mass pass without a mask (sn_solve.c pass_M_ff; as the
+ * M4's above): x86-64 AVX2, the row's sum and acc_j's update as int64
+ * lanes (sn_kernels_avx2.c; exact sums, the same integers). */
+#define SN_K_MASS_FF 1
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

@@ -324,6 +324,28 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
 }
 
+/* acc += M^ y over the free rows (acc zeroed by the caller): row i's sum
+ * M_ii y_i + sum_j M_ij y_j in lanes, acc_j += M_ij y_i (|M| <= 2^23, |y| <=
+ * 2^28: products < 2^51, exact int64 sums in any order) */
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF) {
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const __m256i yi = sn_k_ld3d(y + 3 * i);
+        __m256i l = _mm256_mul_epi32(_mm256_set1_epi32(rd_real(md, i)), yi);
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            __m256i m;
+            if (j >= nF) break; /* skeleton columns come last */
+            m = _mm256_set1_epi32(rd_real(mo, e));
+            l = _mm256_add_epi64(l, _mm256_mul_epi32(m, sn_k_ld3d(y + 3 * j)));
+            sn_k_st3q(acc + 3 * j, _mm256_add_epi64(sn_k_ld3q(acc + 3 * j), _mm256_mul_epi32(m, yi)));
+        }
+        sn_k_st3q(acc + 3 * i, _mm256_add_epi64(sn_k_ld3q(acc + 3 * i), l));
+    }
+}
+
 /* The IC(0) sweeps' rounding (sn_kernels_ic.h sn_k_ic_rnd): row s =
  * [2^62 + 2^(s-1) (0 for s = 0) x4 | 2^(62-s) x4], s = 0..62, so that
  * round(p, s) = ((p + row[0]) >>> s) - row[4] with one folded load each. */

@@ -393,7 +393,7 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
     uint32_t i, nF = v->nF;
     acc_zero(acc, 3 * nF);
 #if defined(SN_K_MASS_FF)
-    if (!mask) { sn_k_mass_ff(rp, cols, md, mo, y, acc, nF); return; } /* the M4's loop (sn_kernels.h) */
+    if (!mask) { sn_k_mass_ff(rp, cols, md, mo, y, acc, nF); return; } /* the M4's and x86-64 AVX2's loops (sn_kernels.h) */
 #endif
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
