@@ -27,6 +27,9 @@ static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (
 static int32_t rnd_in(int32_t lim) { return (int32_t)((int64_t)(rnd32() % (2u * (uint32_t)lim + 1u)) - lim); }
 
 static void put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+#if defined(SN_FLOAT) && defined(SN_K_MASS_FF)
+static uint32_t fbits(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+#endif
 
 #if defined(SN_FLOAT)
 #define REC 1296
@@ -1300,16 +1303,29 @@ static void test_mass_ff(void) {
         const uint32_t nF = 1u + rnd32() % 40u;
         const int wild = t % 8 == 0;
         uint32_t i, e = 0, k;
+#if defined(SN_FLOAT) /* x86-64 AVX2's float pass: values and the blob's float bits */
+        (void)wild;
+        for (i = 0; i < 3 * 48; i++) y[i] = (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 20u)) * (rnd32() % 16u ? 1.0f : -0.0f);
+#else
         for (i = 0; i < 3 * 48; i++) y[i] = wild ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : rnd32() & 1 ? rnd_in(SN_LIM) : (rnd32() & 1 ? SN_LIM : -SN_LIM);
+#endif
         for (i = 0; i < nF; i++) {
             const uint32_t nb = rnd32() % 9u;
             put32(rp + 4 * i, e);
+#if defined(SN_FLOAT)
+            put32(md + 4 * i, fbits((float)rnd_in(1 << 23) / 1024.0f));
+#else
             put32(md + 4 * i, wild ? 0x007FFFFFu : (uint32_t)rnd_in(1 << 23));
+#endif
             for (k = 0; k < nb; k++, e++) {
                 const uint32_t j = rnd32() % 12u == 0 ? nF + rnd32() % 8u : rnd32() % nF;
                 cols[2 * e] = (unsigned char)j;
                 cols[2 * e + 1] = (unsigned char)(j >> 8);
+#if defined(SN_FLOAT)
+                put32(mo + 4 * e, fbits((float)rnd_in(1 << 23) / 1024.0f * (rnd32() % 16u ? 1.0f : -0.0f)));
+#else
                 put32(mo + 4 * e, wild ? 0xFF800000u : (uint32_t)rnd_in(1 << 23));
+#endif
             }
         }
         put32(rp + 4 * nF, e);
@@ -1318,16 +1334,16 @@ static void test_mass_ff(void) {
         for (i = 0; i < nF; i++) {
             uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
             sn_acc l[3];
-            for (k = 0; k < 3; k++) l[k] = sn_mul(sn_rd_i32(md + 4 * i), y[3 * i + k]);
+            for (k = 0; k < 3; k++) l[k] = (sn_acc)0 + sn_mul(rd_real(md, i), y[3 * i + k]); /* pass_M_ff: l = 0, then += */
             for (; b < end; b++) {
                 const uint32_t j = sn_rd_u16(cols + 2 * b);
-                const sn_q m = sn_rd_i32(mo + 4 * b);
+                const sn_q m = rd_real(mo, b);
                 if (j >= nF) { stops++; break; }
                 for (k = 0; k < 3; k++) { l[k] += sn_mul(m, y[3 * j + k]); a2[3 * j + k] += sn_mul(m, y[3 * i + k]); }
             }
             for (k = 0; k < 3; k++) a2[3 * i + k] += l[k];
         }
-        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0;
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0; /* float: bit for bit, signed zeros included */
     }
     T_CHECK(bad == 0, "mass pass (path %s): %d of 500 structures differ from the reference loop", sn_kernels_name(), bad);
     T_FIGURE("mass pass: 500 random row structures, %d rows stopped at a column >= nF", stops);

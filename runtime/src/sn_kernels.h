@@ -198,6 +198,11 @@ SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
 #define SN_K_MASS_FF 1
 void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
                   const sn_q *y, sn_acc *acc, uint32_t nF);
+#elif defined(SN_KERNELS_FAVX2)
+/* the float flavour's (sn_kernels_fsimd.c): pass_M_ff's floats */
+#define SN_K_MASS_FF 1
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

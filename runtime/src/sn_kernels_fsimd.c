@@ -192,6 +192,31 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
 }
 
+#if defined(SN_KERNELS_FAVX2)
+/* The mat-vec's mass pass without a mask (sn_solve.c pass_M_ff; x86-64
+ * round 2): acc += M^ y over the free rows, lanes the 3 components, each
+ * lane's sums in pass_M_ff's order: l = 0 + M_ii y_i, l += M_ij y_j, then
+ * acc_i += l; acc_j += M_ij y_i as the row reaches j. The same floats. */
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF) {
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const sn_fv yi = fv_ld3(y + 3 * i);
+        sn_fv l = FV_ADD(FV_SET1(0.0f), FV_MUL(FV_SET1(rd_real(md, i)), yi));
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            sn_fv m;
+            if (j >= nF) break; /* skeleton columns come last */
+            m = FV_SET1(rd_real(mo, e));
+            l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
+            fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
+        }
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), l));
+    }
+}
+#endif
+
 #if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)
 const char *sn_kernels_name(void) { return "avx512"; }
 #elif defined(SN_KERNELS_FAVX2)
