@@ -323,9 +323,13 @@ SN_INLINE float sn_k_ic_scale(const unsigned char *b) {
     return s;
 }
 #if defined(SN_KERNELS_FAVX2)
+/* 2^-frac, frac = 0..SN_ICHOL_FRAC_MAX (sn_kernels_fsimd.c): one broadcast
+ * load instead of forming the float's bits per block (x86-64 round 2) */
+extern const float sn_k_ic_p2[63]; /* frac 0..62 */
+#define SN_K_IC_S(b) _mm_broadcast_ss(&sn_k_ic_p2[(b)[18]])
 #define SN_K_IC_F(v) _mm_cvtepi32_ps(_mm_cvtepi16_epi32(v))
 SN_INLINE void sn_k_ic_rows(const unsigned char *b, sn_fv r[3]) {
-    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    const sn_fv s = SN_K_IC_S(b);
     r[0] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)b)), s);
     r[1] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 6))), s);
     r[2] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 12))), s);
@@ -335,7 +339,7 @@ SN_INLINE void sn_k_ic_cols(const unsigned char *b, sn_fv c[3]) {
     const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
     const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
-    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    const sn_fv s = SN_K_IC_S(b);
     c[0] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh0)), s);
     c[1] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh1)), s);
     c[2] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(w, sh0)), s);
