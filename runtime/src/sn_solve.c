@@ -186,12 +186,13 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         fr = (uint32_t)(a0 < nF);
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
+#if defined(SN_K_CORNER) /* x86-64 AVX2: the steps below in registers (sn_kernels_rot.h) */
             sn_q wa[3];
             fr |= (uint32_t)(a < nF) << k;
-#if defined(SN_K_CORNER) /* x86-64 AVX2: the steps below in registers (sn_kernels_rot.h) */
             sn_k_corner(&rm, pos + 3 * a, pos + 3 * a0, w_of(h, w, vel, a, wa), w0, rest, 3 * a, 3 * a0, d + 3 * k, uu + 3 * k, sat);
 #else
-            sn_q t[3], s[3], l[3], xr[3];
+            sn_q t[3], s[3], l[3], wa[3], xr[3];
+            fr |= (uint32_t)(a < nF) << k;
             sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
             sn_k_sub3(w_of(h, w, vel, a, wa), w0, s, sat);
             sn_k_rot_t(R, t, l, sat);
