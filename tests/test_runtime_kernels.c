@@ -27,6 +27,9 @@ static uint32_t rnd32(void) { rng = rng * 1664525u + 1013904223u; return rng ^ (
 static int32_t rnd_in(int32_t lim) { return (int32_t)((int64_t)(rnd32() % (2u * (uint32_t)lim + 1u)) - lim); }
 
 static void put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+#if defined(SN_FLOAT) && defined(SN_K_MASS_FF)
+static uint32_t fbits(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+#endif
 
 #if defined(SN_FLOAT)
 #define REC 1296
@@ -1139,6 +1142,181 @@ static void test_ic_fwd(void) {
 }
 #endif
 
+#if defined(SN_K_IC_FWD_RUN)
+/* x86-64's forward-sweep column (sn_k_ic_fwd_run) against ic_forward's
+ * loop on the portable reference (sn_k_ic_col_ref per block, stopping at
+ * the first row >= nF) and, per block, a double reference of the rounded
+ * row (exact below 2^53): random columns of 0..12 blocks, rows sometimes
+ * past nF, vertex exponents 0..15 and fracs 0..47 (shifts -15..62: the
+ * scale-up below 0, the table's ends 0 and 62), y at the state bound and
+ * INT32_MIN/MAX; accumulators, clamp count and blocks read must match. */
+static void test_ic_fwd_run(void) {
+    static unsigned char L[12 * 20], cols[24];
+    static sn_acc a1[90], a2[90];
+    static double a3[90];
+    int t, bad = 0, bad_d = 0, lo = 0, hi = 0, neg = 0, stops = 0;
+    for (t = 0; t < 6000; t++) {
+        sn_q y[3];
+        uint8_t kk[30];
+        const uint32_t nF = 20u + rnd32() % 10u, nb = rnd32() % 13u;
+        const int kj = (int)(rnd32() % 16u), wild = t % 8 == 0;
+        uint32_t e, k, n1, n2 = 0, s1 = 0, s2 = 0;
+        for (k = 0; k < 3; k++)
+            y[k] = wild ? (t % 16 == 0 ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : (rnd32() & 1 ? SN_LIM : -SN_LIM)) : rnd_in(SN_LIM);
+        for (k = 0; k < 30; k++) kk[k] = (uint8_t)(rnd32() % 16u);
+        for (k = 0; k < 90; k++) a3[k] = (double)(a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12);
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            const uint32_t row = rnd32() % 16u == 0 ? nF + rnd32() % 3u : rnd32() % nF;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 4u == 0 ? (rnd32() & 1 ? 47u : 0u) : rnd32() % 48u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)row;
+            cols[2 * e + 1] = 0;
+        }
+        n1 = sn_k_ic_fwd_run(L, cols, cols + 2 * nb, y, kj, kk, nF, a1, &s1);
+        for (e = 0; e < nb; e++) {
+            const uint32_t i = cols[2 * e];
+            const unsigned char *b = L + 20 * e;
+            int s, c, r;
+            if (i >= nF) { stops++; break; }
+            s = (int)b[18] + kj - (int)kk[i];
+            lo += s == 0;
+            hi += s == 62;
+            neg += s < 0;
+            sn_k_ic_col_ref(b, y, s, a2 + 3 * i, &s2);
+            for (c = 0; c < 3; c++) { /* round half up (s >= 0), or scaled up and clamped */
+                double p = 0;
+                for (r = 0; r < 3; r++) p += (double)(int16_t)(uint16_t)(b[6 * r + 2 * c] | b[6 * r + 2 * c + 1] << 8) * (double)y[r];
+                p = s >= 0 ? floor(ldexp(p, -s) + (s > 0 ? 0.5 : 0.0)) : ldexp(p, -s);
+                a3[3 * i + (uint32_t)c] += p > SN_LIM && s < 0 ? SN_LIM : p < -SN_LIM && s < 0 ? -SN_LIM : p;
+            }
+            n2++;
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2 || n1 != n2;
+        for (k = 0; k < 90; k++) bad_d += (double)a1[k] != a3[k];
+    }
+    T_CHECK(bad == 0, "IC(0) forward columns (path %s): %d of 6000 columns differ from the reference loop", sn_kernels_name(), bad);
+    T_CHECK(bad_d == 0, "IC(0) forward columns (path %s): %d accumulators off the double reference", sn_kernels_name(), bad_d);
+    T_FIGURE("IC(0) forward columns (x86): 6000 columns of 0..12 blocks, %d blocks at shift 0, %d at 62, %d below 0, %d stopped at a row >= nF",
+             lo, hi, neg, stops);
+}
+#endif
+
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+/* x86-64's fused IC(0) sweep loops (sn_precond.c ic_fused) against the
+ * reference per block (sn_k_ic_col_ref / sn_k_ic_row_ref, the portable
+ * loops' order): the backward row with z read from the accumulators
+ * (fixed: sn_k_ic_bwd_rowq, int64 z_i; float: sn_k_ic_bwd_rowv, two
+ * blocks a step and the odd one) over 0..13 blocks with fracs 0..47 (the
+ * float scale's range), and the float forward column (sn_k_ic_fwd_ops;
+ * fixed: test_ic_fwd_run). Exact: the same integers / floats. */
+static void test_ic_fused(void) {
+    static unsigned char L[13 * 20], cols[26];
+    static sn_acc zq[90], a1[90], a2[90];
+    int t, bad_r = 0, bad_c = 0;
+    for (t = 0; t < 4000; t++) {
+        const uint32_t nb = rnd32() % 14u, nF = 24u;
+        uint32_t e, k;
+        sn_q y[3], z[90];
+        sn_acc lr[4] = {0, 0, 0, 0}, lv[4];
+        uint32_t s1 = 0;
+        const int wild = t % 8 == 0;
+        for (k = 0; k < 90; k++) {
+#if defined(SN_FLOAT)
+            z[k] = (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 24u));
+#else
+            z[k] = wild ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+#endif
+            zq[k] = (sn_acc)z[k];
+#if defined(SN_FLOAT)
+            a1[k] = a2[k] = (float)rnd_in(1 << 20) / 64.0f;
+#else
+            a1[k] = a2[k] = (int64_t)rnd_in(1 << 30) << 12;
+#endif
+        }
+        for (e = 0; e < nb; e++) {
+            unsigned char *b = L + 20 * e;
+            for (k = 0; k < 9; k++) {
+                const int32_t m = wild ? (rnd32() & 1 ? 32767 : -32767) : rnd_in(32767);
+                const uint16_t u = (uint16_t)(m < 0 ? m + 65536 : m);
+                b[2 * k] = (unsigned char)u;
+                b[2 * k + 1] = (unsigned char)(u >> 8);
+            }
+            b[18] = (unsigned char)(rnd32() % 4u == 0 ? (rnd32() & 1 ? 47u : 0u) : rnd32() % 48u);
+            b[19] = 0;
+            cols[2 * e] = (unsigned char)(rnd32() % (nF + 3u)); /* rows past nF: the forward column stops there */
+            cols[2 * e + 1] = 0;
+        }
+        for (e = 0; e < nb; e++) sn_k_ic_row_ref(L + 20 * e, z + 3 * (cols[2 * e] % 30u), lr, &s1);
+        for (e = 0; e < nb; e++) cols[2 * e] = (unsigned char)(cols[2 * e] % 30u);
+#if defined(SN_FLOAT)
+        {
+            const sn_fv r = sn_k_ic_bwd_rowv(L, cols, nb, zq);
+            FV_ST4(lv, r);
+        }
+#else
+        _mm256_storeu_si256((__m256i *)(void *)lv, sn_k_ic_bwd_rowq(L, cols, nb, zq));
+#endif
+        bad_r += memcmp(lv, lr, 3 * sizeof lv[0]) != 0;
+#if defined(SN_FLOAT)
+        {
+            uint32_t n1, n2 = 0;
+            for (k = 0; k < 3; k++) y[k] = z[k];
+            n1 = sn_k_ic_fwd_ops(L, cols, cols + 2 * nb, FV_SET1(y[0]), FV_SET1(y[1]), FV_SET1(y[2]), nF, a1);
+            for (e = 0; e < nb && cols[2 * e] < nF; e++, n2++) sn_k_ic_col_ref(L + 20 * e, y, 0, a2 + 3 * cols[2 * e], &s1);
+            bad_c += memcmp(a1, a2, sizeof a1) != 0 || n1 != n2;
+        }
+#else
+        (void)y; (void)a1; (void)a2;
+#endif
+    }
+    T_CHECK(bad_r == 0, "fused IC(0) backward rows (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_r);
+    T_CHECK(bad_c == 0, "fused IC(0) forward columns (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_c);
+}
+#endif
+
+#if defined(SN_K_ENERGY24)
+/* x86-64's cell energy sum (sn_k_energy24) against the reference loop,
+ * sum over k = 3..23 of sn_mul(d[k], sn_out(l[k], s)) (sn_internal.h):
+ * d at and inside +-2^28, l up to +-2^62 (clamps on both sides; float:
+ * also +-inf and NaN), shifts -3..61; the value (fixed: the int64; float:
+ * the reference order's float) and the clamp count must match. */
+static void test_energy24(void) {
+    int t, bad = 0, clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        sn_q d[24];
+        sn_acc l[24], ref = 0, got;
+        uint32_t k, s1 = 0, s2 = 0;
+        const int s = (int)(rnd32() % 65u) - 3;
+        for (k = 0; k < 24; k++) {
+            d[k] = t % 8 == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+#if defined(SN_FLOAT)
+            d[k] = (float)rnd_in(1 << 20) / 1024.0f;
+            l[k] = (float)rnd_in(1 << 24) / 2048.0f; /* +-8192: about a quarter beyond SN_FLIM */
+            if (t % 16 == 1 && rnd32() % 4u == 0) { /* sn_out's other float cases: +-inf, NaN */
+                const uint32_t u = rnd32() % 3u;
+                l[k] = u == 0 ? (sn_acc)HUGE_VAL : u == 1 ? (sn_acc)-HUGE_VAL : (sn_acc)NAN;
+            }
+#else
+            l[k] = (int64_t)rnd_in(1 << 30) * ((int64_t)1 << (rnd32() % 33u));
+#endif
+        }
+        for (k = 3; k < 24; k++) ref += sn_mul(d[k], sn_out(l[k], s, &s2));
+        got = sn_k_energy24(d, l, s, &s1);
+        clamps += (int)s2;
+        bad += got != ref || s1 != s2;
+    }
+    T_CHECK(bad == 0, "cell energy sum (path %s): %d of 4000 cells differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("cell energy sums: 4000 cells, shifts -3..61, %d clamped terms", clamps);
+}
+#endif
+
 #if defined(SN_K_MASS_FF)
 /* The M4's mass pass (sn_k_mass_ff) against pass_M_ff's loop written here
  * with sn_mul (exact int64 sums: tolerance 0): random row structures of
@@ -1154,16 +1332,29 @@ static void test_mass_ff(void) {
         const uint32_t nF = 1u + rnd32() % 40u;
         const int wild = t % 8 == 0;
         uint32_t i, e = 0, k;
+#if defined(SN_FLOAT) /* x86-64 AVX2's float pass: values and the blob's float bits */
+        (void)wild;
+        for (i = 0; i < 3 * 48; i++) y[i] = (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 20u)) * (rnd32() % 16u ? 1.0f : -0.0f);
+#else
         for (i = 0; i < 3 * 48; i++) y[i] = wild ? (rnd32() & 1 ? INT32_MAX : INT32_MIN) : rnd32() & 1 ? rnd_in(SN_LIM) : (rnd32() & 1 ? SN_LIM : -SN_LIM);
+#endif
         for (i = 0; i < nF; i++) {
             const uint32_t nb = rnd32() % 9u;
             put32(rp + 4 * i, e);
+#if defined(SN_FLOAT)
+            put32(md + 4 * i, fbits((float)rnd_in(1 << 23) / 1024.0f));
+#else
             put32(md + 4 * i, wild ? 0x007FFFFFu : (uint32_t)rnd_in(1 << 23));
+#endif
             for (k = 0; k < nb; k++, e++) {
                 const uint32_t j = rnd32() % 12u == 0 ? nF + rnd32() % 8u : rnd32() % nF;
                 cols[2 * e] = (unsigned char)j;
                 cols[2 * e + 1] = (unsigned char)(j >> 8);
+#if defined(SN_FLOAT)
+                put32(mo + 4 * e, fbits((float)rnd_in(1 << 23) / 1024.0f * (rnd32() % 16u ? 1.0f : -0.0f)));
+#else
                 put32(mo + 4 * e, wild ? 0xFF800000u : (uint32_t)rnd_in(1 << 23));
+#endif
             }
         }
         put32(rp + 4 * nF, e);
@@ -1172,16 +1363,16 @@ static void test_mass_ff(void) {
         for (i = 0; i < nF; i++) {
             uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
             sn_acc l[3];
-            for (k = 0; k < 3; k++) l[k] = sn_mul(sn_rd_i32(md + 4 * i), y[3 * i + k]);
+            for (k = 0; k < 3; k++) l[k] = (sn_acc)0 + sn_mul(rd_real(md, i), y[3 * i + k]); /* pass_M_ff: l = 0, then += */
             for (; b < end; b++) {
                 const uint32_t j = sn_rd_u16(cols + 2 * b);
-                const sn_q m = sn_rd_i32(mo + 4 * b);
+                const sn_q m = rd_real(mo, b);
                 if (j >= nF) { stops++; break; }
                 for (k = 0; k < 3; k++) { l[k] += sn_mul(m, y[3 * j + k]); a2[3 * j + k] += sn_mul(m, y[3 * i + k]); }
             }
             for (k = 0; k < 3; k++) a2[3 * i + k] += l[k];
         }
-        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0;
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0; /* float: bit for bit, signed zeros included */
     }
     T_CHECK(bad == 0, "mass pass (path %s): %d of 500 structures differ from the reference loop", sn_kernels_name(), bad);
     T_FIGURE("mass pass: 500 random row structures, %d rows stopped at a column >= nF", stops);
@@ -1550,6 +1741,15 @@ int main(void) {
     test_ic_rows();
 #if defined(SN_K_IC_FWD_COL)
     test_ic_fwd();
+#endif
+#if defined(SN_K_IC_FWD_RUN)
+    test_ic_fwd_run();
+#endif
+#if defined(SN_K_ENERGY24)
+    test_energy24();
+#endif
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+    test_ic_fused();
 #endif
 #if !defined(SN_FLOAT)
     test_out_edges();

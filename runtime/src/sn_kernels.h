@@ -181,7 +181,9 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * columns, after sn_k_mass_ff did the free ones with y = a1 v: acc_i +=
  * M_ij sn_add(coef(vel_j, a1), ds_{j-nF}) over row i's blocks with j >= nF,
  * y formed per block (the reference's values and clamp counts); requires
- * |a1| <= ONE_COEF (sn_rhs's pre). */
+ * |a1| <= ONE_COEF (sn_rhs's pre). Cortex-M4 only: sn_rhs takes the
+ * sn_k_mass_ff route where both exist. */
+#define SN_K_MASS_SK 1
 void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
                   const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat);
 /* cell_forces' corners 1..7 (sn_solve.c): for k = 1..7, a = cl[k], a0 =
@@ -192,6 +194,33 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
 #define SN_K_CORNERS 1
 uint32_t sn_k_corners(const unsigned char *cl, const sn_q *pos, const sn_q *w, const sn_q *vel, uint32_t nF, sn_q b1,
                       const unsigned char *rest, const sn_q *R, const sn_q *w0, sn_q *d, sn_q *uu, uint32_t *sat);
+#endif
+
+#if defined(SN_KERNELS_AVX2)
+#include <immintrin.h>
+/* acc[0..n) = 0 by 32-byte stores (fixed; the float's 1.5 KB stay below
+ * glibc's REP STOSB threshold). GCC made the plain loop a call of
+ * glibc's memset, which runs REP STOSB above 2 KB (a fixed cow's 3 nF
+ * accumulators: 3 KB): callgrind counts each byte an instruction, and the
+ * call costs more than the ~100 stores in hardware. */
+SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
+    uint32_t i = 0;
+    for (; i + 4 <= n; i += 4) _mm256_storeu_si256((__m256i *)(void *)(acc + i), _mm256_setzero_si256());
+    for (; i < n; i++) acc[i] = 0;
+}
+#define SN_K_ZERO 1
+
+/* The mat-vec's mass pass without a mask (sn_solve.c pass_M_ff; as the
+ * M4's above): x86-64 AVX2, the row's sum and acc_j's update as int64
+ * lanes (sn_kernels_avx2.c; exact sums, the same integers). */
+#define SN_K_MASS_FF 1
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF);
+#elif defined(SN_KERNELS_FAVX2)
+/* the float flavour's (sn_kernels_fsimd.c): pass_M_ff's floats */
+#define SN_K_MASS_FF 1
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

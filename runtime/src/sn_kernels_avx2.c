@@ -11,6 +11,7 @@
  * order: exact, bounded (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
+#include "sn_kernels_ic.h" /* sn_k_ic_rtab */
 
 #if defined(SN_KERNELS_AVX2)
 #include <immintrin.h>
@@ -322,6 +323,41 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     *sat += c;
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
 }
+
+/* acc += M^ y over the free rows (acc zeroed by the caller): row i's sum
+ * M_ii y_i + sum_j M_ij y_j in lanes, acc_j += M_ij y_i (|M| <= 2^23, |y| <=
+ * 2^28: products < 2^51, exact int64 sums in any order) */
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF) {
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const __m256i yi = sn_k_ld3d(y + 3 * i);
+        __m256i l = _mm256_mul_epi32(_mm256_set1_epi32(rd_real(md, i)), yi);
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            __m256i m;
+            if (j >= nF) break; /* skeleton columns come last */
+            m = _mm256_set1_epi32(rd_real(mo, e));
+            l = _mm256_add_epi64(l, _mm256_mul_epi32(m, sn_k_ld3d(y + 3 * j)));
+            sn_k_st3q(acc + 3 * j, _mm256_add_epi64(sn_k_ld3q(acc + 3 * j), _mm256_mul_epi32(m, yi)));
+        }
+        sn_k_st3q(acc + 3 * i, _mm256_add_epi64(sn_k_ld3q(acc + 3 * i), l));
+    }
+}
+
+/* The IC(0) sweeps' rounding (sn_kernels_ic.h sn_k_ic_rnd): row s =
+ * [2^62 + 2^(s-1) (0 for s = 0) x4 | 2^(62-s) x4], s = 0..62, so that
+ * round(p, s) = ((p + row[0]) >>> s) - row[4] with one folded load each. */
+#define RT_B(s) (((int64_t)1 << 62) + ((s) > 0 ? (int64_t)1 << ((s) > 0 ? (s) - 1 : 0) : 0))
+#define RT_ROW(s) {RT_B(s), RT_B(s), RT_B(s), RT_B(s), ((int64_t)1 << 62) >> (s), ((int64_t)1 << 62) >> (s), \
+                   ((int64_t)1 << 62) >> (s), ((int64_t)1 << 62) >> (s)}
+#define RT_8(s) RT_ROW(s), RT_ROW(s + 1), RT_ROW(s + 2), RT_ROW(s + 3), RT_ROW(s + 4), RT_ROW(s + 5), RT_ROW(s + 6), RT_ROW(s + 7)
+const int64_t sn_k_ic_rtab[SN_K_IC_RT_N][8] = {RT_8(0), RT_8(8), RT_8(16), RT_8(24), RT_8(32), RT_8(40), RT_8(48),
+                                                RT_ROW(56), RT_ROW(57), RT_ROW(58), RT_ROW(59), RT_ROW(60), RT_ROW(61), RT_ROW(62)};
+#undef RT_8
+#undef RT_ROW
+#undef RT_B
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 const char *sn_kernels_name(void) { return "avx512"; }

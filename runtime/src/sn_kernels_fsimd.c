@@ -192,6 +192,42 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
     for (; i < n; i++) out[i] = sn_add(a[i], sn_mulq(s, x[i], sh, sat), sat);
 }
 
+#if defined(SN_KERNELS_FAVX2)
+/* 2^-frac for the IC(0) blocks' decode (sn_kernels_ic.h SN_K_IC_S), exact;
+ * frac <= SN_ICHOL_FRAC_MAX = 47 in a valid blob, the table to 62 (the
+ * kernel test's fracs) */
+const float sn_k_ic_p2[63] = {
+    0x1p-0f,  0x1p-1f,  0x1p-2f,  0x1p-3f,  0x1p-4f,  0x1p-5f,  0x1p-6f,  0x1p-7f,  0x1p-8f,  0x1p-9f,  0x1p-10f, 0x1p-11f,
+    0x1p-12f, 0x1p-13f, 0x1p-14f, 0x1p-15f, 0x1p-16f, 0x1p-17f, 0x1p-18f, 0x1p-19f, 0x1p-20f, 0x1p-21f, 0x1p-22f, 0x1p-23f,
+    0x1p-24f, 0x1p-25f, 0x1p-26f, 0x1p-27f, 0x1p-28f, 0x1p-29f, 0x1p-30f, 0x1p-31f, 0x1p-32f, 0x1p-33f, 0x1p-34f, 0x1p-35f,
+    0x1p-36f, 0x1p-37f, 0x1p-38f, 0x1p-39f, 0x1p-40f, 0x1p-41f, 0x1p-42f, 0x1p-43f, 0x1p-44f, 0x1p-45f, 0x1p-46f, 0x1p-47f,
+    0x1p-48f, 0x1p-49f, 0x1p-50f, 0x1p-51f, 0x1p-52f, 0x1p-53f, 0x1p-54f, 0x1p-55f, 0x1p-56f, 0x1p-57f, 0x1p-58f, 0x1p-59f,
+    0x1p-60f, 0x1p-61f, 0x1p-62f};
+
+/* The mat-vec's mass pass without a mask (sn_solve.c pass_M_ff; x86-64
+ * round 2): acc += M^ y over the free rows, lanes the 3 components, each
+ * lane's sums in pass_M_ff's order: l = 0 + M_ii y_i, l += M_ij y_j, then
+ * acc_i += l; acc_j += M_ij y_i as the row reaches j. The same floats. */
+void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                  const sn_q *y, sn_acc *acc, uint32_t nF) {
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const sn_fv yi = fv_ld3(y + 3 * i);
+        sn_fv l = FV_ADD(FV_SET1(0.0f), FV_MUL(FV_SET1(rd_real(md, i)), yi));
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            sn_fv m;
+            if (j >= nF) break; /* skeleton columns come last */
+            m = FV_SET1(rd_real(mo, e));
+            l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
+            fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
+        }
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), l));
+    }
+}
+#endif
+
 #if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)
 const char *sn_kernels_name(void) { return "avx512"; }
 #elif defined(SN_KERNELS_FAVX2)

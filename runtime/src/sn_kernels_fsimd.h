@@ -72,8 +72,14 @@ SN_INLINE void fv_blk(const void *B, sn_fv r[3], sn_fv c[3]) {
  * -SN_FLIM, NaN -> +0; the bad lanes' mask in *m */
 SN_INLINE sn_fv fv_clamp(sn_fv a, int *m) {
     const sn_fv lim = _mm_set1_ps(SN_FLIM), nlim = _mm_set1_ps(-SN_FLIM);
-    const sn_fv hi = _mm_cmpgt_ps(a, lim), lo = _mm_cmplt_ps(a, nlim), nan = _mm_cmpunord_ps(a, a);
-    *m = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(hi, lo), nan));
+    sn_fv hi, lo, nan;
+    /* the common case first (x86-64 round 2): |a| <= SN_FLIM in every lane,
+     * NaN excluded (one unordered-or-greater compare): a, mask 0 */
+    *m = _mm_movemask_ps(_mm_cmp_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), a), lim, _CMP_NLE_UQ));
+    if (!*m) return a;
+    hi = _mm_cmpgt_ps(a, lim);
+    lo = _mm_cmplt_ps(a, nlim);
+    nan = _mm_cmpunord_ps(a, a);
     return _mm_andnot_ps(nan, _mm_blendv_ps(_mm_blendv_ps(a, lim, hi), nlim, lo));
 }
 #elif defined(SN_KERNELS_FNEON)
@@ -124,6 +130,14 @@ SN_INLINE sn_fv fv_clamp(sn_fv a, int *m) {
 /* lanes 0..2 through sn_out (clamp, count) */
 SN_INLINE sn_fv fv_out3(sn_fv a, uint32_t *sat) {
     int m;
+#if defined(SN_KERNELS_FAVX2)
+    /* x86-64 round 2: the common case first, lanes 0..2 finite and within
+     * +-SN_FLIM (|a| by the sign mask, one unordered-or-greater compare):
+     * a unchanged, as fv_clamp leaves it (lane 3: junk either way, never
+     * stored, counted or read) */
+    m = _mm_movemask_ps(_mm_cmp_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), a), _mm_set1_ps(SN_FLIM), _CMP_NLE_UQ));
+    if (!(m & 7)) return a;
+#endif
     a = fv_clamp(a, &m);
     if (m) *sat += (uint32_t)(0x32212110u >> (4 * (m & 7)) & 15u); /* clamps are rare: a branch, then lanes 0..2's count */
     return a;

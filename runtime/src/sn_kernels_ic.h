@@ -83,51 +83,111 @@ SN_INLINE void sn_k_ic_row_ref(const unsigned char *b, const sn_q z[3], sn_acc l
 /* 4 int64 lanes (the 4th unused). Round half up for 0 <= s <= 62 without an
  * arithmetic 64-bit shift (AVX2 has none): with B = 2^62, p + 2^(s-1) + B
  * is >= 0 and < 2^63 (|p| < 2^44.6), so its logical shift is the floor, and
- * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s). */
-#if defined(__AVX512F__) && defined(__AVX512VL__)
-/* AVX-512VL has the 64-bit arithmetic shift (VPSRAQ): p + 2^(s-1) (1 << s
- * >> 1: 0 for s = 0), shifted by s, the same floor (no overflow: |p| < 2^44.6) */
+ * B >> s is exact (s <= 62): floor((x + B) / 2^s) - B / 2^s = floor(x / 2^s).
+ * The two constants per s come from a table (sn_kernels_avx2.c: row s =
+ * [2^62 + 2^(s-1) x4 | 2^(62-s) x4]), one folded load each: the sweeps
+ * round every block at its own s, and building them cost ~10 instructions. */
+#define SN_K_IC_RT_N 63 /* s = 0..62: the forward shift's range (SN_ICHOL_FRAC_MAX + 15) */
+extern const int64_t sn_k_ic_rtab[SN_K_IC_RT_N][8];
 SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
-    const __m128i c = _mm_cvtsi32_si128(s);
-    const __m256i half = _mm256_srli_epi64(_mm256_sll_epi64(_mm256_set1_epi64x(1), c), 1);
-    return _mm256_sra_epi64(_mm256_add_epi64(p, half), c);
+    const int64_t *t = sn_k_ic_rtab[s];
+    return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_loadu_si256((const __m256i *)(const void *)t)),
+                                             _mm_cvtsi32_si128(s)),
+                            _mm256_loadu_si256((const __m256i *)(const void *)(t + 4)));
 }
-#else
-SN_INLINE __m256i sn_k_ic_rshr(__m256i p, int s) {
-    const int64_t bias = ((int64_t)1 << 62) + (s > 0 ? (int64_t)1 << (s - 1) : 0);
-    return _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(p, _mm256_set1_epi64x(bias)), _mm_cvtsi32_si128(s)),
-                            _mm256_set1_epi64x(((int64_t)1 << 62) >> s));
-}
-#endif
 #define SN_K_IC_W(p) _mm256_cvtepi16_epi64(_mm_loadl_epi64((const __m128i *)(const void *)(p)))
-
-/* columns of U as lanes: U0..U3, U3..U6, U6..U9 (8-byte loads, inside the
- * 20-byte block); lane c = sum_r U[3r+c] y[r]. s < 0 (scale-up and clamp,
- * a rare blob): the reference. */
-SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
-    __m256i p;
-    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
-    p = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), _mm256_set1_epi64x(y[0])),
-                                          _mm256_mul_epi32(SN_K_IC_W(b + 6), _mm256_set1_epi64x(y[1]))),
-                         _mm256_mul_epi32(SN_K_IC_W(b + 12), _mm256_set1_epi64x(y[2])));
-    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(p, s))); /* sn_kernels_rot.h: no masked moves */
+/* U^T y in lanes 0..2 (lane 3 junk): columns of U as lanes, U0..U3, U3..U6,
+ * U6..U9 (8-byte loads, inside the 20-byte block); y as VPMULDQ operands
+ * (the even int32 slots: y[c] in every slot) */
+SN_INLINE __m256i sn_k_ic_colp(const unsigned char *b, __m256i y0, __m256i y1, __m256i y2) {
+    return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(SN_K_IC_W(b), y0), _mm256_mul_epi32(SN_K_IC_W(b + 6), y1)),
+                            _mm256_mul_epi32(SN_K_IC_W(b + 12), y2));
 }
-
-/* rows of U as lanes: (U0,U3,U6) (U1,U4,U7) from bytes 0..15, (U2,U5,U8)
- * from bytes 4..19 by the same byte shuffle; frac = b[18] >= 0. */
-SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
-    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, 0, 1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
+/* U z in lanes 0..2 (lane 3: 0): rows of U as lanes, (U0,U3,U6) (U1,U4,U7) from bytes
+ * 0..15, (U2,U5,U8) from bytes 4..19 by the same byte shuffle */
+SN_INLINE __m256i sn_k_ic_rowp(const unsigned char *b, __m256i z0, __m256i z1, __m256i z2) {
+    const __m128i sh0 = _mm_setr_epi8(0, 1, 6, 7, 12, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1); /* lane 3: 0 */
+    const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
     const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
-    __m256i p;
+    return _mm256_add_epi64(
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh0)), z0),
+                         _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh1)), z1)),
+        _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(w, sh0)), z2));
+}
+
+/* s < 0 (scale-up and clamp, a rare blob): the reference. */
+SN_INLINE void sn_k_ic_col(const unsigned char *b, const sn_q y[3], int s, sn_acc a[3], uint32_t *sat) {
+    if (s < 0) { sn_k_ic_col_ref(b, y, s, a, sat); return; }
+    sn_k_st3q(a, _mm256_add_epi64(sn_k_ld3q(a), sn_k_ic_rshr(sn_k_ic_colp(b, _mm256_set1_epi32(y[0]), _mm256_set1_epi32(y[1]),
+                                                                           _mm256_set1_epi32(y[2])), s))); /* no masked moves */
+}
+/* frac = b[18] >= 0 */
+SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4], uint32_t *sat) {
     (void)sat;
-    p = _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh0)), _mm256_set1_epi64x(z[0])),
-                         _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(v, sh1)), _mm256_set1_epi64x(z[1]))),
-        _mm256_mul_epi32(_mm256_cvtepi16_epi64(_mm_shuffle_epi8(w, sh0)), _mm256_set1_epi64x(z[2])));
-    p = _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)(const void *)l), sn_k_ic_rshr(p, b[18]));
-    _mm256_storeu_si256((__m256i *)(void *)l, p);
+    _mm256_storeu_si256((__m256i *)(void *)l,
+                        _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)(const void *)l),
+                                         sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi32(z[0]), _mm256_set1_epi32(z[1]),
+                                                                   _mm256_set1_epi32(z[2])), b[18])));
+}
+
+/* The sweeps' loops (sn_precond.c ic_forward / ic_backward), x86-64 round
+ * 2: y_j's operands built once per column, the row's sum kept in a
+ * register; the same integers as the per-block calls above. */
+/* ic_forward's column j: acc_i += round(U_ji^T y_j, frac + k_j - k_i) over
+ * the blocks at blk, their row indices at cols < cend, up to the first
+ * i >= nF; returns the blocks read. */
+#define SN_K_IC_FWD_RUN 1
+/* y0..y2: y's entries as VPMULDQ operands. Always inlined: GCC kept it a
+ * call from sn_precond.c's fused sweep (~40 instructions a vertex). */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend, __m256i y0,
+                                   __m256i y1, __m256i y2, const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc,
+                                   uint32_t *sat) {
+    const unsigned char *c = cols;
+    for (; c < cend; c += 2, blk += SN_ELEM_ICHOL) {
+        const uint32_t i = sn_rd_u16(c);
+        int s;
+        if (i >= nF) break; /* skeleton columns: not in ICHOL */
+        s = (int)blk[18] + kj - (int)kk[i];
+        if (s < 0) sn_k_ic_col_ref(blk, y, s, acc + 3 * i, sat);
+        else sn_k_st3q(acc + 3 * i, _mm256_add_epi64(sn_k_ld3q(acc + 3 * i), sn_k_ic_rshr(sn_k_ic_colp(blk, y0, y1, y2), s)));
+    }
+    return (uint32_t)(c - cols) / 2u;
+}
+SN_INLINE uint32_t sn_k_ic_fwd_run(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend,
+                                   const sn_q y[3], int kj, const uint8_t *kk, uint32_t nF, sn_acc *acc, uint32_t *sat) {
+    return sn_k_ic_fwd_ops(blk, cols, cend, _mm256_set1_epi32(y[0]), _mm256_set1_epi32(y[1]), _mm256_set1_epi32(y[2]), y, kj,
+                           kk, nF, acc, sat);
+}
+/* ic_backward's row: l = sum of round(U_e z_cols[e], frac_e) over nb blocks
+ * (l[3] scratch) */
+#define SN_K_IC_BWD_ROW 1
+SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
+                               uint32_t *sat) {
+    __m256i a = _mm256_setzero_si256();
+    uint32_t e;
+    (void)sat;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_q *zi = z + 3 * sn_rd_u16(cols + 2 * e);
+        a = _mm256_add_epi64(a, sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi32(zi[0]), _mm256_set1_epi32(zi[1]),
+                                                          _mm256_set1_epi32(zi[2])), b[18]));
+    }
+    _mm256_storeu_si256((__m256i *)(void *)l, a);
+}
+/* the same sum as lanes (lane 3: 0), z_i read as the int64 zq[3 i..3 i+2]
+ * (|z_i| <= SN_LIM: VPMULDQ's low halves are the values) */
+SN_INLINE __m256i sn_k_ic_bwd_rowq(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
+    __m256i a = _mm256_setzero_si256();
+    uint32_t e;
+    for (e = 0; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_acc *zi = zq + 3 * sn_rd_u16(cols + 2 * e);
+        a = _mm256_add_epi64(a, sn_k_ic_rshr(sn_k_ic_rowp(b, _mm256_set1_epi64x(zi[0]), _mm256_set1_epi64x(zi[1]),
+                                                          _mm256_set1_epi64x(zi[2])), b[18]));
+    }
+    return a;
 }
 #undef SN_K_IC_W
 
@@ -263,9 +323,13 @@ SN_INLINE float sn_k_ic_scale(const unsigned char *b) {
     return s;
 }
 #if defined(SN_KERNELS_FAVX2)
+/* 2^-frac, frac = 0..SN_ICHOL_FRAC_MAX (sn_kernels_fsimd.c): one broadcast
+ * load instead of forming the float's bits per block (x86-64 round 2) */
+extern const float sn_k_ic_p2[63]; /* frac 0..62 */
+#define SN_K_IC_S(b) _mm_broadcast_ss(&sn_k_ic_p2[(b)[18]])
 #define SN_K_IC_F(v) _mm_cvtepi32_ps(_mm_cvtepi16_epi32(v))
 SN_INLINE void sn_k_ic_rows(const unsigned char *b, sn_fv r[3]) {
-    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    const sn_fv s = SN_K_IC_S(b);
     r[0] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)b)), s);
     r[1] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 6))), s);
     r[2] = FV_MUL(SN_K_IC_F(_mm_loadl_epi64((const __m128i *)(const void *)(b + 12))), s);
@@ -275,7 +339,7 @@ SN_INLINE void sn_k_ic_cols(const unsigned char *b, sn_fv c[3]) {
     const __m128i sh1 = _mm_setr_epi8(2, 3, 8, 9, 14, 15, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)b);
     const __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(b + 4));
-    const sn_fv s = FV_SET1(sn_k_ic_scale(b));
+    const sn_fv s = SN_K_IC_S(b);
     c[0] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh0)), s);
     c[1] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(v, sh1)), s);
     c[2] = FV_MUL(SN_K_IC_F(_mm_shuffle_epi8(w, sh0)), s);
@@ -315,6 +379,69 @@ SN_INLINE void sn_k_ic_row(const unsigned char *b, const sn_q z[3], sn_acc l[4],
     sn_k_ic_cols(b, c);
     FV_ST4(l, FV_ADD(FV_LD4(l), FV_MAC3(c, FV_SET1(z[0]), FV_SET1(z[1]), FV_SET1(z[2]))));
 }
+#if defined(SN_KERNELS_FAVX2)
+/* x86-64 round 2 (sn_precond.c ic_fused): ic_forward's column j with y_j's
+ * lanes broadcast once (y0..y2), and ic_backward's row sum as lanes, z_i
+ * read from zq (3 floats per vertex); each lane the reference's
+ * ((p0 + p1) + p2) added to its accumulator in the reference's order. */
+SN_INLINE uint32_t sn_k_ic_fwd_ops(const unsigned char *blk, const unsigned char *cols, const unsigned char *cend, sn_fv y0,
+                                   sn_fv y1, sn_fv y2, uint32_t nF, sn_acc *acc) {
+    const unsigned char *c = cols;
+    for (; c < cend; c += 2, blk += SN_ELEM_ICHOL) {
+        const uint32_t i = sn_rd_u16(c);
+        sn_fv r[3];
+        if (i >= nF) break; /* skeleton columns: not in ICHOL */
+        sn_k_ic_rows(blk, r);
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), FV_MAC3(r, y0, y1, y2)));
+    }
+    return (uint32_t)(c - cols) / 2u;
+}
+/* Two blocks at once in 8 lanes, [block e | block e+1]: each column by one
+ * VPSHUFB putting the int16 in the high half of a 32-bit slot (VPSRAD 16
+ * sign-extends: the VPMOVSXWD value) and the two scales 2^-frac from the
+ * frac bytes (127 - frac) << 23, the same floats as sn_k_ic_cols; the two
+ * row sums then added to l one after the other (l + A) + B, the
+ * reference's order. */
+SN_INLINE __m256 sn_k_ic_cols2(const unsigned char *b, __m256 c[3]) {
+    const __m256i m0 = _mm256_setr_epi8(-1, -1, 0, 1, -1, -1, 6, 7, -1, -1, 12, 13, -1, -1, -1, -1,
+                                        -1, -1, 0, 1, -1, -1, 6, 7, -1, -1, 12, 13, -1, -1, -1, -1);
+    const __m256i m1 = _mm256_setr_epi8(-1, -1, 2, 3, -1, -1, 8, 9, -1, -1, 14, 15, -1, -1, -1, -1,
+                                        -1, -1, 2, 3, -1, -1, 8, 9, -1, -1, 14, 15, -1, -1, -1, -1);
+    const __m256i mf = _mm256_setr_epi8(14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1,
+                                        14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1, 14, -1, -1, -1);
+    const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
+                                              _mm_loadu_si128((const __m128i *)(const void *)(b + SN_ELEM_ICHOL)), 1);
+    const __m256i w = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)(b + 4))),
+                                              _mm_loadu_si128((const __m128i *)(const void *)(b + SN_ELEM_ICHOL + 4)), 1);
+    const __m256 sc = _mm256_castsi256_ps(
+        _mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), _mm256_shuffle_epi8(w, mf)), 23)); /* b[18]: w's byte 14 */
+    c[0] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(v, m0), 16)), sc);
+    c[1] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(v, m1), 16)), sc);
+    c[2] = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_shuffle_epi8(w, m0), 16)), sc);
+    return sc;
+}
+#define SN_K_ZZ(p, q) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(p)), _mm_broadcast_ss(q), 1)
+SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
+    sn_fv a = FV_SET1(0.0f); /* the reference's l = 0, then l += each block's row sums */
+    uint32_t e = 0;
+    for (; e + 2 <= nb; e += 2, b += 2 * SN_ELEM_ICHOL) {
+        const sn_acc *z1 = zq + 3 * sn_rd_u16(cols + 2 * e), *z2 = zq + 3 * sn_rd_u16(cols + 2 * e + 2);
+        __m256 c[3], p;
+        (void)sn_k_ic_cols2(b, c);
+        p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(c[0], SN_K_ZZ(z1, z2)), _mm256_mul_ps(c[1], SN_K_ZZ(z1 + 1, z2 + 1))),
+                          _mm256_mul_ps(c[2], SN_K_ZZ(z1 + 2, z2 + 2)));
+        a = FV_ADD(FV_ADD(a, _mm256_castps256_ps128(p)), _mm256_extractf128_ps(p, 1));
+    }
+    for (; e < nb; e++, b += SN_ELEM_ICHOL) {
+        const sn_acc *zi = zq + 3 * sn_rd_u16(cols + 2 * e);
+        sn_fv c[3];
+        sn_k_ic_cols(b, c);
+        a = FV_ADD(a, FV_MAC3(c, FV_SET1(zi[0]), FV_SET1(zi[1]), FV_SET1(zi[2])));
+    }
+    return a;
+}
+#undef SN_K_ZZ
+#endif
 
 #else
 #define sn_k_ic_col sn_k_ic_col_ref

@@ -39,26 +39,40 @@ SN_INLINE void sn_k_st3q(int64_t *p, __m256i v) {
 SN_INLINE __m256i sn_k_rot3(const sn_q *R, const sn_q v[3], __m256i i0, __m256i i1, __m256i i2) {
     const __m256i r0 = SN_K_R8(R), r1 = SN_K_R8(R + 1);
     return _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_set1_epi64x(v[0])),
-                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi64x(v[1]))),
-        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi64x(v[2])));
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_set1_epi32(v[0])),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_set1_epi32(v[1]))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_set1_epi32(v[2])));
 }
-/* lanes 0..2 -> out: sn_out(x, SN_Q_ROT) each */
-SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
+/* nonzero where a lane may lie outside +-SN_LIM: (y + 2^28) >> 29 (logical)
+ * is 0 exactly for y in [-2^28, 2^28) (y = 2^28 only takes the full path);
+ * the full compares and blends run only then (x86-64 round 2) */
+#define SN_K_INLIM(y) _mm256_testz_si256(_mm256_srli_epi64(_mm256_add_epi64((y), _mm256_set1_epi64x(SN_LIM)), 29), \
+                                         _mm256_set1_epi64x(-1))
+/* sn_out(x, SN_Q_ROT) per lane, lanes 0..2 (lane 3: 0, so that callers'
+ * clamps of sums with it count nothing there) */
+SN_INLINE __m256i sn_k_rot_rnd(__m256i x, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
     __m256i y = _mm256_sub_epi64(
         _mm256_srli_epi64(_mm256_add_epi64(x, _mm256_set1_epi64x(((int64_t)1 << 62) + ((int64_t)1 << (SN_Q_ROT - 1)))), SN_Q_ROT),
         _mm256_set1_epi64x((int64_t)1 << (62 - SN_Q_ROT)));
-    const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
-    const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
+    __m256i hi, lo;
+    int m;
+    y = _mm256_blend_epi32(y, _mm256_setzero_si256(), 0xC0);
+    if (SN_K_INLIM(y)) return y;
+    hi = _mm256_cmpgt_epi64(y, lim);
+    lo = _mm256_cmpgt_epi64(nlim, y);
+    m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo))) & 7;
     y = _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
     if (m) *sat += (uint32_t)((m & 1) + (m >> 1 & 1) + (m >> 2)); /* rare */
-    {
-        const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
-        const int32_t o2 = _mm_extract_epi32(o, 2);
-        _mm_storel_epi64((__m128i *)(void *)out, o); /* no VPMASKMOVD (see sn_k_st3q) */
-        memcpy(out + 2, &o2, 4);
-    }
+    return y;
+}
+/* lanes 0..2 -> out: sn_out(x, SN_Q_ROT) each */
+SN_INLINE void sn_k_rot_out(__m256i x, sn_q out[3], uint32_t *sat) {
+    const __m256i y = sn_k_rot_rnd(x, sat);
+    const __m128i o = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(y, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
+    const int32_t o2 = _mm_extract_epi32(o, 2);
+    _mm_storel_epi64((__m128i *)(void *)out, o); /* no VPMASKMOVD (see sn_k_st3q) */
+    memcpy(out + 2, &o2, 4);
 }
 /* out = R^T v: lane k = R[k] v0 + R[3+k] v1 + R[6+k] v2 */
 SN_INLINE void sn_k_rot_t(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
@@ -73,6 +87,26 @@ SN_INLINE __m256i sn_k_rot_x(const sn_q R[9], const sn_q v[3]) {
 }
 SN_INLINE void sn_k_rot(const sn_q R[9], const sn_q v[3], sn_q out[3], uint32_t *sat) {
     sn_k_rot_out(sn_k_rot_x(R, v), out, sat);
+}
+/* R^T v and R v from v's int64 lanes (x86-64 round 2: the IC(0) sweeps
+ * rotate a vertex's value where they form it, sn_precond.c) */
+SN_INLINE __m256i sn_k_rot3v(const sn_q *R, __m256i v, __m256i i0, __m256i i1, __m256i i2) {
+    const __m256i r0 = SN_K_R8(R), r1 = SN_K_R8(R + 1);
+    return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i0), _mm256_permute4x64_epi64(v, 0x00)),
+                                             _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r0, i1), _mm256_permute4x64_epi64(v, 0x55))),
+                            _mm256_mul_epi32(_mm256_permutevar8x32_epi32(r1, i2), _mm256_permute4x64_epi64(v, 0xAA)));
+}
+/* sn_out(R^T v, SN_Q_ROT) as lanes (v in memory) */
+SN_INLINE __m256i sn_k_rot_t4(const sn_q R[9], const sn_q v[3], uint32_t *sat) {
+    return sn_k_rot_rnd(sn_k_rot3(R, v, _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0), _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0),
+                                  _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0)),
+                        sat);
+}
+/* out = sn_out(R v, SN_Q_ROT), v as lanes */
+SN_INLINE void sn_k_rot4(const sn_q R[9], __m256i v, sn_q out[3], uint32_t *sat) {
+    sn_k_rot_out(sn_k_rot3v(R, v, _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0), _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0),
+                            _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0)),
+                 out, sat);
 }
 /* acc += R t (int64, masked to the 3 entries) */
 SN_INLINE void sn_k_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
@@ -267,6 +301,64 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     sn_k_sym_cols(b, c);
     fv_st3(out, fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(e[0]), FV_SET1(e[1]), FV_SET1(e[2]))), sat));
 }
+#if defined(SN_KERNELS_FAVX2)
+/* cell_forces' elastic energy term: ec = sum over k = 3..23 of
+ * d[k] sn_out(l[k]) added in k order (x86-64 round 2): the clamps and
+ * products 8 at a time (the same floats; lanes 0..2 neither counted nor
+ * summed), the sum in the reference's order. */
+#define SN_K_ENERGY24 1
+SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint32_t *sat) {
+    const __m256 lim = _mm256_set1_ps(SN_FLIM), nlim = _mm256_set1_ps(-SN_FLIM);
+    float p[24];
+    sn_acc ec = 0;
+    uint32_t k;
+    (void)s;
+    for (k = 0; k < 24; k += 8) {
+        const __m256 x = _mm256_loadu_ps(l + k);
+        const __m256 hi = _mm256_cmp_ps(x, lim, _CMP_GT_OQ), lo = _mm256_cmp_ps(x, nlim, _CMP_LT_OQ);
+        const __m256 nan = _mm256_cmp_ps(x, x, _CMP_UNORD_Q);
+        const int m = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(hi, lo), nan)) & (k ? 0xFF : 0xF8);
+        if (m) *sat += (uint32_t)((0x4332322132212110ull >> (4 * (m & 15)) & 15u) + (0x4332322132212110ull >> (4 * (m >> 4)) & 15u)); /* rare */
+        _mm256_storeu_ps(p + k, _mm256_mul_ps(_mm256_loadu_ps(d + k),
+                                              _mm256_andnot_ps(nan, _mm256_blendv_ps(_mm256_blendv_ps(x, lim, hi), nlim, lo))));
+    }
+    for (k = 3; k < 24; k++) ec += p[k];
+    return ec;
+}
+/* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
+ * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
+ * in registers between the steps; the reference's floats and counts. */
+/* A cell's frame as rows (R^T v, sn_k_rot_t) and columns (R v,
+ * sn_k_out_rot_acc) once for its corners (x86-64 round 2): the same floats. */
+#define SN_K_ROTM 1
+typedef struct { sn_fv r[3], c[3]; } sn_k_rotm;
+SN_INLINE void sn_k_rotm_ld(sn_k_rotm *m, const sn_q *R) {
+    fv_rows(R, m->r); /* lane k: R[k] v0 + R[3+k] v1 + R[6+k] v2 */
+    fv_cols(R, m->c); /* lane k: R[3k] v0 + R[3k+1] v1 + R[3k+2] v2 */
+}
+SN_INLINE void sn_k_rot_t_m(const sn_k_rotm *m, const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    fv_st3(out, fv_out3(FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat));
+}
+SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc l[3], int sh, uint32_t *sat) {
+    const sn_fv t = fv_out3(fv_ld3(l), sat);
+    (void)sh;
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
+#define SN_K_CORNER 1
+SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+                           uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
+    const sn_fv *r = m->r;
+    sn_fv t, x;
+    t = fv_out3(FV_ADD(fv_ld3(wa), SN_K_NEG(fv_ld3(w0))), sat);
+    fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
+    t = fv_out3(FV_ADD(fv_ld3(pa), SN_K_NEG(fv_ld3(p0))), sat);
+    t = fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat);
+    x = fv_out3(FV_ADD(fv_ld3(f + ia), SN_K_NEG(fv_ld3(f + ib))), sat);
+    fv_st3(d, fv_out3(FV_ADD(t, SN_K_NEG(x)), sat));
+}
+#endif
 #elif defined(SN_KERNELS_AVX2)
 /* Fixed AVX2 (and AVX-512): the helpers on int64 lanes (the 4th lane 0 or
  * unused, never stored). sn_k_out4 is sn_out per lane with shift s (0..62
@@ -291,7 +383,10 @@ SN_INLINE __m256i sn_k_out4(__m256i x, __m256i s, uint32_t *sat) {
 #else
 SN_INLINE __m256i sn_k_clamp4(__m256i y, uint32_t *sat) {
     const __m256i lim = _mm256_set1_epi64x(SN_LIM), nlim = _mm256_set1_epi64x(-(int64_t)SN_LIM);
-    const __m256i hi = _mm256_cmpgt_epi64(y, lim), lo = _mm256_cmpgt_epi64(nlim, y);
+    __m256i hi, lo;
+    if (SN_K_INLIM(y)) return y;
+    hi = _mm256_cmpgt_epi64(y, lim);
+    lo = _mm256_cmpgt_epi64(nlim, y);
     const int m = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, lo)));
     if (m) *sat += sn_k_cnt4(m); /* rare */
     return _mm256_blendv_epi8(_mm256_blendv_epi8(y, lim, hi), nlim, lo);
@@ -341,20 +436,91 @@ SN_INLINE void sn_k_add3(const sn_q x[3], const sn_q y[3], sn_q out[3], uint32_t
     sn_k_st3d(out, sn_k_clamp4(_mm256_add_epi64(sn_k_ld3d(x), sn_k_ld3d(y)), sat));
 }
 SN_INLINE void sn_k_coef3(const sn_q x[3], sn_q c, sn_q out[3], uint32_t *sat) {
-    sn_k_st3d(out, sn_k_out4(_mm256_mul_epi32(sn_k_ld3d(x), _mm256_set1_epi64x(c)), _mm256_set1_epi64x(SN_Q_COEF), sat));
+    sn_k_st3d(out, sn_k_out4(_mm256_mul_epi32(sn_k_ld3d(x), _mm256_set1_epi32(c)), _mm256_set1_epi64x(SN_Q_COEF), sat));
 }
 SN_INLINE void sn_k_sub3a(sn_q x[3], const sn_acc y[3], uint32_t *sat) {
     sn_k_st3d(x, sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(x), sn_k_ld3q(y)), sat));
 }
-/* l = D e (D: xx yy zz xy xz yz, 6 int32 at b), out = sn_out(l, sh) */
-SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+/* l = D e (D: xx yy zz xy xz yz, 6 int32 at b) rounded: sn_out(l, sh) as lanes (lane 3: 0) */
+SN_INLINE __m256i sn_k_sym_out4(const unsigned char *b, const sn_q e[3], int sh, uint32_t *sat) {
     const __m256i v = _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)b)),
                                               _mm_loadl_epi64((const __m128i *)(const void *)(b + 16)), 1); /* xx yy zz xy xz yz 0 0 */
     const __m256i x = _mm256_add_epi64(
-        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi64x(e[0])),
-                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi64x(e[1]))),
-        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi64x(e[2])));
-    sn_k_st3d(out, sn_k_out4(x, sn_k_sh4(sh), sat)); /* lane 3: 0 * e */
+        _mm256_add_epi64(_mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 0, 3, 0, 4, 0, 6, 0)), _mm256_set1_epi32(e[0])),
+                         _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(3, 0, 1, 0, 5, 0, 6, 0)), _mm256_set1_epi32(e[1]))),
+        _mm256_mul_epi32(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(4, 0, 5, 0, 2, 0, 6, 0)), _mm256_set1_epi32(e[2])));
+    return sn_k_out4(x, sn_k_sh4(sh), sat); /* lane 3: 0 * e */
+}
+SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    sn_k_st3d(out, sn_k_sym_out4(b, e, sh, sat));
+}
+/* A cell's frame permuted once for its corners (x86-64 round 2: cell_stiff,
+ * cell_forces): t0..t2 for R^T v (sn_k_rot_t's lanes), c0..c2 for R v
+ * (sn_k_out_rot_acc's); sn_k_rot_t_m / sn_k_out_rot_acc_m are those two
+ * with the permutes done, the same integers. */
+#define SN_K_ROTM 1
+typedef struct { __m256i t0, t1, t2, c0, c1, c2; } sn_k_rotm;
+SN_INLINE void sn_k_rotm_ld(sn_k_rotm *m, const sn_q *R) {
+    const __m256i r0 = _mm256_loadu_si256((const __m256i *)(const void *)R);
+    const __m256i r1 = _mm256_loadu_si256((const __m256i *)(const void *)(R + 1));
+    const __m256i ic1 = _mm256_setr_epi32(1, 0, 4, 0, 7, 0, 0, 0);
+    m->t0 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(0, 0, 1, 0, 2, 0, 0, 0));
+    m->t1 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(3, 0, 4, 0, 5, 0, 0, 0));
+    m->t2 = _mm256_permutevar8x32_epi32(r1, _mm256_setr_epi32(5, 0, 6, 0, 7, 0, 0, 0));
+    m->c0 = _mm256_permutevar8x32_epi32(r0, _mm256_setr_epi32(0, 0, 3, 0, 6, 0, 0, 0));
+    m->c1 = _mm256_permutevar8x32_epi32(r0, ic1);
+    m->c2 = _mm256_permutevar8x32_epi32(r1, ic1);
+}
+SN_INLINE __m256i sn_k_rot_t_mv(const sn_k_rotm *m, __m256i v, uint32_t *sat) { /* v as lanes */
+    return sn_k_rot_rnd(_mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->t0, _mm256_permute4x64_epi64(v, 0x00)),
+                                                          _mm256_mul_epi32(m->t1, _mm256_permute4x64_epi64(v, 0x55))),
+                                         _mm256_mul_epi32(m->t2, _mm256_permute4x64_epi64(v, 0xAA))),
+                        sat);
+}
+SN_INLINE void sn_k_rot_t_m(const sn_k_rotm *m, const sn_q v[3], sn_q out[3], uint32_t *sat) {
+    sn_k_rot_out(_mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->t0, _mm256_set1_epi32(v[0])),
+                                                   _mm256_mul_epi32(m->t1, _mm256_set1_epi32(v[1]))),
+                                  _mm256_mul_epi32(m->t2, _mm256_set1_epi32(v[2]))),
+                 out, sat);
+}
+SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc l[3], int sh, uint32_t *sat) {
+    const __m256i t = sn_k_out4(sn_k_ld3q(l), sn_k_sh4(sh), sat); /* lane 3: 0 */
+    const __m256i x = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epi32(m->c0, _mm256_permute4x64_epi64(t, 0x00)),
+                                                        _mm256_mul_epi32(m->c1, _mm256_permute4x64_epi64(t, 0x55))),
+                                       _mm256_mul_epi32(m->c2, _mm256_permute4x64_epi64(t, 0xAA)));
+    sn_k_st3q(acc, _mm256_add_epi64(sn_k_ld3q(acc), x)); /* acc += R t */
+}
+/* cell_forces' elastic energy term: sum over k = 3..23 of d[k] sn_out(l[k], s)
+ * (x86-64 round 2), 4 terms a vector (lanes 0..2 of the first masked to 0:
+ * no term, no clamp). |d|, |sn_out| <= 2^28: each product < 2^56, the sum
+ * of 21 < 2^61, exact in any order: the reference loop's int64. */
+#define SN_K_ENERGY24 1
+SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint32_t *sat) {
+    const __m256i sv = sn_k_sh4(s);
+    __m256i a = _mm256_setzero_si256();
+    int64_t t[4];
+    uint32_t k;
+    for (k = 0; k < 24; k += 4) {
+        __m256i x = _mm256_loadu_si256((const __m256i *)(const void *)(l + k));
+        if (k == 0) x = _mm256_blend_epi32(x, _mm256_setzero_si256(), 0x3F); /* k = 0..2: d_0 = 0 */
+        a = _mm256_add_epi64(a, _mm256_mul_epi32(sn_k_out4(x, sv, sat),
+                                                 _mm256_cvtepi32_epi64(_mm_loadu_si128((const __m128i *)(const void *)(d + k)))));
+    }
+    _mm256_storeu_si256((__m256i *)(void *)t, a);
+    return t[0] + t[1] + t[2] + t[3];
+}
+/* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_out(R^T s), d = sn_add(sn_out(R^T t),
+ * -sn_add(x_a, -x_0)) (x: the blob's rest positions at reals ia, ib), kept
+ * in int64 lanes between the steps; the same integers and counts. */
+#define SN_K_CORNER 1
+SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
+                           uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const __m256i t = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(pa), sn_k_ld3d(p0)), sat);
+    const __m256i s = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(wa), sn_k_ld3d(w0)), sat);
+    const __m256i x = sn_k_clamp4(_mm256_sub_epi64(sn_k_ld3d(rest + 4u * ia), sn_k_ld3d(rest + 4u * ib)), sat);
+    sn_k_st3d(uu, sn_k_rot_t_mv(m, s, sat));
+    sn_k_st3d(d, sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_t_mv(m, t, sat), x), sat)); /* lane 3: 0 */
 }
 #else /* the reference loops (written as loops: the Cortex-M4's code is smaller and faster than written out) */
 #if defined(SN_KERNELS_M4)

@@ -35,7 +35,7 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
     struct sn_m4_icc c;
     sn_k_ic_fwd_init(&c, kk, acc, nF);
 #endif
-#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+#if defined(SN_K_ZERO) /* the M4's and x86-64 AVX2's (sn_kernels.h) */
     sn_k_zero(acc, 3 * nF);
 #else
     for (j = 0; j < 3 * nF; j++) acc[j] = 0;
@@ -49,6 +49,9 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
         e = sn_rd_u32(rp + 4 * j);
         if (e < end)
             n += sn_k_ic_fwd_col(&c, L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, yj, kk[j], sat);
+#elif defined(SN_K_IC_FWD_RUN) /* x86-64 AVX2's loop (sn_kernels_ic.h) */
+        e = sn_rd_u32(rp + 4 * j);
+        n += sn_k_ic_fwd_run(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, yj, kk[j], kk, nF, acc, sat);
 #else
         for (e = sn_rd_u32(rp + 4 * j); e < end; e++, n++) {
             uint32_t i = sn_rd_u16(cols + 2 * e);
@@ -77,7 +80,7 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
     uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
-#if defined(SN_K_IC_BWD_ROW) /* the M4's loop (sn_kernels_ic.h) */
+#if defined(SN_K_IC_BWD_ROW) /* the M4's and x86-64 AVX2's loops (sn_kernels_ic.h) */
         sn_acc l[4];
         n -= f - b;
         sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
@@ -94,6 +97,82 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
         sn_k_sub3a(z + 3 * j, l, sat);
     }
 }
+
+#if defined(SN_KERNELS_AVX2)
+/* x86-64 round 2 (AVX2, fixed; NUMERICS.md "x86-64 solve, round 2"): IC(0)
+ * without mask or scale, the per-vertex passes fused into the sweeps, the
+ * same integers and clamp counts as precond_core's passes: the forward
+ * sweep forms t_j = R_j^T r_j where it reaches j (y_j = sn_out(t_j - acc_j)),
+ * the backward sweep w_j = D^-1 y_j and z'_j = sn_out(w_j - l_j) where it
+ * reaches j, keeps z'_j in acc_j (int64; row j's count, read first, is its
+ * last use) for the rows above, and writes z_j = R_j z'_j. One pass over
+ * the vertices each way instead of five. */
+static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
+                     uint32_t *sat) {
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
+    const uint32_t nF = v->nF;
+    uint32_t j, n = 0;
+    sn_k_zero(acc, 3 * nF);
+    for (j = 0; j < nF; j++) {
+        const uint32_t e = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4);
+        const __m256i y = sn_k_clamp4(_mm256_sub_epi64(sn_k_rot_t4(R + rs * j, r + 3 * j, sat), sn_k_ld3q(acc + 3 * j)), sat);
+        uint32_t m;
+        sn_k_st3d(z + 3 * j, y);
+        m = sn_k_ic_fwd_ops(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, _mm256_permute4x64_epi64(y, 0x00),
+                            _mm256_permute4x64_epi64(y, 0x55), _mm256_permute4x64_epi64(y, 0xAA), z + 3 * j, kk[j], kk, nF, acc, sat);
+        acc[3 * j] = (sn_acc)m; /* acc_j is consumed: row j's free column count */
+        n += m;
+    }
+    j = nF;
+    while (j-- > 0) {
+        const uint32_t m = (uint32_t)acc[3 * j], b = sn_rd_u32(rp + 4 * j);
+        __m256i w = sn_k_sym_out4(P + (size_t)j * 6 * SN_REAL_BYTES, z + 3 * j, v->frac_P + SN_KREL(kk[j]), sat);
+        n -= m;
+        w = sn_k_clamp4(_mm256_sub_epi64(w, sn_k_ic_bwd_rowq(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc)), sat);
+        sn_k_st3q(acc + 3 * j, w); /* z'_j, for the rows above */
+        sn_k_rot4(R + rs * j, w, z + 3 * j, sat);
+    }
+}
+#elif defined(SN_KERNELS_FAVX2)
+/* The float flavour's (AVX2): the same passes fused, each value the
+ * reference's floats (sn_kernels_fsimd.h: the operations in its order). */
+static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
+                     uint32_t *sat) {
+    const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
+    const uint32_t nF = v->nF;
+    uint32_t j, n = 0;
+    (void)kk;
+    for (j = 0; j < 3 * nF; j++) acc[j] = 0;
+    for (j = 0; j < nF; j++) {
+        const uint32_t e = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4);
+        const sn_q *rj = r + 3 * j;
+        sn_fv c[3], y;
+        uint32_t m;
+        fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t) */
+        y = fv_out3(FV_SUB(fv_out3(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), sat), fv_ld3(acc + 3 * j)), sat);
+        fv_st3(z + 3 * j, y);
+        m = sn_k_ic_fwd_ops(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, SN_K_LANE(y, 0), SN_K_LANE(y, 1),
+                            SN_K_LANE(y, 2), nF, acc);
+        acc[3 * j] = (sn_acc)m; /* acc_j is consumed: row j's free column count */
+        n += m;
+    }
+    j = nF;
+    while (j-- > 0) {
+        const uint32_t m = (uint32_t)acc[3 * j], b = sn_rd_u32(rp + 4 * j);
+        const sn_q *yj = z + 3 * j;
+        sn_fv c[3], w;
+        sn_k_sym_cols(P + (size_t)j * 6 * SN_REAL_BYTES, c); /* w = D^-1 y_j (sn_k_sym_out) */
+        w = fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(yj[0]), FV_SET1(yj[1]), FV_SET1(yj[2]))), sat);
+        n -= m;
+        w = fv_out3(FV_SUB(w, sn_k_ic_bwd_rowv(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc)), sat);
+        fv_st3(acc + 3 * j, w); /* z'_j, for the rows above */
+        fv_cols(R + rs * j, c); /* z_j = R z'_j (sn_k_rot) */
+        fv_st3(z + 3 * j, fv_out3(FV_MAC3(c, SN_K_LANE(w, 0), SN_K_LANE(w, 1), SN_K_LANE(w, 2)), sat));
+    }
+}
+#endif
 
 /* t = s t, s a Q30 scale in (0, 1] (adaptation's source rows): no clamp */
 SN_INLINE void scale3(sn_q t[3], sn_q s, uint32_t *sat) {
@@ -127,6 +206,9 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
         }
         return;
     }
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+    if (!mask && !sc) { ic_fused(v, kk, R, rs, r, z, WARR(h, o_acc, sn_acc), sat); return; }
+#endif
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i] == !inv) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
         else {

@@ -37,7 +37,7 @@ SN_INLINE void sca_mac(sn_acc acc[3], sn_q m, const sn_q e[3]) {
 }
 
 static void acc_zero(sn_acc *acc, uint32_t n3) {
-#if defined(SN_K_ZERO) /* the M4's (sn_kernels.h) */
+#if defined(SN_K_ZERO) /* the M4's and x86-64 AVX2's (sn_kernels.h) */
     sn_k_zero(acc, n3);
 #else
     uint32_t i;
@@ -185,6 +185,10 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         uint32_t fr = 0; /* the free corners: lu's rows read below */
         uint32_t on = dt ? DT(dt, o_on, const uint32_t)[e] : 0;
         const sn_q *w0 = w_of(h, w, vel, a0, w0s);
+#if defined(SN_K_ROTM) /* x86-64 AVX2: R permuted once for the corners (sn_kernels_rot.h) */
+        sn_k_rotm rm;
+        sn_k_rotm_ld(&rm, R);
+#endif
         /* corner 0 is a0: its t, s and rest difference are 0, so d_0 = uu_0 = 0
          * exactly (no clamp), without its two rotations */
         for (c = 0; c < 3; c++) d[c] = uu[c] = 0;
@@ -194,6 +198,11 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
 #else
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
+#if defined(SN_K_CORNER) /* x86-64 AVX2: the steps below in registers (sn_kernels_rot.h) */
+            sn_q wa[3];
+            fr |= (uint32_t)(a < nF) << k;
+            sn_k_corner(&rm, pos + 3 * a, pos + 3 * a0, w_of(h, w, vel, a, wa), w0, rest, 3 * a, 3 * a0, d + 3 * k, uu + 3 * k, sat);
+#else
             sn_q t[3], s[3], l[3], wa[3], xr[3];
             fr |= (uint32_t)(a < nF) << k;
             sn_k_sub3(pos + 3 * a, pos + 3 * a0, t, sat); /* sn_add(x, -y) per entry */
@@ -202,6 +211,7 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
             sn_k_rot_t(R, s, uu + 3 * k, sat);
             sn_k_sub3r(rest, 3 * a, 3 * a0, xr, sat);
             sn_k_sub3(l, xr, d + 3 * k, sat);
+#endif
         }
 #endif
         sn_k_cell_mul2(K, d, uu, ld, lu, fr);
@@ -209,6 +219,8 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         if (on) detail_cell_rhs(h, dt, e, on, R, d, uu, (const sn_q(*)[3])yx, lc, sacc, sat);
 #if defined(SN_K_ENERGY)
         ec = sn_k_energy(d, ld, v->frac_S, &esat); /* the M4's (sn_kernels_rot.h) */
+#elif defined(SN_K_ENERGY24) /* x86-64 AVX2 (sn_kernels_rot.h) */
+        ec = sn_k_energy24(d, ld, v->frac_S, &esat);
 #else
         for (k = 3; k < 24; k++) ec += sn_k_mul_out(d[k], ld[k], v->frac_S, &esat); /* d_0 = 0: no term */
 #endif
@@ -218,7 +230,11 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
             sn_acc ls[3];
             if (a >= nF) continue; /* skeleton rows are not unknowns (blob-fixed) */
             for (c = 0; c < 3; c++) ls[c] = ld[3 * k + c] + lu[3 * k + c] + (v->cut ? lx[3 * k + c] : 0) + (on ? lc[3 * k + c] : 0);
+#if defined(SN_K_ROTM)
+            sn_k_out_rot_acc_m(acc + 3 * a, &rm, ls, v->frac_S - SN_KREL(kk[a]), sat);
+#else
             sn_k_out_rot_acc(acc + 3 * a, R, ls, v->frac_S - SN_KREL(kk[a]), sat); /* R round(ld + lu [+ lx]) */
+#endif
         }
     }
 }
@@ -360,7 +376,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     pre = v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF;
     if (pre)
         for (i = 0; i < nF; i++) sn_k_coef3(vel + 3 * i, v->a1, u + 3 * i, sat);
-#if defined(SN_K_MASS_FF)
+#if defined(SN_K_MASS_FF) && defined(SN_K_MASS_SK)
     /* the M4: the free blocks by the mat-vec's loop, then the skeleton
      * columns (sn_kernels.h); exact int64 sums of the same products, each
      * partial sum within the pass's bound in any order (NUMERICS.md "M4
@@ -438,7 +454,7 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
     uint32_t i, nF = v->nF;
     acc_zero(acc, 3 * nF);
 #if defined(SN_K_MASS_FF)
-    if (!mask) { sn_k_mass_ff(rp, cols, md, mo, y, acc, nF); return; } /* the M4's loop (sn_kernels.h) */
+    if (!mask) { sn_k_mass_ff(rp, cols, md, mo, y, acc, nF); return; } /* the M4's and x86-64 AVX2's loops (sn_kernels.h) */
 #endif
     for (i = 0; i < nF; i++) {
         uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
@@ -470,10 +486,19 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_q u[24];
     sn_acc l[24];
     uint8_t fc[8];
+#if defined(SN_K_ROTM) /* x86-64 AVX2: R permuted once for the corners (sn_kernels_rot.h) */
+    sn_k_rotm rm;
+    sn_k_rotm_ld(&rm, R);
+#define SN_ROT_T(v, o) sn_k_rot_t_m(&rm, (v), (o), sat)
+#define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc_m((x), &rm, (l), (sh), sat)
+#else
+#define SN_ROT_T(v, o) sn_k_rot_t(R, (v), (o), sat)
+#define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc((x), R, (l), (sh), sat)
+#endif
     for (k = 0; k < 8; k++) {
         uint32_t a = sn_rd_u16(cl + 2 * k);
         if (a >= nF || (mask && !mask[a])) continue;
-        sn_k_rot_t(R, d + 3 * a, u + 3 * nf, sat);
+        SN_ROT_T(d + 3 * a, u + 3 * nf);
         fc[nf] = (uint8_t)k;
         vi[nf++] = a;
     }
@@ -481,8 +506,10 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
     sn_k_cell_mul(K, fc, nf, u, l);
     for (k = 0; k < nf; k++) {
         uint32_t a = vi[k];
-        sn_k_out_rot_acc(acc + 3 * a, R, l + 3 * k, h->v.frac_S - SN_KREL(kk[a]), sat); /* R round(l) */
+        SN_OUT_ROT_ACC(acc + 3 * a, l + 3 * k, h->v.frac_S - SN_KREL(kk[a])); /* R round(l) */
     }
+#undef SN_ROT_T
+#undef SN_OUT_ROT_ACC
 }
 
 void sn_cell_stiff_acc(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
