@@ -1379,7 +1379,7 @@ static void test_mass_ff(void) {
 }
 #endif
 
-#if defined(SN_K_MASS_FF)
+#if defined(SN_K_MASS_SK)
 /* The M4's right-hand-side mass pass at the skeleton columns (sn_k_mass_sk)
  * against sn_rhs's loop written here with the reference helpers (coef =
  * sn_mulq, sn_add, sn_mul; exact int64 sums and the clamp count: tolerance
@@ -1758,6 +1758,8 @@ int main(void) {
 #endif
 #if defined(SN_K_MASS_FF)
     test_mass_ff();
+#endif
+#if defined(SN_K_MASS_SK)
     test_mass_sk();
 #endif
 #if defined(SN_K_CORNERS)
