@@ -766,6 +766,109 @@ static void test_seg_star(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+/* ---- the fixed star projection of a sheet node and the pair (sn_segment_sweep.c): the
+ * step's forms (x86-64 AVX2: seg_star_iv, seg_pair_iv, the ends in int64 lanes) against
+ * star() and pair_core() bit for bit with the saturation counts (on paths
+ * without them the scalar against itself: the test still runs). 40000 random nodes of 3 or 4
+ * ends (distinct segments of 6, random signs), on level 0 (one half length
+ * 2^8..2^26, its reciprocal, shift and turn factors as seg_level and
+ * seg_sweep_prep form them) and on a coarse level (each segment's own half
+ * 1..2^27.8 with its reciprocal and shift 0..27, words 12-14), omega
+ * (1-gamma) and omega gamma over their whole ranges; centres within the
+ * state bound, every 8th segment at +-SN_LIM (the mean, the gaps and G + t
+ * clamp), unit directions in Q30 with |u| in [0.987, 1] (the bound every
+ * write of u keeps); short halves and long gaps drive the turn limiter.
+ * Tolerance 0. */
+static void seg_recip_t(sn_q x, sn_q *r, sn_q *sh) { /* sn_segment_mesh.c recip(): 2^(29+b)/x, b - 1 */
+    int b = 0;
+    while (b < 32 && ((uint64_t)x >> b) != 0) b++;
+    *r = (sn_q)(((uint64_t)1 << (29 + b)) / (uint64_t)x);
+    *sh = b - 1;
+}
+static sn_q seg_half_t(int lo, int hi) { /* 2^lo..2^hi, log-uniform */
+    const int b = lo + (int)(rnd32() % (unsigned)(hi - lo + 1));
+    const sn_q x = (sn_q)(((int64_t)1 << b) + (int64_t)(rnd32() % (1u << b)));
+    return x < 1 ? 1 : x;
+}
+static void test_seg_star_fixed(void) {
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W];
+    seg_ctx C;
+    seg_lvl L;
+    int t, bad = 0, bad_pair = 0;
+    unsigned long sats = 0;
+    memset(&C, 0, sizeof C);
+    memset(&L, 0, sizeof L);
+    for (t = 0; t < 40000; t++) {
+        const unsigned k = 3u + (unsigned)(t & 1);
+        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, pa = 0, pb = 0, j, w;
+        int sgn[5];
+        sn_q rh, sh;
+        for (j = 5; j > 0; j--) { /* distinct segments in a random order */
+            const uint32_t r = rnd32() % (j + 1u), x = perm[j];
+            perm[j] = perm[r]; perm[r] = x;
+        }
+        for (j = 0; j < 5; j++) seg[j] = perm[j];
+        for (j = 0; j < 5; j++) sgn[j] = rnd32() & 1 ? 1 : -1;
+        L.l = (unsigned)(t >> 1 & 1);
+        L.half = seg_half_t(8, 26);
+        seg_recip_t(L.half, &rh, &sh);
+        L.rh = rh;
+        L.sh = (int)sh;
+        /* omega (1-gamma) <= 2^30, omega gamma < 2^31 (sn_segment.c) */
+        C.rf1 = (sn_q)(rnd32() % ((1u << 30) + 1u));
+        C.g1n = (seg_n)(rnd32() & 0x7FFFFFFFu);
+        C.kf1 = (seg_n)(((int64_t)C.rf1 * rh + ((int64_t)1 << 29)) >> 30);
+        C.bias0 = ((sn_acc)1 << sh) >> 1;
+        for (j = 0; j < 6; j++) {
+            sn_q *S = SA + SEG_W * j;
+            const int edge = rnd32() % 8u == 0;
+            double v[3], n2;
+            const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+            for (w = 0; w < 3; w++) S[w] = edge ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            do {
+                for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+                n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            } while (n2 < 1e10);
+            for (w = 0; w < 3; w++) S[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            for (w = 6; w < SEG_W; w++) S[w] = (sn_q)rnd32(); /* not read but 12-14 on a coarse level */
+            S[12] = seg_half_t(0, 27);
+            seg_recip_t(S[12], &S[13], &S[14]);
+        }
+        C.rf2 = C.rf1 >> 1;
+        C.gh = (sn_q)(rnd32() % (1u << 30));
+        C.kf0 = (seg_n)(((int64_t)C.rf2 * rh + ((int64_t)1 << 29)) >> 30);
+        memcpy(SB, SA, sizeof SA);
+        memcpy(SP, SA, sizeof SA);
+        memcpy(SQ, SA, sizeof SA);
+        L.S = SA;
+        seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
+        L.S = SB;
+        seg_star_test(&C, &L, seg, sgn, k, 1, &sb);
+        L.S = SP; /* a pair of the first two ends */
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 0, &pa);
+        L.S = SQ;
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
+        bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+        sats += pa;
+        if (memcmp(SA, SB, sizeof SA) != 0 || sa != sb) {
+            if (bad < 3) {
+                for (j = 0; j < 6 * SEG_W; j++)
+                    if (SA[j] != SB[j]) printf("  star node %d (k %u, l %u): word %u of segment %u: %ld vs %ld\n", t, k, L.l,
+                                               j % SEG_W, j / SEG_W, (long)SA[j], (long)SB[j]);
+                printf("  counts %u vs %u\n", (unsigned)sa, (unsigned)sb);
+            }
+            bad++;
+        }
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "fixed star (path %s): %d of 40000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
+    T_CHECK(bad_pair == 0, "fixed pair (path %s): %d of 40000 pairs differ from pair() (state or counts)", sn_kernels_name(),
+            bad_pair);
+    T_FIGURE("fixed star and pair: 40000 random nodes and pairs, %lu clamps counted", sats);
+}
+#endif
+
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
  * sn_k_add3, sn_k_coef3, sn_k_sub3r, sn_k_sym_out, sn_k_out_rot_acc, sn_k_outv, sn_k_mix) against the
  * formulas written here with sn_out/sn_add/sn_mul (sn_internal.h, the
@@ -1325,6 +1428,7 @@ int main(void) {
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();
+    test_seg_star_fixed();
     test_mul_out();
 #endif
 #if defined(SN_FLOAT)

@@ -114,8 +114,8 @@ sn_real seg_gap(sn_len2 n2, const seg_lvl *L) {
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
  * perpendicular part */
-SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
-                  uint32_t *sat) {
+SEG_HOT void pair_core(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                       uint32_t *sat) {
     sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
@@ -153,6 +153,20 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
         move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, bb, &ls);
     }
     *sat += ls;
+}
+
+/* the pair as the sweeps run it: fixed AVX2 its two moves in lanes (seg_pair_iv) */
+SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure, uint32_t *sat) {
+#if defined(SEG_STAR_IV)
+    if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
+#endif
+    pair_core(C, L, a, sa, b, sb, measure, sat);
+}
+
+/* pair_core (simd 0) or the step's pair, for test_runtime_kernels; not called by the step */
+void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat) {
+    if (simd) pair(C, L, a, sa, b, sb, 0, sat);
+    else pair_core(C, L, a, sa, b, sb, 0, sat);
 }
 
 /* The ends meeting at a sheet node (k >= 3) projected together towards
@@ -346,21 +360,21 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
 }
 #endif
 
-#if defined(SN_FLOAT)
-/* star() (simd 0) or the step's form of it (star_fv where built, else
- * star) as a call: test_runtime_kernels compares the two bit for bit. Not
- * called by the step. */
+/* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
+ * built, else star) as a call: test_runtime_kernels compares the two bit
+ * for bit. Not called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
 #if defined(SEG_STAR_SSE)
     if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
+#elif defined(SEG_STAR_IV)
+    if (simd) { seg_star_iv(C, L, seg, sgn, k, sat); return; }
 #else
     (void)simd;
 #endif
     if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
 }
-#endif
 
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
@@ -450,6 +464,8 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
 #if defined(SEG_STAR_SSE)
     else star_fv(C, L, seg, sgn, k, sat);
+#elif defined(SEG_STAR_IV)
+    else seg_star_iv(C, L, seg, sgn, k, sat);
 #else
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
