@@ -703,9 +703,10 @@ static void test_seg_move_ops(void) {
 #endif
 
 #if defined(SN_FLOAT)
-/* ---- the float star projection of a sheet node (sn_segment_sweep.c): the
- * step's form (x86-64: star_fv, the ends in SSE lanes) against star()
- * itself, bit for bit with the saturation counts: 20000 random nodes of 3
+/* ---- the float star projection of a sheet node and the pair
+ * (sn_segment_sweep.c): the step's forms (x86-64: star_fv, pair_fv, the ends
+ * in SSE lanes) against star() and pair_core() bit for bit with the
+ * saturation counts (the pair: the node's first two ends): 20000 random nodes of 3
  * or 4 ends (distinct segments of 6, random signs) on level 0 and on a
  * coarse level (the segments' own half lengths and turn factors), random
  * centres and unit directions; every 8th segment pushed to the clamps
@@ -714,16 +715,16 @@ static void test_seg_move_ops(void) {
  * and every 64th node with a NaN centre (sn_out's replacement). Tolerance 0. */
 static float rnd_f(float a) { return a * ((float)(rnd32() % 2000001u) / 1000000.0f - 1.0f); }
 static void test_seg_star(void) {
-    static sn_q SA[6 * SEG_W], SB[6 * SEG_W];
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W];
     seg_ctx C;
     seg_lvl L;
-    int t, bad = 0;
+    int t, bad = 0, bad_pair = 0;
     unsigned long sats = 0;
     memset(&C, 0, sizeof C);
     memset(&L, 0, sizeof L);
     for (t = 0; t < 20000; t++) {
         const unsigned k = 3u + (unsigned)(t & 1);
-        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, j, w;
+        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, pa = 0, pb = 0, j, w;
         int sgn[5];
         float rf = (float)(rnd32() % 1001u) / 1000.0f;
         for (j = 5; j > 0; j--) { /* distinct segments in a random order */
@@ -753,15 +754,28 @@ static void test_seg_star(void) {
             S[13] = 1.0f / S[12];
         }
         if (t % 64 == 5) SA[SEG_W * seg[0]] = NAN;
+        C.rf2 = 0.5f * rf;
+        C.kf0 = 0.5f * C.kf1;
+        C.gh = (float)(rnd32() % 1001u) / 1000.0f;
         memcpy(SB, SA, sizeof SA);
+        memcpy(SP, SA, sizeof SA);
+        memcpy(SQ, SA, sizeof SA);
         L.S = SA;
         seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
         L.S = SB;
         seg_star_test(&C, &L, seg, sgn, k, 1, &sb);
         bad += memcmp(SA, SB, sizeof SA) != 0 || sa != sb;
         sats += sa;
+        L.S = SP; /* a pair of the first two ends */
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 0, &pa);
+        L.S = SQ;
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
+        bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+        sats += pa;
     }
     T_CHECK(bad == 0, "float star (path %s): %d of 20000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
+    T_CHECK(bad_pair == 0, "float pair (path %s): %d of 20000 pairs differ from pair() (state or counts)", sn_kernels_name(),
+            bad_pair);
     T_FIGURE("float star: 20000 random nodes, %lu clamps and NaN replacements counted", sats);
 }
 #endif

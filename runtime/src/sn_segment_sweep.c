@@ -155,10 +155,17 @@ SEG_HOT void pair_core(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_
     *sat += ls;
 }
 
-/* the pair as the sweeps run it: fixed AVX2 its two moves in lanes (seg_pair_iv) */
+#if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
+#define SEG_STAR_SSE 1
+static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+#endif
+/* the pair as the sweeps run it: its two moves in lanes where built (fixed
+ * AVX2 seg_pair_iv, float x86-64 pair_fv) */
 SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure, uint32_t *sat) {
 #if defined(SEG_STAR_IV)
     if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
+#elif defined(SEG_STAR_SSE)
+    if (!measure) { pair_fv(C, L, a, sa, b, sb, sat); return; }
 #endif
     pair_core(C, L, a, sa, b, sb, measure, sat);
 }
@@ -234,9 +241,6 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     *sat += ls;
 }
 
-#if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
-#define SEG_STAR_SSE 1
-#endif
 #if defined(SEG_STAR_SSE)
 /* Float, x86-64 (SSE2, the baseline; AVX2 builds the same code VEX-encoded;
  * not under SN_SIMD_SCALAR): star() with its
@@ -356,6 +360,68 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
     _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1);
     if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    *sat += ls;
+}
+/* pair() (not measuring) with its two moves in lanes 0 (segment a) and 1
+ * (b) of star_fv's vectors (lanes 2-3 repeat them, unstored, uncounted):
+ * d = P_b - P_a once (lane 0, sn_out counted there), t = d omega gamma/2;
+ * b takes -d, -t (float negation: exact), each lane move_seg's floats */
+static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat) {
+    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b;
+    const __m128 sz = _mm_set1_ps(-0.0f), n1 = _mm_setr_ps(0.0f, -0.0f, 0.0f, -0.0f);
+    const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(_mm_setr_epi32(sa, sb, sa, sb), _mm_setzero_si128())), sz);
+    __m128 G0, G1, G2, u0, u1, u2, R0, R1, d0, d1, d2, kv, hv, g;
+    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    uint32_t ls = 0;
+    /* words 0-3 of A, B, A, B transposed to G0, G1, G2, u0; words 4-5 by pairs */
+    G0 = _mm_loadu_ps(A); G1 = _mm_loadu_ps(B); G2 = G0; u0 = G1;
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(A + 4))), (const __m64 *)(const void *)(B + 4));
+    u1 = _mm_shuffle_ps(R0, R0, _MM_SHUFFLE(2, 0, 2, 0));
+    u2 = _mm_shuffle_ps(R0, R0, _MM_SHUFFLE(3, 1, 3, 1));
+    if (L->l != 0) {
+        hv = _mm_setr_ps(A[12], B[12], A[12], B[12]);
+        kv = _mm_mul_ps(_mm_set1_ps(C->rf2), _mm_setr_ps(A[13], B[13], A[13], B[13]));
+    } else {
+        hv = _mm_set1_ps(L->half);
+        kv = _mm_set1_ps(C->kf0);
+    }
+    hv = _mm_xor_ps(hv, neg);
+    kv = _mm_xor_ps(kv, neg);
+    /* lane 0: P_b - P_a (lanes swapped in pairs) */
+    R0 = _mm_add_ps(G0, _mm_mul_ps(hv, u0));
+    d0 = _mm_sub_ps(_mm_shuffle_ps(R0, R0, _MM_SHUFFLE(2, 3, 0, 1)), R0);
+    R0 = _mm_add_ps(G1, _mm_mul_ps(hv, u1));
+    d1 = _mm_sub_ps(_mm_shuffle_ps(R0, R0, _MM_SHUFFLE(2, 3, 0, 1)), R0);
+    R0 = _mm_add_ps(G2, _mm_mul_ps(hv, u2));
+    d2 = _mm_sub_ps(_mm_shuffle_ps(R0, R0, _MM_SHUFFLE(2, 3, 0, 1)), R0);
+    d0 = fv_out(d0, 0x1, &ls); d1 = fv_out(d1, 0x1, &ls); d2 = fv_out(d2, 0x1, &ls);
+    /* t = d omega gamma / 2 (lane 0), then both broadcast, negated in lane 1 */
+    g = _mm_set1_ps(C->gh);
+    R0 = _mm_mul_ps(d0, g); R1 = _mm_mul_ps(d1, g); g = _mm_mul_ps(d2, g);
+    G0 = fv_out(_mm_add_ps(G0, _mm_xor_ps(_mm_shuffle_ps(R0, R0, 0), n1)), 0x3, &ls);
+    G1 = fv_out(_mm_add_ps(G1, _mm_xor_ps(_mm_shuffle_ps(R1, R1, 0), n1)), 0x3, &ls);
+    G2 = fv_out(_mm_add_ps(G2, _mm_xor_ps(_mm_shuffle_ps(g, g, 0), n1)), 0x3, &ls);
+    d0 = _mm_xor_ps(_mm_shuffle_ps(d0, d0, 0), n1);
+    d1 = _mm_xor_ps(_mm_shuffle_ps(d1, d1, 0), n1);
+    d2 = _mm_xor_ps(_mm_shuffle_ps(d2, d2, 0), n1);
+    /* move_seg's turn per lane (as star_fv) */
+    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
+    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
+    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
+    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
+    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
+    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
+    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
+    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
+    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
+                    _mm_mul_ps(_mm_set1_ps(0.5f),
+                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
+    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_unpacklo_ps(u1, u2);
+    _mm_storeu_ps(A, G0); _mm_storel_pi((__m64 *)(void *)(A + 4), R0);
+    _mm_storeu_ps(B, G1); _mm_storeh_pi((__m64 *)(void *)(B + 4), R0);
     *sat += ls;
 }
 #endif
