@@ -715,10 +715,10 @@ static void test_seg_move_ops(void) {
  * and every 64th node with a NaN centre (sn_out's replacement). Tolerance 0. */
 static float rnd_f(float a) { return a * ((float)(rnd32() % 2000001u) / 1000000.0f - 1.0f); }
 static void test_seg_star(void) {
-    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W];
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
     seg_ctx C;
     seg_lvl L;
-    int t, bad = 0, bad_pair = 0;
+    int t, bad = 0, bad_pair = 0, bad_pins = 0;
     unsigned long sats = 0;
     memset(&C, 0, sizeof C);
     memset(&L, 0, sizeof L);
@@ -760,6 +760,7 @@ static void test_seg_star(void) {
         memcpy(SB, SA, sizeof SA);
         memcpy(SP, SA, sizeof SA);
         memcpy(SQ, SA, sizeof SA);
+        memcpy(SQ0, SA, sizeof SA);
         L.S = SA;
         seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
         L.S = SB;
@@ -772,7 +773,25 @@ static void test_seg_star(void) {
         seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
         bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
         sats += pa;
+        {   /* an attachment's pins on 2..4 of the ends (the target: every 8th
+             * beyond SN_FLIM, every 64th NaN) */
+            const unsigned kp = 2u + (unsigned)(t >> 2) % 3u;
+            sn_q T[3];
+            for (j = 0; j < 3; j++) T[j] = t % 8 == 6 ? rnd_f(2.0f * SN_FLIM) : rnd_f(8.0f);
+            if (t % 64 == 9) T[1] = NAN;
+            memcpy(SP, SQ0, sizeof SP);
+            memcpy(SQ, SQ0, sizeof SQ);
+            pa = pb = 0;
+            L.S = SP;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 0, &pa);
+            L.S = SQ;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 1, &pb);
+            bad_pins += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+            sats += pa;
+        }
     }
+    T_CHECK(bad_pins == 0, "float pins (path %s): %d of 20000 attachments differ from pin() (state or counts)",
+            sn_kernels_name(), bad_pins);
     T_CHECK(bad == 0, "float star (path %s): %d of 20000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
     T_CHECK(bad_pair == 0, "float pair (path %s): %d of 20000 pairs differ from pair() (state or counts)", sn_kernels_name(),
             bad_pair);
@@ -806,10 +825,10 @@ static sn_q seg_half_t(int lo, int hi) { /* 2^lo..2^hi, log-uniform */
     return x < 1 ? 1 : x;
 }
 static void test_seg_star_fixed(void) {
-    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W];
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
     seg_ctx C;
     seg_lvl L;
-    int t, bad = 0, bad_pair = 0;
+    int t, bad = 0, bad_pair = 0, bad_pins = 0;
     unsigned long sats = 0;
     memset(&C, 0, sizeof C);
     memset(&L, 0, sizeof L);
@@ -855,6 +874,7 @@ static void test_seg_star_fixed(void) {
         memcpy(SB, SA, sizeof SA);
         memcpy(SP, SA, sizeof SA);
         memcpy(SQ, SA, sizeof SA);
+        memcpy(SQ0, SA, sizeof SA);
         L.S = SA;
         seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
         L.S = SB;
@@ -865,6 +885,22 @@ static void test_seg_star_fixed(void) {
         seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
         bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
         sats += pa;
+        {   /* an attachment's pins on 2..4 of the ends, the target within the
+             * state bound, at it, or (every 8th) beyond (the gap's clamp) */
+            const unsigned kp = 2u + (unsigned)(t >> 2) % 3u;
+            sn_q T[3];
+            for (j = 0; j < 3; j++)
+                T[j] = t % 8 == 6 ? rnd_in(1 << 30) : (rnd32() % 16u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM));
+            memcpy(SP, SQ0, sizeof SP);
+            memcpy(SQ, SQ0, sizeof SQ);
+            pa = pb = 0;
+            L.S = SP;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 0, &pa);
+            L.S = SQ;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 1, &pb);
+            bad_pins += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+            sats += pa;
+        }
         if (memcmp(SA, SB, sizeof SA) != 0 || sa != sb) {
             if (bad < 3) {
                 for (j = 0; j < 6 * SEG_W; j++)
@@ -879,7 +915,9 @@ static void test_seg_star_fixed(void) {
     T_CHECK(bad == 0, "fixed star (path %s): %d of 40000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
     T_CHECK(bad_pair == 0, "fixed pair (path %s): %d of 40000 pairs differ from pair() (state or counts)", sn_kernels_name(),
             bad_pair);
-    T_FIGURE("fixed star and pair: 40000 random nodes and pairs, %lu clamps counted", sats);
+    T_CHECK(bad_pins == 0, "fixed pins (path %s): %d of 40000 attachments differ from pin() (state or counts)",
+            sn_kernels_name(), bad_pins);
+    T_FIGURE("fixed star, pair, pins: 40000 random nodes, pairs and attachments, %lu clamps counted", sats);
 }
 #endif
 

@@ -234,6 +234,67 @@ void seg_pair_iv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     store_iv(A, B, A, B, G, u, 2u);
     *sat += ls;
 }
+
+/* An attachment's pins (pin(), not measuring) on its k = 2..4 ends at once:
+ * the ends are distinct segments and the target T fixed, so the k moves are
+ * independent (any order: the same state). Per lane: the end P = G +- r30s(half, u)
+ * (end_of: the offset rounded from the positive half, then added or
+ * subtracted) clamped and counted, d = T - P (sn_add: int64, clamped and
+ * counted), t = r30s(d, omega gamma) clamped and counted, move_seg. */
+void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                 uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1];
+    sn_q *S2 = k >= 3u ? L->S + SEG_W * seg[2] : S0, *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const int km = k == 4u ? 0x55 : (k == 3u ? 0x15 : 0x05), kq = k == 4u ? 0xF : (k == 3u ? 0x7 : 0x3);
+    const v4 neg = _mm256_setr_epi64x(sgn[0] < 0 ? -1 : 0, sgn[1] < 0 ? -1 : 0, (k >= 3u ? sgn[2] : sgn[0]) < 0 ? -1 : 0,
+                                      (k == 4u ? sgn[3] : sgn[0]) < 0 ? -1 : 0);
+    const v4 lim = V64(SN_LIM), nlim = V64(-SN_LIM), g = V64(C->g1n);
+    v4 G[3], u[3], P[3], d[3], hv, kv, shv, bv;
+    uint32_t ls = 0;
+    unsigned c;
+    load_iv(S0, S1, S2, S3, G, u);
+    if (L->l != 0) {
+        hv = _mm256_setr_epi64x(S0[12], S1[12], S2[12], S3[12]);
+        kv = r30sv(V64(C->rf1), _mm256_setr_epi64x(S0[13], S1[13], S2[13], S3[13]));
+        shv = _mm256_setr_epi64x(S0[14], S1[14], S2[14], S3[14]);
+        bv = _mm256_srli_epi64(_mm256_sllv_epi64(V64(1), shv), 1);
+    } else {
+        hv = V64(L->half);
+        kv = V64(C->kf1);
+        shv = V64(L->sh);
+        bv = V64(C->bias0);
+    }
+    kv = negv(kv, neg);
+    IV_UNROLL3
+    for (c = 0; c < 3; c++) P[c] = _mm256_add_epi32(G[c], negv(r30sv(hv, u[c]), neg));
+    outv3(P, km, &ls);
+    IV_UNROLL3
+    for (c = 0; c < 3; c++) d[c] = _mm256_sub_epi64(V64(T[c]), sextv(P[c]));
+    {   /* sn_add's clamp of the int64 differences */
+        const v4 o = _mm256_or_si256(_mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi64(d[0], lim), _mm256_cmpgt_epi64(nlim, d[0])),
+                                                     _mm256_or_si256(_mm256_cmpgt_epi64(d[1], lim), _mm256_cmpgt_epi64(nlim, d[1]))),
+                                     _mm256_or_si256(_mm256_cmpgt_epi64(d[2], lim), _mm256_cmpgt_epi64(nlim, d[2])));
+        if (_mm256_movemask_pd(_mm256_castsi256_pd(o)) & kq) {
+            int64_t x[4];
+            unsigned j;
+            for (c = 0; c < 3; c++) {
+                _mm256_storeu_si256((v4 *)(void *)x, d[c]);
+                for (j = 0; j < k; j++)
+                    if (x[j] > SN_LIM || x[j] < -SN_LIM) { ls++; x[j] = x[j] > 0 ? SN_LIM : -SN_LIM; }
+                d[c] = LDV(x);
+            }
+        }
+    }
+    IV_UNROLL3
+    for (c = 0; c < 3; c++) P[c] = r30sv(d[c], g); /* t */
+    outv3(P, km, &ls);
+    IV_UNROLL3
+    for (c = 0; c < 3; c++) G[c] = _mm256_add_epi32(G[c], P[c]);
+    outv3(G, km, &ls);
+    turn_iv(u, d, kv, shv, bv);
+    store_iv(S0, S1, S2, S3, G, u, k);
+    *sat += ls;
+}
 #else
 typedef int sn_kernels_seg_avx2_empty_; /* ISO C: a translation unit declares something */
 #endif

@@ -353,7 +353,14 @@ void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const in
 void seg_star_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat);
 /* and pair()'s two moves (not measuring) in two lanes */
 void seg_pair_iv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+/* and an attachment's pins on its k = 2..4 ends (not measuring) in lanes */
+void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                 uint32_t *sat);
 #endif
+/* an attachment's pins on k ends (not measuring): the scalar pins (simd 0)
+ * or the step's form, for the kernel test only */
+void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                   int simd, uint32_t *sat);
 /* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat);
 /* every segment's u of level L to unit length (three Newton steps) */

@@ -157,13 +157,19 @@ SEG_HOT void pair_core(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_
 
 #if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
 #define SEG_STAR_SSE 1
+#if defined(__AVX__)
+static void pair_f8(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+#else
 static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+#endif
 #endif
 /* the pair as the sweeps run it: its two moves in lanes where built (fixed
  * AVX2 seg_pair_iv, float x86-64 pair_fv) */
 SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure, uint32_t *sat) {
 #if defined(SEG_STAR_IV)
     if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
+#elif defined(SEG_STAR_SSE) && defined(__AVX__)
+    if (!measure) { pair_f8(C, L, a, sa, b, sb, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure) { pair_fv(C, L, a, sa, b, sb, sat); return; }
 #endif
@@ -362,6 +368,7 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
     *sat += ls;
 }
+#if !defined(__AVX__)
 /* pair() (not measuring) with its two moves in lanes 0 (segment a) and 1
  * (b) of star_fv's vectors (lanes 2-3 repeat them, unstored, uncounted):
  * d = P_b - P_a once (lane 0, sn_out counted there), t = d omega gamma/2;
@@ -425,6 +432,136 @@ static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b
     *sat += ls;
 }
 #endif
+#if defined(__AVX__)
+/* Float AVX (the AVX2 builds): pair() with an end per 128-bit half of
+ * 8-lane vectors, its x, y, z in lanes 0-2 (lane 3 a neighbouring word,
+ * never stored or counted): one operation per step of the move for both
+ * ends and all three components; the dot products summed in star()'s order
+ * ((x + y) + z) by in-lane shuffles. The same floats and counts as
+ * pair_core (test_seg_star). */
+typedef __m256 f8;
+/* per half: ((q0 + q1) + q2) in every lane */
+SN_INLINE f8 f8_dot3(f8 q) {
+    const f8 s = _mm256_add_ps(q, _mm256_permute_ps(q, _MM_SHUFFLE(3, 3, 3, 1)));
+    return _mm256_permute_ps(_mm256_add_ps(s, _mm256_permute_ps(q, _MM_SHUFFLE(3, 3, 3, 2))), 0);
+}
+/* fv_lim, fv_out on 8 lanes */
+SN_INLINE f8 f8_lim(f8 a, f8 m) {
+    const f8 nm = _mm256_xor_ps(m, _mm256_set1_ps(-0.0f));
+    return _mm256_blendv_ps(_mm256_blendv_ps(a, nm, _mm256_cmp_ps(a, nm, _CMP_LT_OS)), m, _mm256_cmp_ps(a, m, _CMP_GT_OS));
+}
+SN_INLINE f8 f8_out(f8 v, int km, uint32_t *sat) {
+    const f8 lim = _mm256_set1_ps(SN_FLIM), nlim = _mm256_set1_ps(-SN_FLIM);
+    const int f = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(v, lim, _CMP_GT_OS), _mm256_cmp_ps(v, nlim, _CMP_LT_OS)),
+                                                  _mm256_cmp_ps(v, v, _CMP_UNORD_Q))) & km;
+    if (f) {
+        float x[8];
+        unsigned j;
+        _mm256_storeu_ps(x, v);
+        for (j = 0; j < 8; j++)
+            if (f >> j & 1) x[j] = sn_out(x[j], 0, sat);
+        v = _mm256_loadu_ps(x);
+    }
+    return v;
+}
+#define F8_PAIR(lo, hi) _mm256_insertf128_ps(_mm256_castps128_ps256(lo), (hi), 1)
+static void pair_f8(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat) {
+    sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b;
+    const f8 nb = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, -0.0f, -0.0f, -0.0f, -0.0f);
+    f8 G = F8_PAIR(_mm_loadu_ps(A), _mm_loadu_ps(B)), u = F8_PAIR(_mm_loadu_ps(A + 3), _mm_loadu_ps(B + 3));
+    f8 P, d, t, du, e, eu, x, w, r;
+    float ha, hb, ka, kb;
+    uint32_t ls = 0;
+    if (L->l != 0) { ha = A[12]; hb = B[12]; ka = C->rf2 * A[13]; kb = C->rf2 * B[13]; }
+    else { ha = hb = L->half; ka = kb = C->kf0; }
+    if (sa < 0) { ha = -ha; ka = -ka; }
+    if (sb < 0) { hb = -hb; kb = -kb; }
+    /* lanes 0-2: d = P_b - P_a, counted there; b takes -d, -t */
+    P = _mm256_add_ps(G, _mm256_mul_ps(F8_PAIR(_mm_set1_ps(ha), _mm_set1_ps(hb)), u));
+    d = f8_out(_mm256_sub_ps(_mm256_permute2f128_ps(P, P, 0x01), P), 0x07, &ls);
+    d = _mm256_permute2f128_ps(d, d, 0x00);
+    t = _mm256_xor_ps(_mm256_mul_ps(d, _mm256_set1_ps(C->gh)), nb);
+    d = _mm256_xor_ps(d, nb);
+    G = f8_out(_mm256_add_ps(G, t), 0x77, &ls);
+    du = f8_dot3(_mm256_mul_ps(d, u));
+    e = f8_lim(_mm256_mul_ps(_mm256_sub_ps(d, _mm256_mul_ps(du, u)), F8_PAIR(_mm_set1_ps(ka), _mm_set1_ps(kb))),
+               _mm256_set1_ps(ROT_MAX));
+    eu = f8_dot3(_mm256_mul_ps(e, u));
+    x = _mm256_sub_ps(_mm256_add_ps(u, e), _mm256_mul_ps(eu, u));
+    u = _mm256_mul_ps(x, _mm256_sub_ps(_mm256_set1_ps(1.5f), _mm256_mul_ps(_mm256_set1_ps(0.5f), f8_dot3(_mm256_mul_ps(x, x)))));
+    /* back: words 0-3 = G0 G1 G2 u0, words 4-5 = u1 u2 */
+    w = _mm256_blend_ps(G, _mm256_permute_ps(u, 0), 0x88);
+    r = _mm256_permute_ps(u, _MM_SHUFFLE(3, 3, 2, 1));
+    _mm_storeu_ps(A, _mm256_castps256_ps128(w));
+    _mm_storel_pi((__m64 *)(void *)(A + 4), _mm256_castps256_ps128(r));
+    _mm_storeu_ps(B, _mm256_extractf128_ps(w, 1));
+    _mm_storel_pi((__m64 *)(void *)(B + 4), _mm256_extractf128_ps(r, 1));
+    *sat += ls;
+}
+#endif
+/* An attachment's pins (pin(), not measuring) on its k = 2..4 ends in the
+ * lanes of star_fv's vectors (distinct segments, a fixed target: the moves
+ * are independent). Per lane pin()'s floats: P = sn_out(G +- half u),
+ * d = sn_out(T - P), t = sn_out(d omega gamma), move_seg. */
+static void pins_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                    uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1];
+    sn_q *S2 = k >= 3u ? L->S + SEG_W * seg[2] : S0, *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const int km = k == 4u ? 0xF : (k == 3u ? 0x7 : 0x3);
+    const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(
+                                      _mm_setr_epi32(sgn[0], sgn[1], k >= 3u ? sgn[2] : sgn[0], k == 4u ? sgn[3] : sgn[0]),
+                                      _mm_setzero_si128())),
+                                  _mm_set1_ps(-0.0f));
+    __m128 G0, G1, G2, u0, u1, u2, R0, R1, d0, d1, d2, kv, hv;
+    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    uint32_t ls = 0;
+    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
+    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
+    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
+    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
+    if (L->l != 0) {
+        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
+        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
+    } else {
+        hv = _mm_set1_ps(L->half);
+        kv = _mm_set1_ps(C->kf1);
+    }
+    kv = _mm_xor_ps(kv, neg);
+    /* end_of: the offset from the positive half, added or subtracted (x - o = x + (-o)) */
+    d0 = fv_out(_mm_add_ps(G0, _mm_xor_ps(_mm_mul_ps(u0, hv), neg)), km, &ls);
+    d1 = fv_out(_mm_add_ps(G1, _mm_xor_ps(_mm_mul_ps(u1, hv), neg)), km, &ls);
+    d2 = fv_out(_mm_add_ps(G2, _mm_xor_ps(_mm_mul_ps(u2, hv), neg)), km, &ls);
+    d0 = fv_out(_mm_sub_ps(_mm_set1_ps(T[0]), d0), km, &ls);
+    d1 = fv_out(_mm_sub_ps(_mm_set1_ps(T[1]), d1), km, &ls);
+    d2 = fv_out(_mm_sub_ps(_mm_set1_ps(T[2]), d2), km, &ls);
+    hv = _mm_set1_ps(C->g1n);
+    G0 = fv_out(_mm_add_ps(G0, fv_out(_mm_mul_ps(d0, hv), km, &ls)), km, &ls);
+    G1 = fv_out(_mm_add_ps(G1, fv_out(_mm_mul_ps(d1, hv), km, &ls)), km, &ls);
+    G2 = fv_out(_mm_add_ps(G2, fv_out(_mm_mul_ps(d2, hv), km, &ls)), km, &ls);
+    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
+    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
+    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
+    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
+    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
+    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
+    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
+    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
+    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
+                    _mm_mul_ps(_mm_set1_ps(0.5f),
+                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
+    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    R0 = _mm_unpacklo_ps(u1, u2);
+    R1 = _mm_unpackhi_ps(u1, u2);
+    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
+    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
+    if (k >= 3u) { _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1); }
+    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    *sat += ls;
+}
+#endif
 
 /* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
  * built, else star) as a call: test_runtime_kernels compares the two bit
@@ -478,6 +615,27 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     }
     move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, bias, &ls);
     *sat += ls;
+}
+
+/* an attachment's pins on its k ends: 2..4 at once in lanes where built
+ * (seg_pins_iv, pins_fv), else one by one */
+SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                    int measure, uint32_t *sat) {
+    unsigned j;
+#if defined(SEG_STAR_IV)
+    if (!measure && k >= 2u && k <= 4u) { seg_pins_iv(C, L, seg, sgn, k, T, sat); return; }
+#elif defined(SEG_STAR_SSE)
+    if (!measure && k >= 2u && k <= 4u) { pins_fv(C, L, seg, sgn, k, T, sat); return; }
+#endif
+    for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
+}
+
+/* the scalar pins (simd 0) or the step's (pins), for test_runtime_kernels; not called by the step */
+void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                   int simd, uint32_t *sat) {
+    unsigned j;
+    if (simd) { pins(C, L, seg, sgn, k, T, 0, sat); return; }
+    for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, 0, sat);
 }
 
 /* attachment target in the internal frame */
@@ -567,7 +725,7 @@ void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t
         if (i < SEG_TCACHE) { /* the same target, clamp count and ends as computed per sweep */
             if (C->ak[i] == 0) continue;
             *sat += C->Tsat[i];
-            for (j = 0; j < C->ak[i]; j++) pin(C, L, C->aseg[i][j], C->asgn[i][j], C->T[i], measure, sat);
+            pins(C, L, C->aseg[i], C->asgn[i], C->ak[i], C->T[i], measure, sat);
             continue;
         }
         ln = level_node(M, L, sn_rd_u16(rec));
