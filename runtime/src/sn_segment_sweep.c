@@ -157,7 +157,7 @@ SEG_HOT void pair_core(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_
 
 #if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
 #define SEG_STAR_SSE 1
-#if defined(__AVX__)
+#if defined(__AVX2__)
 static void pair_f8(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
 #else
 static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
@@ -168,7 +168,7 @@ static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b
 SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure, uint32_t *sat) {
 #if defined(SEG_STAR_IV)
     if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
-#elif defined(SEG_STAR_SSE) && defined(__AVX__)
+#elif defined(SEG_STAR_SSE) && defined(__AVX2__)
     if (!measure) { pair_f8(C, L, a, sa, b, sb, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure) { pair_fv(C, L, a, sa, b, sb, sat); return; }
@@ -288,6 +288,7 @@ SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
     }
     return v;
 }
+#if !defined(__AVX2__) /* AVX builds: star_f8, pair_f8 below */
 static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
     sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
     sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
@@ -368,7 +369,6 @@ static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
     *sat += ls;
 }
-#if !defined(__AVX__)
 /* pair() (not measuring) with its two moves in lanes 0 (segment a) and 1
  * (b) of star_fv's vectors (lanes 2-3 repeat them, unstored, uncounted):
  * d = P_b - P_a once (lane 0, sn_out counted there), t = d omega gamma/2;
@@ -432,7 +432,7 @@ static void pair_fv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b
     *sat += ls;
 }
 #endif
-#if defined(__AVX__)
+#if defined(__AVX2__)
 /* Float AVX (the AVX2 builds): pair() with an end per 128-bit half of
  * 8-lane vectors, its x, y, z in lanes 0-2 (lane 3 a neighbouring word,
  * never stored or counted): one operation per step of the move for both
@@ -465,11 +465,29 @@ SN_INLINE f8 f8_out(f8 v, int km, uint32_t *sat) {
     return v;
 }
 #define F8_PAIR(lo, hi) _mm256_insertf128_ps(_mm256_castps128_ps256(lo), (hi), 1)
+/* move_seg's turn per half: u + e, e = lim((d - (d.u) u) kf), then one Newton step */
+SN_INLINE f8 f8_turn(f8 u, f8 d, f8 kv) {
+    const f8 du = f8_dot3(_mm256_mul_ps(d, u));
+    const f8 e = f8_lim(_mm256_mul_ps(_mm256_sub_ps(d, _mm256_mul_ps(du, u)), kv), _mm256_set1_ps(ROT_MAX));
+    const f8 eu = f8_dot3(_mm256_mul_ps(e, u));
+    const f8 x = _mm256_sub_ps(_mm256_add_ps(u, e), _mm256_mul_ps(eu, u));
+    return _mm256_mul_ps(x, _mm256_sub_ps(_mm256_set1_ps(1.5f), _mm256_mul_ps(_mm256_set1_ps(0.5f), f8_dot3(_mm256_mul_ps(x, x)))));
+}
+/* words 0-5 of A (low half) and B (high half, if hb): G0 G1 G2 u0 u1 u2 */
+SN_INLINE void f8_store(sn_q *A, sn_q *B, f8 G, f8 u, int hb) {
+    const f8 w = _mm256_blend_ps(G, _mm256_permute_ps(u, 0), 0x88), r = _mm256_permute_ps(u, _MM_SHUFFLE(3, 3, 2, 1));
+    _mm_storeu_ps(A, _mm256_castps256_ps128(w));
+    _mm_storel_pi((__m64 *)(void *)(A + 4), _mm256_castps256_ps128(r));
+    if (hb) {
+        _mm_storeu_ps(B, _mm256_extractf128_ps(w, 1));
+        _mm_storel_pi((__m64 *)(void *)(B + 4), _mm256_extractf128_ps(r, 1));
+    }
+}
 static void pair_f8(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat) {
     sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b;
     const f8 nb = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, -0.0f, -0.0f, -0.0f, -0.0f);
     f8 G = F8_PAIR(_mm_loadu_ps(A), _mm_loadu_ps(B)), u = F8_PAIR(_mm_loadu_ps(A + 3), _mm_loadu_ps(B + 3));
-    f8 P, d, t, du, e, eu, x, w, r;
+    f8 P, d, t;
     float ha, hb, ka, kb;
     uint32_t ls = 0;
     if (L->l != 0) { ha = A[12]; hb = B[12]; ka = C->rf2 * A[13]; kb = C->rf2 * B[13]; }
@@ -483,19 +501,64 @@ static void pair_f8(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b
     t = _mm256_xor_ps(_mm256_mul_ps(d, _mm256_set1_ps(C->gh)), nb);
     d = _mm256_xor_ps(d, nb);
     G = f8_out(_mm256_add_ps(G, t), 0x77, &ls);
-    du = f8_dot3(_mm256_mul_ps(d, u));
-    e = f8_lim(_mm256_mul_ps(_mm256_sub_ps(d, _mm256_mul_ps(du, u)), F8_PAIR(_mm_set1_ps(ka), _mm_set1_ps(kb))),
-               _mm256_set1_ps(ROT_MAX));
-    eu = f8_dot3(_mm256_mul_ps(e, u));
-    x = _mm256_sub_ps(_mm256_add_ps(u, e), _mm256_mul_ps(eu, u));
-    u = _mm256_mul_ps(x, _mm256_sub_ps(_mm256_set1_ps(1.5f), _mm256_mul_ps(_mm256_set1_ps(0.5f), f8_dot3(_mm256_mul_ps(x, x)))));
-    /* back: words 0-3 = G0 G1 G2 u0, words 4-5 = u1 u2 */
-    w = _mm256_blend_ps(G, _mm256_permute_ps(u, 0), 0x88);
-    r = _mm256_permute_ps(u, _MM_SHUFFLE(3, 3, 2, 1));
-    _mm_storeu_ps(A, _mm256_castps256_ps128(w));
-    _mm_storel_pi((__m64 *)(void *)(A + 4), _mm256_castps256_ps128(r));
-    _mm_storeu_ps(B, _mm256_extractf128_ps(w, 1));
-    _mm_storel_pi((__m64 *)(void *)(B + 4), _mm256_extractf128_ps(r, 1));
+    u = f8_turn(u, d, F8_PAIR(_mm_set1_ps(ka), _mm_set1_ps(kb)));
+    f8_store(A, B, G, u, 1);
+    *sat += ls;
+}
+
+/* star() with ends 0, 1 in the halves of one vector and 2, 3 in another
+ * (k = 3: the 4th half repeats end 0, never summed, counted or stored);
+ * the mean's and the last share's sums end by end from 0 as star() */
+static void star_f8(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
+    sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const int k23 = k == 4u ? 0x77 : 0x07;
+    const f8 z = _mm256_setzero_ps();
+    f8 Ga = F8_PAIR(_mm_loadu_ps(S0), _mm_loadu_ps(S1)), ua = F8_PAIR(_mm_loadu_ps(S0 + 3), _mm_loadu_ps(S1 + 3));
+    f8 Gb = F8_PAIR(_mm_loadu_ps(S2), _mm_loadu_ps(S3)), ub = F8_PAIR(_mm_loadu_ps(S2 + 3), _mm_loadu_ps(S3 + 3));
+    /* the ends' signs as sign bits, per half (negation = star()'s -h, -kf) */
+    const __m256i sv = _mm256_castsi128_si256(_mm_cmplt_epi32(
+        _mm_setr_epi32(sgn[0], sgn[1], sgn[2], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128()));
+    const f8 sz = _mm256_set1_ps(-0.0f);
+    const f8 na = _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1))), sz);
+    const f8 nb = _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3))), sz);
+    f8 Pa, Pb, m, da, db, ta, tb, l, ha, hb, ka, kb;
+    uint32_t ls = 0;
+    if (L->l != 0) {
+        const f8 rf = _mm256_set1_ps(C->rf1);
+        ha = F8_PAIR(_mm_set1_ps(S0[12]), _mm_set1_ps(S1[12]));
+        hb = F8_PAIR(_mm_set1_ps(S2[12]), _mm_set1_ps(S3[12]));
+        ka = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S0[13]), _mm_set1_ps(S1[13])));
+        kb = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S2[13]), _mm_set1_ps(S3[13])));
+    } else {
+        ha = hb = _mm256_set1_ps(L->half);
+        ka = kb = _mm256_set1_ps(C->kf1);
+    }
+    ha = _mm256_xor_ps(ha, na); hb = _mm256_xor_ps(hb, nb);
+    ka = _mm256_xor_ps(ka, na); kb = _mm256_xor_ps(kb, nb);
+    Pa = _mm256_add_ps(Ga, _mm256_mul_ps(ha, ua));
+    Pb = _mm256_add_ps(Gb, _mm256_mul_ps(hb, ub));
+    /* low half: (((0 + P0) + P1) + P2) (+ P3) / k */
+    m = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(z, Pa), _mm256_permute2f128_ps(Pa, Pa, 0x01)), Pb);
+    if (k == 4u) m = _mm256_add_ps(m, _mm256_permute2f128_ps(Pb, Pb, 0x01));
+    m = f8_out(_mm256_div_ps(m, _mm256_set1_ps((float)k)), 0x07, &ls);
+    m = _mm256_permute2f128_ps(m, m, 0x00);
+    da = f8_out(_mm256_sub_ps(m, Pa), 0x77, &ls);
+    db = f8_out(_mm256_sub_ps(m, Pb), k23, &ls);
+    m = _mm256_set1_ps(C->g1n);
+    ta = _mm256_mul_ps(da, m);
+    tb = _mm256_mul_ps(db, m);
+    /* the last end's: ((0 - t0) - t1) (- t2), limited */
+    l = _mm256_sub_ps(_mm256_sub_ps(z, ta), _mm256_permute2f128_ps(ta, ta, 0x01));
+    if (k == 4u) l = _mm256_sub_ps(l, tb);
+    l = f8_lim(l, _mm256_set1_ps((sn_acc)2 * SN_LIM));
+    tb = k == 4u ? _mm256_insertf128_ps(tb, _mm256_castps256_ps128(l), 1) : _mm256_insertf128_ps(tb, _mm256_castps256_ps128(l), 0);
+    Ga = f8_out(_mm256_add_ps(Ga, ta), 0x77, &ls);
+    Gb = f8_out(_mm256_add_ps(Gb, tb), k23, &ls);
+    ua = f8_turn(ua, da, ka);
+    ub = f8_turn(ub, db, kb);
+    f8_store(S0, S1, Ga, ua, 1);
+    f8_store(S2, S3, Gb, ub, k == 4u);
     *sat += ls;
 }
 #endif
@@ -568,7 +631,9 @@ static void pins_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
  * for bit. Not called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
-#if defined(SEG_STAR_SSE)
+#if defined(SEG_STAR_SSE) && defined(__AVX2__)
+    if (simd) { star_f8(C, L, seg, sgn, k, sat); return; }
+#elif defined(SEG_STAR_SSE)
     if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
 #elif defined(SEG_STAR_IV)
     if (simd) { seg_star_iv(C, L, seg, sgn, k, sat); return; }
@@ -686,7 +751,9 @@ SN_INLINE void ring(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
 SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k,
                          int measure, uint32_t *sat) {
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
-#if defined(SEG_STAR_SSE)
+#if defined(SEG_STAR_SSE) && defined(__AVX2__)
+    else star_f8(C, L, seg, sgn, k, sat);
+#elif defined(SEG_STAR_SSE)
     else star_fv(C, L, seg, sgn, k, sat);
 #elif defined(SEG_STAR_IV)
     else seg_star_iv(C, L, seg, sgn, k, sat);
