@@ -562,6 +562,47 @@ static void star_f8(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     *sat += ls;
 }
 #endif
+#if defined(__AVX2__)
+/* pins_fv with ends 0-1 and 2-3 in the halves of two 8-lane vectors (k = 2:
+ * one vector; k = 3: the 4th half repeats end 0, never counted or stored) */
+SN_INLINE void pin_f8(const seg_ctx *C, sn_q *A, sn_q *B, f8 neg, f8 h, f8 kv, const f8 T, int km, int hb, uint32_t *sat) {
+    f8 G = F8_PAIR(_mm_loadu_ps(A), _mm_loadu_ps(B)), u = F8_PAIR(_mm_loadu_ps(A + 3), _mm_loadu_ps(B + 3)), d;
+    /* end_of: the offset from the positive half, added or subtracted */
+    d = f8_out(_mm256_add_ps(G, _mm256_xor_ps(_mm256_mul_ps(u, h), neg)), km, sat);
+    d = f8_out(_mm256_sub_ps(T, d), km, sat);
+    G = f8_out(_mm256_add_ps(G, f8_out(_mm256_mul_ps(d, _mm256_set1_ps(C->g1n)), km, sat)), km, sat);
+    u = f8_turn(u, d, _mm256_xor_ps(kv, neg));
+    f8_store(A, B, G, u, hb);
+}
+static void pins_f8(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                    uint32_t *sat) {
+    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1];
+    sn_q *S2 = k >= 3u ? L->S + SEG_W * seg[2] : S0, *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
+    const __m256i sv = _mm256_castsi128_si256(_mm_cmplt_epi32(
+        _mm_setr_epi32(sgn[0], sgn[1], k >= 3u ? sgn[2] : sgn[0], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128()));
+    const f8 sz = _mm256_set1_ps(-0.0f);
+    const f8 Tv = _mm256_setr_ps(T[0], T[1], T[2], 0.0f, T[0], T[1], T[2], 0.0f);
+    f8 ha, hb, ka, kb;
+    uint32_t ls = 0;
+    if (L->l != 0) {
+        const f8 rf = _mm256_set1_ps(C->rf1);
+        ha = F8_PAIR(_mm_set1_ps(S0[12]), _mm_set1_ps(S1[12]));
+        hb = F8_PAIR(_mm_set1_ps(S2[12]), _mm_set1_ps(S3[12]));
+        ka = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S0[13]), _mm_set1_ps(S1[13])));
+        kb = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S2[13]), _mm_set1_ps(S3[13])));
+    } else {
+        ha = hb = _mm256_set1_ps(L->half);
+        ka = kb = _mm256_set1_ps(C->kf1);
+    }
+    pin_f8(C, S0, S1, _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1))), sz),
+           ha, ka, Tv, 0x77, 1, &ls);
+    if (k >= 3u)
+        pin_f8(C, S2, S3, _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3))), sz),
+               hb, kb, Tv, k == 4u ? 0x77 : 0x07, k == 4u, &ls);
+    *sat += ls;
+}
+#endif
+#if !defined(__AVX2__)
 /* An attachment's pins (pin(), not measuring) on its k = 2..4 ends in the
  * lanes of star_fv's vectors (distinct segments, a fixed target: the moves
  * are independent). Per lane pin()'s floats: P = sn_out(G +- half u),
@@ -624,6 +665,7 @@ static void pins_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const i
     if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
     *sat += ls;
 }
+#endif
 #endif
 
 /* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
@@ -689,6 +731,8 @@ SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     unsigned j;
 #if defined(SEG_STAR_IV)
     if (!measure && k >= 2u && k <= 4u) { seg_pins_iv(C, L, seg, sgn, k, T, sat); return; }
+#elif defined(SEG_STAR_SSE) && defined(__AVX2__)
+    if (!measure && k >= 2u && k <= 4u) { pins_f8(C, L, seg, sgn, k, T, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure && k >= 2u && k <= 4u) { pins_fv(C, L, seg, sgn, k, T, sat); return; }
 #endif
