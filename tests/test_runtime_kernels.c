@@ -824,6 +824,42 @@ static sn_q seg_half_t(int lo, int hi) { /* 2^lo..2^hi, log-uniform */
     const sn_q x = (sn_q)(((int64_t)1 << b) + (int64_t)(rnd32() % (1u << b)));
     return x < 1 ? 1 : x;
 }
+/* the move itself (sn_segment_sweep.c move_seg: Cortex-M4 its turn in
+ * Thumb-2, turn_m4) against the portable C (move_seg_c), bit for bit with
+ * the counts: 60000 random moves, gaps within the state bound (every 8th at
+ * +-SN_LIM), translations up to 2^29, unit directions (|u| in [0.987, 1]),
+ * turn factors up to +-2^30 at random magnitudes and shifts 0..29 (the
+ * limiter's both sides and its edge), centres up to the bound. Tolerance 0. */
+static void test_seg_move(void) {
+    int t, bad = 0;
+    unsigned long sats = 0;
+    for (t = 0; t < 60000; t++) {
+        sn_q A[SEG_W], B[SEG_W], d[3], tt[3];
+        const int sh = (int)(rnd32() % 30u), mb = (int)(rnd32() % 31u);
+        const sn_q kf = (sn_q)((int64_t)rnd_in(1 << 30) >> (30 - mb));
+        uint32_t sa = 0, sb = 0, w;
+        double v[3], n2;
+        const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+        do {
+            for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        } while (n2 < 1e10);
+        for (w = 0; w < SEG_W; w++) A[w] = (sn_q)rnd32();
+        for (w = 0; w < 3; w++) {
+            A[w] = rnd32() % 8u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            A[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            d[w] = rnd32() % 8u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM) >> (rnd32() % 20u);
+            tt[w] = rnd_in(2 * SN_LIM);
+        }
+        memcpy(B, A, sizeof A);
+        seg_move_test(A, d, tt, kf, sh, 0, &sa);
+        seg_move_test(B, d, tt, kf, sh, 1, &sb);
+        bad += memcmp(A, B, sizeof A) != 0 || sa != sb;
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "segment move (path %s): %d of 60000 moves differ from move_seg_c (state or counts)", sn_kernels_name(), bad);
+    T_FIGURE("segment move: 60000 random moves, %lu clamps counted", sats);
+}
 static void test_seg_star_fixed(void) {
     static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
     seg_ctx C;
@@ -905,7 +941,7 @@ static void test_seg_star_fixed(void) {
             if (bad < 3) {
                 for (j = 0; j < 6 * SEG_W; j++)
                     if (SA[j] != SB[j]) printf("  star node %d (k %u, l %u): word %u of segment %u: %ld vs %ld\n", t, k, L.l,
-                                               j % SEG_W, j / SEG_W, (long)SA[j], (long)SB[j]);
+                                               (unsigned)(j % SEG_W), (unsigned)(j / SEG_W), (long)SA[j], (long)SB[j]);
                 printf("  counts %u vs %u\n", (unsigned)sa, (unsigned)sb);
             }
             bad++;
@@ -1480,6 +1516,7 @@ int main(void) {
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();
+    test_seg_move();
     test_seg_star_fixed();
     test_mul_out();
 #endif

@@ -361,6 +361,8 @@ void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
  * or the step's form, for the kernel test only */
 void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                    int simd, uint32_t *sat);
+/* a segment's move (d, t, turn factor, shift): the portable C (simd 0) or the step's form, for the kernel test only */
+void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat);
 /* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat);
 /* every segment's u of level L to unit length (three Newton steps) */

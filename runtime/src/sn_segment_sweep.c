@@ -62,8 +62,8 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
 #else
 #define SEG_HOT static inline
 #endif
-SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
-                        int sh, sn_acc bias, uint32_t *sat) {
+SEG_HOT void move_seg_c(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+                          int sh, sn_acc bias, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
@@ -87,6 +87,123 @@ SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1,
     S[0] = (sn_q)SEG_OUT((seg_n)S[0] + t0, sat);
     S[1] = (sn_q)SEG_OUT((seg_n)S[1] + t1, sat);
     S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
+}
+
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#define SEG_TURN_M4 1
+/* Cortex-M4 (Thumb-2, DSP): move_seg's turn (words 3-5) in one asm block,
+ * the same integers as move_seg_c with the vectors in registers: r30 as
+ * SMLAL onto the rounding bias (2^29, 0) and the two words' shift, r30s
+ * as SMMULR of 4x (|du|, |eu| < 2^29, as r30s), the turn's shift on the
+ * SMLAL sum p kf + bias with its clamp (seg_rsh, seg_lim: the low word
+ * within +-2^28 and the high word its sign), f = (3 2^60 + 2^30 - |x|^2)
+ * >> 31 by RSBS/SBC. The translation G + t stays C (move_seg). */
+/* one copy, called (inlined at its ten call sites it cost more: 3,489,197
+ * instructions per cow step against 3,483,190, and flash) */
+__attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, int32_t d2, int32_t kf, int32_t sh, int32_t bias) {
+    int32_t u0, u1, u2, a, b, c;
+#define SEG_E(d) /* e = seg_lim(seg_rsh(d kf, sh, bias), 2^28) into d */                  \
+    "mov %[a], %[bias]\n\t"                                                                \
+    "mov %[b], #0\n\t"                                                                     \
+    "smlal %[a], %[b], %[" d "], %[kf]\n\t"                                                \
+    "lsr %[a], %[a], %[sh]\n\t"                                                            \
+    "rsb %[c], %[sh], #31\n\t"                                                             \
+    "lsl %[c], %[b], %[c]\n\t"                                                             \
+    "orr %[a], %[a], %[c], lsl #1\n\t"                                                     \
+    "asr %[b], %[b], %[sh]\n\t"                                                            \
+    "add %[c], %[a], #0x10000000\n\t"                                                      \
+    "cmp %[c], #0x20000000\n\t"                                                            \
+    "bhi 1f\n\t"                                                                           \
+    "cmp %[b], %[a], asr #31\n\t"                                                          \
+    "beq 2f\n"                                                                             \
+    "1:\n\t"                                                                               \
+    "mov %[a], #0x10000000\n\t"                                                            \
+    "cmp %[b], #0\n\t"                                                                     \
+    "it lt\n\t"                                                                            \
+    "rsblt %[a], %[a], #0\n"                                                               \
+    "2:\n\t"                                                                               \
+    "mov %[" d "], %[a]\n\t"
+#define SEG_U(u, off) /* u' = r30(x f), stored */                                          \
+    "mov %[b], #0x20000000\n\t"                                                            \
+    "mov %[c], #0\n\t"                                                                     \
+    "smlal %[b], %[c], %[" u "], %[a]\n\t"                                                 \
+    "lsr %[b], %[b], #30\n\t"                                                              \
+    "orr %[b], %[b], %[c], lsl #2\n\t"                                                     \
+    "str %[b], [%[S], #" off "]\n\t"
+    __asm__ volatile(
+        "ldr %[u0], [%[S], #12]\n\t"
+        "ldr %[u1], [%[S], #16]\n\t"
+        "ldr %[u2], [%[S], #20]\n\t"
+        /* du = r30(d.u); 4 du; d_perp = d - r30s(du, u) */
+        "mov %[a], #0x20000000\n\t"
+        "mov %[b], #0\n\t"
+        "smlal %[a], %[b], %[d0], %[u0]\n\t"
+        "smlal %[a], %[b], %[d1], %[u1]\n\t"
+        "smlal %[a], %[b], %[d2], %[u2]\n\t"
+        "lsr %[a], %[a], #30\n\t"
+        "orr %[a], %[a], %[b], lsl #2\n\t"
+        "lsl %[a], %[a], #2\n\t"
+        "smmulr %[b], %[a], %[u0]\n\t"
+        "sub %[d0], %[d0], %[b]\n\t"
+        "smmulr %[b], %[a], %[u1]\n\t"
+        "sub %[d1], %[d1], %[b]\n\t"
+        "smmulr %[b], %[a], %[u2]\n\t"
+        "sub %[d2], %[d2], %[b]\n\t"
+        SEG_E("d0") SEG_E("d1") SEG_E("d2")
+        /* eu = r30(e.u); x = u + e - r30s(eu, u) */
+        "mov %[a], #0x20000000\n\t"
+        "mov %[b], #0\n\t"
+        "smlal %[a], %[b], %[d0], %[u0]\n\t"
+        "smlal %[a], %[b], %[d1], %[u1]\n\t"
+        "smlal %[a], %[b], %[d2], %[u2]\n\t"
+        "lsr %[a], %[a], #30\n\t"
+        "orr %[a], %[a], %[b], lsl #2\n\t"
+        "lsl %[a], %[a], #2\n\t"
+        "smmulr %[b], %[a], %[u0]\n\t"
+        "add %[u0], %[u0], %[d0]\n\t"
+        "sub %[u0], %[u0], %[b]\n\t"
+        "smmulr %[b], %[a], %[u1]\n\t"
+        "add %[u1], %[u1], %[d1]\n\t"
+        "sub %[u1], %[u1], %[b]\n\t"
+        "smmulr %[b], %[a], %[u2]\n\t"
+        "add %[u2], %[u2], %[d2]\n\t"
+        "sub %[u2], %[u2], %[b]\n\t"
+        /* f = (3 2^60 + 2^30 - |x|^2) >> 31 (positive) */
+        "smull %[a], %[b], %[u0], %[u0]\n\t"
+        "smlal %[a], %[b], %[u1], %[u1]\n\t"
+        "smlal %[a], %[b], %[u2], %[u2]\n\t"
+        "rsbs %[a], %[a], #0x40000000\n\t"
+        "mov %[c], #0x30000000\n\t"
+        "sbc %[b], %[c], %[b]\n\t"
+        "lsr %[a], %[a], #31\n\t"
+        "orr %[a], %[a], %[b], lsl #1\n\t"
+        SEG_U("u0", "12") SEG_U("u1", "16") SEG_U("u2", "20")
+        : [d0] "+&r"(d0), [d1] "+&r"(d1), [d2] "+&r"(d2), [kf] "+&r"(kf), [sh] "+&r"(sh), [bias] "+&r"(bias),
+          [u0] "=&r"(u0), [u1] "=&r"(u1), [u2] "=&r"(u2), [a] "=&r"(a), [b] "=&r"(b), [c] "=&r"(c)
+        : [S] "r"(S)
+        : "cc", "memory");
+#undef SEG_E
+#undef SEG_U
+}
+#endif
+/* the move as the sweeps run it: Cortex-M4 the turn in Thumb-2 (turn_m4) */
+SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+                      int sh, sn_acc bias, uint32_t *sat) {
+#if defined(SEG_TURN_M4)
+    turn_m4(S, d0, d1, d2, kf, sh, (int32_t)bias);
+    S[0] = (sn_q)SEG_OUT((seg_n)S[0] + t0, sat);
+    S[1] = (sn_q)SEG_OUT((seg_n)S[1] + t1, sat);
+    S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
+#else
+    move_seg_c(S, d0, d1, d2, t0, t1, t2, kf, sh, bias, sat);
+#endif
+}
+
+/* move_seg_c (simd 0) or move_seg (the step's), for test_runtime_kernels (not called by the step) */
+void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat) {
+    if (simd) move_seg(S, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
+    else move_seg_c(S, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
 }
 
 static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
