@@ -811,7 +811,8 @@ static void test_seg_star(void) {
  * (1-gamma) and omega gamma over their whole ranges; centres within the
  * state bound, every 8th segment at +-SN_LIM (the mean, the gaps and G + t
  * clamp), unit directions in Q30 with |u| in [0.987, 1] (the bound every
- * write of u keeps); short halves and long gaps drive the turn limiter.
+ * write of u keeps; every 8th (1/2, 1/2, 1/sqrt 2): the end offsets'
+ * rounding ties); short halves and long gaps drive the turn limiter.
  * Tolerance 0. */
 static void seg_recip_t(sn_q x, sn_q *r, sn_q *sh) { /* sn_segment_mesh.c recip(): 2^(29+b)/x, b - 1 */
     int b = 0;
@@ -900,6 +901,11 @@ static void test_seg_star_fixed(void) {
                 n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
             } while (n2 < 1e10);
             for (w = 0; w < 3; w++) S[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            if (rnd32() % 8u == 1) { /* (+-1/2, +-1/2, +-1/sqrt 2) permuted: an odd half's h u_k/2^30 is a tie */
+                const uint32_t r = rnd32() % 3u;
+                for (w = 0; w < 3; w++)
+                    S[3 + w] = (rnd32() & 1 ? 1 : -1) * (w == r ? 759250125 : (1 << 29));
+            }
             for (w = 6; w < SEG_W; w++) S[w] = (sn_q)rnd32(); /* not read but 12-14 on a coarse level */
             S[12] = seg_half_t(0, 27);
             seg_recip_t(S[12], &S[13], &S[14]);
