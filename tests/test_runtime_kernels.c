@@ -712,7 +712,8 @@ static void test_seg_move_ops(void) {
  * centres and unit directions; every 8th segment pushed to the clamps
  * (centre at +-(SN_FLIM - 0.5): the mean, the gaps and G + t clamp; half
  * lengths to 3 and turn factors to 40: the turn limiter), -0.0 components,
- * and every 64th node with a NaN centre (sn_out's replacement). Tolerance 0. */
+ * every 64th node with a NaN centre (sn_out's replacement), every 64th a
+ * NaN direction (the limiter keeps a NaN). Tolerance 0. */
 static float rnd_f(float a) { return a * ((float)(rnd32() % 2000001u) / 1000000.0f - 1.0f); }
 static void test_seg_star(void) {
     static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
@@ -754,6 +755,7 @@ static void test_seg_star(void) {
             S[13] = 1.0f / S[12];
         }
         if (t % 64 == 5) SA[SEG_W * seg[0]] = NAN;
+        if (t % 64 == 21) SA[SEG_W * seg[1] + 4] = NAN; /* a NaN direction: NaN reaches the turn limiter */
         C.rf2 = 0.5f * rf;
         C.kf0 = 0.5f * C.kf1;
         C.gh = (float)(rnd32() % 1001u) / 1000.0f;

@@ -562,15 +562,17 @@ SN_INLINE f8 f8_dot3(f8 q) {
     const f8 s = _mm256_add_ps(q, _mm256_permute_ps(q, _MM_SHUFFLE(3, 3, 3, 1)));
     return _mm256_permute_ps(_mm256_add_ps(s, _mm256_permute_ps(q, _MM_SHUFFLE(3, 3, 3, 2))), 0);
 }
-/* fv_lim, fv_out on 8 lanes */
+/* seg_lim, a > m ? m : (a < -m ? -m : a), as MINPS/MAXPS with the limit
+ * first: min(m, a) = m < a ? m : a and max(-m, r) = -m > r ? -m : r, so a
+ * NaN (every compare false) and -0.0 come through as a (fv_lim's values) */
 SN_INLINE f8 f8_lim(f8 a, f8 m) {
-    const f8 nm = _mm256_xor_ps(m, _mm256_set1_ps(-0.0f));
-    return _mm256_blendv_ps(_mm256_blendv_ps(a, nm, _mm256_cmp_ps(a, nm, _CMP_LT_OS)), m, _mm256_cmp_ps(a, m, _CMP_GT_OS));
+    return _mm256_max_ps(_mm256_xor_ps(m, _mm256_set1_ps(-0.0f)), _mm256_min_ps(m, a));
 }
+/* sn_out(v, 0) in the lanes of km: the lanes with |v| > SN_FLIM or NaN
+ * (one unordered-or-greater compare of |v|) through sn_out */
 SN_INLINE f8 f8_out(f8 v, int km, uint32_t *sat) {
-    const f8 lim = _mm256_set1_ps(SN_FLIM), nlim = _mm256_set1_ps(-SN_FLIM);
-    const int f = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(v, lim, _CMP_GT_OS), _mm256_cmp_ps(v, nlim, _CMP_LT_OS)),
-                                                  _mm256_cmp_ps(v, v, _CMP_UNORD_Q))) & km;
+    const int f = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), v), _mm256_set1_ps(SN_FLIM),
+                                                   _CMP_NLE_UQ)) & km;
     if (f) {
         float x[8];
         unsigned j;
