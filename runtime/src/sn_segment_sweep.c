@@ -376,8 +376,9 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
  * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
  * scalar star's floats and counts. */
 #include <immintrin.h>
+#if !defined(__AVX2__) /* the SSE kernels' helpers (AVX2 builds: the 8-lane ones below) */
 /* mask ? b : a per lane, mask all ones or zeros (a compare's): BLENDVPS
- * where built (SSE4.1, AVX2 builds), else bitwise (SSE2) */
+ * where built (SSE4.1), else bitwise (SSE2) */
 SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) {
 #if defined(__SSE4_1__)
     return _mm_blendv_ps(a, b, mask);
@@ -405,6 +406,7 @@ SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
     }
     return v;
 }
+#endif
 #if !defined(__AVX2__) /* AVX builds: star_f8, pair_f8 below */
 static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
     sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
