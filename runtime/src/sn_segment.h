@@ -361,6 +361,15 @@ void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
  * or the step's form, for the kernel test only */
 void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                    int simd, uint32_t *sat);
+#if defined(SN_FLOAT) && !defined(SN_SIMD_SCALAR) && (defined(__AVX2__) || (defined(__x86_64__) && defined(__SSE2__)))
+#define SEG_STAR_SSE 1
+/* float, x86-64: star(), pair() (not measuring) and an attachment's pins on
+ * its 2-4 ends in SIMD lanes, the same floats (sn_kernels_seg_fx86.c) */
+void seg_star_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat);
+void seg_pair_fx(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                 uint32_t *sat);
+#endif
 /* a segment's move (d, t, turn factor, shift): the portable C (simd 0) or the step's form, for the kernel test only */
 void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat);
 /* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
