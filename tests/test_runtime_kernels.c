@@ -735,27 +735,29 @@ static void test_seg_move_ops(void) {
 #endif
 
 #if defined(SN_FLOAT)
-/* ---- the float star projection of a sheet node (sn_segment_sweep.c): the
- * step's form (x86-64: star_fv, the ends in SSE lanes) against star()
- * itself, bit for bit with the saturation counts: 20000 random nodes of 3
+/* ---- the float star projection of a sheet node and the pair
+ * (sn_segment_sweep.c): the step's forms (x86-64: star_fv, pair_fv, the ends
+ * in SSE lanes) against star() and pair_core() bit for bit with the
+ * saturation counts (the pair: the node's first two ends): 20000 random nodes of 3
  * or 4 ends (distinct segments of 6, random signs) on level 0 and on a
  * coarse level (the segments' own half lengths and turn factors), random
  * centres and unit directions; every 8th segment pushed to the clamps
  * (centre at +-(SN_FLIM - 0.5): the mean, the gaps and G + t clamp; half
  * lengths to 3 and turn factors to 40: the turn limiter), -0.0 components,
- * and every 64th node with a NaN centre (sn_out's replacement). Tolerance 0. */
+ * every 64th node with a NaN centre (sn_out's replacement), every 64th a
+ * NaN direction (the limiter keeps a NaN). Tolerance 0. */
 static float rnd_f(float a) { return a * ((float)(rnd32() % 2000001u) / 1000000.0f - 1.0f); }
 static void test_seg_star(void) {
-    static sn_q SA[6 * SEG_W], SB[6 * SEG_W];
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
     seg_ctx C;
     seg_lvl L;
-    int t, bad = 0;
+    int t, bad = 0, bad_pair = 0, bad_pins = 0;
     unsigned long sats = 0;
     memset(&C, 0, sizeof C);
     memset(&L, 0, sizeof L);
     for (t = 0; t < 20000; t++) {
         const unsigned k = 3u + (unsigned)(t & 1);
-        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, j, w;
+        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, pa = 0, pb = 0, j, w;
         int sgn[5];
         float rf = (float)(rnd32() % 1001u) / 1000.0f;
         for (j = 5; j > 0; j--) { /* distinct segments in a random order */
@@ -785,16 +787,213 @@ static void test_seg_star(void) {
             S[13] = 1.0f / S[12];
         }
         if (t % 64 == 5) SA[SEG_W * seg[0]] = NAN;
+        if (t % 64 == 21) SA[SEG_W * seg[1] + 4] = NAN; /* a NaN direction: NaN reaches the turn limiter */
+        C.rf2 = 0.5f * rf;
+        C.kf0 = 0.5f * C.kf1;
+        C.gh = (float)(rnd32() % 1001u) / 1000.0f;
         memcpy(SB, SA, sizeof SA);
+        memcpy(SP, SA, sizeof SA);
+        memcpy(SQ, SA, sizeof SA);
+        memcpy(SQ0, SA, sizeof SA);
         L.S = SA;
         seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
         L.S = SB;
         seg_star_test(&C, &L, seg, sgn, k, 1, &sb);
         bad += memcmp(SA, SB, sizeof SA) != 0 || sa != sb;
         sats += sa;
+        L.S = SP; /* a pair of the first two ends */
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 0, &pa);
+        L.S = SQ;
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
+        bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+        sats += pa;
+        {   /* an attachment's pins on 2..4 of the ends (the target: every 8th
+             * beyond SN_FLIM, every 64th NaN) */
+            const unsigned kp = 2u + (unsigned)(t >> 2) % 3u;
+            sn_q T[3];
+            for (j = 0; j < 3; j++) T[j] = t % 8 == 6 ? rnd_f(2.0f * SN_FLIM) : rnd_f(8.0f);
+            if (t % 64 == 9) T[1] = NAN;
+            memcpy(SP, SQ0, sizeof SP);
+            memcpy(SQ, SQ0, sizeof SQ);
+            pa = pb = 0;
+            L.S = SP;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 0, &pa);
+            L.S = SQ;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 1, &pb);
+            bad_pins += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+            sats += pa;
+        }
     }
+    T_CHECK(bad_pins == 0, "float pins (path %s): %d of 20000 attachments differ from pin() (state or counts)",
+            sn_kernels_name(), bad_pins);
     T_CHECK(bad == 0, "float star (path %s): %d of 20000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
+    T_CHECK(bad_pair == 0, "float pair (path %s): %d of 20000 pairs differ from pair() (state or counts)", sn_kernels_name(),
+            bad_pair);
     T_FIGURE("float star: 20000 random nodes, %lu clamps and NaN replacements counted", sats);
+}
+#endif
+
+#if !defined(SN_FLOAT)
+/* ---- the fixed star projection of a sheet node and the pair (sn_segment_sweep.c): the
+ * step's forms (x86-64 AVX2: seg_star_iv, seg_pair_iv, the ends in int64 lanes) against
+ * star() and pair_core() bit for bit with the saturation counts (on paths
+ * without them the scalar against itself: the test still runs). 40000 random nodes of 3 or 4
+ * ends (distinct segments of 6, random signs), on level 0 (one half length
+ * 2^8..2^26, its reciprocal, shift and turn factors as seg_level and
+ * seg_sweep_prep form them) and on a coarse level (each segment's own half
+ * 1..2^27.8 with its reciprocal and shift 0..27, words 12-14), omega
+ * (1-gamma) and omega gamma over their whole ranges; centres within the
+ * state bound, every 8th segment at +-SN_LIM (the mean, the gaps and G + t
+ * clamp), unit directions in Q30 with |u| in [0.987, 1] (the bound every
+ * write of u keeps; every 8th (1/2, 1/2, 1/sqrt 2): the end offsets'
+ * rounding ties); short halves and long gaps drive the turn limiter.
+ * Tolerance 0. */
+static void seg_recip_t(sn_q x, sn_q *r, sn_q *sh) { /* sn_segment_mesh.c recip(): 2^(29+b)/x, b - 1 */
+    int b = 0;
+    while (b < 32 && ((uint64_t)x >> b) != 0) b++;
+    *r = (sn_q)(((uint64_t)1 << (29 + b)) / (uint64_t)x);
+    *sh = b - 1;
+}
+static sn_q seg_half_t(int lo, int hi) { /* 2^lo..2^hi, log-uniform */
+    const int b = lo + (int)(rnd32() % (unsigned)(hi - lo + 1));
+    const sn_q x = (sn_q)(((int64_t)1 << b) + (int64_t)(rnd32() % (1u << b)));
+    return x < 1 ? 1 : x;
+}
+/* the move itself (sn_segment_sweep.c move_seg: Cortex-M4 its turn in
+ * Thumb-2, turn_m4) against the portable C (move_seg_c), bit for bit with
+ * the counts: 60000 random moves, gaps within the state bound (every 8th at
+ * +-SN_LIM), translations up to 2^29, unit directions (|u| in [0.987, 1]),
+ * turn factors up to +-2^30 at random magnitudes and shifts 0..29 (the
+ * limiter's both sides and its edge), centres up to the bound. Tolerance 0. */
+static void test_seg_move(void) {
+    int t, bad = 0;
+    unsigned long sats = 0;
+    for (t = 0; t < 60000; t++) {
+        sn_q A[SEG_W], B[SEG_W], d[3], tt[3];
+        const int sh = (int)(rnd32() % 30u), mb = (int)(rnd32() % 31u);
+        const sn_q kf = (sn_q)((int64_t)rnd_in(1 << 30) >> (30 - mb));
+        uint32_t sa = 0, sb = 0, w;
+        double v[3], n2;
+        const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+        do {
+            for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        } while (n2 < 1e10);
+        for (w = 0; w < SEG_W; w++) A[w] = (sn_q)rnd32();
+        for (w = 0; w < 3; w++) {
+            A[w] = rnd32() % 8u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            A[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            d[w] = rnd32() % 8u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM) >> (rnd32() % 20u);
+            tt[w] = rnd_in(2 * SN_LIM);
+        }
+        memcpy(B, A, sizeof A);
+        seg_move_test(A, d, tt, kf, sh, 0, &sa);
+        seg_move_test(B, d, tt, kf, sh, 1, &sb);
+        bad += memcmp(A, B, sizeof A) != 0 || sa != sb;
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "segment move (path %s): %d of 60000 moves differ from move_seg_c (state or counts)", sn_kernels_name(), bad);
+    T_FIGURE("segment move: 60000 random moves, %lu clamps counted", sats);
+}
+static void test_seg_star_fixed(void) {
+    static sn_q SA[6 * SEG_W], SB[6 * SEG_W], SP[6 * SEG_W], SQ[6 * SEG_W], SQ0[6 * SEG_W];
+    seg_ctx C;
+    seg_lvl L;
+    int t, bad = 0, bad_pair = 0, bad_pins = 0;
+    unsigned long sats = 0;
+    memset(&C, 0, sizeof C);
+    memset(&L, 0, sizeof L);
+    for (t = 0; t < 40000; t++) {
+        const unsigned k = 3u + (unsigned)(t & 1);
+        uint32_t seg[5], perm[6] = {0, 1, 2, 3, 4, 5}, sa = 0, sb = 0, pa = 0, pb = 0, j, w;
+        int sgn[5];
+        sn_q rh, sh;
+        for (j = 5; j > 0; j--) { /* distinct segments in a random order */
+            const uint32_t r = rnd32() % (j + 1u), x = perm[j];
+            perm[j] = perm[r]; perm[r] = x;
+        }
+        for (j = 0; j < 5; j++) seg[j] = perm[j];
+        for (j = 0; j < 5; j++) sgn[j] = rnd32() & 1 ? 1 : -1;
+        L.l = (unsigned)(t >> 1 & 1);
+        L.half = seg_half_t(8, 26);
+        seg_recip_t(L.half, &rh, &sh);
+        L.rh = rh;
+        L.sh = (int)sh;
+        /* omega (1-gamma) <= 2^30, omega gamma < 2^31 (sn_segment.c) */
+        C.rf1 = (sn_q)(rnd32() % ((1u << 30) + 1u));
+        C.g1n = (seg_n)(rnd32() & 0x7FFFFFFFu);
+        C.kf1 = (seg_n)(((int64_t)C.rf1 * rh + ((int64_t)1 << 29)) >> 30);
+        C.bias0 = ((sn_acc)1 << sh) >> 1;
+        for (j = 0; j < 6; j++) {
+            sn_q *S = SA + SEG_W * j;
+            const int edge = rnd32() % 8u == 0;
+            double v[3], n2;
+            const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+            for (w = 0; w < 3; w++) S[w] = edge ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            do {
+                for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+                n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            } while (n2 < 1e10);
+            for (w = 0; w < 3; w++) S[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            if (rnd32() % 8u == 1) { /* (+-1/2, +-1/2, +-1/sqrt 2) permuted: an odd half's h u_k/2^30 is a tie */
+                const uint32_t r = rnd32() % 3u;
+                for (w = 0; w < 3; w++)
+                    S[3 + w] = (rnd32() & 1 ? 1 : -1) * (w == r ? 759250125 : (1 << 29));
+            }
+            for (w = 6; w < SEG_W; w++) S[w] = (sn_q)rnd32(); /* not read but 12-14 on a coarse level */
+            S[12] = seg_half_t(0, 27);
+            seg_recip_t(S[12], &S[13], &S[14]);
+        }
+        C.rf2 = C.rf1 >> 1;
+        C.gh = (sn_q)(rnd32() % (1u << 30));
+        C.kf0 = (seg_n)(((int64_t)C.rf2 * rh + ((int64_t)1 << 29)) >> 30);
+        memcpy(SB, SA, sizeof SA);
+        memcpy(SP, SA, sizeof SA);
+        memcpy(SQ, SA, sizeof SA);
+        memcpy(SQ0, SA, sizeof SA);
+        L.S = SA;
+        seg_star_test(&C, &L, seg, sgn, k, 0, &sa);
+        L.S = SB;
+        seg_star_test(&C, &L, seg, sgn, k, 1, &sb);
+        L.S = SP; /* a pair of the first two ends */
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 0, &pa);
+        L.S = SQ;
+        seg_pair_test(&C, &L, seg[0], sgn[0], seg[1], sgn[1], 1, &pb);
+        bad_pair += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+        sats += pa;
+        {   /* an attachment's pins on 2..4 of the ends, the target within the
+             * state bound, at it, or (every 8th) beyond (the gap's clamp) */
+            const unsigned kp = 2u + (unsigned)(t >> 2) % 3u;
+            sn_q T[3];
+            for (j = 0; j < 3; j++)
+                T[j] = t % 8 == 6 ? rnd_in(1 << 30) : (rnd32() % 16u == 0 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM));
+            memcpy(SP, SQ0, sizeof SP);
+            memcpy(SQ, SQ0, sizeof SQ);
+            pa = pb = 0;
+            L.S = SP;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 0, &pa);
+            L.S = SQ;
+            seg_pins_test(&C, &L, seg, sgn, kp, T, 1, &pb);
+            bad_pins += memcmp(SP, SQ, sizeof SP) != 0 || pa != pb;
+            sats += pa;
+        }
+        if (memcmp(SA, SB, sizeof SA) != 0 || sa != sb) {
+            if (bad < 3) {
+                for (j = 0; j < 6 * SEG_W; j++)
+                    if (SA[j] != SB[j]) printf("  star node %d (k %u, l %u): word %u of segment %u: %ld vs %ld\n", t, k, L.l,
+                                               (unsigned)(j % SEG_W), (unsigned)(j / SEG_W), (long)SA[j], (long)SB[j]);
+                printf("  counts %u vs %u\n", (unsigned)sa, (unsigned)sb);
+            }
+            bad++;
+        }
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "fixed star (path %s): %d of 40000 nodes differ from star() (state or counts)", sn_kernels_name(), bad);
+    T_CHECK(bad_pair == 0, "fixed pair (path %s): %d of 40000 pairs differ from pair() (state or counts)", sn_kernels_name(),
+            bad_pair);
+    T_CHECK(bad_pins == 0, "fixed pins (path %s): %d of 40000 attachments differ from pin() (state or counts)",
+            sn_kernels_name(), bad_pins);
+    T_FIGURE("fixed star, pair, pins: 40000 random nodes, pairs and attachments, %lu clamps counted", sats);
 }
 #endif
 
@@ -1777,6 +1976,8 @@ int main(void) {
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();
+    test_seg_move();
+    test_seg_star_fixed();
     test_mul_out();
 #endif
 #if defined(SN_FLOAT)

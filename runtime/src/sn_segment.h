@@ -343,12 +343,37 @@ void seg_attach_target(const sn_ihdr *h, const unsigned char *rec, sn_q T[3], ui
 void seg_sweep_prep(seg_ctx *C, const seg_lvl *L);
 /* one sweep in direction dir (0 up / row-major, 1 back), or (measure) the gaps it would close */
 void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat);
-#if defined(SN_FLOAT)
 /* a sheet node's star projection (k = 3, 4 ends): the scalar one (simd 0)
  * or the step's (SIMD where built), for the kernel test only */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat);
+#if !defined(SN_FLOAT) && !defined(SN_SIMD_SCALAR) && defined(__AVX2__) && defined(__x86_64__)
+#define SEG_STAR_IV 1
+/* fixed, x86-64 AVX2: star() with its ends in int64 lanes (sn_kernels_seg_avx2.c), the same bits */
+void seg_star_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat);
+/* and pair()'s two moves (not measuring) in two lanes */
+void seg_pair_iv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+/* and an attachment's pins on its k = 2..4 ends (not measuring) in lanes */
+void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                 uint32_t *sat);
 #endif
+/* an attachment's pins on k ends (not measuring): the scalar pins (simd 0)
+ * or the step's form, for the kernel test only */
+void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                   int simd, uint32_t *sat);
+#if defined(SN_FLOAT) && !defined(SN_SIMD_SCALAR) && (defined(__AVX2__) || (defined(__x86_64__) && defined(__SSE2__)))
+#define SEG_STAR_SSE 1
+/* float, x86-64: star(), pair() (not measuring) and an attachment's pins on
+ * its 2-4 ends in SIMD lanes, the same floats (sn_kernels_seg_fx86.c) */
+void seg_star_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat);
+void seg_pair_fx(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat);
+void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                 uint32_t *sat);
+#endif
+/* a segment's move (d, t, turn factor, shift): the portable C (simd 0) or the step's form, for the kernel test only */
+void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat);
+/* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
+void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat);
 /* every segment's u of level L to unit length (three Newton steps) */
 void seg_renormalize(const seg_lvl *L);
 /* the measuring pass's largest |d|^2 as a length in public Q16.16 segment lengths (or float) */

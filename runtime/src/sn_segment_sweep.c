@@ -4,9 +4,10 @@
  * in a fixed order, the measuring pass. The hot part of the segment step
  * (NUMERICS.md "Segment meshes": Sweep, "Fewer operations in the sweeps").
  * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
+ * The same moves in SIMD lanes: sn_kernels_seg_avx2.c (fixed, x86-64 AVX2),
+ * sn_kernels_seg_fx86.c (float, x86-64); the Cortex-M4 turn here (turn_m4).
  */
 #include "sn_segment.h"
-#include "sn_kernels.h" /* SN_SIMD_SCALAR, the float x86-64 star (star_fv) */
 
 /* ---------------- the displacement constraint (seed 004 §3.2) ---------------- */
 
@@ -62,8 +63,8 @@ SN_INLINE seg_n seg_kf(const seg_lvl *L, uint32_t i, int s, sn_q rf, int *sh) {
 #else
 #define SEG_HOT static inline
 #endif
-SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
-                        int sh, sn_acc bias, uint32_t *sat) {
+SEG_HOT void move_seg_c(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+                          int sh, sn_acc bias, uint32_t *sat) {
     seg_n u0 = S[3], u1 = S[4], u2 = S[5], du, e0, e1, e2, eu, x0, x1, x2, f;
     d0 = NARROW(d0); d1 = NARROW(d1); d2 = NARROW(d2); /* (32-bit products, see narrow) */
     du = NARROW(r30(MUL(d0, u0) + MUL(d1, u1) + MUL(d2, u2)));
@@ -87,6 +88,123 @@ SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1,
     S[0] = (sn_q)SEG_OUT((seg_n)S[0] + t0, sat);
     S[1] = (sn_q)SEG_OUT((seg_n)S[1] + t1, sat);
     S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
+}
+
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#define SEG_TURN_M4 1
+/* Cortex-M4 (Thumb-2, DSP): move_seg's turn (words 3-5) in one asm block,
+ * the same integers as move_seg_c with the vectors in registers: r30 as
+ * SMLAL onto the rounding bias (2^29, 0) and the two words' shift, r30s
+ * as SMMULR of 4x (|du|, |eu| < 2^29, as r30s), the turn's shift on the
+ * SMLAL sum p kf + bias with its clamp (seg_rsh, seg_lim: the low word
+ * within +-2^28 and the high word its sign), f = (3 2^60 + 2^30 - |x|^2)
+ * >> 31 by RSBS/SBC. The translation G + t stays C (move_seg). */
+/* one copy, called (inlined at its ten call sites it cost more: 3,489,197
+ * instructions per cow step against 3,483,190, and flash) */
+__attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, int32_t d2, int32_t kf, int32_t sh, int32_t bias) {
+    int32_t u0, u1, u2, a, b, c;
+#define SEG_E(d) /* e = seg_lim(seg_rsh(d kf, sh, bias), 2^28) into d */                  \
+    "mov %[a], %[bias]\n\t"                                                                \
+    "mov %[b], #0\n\t"                                                                     \
+    "smlal %[a], %[b], %[" d "], %[kf]\n\t"                                                \
+    "lsr %[a], %[a], %[sh]\n\t"                                                            \
+    "rsb %[c], %[sh], #31\n\t"                                                             \
+    "lsl %[c], %[b], %[c]\n\t"                                                             \
+    "orr %[a], %[a], %[c], lsl #1\n\t"                                                     \
+    "asr %[b], %[b], %[sh]\n\t"                                                            \
+    "add %[c], %[a], #0x10000000\n\t"                                                      \
+    "cmp %[c], #0x20000000\n\t"                                                            \
+    "bhi 1f\n\t"                                                                           \
+    "cmp %[b], %[a], asr #31\n\t"                                                          \
+    "beq 2f\n"                                                                             \
+    "1:\n\t"                                                                               \
+    "mov %[a], #0x10000000\n\t"                                                            \
+    "cmp %[b], #0\n\t"                                                                     \
+    "it lt\n\t"                                                                            \
+    "rsblt %[a], %[a], #0\n"                                                               \
+    "2:\n\t"                                                                               \
+    "mov %[" d "], %[a]\n\t"
+#define SEG_U(u, off) /* u' = r30(x f), stored */                                          \
+    "mov %[b], #0x20000000\n\t"                                                            \
+    "mov %[c], #0\n\t"                                                                     \
+    "smlal %[b], %[c], %[" u "], %[a]\n\t"                                                 \
+    "lsr %[b], %[b], #30\n\t"                                                              \
+    "orr %[b], %[b], %[c], lsl #2\n\t"                                                     \
+    "str %[b], [%[S], #" off "]\n\t"
+    __asm__ volatile(
+        "ldr %[u0], [%[S], #12]\n\t"
+        "ldr %[u1], [%[S], #16]\n\t"
+        "ldr %[u2], [%[S], #20]\n\t"
+        /* du = r30(d.u); 4 du; d_perp = d - r30s(du, u) */
+        "mov %[a], #0x20000000\n\t"
+        "mov %[b], #0\n\t"
+        "smlal %[a], %[b], %[d0], %[u0]\n\t"
+        "smlal %[a], %[b], %[d1], %[u1]\n\t"
+        "smlal %[a], %[b], %[d2], %[u2]\n\t"
+        "lsr %[a], %[a], #30\n\t"
+        "orr %[a], %[a], %[b], lsl #2\n\t"
+        "lsl %[a], %[a], #2\n\t"
+        "smmulr %[b], %[a], %[u0]\n\t"
+        "sub %[d0], %[d0], %[b]\n\t"
+        "smmulr %[b], %[a], %[u1]\n\t"
+        "sub %[d1], %[d1], %[b]\n\t"
+        "smmulr %[b], %[a], %[u2]\n\t"
+        "sub %[d2], %[d2], %[b]\n\t"
+        SEG_E("d0") SEG_E("d1") SEG_E("d2")
+        /* eu = r30(e.u); x = u + e - r30s(eu, u) */
+        "mov %[a], #0x20000000\n\t"
+        "mov %[b], #0\n\t"
+        "smlal %[a], %[b], %[d0], %[u0]\n\t"
+        "smlal %[a], %[b], %[d1], %[u1]\n\t"
+        "smlal %[a], %[b], %[d2], %[u2]\n\t"
+        "lsr %[a], %[a], #30\n\t"
+        "orr %[a], %[a], %[b], lsl #2\n\t"
+        "lsl %[a], %[a], #2\n\t"
+        "smmulr %[b], %[a], %[u0]\n\t"
+        "add %[u0], %[u0], %[d0]\n\t"
+        "sub %[u0], %[u0], %[b]\n\t"
+        "smmulr %[b], %[a], %[u1]\n\t"
+        "add %[u1], %[u1], %[d1]\n\t"
+        "sub %[u1], %[u1], %[b]\n\t"
+        "smmulr %[b], %[a], %[u2]\n\t"
+        "add %[u2], %[u2], %[d2]\n\t"
+        "sub %[u2], %[u2], %[b]\n\t"
+        /* f = (3 2^60 + 2^30 - |x|^2) >> 31 (positive) */
+        "smull %[a], %[b], %[u0], %[u0]\n\t"
+        "smlal %[a], %[b], %[u1], %[u1]\n\t"
+        "smlal %[a], %[b], %[u2], %[u2]\n\t"
+        "rsbs %[a], %[a], #0x40000000\n\t"
+        "mov %[c], #0x30000000\n\t"
+        "sbc %[b], %[c], %[b]\n\t"
+        "lsr %[a], %[a], #31\n\t"
+        "orr %[a], %[a], %[b], lsl #1\n\t"
+        SEG_U("u0", "12") SEG_U("u1", "16") SEG_U("u2", "20")
+        : [d0] "+&r"(d0), [d1] "+&r"(d1), [d2] "+&r"(d2), [kf] "+&r"(kf), [sh] "+&r"(sh), [bias] "+&r"(bias),
+          [u0] "=&r"(u0), [u1] "=&r"(u1), [u2] "=&r"(u2), [a] "=&r"(a), [b] "=&r"(b), [c] "=&r"(c)
+        : [S] "r"(S)
+        : "cc", "memory");
+#undef SEG_E
+#undef SEG_U
+}
+#endif
+/* the move as the sweeps run it: Cortex-M4 the turn in Thumb-2 (turn_m4) */
+SEG_HOT void move_seg(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t1, seg_n t2, seg_n kf,
+                      int sh, sn_acc bias, uint32_t *sat) {
+#if defined(SEG_TURN_M4)
+    turn_m4(S, d0, d1, d2, kf, sh, (int32_t)bias);
+    S[0] = (sn_q)SEG_OUT((seg_n)S[0] + t0, sat);
+    S[1] = (sn_q)SEG_OUT((seg_n)S[1] + t1, sat);
+    S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
+#else
+    move_seg_c(S, d0, d1, d2, t0, t1, t2, kf, sh, bias, sat);
+#endif
+}
+
+/* move_seg_c (simd 0) or move_seg (the step's), for test_runtime_kernels (not called by the step) */
+void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat) {
+    if (simd) move_seg(S, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
+    else move_seg_c(S, d[0], d[1], d[2], t[0], t[1], t[2], kf, sh, seg_bias(sh), sat);
 }
 
 static void seg_move(const seg_lvl *L, uint32_t i, int s, const sn_q t[3], const sn_q d[3], sn_q rf,
@@ -114,8 +232,8 @@ sn_real seg_gap(sn_len2 n2, const seg_lvl *L) {
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
  * perpendicular part */
-SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
-                  uint32_t *sat) {
+SEG_HOT void pair_core(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure,
+                       uint32_t *sat) {
     sn_q *A = L->S + SEG_W * a, *B = L->S + SEG_W * b, d[3];
     seg_n ha, hb, ka, kb, t[3];
     uint32_t ls = 0; /* local count: no aliasing with the state words */
@@ -153,6 +271,23 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
         move_seg(B, -d[0], -d[1], -d[2], -t[0], -t[1], -t[2], kb, shb, bb, &ls);
     }
     *sat += ls;
+}
+
+/* the pair as the sweeps run it: its two moves in lanes where built (fixed
+ * AVX2 seg_pair_iv, float x86-64 pair_fv) */
+SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int measure, uint32_t *sat) {
+#if defined(SEG_STAR_IV)
+    if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
+#elif defined(SEG_STAR_SSE)
+    if (!measure) { seg_pair_fx(C, L, a, sa, b, sb, sat); return; }
+#endif
+    pair_core(C, L, a, sa, b, sb, measure, sat);
+}
+
+/* pair_core (simd 0) or the step's pair, for test_runtime_kernels; not called by the step */
+void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat) {
+    if (simd) pair(C, L, a, sa, b, sb, 0, sat);
+    else pair_core(C, L, a, sa, b, sb, 0, sat);
 }
 
 /* The ends meeting at a sheet node (k >= 3) projected together towards
@@ -220,147 +355,22 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     *sat += ls;
 }
 
-#if defined(SN_FLOAT) && (defined(SN_KERNELS_FAVX2) || (defined(__x86_64__) && defined(__SSE2__) && !defined(SN_SIMD_SCALAR)))
-#define SEG_STAR_SSE 1
-#endif
-#if defined(SEG_STAR_SSE)
-/* Float, x86-64 (SSE2, the baseline; AVX2 builds the same code VEX-encoded;
- * not under SN_SIMD_SCALAR): star() with its
- * k = 3 or 4 ends in the lanes of SSE vectors (lane 3 at k = 3 repeats end
- * 0 and is never counted or stored). Every lane computes star()'s float
- * expressions in its order (((a + b) + c), separate multiplies and adds, no
- * FMA: NUMERICS.md "SIMD kernels", float flavour), the sums over the ends
- * (the mean's, the last end's share) run end by end as in star() on the
- * transposed vectors, the clamps are star()'s compares (blends, NaN kept),
- * and sn_out's rare clamped or NaN lanes go through sn_out itself: the
- * scalar star's floats and counts. */
-#include <immintrin.h>
-/* mask ? b : a per lane, mask all ones or zeros (a compare's): BLENDVPS
- * where built (SSE4.1, AVX2 builds), else bitwise (SSE2) */
-SN_INLINE __m128 fv_sel(__m128 a, __m128 b, __m128 mask) {
-#if defined(__SSE4_1__)
-    return _mm_blendv_ps(a, b, mask);
-#else
-    return _mm_or_ps(_mm_and_ps(mask, b), _mm_andnot_ps(mask, a));
-#endif
-}
-/* seg_lim: a > m ? m : (a < -m ? -m : a) (-m by the sign bit, as negation) */
-SN_INLINE __m128 fv_lim(__m128 a, __m128 m) {
-    const __m128 nm = _mm_xor_ps(m, _mm_set1_ps(-0.0f));
-    return fv_sel(fv_sel(a, nm, _mm_cmplt_ps(a, nm)), m, _mm_cmpgt_ps(a, m));
-}
-/* sn_out(v, 0) in the lanes of km: unchanged unless beyond +-SN_FLIM or NaN */
-SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
-    const __m128 lim = _mm_set1_ps(SN_FLIM), nlim = _mm_set1_ps(-SN_FLIM);
-    const int f = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(v, lim), _mm_cmplt_ps(v, nlim)),
-                                            _mm_cmpunord_ps(v, v))) & km;
-    if (f) {
-        float x[4];
-        unsigned j;
-        _mm_storeu_ps(x, v);
-        for (j = 0; j < 4; j++)
-            if (f >> j & 1) x[j] = sn_out(x[j], 0, sat);
-        v = _mm_loadu_ps(x);
-    }
-    return v;
-}
-static void star_fv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
-    sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
-    sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
-    const int km = k == 4u ? 0xF : 0x7;
-    const __m128 z = _mm_setzero_ps();
-    /* the ends' signs as sign bits (negation = the scalar's -h, -kf) */
-    const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(
-                                      _mm_setr_epi32(sgn[0], sgn[1], sgn[2], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128())),
-                                  _mm_set1_ps(-0.0f));
-    __m128 G0, G1, G2, u0, u1, u2, P0, P1, P2, R0, R1, R2, R3, m, d0, d1, d2, t0, t1, t2, last, kv, hv;
-    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
-    uint32_t ls = 0;
-    /* words 0-3 of the four segments transposed to G0, G1, G2, u0; words 4-5 by pairs */
-    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
-    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
-    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
-    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
-    if (L->l != 0) {
-        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
-        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
-    } else {
-        hv = _mm_set1_ps(L->half);
-        kv = _mm_set1_ps(C->kf1);
-    }
-    hv = _mm_xor_ps(hv, neg);
-    kv = _mm_xor_ps(kv, neg);
-    P0 = _mm_add_ps(G0, _mm_mul_ps(hv, u0));
-    P1 = _mm_add_ps(G1, _mm_mul_ps(hv, u1));
-    P2 = _mm_add_ps(G2, _mm_mul_ps(hv, u2));
-    /* the mean: per end (P_j0, P_j1, P_j2, 0), summed end by end from 0 */
-    R0 = P0; R1 = P1; R2 = P2; R3 = z;
-    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
-    m = _mm_add_ps(_mm_add_ps(_mm_add_ps(z, R0), R1), R2);
-    if (k == 4u) m = _mm_add_ps(m, R3);
-    m = fv_out(_mm_div_ps(m, _mm_set1_ps((float)k)), 0x7, &ls);
-    d0 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x00), P0), km, &ls);
-    d1 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0x55), P1), km, &ls);
-    d2 = fv_out(_mm_sub_ps(_mm_shuffle_ps(m, m, 0xAA), P2), km, &ls);
-    /* t = D omega gamma; the last end's: minus the others', end by end from 0 */
-    hv = _mm_set1_ps(C->g1n);
-    t0 = _mm_mul_ps(d0, hv); t1 = _mm_mul_ps(d1, hv); t2 = _mm_mul_ps(d2, hv);
-    R0 = t0; R1 = t1; R2 = t2; R3 = z;
-    _MM_TRANSPOSE4_PS(R0, R1, R2, R3);
-    last = _mm_sub_ps(_mm_sub_ps(z, R0), R1);
-    if (k == 4u) last = _mm_sub_ps(last, R2);
-    last = fv_lim(last, _mm_set1_ps((sn_acc)2 * SN_LIM));
-    {
-        const __m128 lm = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32((int)k - 1)));
-        t0 = fv_sel(t0, _mm_shuffle_ps(last, last, 0x00), lm);
-        t1 = fv_sel(t1, _mm_shuffle_ps(last, last, 0x55), lm);
-        t2 = fv_sel(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
-    }
-    /* move_seg per lane (kv: the ends' turn factors) */
-    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
-    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
-    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
-    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
-    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
-    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
-    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
-    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
-    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
-                    _mm_mul_ps(_mm_set1_ps(0.5f),
-                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
-    /* back: G0, G1, G2, u0 transposed to words 0-3, u1 u2 by pairs (not lane 3 at k = 3) */
-    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
-    G0 = fv_out(_mm_add_ps(G0, t0), km, &ls);
-    G1 = fv_out(_mm_add_ps(G1, t1), km, &ls);
-    G2 = fv_out(_mm_add_ps(G2, t2), km, &ls);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_unpacklo_ps(u1, u2);
-    R1 = _mm_unpackhi_ps(u1, u2);
-    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
-    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
-    _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1);
-    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
-    *sat += ls;
-}
-#endif
 
-#if defined(SN_FLOAT)
-/* star() (simd 0) or the step's form of it (star_fv where built, else
- * star) as a call: test_runtime_kernels compares the two bit for bit. Not
- * called by the step. */
+/* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
+ * built, else star) as a call: test_runtime_kernels compares the two bit
+ * for bit. Not called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
 #if defined(SEG_STAR_SSE)
-    if (simd) { star_fv(C, L, seg, sgn, k, sat); return; }
+    if (simd) { seg_star_fx(C, L, seg, sgn, k, sat); return; }
+#elif defined(SEG_STAR_IV)
+    if (simd) { seg_star_iv(C, L, seg, sgn, k, sat); return; }
 #else
     (void)simd;
 #endif
     if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
 }
-#endif
 
 /* an endpoint against a point of infinite mass: the segment takes gamma d
  * and rotates to close (1-gamma) of the perpendicular part */
@@ -398,6 +408,27 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     }
     move_seg(S, d[0], d[1], d[2], t0, t1, t2, kf, sh, bias, &ls);
     *sat += ls;
+}
+
+/* an attachment's pins on its k ends: 2..4 at once in lanes where built
+ * (seg_pins_iv, pins_fv), else one by one */
+SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                    int measure, uint32_t *sat) {
+    unsigned j;
+#if defined(SEG_STAR_IV)
+    if (!measure && k >= 2u && k <= 4u) { seg_pins_iv(C, L, seg, sgn, k, T, sat); return; }
+#elif defined(SEG_STAR_SSE)
+    if (!measure && k >= 2u && k <= 4u) { seg_pins_fx(C, L, seg, sgn, k, T, sat); return; }
+#endif
+    for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
+}
+
+/* the scalar pins (simd 0) or the step's (pins), for test_runtime_kernels; not called by the step */
+void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
+                   int simd, uint32_t *sat) {
+    unsigned j;
+    if (simd) { pins(C, L, seg, sgn, k, T, 0, sat); return; }
+    for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, 0, sat);
 }
 
 /* attachment target in the internal frame */
@@ -449,7 +480,9 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
                          int measure, uint32_t *sat) {
     if (measure || k < 3) ring(C, L, seg, sgn, k, measure, sat);
 #if defined(SEG_STAR_SSE)
-    else star_fv(C, L, seg, sgn, k, sat);
+    else seg_star_fx(C, L, seg, sgn, k, sat);
+#elif defined(SEG_STAR_IV)
+    else seg_star_iv(C, L, seg, sgn, k, sat);
 #else
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
@@ -485,7 +518,7 @@ void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t
         if (i < SEG_TCACHE) { /* the same target, clamp count and ends as computed per sweep */
             if (C->ak[i] == 0) continue;
             *sat += C->Tsat[i];
-            for (j = 0; j < C->ak[i]; j++) pin(C, L, C->aseg[i][j], C->asgn[i][j], C->T[i], measure, sat);
+            pins(C, L, C->aseg[i], C->asgn[i], C->ak[i], C->T[i], measure, sat);
             continue;
         }
         ln = level_node(M, L, sn_rd_u16(rec));
