@@ -138,6 +138,26 @@ IV_HOT void turn_iv(v4 u[3], const v4 d[3], v4 kv, v4 shv, v4 bv) {
     u[0] = r30sv(x0, f); u[1] = r30sv(x1, f); u[2] = r30sv(x2, f);
 }
 
+/* An end's level constants in the lanes (seg_kf, seg_bias): on a coarse
+ * level each segment's own half (word 12), turn factor r30s(rf, word 13),
+ * shift (word 14) and bias 2^(shift-1); on level 0 the level's half, kf,
+ * shift and bias0 in every lane. rf, kf: rf1, kf1 (star, pins) or rf2, kf0
+ * (pair). */
+IV_HOT void lvl_iv(const seg_ctx *C, const seg_lvl *L, const sn_q *S0, const sn_q *S1, const sn_q *S2, const sn_q *S3,
+                   sn_q rf, seg_n kf, v4 *hv, v4 *kv, v4 *shv, v4 *bv) {
+    if (L->l != 0) {
+        *hv = _mm256_setr_epi64x(S0[12], S1[12], S2[12], S3[12]);
+        *kv = r30sv(V64(rf), _mm256_setr_epi64x(S0[13], S1[13], S2[13], S3[13]));
+        *shv = _mm256_setr_epi64x(S0[14], S1[14], S2[14], S3[14]);
+        *bv = _mm256_srli_epi64(_mm256_sllv_epi64(V64(1), *shv), 1);
+    } else {
+        *hv = V64(L->half);
+        *kv = V64(kf);
+        *shv = V64(L->sh);
+        *bv = V64(C->bias0);
+    }
+}
+
 void seg_star_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
     sn_q *S0 = L->S + SEG_W * seg[0], *S1 = L->S + SEG_W * seg[1], *S2 = L->S + SEG_W * seg[2];
     sn_q *S3 = k == 4u ? L->S + SEG_W * seg[3] : S0;
@@ -152,17 +172,7 @@ void seg_star_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
     uint32_t ls = 0;
     unsigned c;
     load_iv(S0, S1, S2, S3, G, u);
-    if (L->l != 0) { /* a coarse end's own half, turn factor (seg_kf), shift and bias (seg_bias) */
-        hv = _mm256_setr_epi64x(S0[12], S1[12], S2[12], S3[12]);
-        kv = r30sv(V64(C->rf1), _mm256_setr_epi64x(S0[13], S1[13], S2[13], S3[13]));
-        shv = _mm256_setr_epi64x(S0[14], S1[14], S2[14], S3[14]);
-        bv = _mm256_srli_epi64(_mm256_sllv_epi64(V64(1), shv), 1);
-    } else {
-        hv = V64(L->half);
-        kv = V64(C->kf1);
-        shv = V64(L->sh);
-        bv = V64(C->bias0);
-    }
+    lvl_iv(C, L, S0, S1, S2, S3, C->rf1, C->kf1, &hv, &kv, &shv, &bv);
     hv = negv(hv, neg);
     kv = negv(kv, neg);
     IV_UNROLL3
@@ -205,17 +215,7 @@ void seg_pair_iv(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     uint32_t ls = 0;
     unsigned c;
     load_iv(A, B, A, B, G, u);
-    if (L->l != 0) {
-        hv = _mm256_setr_epi64x(A[12], B[12], A[12], B[12]);
-        kv = r30sv(V64(C->rf2), _mm256_setr_epi64x(A[13], B[13], A[13], B[13]));
-        shv = _mm256_setr_epi64x(A[14], B[14], A[14], B[14]);
-        bv = _mm256_srli_epi64(_mm256_sllv_epi64(V64(1), shv), 1);
-    } else {
-        hv = V64(L->half);
-        kv = V64(C->kf0);
-        shv = V64(L->sh);
-        bv = V64(C->bias0);
-    }
+    lvl_iv(C, L, A, B, A, B, C->rf2, C->kf0, &hv, &kv, &shv, &bv);
     hv = negv(hv, neg);
     kv = negv(kv, neg);
     IV_UNROLL3
@@ -253,17 +253,7 @@ void seg_pins_iv(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
     uint32_t ls = 0;
     unsigned c;
     load_iv(S0, S1, S2, S3, G, u);
-    if (L->l != 0) {
-        hv = _mm256_setr_epi64x(S0[12], S1[12], S2[12], S3[12]);
-        kv = r30sv(V64(C->rf1), _mm256_setr_epi64x(S0[13], S1[13], S2[13], S3[13]));
-        shv = _mm256_setr_epi64x(S0[14], S1[14], S2[14], S3[14]);
-        bv = _mm256_srli_epi64(_mm256_sllv_epi64(V64(1), shv), 1);
-    } else {
-        hv = V64(L->half);
-        kv = V64(C->kf1);
-        shv = V64(L->sh);
-        bv = V64(C->bias0);
-    }
+    lvl_iv(C, L, S0, S1, S2, S3, C->rf1, C->kf1, &hv, &kv, &shv, &bv);
     kv = negv(kv, neg);
     IV_UNROLL3
     for (c = 0; c < 3; c++) P[c] = _mm256_add_epi32(G[c], negv(r30sv(hv, u[c]), neg));

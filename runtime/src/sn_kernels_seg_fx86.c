@@ -49,6 +49,59 @@ SN_INLINE __m128 fv_out(__m128 v, int km, uint32_t *sat) {
     }
     return v;
 }
+
+/* words 0-5 of four segments (S3 may repeat S0) transposed: G the positions'
+ * x, y, z and u the directions', an end per lane */
+SN_INLINE void fv_load4(const sn_q *S0, const sn_q *S1, const sn_q *S2, const sn_q *S3, __m128 *G0, __m128 *G1,
+                        __m128 *G2, __m128 *u0, __m128 *u1, __m128 *u2) {
+    __m128 a = _mm_loadu_ps(S0), b = _mm_loadu_ps(S1), c = _mm_loadu_ps(S2), d = _mm_loadu_ps(S3), R0, R1;
+    _MM_TRANSPOSE4_PS(a, b, c, d);
+    *G0 = a; *G1 = b; *G2 = c; *u0 = d;
+    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
+    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
+    *u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
+    *u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
+}
+/* back: words 0-5 of the first n (2..4) segments */
+SN_INLINE void fv_store(sn_q *S0, sn_q *S1, sn_q *S2, sn_q *S3, __m128 G0, __m128 G1, __m128 G2, __m128 u0, __m128 u1,
+                        __m128 u2, unsigned n) {
+    __m128 R0 = _mm_unpacklo_ps(u1, u2), R1 = _mm_unpackhi_ps(u1, u2);
+    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
+    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
+    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
+    if (n >= 3u) { _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1); }
+    if (n == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+}
+/* the ends' level constants (seg_kf): a coarse end's own half (word 12) and
+ * turn factor rf s_13; level 0's half and kf in every lane */
+SN_INLINE void fv_lvl(const seg_lvl *L, const sn_q *S0, const sn_q *S1, const sn_q *S2, const sn_q *S3, sn_q rf, seg_n kf,
+                      __m128 *hv, __m128 *kv) {
+    if (L->l != 0) {
+        *hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
+        *kv = _mm_mul_ps(_mm_set1_ps(rf), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
+    } else {
+        *hv = _mm_set1_ps(L->half);
+        *kv = _mm_set1_ps(kf);
+    }
+}
+/* move_seg's turn per lane: u turned towards the gap d by the factor kv
+ * (limited), renormalized by one Newton step; move_seg's floats in order */
+SN_INLINE void fv_turn(__m128 *u0, __m128 *u1, __m128 *u2, __m128 d0, __m128 d1, __m128 d2, __m128 kv) {
+    const __m128 a = *u0, b = *u1, c = *u2;
+    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, a), _mm_mul_ps(d1, b)), _mm_mul_ps(d2, c));
+    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, a)), kv), _mm_set1_ps(ROT_MAX));
+    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, b)), kv), _mm_set1_ps(ROT_MAX));
+    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, c)), kv), _mm_set1_ps(ROT_MAX));
+    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, a), _mm_mul_ps(e1, b)), _mm_mul_ps(e2, c));
+    x0 = _mm_sub_ps(_mm_add_ps(a, e0), _mm_mul_ps(eu, a));
+    x1 = _mm_sub_ps(_mm_add_ps(b, e1), _mm_mul_ps(eu, b));
+    x2 = _mm_sub_ps(_mm_add_ps(c, e2), _mm_mul_ps(eu, c));
+    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
+                    _mm_mul_ps(_mm_set1_ps(0.5f),
+                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
+    *u0 = _mm_mul_ps(x0, fn); *u1 = _mm_mul_ps(x1, fn); *u2 = _mm_mul_ps(x2, fn);
+}
 #endif
 #if !defined(__AVX2__) /* AVX builds: star_f8, pair_f8 below */
 /* (star_fv) */
@@ -62,22 +115,9 @@ void seg_star_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
                                       _mm_setr_epi32(sgn[0], sgn[1], sgn[2], k == 4u ? sgn[3] : sgn[0]), _mm_setzero_si128())),
                                   _mm_set1_ps(-0.0f));
     __m128 G0, G1, G2, u0, u1, u2, P0, P1, P2, R0, R1, R2, R3, m, d0, d1, d2, t0, t1, t2, last, kv, hv;
-    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
     uint32_t ls = 0;
-    /* words 0-3 of the four segments transposed to G0, G1, G2, u0; words 4-5 by pairs */
-    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
-    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
-    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
-    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
-    if (L->l != 0) {
-        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
-        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
-    } else {
-        hv = _mm_set1_ps(L->half);
-        kv = _mm_set1_ps(C->kf1);
-    }
+    fv_load4(S0, S1, S2, S3, &G0, &G1, &G2, &u0, &u1, &u2);
+    fv_lvl(L, S0, S1, S2, S3, C->rf1, C->kf1, &hv, &kv);
     hv = _mm_xor_ps(hv, neg);
     kv = _mm_xor_ps(kv, neg);
     P0 = _mm_add_ps(G0, _mm_mul_ps(hv, u0));
@@ -107,29 +147,12 @@ void seg_star_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
         t2 = fv_sel(t2, _mm_shuffle_ps(last, last, 0xAA), lm);
     }
     /* move_seg per lane (kv: the ends' turn factors) */
-    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
-    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
-    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
-    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
-    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
-    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
-    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
-    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
-    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
-                    _mm_mul_ps(_mm_set1_ps(0.5f),
-                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
-    /* back: G0, G1, G2, u0 transposed to words 0-3, u1 u2 by pairs (not lane 3 at k = 3) */
-    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
+    fv_turn(&u0, &u1, &u2, d0, d1, d2, kv);
     G0 = fv_out(_mm_add_ps(G0, t0), km, &ls);
     G1 = fv_out(_mm_add_ps(G1, t1), km, &ls);
     G2 = fv_out(_mm_add_ps(G2, t2), km, &ls);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_unpacklo_ps(u1, u2);
-    R1 = _mm_unpackhi_ps(u1, u2);
-    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
-    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
-    _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1);
-    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    /* back: words 0-5 of the k ends (not lane 3 at k = 3) */
+    fv_store(S0, S1, S2, S3, G0, G1, G2, u0, u1, u2, k);
     *sat += ls;
 }
 /* pair() (not measuring) with its two moves in lanes 0 (segment a) and 1
@@ -142,7 +165,6 @@ void seg_pair_fx(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     const __m128 sz = _mm_set1_ps(-0.0f), n1 = _mm_setr_ps(0.0f, -0.0f, 0.0f, -0.0f);
     const __m128 neg = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(_mm_setr_epi32(sa, sb, sa, sb), _mm_setzero_si128())), sz);
     __m128 G0, G1, G2, u0, u1, u2, R0, R1, d0, d1, d2, kv, hv, g;
-    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
     uint32_t ls = 0;
     /* words 0-3 of A, B, A, B transposed to G0, G1, G2, u0; words 4-5 by pairs */
     G0 = _mm_loadu_ps(A); G1 = _mm_loadu_ps(B); G2 = G0; u0 = G1;
@@ -150,13 +172,7 @@ void seg_pair_fx(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(A + 4))), (const __m64 *)(const void *)(B + 4));
     u1 = _mm_shuffle_ps(R0, R0, _MM_SHUFFLE(2, 0, 2, 0));
     u2 = _mm_shuffle_ps(R0, R0, _MM_SHUFFLE(3, 1, 3, 1));
-    if (L->l != 0) {
-        hv = _mm_setr_ps(A[12], B[12], A[12], B[12]);
-        kv = _mm_mul_ps(_mm_set1_ps(C->rf2), _mm_setr_ps(A[13], B[13], A[13], B[13]));
-    } else {
-        hv = _mm_set1_ps(L->half);
-        kv = _mm_set1_ps(C->kf0);
-    }
+    fv_lvl(L, A, B, A, B, C->rf2, C->kf0, &hv, &kv);
     hv = _mm_xor_ps(hv, neg);
     kv = _mm_xor_ps(kv, neg);
     /* lane 0: P_b - P_a (lanes swapped in pairs) */
@@ -177,22 +193,8 @@ void seg_pair_fx(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, i
     d1 = _mm_xor_ps(_mm_shuffle_ps(d1, d1, 0), n1);
     d2 = _mm_xor_ps(_mm_shuffle_ps(d2, d2, 0), n1);
     /* move_seg's turn per lane (as star_fv) */
-    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
-    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
-    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
-    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
-    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
-    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
-    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
-    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
-    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
-                    _mm_mul_ps(_mm_set1_ps(0.5f),
-                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
-    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_unpacklo_ps(u1, u2);
-    _mm_storeu_ps(A, G0); _mm_storel_pi((__m64 *)(void *)(A + 4), R0);
-    _mm_storeu_ps(B, G1); _mm_storeh_pi((__m64 *)(void *)(B + 4), R0);
+    fv_turn(&u0, &u1, &u2, d0, d1, d2, kv);
+    fv_store(A, B, A, B, G0, G1, G2, u0, u1, u2, 2u);
     *sat += ls;
 }
 #endif
@@ -386,22 +388,10 @@ void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
                                       _mm_setr_epi32(sgn[0], sgn[1], k >= 3u ? sgn[2] : sgn[0], k == 4u ? sgn[3] : sgn[0]),
                                       _mm_setzero_si128())),
                                   _mm_set1_ps(-0.0f));
-    __m128 G0, G1, G2, u0, u1, u2, R0, R1, d0, d1, d2, kv, hv;
-    __m128 du, e0, e1, e2, eu, x0, x1, x2, fn;
+    __m128 G0, G1, G2, u0, u1, u2, d0, d1, d2, kv, hv;
     uint32_t ls = 0;
-    G0 = _mm_loadu_ps(S0); G1 = _mm_loadu_ps(S1); G2 = _mm_loadu_ps(S2); u0 = _mm_loadu_ps(S3);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S0 + 4))), (const __m64 *)(const void *)(S1 + 4));
-    R1 = _mm_loadh_pi(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)(S2 + 4))), (const __m64 *)(const void *)(S3 + 4));
-    u1 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(2, 0, 2, 0));
-    u2 = _mm_shuffle_ps(R0, R1, _MM_SHUFFLE(3, 1, 3, 1));
-    if (L->l != 0) {
-        hv = _mm_setr_ps(S0[12], S1[12], S2[12], S3[12]);
-        kv = _mm_mul_ps(_mm_set1_ps(C->rf1), _mm_setr_ps(S0[13], S1[13], S2[13], S3[13]));
-    } else {
-        hv = _mm_set1_ps(L->half);
-        kv = _mm_set1_ps(C->kf1);
-    }
+    fv_load4(S0, S1, S2, S3, &G0, &G1, &G2, &u0, &u1, &u2);
+    fv_lvl(L, S0, S1, S2, S3, C->rf1, C->kf1, &hv, &kv);
     kv = _mm_xor_ps(kv, neg);
     /* end_of: the offset from the positive half, added or subtracted (x - o = x + (-o)) */
     d0 = fv_out(_mm_add_ps(G0, _mm_xor_ps(_mm_mul_ps(u0, hv), neg)), km, &ls);
@@ -414,25 +404,8 @@ void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
     G0 = fv_out(_mm_add_ps(G0, fv_out(_mm_mul_ps(d0, hv), km, &ls)), km, &ls);
     G1 = fv_out(_mm_add_ps(G1, fv_out(_mm_mul_ps(d1, hv), km, &ls)), km, &ls);
     G2 = fv_out(_mm_add_ps(G2, fv_out(_mm_mul_ps(d2, hv), km, &ls)), km, &ls);
-    du = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d0, u0), _mm_mul_ps(d1, u1)), _mm_mul_ps(d2, u2));
-    e0 = fv_lim(_mm_mul_ps(_mm_sub_ps(d0, _mm_mul_ps(du, u0)), kv), _mm_set1_ps(ROT_MAX));
-    e1 = fv_lim(_mm_mul_ps(_mm_sub_ps(d1, _mm_mul_ps(du, u1)), kv), _mm_set1_ps(ROT_MAX));
-    e2 = fv_lim(_mm_mul_ps(_mm_sub_ps(d2, _mm_mul_ps(du, u2)), kv), _mm_set1_ps(ROT_MAX));
-    eu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, u0), _mm_mul_ps(e1, u1)), _mm_mul_ps(e2, u2));
-    x0 = _mm_sub_ps(_mm_add_ps(u0, e0), _mm_mul_ps(eu, u0));
-    x1 = _mm_sub_ps(_mm_add_ps(u1, e1), _mm_mul_ps(eu, u1));
-    x2 = _mm_sub_ps(_mm_add_ps(u2, e2), _mm_mul_ps(eu, u2));
-    fn = _mm_sub_ps(_mm_set1_ps(1.5f),
-                    _mm_mul_ps(_mm_set1_ps(0.5f),
-                               _mm_add_ps(_mm_add_ps(_mm_mul_ps(x0, x0), _mm_mul_ps(x1, x1)), _mm_mul_ps(x2, x2))));
-    u0 = _mm_mul_ps(x0, fn); u1 = _mm_mul_ps(x1, fn); u2 = _mm_mul_ps(x2, fn);
-    _MM_TRANSPOSE4_PS(G0, G1, G2, u0);
-    R0 = _mm_unpacklo_ps(u1, u2);
-    R1 = _mm_unpackhi_ps(u1, u2);
-    _mm_storeu_ps(S0, G0); _mm_storel_pi((__m64 *)(void *)(S0 + 4), R0);
-    _mm_storeu_ps(S1, G1); _mm_storeh_pi((__m64 *)(void *)(S1 + 4), R0);
-    if (k >= 3u) { _mm_storeu_ps(S2, G2); _mm_storel_pi((__m64 *)(void *)(S2 + 4), R1); }
-    if (k == 4u) { _mm_storeu_ps(S3, u0); _mm_storeh_pi((__m64 *)(void *)(S3 + 4), R1); }
+    fv_turn(&u0, &u1, &u2, d0, d1, d2, kv);
+    fv_store(S0, S1, S2, S3, G0, G1, G2, u0, u1, u2, k);
     *sat += ls;
 }
 #endif
