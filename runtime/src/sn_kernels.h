@@ -173,7 +173,8 @@ SN_INLINE void sn_k_zero(sn_acc *acc, uint32_t n) {
  * zeroed by the caller: per free row i, acc_i += M_ii y_i + sum over the
  * row's blocks (i,j) up to the first j >= nF of M_ij y_j, and acc_j +=
  * M_ij y_i (rp: ROWPTR, cols: COLS, md: MDIAG, mo: MOFF). Cortex-M4:
- * Thumb-2 (sn_kernels_m4.c); other paths keep pass_M_ff's loop. */
+ * Thumb-2 (sn_kernels_m4.c); x86-64 AVX2 below; the portable paths keep
+ * pass_M_ff's loop. */
 #define SN_K_MASS_FF 1
 void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
                   const sn_q *y, sn_acc *acc, uint32_t nF);
