@@ -1035,20 +1035,7 @@ void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int 
          * word is it (2^31 reads as INT32_MIN: outside +-SN_LIM, clamped by
          * the high word's sign) and |v| <= SN_LIM is the one unsigned
          * compare, without sn_k_out_w's high-word test (cow_fem step -14 k) */
-        const uint32_t bit = (uint32_t)1 << (sh - 1);
-        sn_q *const end = out + n;
-        while (out != end) {
-            const sn_q xi = *x++;
-            const int64_t p = sn_mul(s, xi) + (int64_t)bit; /* SMLAL from the rounding term */
-            const int32_t hi = (int32_t)(p >> 32);
-            int32_t q = (int32_t)(((uint32_t)p >> sh) | ((uint32_t)hi << (32 - sh)));
-            SN_RANGE(SN_WITHIN(sn_mul(s, xi), 59), "CG update product beyond 2^59", xi);
-            if ((uint32_t)q + (uint32_t)SN_LIM > 2u * (uint32_t)SN_LIM) {
-                (*sat)++;
-                q = hi < 0 ? -SN_LIM : SN_LIM;
-            }
-            *out++ = sn_add(*a++, q, sat);
-        }
+        sn_m4_axpy_hi(out, a, s, x, n, sh, sat);
     } else if (sh > 0 && sh < 32) {
         /* sn_k_out_w (sn_kernels_rot.h): the rounding add, the shift on the
          * two words and |v| <= SN_LIM as the low word within +-SN_LIM and

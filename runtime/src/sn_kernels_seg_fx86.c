@@ -234,6 +234,22 @@ SN_INLINE f8 f8_out(f8 v, int km, uint32_t *sat) {
 }
 #define F8_PAIR(lo, hi) _mm256_insertf128_ps(_mm256_castps128_ps256(lo), (hi), 1)
 /* move_seg's turn per half: u + e, e = lim((d - (d.u) u) kf), then one Newton step */
+/* the ends' level constants (seg_kf), ends 0-1 in ha / ka and 2-3 in hb /
+ * kb, an end per half: a coarse end's own half (word 12) and turn factor
+ * rf1 s_13; level 0's half and kf1 everywhere (star_f8, pins_f8) */
+SN_INLINE void f8_lvl(const seg_ctx *C, const seg_lvl *L, const sn_q *S0, const sn_q *S1, const sn_q *S2, const sn_q *S3,
+                      f8 *ha, f8 *hb, f8 *ka, f8 *kb) {
+    if (L->l != 0) {
+        const f8 rf = _mm256_set1_ps(C->rf1);
+        *ha = F8_PAIR(_mm_set1_ps(S0[12]), _mm_set1_ps(S1[12]));
+        *hb = F8_PAIR(_mm_set1_ps(S2[12]), _mm_set1_ps(S3[12]));
+        *ka = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S0[13]), _mm_set1_ps(S1[13])));
+        *kb = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S2[13]), _mm_set1_ps(S3[13])));
+    } else {
+        *ha = *hb = _mm256_set1_ps(L->half);
+        *ka = *kb = _mm256_set1_ps(C->kf1);
+    }
+}
 SN_INLINE f8 f8_turn(f8 u, f8 d, f8 kv) {
     const f8 du = f8_dot3(_mm256_mul_ps(d, u));
     const f8 e = f8_lim(_mm256_mul_ps(_mm256_sub_ps(d, _mm256_mul_ps(du, u)), kv), _mm256_set1_ps(ROT_MAX));
@@ -294,16 +310,7 @@ void seg_star_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
     const f8 nb = _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3))), sz);
     f8 Pa, Pb, m, da, db, ta, tb, l, ha, hb, ka, kb;
     uint32_t ls = 0;
-    if (L->l != 0) {
-        const f8 rf = _mm256_set1_ps(C->rf1);
-        ha = F8_PAIR(_mm_set1_ps(S0[12]), _mm_set1_ps(S1[12]));
-        hb = F8_PAIR(_mm_set1_ps(S2[12]), _mm_set1_ps(S3[12]));
-        ka = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S0[13]), _mm_set1_ps(S1[13])));
-        kb = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S2[13]), _mm_set1_ps(S3[13])));
-    } else {
-        ha = hb = _mm256_set1_ps(L->half);
-        ka = kb = _mm256_set1_ps(C->kf1);
-    }
+    f8_lvl(C, L, S0, S1, S2, S3, &ha, &hb, &ka, &kb);
     ha = _mm256_xor_ps(ha, na); hb = _mm256_xor_ps(hb, nb);
     ka = _mm256_xor_ps(ka, na); kb = _mm256_xor_ps(kb, nb);
     Pa = _mm256_add_ps(Ga, _mm256_mul_ps(ha, ua));
@@ -355,16 +362,7 @@ void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
     const f8 Tv = _mm256_setr_ps(T[0], T[1], T[2], 0.0f, T[0], T[1], T[2], 0.0f);
     f8 ha, hb, ka, kb;
     uint32_t ls = 0;
-    if (L->l != 0) {
-        const f8 rf = _mm256_set1_ps(C->rf1);
-        ha = F8_PAIR(_mm_set1_ps(S0[12]), _mm_set1_ps(S1[12]));
-        hb = F8_PAIR(_mm_set1_ps(S2[12]), _mm_set1_ps(S3[12]));
-        ka = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S0[13]), _mm_set1_ps(S1[13])));
-        kb = _mm256_mul_ps(rf, F8_PAIR(_mm_set1_ps(S2[13]), _mm_set1_ps(S3[13])));
-    } else {
-        ha = hb = _mm256_set1_ps(L->half);
-        ka = kb = _mm256_set1_ps(C->kf1);
-    }
+    f8_lvl(C, L, S0, S1, S2, S3, &ha, &hb, &ka, &kb);
     pin_f8(C, S0, S1, _mm256_and_ps(_mm256_castsi256_ps(_mm256_permutevar8x32_epi32(sv, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1))), sz),
            ha, ka, Tv, 0x77, 1, &ls);
     if (k >= 3u)

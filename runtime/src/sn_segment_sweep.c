@@ -104,6 +104,15 @@ SEG_HOT void move_seg_c(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t
  * instructions per cow step against 3,483,190, and flash) */
 __attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, int32_t d2, int32_t kf, int32_t sh, int32_t bias) {
     int32_t u0, u1, u2, a, b, c;
+#define SEG_DOTU /* a = 4 r30(d . u) (d0..d2 . u0..u2, from the rounding term 2^29): SMMULR's operand */ \
+    "mov %[a], #0x20000000\n\t"                                                           \
+    "mov %[b], #0\n\t"                                                                    \
+    "smlal %[a], %[b], %[d0], %[u0]\n\t"                                                  \
+    "smlal %[a], %[b], %[d1], %[u1]\n\t"                                                  \
+    "smlal %[a], %[b], %[d2], %[u2]\n\t"                                                  \
+    "lsr %[a], %[a], #30\n\t"                                                             \
+    "orr %[a], %[a], %[b], lsl #2\n\t"                                                    \
+    "lsl %[a], %[a], #2\n\t"
 #define SEG_E(d) /* e = seg_lim(seg_rsh(d kf, sh, bias), 2^28) into d */                  \
     "mov %[a], %[bias]\n\t"                                                                \
     "mov %[b], #0\n\t"                                                                     \
@@ -137,14 +146,7 @@ __attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, i
         "ldr %[u1], [%[S], #16]\n\t"
         "ldr %[u2], [%[S], #20]\n\t"
         /* du = r30(d.u); 4 du; d_perp = d - r30s(du, u) */
-        "mov %[a], #0x20000000\n\t"
-        "mov %[b], #0\n\t"
-        "smlal %[a], %[b], %[d0], %[u0]\n\t"
-        "smlal %[a], %[b], %[d1], %[u1]\n\t"
-        "smlal %[a], %[b], %[d2], %[u2]\n\t"
-        "lsr %[a], %[a], #30\n\t"
-        "orr %[a], %[a], %[b], lsl #2\n\t"
-        "lsl %[a], %[a], #2\n\t"
+        SEG_DOTU
         "smmulr %[b], %[a], %[u0]\n\t"
         "sub %[d0], %[d0], %[b]\n\t"
         "smmulr %[b], %[a], %[u1]\n\t"
@@ -153,14 +155,7 @@ __attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, i
         "sub %[d2], %[d2], %[b]\n\t"
         SEG_E("d0") SEG_E("d1") SEG_E("d2")
         /* eu = r30(e.u); x = u + e - r30s(eu, u) */
-        "mov %[a], #0x20000000\n\t"
-        "mov %[b], #0\n\t"
-        "smlal %[a], %[b], %[d0], %[u0]\n\t"
-        "smlal %[a], %[b], %[d1], %[u1]\n\t"
-        "smlal %[a], %[b], %[d2], %[u2]\n\t"
-        "lsr %[a], %[a], #30\n\t"
-        "orr %[a], %[a], %[b], lsl #2\n\t"
-        "lsl %[a], %[a], #2\n\t"
+        SEG_DOTU
         "smmulr %[b], %[a], %[u0]\n\t"
         "add %[u0], %[u0], %[d0]\n\t"
         "sub %[u0], %[u0], %[b]\n\t"
@@ -186,6 +181,7 @@ __attribute__((noinline)) static void turn_m4(sn_q *S, int32_t d0, int32_t d1, i
         : "cc", "memory");
 #undef SEG_E
 #undef SEG_U
+#undef SEG_DOTU
 }
 #endif
 /* the move as the sweeps run it: Cortex-M4 the turn in Thumb-2 (turn_m4) */
