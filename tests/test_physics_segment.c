@@ -1,5 +1,5 @@
 /* test_physics_segment.c -- segment meshes on the baked examples (seed 004
- * ch. 3-4; runtime/NUMERICS.md "Segment meshes"), fixed and float:
+ * ch. 3-4; runtime/SEGMENTS.md), fixed and float:
  *
  *  - zero saturations: the cow (tail chain and 5x5 two-level blanket held
  *    along its spine, settling from flat in the first steps) over the trot;

@@ -1,5 +1,5 @@
 /* test_runtime_segment.c -- segment meshes in the runtime (seed 004 ch.
- * 3-4; runtime/NUMERICS.md "Segment meshes"). Built fixed and float.
+ * 3-4; runtime/SEGMENTS.md). Built fixed and float.
  *
  *  - vs the double reference (tests/reference/segref.c, written from
  *    NUMERICS.md): a chain under gravity pinned to a moving joint.

@@ -512,7 +512,7 @@ sn_vec3 sn_quat_rotate(sn_quat q, sn_vec3 v);
  * Sheets may spread every force over coarser levels (seed 004 ch. 4): the
  * more goes to the coarse levels, the stiffer the sheet reacts as a whole.
  * The meshes step inside sn_step, after the flesh; their cost is fixed by the
- * blob (runtime/NUMERICS.md "Segment meshes"). */
+ * blob (runtime/SEGMENTS.md). */
 
 /// Kinds of segment mesh.
 typedef enum sn_segment_kind {

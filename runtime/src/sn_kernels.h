@@ -14,7 +14,7 @@
  * Fixed flavour: every path returns the same integers. A kernel's outputs
  * are sums of exact int32 x int32 -> int64 products with no rounding inside
  * the kernel, and every partial sum of any subset of those products is
- * bounded below 2^63 (NUMERICS.md "SIMD kernels"), so any summation order
+ * bounded below 2^63 (KERNELS.md "SIMD kernels"), so any summation order
  * gives the same int64. Rounding happens only in the callers, unchanged.
  * Float flavour: float sums are not associative, so the SIMD paths compute
  * each output with the reference's operations in the reference's order

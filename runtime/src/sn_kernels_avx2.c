@@ -8,7 +8,7 @@
  * halves exactly into int64 lanes (the odd slots are ignored), VPADDQ
  * accumulates. Block (a,b): L_a += B col_c * u_b[c], L_b += B row_r * u_a[r]
  * (that is B^T u_a). Same integer sums as the scalar reference in another
- * order: exact, bounded (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+ * order: exact, bounded (sn_kernels.h, KERNELS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 #include "sn_kernels_ic.h" /* sn_k_ic_rtab */

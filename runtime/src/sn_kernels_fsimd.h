@@ -10,7 +10,7 @@
  * intrinsics are separate operations, and the runtime builds in -std=c99,
  * where gcc does not contract; clang contracts only within one source
  * expression). IEEE float in every lane, round to nearest: the same float
- * as the reference, so the float hash is the scalar one (NUMERICS.md
+ * as the reference, so the float hash is the scalar one (KERNELS.md
  * "SIMD kernels", float flavour). Lane 3 holds junk from inside the block
  * (finite blob reals or their products) and is never stored or counted.
  * ARMv7 NEON is not used: its float arithmetic flushes subnormals to zero. */

@@ -4,7 +4,7 @@
  * component of both products at a time); the CG dot and axpy in C written
  * for one SMLAL per multiply-add. The same
  * exact products as the scalar reference, summed in another order
- * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+ * (sn_kernels.h, KERNELS.md "SIMD kernels"). */
 #include "sn_kernels.h"
 #include "sn_instance.h" /* bitlen64 */
 /* outside the #if: tools/amalgamate.sh inlines a header at its first
@@ -27,7 +27,7 @@
  * spilled the sums: ~100 instructions a block, here 72); each row's
  * pointers (SN_CELLK_OFFIDX's base a (13 - a) / 2 - 1) are formed here, not
  * by a C loop around a call per row ("M4 round 3"). The same exact
- * products as the reference, another order (NUMERICS.md "SIMD kernels"). */
+ * products as the reference, another order (KERNELS.md "SIMD kernels"). */
 void sn_m4_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l);
 __asm__(
     ".syntax unified\n"
@@ -213,7 +213,7 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * 6 multiply-adds (GCC's C of sn_kernels.c: ~124 a block, 36). Rows a
  * outside rows2 take the l1-only copy (l2's row unspecified, the contract).
  * The same exact products as the reference, summed in another order
- * (sn_kernels.h, NUMERICS.md "SIMD kernels"). */
+ * (sn_kernels.h, KERNELS.md "SIMD kernels"). */
 void sn_m4_cell_mul2(const unsigned char *K, const sn_q *u1, const sn_q *u2, sn_acc *l1, sn_acc *l2, uint32_t rows2);
 __asm__(
     ".syntax unified\n"

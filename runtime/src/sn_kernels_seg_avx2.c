@@ -2,7 +2,7 @@
  * (sn_segment_sweep.c star(), seed 004 §3.2) with its k = 3 or 4 ends in the
  * int64 lanes of AVX2 vectors (x86-64 AVX2 and AVX-512 builds, fixed, not
  * under SN_SIMD_SCALAR). Same integers as star(): every factor is an int32
- * (the bounds of star/move_seg, NUMERICS.md "Fixed point, bounds"), so a
+ * (the bounds of star/move_seg, SEGMENTS.md "Fixed point, bounds"), so a
  * product is one VPMULDQ of the lanes' low words; a rounded shift whose
  * result is an int32 is the low word of a LOGICAL shift (AVX2 has no 64-bit
  * arithmetic one: the low 32 bits of x >> s agree for s <= 32); int32 sums
@@ -11,7 +11,7 @@
  * shifts); the mean's sums over the ends are exact int64 sums (any order);
  * the rare clamped lanes of seg_out go through the scalar clamp with their
  * counts. The lane of a missing 4th end (k = 3) repeats end 0 and is
- * neither summed, counted nor stored. NUMERICS.md "Segment sweeps, round 2". */
+ * neither summed, counted nor stored. KERNELS.md "Segment sweeps, round 2". */
 #include "sn_segment.h"
 
 #if defined(SEG_STAR_IV)

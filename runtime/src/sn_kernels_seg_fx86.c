@@ -3,7 +3,7 @@
  * pins) in SIMD lanes: SSE (the baseline; star_fv's vectors, an end per
  * lane) and, in the AVX2 builds, 8-lane vectors with an end per 128-bit
  * half. The scalar code's floats and saturation counts (test_runtime_kernels
- * test_seg_star; NUMERICS.md "Cheaper sweeps, same bits" 6 and "Segment
+ * test_seg_star; KERNELS.md "Cheaper sweeps, same bits" 6 and "Segment
  * sweeps, round 2"). Not built under SN_SIMD_SCALAR. */
 #include "sn_segment.h"
 
@@ -14,7 +14,7 @@
  * k = 3 or 4 ends in the lanes of SSE vectors (lane 3 at k = 3 repeats end
  * 0 and is never counted or stored). Every lane computes star()'s float
  * expressions in its order (((a + b) + c), separate multiplies and adds, no
- * FMA: NUMERICS.md "SIMD kernels", float flavour), the sums over the ends
+ * FMA: KERNELS.md "SIMD kernels", float flavour), the sums over the ends
  * (the mean's, the last end's share) run end by end as in star() on the
  * transposed vectors, the clamps are star()'s compares (blends, NaN kept),
  * and sn_out's rare clamped or NaN lanes go through sn_out itself: the

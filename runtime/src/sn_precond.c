@@ -99,7 +99,7 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z
 }
 
 #if defined(SN_KERNELS_AVX2)
-/* x86-64 round 2 (AVX2, fixed; NUMERICS.md "x86-64 solve, round 2"): IC(0)
+/* x86-64 round 2 (AVX2, fixed; KERNELS.md "x86-64 solve, round 2"): IC(0)
  * without mask or scale, the per-vertex passes fused into the sweeps, the
  * same integers and clamp counts as precond_core's passes: the forward
  * sweep forms t_j = R_j^T r_j where it reaches j (y_j = sn_out(t_j - acc_j)),

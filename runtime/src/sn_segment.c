@@ -2,7 +2,7 @@
  * by displacement constraints (seed 004 ch. 3, Gascuel and Gascuel's method
  * as Palazzi applies it to surfaces), with the multilevel force distribution
  * of seed 004 ch. 4 on sheets (transfers in sn_segment_level.c). Model,
- * units and bounds: runtime/NUMERICS.md "Segment meshes (seed 004 ch. 3-4)".
+ * units and bounds: runtime/SEGMENTS.md.
  * This file: the dynamics, the velocities and the step's order; the sweeps
  * are sn_segment_sweep.c, records, topology, reset, teleport and hash
  * sn_segment_mesh.c.
@@ -15,7 +15,7 @@
  * `coarse_sweeps` on the coarser ones), velocities from the displacements,
  * prolongation to the next finer level. The sweeps' corrections may be
  * over-relaxed by omega = relax/32 (SOR on Palazzi's projection; omega 1
- * is seed 004 §3.2 as written; NUMERICS.md "Segment meshes").
+ * is seed 004 §3.2 as written; SEGMENTS.md).
  *
  * Cost per step, with S_l, N_l, E_l the segments, nodes and rod ends moved
  * at the nodes of level l (a pair 2, a star k), A the attachments, F = 1

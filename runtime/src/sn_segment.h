@@ -105,7 +105,7 @@ SN_INLINE sn_q seg_half(const seg_lvl *L, uint32_t i, sn_q *r, int *sh) {
     return S[12];
 }
 
-/* A value the bounds (NUMERICS.md "Fixed point, bounds") keep within int32 (fixed; float: float), so on
+/* A value the bounds (SEGMENTS.md "Fixed point, bounds") keep within int32 (fixed; float: float), so on
  * a 32-bit target a product of two is one 32x32->64 multiply (SMULL on a
  * Cortex-M4, not a 64x64 one); on a 64-bit target int64 (no sign
  * extensions). The same values either way: the same bits. */
@@ -291,7 +291,7 @@ SN_INLINE sn_q shr30(sn_acc a) {
  * n (3 - n^2)/2 <= 1 (equality at n = 1): an error e = n^2 - 1 becomes
  * -3e^2/4 + e^3/4. A turn of u (|u| in [0.987, 1]) by e perpendicular to u
  * with |e_k| <= 0.25 gives n^2 <= 1.1875, so the result stays in
- * [0.987, 1] (NUMERICS.md "Fixed point, bounds"); the small turns of the
+ * [0.987, 1] (SEGMENTS.md "Fixed point, bounds"); the small turns of the
  * later sweeps restore the length to the LSB, and the sweeps' end
  * renormalizes exactly (renormalize, once per segment and step). */
 SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {

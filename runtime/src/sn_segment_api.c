@@ -1,6 +1,5 @@
 /* sn_segment_api.c -- segment meshes: the validator of the three segment
- * sections (runtime/BLOB.md, bounds derived in NUMERICS.md "Segment
- * meshes") and the public calls (sinew.h, end). */
+ * sections (runtime/BLOB.md, bounds derived in SEGMENTS.md) and the public calls (sinew.h, end). */
 #include "sn_segment.h"
 
 /* |x_a - x_b| within len/1024 + 2 LSB of len (fixed; float: len/1024 + 2^-20 len):
@@ -272,7 +271,7 @@ sn_status sn_apply_segment_impulse(sn_instance *inst, uint32_t mesh, uint32_t no
     if (node >= L.nn) return SN_ERR_ARG;
     acc = L.N + NODE_W * node + 3;
     /* velocity change per step of a segment of mass m0: dv~ = J FORCE / h
-     * (NUMERICS.md "Segment meshes": FORCE F is the per-step velocity
+     * (SEGMENTS.md: FORCE F is the per-step velocity
      * change of mass m0 under F newtons for one step, and J = F h) */
     for (k = 0; k < 3; k++) {
 #if defined(SN_FLOAT)

@@ -1,8 +1,7 @@
 /* sn_segment_mesh.c -- segment meshes (seed 004 ch. 3-4): the mesh records,
  * each level's segments and nodes, which ends meet at a node, node means,
  * segments rebuilt from nodes; the state's reset, teleport and hash. No
- * per-step work beyond node means and restriction's rebuild. NUMERICS.md
- * "Segment meshes (seed 004 ch. 3-4)".
+ * per-step work beyond node means and restriction's rebuild. SEGMENTS.md.
  */
 #include "sn_segment.h"
 

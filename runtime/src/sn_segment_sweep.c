@@ -2,7 +2,7 @@
  * §3.2, Gascuel and Gascuel's method as Palazzi applies it): the moves of one
  * segment end (pair, star, pin, floor), one Gauss-Seidel sweep over a level
  * in a fixed order, the measuring pass. The hot part of the segment step
- * (NUMERICS.md "Segment meshes": Sweep, "Fewer operations in the sweeps").
+ * (SEGMENTS.md: Sweep, "Fewer operations in the sweeps").
  * Cost of a sweep: c3 E_l + c4 A + F c5 2 S_l (sn_segment.c's formula).
  * The same moves in SIMD lanes: sn_kernels_seg_avx2.c (fixed, x86-64 AVX2),
  * sn_kernels_seg_fx86.c (float, x86-64); the Cortex-M4 turn here (turn_m4).
@@ -293,7 +293,7 @@ void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b,
  * perpendicular part. At k = 2 this is pair() (D = d/2). A ring of k pairs
  * costs 2k endpoints and 2k moves; this k and k, and each end reaches the
  * node's mean in one projection instead of exchanging with its two ring
- * neighbours in turn (NUMERICS.md "Segment meshes", Sweep).
+ * neighbours in turn (SEGMENTS.md, Sweep).
  * Linear momentum exact: the last end's t is minus the sum of the others'.
  * Fixed: endpoints |G +- half u| < 2^30, their sum over k <= 5 < 2^32.4,
  * times round(2^30/k) <= 2^28.4 (k >= 3) < 2^61 (mean_k); D clamped to the

@@ -379,7 +379,7 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
 #if defined(SN_K_MASS_FF) && defined(SN_K_MASS_SK)
     /* the M4: the free blocks by the mat-vec's loop, then the skeleton
      * columns (sn_kernels.h); exact int64 sums of the same products, each
-     * partial sum within the pass's bound in any order (NUMERICS.md "M4
+     * partial sum within the pass's bound in any order (KERNELS_M4.md "M4
      * round 4") */
     if (pre) {
         sn_k_mass_ff(rp, cols, md, mo, u, acc, nF);
@@ -478,7 +478,7 @@ static void pass_M_ff(const sn_ihdr *h, const sn_q *y, const uint8_t *mask, sn_a
 /* acc += R S^_e R^T d for one cell over its free corners only (skeleton
  * corners carry no unknown: their terms are exact zeros; with mask, only the
  * corners with mask[a] != 0, the blended mode's region): the free-corner
- * product, 9 f^2 MA (NUMERICS.md "SIMD kernels"). */
+ * product, 9 f^2 MA (KERNELS.md "SIMD kernels"). */
 SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsigned char *cl, const sn_q *R, const uint8_t *mask,
                           const sn_q *d, sn_acc *acc, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);

@@ -90,7 +90,7 @@ void segref_init(segref *r, int kind, int side, const double *nodes, double len,
     }
 }
 
-/* order (NUMERICS.md "Sweep"): attachments; chain nodes up (dir 0) or down
+/* order (SEGMENTS.md "Sweep"): attachments; chain nodes up (dir 0) or down
  * (dir 1); sheet nodes row-major (dir 0) or reversed (dir 1), a node of 3 or
  * 4 ends projected towards their mean (star), a corner's 2 ends as a pair */
 static void sweep(segref *r, int measure, int dir) {
@@ -112,7 +112,7 @@ static void sweep(segref *r, int measure, int dir) {
         if (r->kind && ne >= 3 && !measure) {
             /* star: every end towards the ends' mean m, as an attachment to m:
              * t = omega gamma (m - P_j), turn closing omega (1-gamma) of its
-             * perpendicular part (NUMERICS.md "Segment meshes", node projection) */
+             * perpendicular part (SEGMENTS.md, node projection) */
             double P[4][3], m[3] = {0, 0, 0};
             for (j = 0; j < ne; j++) {
                 endp(r, seg[j], sg[j], P[j]);

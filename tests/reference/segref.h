@@ -1,5 +1,5 @@
 /* segref.h -- double-precision reference of the runtime's segment meshes
- * (runtime/NUMERICS.md "Segment meshes (seed 004 ch. 3-4)"), single level:
+ * (runtime/SEGMENTS.md), single level:
  * chains and sheets, Palazzi's displacement constraints (seed 004 §3.2)
  * with the same order of operations as the runtime (dynamics, symmetric
  * row-major node sweeps: star at sheet nodes of 3-4 ends, pairs elsewhere;
