@@ -34,8 +34,8 @@ uint64_t sn_udiv64(uint64_t n, uint64_t D) {
  * y = floor(sqrt(X)) and r = X - y^2 <= 2y, so the remainder and the trial
  * 4y + 1 stay below 2^32 for 30 steps (y < 2^29 before the 30th); only the
  * last two take 64-bit words. A 32-bit core (Cortex-M4): 12 instructions a
- * step against ~16 for the 64-bit loop below, which a 64-bit target keeps
- * (~8 a step there against ~13). */
+ * step against ~16 for a 64-bit bit loop (a 64-bit target takes the
+ * Karatsuba root below). */
 uint32_t sn_isqrt64_digits(uint64_t x) {
     uint32_t w = (uint32_t)(x >> 32), y = 0, r = 0, t;
     uint64_t r2;
@@ -119,23 +119,11 @@ uint32_t sn_isqrt64_kara(uint64_t x) {
     }
 }
 
-/* the same root by the bit-by-bit method in 64-bit words on a 64-bit target */
+/* floor(sqrt(x)): Karatsuba where a 32-bit divide is an instruction (a
+ * 64-bit target, the M4's UDIV; x86-64 cow_fem: ~90 instructions a root
+ * against the 64-bit bit loop's ~245, 21 k a step), else the digits. */
 uint32_t sn_isqrt64(uint64_t x) {
-#if UINTPTR_MAX > 0xFFFFFFFFu
-    uint64_t rem = x, root = 0, bit = (uint64_t)1 << 62;
-    int i;
-    for (i = 0; i < 32; i++) {
-        uint64_t trial = root + bit;
-        if (rem >= trial) {
-            rem -= trial;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-        bit >>= 2;
-    }
-    return (uint32_t)root;
-#elif defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__ARM_FEATURE_IDIV)
+#if UINTPTR_MAX > 0xFFFFFFFFu || (defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__ARM_FEATURE_IDIV))
     return sn_isqrt64_kara(x);
 #else
     return sn_isqrt64_digits(x);
@@ -185,6 +173,8 @@ static int sn_bitlen64(uint64_t x) {
 #if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && defined(__GNUC__)
     const uint32_t hi = (uint32_t)(x >> 32), lo = (uint32_t)x;
     return hi ? 64 - lz32(hi) : (lo ? 32 - lz32(lo) : 0);
+#elif defined(__GNUC__) && UINTPTR_MAX > 0xFFFFFFFFu
+    return x ? 64 - __builtin_clzll(x) : 0; /* one LZCNT / BSR / CLZ */
 #else
     int n = 0, s;
     for (s = 32; s > 0; s >>= 1)
