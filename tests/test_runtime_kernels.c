@@ -1791,9 +1791,9 @@ static void test_trig(void) {
 }
 #endif
 
-/* The integer square root of this build (sn_isqrt64: on the M4 image
- * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
- * hosts bit by bit) and both 32-bit methods: the exact floor, checked
+/* The integer square root of this build (sn_isqrt64: Karatsuba with a
+ * hardware 32-bit divide (the M4 image's UDIV, 64-bit hosts); 32-bit hosts
+ * the digits) and both methods: the exact floor, checked
  * analytically (r^2 <= x < (r + 1)^2 in uint64, r + 1 = 2^32 excepted),
  * tolerance 0: every method must give the same integer. Inputs: edges,
  * squares and their neighbours at every width, random widths. */
@@ -1812,6 +1812,41 @@ static void test_isqrt(void) {
                sn_isqrt64_digits(x) != r;
     }
     T_CHECK(bad == 0, "isqrt (this build's, Karatsuba, digits): %d of %d inputs not the exact floor", bad, n);
+}
+
+/* sn_udiv64 (64-bit hosts: the divide instruction; 32-bit cores, the M4
+ * image: the constant-time restoring loop): floor(n / D) for 0 < D <= 2^62,
+ * checked analytically with no division: q D <= n < (q + 1) D, the
+ * products in 128 bits from 32-bit limbs. Inputs: edges (D = 1, 2^62,
+ * n = 0, 2^64 - 1, n a multiple of D and its neighbours), random widths.
+ * Tolerance 0: the quotient is an integer. */
+static void mul64x64(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo) {
+    const uint64_t a0 = (uint32_t)a, a1 = a >> 32, b0 = (uint32_t)b, b1 = b >> 32;
+    const uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    const uint64_t mid = (p00 >> 32) + (uint32_t)p01 + (uint32_t)p10;
+    *lo = (mid << 32) | (uint32_t)p00;
+    *hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+}
+static void test_udiv64(void) {
+    static const uint64_t ed[][2] = {{0, 1}, {1, 1}, {0xFFFFFFFFFFFFFFFFull, 1}, {0xFFFFFFFFFFFFFFFFull, 0x4000000000000000ull},
+        {0x3FFFFFFFFFFFFFFFull, 0x4000000000000000ull}, {0x4000000000000000ull, 0x4000000000000000ull},
+        {0xFFFFFFFFFFFFFFFFull, 3}, {0x8000000000000000ull, 0xFFFFFFFFull}, {0x7FFFFFFF80000001ull, 0xFFFFFFFFull}};
+    int i, bad = 0, n = (int)(sizeof ed / sizeof ed[0]) + 30000;
+    for (i = 0; i < n; i++) {
+        uint64_t x, D, q, hi, lo, hi1, lo1;
+        if (i < (int)(sizeof ed / sizeof ed[0])) { x = ed[i][0]; D = ed[i][1]; }
+        else {
+            D = (((uint64_t)rnd32() << 32 | rnd32()) >> (2 + rnd32() % 62u)) | 1u; /* 1 .. 2^62 - 1 */
+            x = ((uint64_t)rnd32() << 32 | rnd32()) >> (rnd32() % 64u);
+            if (i % 3 == 0) { q = x / (D | 1u); x = q * D + (uint64_t)(int64_t)((int)(rnd32() % 3u) - 1) * (q != 0); }
+        }
+        q = sn_udiv64(x, D);
+        mul64x64(q, D, &hi, &lo);           /* q D <= x */
+        mul64x64(q + 1u, D, &hi1, &lo1);    /* (q + 1) D > x; q = 2^64 - 1 only for x = 2^64 - 1, D = 1 */
+        if (q == 0xFFFFFFFFFFFFFFFFull) bad += !(D == 1 && x == q);
+        else bad += !(hi == 0 && lo <= x) || !(hi1 > 0 || lo1 > x);
+    }
+    T_CHECK(bad == 0, "udiv64: %d of %d quotients not the exact floor", bad, n);
 }
 
 /* sn_k_cell_mul2 against the independent reference itself (not only
@@ -1970,6 +2005,7 @@ int main(void) {
     test_rot();
     test_axpy();
     test_isqrt();
+    test_udiv64();
 #if !defined(SN_FLOAT)
     test_rshr();
     test_trig();

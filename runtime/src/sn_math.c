@@ -12,11 +12,14 @@
  */
 #include "sn_internal.h"
 
-/* floor(n / D) for 0 < D <= 2^62: restoring division over the 64 bits of n
- * with no data-dependent branch (a library 64-bit divide is neither
- * constant-time nor available everywhere); the remainder stays below D, so
- * shifting it left never overflows. */
+/* floor(n / D) for 0 < D <= 2^62: on a 32-bit core, restoring division over
+ * the 64 bits of n with no data-dependent branch (libgcc's 64-bit divide is
+ * neither constant-time nor available everywhere); the remainder stays below
+ * D, so shifting it left never overflows. */
 uint64_t sn_udiv64(uint64_t n, uint64_t D) {
+#if UINTPTR_MAX > 0xFFFFFFFFu /* a 64-bit target divides in one instruction: the same quotient */
+    return n / D;
+#else
     uint64_t q = 0, r = 0;
     int i;
     for (i = 63; i >= 0; i--) {
@@ -27,6 +30,7 @@ uint64_t sn_udiv64(uint64_t n, uint64_t D) {
         q |= ge << i;
     }
     return q;
+#endif
 }
 
 /* floor(sqrt(x)) for every uint64 x, exact, by two-bit digits (same code
