@@ -134,7 +134,7 @@ static void test_isqrt(void) {
         }
         if (sn_isqrt64_digits(x) != r && bad++ < 5) /* the 32-bit targets' method, here too */
             T_CHECK(0, "isqrt_digits(%llu) = %u", (unsigned long long)x, sn_isqrt64_digits(x));
-        if (sn_isqrt64_kara(x) != r && bad++ < 5) /* the Cortex-M method, here too */
+        if (sn_isqrt64_kara(x) != r && bad++ < 5) /* Karatsuba (M4, 64-bit hosts: this build's) */
             T_CHECK(0, "isqrt_kara(%llu) = %u", (unsigned long long)x, sn_isqrt64_kara(x));
     }
     T_CHECK(bad == 0, "isqrt: %d of %d inputs not the exact floor", bad, (int)i);
