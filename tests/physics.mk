@@ -345,6 +345,16 @@ $(BUILD)/tests/test_runtime_frames_float: tests/test_runtime_frames.c $(PHYS_HDR
 	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_frames $(BUILD)/tests/test_runtime_frames_float
 
+# The embedded surface's output (sn_embed.c: the plain lattice's own loop)
+# against the general path bit for bit and the double embedding.
+$(BUILD)/tests/test_runtime_surface: tests/test_runtime_surface.c $(PHYS_HDRS) $(SN_LIB_FIXED) $(EX)/cow.blob $(EX)/beast.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -o $@ $< $(SN_LIB_FIXED) -lm
+$(BUILD)/tests/test_runtime_surface_float: tests/test_runtime_surface.c $(PHYS_HDRS) $(SN_LIB_FLOAT) $(EX)/cow_float.blob $(EX)/beast_float.blob
+	@mkdir -p $(@D)
+	$(CC) $(PHYS_CFLAGS) -Iruntime/src -DSN_FLOAT -o $@ $< $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_surface $(BUILD)/tests/test_runtime_surface_float
+
 # make seg-study (issue 15): the segment meshes' gap through the cow's trot for
 # blobs given in SEG_BLOBS (default: the cow, fixed and float); tests/scripts/seg_study.sh
 # bakes the sweep-count variants.

@@ -19,8 +19,9 @@ void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
 }
 
 /* Trilinear weights phi_a (Q30 / float, summing to one) of a cell's 8
- * corners at coordinates t (Q15), corner a at bits (x, y, z). */
-void sn_trilinear(const uint32_t t[3], sn_q phi[8]) {
+ * corners at coordinates t (Q15), corner a at bits (x, y, z). Inlined into
+ * the surface loop below; sn_trilinear for everyone else. */
+SN_INLINE void tri_w(const uint32_t t[3], sn_q phi[8]) {
     /* the four x-y products once (each two corners' first factor, in the
      * order of wx * wy * wz: the same values), written out (no index
      * arithmetic); t <= 32768 (validated), so wx * wy <= 2^30 fits 32 bits */
@@ -40,6 +41,7 @@ void sn_trilinear(const uint32_t t[3], sn_q phi[8]) {
 #endif
 #undef SN_TRI
 }
+void sn_trilinear(const uint32_t t[3], sn_q phi[8]) { tri_w(t, phi); }
 
 /* Current position (internal) of surface vertex s: trilinear in its cell
  * (seed 000 §3.1); on the cut level, in its child (cut_point). A convex
@@ -65,6 +67,51 @@ void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
     for (k = 0; k < 3; k++) out[k] = sn_out(acc[k], SN_Q_ROT, &dummy);
 }
 
+/* sn_surface_point and sn_pub_point for the plain lattice (no cut level, so
+ * no details), a run of vertices at a time: the level tests leave the loop,
+ * the weights and the 24 products are written out (each component's sum in
+ * the order a = 0..7, as there: the same floats; fixed: exact int64 sums)
+ * and the public scale is read once. x86-64 cow_fem: 273 instructions a
+ * vertex against 477 (fixed), 193 against 391 (float); test_runtime_surface. */
+static void surface_plain(const sn_ihdr *h, uint32_t first, uint32_t count, sn_vec3 *out) {
+    const unsigned char *emb = h->v.sec[SN_SEC_EMBED], *cells = h->v.sec[SN_SEC_CELLS];
+    const sn_q *pos = CARR(h, o_pos, sn_q);
+#if defined(SN_FLOAT)
+    const float o0 = h->origin[0], o1 = h->origin[1], o2 = h->origin[2], sc = h->to_pub;
+#else
+    const int sh = h->v.len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+    const int64_t o0 = h->origin[0], o1 = h->origin[1], o2 = h->origin[2];
+#endif
+    uint32_t i, a, dummy = 0;
+    for (i = 0; i < count; i++) {
+        const unsigned char *e = emb + (size_t)(first + i) * SN_ELEM_EMBED;
+        const unsigned char *cell = cells + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
+        uint32_t t[3];
+        sn_q phi[8], p0, p1, p2;
+        sn_acc x = 0, y = 0, z = 0;
+        t[0] = sn_rd_u16(e + 2); t[1] = sn_rd_u16(e + 4); t[2] = sn_rd_u16(e + 6);
+        tri_w(t, phi);
+        for (a = 0; a < 8; a++) {
+            const sn_q *pv = pos + 3 * sn_rd_u16(cell + 2 * a);
+            x += sn_mul(phi[a], pv[0]); y += sn_mul(phi[a], pv[1]); z += sn_mul(phi[a], pv[2]);
+        }
+        p0 = sn_out(x, SN_Q_ROT, &dummy); p1 = sn_out(y, SN_Q_ROT, &dummy); p2 = sn_out(z, SN_Q_ROT, &dummy);
+#if defined(SN_FLOAT)
+        out[i].x = o0 + p0 * sc; out[i].y = o1 + p1 * sc; out[i].z = o2 + p2 * sc;
+#else
+        if (sh >= 0) {
+            out[i].x = clamp32(o0 + (int64_t)p0 * ((int64_t)1 << sh));
+            out[i].y = clamp32(o1 + (int64_t)p1 * ((int64_t)1 << sh));
+            out[i].z = clamp32(o2 + (int64_t)p2 * ((int64_t)1 << sh));
+        } else {
+            out[i].x = clamp32(o0 + sn_rshr64(p0, -sh));
+            out[i].y = clamp32(o1 + sn_rshr64(p1, -sh));
+            out[i].z = clamp32(o2 + sn_rshr64(p2, -sh));
+        }
+#endif
+    }
+}
+
 sn_status sn_get_lattice(const sn_instance *inst, sn_vec3 *out, uint32_t first, uint32_t count) {
     const sn_ihdr *h;
     const sn_q *pos;
@@ -85,11 +132,14 @@ sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, 
     h = chdr_of(inst);
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (first > h->v.nS || count > h->v.nS - first) return SN_ERR_ARG;
-    for (s = 0; s < count; s++) {
-        sn_q p[3];
-        sn_surface_point(h, first + s, p);
-        sn_pub_point(h, p, out + s);
-    }
+    if (h->v.cut) {
+        for (s = 0; s < count; s++) {
+            sn_q p[3];
+            sn_surface_point(h, first + s, p);
+            sn_pub_point(h, p, out + s);
+        }
+    } else
+        surface_plain(h, first, count, out);
     return SN_OK;
 }
 

@@ -1,0 +1,133 @@
+/* test_runtime_surface.c -- sn_get_surface (sn_embed.c): on the plain
+ * lattice a loop of its own (surface_plain: the level tests out of the
+ * loop, the weights and products written out). Checked after 30 steps of
+ * the cow's and the beast's animations (rotated, moving cells):
+ * - against the general path, a vertex at a time (sn_surface_point then
+ *   sn_pub_point, what the cut level still runs): tolerance 0 (the same
+ *   integers; float: each component's sum in the same order), for the whole
+ *   surface and for a run in the middle (first > 0);
+ * - against the double-precision embedding of seed 000 §3.1,
+ *   x = origin + sum_a phi_a(t) p_a with phi_a exact from t (Q15) and p_a the
+ *   internal lattice positions. Fixed tolerance, in public units: each
+ *   Q30 weight is within 2^-31 of its exact value, so the sum is within
+ *   2^-31 sum_a |p_a| internal units, plus 1/2 for rounding it to an
+ *   internal unit; times 2^sh (sh = len_shift - (22 - LEN_FRAC)) and 1/2
+ *   more when sh < 0 rounds it. Float: 2^-20 of max(|origin|, sum |p_a|
+ *   scaled): at most 16 roundings of 2^-24 relative reach the result (a
+ *   weight's two products, its product with p_a, 8 sums, the scale and the
+ *   origin's sum).
+ * - a positive control: one corner position changed in the instance moves
+ *   the vertices it carries (so a loop that ignored positions would fail).
+ */
+#include "sn_test.h"
+#include "reference/phys_util.h"
+#include "reference/phys_pose.h"
+#include "sn_instance.h"
+
+typedef void (*pose_fn_t)(const sn_blob *, unsigned, unsigned, double, sn_xform *);
+
+static unsigned rd16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
+
+static int same_vec(const sn_vec3 *a, const sn_vec3 *b) {
+    return memcmp(&a->x, &b->x, sizeof a->x) == 0 && memcmp(&a->y, &b->y, sizeof a->y) == 0 &&
+           memcmp(&a->z, &b->z, sizeof a->z) == 0;
+}
+
+/* vertices of out[0..n) (surface vertices first..) not equal to the general path's */
+static unsigned general_bad(const sn_ihdr *h, const sn_vec3 *out, uint32_t first, uint32_t n) {
+    unsigned s, bad = 0;
+    for (s = 0; s < n; s++) {
+        sn_q p[3];
+        sn_vec3 g;
+        sn_surface_point(h, first + s, p);
+        sn_pub_point(h, p, &g);
+        bad += !same_vec(&g, out + s);
+    }
+    return bad;
+}
+
+static void asset(const char *name, pose_fn_t pf) {
+    char path[512], nm[64];
+    pu_rt rt;
+    unsigned k, s, nJ, bad, nS, far = 0, moved = 0;
+    sn_xform *pose;
+    sn_vec3 *out, *mid;
+    double h, worst = 0;
+    snprintf(nm, sizeof nm, "%s%s", name, PU_BLOB_SUFFIX);
+    pu_example(path, sizeof path, nm);
+    if (pu_rt_open(&rt, path) != 0) { T_CHECK(0, "%s: cannot open", path); return; }
+    nJ = rt.info.joints;
+    nS = rt.info.surface_vertices;
+    h = pu_len(rt.info.timestep);
+    pose = malloc(nJ * sizeof *pose);
+    out = malloc(nS * sizeof *out);
+    mid = malloc(nS * sizeof *mid);
+    for (k = 0; k < 30; k++) { pf(rt.blob, nJ, k, h, pose); sn_set_pose(rt.inst, pose, nJ); sn_step(rt.inst); }
+    {
+        const sn_ihdr *hd = (const sn_ihdr *)(const void *)rt.inst;
+        const sn_view *v = &hd->v;
+        const sn_q *pos = CARR(hd, o_pos, sn_q);
+        const uint32_t first = nS / 3, cnt = nS / 2;
+        T_CHECK(!v->cut, "%s: a plain lattice (the fast path)", name);
+        T_CHECK(sn_get_surface(rt.inst, out, 0, nS) == SN_OK, "%s: sn_get_surface", name);
+        bad = general_bad(hd, out, 0, nS);
+        T_CHECK(bad == 0, "%s: %u of %u surface vertices differ from the general path", name, bad, nS);
+        T_CHECK(sn_get_surface(rt.inst, mid, first, cnt) == SN_OK, "%s: sn_get_surface from %u", name, first);
+        for (s = 0, bad = 0; s < cnt; s++) bad += !same_vec(mid + s, out + first + s);
+        T_CHECK(bad == 0, "%s: a run from vertex %u: %u of %u differ from the whole surface's", name, first, bad, cnt);
+        for (s = 0; s < nS; s++) { /* the double-precision embedding */
+            const unsigned char *e = v->sec[SN_SEC_EMBED] + (size_t)s * SN_ELEM_EMBED;
+            const unsigned char *cell = v->sec[SN_SEC_CELLS] + (size_t)rd16(e) * SN_ELEM_CELLS;
+            double t[3], ref[3] = {0, 0, 0}, mag = 0, tol, got[3];
+            unsigned a, q;
+            for (q = 0; q < 3; q++) t[q] = rd16(e + 2 + 2 * q) / 32768.0;
+            for (a = 0; a < 8; a++) {
+                const double phi = ((a & 1) ? t[0] : 1 - t[0]) * ((a & 2) ? t[1] : 1 - t[1]) * ((a & 4) ? t[2] : 1 - t[2]);
+                const unsigned vx = rd16(cell + 2 * a);
+                for (q = 0; q < 3; q++) { ref[q] += phi * (double)pos[3 * vx + q]; mag += fabs((double)pos[3 * vx + q]); }
+            }
+            got[0] = (double)out[s].x; got[1] = (double)out[s].y; got[2] = (double)out[s].z;
+#if defined(SN_FLOAT)
+            mag = mag * fabs((double)hd->to_pub);
+            for (q = 0; q < 3; q++) {
+                const double o = (double)hd->origin[q], r = o + ref[q] * (double)hd->to_pub, d = fabs(got[q] - r);
+                tol = ldexp(fabs(o) > mag ? fabs(o) : mag, -20);
+                if (d / tol > worst) worst = d / tol;
+                far += !(d <= tol);
+            }
+#else
+            {
+                const int sh = v->len_shift - (SN_Q_LEN - SN_LEN_FRAC);
+                tol = (ldexp(mag, -31) + 0.5) * ldexp(1.0, sh) + (sh < 0 ? 0.5 : 0.0);
+                for (q = 0; q < 3; q++) {
+                    const double r = (double)hd->origin[q] + ldexp(ref[q], sh), d = fabs(got[q] - r);
+                    if (d / tol > worst) worst = d / tol;
+                    far += !(d <= tol);
+                }
+            }
+#endif
+        }
+        T_CHECK(far == 0, "%s: %u components beyond the tolerance of the double embedding (worst %.3f of it)", name, far, worst);
+        T_FIGURE("%s: %u surface vertices bit for bit with the general path; against double, worst %.3f of the tolerance",
+                 name, nS, worst);
+        {   /* control: one lattice corner moved by 2^-4 of a cell moves the vertices it carries */
+            sn_q *pw = (sn_q *)(void *)(uintptr_t)(const void *)pos;
+            const unsigned vx = rd16(v->sec[SN_SEC_CELLS] + (size_t)rd16(v->sec[SN_SEC_EMBED]) * SN_ELEM_CELLS);
+            const sn_q keep = pw[3 * vx];
+            pw[3 * vx] = keep + (sn_q)(v->cell / 16);
+            sn_get_surface(rt.inst, mid, 0, nS);
+            for (s = 0; s < nS; s++) moved += !same_vec(mid + s, out + s);
+            pw[3 * vx] = keep;
+            T_CHECK(moved > 0, "%s: control: a corner moved, %u surface vertices follow (want > 0)", name, moved);
+            T_CHECK(general_bad(hd, mid, 0, nS) > 0 || moved == 0, "%s: control: the general path sees the restored corner", name);
+        }
+    }
+    free(pose); free(out); free(mid);
+    pu_rt_close(&rt);
+}
+
+int main(void) {
+    asset("cow", pu_cow_pose);
+    asset("beast", pu_beast_pose);
+    return T_END();
+}
