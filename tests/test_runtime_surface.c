@@ -18,6 +18,19 @@
  *   origin's sum).
  * - a positive control: one corner position changed in the instance moves
  *   the vertices it carries (so a loop that ignored positions would fail).
+ * sn_get_normals on that surface against the double-precision area-weighted
+ * normal (the sum of the triangles' cross products at each vertex, then
+ * unit length), per vertex within a bound derived from the arithmetic: the
+ * direction moves by at most 2 E / |S| for an error E of the sum S, plus
+ * the unit step's own (fixed: 2^-28, float: 2^-20). Fixed: each face's
+ * cross product is exact in int64 and rounded once to the mesh's shift
+ * (2^shift <= 2^-23 of the largest component, so E <= k sqrt 3 2^-24 max
+ * for k faces at the vertex). Float: each edge difference and cross product
+ * term rounds (E <= sum_f 6 2^-24 |e1||e2|) and the k sums add
+ * k 2^-24 sum_f |n_f|. Float also: the 4-lane unit step (sn_kernels_fnorm.c)
+ * against the scalar one bit for bit on crafted sums: zero, -0, tiny
+ * (below the 1e-30 cut), subnormal, huge, infinite and NaN components, a
+ * count that leaves a tail.
  */
 #include "sn_test.h"
 #include "reference/phys_util.h"
@@ -45,6 +58,77 @@ static unsigned general_bad(const sn_ihdr *h, const sn_vec3 *out, uint32_t first
     }
     return bad;
 }
+
+/* sn_get_normals against the double area-weighted normals (bound above);
+ * returns the vertices beyond it, *worst the largest error / bound */
+static unsigned normals_bad(const sn_ihdr *h, const sn_vec3 *pos, const sn_vec3 *nrm, double *worst) {
+    const unsigned char *tris = h->v.sec[SN_SEC_TRIS];
+    const unsigned nS = h->v.nS, nT = h->v.nT;
+    double *S = calloc(3u * nS, sizeof *S), *E = calloc(nS, sizeof *E), *A = calloc(nS, sizeof *A), maxn = 0;
+    unsigned *k = calloc(nS, sizeof *k), t, i, bad = 0;
+    for (t = 0; t < nT; t++) {
+        const unsigned v[3] = {rd16(tris + 6 * t), rd16(tris + 6 * t + 2), rd16(tris + 6 * t + 4)};
+        double e1[3], e2[3], n[3], l1, l2, an;
+        unsigned q;
+        e1[0] = (double)pos[v[1]].x - pos[v[0]].x; e1[1] = (double)pos[v[1]].y - pos[v[0]].y; e1[2] = (double)pos[v[1]].z - pos[v[0]].z;
+        e2[0] = (double)pos[v[2]].x - pos[v[0]].x; e2[1] = (double)pos[v[2]].y - pos[v[0]].y; e2[2] = (double)pos[v[2]].z - pos[v[0]].z;
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1]; n[1] = e1[2] * e2[0] - e1[0] * e2[2]; n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]); l2 = sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+        an = fabs(n[0]) + fabs(n[1]) + fabs(n[2]);
+        for (q = 0; q < 3; q++) if (fabs(n[q]) > maxn) maxn = fabs(n[q]);
+        for (q = 0; q < 3; q++) {
+            S[3 * v[q]] += n[0]; S[3 * v[q] + 1] += n[1]; S[3 * v[q] + 2] += n[2];
+            E[v[q]] += 6.0 * ldexp(l1 * l2, -24); A[v[q]] += an; k[v[q]]++;
+        }
+    }
+    for (i = 0; i < nS; i++) {
+        const double len = sqrt(S[3 * i] * S[3 * i] + S[3 * i + 1] * S[3 * i + 1] + S[3 * i + 2] * S[3 * i + 2]);
+#if defined(SN_FLOAT)
+        const double err = E[i] + k[i] * ldexp(A[i], -24), own = ldexp(1.0, -20), one = 1.0;
+#else
+        const double err = k[i] * sqrt(3.0) * ldexp(maxn, -24), own = ldexp(1.0, -28), one = 1073741824.0;
+#endif
+        double tol, d = 0, g[3];
+        unsigned q;
+        if (k[i] == 0 || !(len > 0)) continue; /* no face, or a degenerate sum: no direction to compare */
+        tol = 2.0 * err / len + own;
+        g[0] = (double)nrm[i].x / one; g[1] = (double)nrm[i].y / one; g[2] = (double)nrm[i].z / one;
+        for (q = 0; q < 3; q++) d += (g[q] - S[3 * i + q] / len) * (g[q] - S[3 * i + q] / len);
+        d = sqrt(d);
+        if (d / tol > *worst) *worst = d / tol;
+        bad += !(d <= tol);
+    }
+    free(S); free(E); free(A); free(k);
+    return bad;
+}
+
+#if defined(SN_FLOAT)
+static void fnormals_lanes(void) {
+    static const float sp[] = {0.0f, -0.0f, 1e-31f, 1e-30f, 1.1e-30f, 1e-40f, 1e-20f, 1.0f, -3.5f, 1e30f, 3e38f, -3e38f};
+    enum { N = 4003 };
+    sn_vec3 *a = malloc(N * sizeof *a), *b = malloc(N * sizeof *b);
+    unsigned i, bad = 0;
+    uint32_t r = 12345u;
+    for (i = 0; i < N; i++) {
+        float c[3];
+        unsigned q;
+        for (q = 0; q < 3; q++) {
+            r = r * 1664525u + 1013904223u;
+            if (i % 5 == 0) c[q] = sp[(r >> 8) % (sizeof sp / sizeof sp[0])];
+            else c[q] = ((float)(r >> 8) / 8388608.0f - 1.0f) * ((i % 7 == 0) ? 1e-25f : (i % 11 == 0) ? 1e25f : 1.0f);
+        }
+        if (i % 97 == 0) c[r % 3u] = (float)(HUGE_VAL - HUGE_VAL); /* NaN */
+        if (i % 89 == 0) c[r % 3u] = (float)HUGE_VAL;
+        a[i].x = b[i].x = c[0]; a[i].y = b[i].y = c[1]; a[i].z = b[i].z = c[2];
+    }
+    sn_k_fnormals(a, N);
+    sn_k_fnormals_ref(b, N);
+    for (i = 0; i < N; i++) bad += !same_vec(a + i, b + i);
+    T_CHECK(bad == 0, "normals' unit step: %u of %u vertices differ from the scalar reference", bad, (unsigned)N);
+    T_FIGURE("normals' unit step: %u crafted sums bit for bit with the scalar reference", (unsigned)N);
+    free(a); free(b);
+}
+#endif
 
 static void asset(const char *name, pose_fn_t pf) {
     char path[512], nm[64];
@@ -110,6 +194,16 @@ static void asset(const char *name, pose_fn_t pf) {
         T_CHECK(far == 0, "%s: %u components beyond the tolerance of the double embedding (worst %.3f of it)", name, far, worst);
         T_FIGURE("%s: %u surface vertices bit for bit with the general path; against double, worst %.3f of the tolerance",
                  name, nS, worst);
+        if (v->nT) {
+            sn_vec3 *nrm = malloc(nS * sizeof *nrm);
+            double nw = 0;
+            unsigned nb;
+            T_CHECK(sn_get_normals(rt.inst, out, nrm) == SN_OK, "%s: sn_get_normals", name);
+            nb = normals_bad(hd, out, nrm, &nw);
+            T_CHECK(nb == 0, "%s: %u of %u normals beyond the bound of the double normals (worst %.3f of it)", name, nb, nS, nw);
+            T_FIGURE("%s: %u normals against double, worst %.3f of the bound", name, nS, nw);
+            free(nrm);
+        }
         {   /* control: one lattice corner moved by 2^-4 of a cell moves the vertices it carries */
             sn_q *pw = (sn_q *)(void *)(uintptr_t)(const void *)pos;
             const unsigned vx = rd16(v->sec[SN_SEC_CELLS] + (size_t)rd16(v->sec[SN_SEC_EMBED]) * SN_ELEM_CELLS);
@@ -127,6 +221,9 @@ static void asset(const char *name, pose_fn_t pf) {
 }
 
 int main(void) {
+#if defined(SN_FLOAT)
+    fnormals_lanes();
+#endif
     asset("cow", pu_cow_pose);
     asset("beast", pu_beast_pose);
     return T_END();

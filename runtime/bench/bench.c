@@ -83,7 +83,7 @@ static int bench_blob(const char *path, int only_steps, int contact) {
     void *mem;
     sn_quat *local;
     sn_xform *xf;
-    sn_vec3 *surf;
+    sn_vec3 *surf, *nrm;
     sn_status st;
     uint32_t nnzff = 0, e, blended = 0, i, fc = 0, fc2 = 0;
     int k, warm = 30, n = 400;
@@ -108,6 +108,7 @@ static int bench_blob(const char *path, int only_steps, int contact) {
     local = (sn_quat *)malloc(sizeof *local * info.joints);
     xf = (sn_xform *)malloc(sizeof *xf * info.joints);
     surf = (sn_vec3 *)malloc(sizeof *surf * info.surface_vertices);
+    nrm = (sn_vec3 *)malloc(sizeof *nrm * info.surface_vertices);
     ts = (double *)malloc(sizeof *ts * (size_t)n);
     if (!mem || !local || !xf || !surf || !ts) return 2;
     if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
@@ -166,9 +167,15 @@ static int bench_blob(const char *path, int only_steps, int contact) {
     for (k = 0; k < n; k++) sum += ts[k];
     qsort(ts, (size_t)n, sizeof *ts, bench_cmp_d);
     {
-        double t0 = now();
+        double t0 = now(), t_surf, t_nrm = -1.0;
         int rep = 50;
         for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
+        t_surf = (now() - t0) / rep;
+        if (info.triangles && nrm) { /* the engine's other per-frame output: lighting normals */
+            t0 = now();
+            for (k = 0; k < rep; k++) sn_get_normals(inst, surf, nrm);
+            t_nrm = (now() - t0) / rep;
+        }
         macs = step_macs(info.vertices, info.free_vertices, info.cells, fc, fc2, info.offdiag_blocks, nnzff,
                          info.cg_iters_default);
         printf("  blob %s (%s): %u B blob, %u B instance; nV %u (free %u), nJ %u, cells %u, surface %u, "
@@ -177,8 +184,8 @@ static int bench_blob(const char *path, int only_steps, int contact) {
                info.cells, info.surface_vertices, info.triangles, info.offdiag_blocks, nnzff, blended,
                info.cg_iters_default, sn_kernels_name());
         printf("  figure: %s step time: median %.1f us, min %.1f us, mean %.1f us, p90 %.1f us (%d steps); "
-               "get_surface %.1f us\n", FLAV, 1e6 * ts[n / 2], 1e6 * ts[0], 1e6 * sum / n, 1e6 * ts[n * 9 / 10], n,
-               1e6 * (now() - t0) / rep);
+               "get_surface %.1f us, get_normals %.1f us\n", FLAV, 1e6 * ts[n / 2], 1e6 * ts[0], 1e6 * sum / n,
+               1e6 * ts[n * 9 / 10], n, 1e6 * t_surf, 1e6 * t_nrm);
         printf("  figure: %s memory: instance %u B with its own scratch, or %u B persistent state + a %u B workspace "
                "shared by every instance a thread steps (sn_instance_init_shared, sn_step_with)\n", FLAV, (unsigned)need,
                (unsigned)sn_instance_state_size(blob), (unsigned)sn_workspace_size(blob, SN_MODE_WARPED));
@@ -192,7 +199,7 @@ static int bench_blob(const char *path, int only_steps, int contact) {
         printf("  %s after %d steps: saturations %u, state hash %016llx\n", FLAV, warm + n, s.saturations,
                (unsigned long long)sn_state_hash(inst));
     }
-    free(mem); free(local); free(xf); free(surf); free(ts); free(bytes);
+    free(mem); free(local); free(xf); free(surf); free(nrm); free(ts); free(bytes);
     return 0;
 }
 

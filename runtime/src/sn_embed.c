@@ -146,7 +146,7 @@ sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, 
 sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_vec3 *out) {
     const sn_ihdr *h;
     const unsigned char *tris;
-    uint32_t t, i, nS;
+    uint32_t t, nS;
     if (!inst || !positions || !out) return SN_ERR_NULL;
     h = chdr_of(inst);
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
@@ -167,15 +167,10 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
         out[b].x += n[0]; out[b].y += n[1]; out[b].z += n[2];
         out[c].x += n[0]; out[c].y += n[1]; out[c].z += n[2];
     }
-    for (i = 0; i < nS; i++) {
-        sn_q q[4];
-        /* normalize via the quaternion normalizer's vector path: (x,y,z,0) */
-        q[0] = out[i].x; q[1] = out[i].y; q[2] = out[i].z; q[3] = 0.0f;
-        if (q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f) { out[i].z = 1.0f; continue; }
-        sn_qnormalize(q);
-        out[i].x = q[0]; out[i].y = q[1]; out[i].z = q[2];
-    }
+    /* normalize via the quaternion normalizer's arithmetic on (x,y,z,0) */
+    sn_k_fnormals(out, nS);
 #else
+    uint32_t i;
     {
         /* area-weighted sums in int32: a pre-pass picks one shift for the mesh
          * so the largest face normal is <= 2^24 (128 faces per vertex fit);

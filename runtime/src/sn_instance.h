@@ -248,6 +248,10 @@ void sn_frames_refresh(sn_ihdr *h, uint32_t *sat);  /* joint translations, verte
 void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out);  /* origin + p, public units */
 void sn_trilinear(const uint32_t t[3], sn_q phi[8]);                  /* corner weights at t (Q15), Q30 */
 void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]);    /* surface vertex s, internal */
+#if defined(SN_FLOAT)
+void sn_k_fnormals(sn_vec3 *out, uint32_t n);     /* summed normals -> unit, in place (sn_kernels_fnorm.c) */
+void sn_k_fnormals_ref(sn_vec3 *out, uint32_t n); /* the same, a vertex at a time (tests) */
+#endif
 
 /* Twice the elastic + kinetic energy of the step's starting state in
  * internal units (fixed: Q32, summed with saturation at 2^62), set by
