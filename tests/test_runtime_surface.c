@@ -27,7 +27,8 @@
  * (2^shift <= 2^-23 of the largest component, so E <= k sqrt 3 2^-24 max
  * for k faces at the vertex). Float: each edge difference and cross product
  * term rounds (E <= sum_f 6 2^-24 |e1||e2|) and the k sums add
- * k 2^-24 sum_f |n_f|. Float also: the 4-lane unit step (sn_kernels_fnorm.c)
+ * k 2^-24 sum_f |n_f|. Fixed also: the surface moved by 2^30 (positions
+ * beyond 2^29 take the edge-clamping loop) gives the same normals. Float also: the 4-lane unit step (sn_kernels_fnorm.c)
  * against the scalar one bit for bit on crafted sums: zero, -0, tiny
  * (below the 1e-30 cut), subnormal, huge, infinite and NaN components, a
  * count that leaves a tail.
@@ -202,6 +203,18 @@ static void asset(const char *name, pose_fn_t pf) {
             nb = normals_bad(hd, out, nrm, &nw);
             T_CHECK(nb == 0, "%s: %u of %u normals beyond the bound of the double normals (worst %.3f of it)", name, nb, nS, nw);
             T_FIGURE("%s: %u normals against double, worst %.3f of the bound", name, nS, nw);
+#if !defined(SN_FLOAT)
+            {   /* the surface moved by 2^30 in x: positions beyond +-2^29 take the clamped edge path, whose
+                 * edges here are the same (well inside 2^30), so every normal must be the same bits */
+                sn_vec3 *far = malloc(nS * sizeof *far), *nf = malloc(nS * sizeof *nf);
+                unsigned d = 0;
+                for (s = 0; s < nS; s++) { far[s] = out[s]; far[s].x = out[s].x + (1 << 30); }
+                T_CHECK(sn_get_normals(rt.inst, far, nf) == SN_OK, "%s: sn_get_normals (moved)", name);
+                for (s = 0; s < nS; s++) d += !same_vec(nf + s, nrm + s);
+                T_CHECK(d == 0, "%s: the surface moved by 2^30 (clamped edge path): %u of %u normals differ", name, d, nS);
+                free(far); free(nf);
+            }
+#endif
             free(nrm);
         }
         {   /* control: one lattice corner moved by 2^-4 of a cell moves the vertices it carries */

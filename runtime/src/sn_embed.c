@@ -143,6 +143,28 @@ sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, 
     return SN_OK;
 }
 
+#if !defined(SN_FLOAT)
+/* e1 x e2 of triangle (a, b, c), public units, exact in int64: each edge
+ * component clamped to +-2^30 keeps the products below 2^62; clamp = 0
+ * when every position lies within +-2^29 (the clamp cannot act: the same
+ * products without 12 compares a triangle and pass; cow_fem x86-64
+ * sn_get_normals 3,140,130 -> 2,527,994 instructions) */
+SN_INLINE void face_n(const sn_vec3 *p, uint32_t a, uint32_t b, uint32_t c, int clamp, int64_t n[3]) {
+    int64_t e1[3], e2[3];
+    int k;
+    e1[0] = (int64_t)p[b].x - p[a].x; e1[1] = (int64_t)p[b].y - p[a].y; e1[2] = (int64_t)p[b].z - p[a].z;
+    e2[0] = (int64_t)p[c].x - p[a].x; e2[1] = (int64_t)p[c].y - p[a].y; e2[2] = (int64_t)p[c].z - p[a].z;
+    if (clamp)
+        for (k = 0; k < 3; k++) {
+            e1[k] = e1[k] > (1 << 30) ? (1 << 30) : (e1[k] < -(1 << 30) ? -(1 << 30) : e1[k]);
+            e2[k] = e2[k] > (1 << 30) ? (1 << 30) : (e2[k] < -(1 << 30) ? -(1 << 30) : e2[k]);
+        }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+#endif
+
 sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_vec3 *out) {
     const sn_ihdr *h;
     const unsigned char *tris;
@@ -176,23 +198,17 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
          * so the largest face normal is <= 2^24 (128 faces per vertex fit);
          * beyond that the sums saturate instead of overflowing */
         int64_t maxn = 0;
-        int pass, shift = 0;
+        int pass, shift = 0, wide = 0;
+        for (i = 0; i < nS; i++) /* positions within +-2^29: no edge reaches the clamp */
+            wide |= (uint32_t)positions[i].x + (1u << 29) > (1u << 30) || (uint32_t)positions[i].y + (1u << 29) > (1u << 30) ||
+                    (uint32_t)positions[i].z + (1u << 29) > (1u << 30);
         for (pass = 0; pass < 2; pass++) {
             for (t = 0; t < h->v.nT; t++) {
                 uint32_t a = sn_rd_u16(tris + 6 * t), b = sn_rd_u16(tris + 6 * t + 2), c = sn_rd_u16(tris + 6 * t + 4);
-                int64_t e1[3], e2[3], n[3];
+                int64_t n[3];
                 int k;
-                e1[0] = (int64_t)positions[b].x - positions[a].x; e1[1] = (int64_t)positions[b].y - positions[a].y;
-                e1[2] = (int64_t)positions[b].z - positions[a].z;
-                e2[0] = (int64_t)positions[c].x - positions[a].x; e2[1] = (int64_t)positions[c].y - positions[a].y;
-                e2[2] = (int64_t)positions[c].z - positions[a].z;
-                for (k = 0; k < 3; k++) { /* |e| <= 2^30 keeps cross products < 2^62 */
-                    e1[k] = e1[k] > (1 << 30) ? (1 << 30) : (e1[k] < -(1 << 30) ? -(1 << 30) : e1[k]);
-                    e2[k] = e2[k] > (1 << 30) ? (1 << 30) : (e2[k] < -(1 << 30) ? -(1 << 30) : e2[k]);
-                }
-                n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-                n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-                n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                if (wide) face_n(positions, a, b, c, 1, n);
+                else face_n(positions, a, b, c, 0, n);
                 if (pass == 0) {
                     for (k = 0; k < 3; k++) {
                         int64_t m = n[k] < 0 ? -n[k] : n[k];
