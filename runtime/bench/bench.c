@@ -18,6 +18,12 @@
  *                              --detail-adapt: the runtime re-chooses them
  *                              after each step (sn_set_detail_adapt)
  *   sn_bench --lod L --steps S blob   level L of a 'levels 2' blob
+ *   sn_bench --surface N --steps S blob / --normals N --steps S blob
+ *                              after the S steps, N calls of sn_get_surface
+ *                              (all surface vertices) or of sn_get_normals
+ *                              (on one sn_get_surface's output): for
+ *                              callgrind, instructions per call = (N-call
+ *                              run - 0-call run) / N
  *
  * Built against the shipping library (libsinew.a / libsinew_float.a).
  * The pose sequence: every joint swings about its own axis with its own
@@ -72,7 +78,7 @@ static uint32_t rd32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static int g_details, g_iters, g_lod, g_dadapt; /* --details N, --iterations K, --lod L, --detail-adapt (--steps only) */
+static int g_details, g_iters, g_lod, g_dadapt, g_surface, g_normals; /* --details N, --iterations K, --lod L, --detail-adapt (--steps only) */
 
 static int bench_blob(const char *path, int only_steps, int contact) {
     size_t size, need;
@@ -110,7 +116,7 @@ static int bench_blob(const char *path, int only_steps, int contact) {
     surf = (sn_vec3 *)malloc(sizeof *surf * info.surface_vertices);
     nrm = (sn_vec3 *)malloc(sizeof *nrm * info.surface_vertices);
     ts = (double *)malloc(sizeof *ts * (size_t)n);
-    if (!mem || !local || !xf || !surf || !ts) return 2;
+    if (!mem || !local || !xf || !surf || !nrm || !ts) return 2;
     if (sn_instance_init(mem, need, blob, &inst) != SN_OK) return 1;
     if (only_steps >= 0) { /* one pose, then N steps: a step's cost does not depend on the pose */
         if (contact) { /* the determinism driver's scenario itself (back to rest, then its colliders and pins) */
@@ -140,6 +146,9 @@ static int bench_blob(const char *path, int only_steps, int contact) {
             sn_get_stats(inst, &st);
             fprintf(stderr, "sn_bench: details active %u, refines %u, coarsens %u\n", st.adapt_active, st.adapt_refines, st.adapt_coarsens);
         }
+        if (g_normals > 0) sn_get_surface(inst, surf, 0, info.surface_vertices);
+        for (k = 0; k < g_surface; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
+        for (k = 0; k < g_normals && info.triangles; k++) sn_get_normals(inst, surf, nrm);
         printf("%016llx\n", (unsigned long long)sn_state_hash(inst));
         return 0;
     }
@@ -171,7 +180,7 @@ static int bench_blob(const char *path, int only_steps, int contact) {
         int rep = 50;
         for (k = 0; k < rep; k++) sn_get_surface(inst, surf, 0, info.surface_vertices);
         t_surf = (now() - t0) / rep;
-        if (info.triangles && nrm) { /* the engine's other per-frame output: lighting normals */
+        if (info.triangles) { /* the engine's other per-frame output: lighting normals */
             t0 = now();
             for (k = 0; k < rep; k++) sn_get_normals(inst, surf, nrm);
             t_nrm = (now() - t0) / rep;
@@ -210,6 +219,8 @@ int main(int argc, char **argv) {
         if (strcmp(argv[i], "--iterations") == 0 && i + 1 < argc) { g_iters = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--lod") == 0 && i + 1 < argc) { g_lod = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--detail-adapt") == 0) { g_dadapt = 1; continue; }
+        if (strcmp(argv[i], "--surface") == 0 && i + 1 < argc) { g_surface = atoi(argv[++i]); continue; }
+        if (strcmp(argv[i], "--normals") == 0 && i + 1 < argc) { g_normals = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) { steps = atoi(argv[++i]); continue; }
         if (strcmp(argv[i], "--contact") == 0) { contact = 1; continue; }
         rc |= bench_blob(argv[i], steps, contact);
