@@ -2,6 +2,7 @@
  * each cell, seed 000 §3.1) and area-weighted normals. */
 #include "sn_cut.h" /* sn_cut_interp: the cut level's field */
 #include "sn_detail.h" /* sn_detail_interp: the active details on the surface */
+#include "sn_kernels_surf.h" /* sn_k_tri_w, sn_k_surf1 */
 
 /* ---- outputs ---- */
 
@@ -18,30 +19,8 @@ void sn_pub_point(const sn_ihdr *h, const sn_q p[3], sn_vec3 *out) {
 #endif
 }
 
-/* Trilinear weights phi_a (Q30 / float, summing to one) of a cell's 8
- * corners at coordinates t (Q15), corner a at bits (x, y, z). Inlined into
- * the surface loop below; sn_trilinear for everyone else. */
-SN_INLINE void tri_w(const uint32_t t[3], sn_q phi[8]) {
-    /* the four x-y products once (each two corners' first factor, in the
-     * order of wx * wy * wz: the same values), written out (no index
-     * arithmetic); t <= 32768 (validated), so wx * wy <= 2^30 fits 32 bits */
-    const uint32_t x0 = 32768u - t[0], y0 = 32768u - t[1], z0 = 32768u - t[2];
-#if defined(SN_FLOAT)
-    const float xy0 = (float)x0 * (float)y0, xy1 = (float)t[0] * (float)y0, xy2 = (float)x0 * (float)t[1],
-                xy3 = (float)t[0] * (float)t[1], fz0 = (float)z0, fz1 = (float)t[2];
-#define SN_TRI(xy, z) ((xy) * (z) * (1.0f / 35184372088832.0f)) /* 2^45 */
-    phi[0] = SN_TRI(xy0, fz0); phi[1] = SN_TRI(xy1, fz0); phi[2] = SN_TRI(xy2, fz0); phi[3] = SN_TRI(xy3, fz0);
-    phi[4] = SN_TRI(xy0, fz1); phi[5] = SN_TRI(xy1, fz1); phi[6] = SN_TRI(xy2, fz1); phi[7] = SN_TRI(xy3, fz1);
-#else
-    const uint32_t xy0 = x0 * y0, xy1 = t[0] * y0, xy2 = x0 * t[1], xy3 = t[0] * t[1], z1 = t[2];
-    /* Q30 weight: (wx*wy) Q30, times wz Q15, >> 15 */
-#define SN_TRI(xy, z) ((int32_t)(((uint64_t)(xy) * (z) + (1u << 14)) >> 15))
-    phi[0] = SN_TRI(xy0, z0); phi[1] = SN_TRI(xy1, z0); phi[2] = SN_TRI(xy2, z0); phi[3] = SN_TRI(xy3, z0);
-    phi[4] = SN_TRI(xy0, z1); phi[5] = SN_TRI(xy1, z1); phi[6] = SN_TRI(xy2, z1); phi[7] = SN_TRI(xy3, z1);
-#endif
-#undef SN_TRI
-}
-void sn_trilinear(const uint32_t t[3], sn_q phi[8]) { tri_w(t, phi); }
+/* Trilinear weights phi_a of a cell's 8 corners (sn_kernels_surf.h). */
+void sn_trilinear(const uint32_t t[3], sn_q phi[8]) { sn_k_tri_w(t, phi); }
 
 /* Current position (internal) of surface vertex s: trilinear in its cell
  * (seed 000 §3.1); on the cut level, in its child (cut_point). A convex
@@ -69,9 +48,8 @@ void sn_surface_point(const sn_ihdr *h, uint32_t s, sn_q out[3]) {
 
 /* sn_surface_point and sn_pub_point for the plain lattice (no cut level, so
  * no details), a run of vertices at a time: the level tests leave the loop,
- * the weights and the 24 products are written out (each component's sum in
- * the order a = 0..7, as there: the same floats; fixed: exact int64 sums)
- * and the public scale is read once. x86-64 cow_fem: 273 instructions a
+ * the weights and the 24 products go to sn_k_surf1 (sn_kernels_surf.h: the
+ * same sums; AVX2 the corners in lanes) and the public scale is read once. x86-64 cow_fem: 273 instructions a
  * vertex against 477 (fixed), 193 against 391 (float); test_runtime_surface. */
 static void surface_plain(const sn_ihdr *h, uint32_t first, uint32_t count, sn_vec3 *out) {
     const unsigned char *emb = h->v.sec[SN_SEC_EMBED], *cells = h->v.sec[SN_SEC_CELLS];
@@ -82,20 +60,15 @@ static void surface_plain(const sn_ihdr *h, uint32_t first, uint32_t count, sn_v
     const int sh = h->v.len_shift - (SN_Q_LEN - SN_LEN_FRAC);
     const int64_t o0 = h->origin[0], o1 = h->origin[1], o2 = h->origin[2];
 #endif
-    uint32_t i, a, dummy = 0;
+    uint32_t i, dummy = 0;
     for (i = 0; i < count; i++) {
         const unsigned char *e = emb + (size_t)(first + i) * SN_ELEM_EMBED;
-        const unsigned char *cell = cells + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS;
         uint32_t t[3];
-        sn_q phi[8], p0, p1, p2;
-        sn_acc x = 0, y = 0, z = 0;
+        sn_q p0, p1, p2;
+        sn_acc acc[3];
         t[0] = sn_rd_u16(e + 2); t[1] = sn_rd_u16(e + 4); t[2] = sn_rd_u16(e + 6);
-        tri_w(t, phi);
-        for (a = 0; a < 8; a++) {
-            const sn_q *pv = pos + 3 * sn_rd_u16(cell + 2 * a);
-            x += sn_mul(phi[a], pv[0]); y += sn_mul(phi[a], pv[1]); z += sn_mul(phi[a], pv[2]);
-        }
-        p0 = sn_out(x, SN_Q_ROT, &dummy); p1 = sn_out(y, SN_Q_ROT, &dummy); p2 = sn_out(z, SN_Q_ROT, &dummy);
+        sn_k_surf1(t, cells + (size_t)sn_rd_u16(e) * SN_ELEM_CELLS, pos, acc);
+        p0 = sn_out(acc[0], SN_Q_ROT, &dummy); p1 = sn_out(acc[1], SN_Q_ROT, &dummy); p2 = sn_out(acc[2], SN_Q_ROT, &dummy);
 #if defined(SN_FLOAT)
         out[i].x = o0 + p0 * sc; out[i].y = o1 + p1 * sc; out[i].z = o2 + p2 * sc;
 #else

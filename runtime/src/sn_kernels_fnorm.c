@@ -1,6 +1,6 @@
 /* sn_kernels_fnorm.c -- float flavour: the vertex normals' last step
  * (sn_get_normals), each summed normal scaled to unit length, four
- * vertices at a time on x86-64 (SSE2, every x86-64 build).
+ * vertices at a time on x86-64 (SSE2: every x86-64 build but SIMD=scalar).
  *
  * Bits: each lane computes sn_qnormalize's float arithmetic on (x, y, z, 0)
  * exactly as the scalar code does (sn_funit, sn_frsqrt in sn_math.c): m the
@@ -24,7 +24,7 @@ static void fnorm1(sn_vec3 *o) {
     o->x = q[0]; o->y = q[1]; o->z = q[2];
 }
 
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(SN_SIMD_SCALAR)
 #include <emmintrin.h>
 static __m128 sel(__m128 m, __m128 a, __m128 b) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b)); }
 static __m128 gtmax(__m128 a, __m128 m) { return sel(_mm_cmpgt_ps(a, m), a, m); } /* a > m ? a : m */
@@ -32,7 +32,7 @@ static __m128 gtmax(__m128 a, __m128 m) { return sel(_mm_cmpgt_ps(a, m), a, m); 
 
 void sn_k_fnormals(sn_vec3 *out, uint32_t n) {
     uint32_t i = 0;
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(SN_SIMD_SCALAR)
     const __m128 sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
     const __m128 tiny_m = _mm_set1_ps(1e-30f), tiny_n = _mm_set1_ps(1e-37f), half = _mm_set1_ps(0.5f), th = _mm_set1_ps(1.5f);
     const __m128i magic = _mm_set1_epi32(0x5f3759df);
