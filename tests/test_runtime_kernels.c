@@ -20,6 +20,7 @@
 #include "sn_kernels.h"
 #include "sn_kernels_ic.h"
 #include "sn_kernels_rot.h"
+#include "sn_kernels_surf.h"
 #include "sn_segment.h" /* seg_out, seg_lim */
 
 static uint32_t rng = 12345u;
@@ -1849,6 +1850,38 @@ static void test_udiv64(void) {
     T_CHECK(bad == 0, "udiv64: %d of %d quotients not the exact floor", bad, n);
 }
 
+/* sn_k_surf1 (sn_get_surface's vertex: AVX2 the corners in lanes and
+ * gathers) against sn_k_surf1_ref: 20,000 vertices, t random in [0, 32768]
+ * with the edges 0 and 32768 every 8th, corner ids random in a 64-vertex
+ * array (repeats allowed), positions random within the state bound
+ * (fixed +-2^28, every 4th vertex at +-2^28 exactly; float +-1e3 and,
+ * every 4th, +-2^20 with signed zeros). Tolerance 0: fixed, exact int64
+ * sums; float, the same products summed in the same order. */
+static void test_surf1(void) {
+    static sn_q pos[3 * 64];
+    unsigned char cell[16];
+    int i, bad = 0;
+    for (i = 0; i < 20000; i++) {
+        uint32_t t[3];
+        sn_acc a[3], r[3];
+        int k;
+        for (k = 0; k < 3 * 64; k++) {
+#if defined(SN_FLOAT)
+            pos[k] = i % 4 == 0 ? (float)(rnd32() % 3u) * ((rnd32() & 1) ? 1048576.0f : -1048576.0f) * ((rnd32() % 5u) ? 1.0f : -0.0f)
+                                : (float)rnd_in(1 << 20) / 1024.0f;
+#else
+            pos[k] = i % 4 == 0 ? ((rnd32() & 1) ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+#endif
+        }
+        for (k = 0; k < 8; k++) { const uint32_t v = rnd32() % 64u; cell[2 * k] = (unsigned char)v; cell[2 * k + 1] = 0; }
+        for (k = 0; k < 3; k++) t[k] = i % 8 == 0 ? ((rnd32() & 1) ? 32768u : 0u) : rnd32() % 32769u;
+        sn_k_surf1(t, cell, pos, a);
+        sn_k_surf1_ref(t, cell, pos, r);
+        bad += memcmp(a, r, sizeof a) != 0;
+    }
+    T_CHECK(bad == 0, "surf1: %d of 20000 vertices differ from the reference", bad);
+}
+
 /* sn_k_cell_mul2 against the independent reference itself (not only
  * against two sn_k_cell_mul calls: on the M4 both are assembly): 2000
  * random records (every 8th at the bounds), corner 0's operands 0 (the
@@ -2006,6 +2039,7 @@ int main(void) {
     test_axpy();
     test_isqrt();
     test_udiv64();
+    test_surf1();
 #if !defined(SN_FLOAT)
     test_rshr();
     test_trig();
