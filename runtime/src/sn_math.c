@@ -235,7 +235,9 @@ static int sn_unit(const int64_t *c, int n, int32_t *out) {
     return 1;
 }
 #else
-static int sn_unit(const int64_t *c, int n, int32_t *out) {
+/* inline: each caller's constant n unrolls the loops (x86-64 cow_fem: the
+ * fixed normals -13%, the step's 137 slerps -14 k instructions) */
+SN_INLINE int sn_unit(const int64_t *c, int n, int32_t *out) {
     uint64_t a[4], m = 0, n2 = 0, N, r;
     int i, b;
     for (i = 0; i < n; i++) {
