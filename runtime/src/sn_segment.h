@@ -308,6 +308,30 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
 #endif
 }
 
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#define SEG_M4 1
+/* Cortex-M4 (Thumb-2, DSP): a level-0 star() in one assembly function
+ * (sn_segment_m4.c, sn_m4_star), its operands and scratch here; the
+ * offsets are the assembly's (checked by a typedef there) */
+struct seg_m4_star {
+    sn_q *S;              /* 0: the level's segment words */
+    int32_t h4, kf, sh;   /* 4: 4 half (r30s's SMMULR operand), kf1, the turn's shift */
+    int32_t bias, g1n;    /* 16: the turn's rounding bias (< 2^29), omega gamma */
+    uint32_t ls;          /* 24: clamps counted */
+    int32_t inv;          /* 28: round(2^30 / k) (mean_k) */
+    int32_t m[3], l[3], t[3]; /* 32: the mean, minus the shares so far, this end's t */
+    int32_t rs;           /* 68: 31 - sh */
+    int32_t *plast;       /* 72: the last end's slot */
+    const uint32_t *seg;  /* 76 */
+    const int *sgn;       /* 80 */
+    uint32_t k;           /* 84 */
+    int32_t *slot;        /* 88: the current end's slot while the turn has the registers */
+    int32_t e[4][6];      /* 92: per end P[3], its segment's words, its turn factor, spare */
+};
+void sn_m4_star(struct seg_m4_star *c);
+#endif
+
 #define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */
 typedef struct seg_ctx {
     sn_ihdr *h;
@@ -333,6 +357,9 @@ typedef struct seg_ctx {
     unsigned ak[SEG_TCACHE];
     uint32_t aseg[SEG_TCACHE][5];
     int asgn[SEG_TCACHE][5];
+#if defined(SEG_M4)
+    struct seg_m4_star m4; /* level 0's constants set by sweep_prep */
+#endif
 } seg_ctx;
 
 

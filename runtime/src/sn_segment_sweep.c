@@ -90,8 +90,7 @@ SEG_HOT void move_seg_c(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t
     S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
 }
 
-#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
-    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#if defined(SEG_M4)
 #define SEG_TURN_M4 1
 /* Cortex-M4 (Thumb-2, DSP): move_seg's turn (words 3-5) in one asm block,
  * the same integers as move_seg_c with the vectors in registers: r30 as
@@ -352,15 +351,44 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 }
 
 
+#if defined(SEG_M4)
+/* level 0's constants of sn_m4_star (sweep_prep) */
+static void seg_m4_prep(seg_ctx *C, const seg_lvl *L) {
+    C->m4.S = L->S;
+    C->m4.h4 = 4 * L->half; /* r30s's SMMULR operand: half < 2^28 */
+    C->m4.kf = C->kf1;
+    C->m4.sh = L->sh;
+    C->m4.rs = 31 - L->sh;
+    C->m4.bias = (int32_t)C->bias0;
+    C->m4.g1n = C->g1n;
+}
+/* star() on level 0, Cortex-M4: sn_m4_star (sn_segment_m4.c), the same integers and counts */
+SN_INLINE void star_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.k = k;
+    C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941; /* mean_k's round(2^30/k) */
+    C->m4.ls = 0;
+    sn_m4_star(&C->m4);
+    *sat += C->m4.ls;
+}
+#endif
+
 /* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
- * built, else star) as a call: test_runtime_kernels compares the two bit
- * for bit. Not called by the step. */
+ * built, sn_m4_star on level 0, else star) as a call: test_runtime_kernels
+ * compares the two bit for bit. Not called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
 #if defined(SEG_STAR_SSE)
     if (simd) { seg_star_fx(C, L, seg, sgn, k, sat); return; }
 #elif defined(SEG_STAR_IV)
     if (simd) { seg_star_iv(C, L, seg, sgn, k, sat); return; }
+#elif defined(SEG_M4)
+    if (simd && L->l == 0) {
+        seg_m4_prep(C, L);
+        star_m4(C, seg, sgn, k, sat);
+        return;
+    }
 #else
     (void)simd;
 #endif
@@ -480,6 +508,9 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
 #elif defined(SEG_STAR_IV)
     else seg_star_iv(C, L, seg, sgn, k, sat);
 #else
+#if defined(SEG_M4)
+    else if (L->l == 0) star_m4(C, seg, sgn, k, sat);
+#endif
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
 #endif
@@ -495,6 +526,9 @@ void seg_sweep_prep(seg_ctx *C, const seg_lvl *L) {
     C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
     C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
     C->bias0 = seg_bias(L->sh);
+#if defined(SEG_M4)
+    if (L->l == 0) seg_m4_prep(C, L);
+#endif
     for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
