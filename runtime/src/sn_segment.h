@@ -311,25 +311,27 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
 #if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
     defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
 #define SEG_M4 1
-/* Cortex-M4 (Thumb-2, DSP): a level-0 star() in one assembly function
- * (sn_segment_m4.c, sn_m4_star), its operands and scratch here; the
- * offsets are the assembly's (checked by a typedef there) */
+/* Cortex-M4 (Thumb-2, DSP): level 0's star() and pair() moves in assembly
+ * (sn_segment_m4.c, sn_m4_star, sn_m4_pair), their operands and scratch
+ * here; the offsets are the assembly's (checked by a typedef there) */
 struct seg_m4_star {
     sn_q *S;              /* 0: the level's segment words */
     int32_t h4, kf, sh;   /* 4: 4 half (r30s's SMMULR operand), kf1, the turn's shift */
-    int32_t bias, g1n;    /* 16: the turn's rounding bias (< 2^29), omega gamma */
-    uint32_t ls;          /* 24: clamps counted */
-    int32_t inv;          /* 28: round(2^30 / k) (mean_k) */
-    int32_t m[3], l[3], t[3]; /* 32: the mean, minus the shares so far, this end's t */
-    int32_t rs;           /* 68: 31 - sh */
-    int32_t *plast;       /* 72: the last end's slot */
-    const uint32_t *seg;  /* 76 */
-    const int *sgn;       /* 80 */
-    uint32_t k;           /* 84 */
-    int32_t *slot;        /* 88: the current end's slot while the turn has the registers */
-    int32_t e[4][6];      /* 92: per end P[3], its segment's words, its turn factor, spare */
+    int32_t rs, bias;     /* 16: 31 - sh, the turn's rounding bias (< 2^29) */
+    int32_t g1n;          /* 24: omega gamma */
+    uint32_t ls;          /* 28: clamps counted */
+    int32_t inv;          /* 32: round(2^30 / k) (mean_k) */
+    int32_t *plast;       /* 36: the last end's slot */
+    const uint32_t *seg;  /* 40 */
+    const int *sgn;       /* 44 */
+    uint32_t k;           /* 48 */
+    int32_t *slot;        /* 52: the current end's slot while the turn has the registers */
+    int32_t kf0, gh;      /* 56: the pair's turn factor rf2/half and omega gamma/2 */
+    int32_t e[4][8];      /* 64: per end its segment's words, P or d[3], its turn factor, t[3] */
 };
 void sn_m4_star(struct seg_m4_star *c);
+/* pair(a, sa, b, sb) on level 0 (not measuring); sg: bit 0 sa < 0, bit 1 sb < 0 */
+void sn_m4_pair(struct seg_m4_star *c, uint32_t a, uint32_t b, uint32_t sg);
 #endif
 
 #define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */

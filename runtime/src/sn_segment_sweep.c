@@ -223,6 +223,37 @@ sn_real seg_gap(sn_len2 n2, const seg_lvl *L) {
 #endif
 }
 
+#if defined(SEG_M4)
+/* level 0's constants of sn_m4_star (sweep_prep) */
+static void seg_m4_prep(seg_ctx *C, const seg_lvl *L) {
+    C->m4.S = L->S;
+    C->m4.h4 = 4 * L->half; /* r30s's SMMULR operand: half < 2^28 */
+    C->m4.kf = C->kf1;
+    C->m4.sh = L->sh;
+    C->m4.rs = 31 - L->sh;
+    C->m4.bias = (int32_t)C->bias0;
+    C->m4.g1n = C->g1n;
+    C->m4.kf0 = C->kf0;
+    C->m4.gh = C->gh;
+}
+/* star() on level 0, Cortex-M4: sn_m4_star (sn_segment_m4.c), the same integers and counts */
+SN_INLINE void star_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.k = k;
+    C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941; /* mean_k's round(2^30/k) */
+    C->m4.ls = 0;
+    sn_m4_star(&C->m4);
+    *sat += C->m4.ls;
+}
+/* pair() on level 0 (not measuring), Cortex-M4: sn_m4_pair, the same integers and counts */
+SN_INLINE void pair_m4(seg_ctx *C, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat) {
+    C->m4.ls = 0;
+    sn_m4_pair(&C->m4, a, b, (sa < 0 ? 1u : 0u) | (sb < 0 ? 2u : 0u));
+    *sat += C->m4.ls;
+}
+#endif
+
 /* pair constraint between two endpoints of equal masses: d = P2 - P1,
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
@@ -275,12 +306,17 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure) { seg_pair_fx(C, L, a, sa, b, sb, sat); return; }
+#elif defined(SEG_M4)
+    if (!measure && L->l == 0) { pair_m4(C, a, sa, b, sb, sat); return; }
 #endif
     pair_core(C, L, a, sa, b, sb, measure, sat);
 }
 
 /* pair_core (simd 0) or the step's pair, for test_runtime_kernels; not called by the step */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat) {
+#if defined(SEG_M4)
+    if (simd && L->l == 0) seg_m4_prep(C, L); /* the step's sweep_prep */
+#endif
     if (simd) pair(C, L, a, sa, b, sb, 0, sat);
     else pair_core(C, L, a, sa, b, sb, 0, sat);
 }
@@ -351,28 +387,6 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 }
 
 
-#if defined(SEG_M4)
-/* level 0's constants of sn_m4_star (sweep_prep) */
-static void seg_m4_prep(seg_ctx *C, const seg_lvl *L) {
-    C->m4.S = L->S;
-    C->m4.h4 = 4 * L->half; /* r30s's SMMULR operand: half < 2^28 */
-    C->m4.kf = C->kf1;
-    C->m4.sh = L->sh;
-    C->m4.rs = 31 - L->sh;
-    C->m4.bias = (int32_t)C->bias0;
-    C->m4.g1n = C->g1n;
-}
-/* star() on level 0, Cortex-M4: sn_m4_star (sn_segment_m4.c), the same integers and counts */
-SN_INLINE void star_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
-    C->m4.seg = seg;
-    C->m4.sgn = sgn;
-    C->m4.k = k;
-    C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941; /* mean_k's round(2^30/k) */
-    C->m4.ls = 0;
-    sn_m4_star(&C->m4);
-    *sat += C->m4.ls;
-}
-#endif
 
 /* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
  * built, sn_m4_star on level 0, else star) as a call: test_runtime_kernels
