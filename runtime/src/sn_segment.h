@@ -314,6 +314,10 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
 /* Cortex-M4 (Thumb-2, DSP): level 0's star() and pair() moves in assembly
  * (sn_segment_m4.c, sn_m4_star, sn_m4_pair), their operands and scratch
  * here; the offsets are the assembly's (checked by a typedef there) */
+struct seg_m4_slot {      /* an end's move (8 words) */
+    sn_q *S;                /* its segment's words */
+    int32_t d[3], f, t[3];  /* the gap (the star's first pass: its end P), turn factor, translation */
+};
 struct seg_m4_star {
     sn_q *S;              /* 0: the level's segment words */
     int32_t h4, kf, sh;   /* 4: 4 half (r30s's SMMULR operand), kf1, the turn's shift */
@@ -321,17 +325,19 @@ struct seg_m4_star {
     int32_t g1n;          /* 24: omega gamma */
     uint32_t ls;          /* 28: clamps counted */
     int32_t inv;          /* 32: round(2^30 / k) (mean_k) */
-    int32_t *plast;       /* 36: the last end's slot */
+    struct seg_m4_slot *plast; /* 36: the last end's slot */
     const uint32_t *seg;  /* 40 */
     const int *sgn;       /* 44 */
     uint32_t k;           /* 48 */
-    int32_t *slot;        /* 52: the current end's slot while the turn has the registers */
+    int32_t *slot;        /* 52: the current slot's t while the turn has the registers */
     int32_t kf0, gh;      /* 56: the pair's turn factor rf2/half and omega gamma/2 */
-    int32_t e[4][8];      /* 64: per end its segment's words, P or d[3], its turn factor, t[3] */
+    struct seg_m4_slot e[4]; /* 64: the ends' moves */
 };
 void sn_m4_star(struct seg_m4_star *c);
 /* pair(a, sa, b, sb) on level 0 (not measuring); sg: bit 0 sa < 0, bit 1 sb < 0 */
 void sn_m4_pair(struct seg_m4_star *c, uint32_t a, uint32_t b, uint32_t sg);
+/* an attachment's pins on level 0 (seg, sgn, plast = e + k - 1 set), target T */
+void sn_m4_pins(struct seg_m4_star *c, const sn_q *T);
 #endif
 
 #define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */

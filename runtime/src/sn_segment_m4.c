@@ -29,7 +29,8 @@ typedef char sn_m4_star_layout_[offsetof(struct seg_m4_star, sh) == 12 && offset
                                         offsetof(struct seg_m4_star, plast) == 36 &&
                                         offsetof(struct seg_m4_star, slot) == 52 &&
                                         offsetof(struct seg_m4_star, gh) == 60 &&
-                                        offsetof(struct seg_m4_star, e) == 64 && SEG_W == 16 && SN_LIM == (1 << 28)
+                                        offsetof(struct seg_m4_star, e) == 64 && sizeof(struct seg_m4_slot) == 32 &&
+                                        offsetof(struct seg_m4_slot, f) == 16 && SEG_W == 16 && SN_LIM == (1 << 28)
                                     ? 1
                                     : -1];
 
@@ -357,6 +358,81 @@ __asm__(
     M4S_OUT_SLOW("r2", "r12", "72")
     M4S_OUT_SLOW("r3", "r12", "73")
     ".size sn_m4_pair, .-sn_m4_pair\n"
+    /* an attachment's pins (r1 T; seg, sgn, plast set): per slot P = G +-
+     * r30s(half, u) from the positive half (end_of), clamped; d = T - P
+     * (QSUB, then sn_add's clamp); t = r30s(d, omega gamma), clamped; +-kf1 */
+    ".align 2\n"
+    ".global sn_m4_pins\n"
+    ".thumb_func\n"
+    ".type sn_m4_pins, %function\n"
+    "sn_m4_pins:\n"
+    "push  {r4-r11, lr}\n"
+    "ldr   r2, [r0, #40]\n"
+    "ldr   r3, [r0, #44]\n"
+    "ldr   r10, [r0, #4]\n"
+    "add   r11, r0, #64\n"
+    "8:\n"
+    "ldr   r12, [r2], #4\n"
+    "ldr   lr, [r0, #0]\n"
+    "add   lr, lr, r12, lsl #6\n"
+    "str   lr, [r11]\n"
+    "ldm   lr, {r4-r9}\n"
+    "smmulr r7, r10, r7\n"
+    "smmulr r8, r10, r8\n"
+    "smmulr r9, r10, r9\n"
+    "ldr   lr, [r0, #8]\n"
+    "ldr   r12, [r3], #4\n"
+    "cmp   r12, #0\n"
+    "itttt le\n"
+    "rsble r7, r7, #0\n"
+    "rsble r8, r8, #0\n"
+    "rsble r9, r9, #0\n"
+    "rsble lr, lr, #0\n"
+    "str   lr, [r11, #16]\n"
+    "add   r4, r4, r7\n"
+    M4S_OUT("r4", "r12", "81")
+    "add   r5, r5, r8\n"
+    M4S_OUT("r5", "r12", "82")
+    "add   r6, r6, r9\n"
+    M4S_OUT("r6", "r12", "83")
+    "ldm   r1, {r7-r9}\n"
+    "qsub  r4, r7, r4\n"
+    M4S_OUT("r4", "r12", "84")
+    "qsub  r5, r8, r5\n"
+    M4S_OUT("r5", "r12", "85")
+    "qsub  r6, r9, r6\n"
+    M4S_OUT("r6", "r12", "86")
+    "add   r12, r11, #4\n"
+    "stm   r12, {r4-r6}\n"
+    "ldr   r12, [r0, #24]\n"
+    "lsl   r7, r4, #2\n"
+    "smmulr r7, r7, r12\n"
+    M4S_OUT("r7", "lr", "87")
+    "lsl   r8, r5, #2\n"
+    "smmulr r8, r8, r12\n"
+    M4S_OUT("r8", "lr", "88")
+    "lsl   r9, r6, #2\n"
+    "smmulr r9, r9, r12\n"
+    M4S_OUT("r9", "lr", "89")
+    "add   r12, r11, #20\n"
+    "stm   r12, {r7-r9}\n"
+    "add   r11, r11, #32\n"
+    "ldr   r12, [r0, #36]\n"
+    "cmp   r11, r12\n"
+    "bls   8b\n"
+    "add   r6, r0, #64\n"
+    "b     .Lsnm4_moves\n"
+    M4S_OUT_SLOW("r4", "r12", "81")
+    M4S_OUT_SLOW("r5", "r12", "82")
+    M4S_OUT_SLOW("r6", "r12", "83")
+    M4S_OUT_SLOW("r4", "r12", "84")
+    M4S_OUT_SLOW("r5", "r12", "85")
+    M4S_OUT_SLOW("r6", "r12", "86")
+    M4S_OUT_SLOW("r7", "lr", "87")
+    M4S_OUT_SLOW("r8", "lr", "88")
+    M4S_OUT_SLOW("r9", "lr", "89")
+    ".size sn_m4_pins, .-sn_m4_pins\n"
+
     ".popsection\n");
 #else
 typedef int sn_segment_m4_empty_; /* ISO C: a translation unit declares something */

@@ -448,8 +448,22 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     *sat += ls;
 }
 
+#if defined(SEG_M4)
+/* an attachment's pins on level 0, Cortex-M4: sn_m4_pins, every end's gap
+ * and translation as pin() forms them, then the moves (its ends belong to
+ * distinct segments); the same integers and counts */
+SN_INLINE void pins_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3], uint32_t *sat) {
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.plast = &C->m4.e[k - 1u];
+    C->m4.ls = 0;
+    sn_m4_pins(&C->m4, T);
+    *sat += C->m4.ls;
+}
+#endif
+
 /* an attachment's pins on its k ends: 2..4 at once in lanes where built
- * (seg_pins_iv, pins_fv), else one by one */
+ * (seg_pins_iv, pins_fv; Cortex-M4 level 0 1..4: pins_m4), else one by one */
 SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                     int measure, uint32_t *sat) {
     unsigned j;
@@ -457,6 +471,8 @@ SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     if (!measure && k >= 2u && k <= 4u) { seg_pins_iv(C, L, seg, sgn, k, T, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure && k >= 2u && k <= 4u) { seg_pins_fx(C, L, seg, sgn, k, T, sat); return; }
+#elif defined(SEG_M4)
+    if (!measure && L->l == 0 && k >= 1u && k <= 4u) { pins_m4(C, seg, sgn, k, T, sat); return; }
 #endif
     for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
 }
@@ -465,6 +481,9 @@ SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                    int simd, uint32_t *sat) {
     unsigned j;
+#if defined(SEG_M4)
+    if (simd && L->l == 0) seg_m4_prep(C, L); /* the step's sweep_prep */
+#endif
     if (simd) { pins(C, L, seg, sgn, k, T, 0, sat); return; }
     for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, 0, sat);
 }
