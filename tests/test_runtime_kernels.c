@@ -1050,7 +1050,8 @@ static void test_loops(void) {
 #endif
         sn_q x[3], y[3], o1[3], o2[3], R[9], q1[40], q2[40], ck = rnd_val(0), cm = rnd_val(0);
         sn_acc ya[3], a1[3], a2[3], l[3], in[40];
-        unsigned char D[24];
+        sn_q Dw[6]; /* sn_k_sym_out's block 4-aligned, as the PRECOND section's (the M4's LDM) */
+        unsigned char *D = (unsigned char *)Dw;
         uint8_t kk[14];
         uint32_t s1 = 0, s2 = 0, n = rnd32() % 41u, i;
 #if defined(SN_FLOAT)
@@ -1117,7 +1118,8 @@ static void test_loops(void) {
  * 1) and random values, for every shift 0..62: sn_k_out_rot_acc, sn_k_outv,
  * sn_k_mix, sn_k_mul_out against sn_out (sn_internal.h, the reference),
  * bit for bit with the same clamp counts; on the M4 sn_k_out_w (s < 32) and
- * sn_k_out_hw (32..62) themselves too. */
+ * sn_k_out_hw (32..62) themselves too; sn_k_sym_out's first row at the
+ * same edges for s = 1..31. */
 static int edge_ls(int s, sn_acc *l) {
     static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1),
                                  1 << 30, -(1 << 30)};
@@ -1172,6 +1174,30 @@ static void test_out_edges(void) {
             clamps += s2;
             cases++;
         }
+    }
+    /* sn_k_sym_out (the M4's sn_m4_sym_out for 0 < s < 32) with its first
+     * row's sum at the same edges: xx = 2^(s-1), e0 = 2v, xy = 1, e1 = d,
+     * xz = 0 give l0 = v 2^s + d exactly; the other rows random */
+    for (s = 1; s <= 31; s++) {
+        static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1)};
+        const int32_t h = (int32_t)((uint32_t)1 << (s - 1));
+        const int32_t ds[] = {0, 1, -1, h, -h, h - 1, -h - 1, h + 1, -h + 1};
+        uint32_t a, b;
+        for (a = 0; a < sizeof vs / sizeof vs[0]; a++)
+            for (b = 0; b < sizeof ds / sizeof ds[0]; b++) {
+                sn_q D[6] = {h, rnd_in(1 << 30), rnd_in(1 << 30), 1, 0, rnd_in(1 << 30)}, e[3] = {2 * vs[a], ds[b], rnd_in(1 << 30)};
+                sn_q o1[3], o2[3];
+                sn_acc m[3];
+                uint32_t s1 = 0, s2 = 0, k;
+                sn_k_sym_out((const unsigned char *)D, e, o1, s, &s1);
+                m[0] = sn_mul(D[0], e[0]) + sn_mul(D[3], e[1]) + sn_mul(D[4], e[2]);
+                m[1] = sn_mul(D[3], e[0]) + sn_mul(D[1], e[1]) + sn_mul(D[5], e[2]);
+                m[2] = sn_mul(D[4], e[0]) + sn_mul(D[5], e[1]) + sn_mul(D[2], e[2]);
+                for (k = 0; k < 3; k++) o2[k] = sn_out(m[k], s, &s2);
+                bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2 || m[0] != (int64_t)vs[a] * ((int64_t)1 << s) + ds[b];
+                clamps += s2;
+                cases++;
+            }
     }
     T_CHECK(bad == 0, "rounding helpers at their edges (path %s): %d results or clamp counts off sn_out", sn_kernels_name(), bad);
     T_FIGURE("rounding helpers: %d edge accumulators over shifts 0..62, %u clamps", cases, (unsigned)clamps);

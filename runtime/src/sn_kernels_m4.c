@@ -1138,6 +1138,71 @@ void sn_k_out_rot_acc_c(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh,
     x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
 }
 
+/* sn_k_sym_out (sn_kernels_rot.h) for 0 < sh < 32 in Thumb-2: D's six
+ * entries and e by LDM (b 4-aligned: the PRECOND section is 8-aligned, 24
+ * bytes an entry), the three sums in SMULL/SMLAL register pairs (e read
+ * before out is written: out may be e), each rounded, shifted and clamped
+ * as sn_k_out_w (the count in memory on the rare clamp). GCC: 70
+ * instructions a call, here 53. Exact int64 sums, the same integers. */
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_sym_out,\"ax\",%progbits\n"
+    ".macro sns_out lo, hi\n"
+    "adds  \\lo, \\lo, lr\n"
+    "adc   \\hi, \\hi, #0\n"
+    "lsr   \\lo, \\lo, r3\n"
+    "lsl   r6, \\hi, r1\n"
+    "orr   \\lo, \\lo, r6\n"
+    "asr   \\hi, \\hi, r3\n"
+    "add   r6, \\lo, #0x10000000\n"
+    "cmp   r6, #0x20000000\n"
+    "bhi   .Lsns1\\@\n"
+    "cmp   \\hi, \\lo, asr #31\n"
+    "beq   .Lsns2\\@\n"
+    ".Lsns1\\@:\n"
+    "ldr   r6, [sp, #36]\n"
+    "ldr   r8, [r6]\n"
+    "add   r8, r8, #1\n"
+    "str   r8, [r6]\n"
+    "cmp   \\hi, #0\n"
+    "ite   lt\n"
+    "movlt \\lo, #0xF0000000\n"
+    "movge \\lo, #0x10000000\n"
+    ".Lsns2\\@:\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_sym_out\n"
+    ".thumb_func\n"
+    ".type sn_m4_sym_out, %function\n"
+    "sn_m4_sym_out:\n"            /* r0 b, r1 e, r2 out, r3 sh (1..31), [sp] sat */
+    "push  {r4-r11, lr}\n"
+    "ldm   r0, {r4-r9}\n"         /* xx yy zz xy xz yz */
+    "ldm   r1, {r0, r1, lr}\n"    /* e0 e1 e2 */
+    "smull r10, r11, r4, r0\n"    /* l0 = xx e0 + xy e1 + xz e2 */
+    "smlal r10, r11, r7, r1\n"
+    "smlal r10, r11, r8, lr\n"
+    "smull r4, r12, r7, r0\n"     /* l1 = xy e0 + yy e1 + yz e2 */
+    "smlal r4, r12, r5, r1\n"
+    "smlal r4, r12, r9, lr\n"
+    "smull r5, r7, r8, r0\n"      /* l2 = xz e0 + yz e1 + zz e2 */
+    "smlal r5, r7, r9, r1\n"
+    "smlal r5, r7, r6, lr\n"
+    "mov   lr, #1\n"
+    "sub   r0, r3, #1\n"
+    "lsl   lr, lr, r0\n"          /* 2^(sh-1) */
+    "rsb   r1, r3, #32\n"
+    "sns_out r10, r11\n"
+    "sns_out r4, r12\n"
+    "sns_out r5, r7\n"
+    "str   r10, [r2]\n"
+    "str   r4, [r2, #4]\n"
+    "str   r5, [r2, #8]\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_sym_out, .-sn_m4_sym_out\n"
+    ".purgem sns_out\n"
+    ".popsection\n");
+
 const char *sn_kernels_name(void) { return "m4"; }
 
 #else

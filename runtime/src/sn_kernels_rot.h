@@ -535,8 +535,12 @@ SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3],
     else sn_k_out_rot_acc_c(acc, R, l, sh, sat);
 }
 /* l = D e in int32 registers (e read first: out may be e), then sn_k_out_w
- * (0 < sh < 32) or sn_out; exact sums, the same integers */
+ * (0 < sh < 32: Thumb-2, sn_m4_sym_out in sn_kernels_m4.c; b 4-aligned) or
+ * sn_out; exact sums, the same integers */
+void sn_m4_sym_out(const unsigned char *b, const sn_q *e, sn_q *out, int sh, uint32_t *sat);
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    if ((uint32_t)(sh - 1) < 31u) { sn_m4_sym_out(b, e, out, sh, sat); return; }
+    {
     const sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
     const sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
     int32_t e0 = e[0], e1 = e[1], e2 = e[2];
@@ -545,15 +549,9 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     l0 = sn_mul(xx, e0) + sn_mul(xy, e1) + sn_mul(xz, e2);
     l1 = sn_mul(xy, e0) + sn_mul(yy, e1) + sn_mul(yz, e2);
     l2 = sn_mul(xz, e0) + sn_mul(yz, e1) + sn_mul(zz, e2);
-    if ((uint32_t)(sh - 1) < 31u) {
-        const uint32_t bit = (uint32_t)1 << (sh - 1);
-        out[0] = sn_k_out_w(l0, sh, bit, sat);
-        out[1] = sn_k_out_w(l1, sh, bit, sat);
-        out[2] = sn_k_out_w(l2, sh, bit, sat);
-    } else {
-        out[0] = sn_out(l0, sh, sat);
-        out[1] = sn_out(l1, sh, sat);
-        out[2] = sn_out(l2, sh, sat);
+    out[0] = sn_out(l0, sh, sat);
+    out[1] = sn_out(l1, sh, sat);
+    out[2] = sn_out(l2, sh, sat);
     }
 }
 #define SN_K_SYM_OUT_M4 1
