@@ -1165,6 +1165,19 @@ static void test_out_edges(void) {
                 sn_k_mix(q1, lv, kk, 3, fm, ck, cm, &s1);
                 for (k = 0; k < 3; k++) q2[k] = sn_out(sn_mul(q2[k], ck) + sn_mul(sn_out(lv[k], s, &s2), cm), SN_Q_COEF, &s2);
                 bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+                {   /* the second rounding at its edges (q ck >> 24 = q at ck = 2^24,
+                     * mk cm a small offset or a tie): sn_k_mix's v = +-SN_LIM exactly
+                     * and its neighbours (the M4's test on the high word) */
+                    static const int32_t vq[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1,
+                                                 -(SN_LIM + 1), 1 << 30, -(1 << 30), INT32_MAX, -INT32_MAX};
+                    static const int32_t vm[] = {0, 1, -1, 1 << 23, -(1 << 23)};
+                    const uint32_t a = (uint32_t)i % 13u, b = rnd32() % 5u;
+                    for (k = 0; k < 3; k++) q1[k] = q2[k] = vq[(a + (uint32_t)k * 5u) % 13u];
+                    sn_k_mix(q1, lv, kk, 3, fm, 1 << 24, vm[b], &s1);
+                    for (k = 0; k < 3; k++)
+                        q2[k] = sn_out(sn_mul(q2[k], 1 << 24) + sn_mul(sn_out(lv[k], s, &s2), vm[b]), SN_Q_COEF, &s2);
+                    bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+                }
             }
 #if defined(SN_KERNELS_M4)
             if (s > 0 && s < 32) bad += sn_k_out_w(l[i], s, (uint32_t)1 << (s - 1), &s1) != sn_out(l[i], s, &s2) || s1 != s2;

@@ -1203,6 +1203,105 @@ __asm__(
     ".purgem sns_out\n"
     ".popsection\n");
 
+/* sn_k_mix (sn_kernels_rot.h) in Thumb-2 while a vertex's shift sh = base
+ * - kk is in 1..31: per value mk = sn_k_out_w(acc, sh) (the rounding add,
+ * the shift on the two words, the clamp's two tests), then q = sn_out(q ck
+ * + mk cm, 24) as SMULL/SMLAL, the rounding add and the shift by 24 with
+ * |v| < 2^28 tested on the sum's high word alone (v >> 28 = hi >> 20 in
+ * {-1, 0}); a failed test (v = 2^28 too) re-tests exactly out of line
+ * (.subsection 1), where clamps are counted (lr). GCC: 102 instructions a
+ * vertex, here ~80. */
+typedef char sn_m4_mix_layout_[sizeof(struct sn_m4_mixc) == 32 && SN_Q_COEF == 24 ? 1 : -1];
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_mix,\"ax\",%progbits\n"
+    ".macro snx_val\n"
+    "ldrd  r11, r12, [r2], #8\n"
+    "adds  r11, r11, r9\n"
+    "adc   r12, r12, #0\n"
+    "lsr   r11, r11, r8\n"
+    "lsl   r0, r12, r10\n"
+    "orr   r11, r11, r0\n"
+    "asr   r12, r12, r8\n"
+    "add   r0, r11, #0x10000000\n"
+    "cmp   r0, #0x20000000\n"
+    "bhi   .Lsnxa\\@\n"
+    "cmp   r12, r11, asr #31\n"
+    "bne   .Lsnxa\\@\n"
+    ".Lsnxb\\@:\n"
+    "ldr   r0, [r1]\n"
+    "smull r0, r12, r0, r6\n"
+    "smlal r0, r12, r11, r7\n"
+    "adds  r0, r0, #0x800000\n"
+    "adc   r12, r12, #0\n"
+    "lsr   r0, r0, #24\n"
+    "orr   r0, r0, r12, lsl #8\n"
+    "asr   r11, r12, #20\n"
+    "adds  r11, r11, #1\n"
+    "cmp   r11, #1\n"
+    "bhi   .Lsnxc\\@\n"
+    ".Lsnxd\\@:\n"
+    "str   r0, [r1], #4\n"
+    ".subsection 1\n"
+    ".Lsnxa\\@:\n"               /* mk clamped, counted */
+    "add   lr, lr, #1\n"
+    "cmp   r12, #0\n"
+    "ite   lt\n"
+    "movlt r11, #0xF0000000\n"
+    "movge r11, #0x10000000\n"
+    "b     .Lsnxb\\@\n"
+    ".Lsnxc\\@:\n"               /* the exact test of v (lo r0, hi r12 >> 24) */
+    "asr   r12, r12, #24\n"
+    "add   r11, r0, #0x10000000\n"
+    "cmp   r11, #0x20000000\n"
+    "bhi   .Lsnxf\\@\n"
+    "cmp   r12, r0, asr #31\n"
+    "beq   .Lsnxd\\@\n"
+    ".Lsnxf\\@:\n"
+    "add   lr, lr, #1\n"
+    "cmp   r12, #0\n"
+    "ite   lt\n"
+    "movlt r0, #0xF0000000\n"
+    "movge r0, #0x10000000\n"
+    "b     .Lsnxd\\@\n"
+    ".subsection 0\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_mix\n"
+    ".thumb_func\n"
+    ".type sn_m4_mix, %function\n"
+    "sn_m4_mix:\n"
+    "push  {r0, r4-r11, lr}\n"
+    "ldm   r0, {r1-r7}\n"         /* q acc kk kend base ck cm */
+    "ldr   lr, [r0, #28]\n"
+    "1:\n"
+    "cmp   r3, r4\n"
+    "beq   9f\n"
+    "ldrb  r8, [r3]\n"
+    "sub   r8, r5, r8\n"          /* sh */
+    "sub   r9, r8, #1\n"
+    "cmp   r9, #30\n"
+    "bhi   9f\n"
+    "add   r3, r3, #1\n"
+    "mov   r10, #1\n"
+    "lsl   r9, r10, r9\n"         /* 2^(sh-1) */
+    "rsb   r10, r8, #32\n"
+    "snx_val\n"
+    "snx_val\n"
+    "snx_val\n"
+    "b     1b\n"
+    "9:\n"
+    "ldr   r0, [sp]\n"
+    "stm   r0, {r1-r3}\n"
+    "str   lr, [r0, #28]\n"
+    "pop   {r0, r4-r11, pc}\n"
+    ".subsection 1\n"
+    ".size sn_m4_mix, .-sn_m4_mix\n"
+    ".subsection 0\n"
+    ".purgem snx_val\n"
+    ".popsection\n");
+
 const char *sn_kernels_name(void) { return "m4"; }
 
 #else
