@@ -1624,7 +1624,8 @@ static void test_mass_ff(void) {
  * 0): random ascending rows of 1..40 free rows over nF + 1..16 vertices
  * (free columns first, as the validator's order gives), v' at and inside
  * +-SN_LIM, a1 at and inside +-ONE_COEF (the kernel's contract: sn_rhs's
- * pre) and at +-ONE_COEF / 2 (odd v' gives the rounding's ties), ds making y clamp at SN_LIM, starting accumulators random. */
+ * pre), at +-ONE_COEF / 2 (odd v' gives the rounding's ties) and just inside it (the M4's SMMULR form
+ * for |a1| < ONE_COEF / 2), ds making y clamp at SN_LIM, starting accumulators random. */
 static void test_mass_sk(void) {
     static unsigned char rp[4 * 41], cols[2 * 400], mo[4 * 400];
     static sn_q vel[3 * 56], ds[3 * 16];
@@ -1634,7 +1635,8 @@ static void test_mass_sk(void) {
     for (t = 0; t < 500; t++) {
         const uint32_t nF = 1u + rnd32() % 40u, nS = 1u + rnd32() % 16u, nV = nF + nS;
         const int wild = t % 4 == 0;
-        const sn_q a = t % 8 == 0 ? ONE_COEF : t % 8 == 1 ? -ONE_COEF : t % 8 == 2 ? ONE_COEF / 2 : t % 8 == 3 ? -ONE_COEF / 2 : rnd_in(ONE_COEF);
+        const sn_q a = t % 8 == 0 ? ONE_COEF : t % 8 == 1 ? -ONE_COEF : t % 8 == 2 ? ONE_COEF / 2 : t % 8 == 3 ? -ONE_COEF / 2
+                     : t % 8 == 4 ? ONE_COEF / 2 - 1 : t % 8 == 5 ? -(ONE_COEF / 2 - 1) : rnd_in(ONE_COEF);
         uint32_t i, e = 0, k, s1 = 0, s2 = 0;
         for (i = 0; i < 3 * nV; i++) vel[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
         for (i = 0; i < 3 * nS; i++) ds[i] = wild ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);

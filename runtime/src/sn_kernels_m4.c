@@ -677,9 +677,22 @@ SN_INLINE uint32_t sn_m4_rd_u16(const unsigned char *p) {
     memcpy(&v, p, 2); /* LDRH: little-endian, unaligned allowed */
     return v;
 }
-void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
-                  const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+/* coef_nc(v, a1) = (v a1 + 2^23) >> 24 as one SMMULR of v and a1 2^8 for
+ * |a1| < 2^23 ((v a1 2^8 + 2^31) >> 32: the same floor, a1 2^8 within
+ * int32; sn_rhs's a1 = h alpha is far below): the same value */
+SN_INLINE int32_t sn_m4_coef8(sn_q v, int32_t a8) {
+    int32_t r;
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(v), "r"(a8));
+    return r;
+}
+/* the loop, with the coefficient's product by SMMULR (fast) or
+ * sn_k_coef_nc; forced inline so each call has its own code */
+static inline __attribute__((always_inline)) void mass_sk_loop(const unsigned char *rp, const unsigned char *cols,
+                                                               const unsigned char *mo, const sn_q *vel, const sn_q *ds,
+                                                               sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat,
+                                                               int fast) {
     const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+    const int32_t a8 = fast ? (int32_t)((uint32_t)a1 << 8) : 0;
     uint32_t i, ns = 0, e = sn_rd_u32(rp);
     for (i = 0; i < nF; i++, acc += 3) {
         const uint32_t end = sn_rd_u32(rp + 4 * i + 4);
@@ -690,9 +703,9 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
         for (; e < end; e++) {
             const uint32_t j = sn_m4_rd_u16(cols + 2 * e);
             const sn_q m = rd_real(mo, e), *vj = vel + 3 * j, *dj = ds + 3 * (j - nF);
-            int32_t y0 = sn_add(sn_k_coef_nc(vj[0], a1, bit), dj[0], &ns);
-            int32_t y1 = sn_add(sn_k_coef_nc(vj[1], a1, bit), dj[1], &ns);
-            int32_t y2 = sn_add(sn_k_coef_nc(vj[2], a1, bit), dj[2], &ns);
+            int32_t y0 = sn_add(fast ? sn_m4_coef8(vj[0], a8) : sn_k_coef_nc(vj[0], a1, bit), dj[0], &ns);
+            int32_t y1 = sn_add(fast ? sn_m4_coef8(vj[1], a8) : sn_k_coef_nc(vj[1], a1, bit), dj[1], &ns);
+            int32_t y2 = sn_add(fast ? sn_m4_coef8(vj[2], a8) : sn_k_coef_nc(vj[2], a1, bit), dj[2], &ns);
             SN_K_I32(y0, y1, y2);
             l0 += sn_mul(m, y0);
             l1 += sn_mul(m, y1);
@@ -701,6 +714,11 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
         acc[0] = l0; acc[1] = l1; acc[2] = l2;
     }
     *sat += ns; /* a count: the same total */
+}
+void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
+                  const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+    if (a1 > -((int32_t)1 << 23) && a1 < ((int32_t)1 << 23)) mass_sk_loop(rp, cols, mo, vel, ds, a1, acc, nF, sat, 1);
+    else mass_sk_loop(rp, cols, mo, vel, ds, a1, acc, nF, sat, 0);
 }
 
 /* cell_forces' corners 1..7 (sn_solve.c) in Thumb-2, sn_m4_corners: per
