@@ -995,6 +995,66 @@ static void test_seg_star_fixed(void) {
             sn_kernels_name(), bad_pins);
     T_FIGURE("fixed star, pair, pins: 40000 random nodes, pairs and attachments, %lu clamps counted", sats);
 }
+/* A level-0 sheet's sweep over its nodes (sn_segment_sweep.c): the step's
+ * (Cortex-M4: sheet_m4, each row's interior run without sheet_ends,
+ * sn_m4_star / sn_m4_pair called directly) against the node loop
+ * (node_proj per node), bit for bit with the clamp counts: 300 random sheets
+ * of side 3..8 in both directions, segments as test_seg_star_fixed's (centres
+ * within the state bound, every 8th at +-SN_LIM; unit directions), one half
+ * length 2^8..2^26 with its reciprocal, shift and turn factors. Tolerance 0. */
+static void test_seg_sheet(void) {
+    static sn_q SA[2 * 8 * 7 * SEG_W], SB[2 * 8 * 7 * SEG_W];
+    seg_ctx C;
+    seg_lvl L;
+    int t, bad = 0;
+    unsigned long sats = 0;
+    memset(&C, 0, sizeof C);
+    memset(&L, 0, sizeof L);
+    for (t = 0; t < 300; t++) {
+        const uint32_t sd = 3u + rnd32() % 6u, ns = 2u * sd * (sd - 1u);
+        uint32_t sa = 0, sb = 0, i, w;
+        sn_q rh, sh;
+        L.kind = SN_SEG_SHEET;
+        L.side = sd;
+        L.ns = ns;
+        L.nn = sd * sd;
+        L.l = 0;
+        L.half = seg_half_t(8, 26);
+        seg_recip_t(L.half, &rh, &sh);
+        L.rh = rh;
+        L.sh = (int)sh;
+        C.rf1 = (sn_q)(rnd32() % ((1u << 30) + 1u));
+        C.rf2 = C.rf1 >> 1;
+        C.g1n = (seg_n)(rnd32() & 0x7FFFFFFFu);
+        C.gh = (sn_q)(rnd32() % (1u << 30));
+        C.kf1 = (seg_n)(((int64_t)C.rf1 * rh + ((int64_t)1 << 29)) >> 30);
+        C.kf0 = (seg_n)(((int64_t)C.rf2 * rh + ((int64_t)1 << 29)) >> 30);
+        C.bias0 = ((sn_acc)1 << sh) >> 1;
+        for (i = 0; i < ns; i++) {
+            sn_q *S = SA + SEG_W * i;
+            const int edge = rnd32() % 8u == 0;
+            double v[3], n2;
+            const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+            for (w = 0; w < 3; w++) S[w] = edge ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            do {
+                for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+                n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            } while (n2 < 1e10);
+            for (w = 0; w < 3; w++) S[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            for (w = 6; w < SEG_W; w++) S[w] = (sn_q)rnd32();
+        }
+        memcpy(SB, SA, ns * SEG_W * sizeof SA[0]);
+        L.S = SA;
+        seg_sheet_test(&C, &L, (unsigned)t & 1u, 0, &sa);
+        L.S = SB;
+        seg_sheet_test(&C, &L, (unsigned)t & 1u, 1, &sb);
+        bad += memcmp(SA, SB, ns * SEG_W * sizeof SA[0]) != 0 || sa != sb;
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "fixed sheet sweep (path %s): %d of 300 sheets differ from the node loop (state or counts)",
+            sn_kernels_name(), bad);
+    T_FIGURE("fixed sheet sweep: 300 random sheets of side 3..8, %lu clamps counted", sats);
+}
 #endif
 
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
@@ -2019,6 +2079,7 @@ int main(void) {
     test_seg_move_ops();
     test_seg_move();
     test_seg_star_fixed();
+    test_seg_sheet();
     test_mul_out();
 #endif
 #if defined(SN_FLOAT)

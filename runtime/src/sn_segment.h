@@ -409,6 +409,8 @@ void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
 void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat);
 /* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat);
+/* a sheet's nodes in one sweep of direction dir (not measuring): the node loop (simd 0) or the step's, for the kernel test only */
+void seg_sheet_test(seg_ctx *C, const seg_lvl *L, unsigned dir, int simd, uint32_t *sat);
 /* every segment's u of level L to unit length (three Newton steps) */
 void seg_renormalize(const seg_lvl *L);
 /* the measuring pass's largest |d|^2 as a length in public Q16.16 segment lengths (or float) */

@@ -549,6 +549,96 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
 #endif
 }
 
+/* a sheet's nodes in a sweep: row-major, reversed on odd sweeps */
+static void sheet_nodes(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
+    const uint32_t sd = L->side;
+    uint32_t seg[5], r, c;
+    int sgn[5];
+    unsigned k;
+    for (r = 0; r < sd; r++)
+        for (c = 0; c < sd; c++) {
+            uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
+            if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
+            else k = sheet_ends(sd, rr, cc, seg, sgn);
+            node_proj(C, L, seg, sgn, k, measure, sat);
+        }
+}
+
+#if defined(SEG_M4)
+/* A level-0 sheet's sweep (side > 2, not measuring), Cortex-M4: the nodes
+ * in seg_sweep's order, each row's run of interior nodes (4 ends: left,
+ * up, right, down, the indices stepping by one along the row) without
+ * sheet_ends, the others by it; sn_m4_star / sn_m4_pair called directly
+ * with the clamps counted across the sweep. The same projections in the
+ * same order as node_proj's. */
+static void sheet_m4(seg_ctx *C, const seg_lvl *L, unsigned dir, uint32_t *sat) {
+    const uint32_t sd = L->side, nh = sd * (sd - 1u);
+    uint32_t seg[5], r, c, j;
+    int sgn[5];
+    unsigned k;
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.ls = 0;
+    for (r = 0; r < sd; r++) {
+        const uint32_t rr = dir ? sd - 1u - r : r;
+        for (c = 0; c < sd; c++) {
+            const uint32_t cc = dir ? sd - 1u - c : c;
+            if (c == 1u && rr > 0u && rr + 1u < sd) { /* the row's sd - 2 interior nodes */
+                uint32_t h = rr * (sd - 1u) + cc, n = nh + rr * sd + cc;
+                sgn[0] = sgn[1] = 1;
+                sgn[2] = sgn[3] = -1;
+                C->m4.k = 4u;
+                C->m4.inv = (int32_t)1 << 28;
+                for (j = 0; j < sd - 2u; j++) {
+                    seg[0] = h - 1u;
+                    seg[1] = n - sd;
+                    seg[2] = h;
+                    seg[3] = n;
+                    sn_m4_star(&C->m4);
+                    if (dir) { h--; n--; } else { h++; n++; }
+                }
+                c = sd - 2u;
+                continue;
+            }
+            k = sheet_ends(sd, rr, cc, seg, sgn);
+            if (k == 2u) sn_m4_pair(&C->m4, seg[0], seg[1], (sgn[0] < 0 ? 1u : 0u) | (sgn[1] < 0 ? 2u : 0u));
+            else {
+                C->m4.k = k;
+                C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941;
+                sn_m4_star(&C->m4);
+            }
+        }
+    }
+    *sat += C->m4.ls;
+}
+#endif
+
+/* a sheet's nodes (side > 2) in one sweep (not measuring): the portable
+ * C's (simd 0: pair_core, star) or the step's (sheet_m4 on a Cortex-M4's
+ * level 0, else the node loop), for test_runtime_kernels; not called by
+ * the step */
+void seg_sheet_test(seg_ctx *C, const seg_lvl *L, unsigned dir, int simd, uint32_t *sat) {
+    const uint32_t sd = L->side;
+    uint32_t seg[5], r, c;
+    int sgn[5];
+    unsigned k;
+    if (simd) {
+#if defined(SEG_M4)
+        seg_m4_prep(C, L);
+        if (L->l == 0) { sheet_m4(C, L, dir, sat); return; }
+#endif
+        sheet_nodes(C, L, 0, dir, sat);
+        return;
+    }
+    for (r = 0; r < sd; r++)
+        for (c = 0; c < sd; c++) {
+            k = sheet_ends(sd, dir ? sd - 1u - r : r, dir ? sd - 1u - c : c, seg, sgn);
+            if (k == 2u) pair_core(C, L, seg[0], sgn[0], seg[1], sgn[1], 0, sat);
+            else if (k == 4u) star(C, L, seg, sgn, 4u, sat);
+            else star(C, L, seg, sgn, 3u, sat);
+        }
+}
+
 /* What every sweep of level L reads and no sweep changes, once per level:
  * level 0's turn factors and the first SEG_TCACHE attachments' rod ends
  * (none where the attached fine node is not a node of the level) */
@@ -598,14 +688,11 @@ void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t
             pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
     } else { /* sheet: row-major, reversed on odd sweeps (symmetric Gauss-Seidel) */
-        uint32_t sd = L->side, r, c;
-        for (r = 0; r < sd; r++)
-            for (c = 0; c < sd; c++) {
-                uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
-                if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
-                else k = sheet_ends(sd, rr, cc, seg, sgn);
-                node_proj(C, L, seg, sgn, k, measure, sat);
-            }
+#if defined(SEG_M4)
+        if (L->l == 0 && !measure && L->side > 2u) sheet_m4(C, L, dir, sat);
+        else
+#endif
+        sheet_nodes(C, L, measure, dir, sat);
     }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
