@@ -550,7 +550,7 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
 }
 
 /* a sheet's nodes in a sweep: row-major, reversed on odd sweeps */
-static void sheet_nodes(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
+SN_NOINLINE void sheet_nodes(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
     const uint32_t sd = L->side;
     uint32_t seg[5], r, c;
     int sgn[5];
@@ -566,9 +566,10 @@ static void sheet_nodes(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir,
 
 #if defined(SEG_M4)
 /* A level-0 sheet's sweep (side > 2, not measuring), Cortex-M4: the nodes
- * in seg_sweep's order, each row's run of interior nodes (4 ends: left,
- * up, right, down, the indices stepping by one along the row) without
- * sheet_ends, the others by it; sn_m4_star / sn_m4_pair called directly
+ * in seg_sweep's order, each row's run of middle nodes (sheet_ends' ends
+ * left, up, right, down without the top row's up and the bottom row's
+ * down, the indices stepping by one along the row) without sheet_ends,
+ * the row's first and last node by it; sn_m4_star / sn_m4_pair called directly
  * with the clamps counted across the sweep. The same projections in the
  * same order as node_proj's. */
 static void sheet_m4(seg_ctx *C, const seg_lvl *L, unsigned dir, uint32_t *sat) {
@@ -583,17 +584,24 @@ static void sheet_m4(seg_ctx *C, const seg_lvl *L, unsigned dir, uint32_t *sat) 
         const uint32_t rr = dir ? sd - 1u - r : r;
         for (c = 0; c < sd; c++) {
             const uint32_t cc = dir ? sd - 1u - c : c;
-            if (c == 1u && rr > 0u && rr + 1u < sd) { /* the row's sd - 2 interior nodes */
+            if (c == 1u) { /* the row's sd - 2 middle nodes: left, (up,) right, (down) */
+                const int top = rr == 0u, bottom = rr + 1u == sd;
                 uint32_t h = rr * (sd - 1u) + cc, n = nh + rr * sd + cc;
-                sgn[0] = sgn[1] = 1;
+                sgn[0] = 1;
+                sgn[1] = top ? -1 : 1;
                 sgn[2] = sgn[3] = -1;
-                C->m4.k = 4u;
-                C->m4.inv = (int32_t)1 << 28;
+                C->m4.k = top || bottom ? 3u : 4u;
+                C->m4.inv = top || bottom ? 357913941 : (int32_t)1 << 28;
                 for (j = 0; j < sd - 2u; j++) {
                     seg[0] = h - 1u;
-                    seg[1] = n - sd;
-                    seg[2] = h;
-                    seg[3] = n;
+                    if (top) {
+                        seg[1] = h;
+                        seg[2] = n;
+                    } else {
+                        seg[1] = n - sd;
+                        seg[2] = h;
+                        seg[3] = n; /* not read on the bottom row (k = 3) */
+                    }
                     sn_m4_star(&C->m4);
                     if (dir) { h--; n--; } else { h++; n++; }
                 }
