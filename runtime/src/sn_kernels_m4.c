@@ -1228,7 +1228,7 @@ __asm__(
  * |v| < 2^28 tested on the sum's high word alone (v >> 28 = hi >> 20 in
  * {-1, 0}); a failed test (v = 2^28 too) re-tests exactly out of line
  * (.subsection 1), where clamps are counted (lr). GCC: 102 instructions a
- * vertex, here ~80. */
+ * vertex, here 84. */
 typedef char sn_m4_mix_layout_[sizeof(struct sn_m4_mixc) == 32 && SN_Q_COEF == 24 ? 1 : -1];
 __asm__(
     ".syntax unified\n"
