@@ -996,6 +996,66 @@ static void test_seg_star_fixed(void) {
             sn_kernels_name(), bad_pins);
     T_FIGURE("fixed star, pair, pins: 40000 random nodes, pairs and attachments, %lu clamps counted", sats);
 }
+/* A level-0 sheet's sweep over its nodes (sn_segment_sweep.c): the step's
+ * (Cortex-M4: sheet_m4, each row's interior run without sheet_ends,
+ * sn_m4_star / sn_m4_pair called directly) against the node loop
+ * (node_proj per node), bit for bit with the clamp counts: 300 random sheets
+ * of side 3..8 in both directions, segments as test_seg_star_fixed's (centres
+ * within the state bound, every 8th at +-SN_LIM; unit directions), one half
+ * length 2^8..2^26 with its reciprocal, shift and turn factors. Tolerance 0. */
+static void test_seg_sheet(void) {
+    static sn_q SA[2 * 8 * 7 * SEG_W], SB[2 * 8 * 7 * SEG_W];
+    seg_ctx C;
+    seg_lvl L;
+    int t, bad = 0;
+    unsigned long sats = 0;
+    memset(&C, 0, sizeof C);
+    memset(&L, 0, sizeof L);
+    for (t = 0; t < 300; t++) {
+        const uint32_t sd = 3u + rnd32() % 6u, ns = 2u * sd * (sd - 1u);
+        uint32_t sa = 0, sb = 0, i, w;
+        sn_q rh, sh;
+        L.kind = SN_SEG_SHEET;
+        L.side = sd;
+        L.ns = ns;
+        L.nn = sd * sd;
+        L.l = 0;
+        L.half = seg_half_t(8, 26);
+        seg_recip_t(L.half, &rh, &sh);
+        L.rh = rh;
+        L.sh = (int)sh;
+        C.rf1 = (sn_q)(rnd32() % ((1u << 30) + 1u));
+        C.rf2 = C.rf1 >> 1;
+        C.g1n = (seg_n)(rnd32() & 0x7FFFFFFFu);
+        C.gh = (sn_q)(rnd32() % (1u << 30));
+        C.kf1 = (seg_n)(((int64_t)C.rf1 * rh + ((int64_t)1 << 29)) >> 30);
+        C.kf0 = (seg_n)(((int64_t)C.rf2 * rh + ((int64_t)1 << 29)) >> 30);
+        C.bias0 = ((sn_acc)1 << sh) >> 1;
+        for (i = 0; i < ns; i++) {
+            sn_q *S = SA + SEG_W * i;
+            const int edge = rnd32() % 8u == 0;
+            double v[3], n2;
+            const double len = 1.0 - (rnd32() % 1000u) * 1.2e-5;
+            for (w = 0; w < 3; w++) S[w] = edge ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            do {
+                for (w = 0; w < 3; w++) v[w] = (double)rnd_in(1 << 20);
+                n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            } while (n2 < 1e10);
+            for (w = 0; w < 3; w++) S[3 + w] = (sn_q)floor(v[w] / sqrt(n2) * len * 1073741824.0 + 0.5);
+            for (w = 6; w < SEG_W; w++) S[w] = (sn_q)rnd32();
+        }
+        memcpy(SB, SA, ns * SEG_W * sizeof SA[0]);
+        L.S = SA;
+        seg_sheet_test(&C, &L, (unsigned)t & 1u, 0, &sa);
+        L.S = SB;
+        seg_sheet_test(&C, &L, (unsigned)t & 1u, 1, &sb);
+        bad += memcmp(SA, SB, ns * SEG_W * sizeof SA[0]) != 0 || sa != sb;
+        sats += sa;
+    }
+    T_CHECK(bad == 0, "fixed sheet sweep (path %s): %d of 300 sheets differ from the node loop (state or counts)",
+            sn_kernels_name(), bad);
+    T_FIGURE("fixed sheet sweep: 300 random sheets of side 3..8, %lu clamps counted", sats);
+}
 #endif
 
 /* ---- the loop helpers of sn_kernels_rot.h (sn_k_sub3, sn_k_sub3a,
@@ -1051,7 +1111,8 @@ static void test_loops(void) {
 #endif
         sn_q x[3], y[3], o1[3], o2[3], R[9], q1[40], q2[40], ck = rnd_val(0), cm = rnd_val(0);
         sn_acc ya[3], a1[3], a2[3], l[3], in[40];
-        unsigned char D[24];
+        sn_q Dw[6]; /* sn_k_sym_out's block 4-aligned, as the PRECOND section's (the M4's LDM) */
+        unsigned char *D = (unsigned char *)Dw;
         uint8_t kk[14];
         uint32_t s1 = 0, s2 = 0, n = rnd32() % 41u, i;
 #if defined(SN_FLOAT)
@@ -1118,7 +1179,8 @@ static void test_loops(void) {
  * 1) and random values, for every shift 0..62: sn_k_out_rot_acc, sn_k_outv,
  * sn_k_mix, sn_k_mul_out against sn_out (sn_internal.h, the reference),
  * bit for bit with the same clamp counts; on the M4 sn_k_out_w (s < 32) and
- * sn_k_out_hw (32..62) themselves too. */
+ * sn_k_out_hw (32..62) themselves too; sn_k_sym_out's first row at the
+ * same edges for s = 1..31. */
 static int edge_ls(int s, sn_acc *l) {
     static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1),
                                  1 << 30, -(1 << 30)};
@@ -1164,6 +1226,19 @@ static void test_out_edges(void) {
                 sn_k_mix(q1, lv, kk, 3, fm, ck, cm, &s1);
                 for (k = 0; k < 3; k++) q2[k] = sn_out(sn_mul(q2[k], ck) + sn_mul(sn_out(lv[k], s, &s2), cm), SN_Q_COEF, &s2);
                 bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+                {   /* the second rounding at its edges (q ck >> 24 = q at ck = 2^24,
+                     * mk cm a small offset or a tie): sn_k_mix's v = +-SN_LIM exactly
+                     * and its neighbours (the M4's test on the high word) */
+                    static const int32_t vq[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1,
+                                                 -(SN_LIM + 1), 1 << 30, -(1 << 30), INT32_MAX, -INT32_MAX};
+                    static const int32_t vm[] = {0, 1, -1, 1 << 23, -(1 << 23)};
+                    const uint32_t a = (uint32_t)i % 13u, b = rnd32() % 5u;
+                    for (k = 0; k < 3; k++) q1[k] = q2[k] = vq[(a + (uint32_t)k * 5u) % 13u];
+                    sn_k_mix(q1, lv, kk, 3, fm, 1 << 24, vm[b], &s1);
+                    for (k = 0; k < 3; k++)
+                        q2[k] = sn_out(sn_mul(q2[k], 1 << 24) + sn_mul(sn_out(lv[k], s, &s2), vm[b]), SN_Q_COEF, &s2);
+                    bad += memcmp(q1, q2, sizeof q1) != 0 || s1 != s2;
+                }
             }
 #if defined(SN_KERNELS_M4)
             if (s > 0 && s < 32) bad += sn_k_out_w(l[i], s, (uint32_t)1 << (s - 1), &s1) != sn_out(l[i], s, &s2) || s1 != s2;
@@ -1173,6 +1248,30 @@ static void test_out_edges(void) {
             clamps += s2;
             cases++;
         }
+    }
+    /* sn_k_sym_out (the M4's sn_m4_sym_out for 0 < s < 32) with its first
+     * row's sum at the same edges: xx = 2^(s-1), e0 = 2v, xy = 1, e1 = d,
+     * xz = 0 give l0 = v 2^s + d exactly; the other rows random */
+    for (s = 1; s <= 31; s++) {
+        static const int32_t vs[] = {0, 1, -1, SN_LIM - 1, -(SN_LIM - 1), SN_LIM, -SN_LIM, SN_LIM + 1, -(SN_LIM + 1)};
+        const int32_t h = (int32_t)((uint32_t)1 << (s - 1));
+        const int32_t ds[] = {0, 1, -1, h, -h, h - 1, -h - 1, h + 1, -h + 1};
+        uint32_t a, b;
+        for (a = 0; a < sizeof vs / sizeof vs[0]; a++)
+            for (b = 0; b < sizeof ds / sizeof ds[0]; b++) {
+                sn_q D[6] = {h, rnd_in(1 << 30), rnd_in(1 << 30), 1, 0, rnd_in(1 << 30)}, e[3] = {2 * vs[a], ds[b], rnd_in(1 << 30)};
+                sn_q o1[3], o2[3];
+                sn_acc m[3];
+                uint32_t s1 = 0, s2 = 0, k;
+                sn_k_sym_out((const unsigned char *)D, e, o1, s, &s1);
+                m[0] = sn_mul(D[0], e[0]) + sn_mul(D[3], e[1]) + sn_mul(D[4], e[2]);
+                m[1] = sn_mul(D[3], e[0]) + sn_mul(D[1], e[1]) + sn_mul(D[5], e[2]);
+                m[2] = sn_mul(D[4], e[0]) + sn_mul(D[5], e[1]) + sn_mul(D[2], e[2]);
+                for (k = 0; k < 3; k++) o2[k] = sn_out(m[k], s, &s2);
+                bad += memcmp(o1, o2, sizeof o1) != 0 || s1 != s2 || m[0] != (int64_t)vs[a] * ((int64_t)1 << s) + ds[b];
+                clamps += s2;
+                cases++;
+            }
     }
     T_CHECK(bad == 0, "rounding helpers at their edges (path %s): %d results or clamp counts off sn_out", sn_kernels_name(), bad);
     T_FIGURE("rounding helpers: %d edge accumulators over shifts 0..62, %u clamps", cases, (unsigned)clamps);
@@ -1586,7 +1685,8 @@ static void test_mass_ff(void) {
  * 0): random ascending rows of 1..40 free rows over nF + 1..16 vertices
  * (free columns first, as the validator's order gives), v' at and inside
  * +-SN_LIM, a1 at and inside +-ONE_COEF (the kernel's contract: sn_rhs's
- * pre) and at +-ONE_COEF / 2 (odd v' gives the rounding's ties), ds making y clamp at SN_LIM, starting accumulators random. */
+ * pre), at +-ONE_COEF / 2 (odd v' gives the rounding's ties) and just inside it (the M4's SMMULR form
+ * for |a1| < ONE_COEF / 2), ds making y clamp at SN_LIM, starting accumulators random. */
 static void test_mass_sk(void) {
     static unsigned char rp[4 * 41], cols[2 * 400], mo[4 * 400];
     static sn_q vel[3 * 56], ds[3 * 16];
@@ -1596,7 +1696,8 @@ static void test_mass_sk(void) {
     for (t = 0; t < 500; t++) {
         const uint32_t nF = 1u + rnd32() % 40u, nS = 1u + rnd32() % 16u, nV = nF + nS;
         const int wild = t % 4 == 0;
-        const sn_q a = t % 8 == 0 ? ONE_COEF : t % 8 == 1 ? -ONE_COEF : t % 8 == 2 ? ONE_COEF / 2 : t % 8 == 3 ? -ONE_COEF / 2 : rnd_in(ONE_COEF);
+        const sn_q a = t % 8 == 0 ? ONE_COEF : t % 8 == 1 ? -ONE_COEF : t % 8 == 2 ? ONE_COEF / 2 : t % 8 == 3 ? -ONE_COEF / 2
+                     : t % 8 == 4 ? ONE_COEF / 2 - 1 : t % 8 == 5 ? -(ONE_COEF / 2 - 1) : rnd_in(ONE_COEF);
         uint32_t i, e = 0, k, s1 = 0, s2 = 0;
         for (i = 0; i < 3 * nV; i++) vel[i] = wild && rnd32() & 1 ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
         for (i = 0; i < 3 * nS; i++) ds[i] = wild ? (rnd32() & 1 ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
@@ -2048,6 +2149,7 @@ int main(void) {
     test_seg_move_ops();
     test_seg_move();
     test_seg_star_fixed();
+    test_seg_sheet();
     test_mul_out();
 #endif
 #if defined(SN_FLOAT)

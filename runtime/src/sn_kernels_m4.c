@@ -677,9 +677,22 @@ SN_INLINE uint32_t sn_m4_rd_u16(const unsigned char *p) {
     memcpy(&v, p, 2); /* LDRH: little-endian, unaligned allowed */
     return v;
 }
-void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
-                  const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+/* coef_nc(v, a1) = (v a1 + 2^23) >> 24 as one SMMULR of v and a1 2^8 for
+ * |a1| < 2^23 ((v a1 2^8 + 2^31) >> 32: the same floor, a1 2^8 within
+ * int32; sn_rhs's a1 = h alpha is far below): the same value */
+SN_INLINE int32_t sn_m4_coef8(sn_q v, int32_t a8) {
+    int32_t r;
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(v), "r"(a8));
+    return r;
+}
+/* the loop, with the coefficient's product by SMMULR (fast) or
+ * sn_k_coef_nc; forced inline so each call has its own code */
+static inline __attribute__((always_inline)) void mass_sk_loop(const unsigned char *rp, const unsigned char *cols,
+                                                               const unsigned char *mo, const sn_q *vel, const sn_q *ds,
+                                                               sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat,
+                                                               int fast) {
     const uint32_t bit = (uint32_t)1 << (SN_Q_COEF - 1);
+    const int32_t a8 = fast ? (int32_t)((uint32_t)a1 << 8) : 0;
     uint32_t i, ns = 0, e = sn_rd_u32(rp);
     for (i = 0; i < nF; i++, acc += 3) {
         const uint32_t end = sn_rd_u32(rp + 4 * i + 4);
@@ -690,9 +703,9 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
         for (; e < end; e++) {
             const uint32_t j = sn_m4_rd_u16(cols + 2 * e);
             const sn_q m = rd_real(mo, e), *vj = vel + 3 * j, *dj = ds + 3 * (j - nF);
-            int32_t y0 = sn_add(sn_k_coef_nc(vj[0], a1, bit), dj[0], &ns);
-            int32_t y1 = sn_add(sn_k_coef_nc(vj[1], a1, bit), dj[1], &ns);
-            int32_t y2 = sn_add(sn_k_coef_nc(vj[2], a1, bit), dj[2], &ns);
+            int32_t y0 = sn_add(fast ? sn_m4_coef8(vj[0], a8) : sn_k_coef_nc(vj[0], a1, bit), dj[0], &ns);
+            int32_t y1 = sn_add(fast ? sn_m4_coef8(vj[1], a8) : sn_k_coef_nc(vj[1], a1, bit), dj[1], &ns);
+            int32_t y2 = sn_add(fast ? sn_m4_coef8(vj[2], a8) : sn_k_coef_nc(vj[2], a1, bit), dj[2], &ns);
             SN_K_I32(y0, y1, y2);
             l0 += sn_mul(m, y0);
             l1 += sn_mul(m, y1);
@@ -701,6 +714,11 @@ void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsi
         acc[0] = l0; acc[1] = l1; acc[2] = l2;
     }
     *sat += ns; /* a count: the same total */
+}
+void sn_k_mass_sk(const unsigned char *rp, const unsigned char *cols, const unsigned char *mo, const sn_q *vel,
+                  const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+    if (a1 > -((int32_t)1 << 23) && a1 < ((int32_t)1 << 23)) mass_sk_loop(rp, cols, mo, vel, ds, a1, acc, nF, sat, 1);
+    else mass_sk_loop(rp, cols, mo, vel, ds, a1, acc, nF, sat, 0);
 }
 
 /* cell_forces' corners 1..7 (sn_solve.c) in Thumb-2, sn_m4_corners: per
@@ -1137,6 +1155,170 @@ void sn_k_out_rot_acc_c(sn_acc acc[3], const sn_q *R, const sn_acc l[3], int sh,
     x = acc[1]; x += sn_mul(R[3], t0); x += sn_mul(R[4], t1); x += sn_mul(R[5], t2); acc[1] = x;
     x = acc[2]; x += sn_mul(R[6], t0); x += sn_mul(R[7], t1); x += sn_mul(R[8], t2); acc[2] = x;
 }
+
+/* sn_k_sym_out (sn_kernels_rot.h) for 0 < sh < 32 in Thumb-2: D's six
+ * entries and e by LDM (b 4-aligned: the PRECOND section is 8-aligned, 24
+ * bytes an entry), the three sums in SMULL/SMLAL register pairs (e read
+ * before out is written: out may be e), each rounded, shifted and clamped
+ * as sn_k_out_w (the count in memory on the rare clamp). GCC: 70
+ * instructions a call, here 53. Exact int64 sums, the same integers. */
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_sym_out,\"ax\",%progbits\n"
+    ".macro sns_out lo, hi\n"
+    "adds  \\lo, \\lo, lr\n"
+    "adc   \\hi, \\hi, #0\n"
+    "lsr   \\lo, \\lo, r3\n"
+    "lsl   r6, \\hi, r1\n"
+    "orr   \\lo, \\lo, r6\n"
+    "asr   \\hi, \\hi, r3\n"
+    "add   r6, \\lo, #0x10000000\n"
+    "cmp   r6, #0x20000000\n"
+    "bhi   .Lsns1\\@\n"
+    "cmp   \\hi, \\lo, asr #31\n"
+    "beq   .Lsns2\\@\n"
+    ".Lsns1\\@:\n"
+    "ldr   r6, [sp, #36]\n"
+    "ldr   r8, [r6]\n"
+    "add   r8, r8, #1\n"
+    "str   r8, [r6]\n"
+    "cmp   \\hi, #0\n"
+    "ite   lt\n"
+    "movlt \\lo, #0xF0000000\n"
+    "movge \\lo, #0x10000000\n"
+    ".Lsns2\\@:\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_sym_out\n"
+    ".thumb_func\n"
+    ".type sn_m4_sym_out, %function\n"
+    "sn_m4_sym_out:\n"            /* r0 b, r1 e, r2 out, r3 sh (1..31), [sp] sat */
+    "push  {r4-r11, lr}\n"
+    "ldm   r0, {r4-r9}\n"         /* xx yy zz xy xz yz */
+    "ldm   r1, {r0, r1, lr}\n"    /* e0 e1 e2 */
+    "smull r10, r11, r4, r0\n"    /* l0 = xx e0 + xy e1 + xz e2 */
+    "smlal r10, r11, r7, r1\n"
+    "smlal r10, r11, r8, lr\n"
+    "smull r4, r12, r7, r0\n"     /* l1 = xy e0 + yy e1 + yz e2 */
+    "smlal r4, r12, r5, r1\n"
+    "smlal r4, r12, r9, lr\n"
+    "smull r5, r7, r8, r0\n"      /* l2 = xz e0 + yz e1 + zz e2 */
+    "smlal r5, r7, r9, r1\n"
+    "smlal r5, r7, r6, lr\n"
+    "mov   lr, #1\n"
+    "sub   r0, r3, #1\n"
+    "lsl   lr, lr, r0\n"          /* 2^(sh-1) */
+    "rsb   r1, r3, #32\n"
+    "sns_out r10, r11\n"
+    "sns_out r4, r12\n"
+    "sns_out r5, r7\n"
+    "str   r10, [r2]\n"
+    "str   r4, [r2, #4]\n"
+    "str   r5, [r2, #8]\n"
+    "pop   {r4-r11, pc}\n"
+    ".size sn_m4_sym_out, .-sn_m4_sym_out\n"
+    ".purgem sns_out\n"
+    ".popsection\n");
+
+/* sn_k_mix (sn_kernels_rot.h) in Thumb-2 while a vertex's shift sh = base
+ * - kk is in 1..31: per value mk = sn_k_out_w(acc, sh) (the rounding add,
+ * the shift on the two words, the clamp's two tests), then q = sn_out(q ck
+ * + mk cm, 24) as SMULL/SMLAL, the rounding add and the shift by 24 with
+ * |v| < 2^28 tested on the sum's high word alone (v >> 28 = hi >> 20 in
+ * {-1, 0}); a failed test (v = 2^28 too) re-tests exactly out of line
+ * (.subsection 1), where clamps are counted (lr). GCC: 102 instructions a
+ * vertex, here 84. */
+typedef char sn_m4_mix_layout_[sizeof(struct sn_m4_mixc) == 32 && SN_Q_COEF == 24 ? 1 : -1];
+__asm__(
+    ".syntax unified\n"
+    ".thumb\n"
+    ".pushsection .text.sn_m4_mix,\"ax\",%progbits\n"
+    ".macro snx_val\n"
+    "ldrd  r11, r12, [r2], #8\n"
+    "adds  r11, r11, r9\n"
+    "adc   r12, r12, #0\n"
+    "lsr   r11, r11, r8\n"
+    "lsl   r0, r12, r10\n"
+    "orr   r11, r11, r0\n"
+    "asr   r12, r12, r8\n"
+    "add   r0, r11, #0x10000000\n"
+    "cmp   r0, #0x20000000\n"
+    "bhi   .Lsnxa\\@\n"
+    "cmp   r12, r11, asr #31\n"
+    "bne   .Lsnxa\\@\n"
+    ".Lsnxb\\@:\n"
+    "ldr   r0, [r1]\n"
+    "smull r0, r12, r0, r6\n"
+    "smlal r0, r12, r11, r7\n"
+    "adds  r0, r0, #0x800000\n"
+    "adc   r12, r12, #0\n"
+    "lsr   r0, r0, #24\n"
+    "orr   r0, r0, r12, lsl #8\n"
+    "asr   r11, r12, #20\n"
+    "adds  r11, r11, #1\n"
+    "cmp   r11, #1\n"
+    "bhi   .Lsnxc\\@\n"
+    ".Lsnxd\\@:\n"
+    "str   r0, [r1], #4\n"
+    ".subsection 1\n"
+    ".Lsnxa\\@:\n"               /* mk clamped, counted */
+    "add   lr, lr, #1\n"
+    "cmp   r12, #0\n"
+    "ite   lt\n"
+    "movlt r11, #0xF0000000\n"
+    "movge r11, #0x10000000\n"
+    "b     .Lsnxb\\@\n"
+    ".Lsnxc\\@:\n"               /* the exact test of v (lo r0, hi r12 >> 24) */
+    "asr   r12, r12, #24\n"
+    "add   r11, r0, #0x10000000\n"
+    "cmp   r11, #0x20000000\n"
+    "bhi   .Lsnxf\\@\n"
+    "cmp   r12, r0, asr #31\n"
+    "beq   .Lsnxd\\@\n"
+    ".Lsnxf\\@:\n"
+    "add   lr, lr, #1\n"
+    "cmp   r12, #0\n"
+    "ite   lt\n"
+    "movlt r0, #0xF0000000\n"
+    "movge r0, #0x10000000\n"
+    "b     .Lsnxd\\@\n"
+    ".subsection 0\n"
+    ".endm\n"
+    ".align 2\n"
+    ".global sn_m4_mix\n"
+    ".thumb_func\n"
+    ".type sn_m4_mix, %function\n"
+    "sn_m4_mix:\n"
+    "push  {r0, r4-r11, lr}\n"
+    "ldm   r0, {r1-r7}\n"         /* q acc kk kend base ck cm */
+    "ldr   lr, [r0, #28]\n"
+    "1:\n"
+    "cmp   r3, r4\n"
+    "beq   9f\n"
+    "ldrb  r8, [r3]\n"
+    "sub   r8, r5, r8\n"          /* sh */
+    "sub   r9, r8, #1\n"
+    "cmp   r9, #30\n"
+    "bhi   9f\n"
+    "add   r3, r3, #1\n"
+    "mov   r10, #1\n"
+    "lsl   r9, r10, r9\n"         /* 2^(sh-1) */
+    "rsb   r10, r8, #32\n"
+    "snx_val\n"
+    "snx_val\n"
+    "snx_val\n"
+    "b     1b\n"
+    "9:\n"
+    "ldr   r0, [sp]\n"
+    "stm   r0, {r1-r3}\n"
+    "str   lr, [r0, #28]\n"
+    "pop   {r0, r4-r11, pc}\n"
+    ".subsection 1\n"
+    ".size sn_m4_mix, .-sn_m4_mix\n"
+    ".subsection 0\n"
+    ".purgem snx_val\n"
+    ".popsection\n");
 
 const char *sn_kernels_name(void) { return "m4"; }
 

@@ -535,8 +535,12 @@ SN_INLINE void sn_k_out_rot_acc(sn_acc acc[3], const sn_q *R, const sn_acc l[3],
     else sn_k_out_rot_acc_c(acc, R, l, sh, sat);
 }
 /* l = D e in int32 registers (e read first: out may be e), then sn_k_out_w
- * (0 < sh < 32) or sn_out; exact sums, the same integers */
+ * (0 < sh < 32: Thumb-2, sn_m4_sym_out in sn_kernels_m4.c; b 4-aligned) or
+ * sn_out; exact sums, the same integers */
+void sn_m4_sym_out(const unsigned char *b, const sn_q *e, sn_q *out, int sh, uint32_t *sat);
 SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3], int sh, uint32_t *sat) {
+    if ((uint32_t)(sh - 1) < 31u) { sn_m4_sym_out(b, e, out, sh, sat); return; }
+    {
     const sn_q xx = rd_real(b, 0), yy = rd_real(b, 1), zz = rd_real(b, 2);
     const sn_q xy = rd_real(b, 3), xz = rd_real(b, 4), yz = rd_real(b, 5);
     int32_t e0 = e[0], e1 = e[1], e2 = e[2];
@@ -545,15 +549,9 @@ SN_INLINE void sn_k_sym_out(const unsigned char *b, const sn_q e[3], sn_q out[3]
     l0 = sn_mul(xx, e0) + sn_mul(xy, e1) + sn_mul(xz, e2);
     l1 = sn_mul(xy, e0) + sn_mul(yy, e1) + sn_mul(yz, e2);
     l2 = sn_mul(xz, e0) + sn_mul(yz, e1) + sn_mul(zz, e2);
-    if ((uint32_t)(sh - 1) < 31u) {
-        const uint32_t bit = (uint32_t)1 << (sh - 1);
-        out[0] = sn_k_out_w(l0, sh, bit, sat);
-        out[1] = sn_k_out_w(l1, sh, bit, sat);
-        out[2] = sn_k_out_w(l2, sh, bit, sat);
-    } else {
-        out[0] = sn_out(l0, sh, sat);
-        out[1] = sn_out(l1, sh, sat);
-        out[2] = sn_out(l2, sh, sat);
+    out[0] = sn_out(l0, sh, sat);
+    out[1] = sn_out(l1, sh, sat);
+    out[2] = sn_out(l2, sh, sat);
     }
 }
 #define SN_K_SYM_OUT_M4 1
@@ -699,6 +697,19 @@ SN_INLINE void sn_k_outv(sn_q *out, const sn_acc *in, uint32_t n, int s, uint32_
 #endif
     for (; i < n; i++) out[i] = sn_out(in[i], s, sat);
 }
+#if defined(SN_KERNELS_M4)
+/* sn_k_mix's operands for sn_m4_mix (sn_kernels_m4.c), which advances q,
+ * acc and kk over the vertices up to kend or the first one whose shift
+ * base - kk is outside 1..31, adding its clamps to sat */
+struct sn_m4_mixc {
+    sn_q *q;
+    const sn_acc *acc;
+    const uint8_t *kk, *kend;
+    int32_t base, ck, cm; /* base: fm - SN_KREL(0) */
+    uint32_t sat;
+};
+void sn_m4_mix(struct sn_m4_mixc *c);
+#endif
 SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t n, int fm, sn_q ck, sn_q cm, uint32_t *sat) {
     uint32_t i = 0;
 #if defined(SN_KERNELS_AVX2)
@@ -748,30 +759,35 @@ SN_INLINE void sn_k_mix(sn_q *q, const sn_acc *acc, const uint8_t *kk, uint32_t 
         sn_acc s = sn_mul(q[i], ck) + sn_mul(mk, cm);
         q[i] = sn_out(s, SN_Q_COEF, sat);
     }
-#elif defined(SN_KERNELS_M4) /* sn_k_out_w for both roundings; a vertex's shift outside 1..31: the reference's */
-    /* a vertex's 3 values written out, its shift tested once (the loop of 3
-     * tested it per value and reloaded its operands: cow_fem step -17 k) */
-    const uint32_t cb = (uint32_t)1 << (SN_Q_COEF - 1);
-    for (; i < n / 3; i++) {
-        const int sh = fm - SN_KREL(kk[i]);
-        sn_q *qi = q + 3 * i;
-        const sn_acc *ai = acc + 3 * i;
-        int32_t m0, m1, m2;
-        if ((uint32_t)(sh - 1) < 31u) {
-            const uint32_t bit = (uint32_t)1 << (sh - 1);
-            m0 = sn_k_out_w(ai[0], sh, bit, sat);
-            m1 = sn_k_out_w(ai[1], sh, bit, sat);
-            m2 = sn_k_out_w(ai[2], sh, bit, sat);
-        } else {
-            m0 = sn_out(ai[0], sh, sat);
-            m1 = sn_out(ai[1], sh, sat);
-            m2 = sn_out(ai[2], sh, sat);
+#elif defined(SN_KERNELS_M4)
+    /* Thumb-2 (sn_m4_mix, sn_kernels_m4.c) while a vertex's shift is in
+     * 1..31 (sn_k_out_w's rounding for both roundings); a vertex outside:
+     * the reference's, then the assembly again */
+    struct sn_m4_mixc c;
+    c.q = q;
+    c.acc = acc;
+    c.kk = kk;
+    c.kend = kk + n / 3;
+    c.base = fm - SN_KREL(0);
+    c.ck = ck;
+    c.cm = cm;
+    c.sat = 0;
+    (void)i;
+    for (;;) {
+        uint32_t k;
+        int sh;
+        sn_m4_mix(&c);
+        if (c.kk == c.kend) break;
+        sh = fm - SN_KREL(*c.kk);
+        for (k = 0; k < 3; k++) {
+            sn_q mk = sn_out(c.acc[k], sh, &c.sat);
+            c.q[k] = sn_out(sn_mul(c.q[k], ck) + sn_mul(mk, cm), SN_Q_COEF, &c.sat);
         }
-        SN_K_I32(m0, m1, m2); /* int32 operands: SMULL, SMLAL */
-        qi[0] = sn_k_out_w(sn_mul(qi[0], ck) + sn_mul(m0, cm), SN_Q_COEF, cb, sat);
-        qi[1] = sn_k_out_w(sn_mul(qi[1], ck) + sn_mul(m1, cm), SN_Q_COEF, cb, sat);
-        qi[2] = sn_k_out_w(sn_mul(qi[2], ck) + sn_mul(m2, cm), SN_Q_COEF, cb, sat);
+        c.q += 3;
+        c.acc += 3;
+        c.kk++;
     }
+    *sat += c.sat;
 #else /* per vertex, its shift once (the loop the mat-vec had) */
     for (; i < n / 3; i++) {
         int sh = fm - SN_KREL(kk[i]);

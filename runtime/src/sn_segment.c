@@ -45,7 +45,10 @@ static sn_q lever(sn_q c, sn_q hl, sn_q r, int sh, sn_q f, int fs) {
     sn_q t = ck * r * f;
     (void)sh; (void)fs;
 #else
-    int64_t t = sn_rshr64(sn_rshr64((int64_t)ck * r, sh) * f, fs);
+    /* the quotient (<= 2^30) as an int32 (NARROW: a 32 x 32 product with f
+     * on a 32-bit target), its variable shift on the two words there
+     * (sn_rshr64_var): the same value */
+    int64_t t = sn_rshr64(MUL(NARROW(sn_rshr64_var((int64_t)ck * r, sh)), f), fs);
 #endif
     return (sn_q)(t > ROT_MAX ? ROT_MAX : (t < -ROT_MAX ? -ROT_MAX : t));
 }

@@ -308,6 +308,38 @@ SN_INLINE void newton_unit(const sn_acc x[3], sn_q u[3]) {
 #endif
 }
 
+#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
+    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#define SEG_M4 1
+/* Cortex-M4 (Thumb-2, DSP): level 0's star() and pair() moves in assembly
+ * (sn_segment_m4.c, sn_m4_star, sn_m4_pair), their operands and scratch
+ * here; the offsets are the assembly's (checked by a typedef there) */
+struct seg_m4_slot {      /* an end's move (8 words) */
+    sn_q *S;                /* its segment's words */
+    int32_t d[3], f, t[3];  /* the gap (the star's first pass: its end P), turn factor, translation */
+};
+struct seg_m4_star {
+    sn_q *S;              /* 0: the level's segment words */
+    int32_t h4, kf, sh;   /* 4: 4 half (r30s's SMMULR operand), kf1, the turn's shift */
+    int32_t rs, bias;     /* 16: 31 - sh, the turn's rounding bias (< 2^29) */
+    int32_t g1n;          /* 24: omega gamma */
+    uint32_t ls;          /* 28: clamps counted */
+    int32_t inv;          /* 32: round(2^30 / k) (mean_k) */
+    struct seg_m4_slot *plast; /* 36: the last end's slot */
+    const uint32_t *seg;  /* 40 */
+    const int *sgn;       /* 44 */
+    uint32_t k;           /* 48 */
+    int32_t *slot;        /* 52: the current slot's t while the turn has the registers */
+    int32_t kf0, gh;      /* 56: the pair's turn factor rf2/half and omega gamma/2 */
+    struct seg_m4_slot e[4]; /* 64: the ends' moves */
+};
+void sn_m4_star(struct seg_m4_star *c);
+/* pair(a, sa, b, sb) on level 0 (not measuring); sg: bit 0 sa < 0, bit 1 sb < 0 */
+void sn_m4_pair(struct seg_m4_star *c, uint32_t a, uint32_t b, uint32_t sg);
+/* an attachment's pins on level 0 (seg, sgn, plast = e + k - 1 set), target T */
+void sn_m4_pins(struct seg_m4_star *c, const sn_q *T);
+#endif
+
 #define SEG_TCACHE 4u /* the cow's blanket has 4 attachments, its tail 1 */
 typedef struct seg_ctx {
     sn_ihdr *h;
@@ -333,6 +365,9 @@ typedef struct seg_ctx {
     unsigned ak[SEG_TCACHE];
     uint32_t aseg[SEG_TCACHE][5];
     int asgn[SEG_TCACHE][5];
+#if defined(SEG_M4)
+    struct seg_m4_star m4; /* level 0's constants set by sweep_prep */
+#endif
 } seg_ctx;
 
 
@@ -374,6 +409,8 @@ void seg_pins_fx(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int 
 void seg_move_test(sn_q *S, const sn_q d[3], const sn_q t[3], sn_q kf, int sh, int simd, uint32_t *sat);
 /* a pair's projection (not measuring): the scalar one (simd 0) or the step's, for the kernel test only */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat);
+/* a sheet's nodes in one sweep of direction dir (not measuring): the node loop (simd 0) or the step's, for the kernel test only */
+void seg_sheet_test(seg_ctx *C, const seg_lvl *L, unsigned dir, int simd, uint32_t *sat);
 /* every segment's u of level L to unit length (three Newton steps) */
 void seg_renormalize(const seg_lvl *L);
 /* the measuring pass's largest |d|^2 as a length in public Q16.16 segment lengths (or float) */

@@ -90,8 +90,7 @@ SEG_HOT void move_seg_c(sn_q *S, seg_n d0, seg_n d1, seg_n d2, seg_n t0, seg_n t
     S[2] = (sn_q)SEG_OUT((seg_n)S[2] + t2, sat);
 }
 
-#if !defined(SN_FLOAT) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M' && \
-    defined(__ARM_FEATURE_DSP) && defined(__thumb2__)
+#if defined(SEG_M4)
 #define SEG_TURN_M4 1
 /* Cortex-M4 (Thumb-2, DSP): move_seg's turn (words 3-5) in one asm block,
  * the same integers as move_seg_c with the vectors in registers: r30 as
@@ -224,6 +223,37 @@ sn_real seg_gap(sn_len2 n2, const seg_lvl *L) {
 #endif
 }
 
+#if defined(SEG_M4)
+/* level 0's constants of sn_m4_star (sweep_prep) */
+static void seg_m4_prep(seg_ctx *C, const seg_lvl *L) {
+    C->m4.S = L->S;
+    C->m4.h4 = 4 * L->half; /* r30s's SMMULR operand: half < 2^28 */
+    C->m4.kf = C->kf1;
+    C->m4.sh = L->sh;
+    C->m4.rs = 31 - L->sh;
+    C->m4.bias = (int32_t)C->bias0;
+    C->m4.g1n = C->g1n;
+    C->m4.kf0 = C->kf0;
+    C->m4.gh = C->gh;
+}
+/* star() on level 0, Cortex-M4: sn_m4_star (sn_segment_m4.c), the same integers and counts */
+SN_INLINE void star_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, uint32_t *sat) {
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.k = k;
+    C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941; /* mean_k's round(2^30/k) */
+    C->m4.ls = 0;
+    sn_m4_star(&C->m4);
+    *sat += C->m4.ls;
+}
+/* pair() on level 0 (not measuring), Cortex-M4: sn_m4_pair, the same integers and counts */
+SN_INLINE void pair_m4(seg_ctx *C, uint32_t a, int sa, uint32_t b, int sb, uint32_t *sat) {
+    C->m4.ls = 0;
+    sn_m4_pair(&C->m4, a, b, (sa < 0 ? 1u : 0u) | (sb < 0 ? 2u : 0u));
+    *sat += C->m4.ls;
+}
+#endif
+
 /* pair constraint between two endpoints of equal masses: d = P2 - P1,
  * t = gamma d / 2 computed once, +t on segment 1 and -t on segment 2 (linear
  * momentum kept exactly), each rotating to close (1-gamma)/2 of d's
@@ -276,12 +306,17 @@ SEG_HOT void pair(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, 
     if (!measure) { seg_pair_iv(C, L, a, sa, b, sb, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure) { seg_pair_fx(C, L, a, sa, b, sb, sat); return; }
+#elif defined(SEG_M4)
+    if (!measure && L->l == 0) { pair_m4(C, a, sa, b, sb, sat); return; }
 #endif
     pair_core(C, L, a, sa, b, sb, measure, sat);
 }
 
 /* pair_core (simd 0) or the step's pair, for test_runtime_kernels; not called by the step */
 void seg_pair_test(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, uint32_t b, int sb, int simd, uint32_t *sat) {
+#if defined(SEG_M4)
+    if (simd && L->l == 0) seg_m4_prep(C, L); /* the step's sweep_prep */
+#endif
     if (simd) pair(C, L, a, sa, b, sb, 0, sat);
     else pair_core(C, L, a, sa, b, sb, 0, sat);
 }
@@ -352,15 +387,22 @@ SEG_HOT void star(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 }
 
 
+
 /* star() (simd 0) or the step's form of it (star_fv, seg_star_iv where
- * built, else star) as a call: test_runtime_kernels compares the two bit
- * for bit. Not called by the step. */
+ * built, sn_m4_star on level 0, else star) as a call: test_runtime_kernels
+ * compares the two bit for bit. Not called by the step. */
 void seg_star_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, int simd,
                    uint32_t *sat) {
 #if defined(SEG_STAR_SSE)
     if (simd) { seg_star_fx(C, L, seg, sgn, k, sat); return; }
 #elif defined(SEG_STAR_IV)
     if (simd) { seg_star_iv(C, L, seg, sgn, k, sat); return; }
+#elif defined(SEG_M4)
+    if (simd && L->l == 0) {
+        seg_m4_prep(C, L);
+        star_m4(C, seg, sgn, k, sat);
+        return;
+    }
 #else
     (void)simd;
 #endif
@@ -406,8 +448,22 @@ SEG_HOT void pin(seg_ctx *C, const seg_lvl *L, uint32_t a, int sa, const sn_q T[
     *sat += ls;
 }
 
+#if defined(SEG_M4)
+/* an attachment's pins on level 0, Cortex-M4: sn_m4_pins, every end's gap
+ * and translation as pin() forms them, then the moves (its ends belong to
+ * distinct segments); the same integers and counts */
+SN_INLINE void pins_m4(seg_ctx *C, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3], uint32_t *sat) {
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.plast = &C->m4.e[k - 1u];
+    C->m4.ls = 0;
+    sn_m4_pins(&C->m4, T);
+    *sat += C->m4.ls;
+}
+#endif
+
 /* an attachment's pins on its k ends: 2..4 at once in lanes where built
- * (seg_pins_iv, pins_fv), else one by one */
+ * (seg_pins_iv, pins_fv; Cortex-M4 level 0 1..4: pins_m4), else one by one */
 SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                     int measure, uint32_t *sat) {
     unsigned j;
@@ -415,6 +471,8 @@ SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
     if (!measure && k >= 2u && k <= 4u) { seg_pins_iv(C, L, seg, sgn, k, T, sat); return; }
 #elif defined(SEG_STAR_SSE)
     if (!measure && k >= 2u && k <= 4u) { seg_pins_fx(C, L, seg, sgn, k, T, sat); return; }
+#elif defined(SEG_M4)
+    if (!measure && L->l == 0 && k >= 1u && k <= 4u) { pins_m4(C, seg, sgn, k, T, sat); return; }
 #endif
     for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, measure, sat);
 }
@@ -423,6 +481,9 @@ SEG_HOT void pins(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int
 void seg_pins_test(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], const int sgn[5], unsigned k, const sn_q T[3],
                    int simd, uint32_t *sat) {
     unsigned j;
+#if defined(SEG_M4)
+    if (simd && L->l == 0) seg_m4_prep(C, L); /* the step's sweep_prep */
+#endif
     if (simd) { pins(C, L, seg, sgn, k, T, 0, sat); return; }
     for (j = 0; j < k; j++) pin(C, L, seg[j], sgn[j], T, 0, sat);
 }
@@ -480,9 +541,110 @@ SN_INLINE void node_proj(seg_ctx *C, const seg_lvl *L, const uint32_t seg[5], co
 #elif defined(SEG_STAR_IV)
     else seg_star_iv(C, L, seg, sgn, k, sat);
 #else
+#if defined(SEG_M4)
+    else if (L->l == 0) star_m4(C, seg, sgn, k, sat);
+#endif
     else if (k == 4) star(C, L, seg, sgn, 4u, sat);
     else star(C, L, seg, sgn, 3u, sat);
 #endif
+}
+
+/* a sheet's nodes in a sweep: row-major, reversed on odd sweeps */
+SN_NOINLINE void sheet_nodes(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t *sat) {
+    const uint32_t sd = L->side;
+    uint32_t seg[5], r, c;
+    int sgn[5];
+    unsigned k;
+    for (r = 0; r < sd; r++)
+        for (c = 0; c < sd; c++) {
+            uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
+            if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
+            else k = sheet_ends(sd, rr, cc, seg, sgn);
+            node_proj(C, L, seg, sgn, k, measure, sat);
+        }
+}
+
+#if defined(SEG_M4)
+/* A level-0 sheet's sweep (side > 2, not measuring), Cortex-M4: the nodes
+ * in seg_sweep's order, each row's run of middle nodes (sheet_ends' ends
+ * left, up, right, down without the top row's up and the bottom row's
+ * down, the indices stepping by one along the row) without sheet_ends,
+ * the row's first and last node by it; sn_m4_star / sn_m4_pair called directly
+ * with the clamps counted across the sweep. The same projections in the
+ * same order as node_proj's. */
+static void sheet_m4(seg_ctx *C, const seg_lvl *L, unsigned dir, uint32_t *sat) {
+    const uint32_t sd = L->side, nh = sd * (sd - 1u);
+    uint32_t seg[5], r, c, j;
+    int sgn[5];
+    unsigned k;
+    C->m4.seg = seg;
+    C->m4.sgn = sgn;
+    C->m4.ls = 0;
+    for (r = 0; r < sd; r++) {
+        const uint32_t rr = dir ? sd - 1u - r : r;
+        for (c = 0; c < sd; c++) {
+            const uint32_t cc = dir ? sd - 1u - c : c;
+            if (c == 1u) { /* the row's sd - 2 middle nodes: left, (up,) right, (down) */
+                const int top = rr == 0u, bottom = rr + 1u == sd;
+                uint32_t h = rr * (sd - 1u) + cc, n = nh + rr * sd + cc;
+                sgn[0] = 1;
+                sgn[1] = top ? -1 : 1;
+                sgn[2] = sgn[3] = -1;
+                C->m4.k = top || bottom ? 3u : 4u;
+                C->m4.inv = top || bottom ? 357913941 : (int32_t)1 << 28;
+                for (j = 0; j < sd - 2u; j++) {
+                    seg[0] = h - 1u;
+                    if (top) {
+                        seg[1] = h;
+                        seg[2] = n;
+                    } else {
+                        seg[1] = n - sd;
+                        seg[2] = h;
+                        seg[3] = n; /* not read on the bottom row (k = 3) */
+                    }
+                    sn_m4_star(&C->m4);
+                    if (dir) { h--; n--; } else { h++; n++; }
+                }
+                c = sd - 2u;
+                continue;
+            }
+            k = sheet_ends(sd, rr, cc, seg, sgn);
+            if (k == 2u) sn_m4_pair(&C->m4, seg[0], seg[1], (sgn[0] < 0 ? 1u : 0u) | (sgn[1] < 0 ? 2u : 0u));
+            else {
+                C->m4.k = k;
+                C->m4.inv = k == 4u ? (int32_t)1 << 28 : 357913941;
+                sn_m4_star(&C->m4);
+            }
+        }
+    }
+    *sat += C->m4.ls;
+}
+#endif
+
+/* a sheet's nodes (side > 2) in one sweep (not measuring): the portable
+ * C's (simd 0: pair_core, star) or the step's (sheet_m4 on a Cortex-M4's
+ * level 0, else the node loop), for test_runtime_kernels; not called by
+ * the step */
+void seg_sheet_test(seg_ctx *C, const seg_lvl *L, unsigned dir, int simd, uint32_t *sat) {
+    const uint32_t sd = L->side;
+    uint32_t seg[5], r, c;
+    int sgn[5];
+    unsigned k;
+    if (simd) {
+#if defined(SEG_M4)
+        seg_m4_prep(C, L);
+        if (L->l == 0) { sheet_m4(C, L, dir, sat); return; }
+#endif
+        sheet_nodes(C, L, 0, dir, sat);
+        return;
+    }
+    for (r = 0; r < sd; r++)
+        for (c = 0; c < sd; c++) {
+            k = sheet_ends(sd, dir ? sd - 1u - r : r, dir ? sd - 1u - c : c, seg, sgn);
+            if (k == 2u) pair_core(C, L, seg[0], sgn[0], seg[1], sgn[1], 0, sat);
+            else if (k == 4u) star(C, L, seg, sgn, 4u, sat);
+            else star(C, L, seg, sgn, 3u, sat);
+        }
 }
 
 /* What every sweep of level L reads and no sweep changes, once per level:
@@ -495,6 +657,9 @@ void seg_sweep_prep(seg_ctx *C, const seg_lvl *L) {
     C->kf0 = seg_kf(L, 0, 1, C->rf2, &sh);
     C->kf1 = seg_kf(L, 0, 1, C->rf1, &sh);
     C->bias0 = seg_bias(L->sh);
+#if defined(SEG_M4)
+    if (L->l == 0) seg_m4_prep(C, L);
+#endif
     for (i = 0; i < M->n_attach && i < SEG_TCACHE; i++) {
         const unsigned char *rec = C->h->v.sec[SN_SEC_SEGATTACH] + (size_t)(M->first_attach + i) * ATT_REC;
         int64_t ln = level_node(M, L, sn_rd_u16(rec));
@@ -531,14 +696,11 @@ void seg_sweep(seg_ctx *C, const seg_lvl *L, int measure, unsigned dir, uint32_t
             pair(C, L, n - 1u, 1, n, -1, measure, sat);
         }
     } else { /* sheet: row-major, reversed on odd sweeps (symmetric Gauss-Seidel) */
-        uint32_t sd = L->side, r, c;
-        for (r = 0; r < sd; r++)
-            for (c = 0; c < sd; c++) {
-                uint32_t rr = dir ? sd - 1u - r : r, cc = dir ? sd - 1u - c : c;
-                if (sd == 2u) k = seg_node_ends(L, rr * 2u + cc, seg, sgn); /* with the brace */
-                else k = sheet_ends(sd, rr, cc, seg, sgn);
-                node_proj(C, L, seg, sgn, k, measure, sat);
-            }
+#if defined(SEG_M4)
+        if (L->l == 0 && !measure && L->side > 2u) sheet_m4(C, L, dir, sat);
+        else
+#endif
+        sheet_nodes(C, L, measure, dir, sat);
     }
     if (is_brace(L, 4) && !measure) {
         /* the braces keep the offset of their centres at the step's start
