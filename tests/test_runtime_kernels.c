@@ -1791,6 +1791,113 @@ static void test_trig(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+/* sn_qslerp_at (this build's route: on the M4 image its int32 clamps, the
+ * SMULL / SMLAL blend and sn_slerp_ratio for the division) against the
+ * portable algorithm in int64 (ref_qslerp_at: ref_sincos, C's int64
+ * division for the ratio, sn_unit's portable form with C's uint64 division),
+ * from the library's sn_qslerp_pair: random unit pairs at every angle
+ * (tiny, obtuse, opposite: both paths), raw int32 components, t at and
+ * beyond its ends; and sn_slerp_ratio against C's int64 division with the
+ * clamp at the edges of its cases (N <= 0, the 2^30 + 1 threshold, s at 1
+ * and 2^32 - 1, s >= 2^32). Tolerance 0: the same integers. */
+static int ref_unit4(const int64_t *c, int32_t *out) {
+    uint64_t a[4], m = 0, n2 = 0, N, r;
+    int i, b = 0;
+    for (i = 0; i < 4; i++) {
+        a[i] = c[i] < 0 ? (uint64_t)0 - (uint64_t)c[i] : (uint64_t)c[i];
+        if (a[i] > m) m = a[i];
+    }
+    if (m == 0) return 0;
+    while (b < 64 && m >> b) b++;
+    for (i = 0; i < 4; i++) {
+        a[i] = b > 31 ? a[i] >> (b - 31) : a[i] << (31 - b);
+        n2 += a[i] * a[i];
+    }
+    N = sn_isqrt64(n2); /* exact (test_isqrt) */
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else r = (((uint64_t)1 << 62) + (N >> 1)) / N;
+    for (i = 0; i < 4; i++) {
+        const uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32;
+        out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+    return 1;
+}
+static int64_t ref_c30s(int64_t v) { return v > (1 << 30) ? (1 << 30) : (v < -(1 << 30) ? -(1 << 30) : v); }
+static void ref_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]) {
+    const int64_t Q = (int64_t)1 << 30, P2 = 1686629713, P4 = 843314857;
+    int64_t A[4], o[4], tt, ph, sp, cp, k;
+    int i;
+    for (i = 0; i < 4; i++) A[i] = ref_c30s(a[i]);
+    tt = t < 0 ? 0 : (t > Q ? Q : t);
+    if (tt == 0 || tt == Q) {
+        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == 0 ? A[i] : p->flip ? -ref_c30s(b[i]) : ref_c30s(b[i]));
+        return;
+    }
+    ph = sn_rshr64(p->th * tt, 30);
+    if (ph > 3 * P4) ref_sincos(ph - 2 * P2, 2, &sp, &cp);
+    else if (ph > P4) ref_sincos(ph - P2, 1, &sp, &cp);
+    else ref_sincos(ph, 0, &sp, &cp);
+    k = p->s == 0 ? tt : (sp * Q + (int64_t)(p->s >> 1)) / (int64_t)p->s;
+    k = k < 0 ? 0 : (k > Q ? Q : k);
+    for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + (int64_t)p->v[i] * k, 30);
+    if (!ref_unit4(o, out))
+        for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
+}
+static int64_t ref_ratio(int64_t sp, uint64_t s) {
+    const int64_t k = (sp * ((int64_t)1 << 30) + (int64_t)(s >> 1)) / (int64_t)s;
+    return k < 0 ? 0 : (k > ((int64_t)1 << 30) ? ((int64_t)1 << 30) : k);
+}
+static void rnd_unitq(sn_q q[4]) {
+    double d[4], n = 0;
+    int i;
+    for (i = 0; i < 4; i++) { d[i] = (double)rnd_in(1 << 30); n += d[i] * d[i]; }
+    n = n > 0 ? sqrt(n) : 1;
+    for (i = 0; i < 4; i++) q[i] = (sn_q)(d[i] / n * 1073741824.0);
+}
+static void test_slerp(void) {
+    static const uint64_t se[] = {1, 2, 3, 1u << 15, 0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFEu, 0xFFFFFFFFu,
+                                  0x100000000ull, 0x3FFFFFFFFull, 0x4000000000000000ull};
+    static const int64_t pe[] = {0, 1, -1, 2, (int64_t)1 << 29, ((int64_t)1 << 30) - 1, (int64_t)1 << 30,
+                                 ((int64_t)1 << 30) + 1, -((int64_t)1 << 30), (int64_t)1 << 31};
+    int bad_k = 0, bad_q = 0, nk = 0, nq = 0, t;
+    unsigned i, j;
+    for (i = 0; i < sizeof se / sizeof se[0]; i++)
+        for (j = 0; j < sizeof pe / sizeof pe[0]; j++, nk++) bad_k += sn_slerp_ratio(pe[j], se[i]) != ref_ratio(pe[j], se[i]);
+    for (t = 0; t < 60000; t++, nk++) {
+        /* around the 2^30 + 1 threshold (sp 2^30 + s/2 ~ (2^30 + 1) s) and at random */
+        const uint64_t s = 1u + (uint64_t)(rnd32() >> (rnd32() % 32u)); /* 1..2^32 */
+        const int64_t sp = t % 3 == 0 ? (int64_t)((s * (((uint64_t)1 << 30) + 1) - (s >> 1)) >> 30) + (int64_t)(rnd32() % 5u) - 2
+                                      : (int64_t)rnd_in(1 << 30) + (t % 5 == 0 ? ((int64_t)1 << 30) : 0);
+        bad_k += sn_slerp_ratio(sp, s) != ref_ratio(sp, s);
+    }
+    for (t = 0; t < 20000; t++) {
+        sn_q a[4], b[4], o1[4], o2[4];
+        sn_slerp_pair p;
+        const int kind = t % 8, path = t % 2;
+        int n;
+        rnd_unitq(a);
+        if (kind == 0) { for (j = 0; j < 4; j++) { a[j] = (sn_q)rnd32(); b[j] = (sn_q)rnd32(); } } /* raw int32 */
+        else if (kind == 1) for (j = 0; j < 4; j++) b[j] = a[j] + rnd_in(64); /* tiny angles */
+        else if (kind == 2) for (j = 0; j < 4; j++) b[j] = -a[j] + rnd_in(64); /* opposite */
+        else rnd_unitq(b);
+        sn_qslerp_pair(a, b, path, &p);
+        for (n = 0; n < 6; n++, nq++) {
+            static const sn_q te[] = {0, 1, (1 << 30) - 1, 1 << 30, -5, (1 << 30) + 7};
+            const sn_q tq = n < 2 && t % 4 == 0 ? te[(t / 4 + n) % 6] : (sn_q)(rnd32() % ((1u << 30) + 1u));
+            sn_qslerp_at(a, b, &p, tq, o1);
+            ref_qslerp_at(a, b, &p, tq, o2);
+            bad_q += memcmp(o1, o2, sizeof o1) != 0;
+        }
+    }
+    T_CHECK(bad_k == 0, "sn_slerp_ratio: %d of %d ratios off C's int64 division", bad_k, nk);
+    T_CHECK(bad_q == 0, "sn_qslerp_at (path %s): %d of %d slerps off the portable int64 algorithm", sn_kernels_name(), bad_q, nq);
+    T_FIGURE("slerp: %d ratios, %d slerps from %d pairs", nk, nq, 20000);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: on the M4 image
  * sn_isqrt64_kara, Karatsuba with UDIV; 32-bit hosts the digits; 64-bit
  * hosts bit by bit) and both 32-bit methods: the exact floor, checked
@@ -1973,6 +2080,7 @@ int main(void) {
 #if !defined(SN_FLOAT)
     test_rshr();
     test_trig();
+    test_slerp();
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();

@@ -308,6 +308,14 @@ SN_INLINE uint32_t sn_k_ic_fwd_col(struct sn_m4_icc *c, const unsigned char *blk
     return (uint32_t)(c->cols - cols) / 2u;
 }
 
+/* the fused sweeps' vertex steps (sn_precond.c ic_fused) in Thumb-2
+ * (sn_kernels_m4_ic.c): y_j = sn_out(R_j^T r_j - acc_j); and, for 0 < sh
+ * < 32, z'_j = sn_out(sn_out(D_j^-1 y_j, sh) - l) to zq_j, z_j = R_j z'_j
+ * (z_j holds y_j on entry); the C kernels' values and clamp counts */
+#define SN_K_IC_VTX 1
+void sn_m4_icf_y(const sn_q *R, const sn_q *r, const sn_acc *acc, sn_q *y, uint32_t *sat);
+void sn_m4_icb_z(const unsigned char *P, sn_q *z, const sn_acc *l, sn_q *zq, const sn_q *R, int sh, uint32_t *sat);
+
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
 /* Float: U's rows (col) or columns (row) in lanes, decoded exactly as the

@@ -22,6 +22,32 @@
 #include "sn_kernels_ic.h" /* the block products: portable reference or the build's SIMD path */
 
 
+/* The fused sweeps' vertex steps (ic_fused): y_j = sn_out(R_j^T r_j -
+ * acc_j); z'_j = sn_out(sn_out(D_j^-1 y_j, sh) - l) to zq_j and z_j = R_j
+ * z'_j (z_j holds y_j). The M4's in Thumb-2 (sn_kernels_m4_ic.c) where its
+ * shift allows, the same values and counts. */
+SN_INLINE void ic_y(const sn_q *Rj, const sn_q *rj, const sn_acc *aj, sn_q *yj, uint32_t *sat) {
+#if defined(SN_K_IC_VTX)
+    sn_m4_icf_y(Rj, rj, aj, yj, sat);
+#else
+    sn_k_rot_t(Rj, rj, yj, sat);
+    sn_k_sub3a(yj, aj, sat);
+#endif
+}
+SN_INLINE void ic_z(const unsigned char *Pj, sn_q *zj, const sn_acc *l, sn_q *zqj, const sn_q *Rj, int sh, uint32_t *sat) {
+    sn_q w[3];
+#if defined(SN_K_IC_VTX)
+    if ((uint32_t)(sh - 1) < 31u) {
+        sn_m4_icb_z(Pj, zj, l, zqj, Rj, sh, sat);
+        return;
+    }
+#endif
+    sn_k_sym_out(Pj, zj, w, sh, sat);
+    sn_k_sub3a(w, l, sat);
+    memcpy(zqj, w, sizeof w); /* memcpy: zq may be the accumulators' bytes (ic_fused) */
+    sn_k_rot(Rj, w, zj, sat);
+}
+
 /* y = (I + L^)^-1 y in place: for j ascending, y_i -= U_ji^T y_j (i > j).
  * The rounded block rows bound for y_i are summed in acc (int64: at most
  * SN_MAX_ROW_BLOCKS of them, each < 2^44.6 or clamped to 2^28: < 2^49.3) and
@@ -46,8 +72,8 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, const sn_q *R, s
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
         const uint32_t n0 = n;
-        if (R) sn_k_rot_t(R + rs * j, r + 3 * j, yj, sat); /* t_j */
-        sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
+        if (R) ic_y(R + rs * j, r + 3 * j, acc + 3 * j, yj, sat); /* yj = sn_out(t_j - acc_j) */
+        else sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
 #if defined(SN_K_IC_FWD_COL) /* the M4's loop (sn_kernels_ic.h) */
         e = sn_rd_u32(rp + 4 * j);
         if (e < end)
@@ -87,15 +113,11 @@ static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, const u
     uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
-        sn_q w[3];
         sn_acc l[4];
         n -= f - b;
-        if (R) sn_k_sym_out(P + (size_t)j * 6 * SN_REAL_BYTES, z + 3 * j, w, v->frac_P + SN_KREL(kk[j]), sat); /* Q22 */
-        else memcpy(w, z + 3 * j, sizeof w);
         sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, zq, l, sat); /* l = sum_i round(U_ji z'_i) */
-        sn_k_sub3a(w, l, sat);
-        memcpy(zq + 3 * j, w, sizeof w); /* memcpy: zq may be the accumulators' bytes (ic_fused) */
-        if (R) sn_k_rot(R + rs * j, w, z + 3 * j, sat);
+        if (R) ic_z(P + (size_t)j * 6 * SN_REAL_BYTES, z + 3 * j, l, zq + 3 * j, R + rs * j, v->frac_P + SN_KREL(kk[j]), sat);
+        else sn_k_sub3a(z + 3 * j, l, sat);
     }
 }
 
