@@ -1286,6 +1286,59 @@ static void test_quat_words(void) {
 }
 #endif
 
+#if defined(SN_K_IC_VTX)
+/* The M4's fused-sweep vertex steps (sn_kernels_m4_ic.c, Thumb-2) against
+ * the portable reference written from sn_internal.h's sn_rot_t / sn_rot /
+ * sn_out: y = sn_out(R^T r - acc, 0); w = sn_out(0 + D y, sh) (D symmetric,
+ * stored xx yy zz xy xz yz), z' = sn_out(w - l, 0), z = R z'. Random R
+ * entries within +-2^30, r / y within or at +-SN_LIM, D entries up to int32,
+ * accumulators up to +-2^50 (every 4th case at the bounds: clamps on each
+ * test), sh 1..31; y, z', z and the clamp count must match exactly. */
+static void test_ic_vtx(void) {
+    int t, bad_y = 0, bad_z = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 6000; t++) {
+        const int wild = t % 4 == 0, sh = (int)(1u + rnd32() % 31u);
+        sn_q R[9], r[3], y1[3], y2[3], z1[3], z2[3], zq1[3], zq2[3], w[3], D[6];
+        sn_acc acc[3], l[3], d3[3];
+        unsigned char P[24];
+        uint32_t s1 = 0, s2 = 0;
+        int k;
+        for (k = 0; k < 9; k++) R[k] = wild && rnd32() % 2u ? (rnd32() % 2u ? (1 << 30) : -(1 << 30)) : rnd_in(1 << 30);
+        for (k = 0; k < 6; k++) {
+            D[k] = wild ? (sn_q)rnd32() : rnd_in(1 << 26);
+            put32(P + 4 * k, (uint32_t)D[k]);
+        }
+        for (k = 0; k < 3; k++) {
+            r[k] = wild && rnd32() % 2u ? (rnd32() % 2u ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            acc[k] = (sn_acc)rnd_in(1 << 30) * ((sn_acc)1 << (wild ? 20 : rnd32() % 8u));
+            l[k] = (sn_acc)rnd_in(1 << 30) * ((sn_acc)1 << (wild ? 20 : rnd32() % 8u));
+        }
+        sn_m4_icf_y(R, r, acc, y1, &s1);
+        sn_rot_t(R, r, y2, &s2);
+        for (k = 0; k < 3; k++) y2[k] = sn_out((sn_acc)y2[k] - acc[k], 0, &s2);
+        bad_y += memcmp(y1, y2, sizeof y1) != 0 || s1 != s2;
+        clamps += s2;
+        s1 = s2 = 0;
+        memcpy(z1, y2, sizeof z1);
+        memcpy(z2, y2, sizeof z2);
+        sn_m4_icb_z(P, z1, l, zq1, R, sh, &s1);
+        d3[0] = sn_mul(D[0], z2[0]) + sn_mul(D[3], z2[1]) + sn_mul(D[4], z2[2]);
+        d3[1] = sn_mul(D[3], z2[0]) + sn_mul(D[1], z2[1]) + sn_mul(D[5], z2[2]);
+        d3[2] = sn_mul(D[4], z2[0]) + sn_mul(D[5], z2[1]) + sn_mul(D[2], z2[2]);
+        for (k = 0; k < 3; k++) w[k] = sn_out(sn_out(d3[k], sh, &s2) - l[k], 0, &s2);
+        memcpy(zq2, w, sizeof w);
+        sn_rot(R, w, z2, &s2);
+        bad_z += memcmp(z1, z2, sizeof z1) != 0 || memcmp(zq1, zq2, sizeof zq1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad_y == 0, "M4 fused forward vertex step (sn_m4_icf_y): %d of 6000 off the reference", bad_y);
+    T_CHECK(bad_z == 0, "M4 fused backward vertex step (sn_m4_icb_z): %d of 6000 off the reference", bad_z);
+    T_CHECK(clamps > 1000, "the vertex steps' cases clamp (%lu clamps)", (unsigned long)clamps);
+    T_FIGURE("M4 fused vertex steps: 6000 cases each, %lu clamps", (unsigned long)clamps);
+}
+#endif
+
 #if defined(SN_K_IC_FWD_COL)
 /* The M4's forward-sweep column (sn_k_ic_fwd_col: sn_m4_ic_cols and its
  * reference fallback) against ic_forward's loop on the portable reference
@@ -2047,6 +2100,9 @@ int main(void) {
     test_ic_rows();
 #if defined(SN_K_IC_FWD_COL)
     test_ic_fwd();
+#endif
+#if defined(SN_K_IC_VTX)
+    test_ic_vtx();
 #endif
 #if defined(SN_K_IC_FWD_RUN)
     test_ic_fwd_run();
