@@ -458,9 +458,8 @@ SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *co
 
 /* l = sum of round(U_e z_cols[e]) over nb consecutive blocks (the backward
  * sweep's row j, its free columns: cols the row's LE u16 column indices;
- * l[3] scratch); every path but the M4's: the loop of sn_k_ic_row from 0
- * (ic_backward keeps its own copy of that loop there: the x86-64 code as
- * before) */
+ * l[3] scratch); the paths without their own (scalar, NEON, the float
+ * flavour's): the loop of sn_k_ic_row from 0 */
 #if !defined(SN_K_IC_BWD_ROW)
 SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
                                uint32_t *sat) {

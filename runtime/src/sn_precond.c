@@ -16,7 +16,9 @@
  * at most 2^15 and clamped, counted), summed in int64 with the vertex's other
  * rows (the instance's accumulators, scratch here) and clamped once (counted)
  * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
- * round by frac into Q22 each, summed in int64, clamped once per vertex. */
+ * round by frac into Q22 each, summed in int64, clamped once per vertex.
+ * Unmasked applies run the per-vertex passes inside the two sweeps
+ * (ic_fused, every path); masked or scaled ones the five passes. */
 #include "sn_instance.h"
 #include "sn_kernels_rot.h" /* the frame rotations */
 #include "sn_kernels_ic.h" /* the block products: portable reference or the build's SIMD path */
