@@ -1386,6 +1386,59 @@ static void test_quat_words(void) {
 }
 #endif
 
+#if defined(SN_K_IC_VTX)
+/* The M4's fused-sweep vertex steps (sn_kernels_m4_ic.c, Thumb-2) against
+ * the portable reference written from sn_internal.h's sn_rot_t / sn_rot /
+ * sn_out: y = sn_out(R^T r - acc, 0); w = sn_out(0 + D y, sh) (D symmetric,
+ * stored xx yy zz xy xz yz), z' = sn_out(w - l, 0), z = R z'. Random R
+ * entries within +-2^30, r / y within or at +-SN_LIM, D entries up to int32,
+ * accumulators up to +-2^50 (every 4th case at the bounds: clamps on each
+ * test), sh 1..31; y, z', z and the clamp count must match exactly. */
+static void test_ic_vtx(void) {
+    int t, bad_y = 0, bad_z = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 6000; t++) {
+        const int wild = t % 4 == 0, sh = (int)(1u + rnd32() % 31u);
+        sn_q R[9], r[3], y1[3], y2[3], z1[3], z2[3], zq1[3], zq2[3], w[3], D[6];
+        sn_acc acc[3], l[3], d3[3];
+        unsigned char P[24];
+        uint32_t s1 = 0, s2 = 0;
+        int k;
+        for (k = 0; k < 9; k++) R[k] = wild && rnd32() % 2u ? (rnd32() % 2u ? (1 << 30) : -(1 << 30)) : rnd_in(1 << 30);
+        for (k = 0; k < 6; k++) {
+            D[k] = wild ? (sn_q)rnd32() : rnd_in(1 << 26);
+            put32(P + 4 * k, (uint32_t)D[k]);
+        }
+        for (k = 0; k < 3; k++) {
+            r[k] = wild && rnd32() % 2u ? (rnd32() % 2u ? SN_LIM : -SN_LIM) : rnd_in(SN_LIM);
+            acc[k] = (sn_acc)rnd_in(1 << 30) * ((sn_acc)1 << (wild ? 20 : rnd32() % 8u));
+            l[k] = (sn_acc)rnd_in(1 << 30) * ((sn_acc)1 << (wild ? 20 : rnd32() % 8u));
+        }
+        sn_m4_icf_y(R, r, acc, y1, &s1);
+        sn_rot_t(R, r, y2, &s2);
+        for (k = 0; k < 3; k++) y2[k] = sn_out((sn_acc)y2[k] - acc[k], 0, &s2);
+        bad_y += memcmp(y1, y2, sizeof y1) != 0 || s1 != s2;
+        clamps += s2;
+        s1 = s2 = 0;
+        memcpy(z1, y2, sizeof z1);
+        memcpy(z2, y2, sizeof z2);
+        sn_m4_icb_z(P, z1, l, zq1, R, sh, &s1);
+        d3[0] = sn_mul(D[0], z2[0]) + sn_mul(D[3], z2[1]) + sn_mul(D[4], z2[2]);
+        d3[1] = sn_mul(D[3], z2[0]) + sn_mul(D[1], z2[1]) + sn_mul(D[5], z2[2]);
+        d3[2] = sn_mul(D[4], z2[0]) + sn_mul(D[5], z2[1]) + sn_mul(D[2], z2[2]);
+        for (k = 0; k < 3; k++) w[k] = sn_out(sn_out(d3[k], sh, &s2) - l[k], 0, &s2);
+        memcpy(zq2, w, sizeof w);
+        sn_rot(R, w, z2, &s2);
+        bad_z += memcmp(z1, z2, sizeof z1) != 0 || memcmp(zq1, zq2, sizeof zq1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad_y == 0, "M4 fused forward vertex step (sn_m4_icf_y): %d of 6000 off the reference", bad_y);
+    T_CHECK(bad_z == 0, "M4 fused backward vertex step (sn_m4_icb_z): %d of 6000 off the reference", bad_z);
+    T_CHECK(clamps > 1000, "the vertex steps' cases clamp (%lu clamps)", (unsigned long)clamps);
+    T_FIGURE("M4 fused vertex steps: 6000 cases each, %lu clamps", (unsigned long)clamps);
+}
+#endif
+
 #if defined(SN_K_IC_FWD_COL)
 /* The M4's forward-sweep column (sn_k_ic_fwd_col: sn_m4_ic_cols and its
  * reference fallback) against ic_forward's loop on the portable reference
@@ -1893,6 +1946,113 @@ static void test_trig(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+/* sn_qslerp_at (this build's route: on the M4 image its int32 clamps, the
+ * SMULL / SMLAL blend and sn_slerp_ratio for the division) against the
+ * portable algorithm in int64 (ref_qslerp_at: ref_sincos, C's int64
+ * division for the ratio, sn_unit's portable form with C's uint64 division),
+ * from the library's sn_qslerp_pair: random unit pairs at every angle
+ * (tiny, obtuse, opposite: both paths), raw int32 components, t at and
+ * beyond its ends; and sn_slerp_ratio against C's int64 division with the
+ * clamp at the edges of its cases (N <= 0, the 2^30 + 1 threshold, s at 1
+ * and 2^32 - 1, s >= 2^32). Tolerance 0: the same integers. */
+static int ref_unit4(const int64_t *c, int32_t *out) {
+    uint64_t a[4], m = 0, n2 = 0, N, r;
+    int i, b = 0;
+    for (i = 0; i < 4; i++) {
+        a[i] = c[i] < 0 ? (uint64_t)0 - (uint64_t)c[i] : (uint64_t)c[i];
+        if (a[i] > m) m = a[i];
+    }
+    if (m == 0) return 0;
+    while (b < 64 && m >> b) b++;
+    for (i = 0; i < 4; i++) {
+        a[i] = b > 31 ? a[i] >> (b - 31) : a[i] << (31 - b);
+        n2 += a[i] * a[i];
+    }
+    N = sn_isqrt64(n2); /* exact (test_isqrt) */
+    if (n2 - N * N > N) N++;
+    if (N <= ((uint64_t)1 << 30)) r = (uint64_t)1 << 32;
+    else if (N >= ((uint64_t)1 << 32)) r = (uint64_t)1 << 30;
+    else r = (((uint64_t)1 << 62) + (N >> 1)) / N;
+    for (i = 0; i < 4; i++) {
+        const uint64_t v = (a[i] * r + ((uint64_t)1 << 31)) >> 32;
+        out[i] = c[i] < 0 ? -(int32_t)v : (int32_t)v;
+    }
+    return 1;
+}
+static int64_t ref_c30s(int64_t v) { return v > (1 << 30) ? (1 << 30) : (v < -(1 << 30) ? -(1 << 30) : v); }
+static void ref_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]) {
+    const int64_t Q = (int64_t)1 << 30, P2 = 1686629713, P4 = 843314857;
+    int64_t A[4], o[4], tt, ph, sp, cp, k;
+    int i;
+    for (i = 0; i < 4; i++) A[i] = ref_c30s(a[i]);
+    tt = t < 0 ? 0 : (t > Q ? Q : t);
+    if (tt == 0 || tt == Q) {
+        for (i = 0; i < 4; i++) out[i] = (int32_t)(tt == 0 ? A[i] : p->flip ? -ref_c30s(b[i]) : ref_c30s(b[i]));
+        return;
+    }
+    ph = sn_rshr64(p->th * tt, 30);
+    if (ph > 3 * P4) ref_sincos(ph - 2 * P2, 2, &sp, &cp);
+    else if (ph > P4) ref_sincos(ph - P2, 1, &sp, &cp);
+    else ref_sincos(ph, 0, &sp, &cp);
+    k = p->s == 0 ? tt : (sp * Q + (int64_t)(p->s >> 1)) / (int64_t)p->s;
+    k = k < 0 ? 0 : (k > Q ? Q : k);
+    for (i = 0; i < 4; i++) o[i] = sn_rshr64(A[i] * cp + (int64_t)p->v[i] * k, 30);
+    if (!ref_unit4(o, out))
+        for (i = 0; i < 4; i++) out[i] = (int32_t)A[i];
+}
+static int64_t ref_ratio(int64_t sp, uint64_t s) {
+    const int64_t k = (sp * ((int64_t)1 << 30) + (int64_t)(s >> 1)) / (int64_t)s;
+    return k < 0 ? 0 : (k > ((int64_t)1 << 30) ? ((int64_t)1 << 30) : k);
+}
+static void rnd_unitq(sn_q q[4]) {
+    double d[4], n = 0;
+    int i;
+    for (i = 0; i < 4; i++) { d[i] = (double)rnd_in(1 << 30); n += d[i] * d[i]; }
+    n = n > 0 ? sqrt(n) : 1;
+    for (i = 0; i < 4; i++) q[i] = (sn_q)(d[i] / n * 1073741824.0);
+}
+static void test_slerp(void) {
+    static const uint64_t se[] = {1, 2, 3, 1u << 15, 0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFEu, 0xFFFFFFFFu,
+                                  0x100000000ull, 0x3FFFFFFFFull, 0x4000000000000000ull};
+    static const int64_t pe[] = {0, 1, -1, 2, (int64_t)1 << 29, ((int64_t)1 << 30) - 1, (int64_t)1 << 30,
+                                 ((int64_t)1 << 30) + 1, -((int64_t)1 << 30), (int64_t)1 << 31};
+    int bad_k = 0, bad_q = 0, nk = 0, nq = 0, t;
+    unsigned i, j;
+    for (i = 0; i < sizeof se / sizeof se[0]; i++)
+        for (j = 0; j < sizeof pe / sizeof pe[0]; j++, nk++) bad_k += sn_slerp_ratio(pe[j], se[i]) != ref_ratio(pe[j], se[i]);
+    for (t = 0; t < 60000; t++, nk++) {
+        /* around the 2^30 + 1 threshold (sp 2^30 + s/2 ~ (2^30 + 1) s) and at random */
+        const uint64_t s = 1u + (uint64_t)(rnd32() >> (rnd32() % 32u)); /* 1..2^32 */
+        const int64_t sp = t % 3 == 0 ? (int64_t)((s * (((uint64_t)1 << 30) + 1) - (s >> 1)) >> 30) + (int64_t)(rnd32() % 5u) - 2
+                                      : (int64_t)rnd_in(1 << 30) + (t % 5 == 0 ? ((int64_t)1 << 30) : 0);
+        bad_k += sn_slerp_ratio(sp, s) != ref_ratio(sp, s);
+    }
+    for (t = 0; t < 20000; t++) {
+        sn_q a[4], b[4], o1[4], o2[4];
+        sn_slerp_pair p;
+        const int kind = t % 8, path = t % 2;
+        int n;
+        rnd_unitq(a);
+        if (kind == 0) { for (j = 0; j < 4; j++) { a[j] = (sn_q)rnd32(); b[j] = (sn_q)rnd32(); } } /* raw int32 */
+        else if (kind == 1) for (j = 0; j < 4; j++) b[j] = a[j] + rnd_in(64); /* tiny angles */
+        else if (kind == 2) for (j = 0; j < 4; j++) b[j] = -a[j] + rnd_in(64); /* opposite */
+        else rnd_unitq(b);
+        sn_qslerp_pair(a, b, path, &p);
+        for (n = 0; n < 6; n++, nq++) {
+            static const sn_q te[] = {0, 1, (1 << 30) - 1, 1 << 30, -5, (1 << 30) + 7};
+            const sn_q tq = n < 2 && t % 4 == 0 ? te[(t / 4 + n) % 6] : (sn_q)(rnd32() % ((1u << 30) + 1u));
+            sn_qslerp_at(a, b, &p, tq, o1);
+            ref_qslerp_at(a, b, &p, tq, o2);
+            bad_q += memcmp(o1, o2, sizeof o1) != 0;
+        }
+    }
+    T_CHECK(bad_k == 0, "sn_slerp_ratio: %d of %d ratios off C's int64 division", bad_k, nk);
+    T_CHECK(bad_q == 0, "sn_qslerp_at (path %s): %d of %d slerps off the portable int64 algorithm", sn_kernels_name(), bad_q, nq);
+    T_FIGURE("slerp: %d ratios, %d slerps from %d pairs", nk, nq, 20000);
+}
+#endif
+
 /* The integer square root of this build (sn_isqrt64: Karatsuba with a
  * hardware 32-bit divide (the M4 image's UDIV, 64-bit hosts); 32-bit hosts
  * the digits) and both methods: the exact floor, checked
@@ -2110,6 +2270,9 @@ int main(void) {
 #if defined(SN_K_IC_FWD_COL)
     test_ic_fwd();
 #endif
+#if defined(SN_K_IC_VTX)
+    test_ic_vtx();
+#endif
 #if defined(SN_K_IC_FWD_RUN)
     test_ic_fwd_run();
 #endif
@@ -2144,6 +2307,7 @@ int main(void) {
 #if !defined(SN_FLOAT)
     test_rshr();
     test_trig();
+    test_slerp();
     test_dot();
     test_seg_clamps();
     test_seg_move_ops();

@@ -17,11 +17,15 @@
  * blocks of 3-term rows plus three 3-term products): Higham's bound for
  * sequences of dot products. Both: the error must also reach a fraction of
  * the bound on some component (REACH: a test that cannot fail is no test).
- * Assets: cow and beast (their example blobs, ICHOL by default). */
+ * Assets: cow and beast (their example blobs, ICHOL by default).
+ * Also: the fused sweeps (sn_precond) give the bits and clamp count of the
+ * five passes (sn_precond_mask over every vertex) on these residuals and on
+ * four that clamp. */
 #include "sn_test.h"
 #include "reference/phys_util.h"
 #include "reference/phys_pose.h"
 #include "sn_instance.h"
+#include "sn_kernels.h" /* sn_kernels_name */
 
 /* fixed: the propagated bound is tight (measured 0.4-0.8 of it); float:
  * gamma_n is a worst case over n operations (measured ~0.01 of it) */
@@ -84,6 +88,21 @@ static void sweeps(const snref_model *m, const double *Rv, const double *kq, con
     }
 }
 
+/* 1 if the five passes (sn_precond_mask over every vertex: precond_core's
+ * unfused route) give z and the clamp count sat that sn_precond (the fused
+ * sweeps, ic_fused: every path but the masked ones) gave for r */
+static int fused_vs_passes(sn_ihdr *hd, const sn_q *r, const sn_q *z, uint32_t sat, unsigned nF) {
+    uint8_t *all = malloc(nF);
+    sn_q *z5 = malloc(3 * nF * sizeof *z5);
+    uint32_t sat5 = 0;
+    int same;
+    memset(all, 1, nF);
+    sn_precond_mask(hd, all, 0, NULL, r, z5, &sat5);
+    same = memcmp(z, z5, 3 * nF * sizeof *z5) == 0 && sat == sat5;
+    free(all); free(z5);
+    return same;
+}
+
 typedef void (*pose_fn_t)(const sn_blob *, unsigned, unsigned, double, sn_xform *);
 static void asset(const char *name, pose_fn_t pf) {
     char path[512], nm[64];
@@ -111,6 +130,7 @@ static void asset(const char *name, pose_fn_t pf) {
         double *Rv = malloc(9 * m.nF * sizeof *Rv), *kq = malloc(m.nF * sizeof *kq), *x = malloc(n3 * sizeof *x);
         double *ze = malloc(n3 * sizeof *ze), *eb = malloc(n3 * sizeof *eb), *xa = malloc(n3 * sizeof *xa);
         double worst = 0, reach = 0, zmax = 0;
+        int same5 = 0, clamped = 0;
         for (i = 0; i < m.nF; i++) {
 #if defined(SN_FLOAT)
             for (c = 0; c < 9; c++) Rv[9 * i + c] = Rq[9 * i + c];
@@ -141,6 +161,7 @@ static void asset(const char *name, pose_fn_t pf) {
             }
             sn_precond(hd, r, z, &sat);
             T_CHECK(sat == 0, "%s trial %u: %u saturations", name, trial, sat);
+            same5 += fused_vs_passes(hd, r, z, sat, m.nF);
             sweeps(&m, Rv, kq, x, ze, 0);
 #if defined(SN_FLOAT)
             sweeps(&m, Rv, kq, xa, eb, 2);
@@ -160,6 +181,25 @@ static void asset(const char *name, pose_fn_t pf) {
                 if (fabs(ze[i]) > zmax) zmax = fabs(ze[i]);
             }
         }
+        {   /* clamps on both routes: r at and inside +-SN_LIM (fixed), up to 1e4 > SN_FLIM (float) */
+            uint32_t sat = 0;
+            for (trial = 0; trial < 4; trial++) {
+                for (i = 0; i < n3; i++) {
+#if defined(SN_FLOAT)
+                    r[i] = (float)((2 * urand() - 1) * 1e4);
+#else
+                    r[i] = urand() < 0.5 ? (urand() < 0.5 ? SN_LIM : -SN_LIM) : (sn_q)((2 * urand() - 1) * SN_LIM);
+#endif
+                }
+                sat = 0;
+                sn_precond(hd, r, z, &sat);
+                same5 += fused_vs_passes(hd, r, z, sat, m.nF);
+                clamped += sat > 0;
+            }
+        }
+        T_CHECK(same5 == 24, "%s: the fused sweeps (sn_precond, path %s) give the five passes' bits and clamp count (sn_precond_mask, all "
+                "vertices) in %d of 24 residuals", name, sn_kernels_name(), same5);
+        T_CHECK(clamped == 4, "%s: the residuals at the state range clamp (%d of 4 with clamps)", name, clamped);
         T_FIGURE("%s %s: IC(0) apply vs the double solve of the same factor, 20 random residuals scaled to max |z| 8 and 0.01 internal units, %u free vertices, %u blocks: "
                  "largest error / derived bound %.3f (max |z| %.3g)", name, PU_FLAVOUR_NAME, m.nF, m.nIC, worst, zmax);
         T_CHECK(worst <= 1.0, "%s: the runtime's IC(0) apply is within the bound derived from its formats (worst %.3f of it)", name, worst);

@@ -284,6 +284,11 @@ typedef struct sn_slerp_pair {
 typedef char sn_slerp_pair_fits_[sizeof(sn_slerp_pair) <= SN_FPAIR_BYTES ? 1 : -1];
 void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p);
 void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]);
+#if !defined(SN_FLOAT)
+/* sn_qslerp_at's ratio clamp((sp 2^30 + floor(s/2)) / s, 0, 2^30) for s > 0
+ * without a 64-bit divide (its route on 32-bit targets; the kernel test) */
+int64_t sn_slerp_ratio(int64_t sp, uint64_t s);
+#endif
 /* Angle (public degrees: fixed Q16.16) of the rotation q about the unit
  * axis a (Q30 / float): the twist of a swing-twist decomposition,
  * 2 atan2(v.a, w) with q's sign chosen so w >= 0, in (-180, 180]. */

@@ -308,6 +308,14 @@ SN_INLINE uint32_t sn_k_ic_fwd_col(struct sn_m4_icc *c, const unsigned char *blk
     return (uint32_t)(c->cols - cols) / 2u;
 }
 
+/* the fused sweeps' vertex steps (sn_precond.c ic_fused) in Thumb-2
+ * (sn_kernels_m4_ic.c): y_j = sn_out(R_j^T r_j - acc_j); and, for 0 < sh
+ * < 32, z'_j = sn_out(sn_out(D_j^-1 y_j, sh) - l) to zq_j, z_j = R_j z'_j
+ * (z_j holds y_j on entry); the C kernels' values and clamp counts */
+#define SN_K_IC_VTX 1
+void sn_m4_icf_y(const sn_q *R, const sn_q *r, const sn_acc *acc, sn_q *y, uint32_t *sat);
+void sn_m4_icb_z(const unsigned char *P, sn_q *z, const sn_acc *l, sn_q *zq, const sn_q *R, int sh, uint32_t *sat);
+
 #elif defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 #include "sn_kernels_fsimd.h"
 /* Float: U's rows (col) or columns (row) in lanes, decoded exactly as the
@@ -450,9 +458,8 @@ SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *co
 
 /* l = sum of round(U_e z_cols[e]) over nb consecutive blocks (the backward
  * sweep's row j, its free columns: cols the row's LE u16 column indices;
- * l[3] scratch); every path but the M4's: the loop of sn_k_ic_row from 0
- * (ic_backward keeps its own copy of that loop there: the x86-64 code as
- * before) */
+ * l[3] scratch); the paths without their own (scalar, NEON, the float
+ * flavour's): the loop of sn_k_ic_row from 0 */
 #if !defined(SN_K_IC_BWD_ROW)
 SN_INLINE void sn_k_ic_bwd_row(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_q *z, sn_acc l[4],
                                uint32_t *sat) {

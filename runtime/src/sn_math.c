@@ -486,6 +486,29 @@ void sn_qslerp_pair(const sn_q a[4], const sn_q b[4], int path, sn_slerp_pair *p
     p->th = th;
     p->flip = flip;
 }
+/* The slerp's ratio k = clamp((sp 2^30 + floor(s/2)) / s, 0, 2^30) (C's
+ * truncating int64 division, s > 0) without a 64-bit divide: N = sp 2^30 +
+ * floor(s/2) <= 0 gives a quotient <= 0, so 0; N >= (2^30 + 1) s one above
+ * 2^30, so 2^30; else the quotient floor(N / s) is in [0, 2^30] and, for s <
+ * 2^32 (always: sn_qslerp_pair's s <= isqrt(4 (2^31 - 1)^2) + 1 < 2^32),
+ * sn_div64n's: N and s shifted by s's leading zeros z (the same quotient;
+ * N 2^z < (2^30 + 1) 2^32 < 2^63, and N 2^z < (s 2^z) 2^32: its 32-bit
+ * quotient). s >= 2^32 (no pair makes one): sn_udiv64, the same floor,
+ * clamped (s < 2^63: the division's divisor (int64_t)s is s). The
+ * same integers as the division (the kernel test checks both against it);
+ * 32-bit targets only: a 64-bit one divides natively. */
+int64_t sn_slerp_ratio(int64_t sp, uint64_t s) {
+    const int64_t N = sp * SN_Q30 + (int64_t)(s >> 1);
+    int z;
+    if (N <= 0) return 0;
+    if (s >> 32) { /* (int64_t)s the same value for s < 2^63; sn_udiv64 exact for such divisors */
+        const uint64_t q = sn_udiv64((uint64_t)N, s);
+        return q > SN_Q30 ? SN_Q30 : (int64_t)q;
+    }
+    if ((uint64_t)N >= (s << 30) + s) return SN_Q30; /* (2^30 + 1) s < 2^63 */
+    z = lz32((uint32_t)s);
+    return sn_div64n((uint64_t)N << z, (uint32_t)s << z);
+}
 /* The slerp at t from its pair part p (of these a and b). */
 void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q t, sn_q out[4]) {
     int64_t A[4], o[4], tt, ph, sp, cp, k;
@@ -509,7 +532,11 @@ void sn_qslerp_at(const sn_q a[4], const sn_q b[4], const sn_slerp_pair *p, sn_q
     else if (ph > SN_PI_4_Q30) sn_sincos_red(ph - SN_PI_2_Q30, 1, &sp, &cp);
     else sn_sincos_red(ph, 0, &sp, &cp);
     if (s == 0) k = tt;
+#if UINTPTR_MAX > 0xFFFFFFFFu
     else k = (sp * SN_Q30 + (int64_t)(s >> 1)) / (int64_t)s;
+#else
+    else k = sn_slerp_ratio(sp, s); /* the same integer, no library 64-bit divide */
+#endif
     k = k < 0 ? 0 : (k > SN_Q30 ? SN_Q30 : k);
 #if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
     { /* Cortex-M: int32 operands, SMULL / SMLAL (GCC multiplied 64 x 64):

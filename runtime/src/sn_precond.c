@@ -16,18 +16,56 @@
  * at most 2^15 and clamped, counted), summed in int64 with the vertex's other
  * rows (the instance's accumulators, scratch here) and clamped once (counted)
  * into y_i. w, z' are Q22 like block Jacobi's z; the backward block rows
- * round by frac into Q22 each, summed in int64, clamped once per vertex. */
+ * round by frac into Q22 each, summed in int64, clamped once per vertex.
+ * Unmasked applies run the per-vertex passes inside the two sweeps
+ * (ic_fused, every path); masked or scaled ones the five passes. */
 #include "sn_instance.h"
 #include "sn_kernels_rot.h" /* the frame rotations */
 #include "sn_kernels_ic.h" /* the block products: portable reference or the build's SIMD path */
 
 
+/* The fused sweeps' vertex steps (ic_fused): y_j = sn_out(R_j^T r_j -
+ * acc_j); z'_j = sn_out(sn_out(D_j^-1 y_j, sh) - l) to zq_j and z_j = R_j
+ * z'_j (z_j holds y_j). The M4's in Thumb-2 (sn_kernels_m4_ic.c) where its
+ * shift allows, the same values and counts. */
+SN_INLINE void ic_y(const sn_q *Rj, const sn_q *rj, const sn_acc *aj, sn_q *yj, uint32_t *sat) {
+#if defined(SN_K_IC_VTX)
+    sn_m4_icf_y(Rj, rj, aj, yj, sat);
+#else
+    sn_k_rot_t(Rj, rj, yj, sat);
+    sn_k_sub3a(yj, aj, sat);
+#endif
+}
+SN_INLINE void ic_z(const unsigned char *Pj, sn_q *zj, const sn_acc *l, sn_q *zqj, const sn_q *Rj, int sh, uint32_t *sat) {
+    sn_q w[3];
+#if defined(SN_K_IC_VTX)
+    if ((uint32_t)(sh - 1) < 31u) {
+        sn_m4_icb_z(Pj, zj, l, zqj, Rj, sh, sat);
+        return;
+    }
+#endif
+    sn_k_sym_out(Pj, zj, w, sh, sat);
+    sn_k_sub3a(w, l, sat);
+    memcpy(zqj, w, sizeof w); /* memcpy: zq may be the accumulators' bytes (ic_fused) */
+    sn_k_rot(Rj, w, zj, sat);
+}
+
 /* y = (I + L^)^-1 y in place: for j ascending, y_i -= U_ji^T y_j (i > j).
  * The rounded block rows bound for y_i are summed in acc (int64: at most
  * SN_MAX_ROW_BLOCKS of them, each < 2^44.6 or clamped to 2^28: < 2^49.3) and
- * y_i is formed, clamped once, when the sweep reaches i. Returns the ICHOL
- * count (the blocks it read). */
-static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc *acc, uint32_t *sat) {
+ * y_i is formed, clamped once, when the sweep reaches i. With R (the fused
+ * sweep, ic_fused) y_j enters as t_j = R_j^T r_j, formed there; without, y
+ * holds t already. Returns the ICHOL count (the blocks it read). */
+/* ic_forward and ic_backward always inlined: at the five passes' call R is
+ * NULL and its branches fold away (as a call, the masked applies of the
+ * M4's adaptation runs took +0.6%) */
+#if defined(__GNUC__)
+#define SN_IC_INLINE __attribute__((always_inline)) SN_INLINE
+#else
+#define SN_IC_INLINE SN_INLINE
+#endif
+SN_IC_INLINE uint32_t ic_forward(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *y, sn_acc *acc,
+                           uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL];
     uint32_t j, e, n = 0, nF = v->nF;
@@ -44,7 +82,8 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
         uint32_t end = sn_rd_u32(rp + 4 * j + 4);
         sn_q *yj = y + 3 * j;
         const uint32_t n0 = n;
-        sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
+        if (R) ic_y(R + rs * j, r + 3 * j, acc + 3 * j, yj, sat); /* yj = sn_out(t_j - acc_j) */
+        else sn_k_sub3a(yj, acc + 3 * j, sat); /* yj = sn_out(yj - acc_j) */
 #if defined(SN_K_IC_FWD_COL) /* the M4's loop (sn_kernels_ic.h) */
         e = sn_rd_u32(rp + 4 * j);
         if (e < end)
@@ -73,28 +112,22 @@ static uint32_t ic_forward(const sn_view *v, const uint8_t *kk, sn_q *y, sn_acc 
 
 /* z = (I + L^)^-T z in place: for j descending, z_j -= sum_i U_ji z_i (Q22;
  * each block row rounded by frac, < 2^44.6; their sum < 2^49.3). cnt[3 j]:
- * row j's free column count (ic_forward leaves it in its accumulators). */
-static void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, sn_q *z, uint32_t *sat) {
+ * row j's free column count (ic_forward leaves it in its accumulators).
+ * Without R, z holds w = D^-1 y and becomes z'. With R (ic_fused), z holds
+ * y: w_j = D^-1 y_j is formed where the sweep reaches j, z'_j kept in zq
+ * (the rows above read it there) and z_j = R_j z'_j written. */
+SN_IC_INLINE void ic_backward(const sn_view *v, uint32_t n, const sn_acc *cnt, const uint8_t *kk, const sn_q *R, size_t rs, sn_q *zq,
+                        sn_q *z, uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
-    const unsigned char *L = v->sec[SN_SEC_ICHOL];
+    const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
     uint32_t j = v->nF;
     while (j-- > 0) {
         uint32_t b = sn_rd_u32(rp + 4 * j), f = b + (uint32_t)cnt[3 * j]; /* free columns first */
-#if defined(SN_K_IC_BWD_ROW) /* the M4's and x86-64 AVX2's loops (sn_kernels_ic.h) */
         sn_acc l[4];
         n -= f - b;
-        sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, z, l, sat); /* l = sum_i round(U_ji z_i) */
-#else
-        sn_acc l[4] = {0, 0, 0, 0};
-        const unsigned char *blk;
-        uint32_t e;
-        n -= f - b;
-        blk = L + (size_t)n * SN_ELEM_ICHOL;
-        for (e = b; e < f; e++, blk += SN_ELEM_ICHOL) {
-            sn_k_ic_row(blk, z + 3 * sn_rd_u16(cols + 2 * e), l, sat); /* l += round(U_ji z_i) */
-        }
-#endif
-        sn_k_sub3a(z + 3 * j, l, sat);
+        sn_k_ic_bwd_row(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, f - b, zq, l, sat); /* l = sum_i round(U_ji z'_i) */
+        if (R) ic_z(P + (size_t)j * 6 * SN_REAL_BYTES, z + 3 * j, l, zq + 3 * j, R + rs * j, v->frac_P + SN_KREL(kk[j]), sat);
+        else sn_k_sub3a(z + 3 * j, l, sat);
     }
 }
 
@@ -172,6 +205,21 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
         fv_st3(z + 3 * j, fv_out3(FV_MAC3(c, SN_K_LANE(w, 0), SN_K_LANE(w, 1), SN_K_LANE(w, 2)), sat));
     }
 }
+#else
+/* The portable route (scalar, NEON, the M4; fixed and float): the same
+ * passes fused as above through ic_forward / ic_backward with R, the same
+ * values and clamp counts as precond_core's five passes (each vertex's
+ * rotation, D^-1 and rotation back run on the same inputs, only earlier).
+ * z'_j goes to zq, the top 12 nF bytes of the accumulators: row j's count
+ * acc[3 j] (read before z'_j is written) and the counts below it lie below
+ * zq + 3 j (fixed: byte 24 j + 8 <= 12 nF + 12 j for j < nF; float, 4-byte
+ * accumulators: zq is acc, z'_j acc_j's own slot), and rows read only
+ * columns i > j (the validator: upper triangle), written before. */
+static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
+                     uint32_t *sat) {
+    sn_q *zq = (sn_q *)(void *)((unsigned char *)acc + 3 * (size_t)v->nF * (sizeof(sn_acc) - sizeof(sn_q)));
+    ic_backward(v, ic_forward(v, kk, R, rs, r, z, acc, sat), acc, kk, R, rs, zq, z, sat);
+}
 #endif
 
 /* t = s t, s a Q30 scale in (0, 1] (adaptation's source rows): no clamp */
@@ -206,9 +254,7 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
         }
         return;
     }
-#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
     if (!mask && !sc) { ic_fused(v, kk, R, rs, r, z, WARR(h, o_acc, sn_acc), sat); return; }
-#endif
     for (i = 0; i < v->nF; i++) {
         if (mask && !mask[i] == !inv) z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0;
         else {
@@ -216,11 +262,11 @@ static void precond_core(sn_ihdr *h, const sn_q *R, size_t rs, const uint8_t *ma
             if (sc) scale3(z + 3 * i, sc[i], sat);
         }
     }
-    n = ic_forward(v, kk, z, WARR(h, o_acc, sn_acc), sat);
+    n = ic_forward(v, kk, NULL, 0, NULL, z, WARR(h, o_acc, sn_acc), sat);
     for (i = 0; i < v->nF; i++) { /* w = D^-1 y: Q(19 + k_i) -> Q22 */
         sn_k_sym_out(P + (size_t)i * 6 * SN_REAL_BYTES, z + 3 * i, z + 3 * i, v->frac_P + SN_KREL(kk[i]), sat);
     }
-    ic_backward(v, n, WARR(h, o_acc, sn_acc), z, sat);
+    ic_backward(v, n, WARR(h, o_acc, sn_acc), kk, NULL, 0, z, z, sat);
     for (i = 0; i < v->nF; i++) {
         sn_q t[3] = {z[3 * i], z[3 * i + 1], z[3 * i + 2]};
         if (mask && !mask[i] == !inv) { z[3 * i] = z[3 * i + 1] = z[3 * i + 2] = 0; continue; }
