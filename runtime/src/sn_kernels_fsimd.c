@@ -228,6 +228,101 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
 }
 #endif
 
+#if defined(SN_KERNELS_FAVX2)
+/* The float right-hand side's loops (sn_kernels.h SN_K_FRHS; x86-64 round
+ * 3): lanes are entries, each the reference's expression (a tail entry by
+ * the reference itself); clamps counted per lane from the 4-bit masks. */
+#define BITS4(m) ((uint32_t)(0x4332322132212110ull >> (4 * (m)) & 15u))
+void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat) {
+    const sn_fv c = FV_SET1(ck);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m1, m2;
+        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), FV_LD4(x0 + i)), &m1);
+        FV_ST4(u + i, fv_clamp(FV_MUL(v, c), &m2));
+        if (m1 | m2) t += BITS4(m1) + BITS4(m2); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) u[i] = sn_mulq(sn_add(vel[i], x0[i], sat), ck, SN_Q_COEF, sat);
+}
+void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat) {
+    const sn_fv c = FV_SET1(a1);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m1, m2, m3;
+        const sn_fv x = FV_LD4(x0 + i);
+        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), x), &m1);
+        const sn_fv y = fv_clamp(FV_MUL(v, c), &m2);
+        FV_ST4(u + i, fv_clamp(FV_ADD(y, x), &m3));
+        if (m1 | m2 | m3) t += BITS4(m1) + BITS4(m2) + BITS4(m3); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) u[i] = sn_add(sn_mulq(sn_add(vel[i], x0[i], sat), a1, SN_Q_COEF, sat), x0[i], sat);
+}
+void sn_k_negout(sn_q *b, const sn_acc *acc, uint32_t n, uint32_t *sat) {
+    const sn_fv sg = FV_SET1(-0.0f);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m;
+        FV_ST4(b + i, _mm_xor_ps(fv_clamp(FV_LD4(acc + i), &m), sg)); /* the reference's negation: the sign flipped */
+        if (m) t += BITS4(m); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) b[i] = -sn_out(acc[i], 0, sat);
+}
+void sn_k_mass_rhs(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                   const sn_q *y, const sn_q *vel, const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+    const sn_fv c = FV_SET1(a1);
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const sn_fv yi = fv_ld3(y + 3 * i);
+        sn_fv l = FV_ADD(FV_SET1(0.0f), FV_MUL(FV_SET1(rd_real(md, i)), yi));
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            const sn_fv m = FV_SET1(rd_real(mo, e));
+            if (j >= nF) { /* y_j = sn_add(coef(v_j, a1), ds_j) per block, as sn_k_coef3 and sn_k_add3 */
+                const sn_fv yj = fv_out3(FV_ADD(fv_out3(FV_MUL(fv_ld3(vel + 3 * j), c), sat), fv_ld3(ds + 3 * (j - nF))), sat);
+                l = FV_ADD(l, FV_MUL(m, yj));
+                continue;
+            }
+            l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
+            fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
+        }
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), l));
+    }
+}
+void sn_k_grav_rhs(sn_q *b, const sn_acc *acc, const sn_q *R, const unsigned char *ml, const sn_q g[3], int modelled,
+                   uint32_t nF, uint32_t *sat) {
+    const sn_fv g0 = FV_SET1(g[0]), g1 = FV_SET1(g[1]), g2 = FV_SET1(g[2]), gv = fv_ld3(g), sg = FV_SET1(-0.0f);
+    sn_fv c[3];
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        sn_fv gi = gv, gr, t;
+        fv_cols(R + 9 * i, c);
+        gr = fv_out3(FV_MAC3(c, g0, g1, g2), sat); /* sn_k_rot: formed (and counted) as the reference does, modelled or not */
+        if (modelled) gi = fv_out3(FV_ADD(gv, _mm_xor_ps(gr, sg)), sat); /* sn_add(g, -gr) */
+        t = fv_out3(FV_ADD(fv_ld3(b + 3 * i), fv_out3(FV_MUL(FV_SET1(rd_real(ml, i)), gi), sat)), sat);
+        fv_st3(b + 3 * i, fv_out3(FV_ADD(t, _mm_xor_ps(fv_out3(fv_ld3(acc + 3 * i), sat), sg)), sat));
+    }
+}
+/* products 4 at a time (the same floats), added to s one by one in i order */
+float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n) {
+    float s = 0.0f;
+    uint32_t i;
+    for (i = 0; i + 4 <= n; i += 4) {
+        const sn_fv p = FV_MUL(FV_LD4(a + i), FV_LD4(b + i));
+        s += _mm_cvtss_f32(p);
+        s += _mm_cvtss_f32(_mm_movehdup_ps(p));
+        s += _mm_cvtss_f32(_mm_movehl_ps(p, p));
+        s += _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+    for (; i < n; i++) s += a[i] * b[i];
+    return s;
+}
+#undef BITS4
+#endif
+
 #if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)
 const char *sn_kernels_name(void) { return "avx512"; }
 #elif defined(SN_KERNELS_FAVX2)
