@@ -1578,6 +1578,60 @@ static void test_mass_ff(void) {
 }
 #endif
 
+#if defined(SN_K_FREE8)
+/* sn_k_free8 (a cell's free corners as bits) against the loop it replaced,
+ * indices and nF over the whole u16 range (the signed compare's edge at
+ * 2^15 included), nF 0 and indices at nF - 1, nF, nF + 1 */
+static void test_free8(void) {
+    int t, bad = 0;
+    for (t = 0; t < 20000; t++) {
+        unsigned char cl[16];
+        const uint32_t nF = t % 7 == 0 ? 0u : t % 7 == 1 ? 65535u : t % 7 == 2 ? 32768u + rnd32() % 3u - 1u : rnd32() % 65536u;
+        uint32_t k, ref = 0;
+        for (k = 0; k < 8; k++) {
+            const uint32_t a = rnd32() & 1 ? (nF + rnd32() % 3u - 1u) & 0xFFFFu : rnd32() % 65536u;
+            cl[2 * k] = (unsigned char)a;
+            cl[2 * k + 1] = (unsigned char)(a >> 8);
+            ref |= (uint32_t)(a < nF) << k;
+        }
+        bad += sn_k_free8(cl, nF) != ref;
+    }
+    T_CHECK(bad == 0, "sn_k_free8: %d of 20000 records differ from the corner loop", bad);
+}
+/* sn_k_out_rot_acc2_m (cell_forces' corner row out) against its loop:
+ * ls = ld + lu + 0 + 0, sn_out per entry, acc += R t (sn_rot_acc); clamps,
+ * NaN and signed zeros included */
+static void test_out_rot2(void) {
+    int t, k, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        sn_q R[9], ts[3];
+        sn_acc ld[3], lu[3], a1[3], a2[3], ls[3];
+        sn_k_rotm rm;
+        uint32_t s1 = 0, s2 = 0;
+        const int extreme = t % 8 == 0;
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 3; k++) {
+            ld[k] = extreme && rnd32() % 4u == 0 ? (rnd32() & 1 ? 5.0e3f : nanf("")) : (float)rnd_in(1 << 20) / 256.0f;
+            lu[k] = rnd32() % 8u == 0 ? -0.0f : (float)rnd_in(1 << 20) / 256.0f;
+            if (rnd32() % 8u == 0) ld[k] = -0.0f;
+            a1[k] = a2[k] = (float)rnd_in(1 << 20);
+        }
+        sn_k_rotm_ld(&rm, R);
+        sn_k_out_rot_acc2_m(a1, &rm, ld, lu, &s1);
+        for (k = 0; k < 3; k++) {
+            ls[k] = ld[k] + lu[k] + (t < 0 ? 1.0f : 0) + (t < 0 ? 1.0f : 0); /* the solve's sum, its +0 shares */
+            ts[k] = sn_out(ls[k], 0, &s2);
+        }
+        sn_rot_acc(a2, R, ts);
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_out_rot_acc2_m: %d of 20000 rows differ from the reference loop", bad);
+    T_FIGURE("cell_forces' row out: 20000 rows, %u clamps and NaN replacements", clamps);
+}
+#endif
+
 #if defined(SN_K_FRHS)
 /* The float right-hand side's kernels (x86-64 AVX2, sn_kernels.h SN_K_FRHS)
  * against rhs_x0's loops written here with the scalar reference (sn_out,
@@ -2102,6 +2156,10 @@ int main(void) {
 #endif
 #if defined(SN_K_MASS_SK)
     test_mass_sk();
+#endif
+#if defined(SN_K_FREE8)
+    test_free8();
+    test_out_rot2();
 #endif
 #if defined(SN_K_FRHS)
     test_frhs_flat();

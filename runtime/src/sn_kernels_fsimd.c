@@ -32,7 +32,7 @@ SN_INLINE void store_rows(sn_acc *l, const sn_fv *L, uint32_t nf) {
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     sn_fv L[8], c[3];
     uint32_t i, j;
-    for (i = 0; i < nf; i++) L[i] = FV_SET1(0.0f);
+    for (i = 0; i < 8; i++) L[i] = FV_SET1(0.0f); /* all 8: stores, not a call of memset */
     for (i = 0; i < nf; i++) {
         const uint32_t a = fc[i];
         const __m256 wa0 = _mm256_set1_ps(u[3 * i]), wa1 = _mm256_set1_ps(u[3 * i + 1]), wa2 = _mm256_set1_ps(u[3 * i + 2]);
@@ -112,12 +112,16 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     for (a = 3; a < 24; a++) /* corner 0's operands are never read */
         W[a] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(u1 + a)), _mm_broadcast_ss(u2 + a), 1);
     for (a = 0; a < 8; a++) L[a] = _mm256_setzero_ps();
+    /* unrolled in full (x86-64 round 3): constant block offsets, L in
+     * registers; the same operations in the same order */
+#pragma GCC unroll 8
     for (a = 0; a < 8; a++) {
         __m256 la = L[a];
         if (a) { /* the diagonal block; corner 0's is a product with 0 */
             f8_cols(BLKP(K, a, a), c);
             la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * a));
         }
+#pragma GCC unroll 8
         for (b = a + 1; b < 8; b++) {
             f8_blk(BLKP(K, a, b), r, c);
             la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * b));

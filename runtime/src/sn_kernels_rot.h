@@ -345,6 +345,23 @@ SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_ac
     (void)sh;
     fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
 }
+/* A cell's free corners (index < nF) as bits 0..7 (x86-64 round 3): the
+ * 8 little-endian u16 indices of its CELLS record (16 bytes) compared at
+ * once, unsigned (a <= nF - 1 as min(a, nF - 1) == a). */
+#define SN_K_FREE8 1
+SN_INLINE uint32_t sn_k_free8(const unsigned char *cl, uint32_t nF) {
+    const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)cl);
+    const __m128i m = _mm_cmpeq_epi16(_mm_min_epu16(v, _mm_set1_epi16((short)(uint16_t)(nF - 1u))), v);
+    return nF ? (uint32_t)_mm_movemask_epi8(_mm_packs_epi16(m, _mm_setzero_si128())) : 0u;
+}
+/* cell_forces' corner row out (sn_solve.c): acc += R sn_out(ld + lu), the
+ * cut level's and details' shares 0 (added as +0, as the reference's loop
+ * does: the sum's signed zero) */
+SN_INLINE void sn_k_out_rot_acc2_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc ld[3], const sn_acc lu[3], uint32_t *sat) {
+    const sn_fv z = FV_SET1(0.0f);
+    const sn_fv t = fv_out3(FV_ADD(FV_ADD(FV_ADD(fv_ld3(ld), fv_ld3(lu)), z), z), sat);
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
 #define SN_K_CORNER 1
 SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
                            uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {

@@ -225,6 +225,16 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         for (k = 3; k < 24; k++) ec += sn_k_mul_out(d[k], ld[k], v->frac_S, &esat); /* d_0 = 0: no term */
 #endif
         *e2 = energy_add(*e2, E_Q32(ec));
+#if defined(SN_K_FREE8) /* x86-64 float: the free corners' bits, no cut level or details (sn_kernels_rot.h) */
+        if (!v->cut && !on) {
+            uint32_t fm;
+            for (fm = fr; fm; fm &= fm - 1u) {
+                const uint32_t a = sn_rd_u16(cl + 2 * (k = (uint32_t)__builtin_ctz(fm)));
+                sn_k_out_rot_acc2_m(acc + 3 * a, &rm, ld + 3 * k, lu + 3 * k, sat);
+            }
+            continue;
+        }
+#endif
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_acc ls[3];
@@ -532,6 +542,17 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
 #else
 #define SN_ROT_T(v, o) sn_k_rot_t(R, (v), (o), sat)
 #define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc((x), R, (l), (sh), sat)
+#endif
+#if defined(SN_K_FREE8) /* x86-64 float: the free corners' bits (sn_kernels_rot.h) */
+    if (!mask) {
+        uint32_t fm;
+        for (fm = sn_k_free8(cl, nF); fm; fm &= fm - 1u) {
+            const uint32_t a = sn_rd_u16(cl + 2 * (k = (uint32_t)__builtin_ctz(fm)));
+            SN_ROT_T(d + 3 * a, u + 3 * nf);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
+        }
+    } else
 #endif
     for (k = 0; k < 8; k++) {
         uint32_t a = sn_rd_u16(cl + 2 * k);
