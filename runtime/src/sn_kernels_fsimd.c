@@ -183,8 +183,22 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
  * scalar (each entry alone: the same floats and counts) */
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
     const sn_fv vs = FV_SET1(s);
-    uint32_t i, c = 0;
-    for (i = 0; i + 4 <= n; i += 4) {
+    uint32_t i = 0, c = 0;
+#if defined(SN_KERNELS_FAVX2)
+    { /* x86-64 round 3: 8 entries at a time while no lane clamps (|s x| and
+       * |a + s x| within SN_FLIM, no NaN: sn_out leaves them), from the
+       * first block with a clamp on the 4-lane loop below */
+        const __m256 s8 = _mm256_set1_ps(s), lim = _mm256_set1_ps(SN_FLIM), sg = _mm256_set1_ps(-0.0f);
+        for (; i + 8 <= n; i += 8) {
+            const __m256 q = _mm256_mul_ps(s8, _mm256_loadu_ps(x + i)), o = _mm256_add_ps(_mm256_loadu_ps(a + i), q);
+            if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(_mm256_andnot_ps(sg, q), lim, _CMP_NLE_UQ),
+                                                _mm256_cmp_ps(_mm256_andnot_ps(sg, o), lim, _CMP_NLE_UQ))))
+                break;
+            _mm256_storeu_ps(out + i, o);
+        }
+    }
+#endif
+    for (; i + 4 <= n; i += 4) {
         int m1, m2;
         sn_fv q = fv_clamp(FV_MUL(vs, FV_LD4(x + i)), &m1);
         q = fv_clamp(FV_ADD(FV_LD4(a + i), q), &m2);
@@ -224,6 +238,12 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
             sn_fv m;
             if (j >= nF) break; /* skeleton columns come last */
             m = FV_SET1(rd_real(mo, e));
+            if (j + 1u < nF) { /* x86-64 round 3: 4-lane loads and store inside the arrays, lane 3 (vertex j + 1's x) kept by a blend */
+                const sn_fv aj = FV_LD4(acc + 3 * j);
+                l = FV_ADD(l, FV_MUL(m, FV_LD4(y + 3 * j)));
+                FV_ST4(acc + 3 * j, _mm_blend_ps(FV_ADD(aj, FV_MUL(m, yi)), aj, 8));
+                continue;
+            }
             l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
             fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
         }
