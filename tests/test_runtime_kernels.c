@@ -1632,6 +1632,62 @@ static void test_out_rot2(void) {
 }
 #endif
 
+#if defined(SN_K_CELL_STIFF)
+/* sn_k_cell_stiff (the mat-vec's cell on x86-64 float) against cell_stiff's
+ * loop written here: u = sn_rot_t(R, d_a) per free corner in order,
+ * sn_k_cell_mul (the product the other tests check against the reference),
+ * acc_a += R sn_out(l_a) by sn_rot_acc; every free-corner count 0..8,
+ * repeated vertices, operands and accumulators with clamps */
+static void test_cell_stiff(void) {
+    static unsigned char K[REC];
+    static double S[24][24];
+    static sn_q d[3 * 48];
+    static sn_acc a1[3 * 48], a2[3 * 48];
+    int t, bad = 0, nfs[9] = {0};
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        unsigned char cl[16];
+        const uint32_t nF = 1u + rnd32() % 40u;
+        const int wild = t % 8 == 0;
+        sn_q R[9], u[24];
+        sn_acc l[24];
+        uint8_t fc[8];
+        uint32_t vi[8], k, c, nf = 0, s1 = 0, s2 = 0;
+        if (t % 50 == 0) make_rec(K, S, t % 100 == 0);
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 3 * 48; k++) {
+            d[k] = wild && rnd32() % 8u == 0 ? (float)rnd_in(1 << 20) : (float)rnd_in(1 << 20) / 1024.0f;
+            a1[k] = a2[k] = (float)rnd_in(1 << 20) / 64.0f;
+        }
+        for (k = 0; k < 8; k++) { /* corners: free (< nF) or not, by a per-record chance; repeats allowed */
+            const uint32_t a = rnd32() % 8u < (uint32_t)(t % 9) ? rnd32() % nF : nF + rnd32() % 8u;
+            cl[2 * k] = (unsigned char)a;
+            cl[2 * k + 1] = (unsigned char)(a >> 8);
+        }
+        sn_k_cell_stiff(K, cl, nF, R, d, a1, &s1);
+        for (k = 0; k < 8; k++) {
+            const uint32_t a = sn_rd_u16(cl + 2 * k);
+            if (a >= nF) continue;
+            sn_rot_t(R, d + 3 * a, u + 3 * nf, &s2);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
+        }
+        nfs[nf]++;
+        if (nf) sn_k_cell_mul(K, fc, nf, u, l);
+        for (k = 0; k < nf; k++) {
+            sn_q o[3];
+            for (c = 0; c < 3; c++) o[c] = sn_out(l[3 * k + c], 0, &s2);
+            sn_rot_acc(a2 + 3 * vi[k], R, o);
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_cell_stiff: %d of 3000 cells differ from cell_stiff's loop", bad);
+    T_FIGURE("mat-vec cells: 3000 (free corners 0..8: %d %d %d %d %d %d %d %d %d), %u clamps", nfs[0], nfs[1], nfs[2], nfs[3],
+             nfs[4], nfs[5], nfs[6], nfs[7], nfs[8], clamps);
+}
+#endif
+
 #if defined(SN_K_FRHS)
 /* The float right-hand side's kernels (x86-64 AVX2, sn_kernels.h SN_K_FRHS)
  * against rhs_x0's loops written here with the scalar reference (sn_out,
@@ -2156,6 +2212,9 @@ int main(void) {
 #endif
 #if defined(SN_K_MASS_SK)
     test_mass_sk();
+#endif
+#if defined(SN_K_CELL_STIFF)
+    test_cell_stiff();
 #endif
 #if defined(SN_K_FREE8)
     test_free8();

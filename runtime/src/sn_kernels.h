@@ -236,6 +236,12 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  *   sn_k_grav_rhs: per free vertex, b_i = sn_add(sn_add(b_i, sn_mulq(m_i,
  *     g_i)), -sn_out(acc_i)), g_i = sn_add(g, -R_i g) (modelled) or g
  *   sn_k_fdot:    s = 0, s += a_i b_i in i order (the CG's float dot) */
+/* cell_stiff without a mask (sn_solve.c) on x86-64 float: acc += R S^ R^T d
+ * over the cell's free corners (K its CELLK record, cl its CELLS record),
+ * the same floats and counts as cell_stiff's loop (sn_kernels_fsimd.c) */
+#define SN_K_CELL_STIFF 1
+void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
+                     uint32_t *sat);
 #define SN_K_FRHS 1
 void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat);
 void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat);

@@ -9,6 +9,7 @@
  * is the scalar reference's float, bit for bit. AVX2 uses 8 lanes for the
  * cell products (two 3-vector halves: below). */
 #include "sn_kernels_fsimd.h"
+#include "sn_kernels_rot.h" /* sn_k_rotm, sn_k_free8 */
 
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 
@@ -77,6 +78,76 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
     store_rows(l, L, nf);
 }
 
+#endif
+
+#if defined(SN_KERNELS_FAVX2)
+/* cell_stiff on x86-64 float (sn_solve.c; round 3): sn_k_rot_t_m for the
+ * free corners in ascending order, sn_k_cell_mul's product (above, u at 4
+ * floats a corner) and sn_k_out_rot_acc_m per corner, the same operations
+ * in the same order (the same floats and counts), one case per corner
+ * count nf: the loops unrolled in full, the accumulators in registers. */
+#define F8_PERM(v, a, b, c, d, e, f) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, d, e, f, f))
+SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uint32_t fm, const sn_k_rotm *m, const sn_q *d,
+                            sn_acc *acc, uint32_t *sat, const uint32_t nf) {
+    float u[32];
+    uint32_t fc[8] = {0}, vi[8] = {0}, i, j; /* set for i < nf: zeroed for GCC's flow analysis */
+    sn_fv L[8], c[3];
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++, fm &= fm - 1u) {
+        const sn_q *v;
+        fc[i] = (uint32_t)__builtin_ctz(fm);
+        vi[i] = sn_rd_u16(cl + 2 * fc[i]);
+        v = d + 3 * vi[i];
+        FV_ST4(u + 4 * i, fv_out3(FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat)); /* lane 3 unread */
+        L[i] = FV_SET1(0.0f);
+    }
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) {
+        const __m256 wa0 = _mm256_set1_ps(u[4 * i]), wa1 = _mm256_set1_ps(u[4 * i + 1]), wa2 = _mm256_set1_ps(u[4 * i + 2]);
+        sn_fv la;
+        fv_cols(BLKP(K, fc[i], fc[i]), c);
+        la = FV_ADD(L[i], FV_MAC3(c, _mm256_castps256_ps128(wa0), _mm256_castps256_ps128(wa1), _mm256_castps256_ps128(wa2)));
+#pragma GCC unroll 8
+        for (j = i + 1; j < nf; j++) {
+            const unsigned char *B = BLKP(K, fc[i], fc[j]);
+            const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+            const __m256 t = _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(u[4 * j]), wa0, 0xF0)),
+                              _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 1]), wa1, 0xF0))),
+                _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 2]), wa2, 0xF0)));
+            la = FV_ADD(la, _mm256_castps256_ps128(t));
+            L[j] = FV_ADD(L[j], _mm256_extractf128_ps(t, 1));
+        }
+        L[i] = la;
+    }
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) { /* sn_k_out_rot_acc_m: acc += R sn_out(l) */
+        const sn_fv t = fv_out3(L[i], sat);
+        sn_acc *a = acc + 3 * vi[i];
+        fv_st3(a, FV_ADD(fv_ld3(a), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+    }
+}
+#undef F8_PERM
+void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
+                     uint32_t *sat) {
+    const uint32_t fm = sn_k_free8(cl, nF);
+    uint32_t n = fm - (fm >> 1 & 0x55u);
+    sn_k_rotm m;
+    n = (n & 0x33u) + (n >> 2 & 0x33u);
+    n = (n + (n >> 4)) & 0x0Fu; /* the free corners' count */
+    sn_k_rotm_ld(&m, R);
+    switch (n) {
+    case 1: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 1); break;
+    case 2: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 2); break;
+    case 3: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 3); break;
+    case 4: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 4); break;
+    case 5: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 5); break;
+    case 6: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 6); break;
+    case 7: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 7); break;
+    case 8: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 8); break;
+    default: break; /* no free corner */
+    }
+}
 #endif
 
 #if defined(SN_KERNELS_FAVX2)

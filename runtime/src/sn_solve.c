@@ -543,6 +543,13 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
 #define SN_ROT_T(v, o) sn_k_rot_t(R, (v), (o), sat)
 #define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc((x), R, (l), (sh), sat)
 #endif
+#if defined(SN_K_CELL_STIFF) /* x86-64 float: the loops below in one kernel (sn_kernels.h) */
+    if (!mask) {
+        (void)kk; (void)u; (void)l; (void)fc; (void)vi; (void)nf; (void)k;
+        sn_k_cell_stiff(K, cl, nF, R, d, acc, sat);
+        return;
+    }
+#endif
 #if defined(SN_K_FREE8) /* x86-64 float: the free corners' bits (sn_kernels_rot.h) */
     if (!mask) {
         uint32_t fm;
