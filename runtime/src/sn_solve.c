@@ -665,6 +665,9 @@ static void matvec(sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_q *q, cons
     if (dt) acc_zero(sacc, 3 * dt->n);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         if (dt && ons[e]) cell_stiff_det(h, dt, e, ons[e], K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, d, acc, sacc, sat);
+#if defined(SN_K_CELL_STIFF) /* x86-64 float: cell_stiff's kernel called here (sn_kernels.h) */
+        else if (!mask) sn_k_cell_stiff(K, cells + (size_t)e * SN_ELEM_CELLS, nF, cR + 9 * e, d, acc, sat);
+#endif
         else cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++)
