@@ -309,12 +309,6 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
             sn_fv m;
             if (j >= nF) break; /* skeleton columns come last */
             m = FV_SET1(rd_real(mo, e));
-            if (j + 1u < nF) { /* x86-64 round 3: 4-lane loads and store inside the arrays, lane 3 (vertex j + 1's x) kept by a blend */
-                const sn_fv aj = FV_LD4(acc + 3 * j);
-                l = FV_ADD(l, FV_MUL(m, FV_LD4(y + 3 * j)));
-                FV_ST4(acc + 3 * j, _mm_blend_ps(FV_ADD(aj, FV_MUL(m, yi)), aj, 8));
-                continue;
-            }
             l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
             fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
         }
