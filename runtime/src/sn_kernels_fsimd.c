@@ -87,6 +87,7 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
  * in the same order (the same floats and counts), one case per corner
  * count nf: the loops unrolled in full, the accumulators in registers. */
 #define F8_PERM(v, a, b, c, d, e, f) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, d, e, f, f))
+__attribute__((always_inline)) /* a copy per count (GCC kept one call with nf a variable) */
 SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uint32_t fm, const sn_k_rotm *m, const sn_q *d,
                             sn_acc *acc, uint32_t *sat, const uint32_t nf) {
     float u[32];
