@@ -1830,6 +1830,44 @@ static void test_fdot(void) {
 }
 #endif
 
+#if defined(SN_K_CORNER0)
+/* sn_k_corner_c0 (cell_forces' corner, corner 0's operands loaded once)
+ * against the reference loop of cell_forces: t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_rot_t(R, s), d = sn_add(sn_rot_t(R, t),
+ * -sn_add(x_a, -x_0)); values with clamps, NaN, signed zeros */
+static void test_corner_c0(void) {
+    static unsigned char rest[4 * 30];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        const int wild = t % 4 == 0;
+        const uint32_t ia = 3u * (rnd32() % 10u), ib = 3u * (rnd32() % 10u);
+        sn_q R[9], pa[3], p0[3], wa[3], w0[3], d1[3], u1[3], d2[3], u2[3], tt[3], ss[3], l[3], xr[3];
+        sn_k_rotm rm;
+        sn_k_c0 c0;
+        uint32_t k, s1 = 0, s2 = 0;
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(frnd(wild)));
+        for (k = 0; k < 3; k++) { pa[k] = frnd(wild); p0[k] = frnd(wild); wa[k] = frnd(wild); w0[k] = frnd(wild); }
+        sn_k_rotm_ld(&rm, R);
+        sn_k_c0_ld(&c0, p0, w0, rest, ib);
+        sn_k_corner_c0(&rm, &c0, pa, wa, rest, ia, d1, u1, &s1);
+        for (k = 0; k < 3; k++) {
+            tt[k] = sn_add(pa[k], -p0[k], &s2);
+            ss[k] = sn_add(wa[k], -w0[k], &s2);
+        }
+        sn_rot_t(R, tt, l, &s2);
+        sn_rot_t(R, ss, u2, &s2);
+        for (k = 0; k < 3; k++) xr[k] = sn_add(rd_real(rest, ia + k), -rd_real(rest, ib + k), &s2);
+        for (k = 0; k < 3; k++) d2[k] = sn_add(l[k], -xr[k], &s2);
+        bad += memcmp(d1, d2, sizeof d1) != 0 || memcmp(u1, u2, sizeof u1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_corner_c0: %d of 20000 corners differ from the reference loop", bad);
+    T_FIGURE("cell_forces' corners: 20000, %u clamps and NaN replacements", clamps);
+}
+#endif
+
 #if defined(SN_K_MASS_SK)
 /* The M4's right-hand-side mass pass at the skeleton columns (sn_k_mass_sk)
  * against sn_rhs's loop written here with the reference helpers (coef =
@@ -2215,6 +2253,9 @@ int main(void) {
 #endif
 #if defined(SN_K_CELL_STIFF)
     test_cell_stiff();
+#endif
+#if defined(SN_K_CORNER0)
+    test_corner_c0();
 #endif
 #if defined(SN_K_FREE8)
     test_free8();

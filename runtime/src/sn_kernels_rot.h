@@ -363,6 +363,28 @@ SN_INLINE void sn_k_out_rot_acc2_m(sn_acc acc[3], const sn_k_rotm *m, const sn_a
     const sn_fv t = fv_out3(FV_ADD(FV_ADD(FV_ADD(fv_ld3(ld), fv_ld3(lu)), z), z), sat);
     fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
 }
+/* sn_k_corner (below) with corner 0's operands (p_0, w_0, x_0) loaded once
+ * per cell (x86-64 round 3: the stores of d and uu kept GCC from hoisting
+ * them); the same floats and counts */
+#define SN_K_CORNER0 1
+typedef struct { sn_fv p0, w0, x0; } sn_k_c0;
+SN_INLINE void sn_k_c0_ld(sn_k_c0 *c, const sn_q *p0, const sn_q *w0, const unsigned char *rest, uint32_t ib) {
+    c->p0 = SN_K_NEG(fv_ld3(p0));
+    c->w0 = SN_K_NEG(fv_ld3(w0));
+    c->x0 = SN_K_NEG(fv_ld3((const float *)(const void *)rest + ib));
+}
+SN_INLINE void sn_k_corner_c0(const sn_k_rotm *m, const sn_k_c0 *c0, const sn_q *pa, const sn_q *wa, const unsigned char *rest,
+                              uint32_t ia, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
+    const sn_fv *r = m->r;
+    sn_fv t, x;
+    t = fv_out3(FV_ADD(fv_ld3(wa), c0->w0), sat);
+    fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
+    t = fv_out3(FV_ADD(fv_ld3(pa), c0->p0), sat);
+    t = fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat);
+    x = fv_out3(FV_ADD(fv_ld3(f + ia), c0->x0), sat);
+    fv_st3(d, fv_out3(FV_ADD(t, SN_K_NEG(x)), sat));
+}
 #define SN_K_CORNER 1
 SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,
                            uint32_t ia, uint32_t ib, sn_q d[3], sn_q uu[3], uint32_t *sat) {

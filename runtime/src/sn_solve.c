@@ -195,6 +195,17 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         fr = (uint32_t)(a0 < nF);
 #if defined(SN_K_CORNERS) /* the M4's Thumb-2 (sn_kernels.h) */
         fr |= sn_k_corners(cl, pos, w, vel, nF, v->b1, rest, R, w0, d, uu, sat);
+#elif defined(SN_K_CORNER0) /* x86-64 float: corner 0's operands once (sn_kernels_rot.h) */
+        {
+            sn_k_c0 c0;
+            sn_k_c0_ld(&c0, pos + 3 * a0, w0, rest, 3 * a0);
+            fr = sn_k_free8(cl, nF);
+            for (k = 1; k < 8; k++) {
+                const uint32_t a = sn_rd_u16(cl + 2 * k);
+                sn_q wa[3];
+                sn_k_corner_c0(&rm, &c0, pos + 3 * a, w_of(h, w, vel, a, wa), rest, 3 * a, d + 3 * k, uu + 3 * k, sat);
+            }
+        }
 #else
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
