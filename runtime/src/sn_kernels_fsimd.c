@@ -168,10 +168,13 @@ SN_INLINE void f8_cols(const unsigned char *B, __m256 c[3]) {
     c[2] = F8_PERM(v1, 1, 4, 7);
 }
 SN_INLINE void f8_blk(const unsigned char *B, __m256 r[3], __m256 c[3]) {
-    const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
-    r[0] = F8_PERM(v0, 0, 1, 2);
-    r[1] = F8_PERM(v0, 3, 4, 5);
-    r[2] = F8_PERM(v1, 5, 6, 7);
+    const float *f = (const float *)(const void *)B;
+    const __m256 v0 = FV_LD8(B), v1 = FV_LD8(f + 1);
+    /* rows by 16-byte broadcasts inside the block (x86-64 round 3: no
+     * permute index registers; lane 3 junk, never stored) */
+    r[0] = _mm256_broadcast_ps((const __m128 *)(const void *)f);
+    r[1] = _mm256_broadcast_ps((const __m128 *)(const void *)(f + 3));
+    r[2] = _mm256_permute_ps(_mm256_broadcast_ps((const __m128 *)(const void *)(f + 5)), _MM_SHUFFLE(3, 3, 2, 1));
     c[0] = F8_PERM(v0, 0, 3, 6);
     c[1] = F8_PERM(v0, 1, 4, 7);
     c[2] = F8_PERM(v1, 1, 4, 7);
