@@ -1731,6 +1731,296 @@ static void test_mass_ff(void) {
 }
 #endif
 
+#if defined(SN_K_FREE8)
+/* sn_k_free8 (a cell's free corners as bits) against the loop it replaced,
+ * indices and nF over the whole u16 range (the signed compare's edge at
+ * 2^15 included), nF 0 and indices at nF - 1, nF, nF + 1 */
+static void test_free8(void) {
+    int t, bad = 0;
+    for (t = 0; t < 20000; t++) {
+        unsigned char cl[16];
+        const uint32_t nF = t % 7 == 0 ? 0u : t % 7 == 1 ? 65535u : t % 7 == 2 ? 32768u + rnd32() % 3u - 1u : rnd32() % 65536u;
+        uint32_t k, ref = 0;
+        for (k = 0; k < 8; k++) {
+            const uint32_t a = rnd32() & 1 ? (nF + rnd32() % 3u - 1u) & 0xFFFFu : rnd32() % 65536u;
+            cl[2 * k] = (unsigned char)a;
+            cl[2 * k + 1] = (unsigned char)(a >> 8);
+            ref |= (uint32_t)(a < nF) << k;
+        }
+        bad += sn_k_free8(cl, nF) != ref;
+    }
+    T_CHECK(bad == 0, "sn_k_free8: %d of 20000 records differ from the corner loop", bad);
+}
+/* sn_k_out_rot_acc2_m (cell_forces' corner row out) against its loop:
+ * ls = ld + lu + 0 + 0, sn_out per entry, acc += R t (sn_rot_acc); clamps,
+ * NaN and signed zeros included */
+static void test_out_rot2(void) {
+    int t, k, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        sn_q R[9], ts[3];
+        sn_acc ld[3], lu[3], a1[3], a2[3], ls[3];
+        sn_k_rotm rm;
+        uint32_t s1 = 0, s2 = 0;
+        const int extreme = t % 8 == 0;
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 3; k++) {
+            ld[k] = extreme && rnd32() % 4u == 0 ? (rnd32() & 1 ? 5.0e3f : nanf("")) : (float)rnd_in(1 << 20) / 256.0f;
+            lu[k] = rnd32() % 8u == 0 ? -0.0f : (float)rnd_in(1 << 20) / 256.0f;
+            if (rnd32() % 8u == 0) ld[k] = -0.0f;
+            a1[k] = a2[k] = (float)rnd_in(1 << 20);
+        }
+        sn_k_rotm_ld(&rm, R);
+        sn_k_out_rot_acc2_m(a1, &rm, ld, lu, &s1);
+        for (k = 0; k < 3; k++) {
+            ls[k] = ld[k] + lu[k] + (t < 0 ? 1.0f : 0) + (t < 0 ? 1.0f : 0); /* the solve's sum, its +0 shares */
+            ts[k] = sn_out(ls[k], 0, &s2);
+        }
+        sn_rot_acc(a2, R, ts);
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_out_rot_acc2_m: %d of 20000 rows differ from the reference loop", bad);
+    T_FIGURE("cell_forces' row out: 20000 rows, %u clamps and NaN replacements", clamps);
+}
+#endif
+
+#if defined(SN_K_CELL_STIFF)
+/* sn_k_cell_stiff (the mat-vec's cell on x86-64 float) against cell_stiff's
+ * loop written here: u = sn_rot_t(R, d_a) per free corner in order,
+ * sn_k_cell_mul (the product the other tests check against the reference),
+ * acc_a += R sn_out(l_a) by sn_rot_acc; every free-corner count 0..8,
+ * repeated vertices, operands and accumulators with clamps */
+static void test_cell_stiff(void) {
+    static unsigned char K[REC];
+    static double S[24][24];
+    static sn_q d[3 * 48];
+    static sn_acc a1[3 * 48], a2[3 * 48];
+    int t, bad = 0, nfs[9] = {0};
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        unsigned char cl[16];
+        const uint32_t nF = 1u + rnd32() % 40u;
+        const int wild = t % 8 == 0;
+        sn_q R[9], u[24];
+        sn_acc l[24];
+        uint8_t fc[8];
+        uint32_t vi[8], k, c, nf = 0, s1 = 0, s2 = 0;
+        if (t % 50 == 0) make_rec(K, S, t % 100 == 0);
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 3 * 48; k++) {
+            d[k] = wild && rnd32() % 8u == 0 ? (float)rnd_in(1 << 20) : (float)rnd_in(1 << 20) / 1024.0f;
+            a1[k] = a2[k] = (float)rnd_in(1 << 20) / 64.0f;
+        }
+        for (k = 0; k < 8; k++) { /* corners: free (< nF) or not, by a per-record chance; repeats allowed */
+            const uint32_t a = rnd32() % 8u < (uint32_t)(t % 9) ? rnd32() % nF : nF + rnd32() % 8u;
+            cl[2 * k] = (unsigned char)a;
+            cl[2 * k + 1] = (unsigned char)(a >> 8);
+        }
+        sn_k_cell_stiff(K, cl, nF, R, d, a1, &s1);
+        for (k = 0; k < 8; k++) {
+            const uint32_t a = sn_rd_u16(cl + 2 * k);
+            if (a >= nF) continue;
+            sn_rot_t(R, d + 3 * a, u + 3 * nf, &s2);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
+        }
+        nfs[nf]++;
+        if (nf) sn_k_cell_mul(K, fc, nf, u, l);
+        for (k = 0; k < nf; k++) {
+            sn_q o[3];
+            for (c = 0; c < 3; c++) o[c] = sn_out(l[3 * k + c], 0, &s2);
+            sn_rot_acc(a2 + 3 * vi[k], R, o);
+        }
+        bad += memcmp(a1, a2, sizeof a1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_cell_stiff: %d of 3000 cells differ from cell_stiff's loop", bad);
+    T_FIGURE("mat-vec cells: 3000 (free corners 0..8: %d %d %d %d %d %d %d %d %d), %u clamps", nfs[0], nfs[1], nfs[2], nfs[3],
+             nfs[4], nfs[5], nfs[6], nfs[7], nfs[8], clamps);
+}
+#endif
+
+#if defined(SN_K_FRHS)
+/* The float right-hand side's kernels (x86-64 AVX2, sn_kernels.h SN_K_FRHS)
+ * against rhs_x0's loops written here with the scalar reference (sn_out,
+ * sn_add, sn_mulq, sn_mul): bit for bit (memcmp: signed zeros included) and
+ * the same clamp counts. Operands: values inside and beyond +-SN_FLIM, NaN,
+ * -0, lengths 0..41 (the 4-lane loop's tails). */
+static float frnd(int wild) {
+    const uint32_t k = rnd32() % 16u;
+    if (wild && k == 0) return nanf("");
+    if (wild && k == 1) return rnd32() & 1 ? 3.0e4f : -3.0e4f; /* clamps */
+    if (k == 2) return -0.0f;
+    return (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 12u));
+}
+static void test_frhs_flat(void) {
+    static sn_q v[48], x[48], u1[48], u2[48];
+    static sn_acc a[48];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 3000; t++) {
+        const uint32_t n = rnd32() % 42u;
+        const int wild = t % 4 == 0, op = t % 3;
+        const sn_q c = t % 5 == 0 ? 1.75f : (float)rnd_in(1 << 20) / 1048576.0f;
+        uint32_t i, s1 = 0, s2 = 0;
+        for (i = 0; i < 48; i++) { v[i] = frnd(wild); x[i] = frnd(wild); a[i] = frnd(wild); u1[i] = u2[i] = 7.0f; }
+        if (op == 0) {
+            sn_k_fold_w(u1, v, x, c, n, &s1);
+            for (i = 0; i < n; i++) u2[i] = sn_mulq(sn_add(v[i], x[i], &s2), c, SN_Q_COEF, &s2);
+        } else if (op == 1) {
+            sn_k_fold_y(u1, v, x, c, n, &s1);
+            for (i = 0; i < n; i++) u2[i] = sn_add(sn_mulq(sn_add(v[i], x[i], &s2), c, SN_Q_COEF, &s2), x[i], &s2);
+        } else {
+            sn_k_negout(u1, a, n, &s1);
+            for (i = 0; i < n; i++) u2[i] = (sn_q)-sn_out(a[i], SN_Q_ROT, &s2);
+        }
+        bad += memcmp(u1, u2, sizeof u1) != 0 || s1 != s2; /* entries past n untouched too */
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "fold_w / fold_y / negout (path %s): %d of 3000 cases differ from the reference loops", sn_kernels_name(), bad);
+    T_FIGURE("fold_w / fold_y / negout: 3000 cases, %u clamps", clamps);
+}
+/* sn_k_mass_rhs: random rows of 1..40 free rows over nF + 1..16 vertices,
+ * free and skeleton columns in random order, y, v', ds with clamping values */
+static void test_mass_rhs(void) {
+    static unsigned char rp[4 * 41], cols[2 * 400], md[4 * 40], mo[4 * 400];
+    static sn_q y[3 * 40], vel[3 * 56], ds[3 * 16];
+    static sn_acc a1[3 * 40], a2[3 * 40];
+    int t, bad = 0, sk = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 500; t++) {
+        const uint32_t nF = 1u + rnd32() % 40u, nS = 1u + rnd32() % 16u;
+        const int wild = t % 4 == 0;
+        const sn_q a = (float)rnd_in(1 << 20) / 1048576.0f;
+        uint32_t i, e = 0, k, s1 = 0, s2 = 0;
+        for (i = 0; i < 3 * nF; i++) { y[i] = frnd(0); a1[i] = a2[i] = frnd(0); }
+        for (i = 0; i < 3 * (nF + nS); i++) vel[i] = frnd(wild);
+        for (i = 0; i < 3 * nS; i++) ds[i] = frnd(wild);
+        for (i = 0; i < nF; i++) {
+            const uint32_t nb = rnd32() % 9u;
+            put32(rp + 4 * i, e);
+            put32(md + 4 * i, fbits((float)rnd_in(1 << 23) / 1024.0f));
+            for (k = 0; k < nb; k++, e++) {
+                const uint32_t j = rnd32() % 3u == 0 ? nF + rnd32() % nS : rnd32() % nF;
+                cols[2 * e] = (unsigned char)j;
+                cols[2 * e + 1] = (unsigned char)(j >> 8);
+                put32(mo + 4 * e, fbits((float)rnd_in(1 << 23) / 1024.0f * (rnd32() % 16u ? 1.0f : -0.0f)));
+            }
+        }
+        put32(rp + 4 * nF, e);
+        sn_k_mass_rhs(rp, cols, md, mo, y, vel, ds, a, a1, nF, &s1);
+        for (i = 0; i < nF; i++) { /* rhs_x0's loop with pre */
+            uint32_t b = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+            sn_acc l[3];
+            for (k = 0; k < 3; k++) l[k] = (sn_acc)0 + sn_mul(rd_real(md, i), y[3 * i + k]);
+            for (; b < end; b++) {
+                const uint32_t j = sn_rd_u16(cols + 2 * b);
+                const sn_q m = rd_real(mo, b);
+                for (k = 0; k < 3; k++) {
+                    if (j >= nF) l[k] += sn_mul(m, sn_add(sn_mulq(vel[3 * j + k], a, SN_Q_COEF, &s2), ds[3 * (j - nF) + k], &s2));
+                    else { l[k] += sn_mul(m, y[3 * j + k]); a2[3 * j + k] += sn_mul(m, y[3 * i + k]); }
+                }
+                sk += j >= nF;
+            }
+            for (k = 0; k < 3; k++) a2[3 * i + k] += l[k];
+        }
+        bad += memcmp(a1, a2, 3 * nF * sizeof a1[0]) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "rhs mass pass (path %s): %d of 500 structures differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("rhs mass pass: 500 random row structures, %d skeleton blocks, %u clamps", sk, clamps);
+}
+/* sn_k_grav_rhs: random frames (any floats: the kernel is the reference's
+ * arithmetic, not a rotation's), masses, g, b and acc, modelled or not */
+static void test_grav_rhs(void) {
+    static sn_q b1[3 * 40], b2[3 * 40], R[9 * 40];
+    static sn_acc acc[3 * 40];
+    static unsigned char ml[4 * 40];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 1000; t++) {
+        const uint32_t nF = rnd32() % 41u;
+        const int wild = t % 4 == 0, mod = t % 2;
+        sn_q g[3];
+        uint32_t i, k, s1 = 0, s2 = 0;
+        for (k = 0; k < 3; k++) g[k] = frnd(0);
+        for (i = 0; i < 3 * 40; i++) { b1[i] = b2[i] = frnd(wild); acc[i] = frnd(wild); }
+        for (i = 0; i < 9 * 40; i++) R[i] = wild ? frnd(0) : (float)rnd_in(1 << 20) / 1048576.0f;
+        for (i = 0; i < 40; i++) put32(ml + 4 * i, fbits(wild && i % 3 == 0 ? 1.0e4f : (float)rnd_in(1 << 20) / 1024.0f));
+        sn_k_grav_rhs(b1, acc, R, ml, g, mod, nF, &s1);
+        for (i = 0; i < nF; i++) { /* rhs_x0's loop */
+            sn_q mi = rd_real(ml, i), gi[3], gr[3];
+            for (k = 0; k < 3; k++) /* sn_rot */
+                gr[k] = sn_out(sn_mul(R[9 * i + 3 * k], g[0]) + sn_mul(R[9 * i + 3 * k + 1], g[1]) + sn_mul(R[9 * i + 3 * k + 2], g[2]), 0, &s2);
+            for (k = 0; k < 3; k++) gi[k] = mod ? sn_add(g[k], -gr[k], &s2) : g[k];
+            for (k = 0; k < 3; k++) {
+                sn_q gg = sn_mulq(mi, gi[k], 0, &s2);
+                sn_q ma = sn_out(acc[3 * i + k], 0, &s2);
+                b2[3 * i + k] = sn_add(sn_add(b2[3 * i + k], gg, &s2), -ma, &s2);
+            }
+        }
+        bad += memcmp(b1, b2, sizeof b1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "rhs gravity pass (path %s): %d of 1000 cases differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("rhs gravity pass: 1000 cases, %u clamps", clamps);
+}
+/* sn_k_fdot: the CG's float dot, the reference's sum in i order */
+static void test_fdot(void) {
+    static sn_q a[400], b[400];
+    int t, bad = 0;
+    for (t = 0; t < 2000; t++) {
+        const uint32_t n = t % 8 == 0 ? 378u : rnd32() % 400u;
+        uint32_t i;
+        float s = 0.0f, r;
+        for (i = 0; i < n; i++) { a[i] = frnd(0); b[i] = frnd(0); }
+        for (i = 0; i < n; i++) s += a[i] * b[i];
+        r = sn_k_fdot(a, b, n);
+        bad += memcmp(&r, &s, sizeof s) != 0;
+    }
+    T_CHECK(bad == 0, "float dot (path %s): %d of 2000 sums differ from the reference order", sn_kernels_name(), bad);
+}
+#endif
+
+#if defined(SN_K_CORNER0)
+/* sn_k_corner_c0 (cell_forces' corner, corner 0's operands loaded once)
+ * against the reference loop of cell_forces: t = sn_add(p_a, -p_0),
+ * s = sn_add(w_a, -w_0), uu = sn_rot_t(R, s), d = sn_add(sn_rot_t(R, t),
+ * -sn_add(x_a, -x_0)); values with clamps, NaN, signed zeros */
+static void test_corner_c0(void) {
+    static unsigned char rest[4 * 30];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 20000; t++) {
+        const int wild = t % 4 == 0;
+        const uint32_t ia = 3u * (rnd32() % 10u), ib = 3u * (rnd32() % 10u);
+        sn_q R[9], pa[3], p0[3], wa[3], w0[3], d1[3], u1[3], d2[3], u2[3], tt[3], ss[3], l[3], xr[3];
+        sn_k_rotm rm;
+        sn_k_c0 c0;
+        uint32_t k, s1 = 0, s2 = 0;
+        for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
+        for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(frnd(wild)));
+        for (k = 0; k < 3; k++) { pa[k] = frnd(wild); p0[k] = frnd(wild); wa[k] = frnd(wild); w0[k] = frnd(wild); }
+        sn_k_rotm_ld(&rm, R);
+        sn_k_c0_ld(&c0, p0, w0, rest, ib);
+        sn_k_corner_c0(&rm, &c0, pa, wa, rest, ia, d1, u1, &s1);
+        for (k = 0; k < 3; k++) {
+            tt[k] = sn_add(pa[k], -p0[k], &s2);
+            ss[k] = sn_add(wa[k], -w0[k], &s2);
+        }
+        sn_rot_t(R, tt, l, &s2);
+        sn_rot_t(R, ss, u2, &s2);
+        for (k = 0; k < 3; k++) xr[k] = sn_add(rd_real(rest, ia + k), -rd_real(rest, ib + k), &s2);
+        for (k = 0; k < 3; k++) d2[k] = sn_add(l[k], -xr[k], &s2);
+        bad += memcmp(d1, d2, sizeof d1) != 0 || memcmp(u1, u2, sizeof u1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_corner_c0: %d of 20000 corners differ from the reference loop", bad);
+    T_FIGURE("cell_forces' corners: 20000, %u clamps and NaN replacements", clamps);
+}
+#endif
+
 #if defined(SN_K_MASS_SK)
 /* The M4's right-hand-side mass pass at the skeleton columns (sn_k_mass_sk)
  * against sn_rhs's loop written here with the reference helpers (coef =
@@ -2292,6 +2582,22 @@ int main(void) {
 #endif
 #if defined(SN_K_MASS_SK)
     test_mass_sk();
+#endif
+#if defined(SN_K_CELL_STIFF)
+    test_cell_stiff();
+#endif
+#if defined(SN_K_CORNER0)
+    test_corner_c0();
+#endif
+#if defined(SN_K_FREE8)
+    test_free8();
+    test_out_rot2();
+#endif
+#if defined(SN_K_FRHS)
+    test_frhs_flat();
+    test_mass_rhs();
+    test_grav_rhs();
+    test_fdot();
 #endif
 #if defined(SN_K_CORNERS)
     test_corners();

@@ -490,7 +490,7 @@ void sn_user_rows(sn_ihdr *h, uint32_t *sat) {
 }
 
 /* ---- the solve's hook ---- */
-uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, uint32_t *sat) {
+uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, sn_q *xold, uint32_t *sat) {
     uint32_t kept, m;
     h->n_rows = 0;
     h->rows_kept = 0;
@@ -505,6 +505,7 @@ uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, uint32_t *sat) {
     h->row_drops = sn_count(h->row_drops, m - kept);
     h->rows_kept = kept;
     if (kept == 0) { h->n_rows = 0; return 0; }
+    if (xold) memcpy(xold, x, 3 * (size_t)h->v.nF * sizeof(sn_q)); /* after the collection: it uses d's storage */
     sn_rows_fix(h, x, sat);
     return kept;
 }

@@ -66,8 +66,9 @@ void sn_crease_rows_push(sn_ihdr *h, uint32_t *sat); /* sn_crease.c: the active 
 
 /* ---- the solve's hooks (sn_solve.c) ---- */
 /* Collect the step's rows, factorize them, and move the warm start x so the
- * rows hold for v + x. Returns the rows kept (0: the solve is unconstrained). */
-uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, uint32_t *sat);
+ * rows hold for v + x; xold (or NULL) gets x as it was before the move when
+ * rows are kept. Returns the rows kept (0: the solve is unconstrained). */
+uint32_t sn_constrain_begin(sn_ihdr *h, sn_q *x, sn_q *xold, uint32_t *sat);
 /* y -= C G^-1 C^T y over the kept rows: force_like selects the per-vertex
  * format Q(19 + k_i) (r, q) instead of Q22 (x, z, d). */
 void sn_rows_filter(sn_ihdr *h, sn_q *y, int force_like, uint32_t *sat);

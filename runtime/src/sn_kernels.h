@@ -222,6 +222,35 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
 #define SN_K_MASS_FF 1
 void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
                   const sn_q *y, sn_acc *acc, uint32_t nF);
+/* The float right-hand side's loops (sn_solve.c rhs_x0, x86-64 AVX2,
+ * sn_kernels_fsimd.c): 4 entries (or a vertex's 3) per operation, every
+ * entry the reference's float and clamp count (sn_out: clamp to
+ * +-SN_FLIM, NaN -> 0, each counted):
+ *   sn_k_fold_w:  u = coef(sn_add(v, x0), ck)              (n entries)
+ *   sn_k_fold_y:  u = sn_add(coef(sn_add(v, x0), a1), x0)  (n entries)
+ *   sn_k_negout:  b = -sn_out(acc)                         (n entries)
+ *   sn_k_mass_rhs: the mass pass with y formed per free vertex: per free
+ *     row i, l = 0 + M_ii y_i, then in the row's order l += M_ij y_j and
+ *     acc_j += M_ij y_i (free j), l += M_ij sn_add(coef(v_j, a1), ds_j-nF)
+ *     (skeleton j: y per block), then acc_i += l
+ *   sn_k_grav_rhs: per free vertex, b_i = sn_add(sn_add(b_i, sn_mulq(m_i,
+ *     g_i)), -sn_out(acc_i)), g_i = sn_add(g, -R_i g) (modelled) or g
+ *   sn_k_fdot:    s = 0, s += a_i b_i in i order (the CG's float dot) */
+/* cell_stiff without a mask (sn_solve.c) on x86-64 float: acc += R S^ R^T d
+ * over the cell's free corners (K its CELLK record, cl its CELLS record),
+ * the same floats and counts as cell_stiff's loop (sn_kernels_fsimd.c) */
+#define SN_K_CELL_STIFF 1
+void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
+                     uint32_t *sat);
+#define SN_K_FRHS 1
+void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat);
+void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat);
+void sn_k_negout(sn_q *b, const sn_acc *acc, uint32_t n, uint32_t *sat);
+void sn_k_mass_rhs(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                   const sn_q *y, const sn_q *vel, const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat);
+void sn_k_grav_rhs(sn_q *b, const sn_acc *acc, const sn_q *R, const unsigned char *ml, const sn_q g[3], int modelled,
+                   uint32_t nF, uint32_t *sat);
+float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

@@ -9,6 +9,7 @@
  * is the scalar reference's float, bit for bit. AVX2 uses 8 lanes for the
  * cell products (two 3-vector halves: below). */
 #include "sn_kernels_fsimd.h"
+#include "sn_kernels_rot.h" /* sn_k_rotm, sn_k_free8 */
 
 #if defined(SN_KERNELS_FAVX2) || defined(SN_KERNELS_FNEON)
 
@@ -32,7 +33,7 @@ SN_INLINE void store_rows(sn_acc *l, const sn_fv *L, uint32_t nf) {
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     sn_fv L[8], c[3];
     uint32_t i, j;
-    for (i = 0; i < nf; i++) L[i] = FV_SET1(0.0f);
+    for (i = 0; i < 8; i++) L[i] = FV_SET1(0.0f); /* all 8: stores, not a call of memset */
     for (i = 0; i < nf; i++) {
         const uint32_t a = fc[i];
         const __m256 wa0 = _mm256_set1_ps(u[3 * i]), wa1 = _mm256_set1_ps(u[3 * i + 1]), wa2 = _mm256_set1_ps(u[3 * i + 2]);
@@ -80,6 +81,77 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
 #endif
 
 #if defined(SN_KERNELS_FAVX2)
+/* cell_stiff on x86-64 float (sn_solve.c; round 3): sn_k_rot_t_m for the
+ * free corners in ascending order, sn_k_cell_mul's product (above, u at 4
+ * floats a corner) and sn_k_out_rot_acc_m per corner, the same operations
+ * in the same order (the same floats and counts), one case per corner
+ * count nf: the loops unrolled in full, the accumulators in registers. */
+#define F8_PERM(v, a, b, c, d, e, f) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, d, e, f, f))
+__attribute__((always_inline)) /* a copy per count (GCC kept one call with nf a variable) */
+SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uint32_t fm, const sn_k_rotm *m, const sn_q *d,
+                            sn_acc *acc, uint32_t *sat, const uint32_t nf) {
+    float u[32];
+    uint32_t fc[8] = {0}, vi[8] = {0}, i, j; /* set for i < nf: zeroed for GCC's flow analysis */
+    sn_fv L[8], c[3];
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++, fm &= fm - 1u) {
+        const sn_q *v;
+        fc[i] = (uint32_t)__builtin_ctz(fm);
+        vi[i] = sn_rd_u16(cl + 2 * fc[i]);
+        v = d + 3 * vi[i];
+        FV_ST4(u + 4 * i, fv_out3(FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat)); /* lane 3 unread */
+        L[i] = FV_SET1(0.0f);
+    }
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) {
+        const __m256 wa0 = _mm256_set1_ps(u[4 * i]), wa1 = _mm256_set1_ps(u[4 * i + 1]), wa2 = _mm256_set1_ps(u[4 * i + 2]);
+        sn_fv la;
+        fv_cols(BLKP(K, fc[i], fc[i]), c);
+        la = FV_ADD(L[i], FV_MAC3(c, _mm256_castps256_ps128(wa0), _mm256_castps256_ps128(wa1), _mm256_castps256_ps128(wa2)));
+#pragma GCC unroll 8
+        for (j = i + 1; j < nf; j++) {
+            const unsigned char *B = BLKP(K, fc[i], fc[j]);
+            const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+            const __m256 t = _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(u[4 * j]), wa0, 0xF0)),
+                              _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 1]), wa1, 0xF0))),
+                _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 2]), wa2, 0xF0)));
+            la = FV_ADD(la, _mm256_castps256_ps128(t));
+            L[j] = FV_ADD(L[j], _mm256_extractf128_ps(t, 1));
+        }
+        L[i] = la;
+    }
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) { /* sn_k_out_rot_acc_m: acc += R sn_out(l) */
+        const sn_fv t = fv_out3(L[i], sat);
+        sn_acc *a = acc + 3 * vi[i];
+        fv_st3(a, FV_ADD(fv_ld3(a), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+    }
+}
+#undef F8_PERM
+void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
+                     uint32_t *sat) {
+    const uint32_t fm = sn_k_free8(cl, nF);
+    uint32_t n = fm - (fm >> 1 & 0x55u);
+    sn_k_rotm m;
+    n = (n & 0x33u) + (n >> 2 & 0x33u);
+    n = (n + (n >> 4)) & 0x0Fu; /* the free corners' count */
+    sn_k_rotm_ld(&m, R);
+    switch (n) {
+    case 1: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 1); break;
+    case 2: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 2); break;
+    case 3: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 3); break;
+    case 4: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 4); break;
+    case 5: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 5); break;
+    case 6: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 6); break;
+    case 7: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 7); break;
+    case 8: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 8); break;
+    default: break; /* no free corner */
+    }
+}
+#endif
+
+#if defined(SN_KERNELS_FAVX2)
 /* AVX2: the two products side by side in 8 lanes, [l1 row | l2 row]: a
  * block's row or column in both halves (one VPERMPS), times [u1_b[c] x4 |
  * u2_b[c] x4] (built once per cell), the rows accumulated in the
@@ -96,10 +168,13 @@ SN_INLINE void f8_cols(const unsigned char *B, __m256 c[3]) {
     c[2] = F8_PERM(v1, 1, 4, 7);
 }
 SN_INLINE void f8_blk(const unsigned char *B, __m256 r[3], __m256 c[3]) {
-    const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
-    r[0] = F8_PERM(v0, 0, 1, 2);
-    r[1] = F8_PERM(v0, 3, 4, 5);
-    r[2] = F8_PERM(v1, 5, 6, 7);
+    const float *f = (const float *)(const void *)B;
+    const __m256 v0 = FV_LD8(B), v1 = FV_LD8(f + 1);
+    /* rows by 16-byte broadcasts inside the block (x86-64 round 3: no
+     * permute index registers; lane 3 junk, never stored) */
+    r[0] = _mm256_broadcast_ps((const __m128 *)(const void *)f);
+    r[1] = _mm256_broadcast_ps((const __m128 *)(const void *)(f + 3));
+    r[2] = _mm256_permute_ps(_mm256_broadcast_ps((const __m128 *)(const void *)(f + 5)), _MM_SHUFFLE(3, 3, 2, 1));
     c[0] = F8_PERM(v0, 0, 3, 6);
     c[1] = F8_PERM(v0, 1, 4, 7);
     c[2] = F8_PERM(v1, 1, 4, 7);
@@ -112,12 +187,16 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
     for (a = 3; a < 24; a++) /* corner 0's operands are never read */
         W[a] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(u1 + a)), _mm_broadcast_ss(u2 + a), 1);
     for (a = 0; a < 8; a++) L[a] = _mm256_setzero_ps();
+    /* unrolled in full (x86-64 round 3): constant block offsets, L in
+     * registers; the same operations in the same order */
+#pragma GCC unroll 8
     for (a = 0; a < 8; a++) {
         __m256 la = L[a];
         if (a) { /* the diagonal block; corner 0's is a product with 0 */
             f8_cols(BLKP(K, a, a), c);
             la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * a));
         }
+#pragma GCC unroll 8
         for (b = a + 1; b < 8; b++) {
             f8_blk(BLKP(K, a, b), r, c);
             la = _mm256_add_ps(la, F8_MAC3(c, W + 3 * b));
@@ -179,8 +258,22 @@ void sn_k_cell_mul2(const unsigned char *K, const sn_q u1[24], const sn_q u2[24]
  * scalar (each entry alone: the same floats and counts) */
 void sn_k_axpy(sn_q *out, const sn_q *a, sn_q s, const sn_q *x, uint32_t n, int sh, uint32_t *sat) {
     const sn_fv vs = FV_SET1(s);
-    uint32_t i, c = 0;
-    for (i = 0; i + 4 <= n; i += 4) {
+    uint32_t i = 0, c = 0;
+#if defined(SN_KERNELS_FAVX2)
+    { /* x86-64 round 3: 8 entries at a time while no lane clamps (|s x| and
+       * |a + s x| within SN_FLIM, no NaN: sn_out leaves them), from the
+       * first block with a clamp on the 4-lane loop below */
+        const __m256 s8 = _mm256_set1_ps(s), lim = _mm256_set1_ps(SN_FLIM), sg = _mm256_set1_ps(-0.0f);
+        for (; i + 8 <= n; i += 8) {
+            const __m256 q = _mm256_mul_ps(s8, _mm256_loadu_ps(x + i)), o = _mm256_add_ps(_mm256_loadu_ps(a + i), q);
+            if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(_mm256_andnot_ps(sg, q), lim, _CMP_NLE_UQ),
+                                                _mm256_cmp_ps(_mm256_andnot_ps(sg, o), lim, _CMP_NLE_UQ))))
+                break;
+            _mm256_storeu_ps(out + i, o);
+        }
+    }
+#endif
+    for (; i + 4 <= n; i += 4) {
         int m1, m2;
         sn_fv q = fv_clamp(FV_MUL(vs, FV_LD4(x + i)), &m1);
         q = fv_clamp(FV_ADD(FV_LD4(a + i), q), &m2);
@@ -226,6 +319,101 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
         fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), l));
     }
 }
+#endif
+
+#if defined(SN_KERNELS_FAVX2)
+/* The float right-hand side's loops (sn_kernels.h SN_K_FRHS; x86-64 round
+ * 3): lanes are entries, each the reference's expression (a tail entry by
+ * the reference itself); clamps counted per lane from the 4-bit masks. */
+#define BITS4(m) ((uint32_t)(0x4332322132212110ull >> (4 * (m)) & 15u))
+void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat) {
+    const sn_fv c = FV_SET1(ck);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m1, m2;
+        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), FV_LD4(x0 + i)), &m1);
+        FV_ST4(u + i, fv_clamp(FV_MUL(v, c), &m2));
+        if (m1 | m2) t += BITS4(m1) + BITS4(m2); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) u[i] = sn_mulq(sn_add(vel[i], x0[i], sat), ck, SN_Q_COEF, sat);
+}
+void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat) {
+    const sn_fv c = FV_SET1(a1);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m1, m2, m3;
+        const sn_fv x = FV_LD4(x0 + i);
+        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), x), &m1);
+        const sn_fv y = fv_clamp(FV_MUL(v, c), &m2);
+        FV_ST4(u + i, fv_clamp(FV_ADD(y, x), &m3));
+        if (m1 | m2 | m3) t += BITS4(m1) + BITS4(m2) + BITS4(m3); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) u[i] = sn_add(sn_mulq(sn_add(vel[i], x0[i], sat), a1, SN_Q_COEF, sat), x0[i], sat);
+}
+void sn_k_negout(sn_q *b, const sn_acc *acc, uint32_t n, uint32_t *sat) {
+    const sn_fv sg = FV_SET1(-0.0f);
+    uint32_t i, t = 0;
+    for (i = 0; i + 4 <= n; i += 4) {
+        int m;
+        FV_ST4(b + i, _mm_xor_ps(fv_clamp(FV_LD4(acc + i), &m), sg)); /* the reference's negation: the sign flipped */
+        if (m) t += BITS4(m); /* rare */
+    }
+    *sat += t;
+    for (; i < n; i++) b[i] = -sn_out(acc[i], 0, sat);
+}
+void sn_k_mass_rhs(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
+                   const sn_q *y, const sn_q *vel, const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat) {
+    const sn_fv c = FV_SET1(a1);
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        uint32_t e = sn_rd_u32(rp + 4 * i), end = sn_rd_u32(rp + 4 * i + 4);
+        const sn_fv yi = fv_ld3(y + 3 * i);
+        sn_fv l = FV_ADD(FV_SET1(0.0f), FV_MUL(FV_SET1(rd_real(md, i)), yi));
+        for (; e < end; e++) {
+            const uint32_t j = sn_rd_u16(cols + 2 * e);
+            const sn_fv m = FV_SET1(rd_real(mo, e));
+            if (j >= nF) { /* y_j = sn_add(coef(v_j, a1), ds_j) per block, as sn_k_coef3 and sn_k_add3 */
+                const sn_fv yj = fv_out3(FV_ADD(fv_out3(FV_MUL(fv_ld3(vel + 3 * j), c), sat), fv_ld3(ds + 3 * (j - nF))), sat);
+                l = FV_ADD(l, FV_MUL(m, yj));
+                continue;
+            }
+            l = FV_ADD(l, FV_MUL(m, fv_ld3(y + 3 * j)));
+            fv_st3(acc + 3 * j, FV_ADD(fv_ld3(acc + 3 * j), FV_MUL(m, yi)));
+        }
+        fv_st3(acc + 3 * i, FV_ADD(fv_ld3(acc + 3 * i), l));
+    }
+}
+void sn_k_grav_rhs(sn_q *b, const sn_acc *acc, const sn_q *R, const unsigned char *ml, const sn_q g[3], int modelled,
+                   uint32_t nF, uint32_t *sat) {
+    const sn_fv g0 = FV_SET1(g[0]), g1 = FV_SET1(g[1]), g2 = FV_SET1(g[2]), gv = fv_ld3(g), sg = FV_SET1(-0.0f);
+    sn_fv c[3];
+    uint32_t i;
+    for (i = 0; i < nF; i++) {
+        sn_fv gi = gv, gr, t;
+        fv_cols(R + 9 * i, c);
+        gr = fv_out3(FV_MAC3(c, g0, g1, g2), sat); /* sn_k_rot: formed (and counted) as the reference does, modelled or not */
+        if (modelled) gi = fv_out3(FV_ADD(gv, _mm_xor_ps(gr, sg)), sat); /* sn_add(g, -gr) */
+        t = fv_out3(FV_ADD(fv_ld3(b + 3 * i), fv_out3(FV_MUL(FV_SET1(rd_real(ml, i)), gi), sat)), sat);
+        fv_st3(b + 3 * i, fv_out3(FV_ADD(t, _mm_xor_ps(fv_out3(fv_ld3(acc + 3 * i), sat), sg)), sat));
+    }
+}
+/* products 4 at a time (the same floats), added to s one by one in i order */
+float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n) {
+    float s = 0.0f;
+    uint32_t i;
+    for (i = 0; i + 4 <= n; i += 4) {
+        const sn_fv p = FV_MUL(FV_LD4(a + i), FV_LD4(b + i));
+        s += _mm_cvtss_f32(p);
+        s += _mm_cvtss_f32(_mm_movehdup_ps(p));
+        s += _mm_cvtss_f32(_mm_movehl_ps(p, p));
+        s += _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+    for (; i < n; i++) s += a[i] * b[i];
+    return s;
+}
+#undef BITS4
 #endif
 
 #if defined(SN_KERNELS_FAVX2) && defined(__AVX512F__) && defined(__AVX512VL__)

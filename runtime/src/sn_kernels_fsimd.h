@@ -29,7 +29,10 @@ typedef __m128 sn_fv;
 #define FV_LD4(p) _mm_loadu_ps((const float *)(const void *)(p))
 #define FV_ST4(p, v) _mm_storeu_ps((float *)(void *)(p), (v))
 SN_INLINE sn_fv fv_ld3(const float *p) { /* MOVSD + MOVSS (no masked load: see fv_st3) */
-    return _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd((const double *)(const void *)p)), _mm_load_ss(p + 2));
+    double d; /* lanes 0-1 by memcpy: _mm_load_sd's double load of float storage breaks strict aliasing (GCC moved it above
+               * the floats' stores once inlined: x86-64 round 3) */
+    memcpy(&d, p, sizeof d);
+    return _mm_movelh_ps(_mm_castpd_ps(_mm_set_sd(d)), _mm_load_ss(p + 2));
 }
 /* lanes 0-1 by MOVLPS, lane 2 by EXTRACTPS (VMASKMOVPS stores are
  * microcoded and slow on AMD Zen) */

@@ -322,7 +322,8 @@ SN_INLINE sn_acc sn_k_energy24(const sn_q d[24], const sn_acc l[24], int s, uint
         _mm256_storeu_ps(p + k, _mm256_mul_ps(_mm256_loadu_ps(d + k),
                                               _mm256_andnot_ps(nan, _mm256_blendv_ps(_mm256_blendv_ps(x, lim, hi), nlim, lo))));
     }
-    for (k = 3; k < 24; k++) ec += p[k];
+#pragma GCC unroll 24
+    for (k = 3; k < 24; k++) ec += p[k]; /* unrolled: 21 adds from memory (x86-64 round 3) */
     return ec;
 }
 /* cell_forces' corner (sn_solve.c; x86-64 round 2): t = sn_add(p_a, -p_0),
@@ -344,6 +345,45 @@ SN_INLINE void sn_k_out_rot_acc_m(sn_acc acc[3], const sn_k_rotm *m, const sn_ac
     const sn_fv t = fv_out3(fv_ld3(l), sat);
     (void)sh;
     fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
+/* A cell's free corners (index < nF) as bits 0..7 (x86-64 round 3): the
+ * 8 little-endian u16 indices of its CELLS record (16 bytes) compared at
+ * once, unsigned (a <= nF - 1 as min(a, nF - 1) == a). */
+#define SN_K_FREE8 1
+SN_INLINE uint32_t sn_k_free8(const unsigned char *cl, uint32_t nF) {
+    const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)cl);
+    const __m128i m = _mm_cmpeq_epi16(_mm_min_epu16(v, _mm_set1_epi16((short)(uint16_t)(nF - 1u))), v);
+    return nF ? (uint32_t)_mm_movemask_epi8(_mm_packs_epi16(m, _mm_setzero_si128())) : 0u;
+}
+/* cell_forces' corner row out (sn_solve.c): acc += R sn_out(ld + lu), the
+ * cut level's and details' shares 0 (added as +0, as the reference's loop
+ * does: the sum's signed zero) */
+SN_INLINE void sn_k_out_rot_acc2_m(sn_acc acc[3], const sn_k_rotm *m, const sn_acc ld[3], const sn_acc lu[3], uint32_t *sat) {
+    const sn_fv z = FV_SET1(0.0f);
+    const sn_fv t = fv_out3(FV_ADD(FV_ADD(FV_ADD(fv_ld3(ld), fv_ld3(lu)), z), z), sat);
+    fv_st3(acc, FV_ADD(fv_ld3(acc), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
+}
+/* sn_k_corner (below) with corner 0's operands (p_0, w_0, x_0) loaded once
+ * per cell (x86-64 round 3: the stores of d and uu kept GCC from hoisting
+ * them); the same floats and counts */
+#define SN_K_CORNER0 1
+typedef struct { sn_fv p0, w0, x0; } sn_k_c0;
+SN_INLINE void sn_k_c0_ld(sn_k_c0 *c, const sn_q *p0, const sn_q *w0, const unsigned char *rest, uint32_t ib) {
+    c->p0 = SN_K_NEG(fv_ld3(p0));
+    c->w0 = SN_K_NEG(fv_ld3(w0));
+    c->x0 = SN_K_NEG(fv_ld3((const float *)(const void *)rest + ib));
+}
+SN_INLINE void sn_k_corner_c0(const sn_k_rotm *m, const sn_k_c0 *c0, const sn_q *pa, const sn_q *wa, const unsigned char *rest,
+                              uint32_t ia, sn_q d[3], sn_q uu[3], uint32_t *sat) {
+    const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
+    const sn_fv *r = m->r;
+    sn_fv t, x;
+    t = fv_out3(FV_ADD(fv_ld3(wa), c0->w0), sat);
+    fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
+    t = fv_out3(FV_ADD(fv_ld3(pa), c0->p0), sat);
+    t = fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat);
+    x = fv_out3(FV_ADD(fv_ld3(f + ia), c0->x0), sat);
+    fv_st3(d, fv_out3(FV_ADD(t, SN_K_NEG(x)), sat));
 }
 #define SN_K_CORNER 1
 SN_INLINE void sn_k_corner(const sn_k_rotm *m, const sn_q *pa, const sn_q *p0, const sn_q *wa, const sn_q *w0, const unsigned char *rest,

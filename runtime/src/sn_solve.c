@@ -195,6 +195,17 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         fr = (uint32_t)(a0 < nF);
 #if defined(SN_K_CORNERS) /* the M4's Thumb-2 (sn_kernels.h) */
         fr |= sn_k_corners(cl, pos, w, vel, nF, v->b1, rest, R, w0, d, uu, sat);
+#elif defined(SN_K_CORNER0) /* x86-64 float: corner 0's operands once (sn_kernels_rot.h) */
+        {
+            sn_k_c0 c0;
+            sn_k_c0_ld(&c0, pos + 3 * a0, w0, rest, 3 * a0);
+            fr = sn_k_free8(cl, nF);
+            for (k = 1; k < 8; k++) {
+                const uint32_t a = sn_rd_u16(cl + 2 * k);
+                sn_q wa[3];
+                sn_k_corner_c0(&rm, &c0, pos + 3 * a, w_of(h, w, vel, a, wa), rest, 3 * a, d + 3 * k, uu + 3 * k, sat);
+            }
+        }
 #else
         for (k = 1; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
@@ -225,6 +236,16 @@ static void cell_forces(sn_ihdr *h, const sn_dstate *dt, const sn_q *w, sn_acc *
         for (k = 3; k < 24; k++) ec += sn_k_mul_out(d[k], ld[k], v->frac_S, &esat); /* d_0 = 0: no term */
 #endif
         *e2 = energy_add(*e2, E_Q32(ec));
+#if defined(SN_K_FREE8) /* x86-64 float: the free corners' bits, no cut level or details (sn_kernels_rot.h) */
+        if (!v->cut && !on) {
+            uint32_t fm;
+            for (fm = fr; fm; fm &= fm - 1u) {
+                const uint32_t a = sn_rd_u16(cl + 2 * (k = (uint32_t)__builtin_ctz(fm)));
+                sn_k_out_rot_acc2_m(acc + 3 * a, &rm, ld + 3 * k, lu + 3 * k, sat);
+            }
+            continue;
+        }
+#endif
         for (k = 0; k < 8; k++) {
             uint32_t a = sn_rd_u16(cl + 2 * k);
             sn_acc ls[3];
@@ -301,11 +322,23 @@ SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua
             bs[3 * i + c] = sn_add(bs[3 * i + c], -sn_out(sacc[3 * i + c], v->frac_M - SN_KREL(dk[i]), sat), sat);
 }
 
+/* The initial residual folded into the right-hand side (float only,
+ * notes_flt.md): the fixed flavour's range of v + x0 is not proven. */
+#if defined(SN_FLOAT)
+#define SN_FOLD 1
+#else
+#define SN_FOLD 0
+#endif
+
 /* Right-hand side b (into r), NUMERICS.md step 5:
  * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S) + f_rig;
  * elastic = 0 leaves out the cell terms (-K~ w and the elastic force: the
- * blended mode adds them per region) but still measures the energy. */
-void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
+ * blended mode adds them per region) but still measures the energy.
+ * With x0 (SN_FOLD; the CG's warm start, free rows): b - A x0, the PCG's
+ * initial residual, without its mat-vec: A = (1+a1) M^ + (1+b1) K~ and both
+ * terms of b are linear in the same operands, so w = (1+b1) (v + x0) and the
+ * mass pass's y = a1 (v + x0) + x0 (notes_flt.md). */
+static void rhs_x0(sn_ihdr *h, sn_q *b, int elastic, const sn_q *x0, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *md = v->sec[SN_SEC_MDIAG], *mo = v->sec[SN_SEC_MOFF];
@@ -324,6 +357,13 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
     /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
      * Stored over free vertices; the skeleton's, computed in cell_forces
      * (w_of), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
+    if (SN_FOLD && x0)
+#if defined(SN_K_FRHS) /* x86-64 AVX2 (sn_kernels.h) */
+        sn_k_fold_w(u, vel, x0, ck, 3 * nF, sat);
+#else
+        for (i = 0; i < 3 * nF; i++) u[i] = coef(sn_add(vel[i], x0[i], sat), ck, sat);
+#endif
+    else
     for (i = 0; i < nF; i++)
 #if defined(SN_KERNELS_M4)
         sn_k_coef3(vel + 3 * i, ck, u + 3 * i, sat); /* coef per entry, in 32-bit words */
@@ -338,6 +378,10 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         for (i = 0; i < 3 * dt->n; i++) ys[i] = sn_add(dc[i], coef(dv[i], ck, sat), sat);
     }
     cell_forces(h, dt, u, acc, &e2, sat);
+#if defined(SN_K_FRHS)
+    if (elastic) sn_k_negout(b, acc, 3 * nF, sat);
+    else
+#endif
     for (i = 0; i < 3 * nF; i++) {
         SN_RANGE(SN_WITHIN(acc[i], 62), "vertex accumulator beyond 8 rotated cell rows", acc[i]);
 #if defined(SN_KERNELS_M4)
@@ -373,8 +417,14 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
      * cell_forces) instead of at each of its blocks; the same values and no
      * clamp count lost. Otherwise (and for skeleton y) per block as before. */
     acc_zero(acc, 3 * nF);
-    pre = v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF;
-    if (pre)
+    pre = (v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF) || (SN_FOLD && x0);
+    if (SN_FOLD && x0) /* y = a1 (v + x0) + x0, once per vertex (its clamps counted once) */
+#if defined(SN_K_FRHS)
+        sn_k_fold_y(u, vel, x0, v->a1, 3 * nF, sat);
+#else
+        for (i = 0; i < 3 * nF; i++) u[i] = sn_add(coef(sn_add(vel[i], x0[i], sat), v->a1, sat), x0[i], sat);
+#endif
+    else if (pre)
         for (i = 0; i < nF; i++) sn_k_coef3(vel + 3 * i, v->a1, u + 3 * i, sat);
 #if defined(SN_K_MASS_FF) && defined(SN_K_MASS_SK)
     /* the M4: the free blocks by the mat-vec's loop, then the skeleton
@@ -385,6 +435,9 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         sn_k_mass_ff(rp, cols, md, mo, u, acc, nF);
         sn_k_mass_sk(rp, cols, mo, vel, ds, v->a1, acc, nF, sat);
     }
+    for (i = pre ? nF : 0; i < nF; i++) {
+#elif defined(SN_K_FRHS) /* x86-64 AVX2: the loop below for every row (sn_kernels.h) */
+    if (pre) sn_k_mass_rhs(rp, cols, md, mo, u, vel, ds, v->a1, acc, nF, sat);
     for (i = pre ? nF : 0; i < nF; i++) {
 #else
     for (i = 0; i < nF; i++) {
@@ -413,6 +466,10 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
         row_done(acc + 3 * i, l);
     }
     if (dt) detail_mass_rhs(h, dt, pre ? u : NULL, ds, acc, b + 3 * nF, sat);
+#if defined(SN_K_FRHS) /* x86-64 AVX2: the loop below (sn_kernels.h) */
+    sn_k_grav_rhs(b, acc, R, ml, v->grav, (v->flags & SN_FLAG_REST_MODELLED) != 0, nF, sat);
+    (void)kk;
+#else
     for (i = 0; i < nF; i++) {
         sn_q mi = rd_real(ml, i), gi[3], gr[3];
         /* rest shape = modelled shape: cancel gravity as the vertex frame turns it */
@@ -440,9 +497,11 @@ void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) {
             b[3 * i + k] = sn_add(sn_add(b[3 * i + k], g, sat), -ma, sat);
         }
     }
+#endif
     sn_rigs(h, b, sat); /* + R_i sum_a tau_a Q^a_i (seed 003 eq. 12) */
     sn_forces_rhs(h, b, sat); /* + applied forces (seed 004 ch. 4 shares) */
 }
+void sn_rhs(sn_ihdr *h, sn_q *b, int elastic, uint32_t *sat) { rhs_x0(h, b, elastic, NULL, sat); }
 
 
 /* Symmetric mass pass over free-free blocks: acc = M^ y (y over free); with
@@ -494,6 +553,24 @@ SN_INLINE void cell_stiff(const sn_ihdr *h, const unsigned char *K, const unsign
 #else
 #define SN_ROT_T(v, o) sn_k_rot_t(R, (v), (o), sat)
 #define SN_OUT_ROT_ACC(x, l, sh) sn_k_out_rot_acc((x), R, (l), (sh), sat)
+#endif
+#if defined(SN_K_CELL_STIFF) /* x86-64 float: the loops below in one kernel (sn_kernels.h) */
+    if (!mask) {
+        (void)kk; (void)u; (void)l; (void)fc; (void)vi; (void)nf; (void)k;
+        sn_k_cell_stiff(K, cl, nF, R, d, acc, sat);
+        return;
+    }
+#endif
+#if defined(SN_K_FREE8) /* x86-64 float: the free corners' bits (sn_kernels_rot.h) */
+    if (!mask) {
+        uint32_t fm;
+        for (fm = sn_k_free8(cl, nF); fm; fm &= fm - 1u) {
+            const uint32_t a = sn_rd_u16(cl + 2 * (k = (uint32_t)__builtin_ctz(fm)));
+            SN_ROT_T(d + 3 * a, u + 3 * nf);
+            fc[nf] = (uint8_t)k;
+            vi[nf++] = a;
+        }
+    } else
 #endif
     for (k = 0; k < 8; k++) {
         uint32_t a = sn_rd_u16(cl + 2 * k);
@@ -599,6 +676,9 @@ static void matvec(sn_ihdr *h, const sn_dstate *dt, const sn_q *d, sn_q *q, cons
     if (dt) acc_zero(sacc, 3 * dt->n);
     for (e = 0; e < v->nC; e++, K += SN_K_CELL_BYTES) {
         if (dt && ons[e]) cell_stiff_det(h, dt, e, ons[e], K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, d, acc, sacc, sat);
+#if defined(SN_K_CELL_STIFF) /* x86-64 float: cell_stiff's kernel called here (sn_kernels.h) */
+        else if (!mask) sn_k_cell_stiff(K, cells + (size_t)e * SN_ELEM_CELLS, nF, cR + 9 * e, d, acc, sat);
+#endif
         else cell_stiff(h, K, cells + (size_t)e * SN_ELEM_CELLS, cR + 9 * e, mask, d, acc, sat);
     }
     for (i = 0; i < 3 * nF; i++)
@@ -619,7 +699,12 @@ static sn_dotv dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) 
     uint32_t i;
     float s = 0.0f;
     (void)kk;
+#if defined(SN_K_FRHS)
+    (void)i;
+    s = sn_k_fdot(a, b, n); /* the same sum (sn_kernels.h) */
+#else
     for (i = 0; i < n; i++) s += a[i] * b[i];
+#endif
     r.m = s;
     return r;
 }
@@ -709,6 +794,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     const uint8_t *kk = CARR(h, o_k, uint8_t);
     sn_dotv rz;
     uint32_t clamps = 0, rows, iters = h->iterations;
+    int fold;
     const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: their dv is the coarse field's */
     sn_dstate *dt = sn_detail_live(h); /* details on the cut level: the CG over nF + n rows, the seats after the free ones */
     sn_q *xf = x;
@@ -721,9 +807,14 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         kk = DT(dt, o_kk, const uint8_t);
         mask = NULL; /* adaptation is level 1's, details the cut level's */
     }
-    sn_rhs(h, r, 1, sat);
-    /* constraint rows: collected, factorized, the warm start moved onto them (sn_constraint.c) */
-    rows = sn_constrain_begin(h, x, sat);
+    /* float: the initial residual b - A x folded into the right-hand side
+     * (rhs_x0) unless level 1's adaptation or the cut level's details are on */
+    fold = SN_FOLD && !mask && !dt;
+    rhs_x0(h, r, 1, fold ? x : NULL, sat);
+    /* constraint rows: collected, factorized, the warm start moved onto them
+     * (sn_constraint.c); folded, the x before the move into d's storage (dead
+     * until the PCG) */
+    rows = sn_constrain_begin(h, x, fold ? d : NULL, sat);
     if (dt) { /* the warm start: the free rows' x, then the seats' own */
         x = DT(dt, o_x, sn_q);
         memcpy(x, xf, n3 * sizeof(sn_q));
@@ -736,8 +827,14 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     /* PCG, warm-started from the previous step's solution, fixed iterations;
      * with rows, residuals and preconditioned residuals are projected onto
      * the free directions (Baraff-Witkin filtered PCG) */
-    matvec(h, dt, x, q, NULL, sat);
-    for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    if (!fold) {
+        matvec(h, dt, x, q, NULL, sat);
+        for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    } else if (rows) { /* the rows moved x: r -= A (x - x before), the mat-vec the fold saved otherwise */
+        for (i = 0; i < n3; i++) d[i] = sn_add(x[i], -d[i], sat);
+        matvec(h, NULL, d, q, NULL, sat);
+        for (i = 0; i < n3; i++) r[i] = sn_add(r[i], -q[i], sat);
+    }
     if (mask) { /* refine estimates from the inactive rows, then r = P^T (b - A P x) */
         sn_adapt_estimate(h, mask, r, q, x, sat);
         sn_adapt_restrict(h, mask, r, sat);
