@@ -10,7 +10,7 @@
  * sn_kernels_rot.h): the same SMULL / SMLAL int64 sums, the same rounding
  * and clamp tests on the two words. GCC's C for the two (the fused C
  * sweeps) kept its values in memory between the kernels: ~300 instructions
- * a vertex, here ~200 (runtime/notes_m4p.md). */
+ * a vertex, here ~200 (runtime/KERNELS_M4.md "M4 round 5a"). */
 #include "sn_kernels.h"
 /* outside the #if: tools/amalgamate.sh inlines a header at its first include only */
 #include "sn_kernels_ic.h"

@@ -323,7 +323,7 @@ SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua
 }
 
 /* The initial residual folded into the right-hand side (float only,
- * notes_flt.md): the fixed flavour's range of v + x0 is not proven. */
+ * KERNELS.md "Float step, round 3"): the fixed flavour's range of v + x0 is not proven. */
 #if defined(SN_FLOAT)
 #define SN_FOLD 1
 #else
@@ -337,7 +337,7 @@ SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua
  * With x0 (SN_FOLD; the CG's warm start, free rows): b - A x0, the PCG's
  * initial residual, without its mat-vec: A = (1+a1) M^ + (1+b1) K~ and both
  * terms of b are linear in the same operands, so w = (1+b1) (v + x0) and the
- * mass pass's y = a1 (v + x0) + x0 (notes_flt.md). */
+ * mass pass's y = a1 (v + x0) + x0 (KERNELS.md "Float step, round 3"). */
 static void rhs_x0(sn_ihdr *h, sn_q *b, int elastic, const sn_q *x0, uint32_t *sat) {
     const sn_view *v = &h->v;
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
