@@ -30,6 +30,16 @@ SN_INLINE void store_rows(sn_acc *l, const sn_fv *L, uint32_t nf) {
  * half to L_b, in the order of the 4-lane code (each half's lane k is the
  * same ((p0 + p1) + p2) of output k): the same floats. */
 #define F8_PERM(v, a, b, c, d, e, f) _mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, d, e, f, f))
+/* block (a, b) of a cell: la += B u_b, lb += B^T u_a (w: u_a's components x8) */
+SN_INLINE void f8_pair(const unsigned char *B, const sn_q *ub, __m256 w0, __m256 w1, __m256 w2, sn_fv *la, sn_fv *lb) {
+    const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
+    const __m256 t = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(ub[0]), w0, 0xF0)),
+                      _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(ub[1]), w1, 0xF0))),
+        _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(ub[2]), w2, 0xF0)));
+    *la = FV_ADD(*la, _mm256_castps256_ps128(t));
+    *lb = FV_ADD(*lb, _mm256_extractf128_ps(t, 1));
+}
 void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const sn_q *u, sn_acc *l) {
     sn_fv L[8], c[3];
     uint32_t i, j;
@@ -42,14 +52,7 @@ void sn_k_cell_mul(const unsigned char *K, const uint8_t *fc, uint32_t nf, const
         la = FV_ADD(L[i], FV_MAC3(c, _mm256_castps256_ps128(wa0), _mm256_castps256_ps128(wa1),
                                   _mm256_castps256_ps128(wa2))); /* diagonal block (a,a) */
         for (j = i + 1; j < nf; j++) {
-            const unsigned char *B = BLKP(K, a, fc[j]);
-            const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
-            const __m256 t = _mm256_add_ps(
-                _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(u[3 * j]), wa0, 0xF0)),
-                              _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(u[3 * j + 1]), wa1, 0xF0))),
-                _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(u[3 * j + 2]), wa2, 0xF0)));
-            la = FV_ADD(la, _mm256_castps256_ps128(t));
-            L[j] = FV_ADD(L[j], _mm256_extractf128_ps(t, 1));
+            f8_pair(BLKP(K, a, fc[j]), u + 3 * j, wa0, wa1, wa2, &la, &L[j]);
         }
         L[i] = la;
     }
@@ -110,14 +113,7 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
         la = FV_ADD(L[i], FV_MAC3(c, _mm256_castps256_ps128(wa0), _mm256_castps256_ps128(wa1), _mm256_castps256_ps128(wa2)));
 #pragma GCC unroll 8
         for (j = i + 1; j < nf; j++) {
-            const unsigned char *B = BLKP(K, fc[i], fc[j]);
-            const __m256 v0 = FV_LD8(B), v1 = FV_LD8((const float *)(const void *)B + 1);
-            const __m256 t = _mm256_add_ps(
-                _mm256_add_ps(_mm256_mul_ps(F8_PERM(v0, 0, 3, 6, 0, 1, 2), _mm256_blend_ps(_mm256_set1_ps(u[4 * j]), wa0, 0xF0)),
-                              _mm256_mul_ps(F8_PERM(v0, 1, 4, 7, 3, 4, 5), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 1]), wa1, 0xF0))),
-                _mm256_mul_ps(F8_PERM(v1, 1, 4, 7, 5, 6, 7), _mm256_blend_ps(_mm256_set1_ps(u[4 * j + 2]), wa2, 0xF0)));
-            la = FV_ADD(la, _mm256_castps256_ps128(t));
-            L[j] = FV_ADD(L[j], _mm256_extractf128_ps(t, 1));
+            f8_pair(BLKP(K, fc[i], fc[j]), u + 4 * j, wa0, wa1, wa2, &la, &L[j]);
         }
         L[i] = la;
     }
