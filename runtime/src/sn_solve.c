@@ -806,8 +806,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         kk = DT(dt, o_kk, const uint8_t);
         mask = NULL; /* adaptation is level 1's, details the cut level's */
     }
-    /* float: the initial residual b - A x folded into the right-hand side
-     * (rhs_x0) unless level 1's adaptation or the cut level's details are on */
+    /* the initial residual b - A x folded into the right-hand side (rhs_x0)
+     * when SN_FOLD (off in both flavours: NUMERICS.md "The initial residual
+     * folded in") and neither level 1's adaptation nor details are on */
     fold = SN_FOLD && !mask && !dt;
     rhs_x0(h, r, 1, fold ? x : NULL, sat);
     /* constraint rows: collected, factorized, the warm start moved onto them
