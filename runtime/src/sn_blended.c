@@ -243,6 +243,7 @@ void sn_blended_solve(sn_ihdr *h, uint32_t *sat) {
             dq = sn_cg_dot(q, d, kk, n3);
             alpha = flat ? 0 : sn_cg_ratio(rz, dq, &clamps);
             sn_cg_axpy(m.xr, alpha, d, n3, sat);
+            if (it + 1 == h->iterations) break; /* the rest is never read (sn_solve.c) */
             sn_cg_axpy(r, (sn_q)-alpha, q, n3, sat);
             region_precond(h, R, &m, r, m.z, sat);
             rz1 = sn_cg_dot(r, m.z, kk, n3);

@@ -861,6 +861,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         alpha = flat ? 0 : ratio(rz, dq, &clamps);
         nalpha = (sn_q)-alpha;
         axpy(x, alpha, d, n3, sat);
+        /* the last iteration's r, z, rz and d are never read: x is the
+         * answer (a fixed count, not a data-dependent exit) */
+        if (it + 1 == iters) break;
         axpy(r, nalpha, q, n3, sat);
         if (rows) sn_rows_filter(h, r, 1, sat);
         if (mask) sn_precond_mask(h, mask, 0, sn_adapt_scales(h), r, z, sat);
