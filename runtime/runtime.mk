@@ -83,6 +83,11 @@ $(BUILD)/tests/test_runtime_segment_float: $(SN_SEG_TEST_DEPS) $(SN_LIB_FLOAT)
 	@mkdir -p $(@D)
 	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ tests/test_runtime_segment.c tests/reference/segref.c $(SN_LIB_FLOAT) -lm
 TEST_BINS += $(BUILD)/tests/test_runtime_segment $(BUILD)/tests/test_runtime_segment_float
+# the float initial-residual fold in torn states (float only: fixed does not fold)
+$(BUILD)/tests/test_runtime_fold_float: tests/test_runtime_fold.c $(SN_TEST_HDRS) $(SN_LIB_FLOAT)
+	@mkdir -p $(@D)
+	$(CC) $(SN_TCFLAGS) -DSN_FLOAT -o $@ tests/test_runtime_fold.c $(SN_LIB_FLOAT) -lm
+TEST_BINS += $(BUILD)/tests/test_runtime_fold_float
 
 # ---- constant cost: the probe tests/scripts/test_cost.sh runs under callgrind ----
 $(BUILD)/tests/cost_probe: tests/cost_probe.c $(SN_HDRS) $(SN_LIB_FIXED)

@@ -580,7 +580,10 @@ static void test_sweep_bits(void) {
     int s, i, m;
     uint64_t h;
 #if defined(SN_FLOAT)
-    const uint64_t want_h = 0x3f6e8cbdde1e2324ull, want_seg = 0xac7ae573f39b1df2ull;
+    /* float: since the float initial-residual fold (runtime/notes_ffold.md;
+     * was 3f6e8cbdde1e2324 / ac7ae573f39b1df2): the lattice the meshes hang
+     * on rounds b - A x0 once; the same on scalar, SSE2, AVX2, AVX-512 */
+    const uint64_t want_h = 0xcdc8bde5ea357190ull, want_seg = 0x434fd0dc722a9d12ull;
 #else
     const uint64_t want_seg = 0x9fde2e03c79b9fbbull;
 #endif

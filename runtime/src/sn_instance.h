@@ -206,6 +206,12 @@ void sn_skeleton(sn_ihdr *h, uint32_t *sat);        /* 3: skeleton positions, fi
  * stored, the same bits frame_of computed (sn_pose.c). */
 void sn_vertex_origin(const sn_ihdr *h, uint32_t i, sn_q c[3]);
 void sn_solve(sn_ihdr *h, uint32_t *sat);           /* 4-7: rhs, PCG, update */
+#if defined(SN_FLOAT)
+/* sn_solve's start apart (sn_solve.c; tests/test_runtime_fold.c): the folded
+ * residual r = b - A x0 (rhs_x0), and q = A d by the mat-vec */
+void sn_fold_rhs(sn_ihdr *h, sn_q *r, const sn_q *x0, uint32_t *sat);
+void sn_fold_matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat);
+#endif
 /* acc += R t (t rotated back out of a cell frame, kept at full precision; sn_solve.c, sn_blended.c) */
 SN_INLINE void sn_rot_acc(sn_acc acc[3], const sn_q *R, const sn_q t[3]) {
     acc[0] += sn_mul(R[0], t[0]) + sn_mul(R[1], t[1]) + sn_mul(R[2], t[2]);

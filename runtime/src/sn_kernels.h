@@ -53,6 +53,19 @@
 /* Bytes of one cell's CELLK record in this flavour (sn_format.h). */
 #if defined(SN_FLOAT)
 #define SN_K_CELL_BYTES SN_ELEM_CELLK(SN_FLAVOUR_FLOAT32, SN_REAL_BYTES)
+/* The float fold's operands per entry (sn_solve.c rhs_x0, SN_FOLD), plain
+ * floats in this order on every path (no clamp: |v|, |x0| <= SN_FLIM and
+ * c in [0, 17] keep them below 2^17.1; runtime/notes_ffold.md); the
+ * product and the sum in two statements, never contracted to an FMA:
+ *   w = (v + x0) (1+b1),   y = a1 (v + x0) + x0 */
+SN_INLINE sn_q sn_fold_w1(sn_q v, sn_q x0, sn_q ck) {
+    const sn_q s = v + x0;
+    return s * ck;
+}
+SN_INLINE sn_q sn_fold_y1(sn_q v, sn_q x0, sn_q a1) {
+    const sn_q s = v + x0, t = s * a1;
+    return t + x0;
+}
 #else
 #define SN_K_CELL_BYTES SN_CELLK_FIXED_BYTES
 
@@ -226,8 +239,8 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * sn_kernels_fsimd.c): 4 entries (or a vertex's 3) per operation, every
  * entry the reference's float and clamp count (sn_out: clamp to
  * +-SN_FLIM, NaN -> 0, each counted):
- *   sn_k_fold_w:  u = coef(sn_add(v, x0), ck)              (n entries)
- *   sn_k_fold_y:  u = sn_add(coef(sn_add(v, x0), a1), x0)  (n entries)
+ *   sn_k_fold_w:  u = sn_fold_w1(v, x0, ck)                (n entries, no clamp)
+ *   sn_k_fold_y:  u = sn_fold_y1(v, x0, a1)                (n entries, no clamp)
  *   sn_k_negout:  b = -sn_out(acc)                         (n entries)
  *   sn_k_mass_rhs: the mass pass with y formed per free vertex: per free
  *     row i, l = 0 + M_ii y_i, then in the row's order l += M_ij y_j and
@@ -243,8 +256,8 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
 void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
                      uint32_t *sat);
 #define SN_K_FRHS 1
-void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat);
-void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat);
+void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n);
+void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n);
 void sn_k_negout(sn_q *b, const sn_acc *acc, uint32_t n, uint32_t *sat);
 void sn_k_mass_rhs(const unsigned char *rp, const unsigned char *cols, const unsigned char *md, const unsigned char *mo,
                    const sn_q *y, const sn_q *vel, const sn_q *ds, sn_q a1, sn_acc *acc, uint32_t nF, uint32_t *sat);

@@ -322,31 +322,22 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  * 3): lanes are entries, each the reference's expression (a tail entry by
  * the reference itself); clamps counted per lane from the 4-bit masks. */
 #define BITS4(m) ((uint32_t)(0x4332322132212110ull >> (4 * (m)) & 15u))
-void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n, uint32_t *sat) {
+/* the fold's operands (sn_kernels.h sn_fold_w1 / sn_fold_y1): the same
+ * float operations per lane, no clamp */
+void sn_k_fold_w(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q ck, uint32_t n) {
     const sn_fv c = FV_SET1(ck);
-    uint32_t i, t = 0;
-    for (i = 0; i + 4 <= n; i += 4) {
-        int m1, m2;
-        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), FV_LD4(x0 + i)), &m1);
-        FV_ST4(u + i, fv_clamp(FV_MUL(v, c), &m2));
-        if (m1 | m2) t += BITS4(m1) + BITS4(m2); /* rare */
-    }
-    *sat += t;
-    for (; i < n; i++) u[i] = sn_mulq(sn_add(vel[i], x0[i], sat), ck, SN_Q_COEF, sat);
+    uint32_t i;
+    for (i = 0; i + 4 <= n; i += 4) FV_ST4(u + i, FV_MUL(FV_ADD(FV_LD4(vel + i), FV_LD4(x0 + i)), c));
+    for (; i < n; i++) u[i] = sn_fold_w1(vel[i], x0[i], ck);
 }
-void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n, uint32_t *sat) {
+void sn_k_fold_y(sn_q *u, const sn_q *vel, const sn_q *x0, sn_q a1, uint32_t n) {
     const sn_fv c = FV_SET1(a1);
-    uint32_t i, t = 0;
+    uint32_t i;
     for (i = 0; i + 4 <= n; i += 4) {
-        int m1, m2, m3;
         const sn_fv x = FV_LD4(x0 + i);
-        const sn_fv v = fv_clamp(FV_ADD(FV_LD4(vel + i), x), &m1);
-        const sn_fv y = fv_clamp(FV_MUL(v, c), &m2);
-        FV_ST4(u + i, fv_clamp(FV_ADD(y, x), &m3));
-        if (m1 | m2 | m3) t += BITS4(m1) + BITS4(m2) + BITS4(m3); /* rare */
+        FV_ST4(u + i, FV_ADD(FV_MUL(FV_ADD(FV_LD4(vel + i), x), c), x));
     }
-    *sat += t;
-    for (; i < n; i++) u[i] = sn_add(sn_mulq(sn_add(vel[i], x0[i], sat), a1, SN_Q_COEF, sat), x0[i], sat);
+    for (; i < n; i++) u[i] = sn_fold_y1(vel[i], x0[i], a1);
 }
 void sn_k_negout(sn_q *b, const sn_acc *acc, uint32_t n, uint32_t *sat) {
     const sn_fv sg = FV_SET1(-0.0f);

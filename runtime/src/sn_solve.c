@@ -323,11 +323,18 @@ SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua
 }
 
 /* The initial residual folded into the right-hand side (KERNELS.md "Float
- * step, round 3"): off in both flavours. Fixed: the range of v + x0 is not
- * proven; float: test_physics_soak_float's cow does not recover from the
- * torn states of its abuse rounds with it (1,822 saturations late in the
- * rest hold, 59.5 body diagonals off), as the fixed fold's soak did not. */
+ * step, round 3"; runtime/notes_ffold.md): float only. Its operands v + x0,
+ * (1+b1)(v + x0) and a1 (v + x0) + x0 are plain floats, not clamped at
+ * SN_FLIM (a torn state's v + x0 can reach 2 SN_FLIM: clamped, the folded
+ * residual was not b - A x0 and test_physics_soak_float's cow did not
+ * recover). Finite: |v|, |x0| <= SN_FLIM and a1, b1 in [0, 16] (validator)
+ * give |w| <= 17 * 2^13 < 2^17.1, |y| < 2^17.1. Fixed: the range of v + x0
+ * is not proven (NUMERICS.md "The initial residual folded in"): off. */
+#if defined(SN_FLOAT)
+#define SN_FOLD 1
+#else
 #define SN_FOLD 0
+#endif
 
 /* Right-hand side b (into r), NUMERICS.md step 5:
  * b = f + m^ g^ [- m^ R g^] - a1 M^ v* - K~ w - M^_FS (v'_S - v_S) + f_rig;
@@ -356,13 +363,15 @@ static void rhs_x0(sn_ihdr *h, sn_q *b, int elastic, const sn_q *x0, uint32_t *s
     /* w = (1+b1) v (free), b1 v' (skeleton): stiffness damping + implicit h K v.
      * Stored over free vertices; the skeleton's, computed in cell_forces
      * (w_of), can clamp only when b1 > 1 (|v'| <= SN_LIM): counted here once. */
-    if (SN_FOLD && x0)
+#if SN_FOLD
+    if (x0)
 #if defined(SN_K_FRHS) /* x86-64 AVX2 (sn_kernels.h) */
-        sn_k_fold_w(u, vel, x0, ck, 3 * nF, sat);
+        sn_k_fold_w(u, vel, x0, ck, 3 * nF);
 #else
-        for (i = 0; i < 3 * nF; i++) u[i] = coef(sn_add(vel[i], x0[i], sat), ck, sat);
+        for (i = 0; i < 3 * nF; i++) u[i] = sn_fold_w1(vel[i], x0[i], ck); /* no clamp (sn_kernels.h) */
 #endif
     else
+#endif
     for (i = 0; i < nF; i++)
 #if defined(SN_KERNELS_M4)
         sn_k_coef3(vel + 3 * i, ck, u + 3 * i, sat); /* coef per entry, in 32-bit words */
@@ -417,13 +426,16 @@ static void rhs_x0(sn_ihdr *h, sn_q *b, int elastic, const sn_q *x0, uint32_t *s
      * clamp count lost. Otherwise (and for skeleton y) per block as before. */
     acc_zero(acc, 3 * nF);
     pre = (v->a1 <= ONE_COEF && v->a1 >= -ONE_COEF) || (SN_FOLD && x0);
-    if (SN_FOLD && x0) /* y = a1 (v + x0) + x0, once per vertex (its clamps counted once) */
+#if SN_FOLD
+    if (x0) /* y = a1 (v + x0) + x0, once per vertex, no clamp */
 #if defined(SN_K_FRHS)
-        sn_k_fold_y(u, vel, x0, v->a1, 3 * nF, sat);
+        sn_k_fold_y(u, vel, x0, v->a1, 3 * nF);
 #else
-        for (i = 0; i < 3 * nF; i++) u[i] = sn_add(coef(sn_add(vel[i], x0[i], sat), v->a1, sat), x0[i], sat);
+        for (i = 0; i < 3 * nF; i++) u[i] = sn_fold_y1(vel[i], x0[i], v->a1);
 #endif
-    else if (pre)
+    else
+#endif
+    if (pre)
         for (i = 0; i < nF; i++) sn_k_coef3(vel + 3 * i, v->a1, u + 3 * i, sat);
 #if defined(SN_K_MASS_FF) && defined(SN_K_MASS_SK)
     /* the M4: the free blocks by the mat-vec's loop, then the skeleton
@@ -794,6 +806,7 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     sn_dotv rz;
     uint32_t clamps = 0, rows, iters = h->iterations;
     int fold;
+    uint32_t cold;
     const uint8_t *mask = sn_adapt_mask(h); /* level 1's inactive detail vertices: their dv is the coarse field's */
     sn_dstate *dt = sn_detail_live(h); /* details on the cut level: the CG over nF + n rows, the seats after the free ones */
     sn_q *xf = x;
@@ -807,10 +820,11 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         mask = NULL; /* adaptation is level 1's, details the cut level's */
     }
     /* the initial residual b - A x folded into the right-hand side (rhs_x0)
-     * when SN_FOLD (off in both flavours: NUMERICS.md "The initial residual
-     * folded in") and neither level 1's adaptation nor details are on */
+     * when SN_FOLD (float) and neither level 1's adaptation nor details are on */
     fold = SN_FOLD && !mask && !dt;
+    cold = *sat;
     rhs_x0(h, r, 1, fold ? x : NULL, sat);
+    cold = fold && *sat != cold; /* a clamp in the folded rhs: its residual is not b - A x0 (below) */
     /* constraint rows: collected, factorized, the warm start moved onto them
      * (sn_constraint.c); folded, the x before the move into d's storage (dead
      * until the PCG) */
@@ -896,12 +910,24 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         x = xf;
     }
     /* v += dv, p += h v  (velocities are per step: h folded in) */
+    /* The folded rhs clamped (a torn state: the state range's guard or a
+     * cell row beyond it, where b's terms and A x0's are not kept apart): the
+     * next step starts cold, x0 = 0, so its folded residual is b itself
+     * whatever clamps (runtime/notes_ffold.md). One memset of 12 nF bytes in
+     * such a step, like a clamp's branch (an unconditional select cost every
+     * step 2-3 k instructions on cow_fem). */
     for (i = 0; i < n3; i++) {
         vel[i] = sn_add(vel[i], x[i], sat);
         pos[i] = sn_add(pos[i], vel[i], sat);
     }
+    if (cold) memset(x, 0, n3 * sizeof(sn_q));
     h->cg_clamps = sn_count(h->cg_clamps, clamps);
 }
+
+#if SN_FOLD
+void sn_fold_rhs(sn_ihdr *h, sn_q *r, const sn_q *x0, uint32_t *sat) { rhs_x0(h, r, 1, x0, sat); }
+void sn_fold_matvec(sn_ihdr *h, const sn_q *d, sn_q *q, uint32_t *sat) { matvec(h, NULL, d, q, NULL, sat); }
+#endif
 
 /* ---- the CG arithmetic of the blended mode (sn_blended.h): the same functions ---- */
 sn_cgdot sn_cg_dot(const sn_q *a, const sn_q *b, const uint8_t *kk, uint32_t n) {
