@@ -1,5 +1,6 @@
 /* test_runtime_fold.c -- the float initial-residual fold (sn_solve.c rhs_x0,
- * SN_FOLD; runtime/notes_ffold.md) in torn states, float flavour only:
+ * SN_FOLD; NUMERICS.md "The initial residual folded in") in torn states,
+ * float flavour only:
  *   operands: a state whose v + x0 leaves the guard SN_FLIM (|v|, |x0| <=
  *     SN_FLIM each; a one-step jump's v with the solve's dv of its size),
  *     otherwise quiet: the folded residual against b - A x0 formed the

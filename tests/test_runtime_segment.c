@@ -580,8 +580,8 @@ static void test_sweep_bits(void) {
     int s, i, m;
     uint64_t h;
 #if defined(SN_FLOAT)
-    /* float: since the float initial-residual fold (runtime/notes_ffold.md;
-     * was 3f6e8cbdde1e2324 / ac7ae573f39b1df2): the lattice the meshes hang
+    /* float: since the float initial-residual fold (NUMERICS.md "The
+     * initial residual folded in"; was 3f6e8cbdde1e2324 / ac7ae573f39b1df2): the lattice the meshes hang
      * on rounds b - A x0 once; the same on scalar, SSE2, AVX2, AVX-512 */
     const uint64_t want_h = 0xcdc8bde5ea357190ull, want_seg = 0x434fd0dc722a9d12ull;
 #else

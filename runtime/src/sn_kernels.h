@@ -55,8 +55,9 @@
 #define SN_K_CELL_BYTES SN_ELEM_CELLK(SN_FLAVOUR_FLOAT32, SN_REAL_BYTES)
 /* The float fold's operands per entry (sn_solve.c rhs_x0, SN_FOLD), plain
  * floats in this order on every path (no clamp: |v|, |x0| <= SN_FLIM and
- * c in [0, 17] keep them below 2^17.1; runtime/notes_ffold.md); the
- * product and the sum in two statements, never contracted to an FMA:
+ * c in [0, 17] keep them below 2^17.1; NUMERICS.md "The initial residual
+ * folded in"); the product and the sum in two statements, never contracted
+ * to an FMA:
  *   w = (v + x0) (1+b1),   y = a1 (v + x0) + x0 */
 SN_INLINE sn_q sn_fold_w1(sn_q v, sn_q x0, sn_q ck) {
     const sn_q s = v + x0;

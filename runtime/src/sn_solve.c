@@ -322,14 +322,14 @@ SN_NOINLINE void detail_mass_rhs(sn_ihdr *h, const sn_dstate *dt, const sn_q *ua
             bs[3 * i + c] = sn_add(bs[3 * i + c], -sn_out(sacc[3 * i + c], v->frac_M - SN_KREL(dk[i]), sat), sat);
 }
 
-/* The initial residual folded into the right-hand side (KERNELS.md "Float
- * step, round 3"; runtime/notes_ffold.md): float only. Its operands v + x0,
+/* The initial residual folded into the right-hand side (NUMERICS.md "The
+ * initial residual folded in"): float only. Its operands v + x0,
  * (1+b1)(v + x0) and a1 (v + x0) + x0 are plain floats, not clamped at
  * SN_FLIM (a torn state's v + x0 can reach 2 SN_FLIM: clamped, the folded
  * residual was not b - A x0 and test_physics_soak_float's cow did not
  * recover). Finite: |v|, |x0| <= SN_FLIM and a1, b1 in [0, 16] (validator)
  * give |w| <= 17 * 2^13 < 2^17.1, |y| < 2^17.1. Fixed: the range of v + x0
- * is not proven (NUMERICS.md "The initial residual folded in"): off. */
+ * is not proven: off. */
 #if defined(SN_FLOAT)
 #define SN_FOLD 1
 #else
@@ -913,9 +913,9 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
     /* The folded rhs clamped (a torn state: the state range's guard or a
      * cell row beyond it, where b's terms and A x0's are not kept apart): the
      * next step starts cold, x0 = 0, so its folded residual is b itself
-     * whatever clamps (runtime/notes_ffold.md). One memset of 12 nF bytes in
-     * such a step, like a clamp's branch (an unconditional select cost every
-     * step 2-3 k instructions on cow_fem). */
+     * whatever clamps (NUMERICS.md "The initial residual folded in"). One
+     * memset of 12 nF bytes in such a step, like a clamp's branch (an
+     * unconditional select cost every step 2-3 k instructions on cow_fem). */
     for (i = 0; i < n3; i++) {
         vel[i] = sn_add(vel[i], x[i], sat);
         pos[i] = sn_add(pos[i], vel[i], sat);
