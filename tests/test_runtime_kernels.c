@@ -21,6 +21,7 @@
 #include "sn_kernels_ic.h"
 #include "sn_kernels_rot.h"
 #include "sn_kernels_surf.h"
+#include "sn_kernels_xnorm.h" /* sn_k_xrsqrt, sn_k_xunit */
 #include "sn_segment.h" /* seg_out, seg_lim */
 
 static uint32_t rng = 12345u;
@@ -2401,6 +2402,67 @@ static void test_udiv64(void) {
     T_CHECK(bad == 0, "udiv64: %d of %d quotients not the exact floor", bad, n);
 }
 
+#if !defined(SN_FLOAT)
+/* The fixed normals' unit step (sn_kernels_xnorm.c; x86-64: the rounded
+ * root from the double root, corrected). sn_k_xrsqrt against its
+ * definition, the nearest integer R to sqrt(x): R^2 - R < x <= R^2 + R
+ * (checked in exact integers) and against sn_isqrt64 rounded as sn_unit
+ * rounds it, on 60,000 x in [16, 3 2^62): random magnitudes, and the
+ * rounding edges k^2 + k, k^2 + k + 1, k^2, k^2 - 1 for random k.
+ * sn_k_xunit against sn_qnormalize on (x, y, z, 0), the scalar reference,
+ * bit for bit: 40,000 sums, random signs and bit lengths 1..32, every 8th
+ * with INT32_MIN / INT32_MAX / 0 / +-1 components, and the zero sum
+ * (0, 0, 2^30). Tolerance 0 (the same integers). */
+static void test_xnorm(void) {
+    enum { NX = 60000, NU = 40000 };
+    static sn_vec3 u[NU], v[NU];
+    static const int32_t edge[] = {0, 1, -1, INT32_MIN, INT32_MAX, -INT32_MAX, 1 << 30, -(1 << 30)};
+    int i, bad = 0, badu = 0, badd = 0;
+    for (i = 0; i < NX; i++) {
+        uint64_t x, R, N;
+        if (i % 2) {
+            const uint64_t k = 4u + (((uint64_t)rnd32() << 32 | rnd32()) % 3719550785u); /* k^2 + k + 1 < 3 2^62 */
+            const unsigned w = (unsigned)(i / 2) % 4u;
+            x = w == 0 ? k * k + k : w == 1 ? k * k + k + 1 : w == 2 ? k * k : k * k - 1;
+        } else {
+            x = ((uint64_t)rnd32() << 32 | rnd32()) >> (rnd32() % 60u);
+            if (x >= 3 * ((uint64_t)1 << 62)) x -= (uint64_t)1 << 62;
+            if (x < 16) x += 16;
+        }
+        R = sn_k_xrsqrt(x);
+        badd += !(R * R - R < x && x <= R * R + R);
+        N = sn_isqrt64(x);
+        if (x - N * N > N) N++;
+        bad += R != N;
+    }
+    T_CHECK(badd == 0, "xrsqrt: %d of %d roots not the nearest integer", badd, (int)NX);
+    T_CHECK(bad == 0, "xrsqrt: %d of %d roots differ from sn_isqrt64 rounded", bad, (int)NX);
+    for (i = 0; i < NU; i++) {
+        int32_t c[3];
+        int k;
+        for (k = 0; k < 3; k++) {
+            const unsigned b = 1u + rnd32() % 32u;
+            const int32_t m = (int32_t)(rnd32() >> (32u - b) >> 1);
+            c[k] = (i % 8 == 0 && rnd32() % 2u) ? edge[rnd32() % 8u] : (rnd32() % 2u ? -m : m);
+        }
+        if (i == 1) c[0] = c[1] = c[2] = 0;
+        u[i].x = c[0]; u[i].y = c[1]; u[i].z = c[2];
+    }
+    memcpy(v, u, sizeof u);
+    sn_k_xunit(u, NU);
+    for (i = 0; i < NU; i++) {
+        sn_q q[4];
+        q[0] = v[i].x; q[1] = v[i].y; q[2] = v[i].z; q[3] = 0;
+        if (q[0] == 0 && q[1] == 0 && q[2] == 0) q[2] = SN_ONE_ROT; /* sn_get_normals' zero sum */
+        else sn_qnormalize(q);
+        badu += u[i].x != q[0] || u[i].y != q[1] || u[i].z != q[2];
+    }
+    T_CHECK(badu == 0, "xunit: %d of %d unit normals differ from sn_qnormalize's", badu, (int)NU);
+    T_CHECK(u[1].x == 0 && u[1].y == 0 && u[1].z == SN_ONE_ROT, "xunit: the zero sum gives (0, 0, 2^30)");
+    T_FIGURE("fixed normals' unit step: %d rounded roots, %d unit vectors bit for bit", (int)NX, (int)NU);
+}
+#endif
+
 /* sn_k_surf1 (sn_get_surface's vertex: AVX2 the corners in lanes and
  * gathers) against sn_k_surf1_ref: 20,000 vertices, t random in [0, 32768]
  * with the edges 0 and 32768 every 8th, corner ids random in a 64-vertex
@@ -2611,6 +2673,7 @@ int main(void) {
     test_udiv64();
     test_surf1();
 #if !defined(SN_FLOAT)
+    test_xnorm();
     test_rshr();
     test_trig();
     test_slerp();
