@@ -203,15 +203,17 @@ static int32_t xr_rnd(int32_t lim) { /* in [-lim, lim] */
 /* sn_k_xnormals against the reference on the asset's triangles: random
  * positions within +-2^29 (the non-wide path, shift > 0), within +-2^10
  * (shift 0), beyond (+-2^31: the clamped path), one point for all (zero
- * sums), 1 - 8 triangles (the lanes' tail) */
+ * sums), within +-2^29 but one vertex of face 0 near -2^31 (the clamped
+ * path, found by the position check), 1 - 8 triangles (the lanes' tail) */
 static void xnormals_random(const char *name, const sn_view *v) {
     const uint32_t nS = v->nS, nT = v->nT;
     sn_vec3 *p = malloc(nS * sizeof *p), *a = malloc(nS * sizeof *a), *b = malloc(nS * sizeof *b);
-    static const int32_t lims[] = {1 << 29, 1 << 10, INT32_MAX, 0};
+    static const int32_t lims[] = {1 << 29, 1 << 10, INT32_MAX, 0, 1 << 29};
     unsigned r, i, d = 0, cases = 0;
-    for (r = 0; r < 12; r++) {
-        const int32_t lim = lims[r % 4];
+    for (r = 0; r < 15; r++) {
+        const int32_t lim = lims[r % 5];
         for (i = 0; i < nS; i++) { p[i].x = lim ? xr_rnd(lim) : 5; p[i].y = lim ? xr_rnd(lim) : -7; p[i].z = lim ? xr_rnd(lim) : 9; }
+        if (r % 5 == 4) p[rd16(v->sec[SN_SEC_TRIS] + 2 * (r % 3))].y = INT32_MIN + (int32_t)r; /* one vertex of face 0 beyond: clamped */
         d += xn_diff(v->sec[SN_SEC_TRIS], nT, p, nS, a, b); cases++;
         d += xn_diff(v->sec[SN_SEC_TRIS], 1 + r % 8, p, nS, a, b); cases++;
     }
@@ -222,7 +224,8 @@ static void xnormals_random(const char *name, const sn_view *v) {
 /* a vertex of k faces, each (0,0,0), (18631,0,0), (0,1801,0): n_z = 18631
  * 1801 = 2^25 - 1, shift 1, each term 2^24: 127 faces sum to 127 2^24 (the
  * plain sums), 128 to 2^31 (saturates at 2^31 - 1; a plain int32 sum
- * would wrap negative), 200 saturate well before the end */
+ * would wrap negative), 200 saturate well before the end; the centre is
+ * each face's first, third and second corner in turn */
 static void xnormals_fan(void) {
     static const unsigned ks[] = {127, 128, 200};
     static unsigned char tris[6 * 200];
@@ -232,9 +235,12 @@ static void xnormals_fan(void) {
         const unsigned k = ks[j], nS = 2 * k + 1;
         for (t = 0; t < k; t++) {
             const unsigned v1 = 2 * t + 1, v2 = 2 * t + 2;
-            tris[6 * t] = 0; tris[6 * t + 1] = 0;
-            tris[6 * t + 2] = (unsigned char)v1; tris[6 * t + 3] = (unsigned char)(v1 >> 8);
-            tris[6 * t + 4] = (unsigned char)v2; tris[6 * t + 5] = (unsigned char)(v2 >> 8);
+            const unsigned cyc[3] = {0, v1, v2}, r0 = t % 3; /* the centre as a, c, b in turn (the same orientation) */
+            unsigned q;
+            for (q = 0; q < 3; q++) {
+                tris[6 * t + 2 * q] = (unsigned char)cyc[(q + r0) % 3];
+                tris[6 * t + 2 * q + 1] = (unsigned char)(cyc[(q + r0) % 3] >> 8);
+            }
             p[v1].x = 18631; p[v1].y = 0; p[v1].z = 0;
             p[v2].x = 0; p[v2].y = 1801; p[v2].z = 0;
         }
