@@ -2411,12 +2411,21 @@ static void test_udiv64(void) {
  * rounding edges k^2 + k, k^2 + k + 1, k^2, k^2 - 1 for random k.
  * sn_k_xunit against sn_qnormalize on (x, y, z, 0), the scalar reference,
  * bit for bit: 40,000 sums, random signs and bit lengths 1..32, every 8th
- * with INT32_MIN / INT32_MAX / 0 / +-1 components, and the zero sum
- * (0, 0, 2^30). Tolerance 0 (the same integers). */
+ * with INT32_MIN / INT32_MAX / 0 / +-1 components, the zero sum (0, 0,
+ * 2^30), and 36 fixed cases (N = 2^30, b = 32, zero sums beside others) at
+ * every position of the AVX2 path's four lanes. Tolerance 0 (the same
+ * integers). */
 static void test_xnorm(void) {
     enum { NX = 60000, NU = 40000 };
     static sn_vec3 u[NU], v[NU];
     static const int32_t edge[] = {0, 1, -1, INT32_MIN, INT32_MAX, -INT32_MAX, 1 << 30, -(1 << 30)};
+    /* N = 2^30 (r = 2^32: v = a), 2^31 magnitudes (b = 32), zero sums beside others, small and equal components */
+    static const int32_t fixed_c[][3] = {{1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {0, 0, 0},
+        {INT32_MIN, INT32_MIN, INT32_MIN}, {INT32_MAX, INT32_MAX, INT32_MAX}, {1, 1, 1}, {1 << 30, 1, 0},
+        {0, 0, 0}, {1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {-3, 4, 0}, {0, 0, 0}, {7, -7, 7},
+        {1 << 30, 0, 0}, {0, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {1, 1 << 20, 0}, {0, 0, 0},
+        {1 << 30, 0, 0}, {0, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {0, 0, 0}, {-1, 0, 0}, {2, 2, 1},
+        {0, 0, 0}, {1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}};
     int i, bad = 0, badu = 0, badd = 0;
     for (i = 0; i < NX; i++) {
         uint64_t x, R, N;
@@ -2446,7 +2455,40 @@ static void test_xnorm(void) {
             c[k] = (i % 8 == 0 && rnd32() % 2u) ? edge[rnd32() % 8u] : (rnd32() % 2u ? -m : m);
         }
         if (i == 1) c[0] = c[1] = c[2] = 0;
+        if (i >= 8 && i < 8 + (int)(sizeof fixed_c / sizeof fixed_c[0])) { /* every lane position of 4 by 9 cases */
+            c[0] = fixed_c[i - 8][0]; c[1] = fixed_c[i - 8][1]; c[2] = fixed_c[i - 8][2];
+        }
         u[i].x = c[0]; u[i].y = c[1]; u[i].z = c[2];
+    }
+    {   /* the corrections' cases, searched: (R, s, t) with s^2 + t^2 = R or R + 1 (n2 = R^2 + R or R^2 + R + 1:
+         * the root just below / above R + 1/2, where the double root rounds either way), and sums of
+         * root N with (2^62 + N/2) mod N within 2^9 of 0 or N (the quotient just above / below an
+         * integer, where the double quotient rounds either way) */
+        /* odd N in (2^30, 2^31) with N m within 2^9 of 2^63 - 1 or 2^63 (m odd; from the factors of
+         * 2^63 - 1 - j and 2^63 + j): (2^62 + (N - 1)/2) mod N below 2^9 (the first 8) or above N - 2^9 */
+        static const int32_t qcase[16] = {1531366081, 1532540863, 1225939123, 1504703107, 1264933055, 1484782557,
+            1694163963, 1347379551, 1427172271, 1167439457, 1580102845, 1723668343, 1783671063, 1263447831, 1684652439,
+            1174172955};
+        int found = 0, tries = 0;
+        for (i = 64; found < 32 && tries < 4000000; tries++) {
+            const uint64_t R = ((uint64_t)1 << 30) + rnd32() % ((uint64_t)1 << 30);
+            if (found < 16) {
+                const uint64_t w = R + (uint64_t)(found & 1), sq = sn_isqrt64(w), rest = w - sq * sq, t = sn_isqrt64(rest);
+                if (t * t != rest) continue;
+                u[i].x = (int32_t)R; u[i].y = (int32_t)sq; u[i].z = (int32_t)t;
+            } else { /* (a0, a1, a2) of root N, a0 >= 2^30 (no scaling), one a_i r + 2^31 within a_i of a multiple
+                      * of 2^32 (so r - 1 or r + 1 changes that output) */
+                const uint64_t N = (uint64_t)qcase[found - 16], Q = (((uint64_t)1 << 62) + (N >> 1)) / N;
+                const uint64_t a1 = rnd32() % (N / 2), a2 = rnd32() % 4096u, a0 = sn_isqrt64(N * N - a1 * a1 - a2 * a2);
+                const uint64_t n2 = a0 * a0 + a1 * a1 + a2 * a2, f0 = sn_isqrt64(n2), Nn = f0 + (n2 - f0 * f0 > f0);
+                const uint64_t m0 = (a0 * Q + ((uint64_t)1 << 31)) & 0xFFFFFFFFu, m1 = (a1 * Q + ((uint64_t)1 << 31)) & 0xFFFFFFFFu;
+                if (Nn != N || a0 < ((uint64_t)1 << 30) || !(m0 < a0 || m0 >= ((uint64_t)1 << 32) - a0 || m1 < a1 || m1 >= ((uint64_t)1 << 32) - a1))
+                    continue;
+                u[i].x = (found & 2) ? -(int32_t)a0 : (int32_t)a0; u[i].y = (int32_t)a1; u[i].z = (found & 4) ? -(int32_t)a2 : (int32_t)a2;
+            }
+            found++; i += 1 + (found % 3); /* across the lanes */
+        }
+        T_CHECK(found == 32, "xunit: %d of 32 correction cases found", found);
     }
     memcpy(v, u, sizeof u);
     sn_k_xunit(u, NU);
