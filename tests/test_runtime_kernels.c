@@ -2410,13 +2410,13 @@ static void test_udiv64(void) {
  * rounds it, on 60,000 x in [16, 3 2^62): random magnitudes, and the
  * rounding edges k^2 + k, k^2 + k + 1, k^2, k^2 - 1 for random k.
  * sn_k_xunit against sn_qnormalize on (x, y, z, 0), the scalar reference,
- * bit for bit: 40,000 sums, random signs and bit lengths 1..32, every 8th
+ * bit for bit: 12,000 sums, random signs and bit lengths 1..32, every 8th
  * with INT32_MIN / INT32_MAX / 0 / +-1 components, the zero sum (0, 0,
  * 2^30), and 36 fixed cases (N = 2^30, b = 32, zero sums beside others) at
  * every position of the AVX2 path's four lanes. Tolerance 0 (the same
  * integers). */
 static void test_xnorm(void) {
-    enum { NX = 60000, NU = 40000 };
+    enum { NX = 60000, NU = 12000 }; /* NU: 288 KB of static arrays on the M4 image too */
     static sn_vec3 u[NU], v[NU];
     static const int32_t edge[] = {0, 1, -1, INT32_MIN, INT32_MAX, -INT32_MAX, 1 << 30, -(1 << 30)};
     /* N = 2^30 (r = 2^32: v = a), 2^31 magnitudes (b = 32), zero sums beside others, small and equal components */
