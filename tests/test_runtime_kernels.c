@@ -2537,6 +2537,48 @@ static void test_surf1(void) {
     T_CHECK(bad == 0, "surf1: %d of 20000 vertices differ from the reference", bad);
 }
 
+/* sn_k_ct8 (the contact rows' point, sn_contact.c: AVX2 the corners in
+ * lanes, masked gathers) against sn_k_ct8_ref: 20,000 points, t as in
+ * test_surf1, corner ids random below 64 with nF random in 0..64 (free,
+ * skeleton and mixed cells), every array random within the state's range
+ * (fixed: int32, every 4th entry at +-SN_LIM or the int32 extremes; float:
+ * +-1e3 and, every 4th, +-2^20 with signed zeros). Tolerance 0: phi, fw,
+ * sp and sv bit for bit (fixed: exact int64 sums; float: the same products
+ * summed in the same order, +0 for the skeleton corners' fw terms). */
+static void test_ct8(void) {
+    static sn_q pos[3 * 64], pst[3 * 64], vel[3 * 64], vpre[3 * 64];
+    sn_q *arr[4];
+    int i, bad = 0, mixed = 0;
+    arr[0] = pos; arr[1] = pst; arr[2] = vel; arr[3] = vpre;
+    for (i = 0; i < 20000; i++) {
+        uint32_t t[3], nF = rnd32() % 65u, nfree = 0;
+        uint16_t vx[8];
+        sn_q pa[8], pr[8];
+        sn_acc fa, fr, sa[3], sr[3], va[3], vr[3];
+        int k, j;
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 3 * 64; k++) {
+#if defined(SN_FLOAT)
+                arr[j][k] = i % 4 == 0 ? (float)(rnd32() % 3u) * ((rnd32() & 1) ? 1048576.0f : -1048576.0f) * ((rnd32() % 5u) ? 1.0f : -0.0f)
+                                       : (float)rnd_in(1 << 20) / 1024.0f;
+#else
+                arr[j][k] = i % 4 == 0 ? ((rnd32() & 1) ? ((rnd32() & 1) ? SN_LIM : INT32_MAX) : ((rnd32() & 1) ? -SN_LIM : INT32_MIN))
+                                       : rnd_in(SN_LIM);
+#endif
+            }
+        for (k = 0; k < 8; k++) { vx[k] = (uint16_t)(rnd32() % 64u); nfree += vx[k] < nF; }
+        mixed += nfree > 0 && nfree < 8;
+        for (k = 0; k < 3; k++) t[k] = i % 8 == 0 ? ((rnd32() & 1) ? 32768u : 0u) : rnd32() % 32769u;
+        /* pst is indexed by v - nF < 64 - nF: within the array */
+        sn_k_ct8(t, vx, nF, pos, pst, vel, vpre, pa, &fa, sa, va);
+        sn_k_ct8_ref(t, vx, nF, pos, pst, vel, vpre, pr, &fr, sr, vr);
+        bad += memcmp(pa, pr, sizeof pa) != 0 || memcmp(&fa, &fr, sizeof fa) != 0 || memcmp(sa, sr, sizeof sa) != 0 ||
+               memcmp(va, vr, sizeof va) != 0;
+    }
+    T_CHECK(bad == 0, "ct8: %d of 20000 contact points differ from the reference", bad);
+    T_CHECK(mixed > 10000, "ct8: %d of 20000 cells mix free and skeleton corners (want most)", mixed);
+}
+
 /* sn_k_cell_mul2 against the independent reference itself (not only
  * against two sn_k_cell_mul calls: on the M4 both are assembly): 2000
  * random records (every 8th at the bounds), corner 0's operands 0 (the
@@ -2714,6 +2756,7 @@ int main(void) {
     test_isqrt();
     test_udiv64();
     test_surf1();
+    test_ct8();
 #if !defined(SN_FLOAT)
     test_xnorm();
     test_rshr();
