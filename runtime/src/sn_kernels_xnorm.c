@@ -304,8 +304,7 @@ void sn_k_xnormals(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uin
             bits |= xabs(n[0]) | xabs(n[1]) | xabs(n[2]);
             out[a].x++; out[b].x++; out[c].x++;
         }
-        for (i = 0; i < nS; i++) deg |= (uint32_t)out[i].x;
-        memset(out, 0, (size_t)nS * sizeof *out);
+        for (i = 0; i < nS; i++) { deg |= (uint32_t)out[i].x; out[i].x = 0; } /* y, z still 0 */
     }
     shift = bitlen64(bits) - 24; /* the largest |n_k| >> shift below 2^24 */
     shift = shift < 0 ? 0 : shift;
