@@ -278,7 +278,8 @@ void sn_k_xnormals(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uin
         }
         deg = 128; /* the saturating sums */
     } else {
-        /* pass 0: the magnitudes' OR, each vertex's faces counted in out[].x */
+        /* pass 0: the magnitudes' OR, each vertex's faces counted in out[].x
+         * (at most 3 nT < 2^31: the triangles' 6 bytes each fit a u32-sized blob) */
 #if defined(SN_KERNELS_AVX2)
         __m256i acc = _mm256_setzero_si256();
         for (; t + 8 <= nT; t += 8) {
