@@ -21,6 +21,7 @@
 #include "sn_kernels_ic.h"
 #include "sn_kernels_rot.h"
 #include "sn_kernels_surf.h"
+#include "sn_kernels_xnorm.h" /* sn_k_xrsqrt, sn_k_xunit */
 #include "sn_segment.h" /* seg_out, seg_lim */
 
 static uint32_t rng = 12345u;
@@ -2402,6 +2403,109 @@ static void test_udiv64(void) {
     T_CHECK(bad == 0, "udiv64: %d of %d quotients not the exact floor", bad, n);
 }
 
+#if !defined(SN_FLOAT)
+/* The fixed normals' unit step (sn_kernels_xnorm.c; x86-64: the rounded
+ * root from the double root, corrected). sn_k_xrsqrt against its
+ * definition, the nearest integer R to sqrt(x): R^2 - R < x <= R^2 + R
+ * (checked in exact integers) and against sn_isqrt64 rounded as sn_unit
+ * rounds it, on 60,000 x in [16, 3 2^62): random magnitudes, and the
+ * rounding edges k^2 + k, k^2 + k + 1, k^2, k^2 - 1 for random k.
+ * sn_k_xunit against sn_qnormalize on (x, y, z, 0), the scalar reference,
+ * bit for bit: 12,000 sums, random signs and bit lengths 1..32, every 8th
+ * with INT32_MIN / INT32_MAX / 0 / +-1 components, the zero sum (0, 0,
+ * 2^30), and 36 fixed cases (N = 2^30, b = 32, zero sums beside others) at
+ * every position of the AVX2 path's four lanes. Tolerance 0 (the same
+ * integers). */
+static void test_xnorm(void) {
+    enum { NX = 60000, NU = 12000 }; /* NU: 288 KB of static arrays on the M4 image too */
+    static sn_vec3 u[NU], v[NU];
+    static const int32_t edge[] = {0, 1, -1, INT32_MIN, INT32_MAX, -INT32_MAX, 1 << 30, -(1 << 30)};
+    /* N = 2^30 (r = 2^32: v = a), 2^31 magnitudes (b = 32), zero sums beside others, small and equal components */
+    static const int32_t fixed_c[][3] = {{1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {0, 0, 0},
+        {INT32_MIN, INT32_MIN, INT32_MIN}, {INT32_MAX, INT32_MAX, INT32_MAX}, {1, 1, 1}, {1 << 30, 1, 0},
+        {0, 0, 0}, {1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {-3, 4, 0}, {0, 0, 0}, {7, -7, 7},
+        {1 << 30, 0, 0}, {0, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {1, 1 << 20, 0}, {0, 0, 0},
+        {1 << 30, 0, 0}, {0, 0, 0}, {5, 0, 0}, {0, 0, -1}, {INT32_MIN, 0, 0}, {0, 0, 0}, {-1, 0, 0}, {2, 2, 1},
+        {0, 0, 0}, {1 << 30, 0, 0}, {5, 0, 0}, {0, 0, -1}};
+    int i, bad = 0, badu = 0, badd = 0;
+    for (i = 0; i < NX; i++) {
+        uint64_t x, R, N;
+        if (i % 2) {
+            const uint64_t k = 4u + (((uint64_t)rnd32() << 32 | rnd32()) % 3719550785u); /* k^2 + k + 1 < 3 2^62 */
+            const unsigned w = (unsigned)(i / 2) % 4u;
+            x = w == 0 ? k * k + k : w == 1 ? k * k + k + 1 : w == 2 ? k * k : k * k - 1;
+        } else {
+            x = ((uint64_t)rnd32() << 32 | rnd32()) >> (rnd32() % 60u);
+            if (x >= 3 * ((uint64_t)1 << 62)) x -= (uint64_t)1 << 62;
+            if (x < 16) x += 16;
+        }
+        R = sn_k_xrsqrt(x);
+        badd += !(R * R - R < x && x <= R * R + R);
+        N = sn_isqrt64(x);
+        if (x - N * N > N) N++;
+        bad += R != N;
+    }
+    T_CHECK(badd == 0, "xrsqrt: %d of %d roots not the nearest integer", badd, (int)NX);
+    T_CHECK(bad == 0, "xrsqrt: %d of %d roots differ from sn_isqrt64 rounded", bad, (int)NX);
+    for (i = 0; i < NU; i++) {
+        int32_t c[3];
+        int k;
+        for (k = 0; k < 3; k++) {
+            const unsigned b = 1u + rnd32() % 32u;
+            const int32_t m = (int32_t)(rnd32() >> (32u - b) >> 1);
+            c[k] = (i % 8 == 0 && rnd32() % 2u) ? edge[rnd32() % 8u] : (rnd32() % 2u ? -m : m);
+        }
+        if (i == 1) c[0] = c[1] = c[2] = 0;
+        if (i >= 8 && i < 8 + (int)(sizeof fixed_c / sizeof fixed_c[0])) { /* every lane position of 4 by 9 cases */
+            c[0] = fixed_c[i - 8][0]; c[1] = fixed_c[i - 8][1]; c[2] = fixed_c[i - 8][2];
+        }
+        u[i].x = c[0]; u[i].y = c[1]; u[i].z = c[2];
+    }
+    {   /* the corrections' cases, searched: (R, s, t) with s^2 + t^2 = R or R + 1 (n2 = R^2 + R or R^2 + R + 1:
+         * the root just below / above R + 1/2, where the double root rounds either way), and sums of
+         * root N with (2^62 + N/2) mod N within 2^9 of 0 or N (the quotient just above / below an
+         * integer, where the double quotient rounds either way) */
+        /* odd N in (2^30, 2^31) with N m within 2^9 of 2^63 - 1 or 2^63 (m odd; from the factors of
+         * 2^63 - 1 - j and 2^63 + j): (2^62 + (N - 1)/2) mod N below 2^9 (the first 8) or above N - 2^9 */
+        static const int32_t qcase[16] = {1531366081, 1532540863, 1225939123, 1504703107, 1264933055, 1484782557,
+            1694163963, 1347379551, 1427172271, 1167439457, 1580102845, 1723668343, 1783671063, 1263447831, 1684652439,
+            1174172955};
+        int found = 0, tries = 0;
+        for (i = 64; found < 32 && tries < 4000000; tries++) {
+            const uint64_t R = ((uint64_t)1 << 30) + rnd32() % ((uint64_t)1 << 30);
+            if (found < 16) {
+                const uint64_t w = R + (uint64_t)(found & 1), sq = sn_isqrt64(w), rest = w - sq * sq, t = sn_isqrt64(rest);
+                if (t * t != rest) continue;
+                u[i].x = (int32_t)R; u[i].y = (int32_t)sq; u[i].z = (int32_t)t;
+            } else { /* (a0, a1, a2) of root N, a0 >= 2^30 (no scaling), one a_i r + 2^31 within a_i of a multiple
+                      * of 2^32 (so r - 1 or r + 1 changes that output) */
+                const uint64_t N = (uint64_t)qcase[found - 16], Q = (((uint64_t)1 << 62) + (N >> 1)) / N;
+                const uint64_t a1 = rnd32() % (N / 2), a2 = rnd32() % 4096u, a0 = sn_isqrt64(N * N - a1 * a1 - a2 * a2);
+                const uint64_t n2 = a0 * a0 + a1 * a1 + a2 * a2, f0 = sn_isqrt64(n2), Nn = f0 + (n2 - f0 * f0 > f0);
+                const uint64_t m0 = (a0 * Q + ((uint64_t)1 << 31)) & 0xFFFFFFFFu, m1 = (a1 * Q + ((uint64_t)1 << 31)) & 0xFFFFFFFFu;
+                if (Nn != N || a0 < ((uint64_t)1 << 30) || !(m0 < a0 || m0 >= ((uint64_t)1 << 32) - a0 || m1 < a1 || m1 >= ((uint64_t)1 << 32) - a1))
+                    continue;
+                u[i].x = (found & 2) ? -(int32_t)a0 : (int32_t)a0; u[i].y = (int32_t)a1; u[i].z = (found & 4) ? -(int32_t)a2 : (int32_t)a2;
+            }
+            found++; i += 1 + (found % 3); /* across the lanes */
+        }
+        T_CHECK(found == 32, "xunit: %d of 32 correction cases found", found);
+    }
+    memcpy(v, u, sizeof u);
+    sn_k_xunit(u, NU);
+    for (i = 0; i < NU; i++) {
+        sn_q q[4];
+        q[0] = v[i].x; q[1] = v[i].y; q[2] = v[i].z; q[3] = 0;
+        if (q[0] == 0 && q[1] == 0 && q[2] == 0) q[2] = SN_ONE_ROT; /* sn_get_normals' zero sum */
+        else sn_qnormalize(q);
+        badu += u[i].x != q[0] || u[i].y != q[1] || u[i].z != q[2];
+    }
+    T_CHECK(badu == 0, "xunit: %d of %d unit normals differ from sn_qnormalize's", badu, (int)NU);
+    T_CHECK(u[1].x == 0 && u[1].y == 0 && u[1].z == SN_ONE_ROT, "xunit: the zero sum gives (0, 0, 2^30)");
+    T_FIGURE("fixed normals' unit step: %d rounded roots, %d unit vectors bit for bit", (int)NX, (int)NU);
+}
+#endif
+
 /* sn_k_surf1 (sn_get_surface's vertex: AVX2 the corners in lanes and
  * gathers) against sn_k_surf1_ref: 20,000 vertices, t random in [0, 32768]
  * with the edges 0 and 32768 every 8th, corner ids random in a 64-vertex
@@ -2432,6 +2536,48 @@ static void test_surf1(void) {
         bad += memcmp(a, r, sizeof a) != 0;
     }
     T_CHECK(bad == 0, "surf1: %d of 20000 vertices differ from the reference", bad);
+}
+
+/* sn_k_ct8 (the contact rows' point, sn_contact.c: AVX2 the corners in
+ * lanes, masked gathers) against sn_k_ct8_ref: 20,000 points, t as in
+ * test_surf1, corner ids random below 64 with nF random in 0..64 (free,
+ * skeleton and mixed cells), every array random within the state's range
+ * (fixed: int32, every 4th entry at +-SN_LIM or the int32 extremes; float:
+ * +-1e3 and, every 4th, +-2^20 with signed zeros). Tolerance 0: phi, fw,
+ * sp and sv bit for bit (fixed: exact int64 sums; float: the same products
+ * summed in the same order, +0 for the skeleton corners' fw terms). */
+static void test_ct8(void) {
+    static sn_q pos[3 * 64], pst[3 * 64], vel[3 * 64], vpre[3 * 64];
+    sn_q *arr[4];
+    int i, bad = 0, mixed = 0;
+    arr[0] = pos; arr[1] = pst; arr[2] = vel; arr[3] = vpre;
+    for (i = 0; i < 20000; i++) {
+        uint32_t t[3], nF = rnd32() % 65u, nfree = 0;
+        uint16_t vx[8];
+        sn_q pa[8], pr[8];
+        sn_acc fa, fr, sa[3], sr[3], va[3], vr[3];
+        int k, j;
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 3 * 64; k++) {
+#if defined(SN_FLOAT)
+                arr[j][k] = i % 4 == 0 ? (float)(rnd32() % 3u) * ((rnd32() & 1) ? 1048576.0f : -1048576.0f) * ((rnd32() % 5u) ? 1.0f : -0.0f)
+                                       : (float)rnd_in(1 << 20) / 1024.0f;
+#else
+                arr[j][k] = i % 4 == 0 ? ((rnd32() & 1) ? ((rnd32() & 1) ? SN_LIM : INT32_MAX) : ((rnd32() & 1) ? -SN_LIM : INT32_MIN))
+                                       : rnd_in(SN_LIM);
+#endif
+            }
+        for (k = 0; k < 8; k++) { vx[k] = (uint16_t)(rnd32() % 64u); nfree += vx[k] < nF; }
+        mixed += nfree > 0 && nfree < 8;
+        for (k = 0; k < 3; k++) t[k] = i % 8 == 0 ? ((rnd32() & 1) ? 32768u : 0u) : rnd32() % 32769u;
+        /* pst is indexed by v - nF < 64 - nF: within the array */
+        sn_k_ct8(t, vx, nF, pos, pst, vel, vpre, pa, &fa, sa, va);
+        sn_k_ct8_ref(t, vx, nF, pos, pst, vel, vpre, pr, &fr, sr, vr);
+        bad += memcmp(pa, pr, sizeof pa) != 0 || memcmp(&fa, &fr, sizeof fa) != 0 || memcmp(sa, sr, sizeof sa) != 0 ||
+               memcmp(va, vr, sizeof va) != 0;
+    }
+    T_CHECK(bad == 0, "ct8: %d of 20000 contact points differ from the reference", bad);
+    T_CHECK(mixed > 10000, "ct8: %d of 20000 cells mix free and skeleton corners (want most)", mixed);
 }
 
 /* sn_k_cell_mul2 against the independent reference itself (not only
@@ -2611,7 +2757,9 @@ int main(void) {
     test_isqrt();
     test_udiv64();
     test_surf1();
+    test_ct8();
 #if !defined(SN_FLOAT)
+    test_xnorm();
     test_rshr();
     test_trig();
     test_slerp();

@@ -131,6 +131,128 @@ static void fnormals_lanes(void) {
 }
 #endif
 
+#if !defined(SN_FLOAT)
+#include "sn_kernels_xnorm.h" /* sn_k_xnormals: crafted meshes */
+/* The fixed normals as sn_embed.c computed them before issue 15 (the
+ * reference for sn_kernels_xnorm.c, bit for bit): edges clamped to +-2^30
+ * when a position lies beyond +-2^29, a pass for the largest |n_k|, the
+ * shift bitlen - 24, the rounded terms summed saturating, sn_qnormalize. */
+static int64_t ref_clamp30(int64_t v) { return v > (1 << 30) ? (1 << 30) : (v < -(1 << 30) ? -(1 << 30) : v); }
+static int32_t ref_sat(int64_t v) { return v > INT32_MAX ? INT32_MAX : (v < INT32_MIN ? INT32_MIN : (int32_t)v); }
+static void ref_face(const sn_vec3 *p, unsigned a, unsigned b, unsigned c, int clamp, int64_t n[3]) {
+    int64_t e1[3], e2[3];
+    int k;
+    e1[0] = (int64_t)p[b].x - p[a].x; e1[1] = (int64_t)p[b].y - p[a].y; e1[2] = (int64_t)p[b].z - p[a].z;
+    e2[0] = (int64_t)p[c].x - p[a].x; e2[1] = (int64_t)p[c].y - p[a].y; e2[2] = (int64_t)p[c].z - p[a].z;
+    if (clamp)
+        for (k = 0; k < 3; k++) { e1[k] = ref_clamp30(e1[k]); e2[k] = ref_clamp30(e2[k]); }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+static void ref_xnormals(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uint32_t nS, sn_vec3 *out) {
+    int64_t maxn = 0;
+    int pass, shift = 0, wide = 0, k;
+    uint32_t i, t;
+    memset(out, 0, nS * sizeof *out);
+    for (i = 0; i < nS; i++)
+        wide |= p[i].x > (1 << 29) || p[i].x < -(1 << 29) || p[i].y > (1 << 29) || p[i].y < -(1 << 29) ||
+                p[i].z > (1 << 29) || p[i].z < -(1 << 29);
+    for (pass = 0; pass < 2; pass++) {
+        for (t = 0; t < nT; t++) {
+            const unsigned a = rd16(tris + 6 * t), b = rd16(tris + 6 * t + 2), c = rd16(tris + 6 * t + 4);
+            int64_t n[3];
+            ref_face(p, a, b, c, wide, n);
+            if (pass == 0) {
+                for (k = 0; k < 3; k++) maxn = (n[k] < 0 ? -n[k] : n[k]) > maxn ? (n[k] < 0 ? -n[k] : n[k]) : maxn;
+            } else {
+                int32_t sv[3];
+                for (k = 0; k < 3; k++) sv[k] = (int32_t)(shift ? (n[k] + ((int64_t)1 << (shift - 1))) >> shift : n[k]);
+                out[a].x = ref_sat((int64_t)out[a].x + sv[0]); out[a].y = ref_sat((int64_t)out[a].y + sv[1]); out[a].z = ref_sat((int64_t)out[a].z + sv[2]);
+                out[b].x = ref_sat((int64_t)out[b].x + sv[0]); out[b].y = ref_sat((int64_t)out[b].y + sv[1]); out[b].z = ref_sat((int64_t)out[b].z + sv[2]);
+                out[c].x = ref_sat((int64_t)out[c].x + sv[0]); out[c].y = ref_sat((int64_t)out[c].y + sv[1]); out[c].z = ref_sat((int64_t)out[c].z + sv[2]);
+            }
+        }
+        if (pass == 0) {
+            uint64_t m = (uint64_t)maxn;
+            int bl = 0;
+            while (m) { bl++; m >>= 1; }
+            shift = bl - 24 < 0 ? 0 : bl - 24;
+        }
+    }
+    for (i = 0; i < nS; i++) {
+        sn_q q[4];
+        q[0] = out[i].x; q[1] = out[i].y; q[2] = out[i].z; q[3] = 0;
+        if (q[0] == 0 && q[1] == 0 && q[2] == 0) { out[i].z = SN_ONE_ROT; continue; }
+        sn_qnormalize(q);
+        out[i].x = q[0]; out[i].y = q[1]; out[i].z = q[2];
+    }
+}
+static unsigned xn_diff(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uint32_t nS, sn_vec3 *a, sn_vec3 *b) {
+    unsigned i, d = 0;
+    sn_k_xnormals(tris, nT, p, nS, a);
+    ref_xnormals(tris, nT, p, nS, b);
+    for (i = 0; i < nS; i++) d += !same_vec(a + i, b + i);
+    return d;
+}
+static uint32_t xr_rng = 777u;
+static int32_t xr_rnd(int32_t lim) { /* in [-lim, lim] */
+    xr_rng = xr_rng * 1664525u + 1013904223u;
+    return (int32_t)((int64_t)((xr_rng ^ (xr_rng >> 15)) % (2u * (uint32_t)lim + 1u)) - lim);
+}
+/* sn_k_xnormals against the reference on the asset's triangles: random
+ * positions within +-2^29 (the non-wide path, shift > 0), within +-2^10
+ * (shift 0), beyond (+-2^31: the clamped path), one point for all (zero
+ * sums), within +-2^29 but one vertex of face 0 near -2^31 (the clamped
+ * path, found by the position check), 1 - 8 triangles (the lanes' tail) */
+static void xnormals_random(const char *name, const sn_view *v) {
+    const uint32_t nS = v->nS, nT = v->nT;
+    sn_vec3 *p = malloc(nS * sizeof *p), *a = malloc(nS * sizeof *a), *b = malloc(nS * sizeof *b);
+    static const int32_t lims[] = {1 << 29, 1 << 10, INT32_MAX, 0, 1 << 29};
+    unsigned r, i, d = 0, cases = 0;
+    for (r = 0; r < 15; r++) {
+        const int32_t lim = lims[r % 5];
+        for (i = 0; i < nS; i++) { p[i].x = lim ? xr_rnd(lim) : 5; p[i].y = lim ? xr_rnd(lim) : -7; p[i].z = lim ? xr_rnd(lim) : 9; }
+        if (r % 5 == 4) p[rd16(v->sec[SN_SEC_TRIS] + 2 * (r % 3))].y = INT32_MIN + (int32_t)r; /* one vertex of face 0 beyond: clamped */
+        d += xn_diff(v->sec[SN_SEC_TRIS], nT, p, nS, a, b); cases++;
+        d += xn_diff(v->sec[SN_SEC_TRIS], 1 + r % 8, p, nS, a, b); cases++;
+    }
+    T_CHECK(d == 0, "%s: sn_k_xnormals on random positions: %u normals differ from the reference", name, d);
+    T_FIGURE("%s: %u random meshes' normals bit for bit with the reference", name, cases);
+    free(p); free(a); free(b);
+}
+/* a vertex of k faces, each (0,0,0), (18631,0,0), (0,1801,0): n_z = 18631
+ * 1801 = 2^25 - 1, shift 1, each term 2^24: 127 faces sum to 127 2^24 (the
+ * plain sums), 128 to 2^31 (saturates at 2^31 - 1; a plain int32 sum
+ * would wrap negative), 200 saturate well before the end; the centre is
+ * each face's first, third and second corner in turn */
+static void xnormals_fan(void) {
+    static const unsigned ks[] = {127, 128, 200};
+    static unsigned char tris[6 * 200];
+    static sn_vec3 p[401], a[401], b[401];
+    unsigned j, t, d = 0;
+    for (j = 0; j < 3; j++) {
+        const unsigned k = ks[j], nS = 2 * k + 1;
+        for (t = 0; t < k; t++) {
+            const unsigned v1 = 2 * t + 1, v2 = 2 * t + 2;
+            const unsigned cyc[3] = {0, v1, v2}, r0 = t % 3; /* the centre as a, c, b in turn (the same orientation) */
+            unsigned q;
+            for (q = 0; q < 3; q++) {
+                tris[6 * t + 2 * q] = (unsigned char)cyc[(q + r0) % 3];
+                tris[6 * t + 2 * q + 1] = (unsigned char)(cyc[(q + r0) % 3] >> 8);
+            }
+            p[v1].x = 18631; p[v1].y = 0; p[v1].z = 0;
+            p[v2].x = 0; p[v2].y = 1801; p[v2].z = 0;
+        }
+        p[0].x = p[0].y = p[0].z = 0;
+        d += xn_diff(tris, k, p, nS, a, b);
+        T_CHECK(a[0].x == 0 && a[0].y == 0 && a[0].z == SN_ONE_ROT, "fan of %u faces: the centre's normal (0, 0, 1), got (%d, %d, %d)",
+                k, (int)a[0].x, (int)a[0].y, (int)a[0].z);
+    }
+    T_CHECK(d == 0, "fans of 127, 128, 200 faces: %u normals differ from the reference", d);
+}
+#endif
+
 static void asset(const char *name, pose_fn_t pf) {
     char path[512], nm[64];
     pu_rt rt;
@@ -204,6 +326,15 @@ static void asset(const char *name, pose_fn_t pf) {
             T_CHECK(nb == 0, "%s: %u of %u normals beyond the bound of the double normals (worst %.3f of it)", name, nb, nS, nw);
             T_FIGURE("%s: %u normals against double, worst %.3f of the bound", name, nS, nw);
 #if !defined(SN_FLOAT)
+            {   /* bit for bit with the reference (the loop before issue 15) */
+                sn_vec3 *rn = malloc(nS * sizeof *rn);
+                unsigned d = 0;
+                ref_xnormals(v->sec[SN_SEC_TRIS], v->nT, out, nS, rn);
+                for (s = 0; s < nS; s++) d += !same_vec(rn + s, nrm + s);
+                T_CHECK(d == 0, "%s: %u of %u normals differ from the reference", name, d, nS);
+                free(rn);
+                xnormals_random(name, v);
+            }
             {   /* the surface moved by 2^30 in x: positions beyond +-2^29 take the clamped edge path, whose
                  * edges here are the same (well inside 2^30), so every normal must be the same bits */
                 sn_vec3 *far = malloc(nS * sizeof *far), *nf = malloc(nS * sizeof *nf);
@@ -236,6 +367,8 @@ static void asset(const char *name, pose_fn_t pf) {
 int main(void) {
 #if defined(SN_FLOAT)
     fnormals_lanes();
+#else
+    xnormals_fan();
 #endif
     asset("cow", pu_cow_pose);
     asset("beast", pu_beast_pose);

@@ -35,6 +35,14 @@
  */
 #include "sn_constraint.h"
 #include "sn_cut.h" /* sn_point_weights: the cut level's field */
+#include "sn_kernels_surf.h" /* sn_k_ct8: the plain lattice's point */
+/* 1: the plain lattice's exact point by sn_k_ct8 in lanes (the scalar
+ * builds keep ct_sum: sn_k_ct8_ref there cost 0.13 M more a cow step) */
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+#define SN_CT_LANES 1
+#else
+#define SN_CT_LANES 0
+#endif
 
 typedef struct sn_col {
     uint32_t kind;
@@ -336,12 +344,15 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
             ne = sn_point_weights(v, sn_rd_u16(e), t, cvx, cw);
             X = cvx;
             W = cw;
-        } else
+        } else if (SN_CT_LANES && exact) /* AVX2: weights, fw and both sums in one kernel, in lanes (sn_kernels_surf.h) */
+            sn_k_ct8(t, vx, v->nF, pos, pst, vel, vpre, phi, &fw, sp, sv);
+        else
             sn_trilinear(t, phi);
         /* a vertex the bones carry (its row's squared length over free
          * corners below 2^-8: sn_constraint.c would drop it) takes no contact */
-        for (k = 0; k < 8; k++) /* the free vertices are corners */
-            if (X[k] < v->nF) fw += sn_mul(W[k], W[k]);
+        if (!(SN_CT_LANES && exact && !v->cut))
+            for (k = 0; k < 8; k++) /* the free vertices are corners */
+                if (X[k] < v->nF) fw += sn_mul(W[k], W[k]);
 #if defined(SN_FLOAT)
         if (fw < 1.0f / 256.0f) continue;
 #else
@@ -349,7 +360,9 @@ void sn_contact_rows(sn_ihdr *h, uint32_t *sat) {
 #endif
         /* the point at the start of the step (skeleton corners where they
          * were) and its predicted velocity (free corners: v + h^2 g) */
-        if (exact && !v->cut) /* the hot loop: each corner's two rows read straight from the arrays (8: unrolled) */
+        if (SN_CT_LANES && exact && !v->cut)
+            ; /* sp, sv from sn_k_ct8 above */
+        else if (exact && !v->cut) /* the hot loop: each corner's two rows read straight from the arrays (8: unrolled) */
             ct_sum(v->nF, pos, pst, vel, vpre, vx, phi, 8u, sp, sv);
         else if (exact)
             ct_sum(v->nF, pos, pst, vel, vpre, X, W, ne, sp, sv);

@@ -3,6 +3,7 @@
 #include "sn_cut.h" /* sn_cut_interp: the cut level's field */
 #include "sn_detail.h" /* sn_detail_interp: the active details on the surface */
 #include "sn_kernels_surf.h" /* sn_k_tri_w, sn_k_surf1 */
+#include "sn_kernels_xnorm.h" /* sn_k_xnormals */
 
 /* ---- outputs ---- */
 
@@ -116,40 +117,19 @@ sn_status sn_get_surface(const sn_instance *inst, sn_vec3 *out, uint32_t first, 
     return SN_OK;
 }
 
-#if !defined(SN_FLOAT)
-/* e1 x e2 of triangle (a, b, c), public units, exact in int64: each edge
- * component clamped to +-2^30 keeps the products below 2^62; clamp = 0
- * when every position lies within +-2^29 (the clamp cannot act: the same
- * products without 12 compares a triangle and pass; cow_fem x86-64
- * sn_get_normals 3,140,130 -> 2,527,994 instructions) */
-SN_INLINE void face_n(const sn_vec3 *p, uint32_t a, uint32_t b, uint32_t c, int clamp, int64_t n[3]) {
-    int64_t e1[3], e2[3];
-    int k;
-    e1[0] = (int64_t)p[b].x - p[a].x; e1[1] = (int64_t)p[b].y - p[a].y; e1[2] = (int64_t)p[b].z - p[a].z;
-    e2[0] = (int64_t)p[c].x - p[a].x; e2[1] = (int64_t)p[c].y - p[a].y; e2[2] = (int64_t)p[c].z - p[a].z;
-    if (clamp)
-        for (k = 0; k < 3; k++) {
-            e1[k] = e1[k] > (1 << 30) ? (1 << 30) : (e1[k] < -(1 << 30) ? -(1 << 30) : e1[k]);
-            e2[k] = e2[k] > (1 << 30) ? (1 << 30) : (e2[k] < -(1 << 30) ? -(1 << 30) : e2[k]);
-        }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-}
-#endif
-
 sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_vec3 *out) {
     const sn_ihdr *h;
     const unsigned char *tris;
-    uint32_t t, nS;
+    uint32_t nS;
     if (!inst || !positions || !out) return SN_ERR_NULL;
     h = chdr_of(inst);
     if (h->magic != SN_INST_MAGIC) return SN_ERR_INSTANCE;
     if (h->v.nT == 0) return SN_ERR_ARG;
     tris = h->v.sec[SN_SEC_TRIS];
     nS = h->v.nS;
-    memset(out, 0, (size_t)nS * sizeof *out);
 #if defined(SN_FLOAT)
+    uint32_t t;
+    memset(out, 0, (size_t)nS * sizeof *out);
     for (t = 0; t < h->v.nT; t++) {
         uint32_t a = sn_rd_u16(tris + 6 * t), b = sn_rd_u16(tris + 6 * t + 2), c = sn_rd_u16(tris + 6 * t + 4);
         float e1[3], e2[3], n[3];
@@ -165,50 +145,8 @@ sn_status sn_get_normals(const sn_instance *inst, const sn_vec3 *positions, sn_v
     /* normalize via the quaternion normalizer's arithmetic on (x,y,z,0) */
     sn_k_fnormals(out, nS);
 #else
-    uint32_t i;
-    {
-        /* area-weighted sums in int32: a pre-pass picks one shift for the mesh
-         * so the largest face normal is <= 2^24 (128 faces per vertex fit);
-         * beyond that the sums saturate instead of overflowing */
-        int64_t maxn = 0;
-        int pass, shift = 0, wide = 0;
-        for (i = 0; i < nS; i++) /* positions within +-2^29: no edge reaches the clamp */
-            wide |= (uint32_t)positions[i].x + (1u << 29) > (1u << 30) || (uint32_t)positions[i].y + (1u << 29) > (1u << 30) ||
-                    (uint32_t)positions[i].z + (1u << 29) > (1u << 30);
-        for (pass = 0; pass < 2; pass++) {
-            for (t = 0; t < h->v.nT; t++) {
-                uint32_t a = sn_rd_u16(tris + 6 * t), b = sn_rd_u16(tris + 6 * t + 2), c = sn_rd_u16(tris + 6 * t + 4);
-                int64_t n[3];
-                int k;
-                if (wide) face_n(positions, a, b, c, 1, n);
-                else face_n(positions, a, b, c, 0, n);
-                if (pass == 0) {
-                    for (k = 0; k < 3; k++) {
-                        int64_t m = n[k] < 0 ? -n[k] : n[k];
-                        maxn = m > maxn ? m : maxn;
-                    }
-                } else {
-                    int32_t s0 = (int32_t)sn_rshr64(n[0], shift), s1 = (int32_t)sn_rshr64(n[1], shift),
-                            s2 = (int32_t)sn_rshr64(n[2], shift);
-                    out[a].x = pub_add(out[a].x, s0); out[a].y = pub_add(out[a].y, s1); out[a].z = pub_add(out[a].z, s2);
-                    out[b].x = pub_add(out[b].x, s0); out[b].y = pub_add(out[b].y, s1); out[b].z = pub_add(out[b].z, s2);
-                    out[c].x = pub_add(out[c].x, s0); out[c].y = pub_add(out[c].y, s1); out[c].z = pub_add(out[c].z, s2);
-                }
-            }
-            if (pass == 0) {
-                shift = bitlen64((uint64_t)maxn) - 24;
-                shift = shift < 0 ? 0 : shift;
-            }
-        }
-    }
-    for (i = 0; i < nS; i++) {
-        sn_q q[4];
-        q[0] = out[i].x; q[1] = out[i].y; q[2] = out[i].z; q[3] = 0;
-        if (q[0] == 0 && q[1] == 0 && q[2] == 0) { out[i].z = SN_ONE_ROT; continue; }
-        /* scale up to use the normalizer's precision, then normalize to Q30 */
-        sn_qnormalize(q);
-        out[i].x = q[0]; out[i].y = q[1]; out[i].z = q[2];
-    }
+    /* sn_kernels_xnorm.c: the face normals summed at one shift for the mesh, then unit length */
+    sn_k_xnormals(tris, h->v.nT, positions, nS, out);
 #endif
     return SN_OK;
 }

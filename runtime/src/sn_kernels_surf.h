@@ -120,4 +120,86 @@ SN_INLINE void sn_k_surf1(const uint32_t t[3], const unsigned char *cell, const 
 #define sn_k_surf1 sn_k_surf1_ref
 #endif
 
+
+/* ---- the contact rows' point (sn_contact.c, plain lattice, exact sums):
+ * the corners' weights phi, the free corners' squared weights fw = sum over
+ * v_a < nF of phi_a^2, and the point and its predicted velocity
+ * sp = sum_a phi_a p_a (p: pos for free corners, pst for skeleton ones at
+ * 3 (v_a - nF)), sv = sum_a phi_a v_a (vpre for free, vel for skeleton).
+ * Bits: fixed, exact int64 sums (phi_a^2 <= 2^60 summing to <= 2^60; |p|,
+ * |v| <= 2^31: partial sums below 2^62), any order; float, each sum a =
+ * 0..7 from 0 in order, the skeleton corners' fw terms +0 (adding +0 to a
+ * sum >= +0 changes no bit). AVX2: the corners in lanes, the positions by
+ * masked gathers (a lane's other array is not read). ---- */
+SN_INLINE void sn_k_ct8_ref(const uint32_t t[3], const uint16_t vx[8], uint32_t nF, const sn_q *pos, const sn_q *pst,
+                            const sn_q *vel, const sn_q *vpre, sn_q phi[8], sn_acc *fw, sn_acc sp[3], sn_acc sv[3]) {
+    sn_acc w = 0, p0 = 0, p1 = 0, p2 = 0, v0 = 0, v1 = 0, v2 = 0;
+    uint32_t k;
+    sn_k_tri_w(t, phi);
+    for (k = 0; k < 8; k++)
+        if (vx[k] < nF) w += sn_mul(phi[k], phi[k]);
+    for (k = 0; k < 8; k++) {
+        const uint32_t a = vx[k];
+        const sn_q *pp = a < nF ? pos + 3 * a : pst + 3 * (a - nF), *vv = a < nF ? vpre + 3 * a : vel + 3 * a;
+        p0 += sn_mul(phi[k], pp[0]); p1 += sn_mul(phi[k], pp[1]); p2 += sn_mul(phi[k], pp[2]);
+        v0 += sn_mul(phi[k], vv[0]); v1 += sn_mul(phi[k], vv[1]); v2 += sn_mul(phi[k], vv[2]);
+    }
+    *fw = w;
+    sp[0] = p0; sp[1] = p1; sp[2] = p2; sv[0] = v0; sv[1] = v1; sv[2] = v2;
+}
+#if defined(SN_KERNELS_AVX2) || defined(SN_KERNELS_FAVX2)
+/* lane a: free ? A[3 v_a + k] : B[3 (v_a - nF) + k] (ia, ib the two indices; off lanes not read) */
+#if defined(SN_FLOAT)
+#define SN_K_G2(A, B, ia, ib, fr, k) \
+    _mm256_mask_i32gather_ps(_mm256_mask_i32gather_ps(_mm256_setzero_ps(), (A) + (k), ia, _mm256_castsi256_ps(fr), 4), (B) + (k), ib, \
+                             _mm256_castsi256_ps(_mm256_xor_si256(fr, _mm256_set1_epi32(-1))), 4)
+#else
+#define SN_K_G2(A, B, ia, ib, fr, k) \
+    _mm256_mask_i32gather_epi32(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), (const int *)((A) + (k)), ia, fr, 4), \
+                                (const int *)((B) + (k)), ib, _mm256_xor_si256(fr, _mm256_set1_epi32(-1)), 4)
+#endif
+SN_INLINE void sn_k_ct8(const uint32_t t[3], const uint16_t vx[8], uint32_t nF, const sn_q *pos, const sn_q *pst,
+                        const sn_q *vel, const sn_q *vpre, sn_q phi[8], sn_acc *fw, sn_acc sp[3], sn_acc sv[3]) {
+    __m256i wx, wy, wz;
+    const __m256i v8 = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)vx));
+    const __m256i fr = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)nF), v8); /* v_a < nF (both below 2^16) */
+    const __m256i ia = _mm256_add_epi32(v8, _mm256_add_epi32(v8, v8));
+    const __m256i ib = _mm256_sub_epi32(ia, _mm256_set1_epi32((int32_t)(3 * nF)));
+    SN_K_W8(t, wx, wy, wz);
+#if defined(SN_FLOAT)
+    {
+        const __m256 ph = _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(wx), _mm256_cvtepi32_ps(wy)), _mm256_cvtepi32_ps(wz)),
+                                        _mm256_set1_ps(1.0f / 35184372088832.0f)), /* sn_k_tri_w's floats */
+                     pf = _mm256_and_ps(ph, _mm256_castsi256_ps(fr));
+        _mm256_storeu_ps(phi, ph);
+        *fw = sn_k_fsum8_seq(_mm256_mul_ps(pf, pf));
+        sp[0] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(pos, pst, ia, ib, fr, 0)));
+        sp[1] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(pos, pst, ia, ib, fr, 1)));
+        sp[2] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(pos, pst, ia, ib, fr, 2)));
+        sv[0] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(vpre, vel, ia, ia, fr, 0)));
+        sv[1] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(vpre, vel, ia, ia, fr, 1)));
+        sv[2] = sn_k_fsum8_seq(_mm256_mul_ps(ph, SN_K_G2(vpre, vel, ia, ia, fr, 2)));
+    }
+#else
+    {
+        const __m256i half = _mm256_set1_epi64x((int64_t)1 << 14), xy = _mm256_mullo_epi32(wx, wy);
+        const __m256i pe = _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(xy, wz), half), 15);
+        const __m256i po = _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(xy, 32), _mm256_srli_epi64(wz, 32)), half), 15);
+        const __m256i ph = _mm256_blend_epi32(pe, _mm256_slli_epi64(po, 32), 0xAA), pf = _mm256_and_si256(ph, fr);
+        _mm256_storeu_si256((__m256i *)(void *)phi, ph);
+        *fw = sn_k_dot8_64(pf, pf);
+        sp[0] = sn_k_dot8_64(ph, SN_K_G2(pos, pst, ia, ib, fr, 0));
+        sp[1] = sn_k_dot8_64(ph, SN_K_G2(pos, pst, ia, ib, fr, 1));
+        sp[2] = sn_k_dot8_64(ph, SN_K_G2(pos, pst, ia, ib, fr, 2));
+        sv[0] = sn_k_dot8_64(ph, SN_K_G2(vpre, vel, ia, ia, fr, 0));
+        sv[1] = sn_k_dot8_64(ph, SN_K_G2(vpre, vel, ia, ia, fr, 1));
+        sv[2] = sn_k_dot8_64(ph, SN_K_G2(vpre, vel, ia, ia, fr, 2));
+    }
+#endif
+}
+#undef SN_K_G2
+#else
+#define sn_k_ct8 sn_k_ct8_ref
+#endif
+
 #endif
