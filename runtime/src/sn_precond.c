@@ -170,6 +170,26 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
 #elif defined(SN_KERNELS_FAVX2)
 /* The float flavour's (AVX2): the same passes fused, each value the
  * reference's floats (sn_kernels_fsimd.h: the operations in its order). */
+/* sn_out(sn_out(a) - b) (fix round 4): when neither a nor a - b has a lane
+ * to clamp, sn_out leaves both and the value is a - b, with no count; one
+ * test for the two (otherwise the two fv_out3, the reference's order) */
+SN_INLINE sn_fv ic_out_sub(sn_fv a, sn_fv b, uint32_t *sat) {
+    const sn_fv d = FV_SUB(a, b);
+    if (!(_mm_movemask_ps(_mm_or_ps(FV_BAD(a), FV_BAD(d))) & 7)) return d;
+    return fv_out3(FV_SUB(fv_out3(a, sat), b), sat);
+}
+/* the backward vertex step: z'_j = sn_out(sn_out(w) - l) to zq_j, z_j =
+ * sn_out(R z'_j) (c: R's columns); no lane to clamp in w, w - l and R (w - l):
+ * one test, their values; otherwise the three fv_out3 in order */
+SN_INLINE void ic_zstep(sn_fv w, sn_fv l, const sn_fv c[3], sn_acc *zqj, sn_q *zj, uint32_t *sat) {
+    sn_fv d = FV_SUB(w, l), z = FV_MAC3(c, SN_K_LANE(d, 0), SN_K_LANE(d, 1), SN_K_LANE(d, 2));
+    if (_mm_movemask_ps(_mm_or_ps(_mm_or_ps(FV_BAD(w), FV_BAD(d)), FV_BAD(z))) & 7) {
+        d = fv_out3(FV_SUB(fv_out3(w, sat), l), sat);
+        z = fv_out3(FV_MAC3(c, SN_K_LANE(d, 0), SN_K_LANE(d, 1), SN_K_LANE(d, 2)), sat);
+    }
+    fv_st3(zqj, d); /* z'_j, for the rows above */
+    fv_st3(zj, z);
+}
 static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
                      uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
@@ -183,26 +203,27 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
         const sn_q *rj = r + 3 * j;
         sn_fv c[3], y;
         uint32_t m;
-        fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t) */
-        y = fv_out3(FV_SUB(fv_out3(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), sat), fv_ld3(acc + 3 * j)), sat);
+        fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t), y = sn_out(t - acc_j) */
+        y = ic_out_sub(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), fv_ld3(acc + 3 * j), sat);
         fv_st3(z + 3 * j, y);
         m = sn_k_ic_fwd_ops(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, SN_K_LANE(y, 0), SN_K_LANE(y, 1),
                             SN_K_LANE(y, 2), nF, acc);
-        acc[3 * j] = (sn_acc)m; /* acc_j is consumed: row j's free column count */
+        memcpy(acc + 3 * j, &m, 4); /* acc_j is consumed: row j's free column count (its bits: no conversion) */
         n += m;
     }
     j = nF;
     while (j-- > 0) {
-        const uint32_t m = (uint32_t)acc[3 * j], b = sn_rd_u32(rp + 4 * j);
+        const uint32_t b = sn_rd_u32(rp + 4 * j);
         const sn_q *yj = z + 3 * j;
-        sn_fv c[3], w;
+        uint32_t m;
+        sn_fv c[3], w, l;
+        memcpy(&m, acc + 3 * j, 4);
         sn_k_sym_cols(P + (size_t)j * 6 * SN_REAL_BYTES, c); /* w = D^-1 y_j (sn_k_sym_out) */
-        w = fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(yj[0]), FV_SET1(yj[1]), FV_SET1(yj[2]))), sat);
+        w = FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(yj[0]), FV_SET1(yj[1]), FV_SET1(yj[2])));
         n -= m;
-        w = fv_out3(FV_SUB(w, sn_k_ic_bwd_rowv(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc)), sat);
-        fv_st3(acc + 3 * j, w); /* z'_j, for the rows above */
+        l = sn_k_ic_bwd_rowv(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc);
         fv_cols(R + rs * j, c); /* z_j = R z'_j (sn_k_rot) */
-        fv_st3(z + 3 * j, fv_out3(FV_MAC3(c, SN_K_LANE(w, 0), SN_K_LANE(w, 1), SN_K_LANE(w, 2)), sat));
+        ic_zstep(w, l, c, acc + 3 * j, z + 3 * j, sat);
     }
 }
 #else
