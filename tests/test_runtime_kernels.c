@@ -1854,6 +1854,11 @@ static float frnd(int wild) {
     if (k == 2) return -0.0f;
     return (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 12u));
 }
+/* uniform in +-0.6 SN_FLIM: differences and 3-term products of such values
+ * clamp now and then, one step at a time */
+static float fnear(void) {
+    return (float)rnd_in(1 << 20) / 1048576.0f * 0.6f * SN_FLIM;
+}
 static void test_frhs_flat(void) {
     static sn_q v[48], x[48], u1[48], u2[48];
     static sn_acc a[48];
@@ -2002,6 +2007,10 @@ static void test_corner_c0(void) {
         for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
         for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(frnd(wild)));
         for (k = 0; k < 3; k++) { pa[k] = frnd(wild); p0[k] = frnd(wild); wa[k] = frnd(wild); w0[k] = frnd(wild); }
+        if (t % 4 == 1) { /* inputs within +-0.6 SN_FLIM: one step alone clamps (the kernel's one test for six) */
+            for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(fnear()));
+            for (k = 0; k < 3; k++) { pa[k] = fnear(); p0[k] = fnear(); wa[k] = fnear(); w0[k] = fnear(); }
+        }
         sn_k_rotm_ld(&rm, R);
         sn_k_c0_ld(&c0, p0, w0, rest, ib);
         sn_k_corner_c0(&rm, &c0, pa, wa, rest, ia, d1, u1, &s1);
