@@ -1571,7 +1571,7 @@ static void test_ic_fwd_run(void) {
 static void test_ic_fused(void) {
     static unsigned char L[13 * 20], cols[26];
     static sn_acc zq[90], a1[90], a2[90];
-    int t, bad_r = 0, bad_c = 0;
+    int t, bad_r = 0, bad_c = 0, bad_f = 0;
     for (t = 0; t < 4000; t++) {
         const uint32_t nb = rnd32() % 14u, nF = 24u;
         uint32_t e, k;
@@ -1612,6 +1612,13 @@ static void test_ic_fused(void) {
             const sn_fv r = sn_k_ic_bwd_rowv(L, cols, nb, zq);
             FV_ST4(lv, r);
         }
+        if (nb) { /* the row with its first block's z'_i from a register (fix round 4): the same floats */
+            sn_acc lw[4];
+            FV_ST4(lw, sn_k_ic_bwd_rowr(L, cols, nb, zq, fv_ld3(zq + 3 * cols[0]), 1));
+            bad_f += memcmp(lw, lr, 3 * sizeof lw[0]) != 0;
+            FV_ST4(lw, sn_k_ic_bwd_rowr(L, cols, nb, zq, FV_SET1(NAN), 0)); /* hf 0: the register unread */
+            bad_f += memcmp(lw, lr, 3 * sizeof lw[0]) != 0;
+        }
 #else
         _mm256_storeu_si256((__m256i *)(void *)lv, sn_k_ic_bwd_rowq(L, cols, nb, zq));
 #endif
@@ -1630,6 +1637,12 @@ static void test_ic_fused(void) {
     }
     T_CHECK(bad_r == 0, "fused IC(0) backward rows (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_r);
     T_CHECK(bad_c == 0, "fused IC(0) forward columns (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_c);
+#if defined(SN_FLOAT)
+    T_CHECK(bad_f == 0, "fused IC(0) backward rows, first z from a register (path %s): %d of 2 x 4000 differ from the reference",
+            sn_kernels_name(), bad_f);
+#else
+    (void)bad_f;
+#endif
 }
 #endif
 
