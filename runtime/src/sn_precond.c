@@ -197,8 +197,7 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
     const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
     const uint32_t nF = v->nF;
     uint32_t j, n = 0;
-    sn_fv nx = FV_SET1(0.0f); /* acc_j when hn: column j - 1 added to it last */
-    int hn = 0;
+    sn_fv nx = FV_SET1(0.0f); /* acc_j: column j - 1 read it (and added to it last, if row j is in it) */
     (void)kk;
     for (j = 0; j < 3 * nF; j++) acc[j] = 0;
     for (j = 0; j < nF; j++) {
@@ -208,17 +207,22 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
         sn_fv c[3], y, y0, y1, y2;
         uint32_t m;
         fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t), y = sn_out(t - acc_j) */
-        y = ic_out_sub(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), hn ? nx : fv_ld3(acc + 3 * j), sat);
+        y = ic_out_sub(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), nx, sat);
         fv_st3(z + 3 * j, y);
         y0 = SN_K_LANE(y, 0); y1 = SN_K_LANE(y, 1); y2 = SN_K_LANE(y, 2);
-        /* row j + 1, if in the column, is its first (rows ascend, the
-         * validator): its sum stays in a register for the next column, off
-         * memory on the sweep's chain (fix round 4; the same floats) */
-        m = (uint32_t)(hn = e < end && j + 1 < nF && sn_rd_u16(cols + 2 * e) == j + 1);
-        if (hn) {
-            sn_fv u[3];
-            sn_k_ic_rows(blk, u);
-            nx = FV_ADD(fv_ld3(acc + 3 * j + 3), FV_MAC3(u, y0, y1, y2));
+        /* acc_j+1 is final but for row j + 1 of this column, its first
+         * block if there (rows ascend, the validator): the sum goes to the
+         * next column in a register, off memory on the sweep's chain (fix
+         * round 4; the same floats) */
+        m = 0;
+        if (j + 1 < nF) {
+            nx = fv_ld3(acc + 3 * j + 3);
+            if (e < end && sn_rd_u16(cols + 2 * e) == j + 1) {
+                sn_fv u[3];
+                sn_k_ic_rows(blk, u);
+                nx = FV_ADD(nx, FV_MAC3(u, y0, y1, y2));
+                m = 1;
+            }
         }
         m += sn_k_ic_fwd_ops(blk + m * SN_ELEM_ICHOL, cols + 2 * (e + m), cols + 2 * end, y0, y1, y2, nF, acc);
         memcpy(acc + 3 * j, &m, 4); /* acc_j is consumed: row j's free column count (its bits: no conversion) */
