@@ -1612,7 +1612,7 @@ static void test_ic_fused(void) {
             const sn_fv r = sn_k_ic_bwd_rowv(L, cols, nb, zq);
             FV_ST4(lv, r);
         }
-        if (nb) { /* the row with its first block's z'_i from a register (fix round 4): the same floats */
+        if (nb) { /* the row with its first block's z'_i from a register (x86-64 round 4): the same floats */
             sn_acc lw[4];
             FV_ST4(lw, sn_k_ic_bwd_rowr(L, cols, nb, zq, fv_ld3(zq + 3 * cols[0]), 1));
             bad_f += memcmp(lw, lr, 3 * sizeof lw[0]) != 0;

@@ -105,7 +105,7 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
         L[i] = FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2]));
         bad = _mm_or_ps(bad, FV_BAD(L[i]));
     }
-    /* sn_out of each: one test for the corners (fix round 4), per corner
+    /* sn_out of each: one test for the corners (x86-64 round 4), per corner
      * only if a lane clamps (the same values and count) */
     if (_mm_movemask_ps(bad) & 7) {
 #pragma GCC unroll 8
@@ -146,7 +146,7 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
 void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
                      uint32_t *sat) {
     const uint32_t fm = sn_k_free8(cl, nF);
-#if defined(__POPCNT__) /* every AVX2 target has it (fix round 4: one instruction for ten) */
+#if defined(__POPCNT__) /* every AVX2 target has it (x86-64 round 4: one instruction for ten) */
     const uint32_t n = (uint32_t)__builtin_popcount(fm); /* the free corners' count */
 #else
     uint32_t n = fm - (fm >> 1 & 0x55u);
@@ -154,7 +154,7 @@ void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t n
     n = (n + (n >> 4)) & 0x0Fu; /* the free corners' count */
 #endif
     sn_k_rotm m;
-    if (!fm) return; /* no free corner (a sixth of cow_fem's cells): before the frame's loads (fix round 4) */
+    if (!fm) return; /* no free corner (a sixth of cow_fem's cells): before the frame's loads (x86-64 round 4) */
     sn_k_rotm_ld(&m, R);
     switch (n) {
     case 1: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 1); break;

@@ -455,7 +455,7 @@ SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *co
     return sn_k_ic_bwd_acc(FV_SET1(0.0f), b, cols, nb, zq); /* the reference's l = 0, then l += each block's row sums */
 }
 /* the same row with its first block's z taken from register zf when hf
- * (fix round 4: z'_j+1, just computed by the backward sweep, enters row j
+ * (x86-64 round 4: z'_j+1, just computed by the backward sweep, enters row j
  * without a store and reload on the sweep's chain); the same pairs and
  * order, the same floats (zf holds zq's value) */
 SN_INLINE sn_fv sn_k_ic_bwd_rowr(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq, sn_fv zf,

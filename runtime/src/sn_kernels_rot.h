@@ -379,7 +379,7 @@ SN_INLINE void sn_k_corner_c0(const sn_k_rotm *m, const sn_k_c0 *c0, const sn_q 
     const sn_fv *r = m->r;
     sn_fv t, x;
 #if defined(SN_KERNELS_FAVX2)
-    { /* the six values without their sn_out and one test (fix round 4):
+    { /* the six values without their sn_out and one test (x86-64 round 4):
        * when no lane clamps, sn_out leaves every one, so these are the
        * values below; otherwise the steps below */
         const sn_fv t1 = FV_ADD(fv_ld3(wa), c0->w0), t2 = FV_ADD(fv_ld3(pa), c0->p0);

@@ -170,7 +170,7 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
 #elif defined(SN_KERNELS_FAVX2)
 /* The float flavour's (AVX2): the same passes fused, each value the
  * reference's floats (sn_kernels_fsimd.h: the operations in its order). */
-/* sn_out(sn_out(a) - b) (fix round 4): when neither a nor a - b has a lane
+/* sn_out(sn_out(a) - b) (x86-64 round 4): when neither a nor a - b has a lane
  * to clamp, sn_out leaves both and the value is a - b, with no count; one
  * test for the two (otherwise the two fv_out3, the reference's order) */
 SN_INLINE sn_fv ic_out_sub(sn_fv a, sn_fv b, uint32_t *sat) {
