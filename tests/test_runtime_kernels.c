@@ -1572,7 +1572,7 @@ static void test_ic_fwd_run(void) {
 static void test_ic_fused(void) {
     static unsigned char L[13 * 20], cols[26];
     static sn_acc zq[90], a1[90], a2[90];
-    int t, bad_r = 0, bad_c = 0;
+    int t, bad_r = 0, bad_c = 0, bad_f = 0;
     for (t = 0; t < 4000; t++) {
         const uint32_t nb = rnd32() % 14u, nF = 24u;
         uint32_t e, k;
@@ -1613,6 +1613,13 @@ static void test_ic_fused(void) {
             const sn_fv r = sn_k_ic_bwd_rowv(L, cols, nb, zq);
             FV_ST4(lv, r);
         }
+        if (nb) { /* the row with its first block's z'_i from a register (x86-64 round 4): the same floats */
+            sn_acc lw[4];
+            FV_ST4(lw, sn_k_ic_bwd_rowr(L, cols, nb, zq, fv_ld3(zq + 3 * cols[0]), 1));
+            bad_f += memcmp(lw, lr, 3 * sizeof lw[0]) != 0;
+            FV_ST4(lw, sn_k_ic_bwd_rowr(L, cols, nb, zq, FV_SET1(NAN), 0)); /* hf 0: the register unread */
+            bad_f += memcmp(lw, lr, 3 * sizeof lw[0]) != 0;
+        }
 #else
         _mm256_storeu_si256((__m256i *)(void *)lv, sn_k_ic_bwd_rowq(L, cols, nb, zq));
 #endif
@@ -1631,6 +1638,12 @@ static void test_ic_fused(void) {
     }
     T_CHECK(bad_r == 0, "fused IC(0) backward rows (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_r);
     T_CHECK(bad_c == 0, "fused IC(0) forward columns (path %s): %d of 4000 differ from the reference", sn_kernels_name(), bad_c);
+#if defined(SN_FLOAT)
+    T_CHECK(bad_f == 0, "fused IC(0) backward rows, first z from a register (path %s): %d of 2 x 4000 differ from the reference",
+            sn_kernels_name(), bad_f);
+#else
+    (void)bad_f;
+#endif
 }
 #endif
 
@@ -1856,6 +1869,11 @@ static float frnd(int wild) {
     if (k == 2) return -0.0f;
     return (float)rnd_in(1 << 20) / (float)(1u << (rnd32() % 12u));
 }
+/* uniform in +-0.6 SN_FLIM: differences and 3-term products of such values
+ * clamp now and then, one step at a time */
+static float fnear(void) {
+    return (float)rnd_in(1 << 20) / 1048576.0f * 0.6f * SN_FLIM;
+}
 static void test_frhs_flat(void) {
     static sn_q v[48], x[48], u1[48], u2[48];
     static sn_acc a[48];
@@ -2004,6 +2022,10 @@ static void test_corner_c0(void) {
         for (k = 0; k < 9; k++) R[k] = (float)rnd_in(1 << 20) / 1048576.0f;
         for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(frnd(wild)));
         for (k = 0; k < 3; k++) { pa[k] = frnd(wild); p0[k] = frnd(wild); wa[k] = frnd(wild); w0[k] = frnd(wild); }
+        if (t % 4 == 1) { /* inputs within +-0.6 SN_FLIM: one step alone clamps (the kernel's one test for six) */
+            for (k = 0; k < 30; k++) put32(rest + 4 * k, fbits(fnear()));
+            for (k = 0; k < 3; k++) { pa[k] = fnear(); p0[k] = fnear(); wa[k] = fnear(); w0[k] = fnear(); }
+        }
         sn_k_rotm_ld(&rm, R);
         sn_k_c0_ld(&c0, p0, w0, rest, ib);
         sn_k_corner_c0(&rm, &c0, pa, wa, rest, ia, d1, u1, &s1);

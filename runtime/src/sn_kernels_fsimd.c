@@ -95,14 +95,25 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
                             sn_acc *acc, uint32_t *sat, const uint32_t nf) {
     float u[32];
     uint32_t fc[8] = {0}, vi[8] = {0}, i, j; /* set for i < nf: zeroed for GCC's flow analysis */
-    sn_fv L[8], c[3];
+    sn_fv L[8], c[3], bad = _mm_setzero_ps();
 #pragma GCC unroll 8
     for (i = 0; i < nf; i++, fm &= fm - 1u) {
         const sn_q *v;
         fc[i] = (uint32_t)__builtin_ctz(fm);
         vi[i] = sn_rd_u16(cl + 2 * fc[i]);
         v = d + 3 * vi[i];
-        FV_ST4(u + 4 * i, fv_out3(FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2])), sat)); /* lane 3 unread */
+        L[i] = FV_MAC3(m->r, FV_SET1(v[0]), FV_SET1(v[1]), FV_SET1(v[2]));
+        bad = _mm_or_ps(bad, FV_BAD(L[i]));
+    }
+    /* sn_out of each: one test for the corners (x86-64 round 4), per corner
+     * only if a lane clamps (the same values and count) */
+    if (_mm_movemask_ps(bad) & 7) {
+#pragma GCC unroll 8
+        for (i = 0; i < nf; i++) L[i] = fv_out3(L[i], sat);
+    }
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) {
+        FV_ST4(u + 4 * i, L[i]); /* lane 3 unread */
         L[i] = FV_SET1(0.0f);
     }
 #pragma GCC unroll 8
@@ -117,9 +128,16 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
         }
         L[i] = la;
     }
+    bad = _mm_setzero_ps();
+#pragma GCC unroll 8
+    for (i = 0; i < nf; i++) bad = _mm_or_ps(bad, FV_BAD(L[i]));
+    if (_mm_movemask_ps(bad) & 7) { /* as above */
+#pragma GCC unroll 8
+        for (i = 0; i < nf; i++) L[i] = fv_out3(L[i], sat);
+    }
 #pragma GCC unroll 8
     for (i = 0; i < nf; i++) { /* sn_k_out_rot_acc_m: acc += R sn_out(l) */
-        const sn_fv t = fv_out3(L[i], sat);
+        const sn_fv t = L[i];
         sn_acc *a = acc + 3 * vi[i];
         fv_st3(a, FV_ADD(fv_ld3(a), FV_MAC3(m->c, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2))));
     }
@@ -128,10 +146,15 @@ SN_INLINE void cell_stiff_n(const unsigned char *K, const unsigned char *cl, uin
 void sn_k_cell_stiff(const unsigned char *K, const unsigned char *cl, uint32_t nF, const sn_q *R, const sn_q *d, sn_acc *acc,
                      uint32_t *sat) {
     const uint32_t fm = sn_k_free8(cl, nF);
+#if defined(__POPCNT__) /* every AVX2 target has it (x86-64 round 4: one instruction for ten) */
+    const uint32_t n = (uint32_t)__builtin_popcount(fm); /* the free corners' count */
+#else
     uint32_t n = fm - (fm >> 1 & 0x55u);
-    sn_k_rotm m;
     n = (n & 0x33u) + (n >> 2 & 0x33u);
     n = (n + (n >> 4)) & 0x0Fu; /* the free corners' count */
+#endif
+    sn_k_rotm m;
+    if (!fm) return; /* no free corner (a sixth of cow_fem's cells): before the frame's loads (x86-64 round 4) */
     sn_k_rotm_ld(&m, R);
     switch (n) {
     case 1: cell_stiff_n(K, cl, fm, &m, d, acc, sat, 1); break;

@@ -41,6 +41,10 @@ SN_INLINE void fv_st3(float *p, sn_fv v) {
     _mm_storel_pi((__m64 *)(void *)p, v);
     memcpy(p + 2, &z, 4);
 }
+/* the lanes sn_out would change (|a| > SN_FLIM or NaN: fv_out3's test) as a
+ * compare mask; OR-ed over several vectors, one test for all of them when
+ * none clamps, the common case (x86-64 round 4) */
+#define FV_BAD(a) _mm_cmp_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), (a)), _mm_set1_ps(SN_FLIM), _CMP_NLE_UQ)
 /* rows and columns of a row-major 3x3 from v0 = B0..B7, v1 = B1..B8 */
 #define FV_PERM(v, a, b, c) _mm256_castps256_ps128(_mm256_permutevar8x32_ps((v), _mm256_setr_epi32(a, b, c, c, 0, 0, 0, 0)))
 SN_INLINE void fv_rows8(__m256 v0, __m256 v1, sn_fv r[3]) {

@@ -429,8 +429,11 @@ SN_INLINE __m256 sn_k_ic_cols2(const unsigned char *b, __m256 c[3]) {
     return sc;
 }
 #define SN_K_ZZ(p, q) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(p)), _mm_broadcast_ss(q), 1)
-SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
-    sn_fv a = FV_SET1(0.0f); /* the reference's l = 0, then l += each block's row sums */
+/* a += each block's row sums, in order (from a = 0: the reference's l) */
+#if defined(__GNUC__)
+__attribute__((always_inline)) /* GCC made it a call once two callers had it */
+#endif
+SN_INLINE sn_fv sn_k_ic_bwd_acc(sn_fv a, const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
     uint32_t e = 0;
     for (; e + 2 <= nb; e += 2, b += 2 * SN_ELEM_ICHOL) {
         const sn_acc *z1 = zq + 3 * sn_rd_u16(cols + 2 * e), *z2 = zq + 3 * sn_rd_u16(cols + 2 * e + 2);
@@ -447,6 +450,35 @@ SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *co
         a = FV_ADD(a, FV_MAC3(c, FV_SET1(zi[0]), FV_SET1(zi[1]), FV_SET1(zi[2])));
     }
     return a;
+}
+SN_INLINE sn_fv sn_k_ic_bwd_rowv(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq) {
+    return sn_k_ic_bwd_acc(FV_SET1(0.0f), b, cols, nb, zq); /* the reference's l = 0, then l += each block's row sums */
+}
+/* the same row with its first block's z taken from register zf when hf
+ * (x86-64 round 4: z'_j+1, just computed by the backward sweep, enters row j
+ * without a store and reload on the sweep's chain); the same pairs and
+ * order, the same floats (zf holds zq's value) */
+SN_INLINE sn_fv sn_k_ic_bwd_rowr(const unsigned char *b, const unsigned char *cols, uint32_t nb, const sn_acc *zq, sn_fv zf,
+                                 int hf) {
+    sn_fv a = FV_SET1(0.0f);
+    const sn_fv f0 = _mm_permute_ps(zf, 0x00), f1 = _mm_permute_ps(zf, 0x55), f2 = _mm_permute_ps(zf, 0xAA);
+    if (hf && nb >= 2) {
+        const sn_acc *z2 = zq + 3 * sn_rd_u16(cols + 2);
+        __m256 c[3], p;
+        (void)sn_k_ic_cols2(b, c);
+        p = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(c[0], _mm256_insertf128_ps(_mm256_castps128_ps256(f0), _mm_broadcast_ss(z2), 1)),
+                          _mm256_mul_ps(c[1], _mm256_insertf128_ps(_mm256_castps128_ps256(f1), _mm_broadcast_ss(z2 + 1), 1))),
+            _mm256_mul_ps(c[2], _mm256_insertf128_ps(_mm256_castps128_ps256(f2), _mm_broadcast_ss(z2 + 2), 1)));
+        a = FV_ADD(FV_ADD(a, _mm256_castps256_ps128(p)), _mm256_extractf128_ps(p, 1));
+        return sn_k_ic_bwd_acc(a, b + 2 * SN_ELEM_ICHOL, cols + 4, nb - 2, zq);
+    }
+    if (hf) { /* nb == 1 */
+        sn_fv c[3];
+        sn_k_ic_cols(b, c);
+        return FV_ADD(a, FV_MAC3(c, f0, f1, f2));
+    }
+    return sn_k_ic_bwd_rowv(b, cols, nb, zq);
 }
 #undef SN_K_ZZ
 #endif

@@ -378,6 +378,23 @@ SN_INLINE void sn_k_corner_c0(const sn_k_rotm *m, const sn_k_c0 *c0, const sn_q 
     const float *f = (const float *)(const void *)rest; /* float blob reals, little-endian host */
     const sn_fv *r = m->r;
     sn_fv t, x;
+#if defined(SN_KERNELS_FAVX2)
+    { /* the six values without their sn_out and one test (x86-64 round 4):
+       * when no lane clamps, sn_out leaves every one, so these are the
+       * values below; otherwise the steps below */
+        const sn_fv t1 = FV_ADD(fv_ld3(wa), c0->w0), t2 = FV_ADD(fv_ld3(pa), c0->p0);
+        const sn_fv u = FV_MAC3(r, SN_K_LANE(t1, 0), SN_K_LANE(t1, 1), SN_K_LANE(t1, 2));
+        const sn_fv l = FV_MAC3(r, SN_K_LANE(t2, 0), SN_K_LANE(t2, 1), SN_K_LANE(t2, 2));
+        const sn_fv x1 = FV_ADD(fv_ld3(f + ia), c0->x0), d1 = FV_ADD(l, SN_K_NEG(x1));
+        const sn_fv bad = _mm_or_ps(_mm_or_ps(_mm_or_ps(FV_BAD(t1), FV_BAD(t2)), _mm_or_ps(FV_BAD(u), FV_BAD(l))),
+                                    _mm_or_ps(FV_BAD(x1), FV_BAD(d1)));
+        if (!(_mm_movemask_ps(bad) & 7)) {
+            fv_st3(uu, u);
+            fv_st3(d, d1);
+            return;
+        }
+    }
+#endif
     t = fv_out3(FV_ADD(fv_ld3(wa), c0->w0), sat);
     fv_st3(uu, fv_out3(FV_MAC3(r, SN_K_LANE(t, 0), SN_K_LANE(t, 1), SN_K_LANE(t, 2)), sat));
     t = fv_out3(FV_ADD(fv_ld3(pa), c0->p0), sat);

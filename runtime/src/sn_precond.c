@@ -170,39 +170,79 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
 #elif defined(SN_KERNELS_FAVX2)
 /* The float flavour's (AVX2): the same passes fused, each value the
  * reference's floats (sn_kernels_fsimd.h: the operations in its order). */
+/* sn_out(sn_out(a) - b) (x86-64 round 4): when neither a nor a - b has a lane
+ * to clamp, sn_out leaves both and the value is a - b, with no count; one
+ * test for the two (otherwise the two fv_out3, the reference's order) */
+SN_INLINE sn_fv ic_out_sub(sn_fv a, sn_fv b, uint32_t *sat) {
+    const sn_fv d = FV_SUB(a, b);
+    if (!(_mm_movemask_ps(_mm_or_ps(FV_BAD(a), FV_BAD(d))) & 7)) return d;
+    return fv_out3(FV_SUB(fv_out3(a, sat), b), sat);
+}
+/* the backward vertex step: z'_j = sn_out(sn_out(w) - l) to zq_j, z_j =
+ * sn_out(R z'_j) (c: R's columns); no lane to clamp in w, w - l and R (w - l):
+ * one test, their values; otherwise the three fv_out3 in order */
+SN_INLINE sn_fv ic_zstep(sn_fv w, sn_fv l, const sn_fv c[3], sn_acc *zqj, sn_q *zj, uint32_t *sat) {
+    sn_fv d = FV_SUB(w, l), z = FV_MAC3(c, SN_K_LANE(d, 0), SN_K_LANE(d, 1), SN_K_LANE(d, 2));
+    if (_mm_movemask_ps(_mm_or_ps(_mm_or_ps(FV_BAD(w), FV_BAD(d)), FV_BAD(z))) & 7) {
+        d = fv_out3(FV_SUB(fv_out3(w, sat), l), sat);
+        z = fv_out3(FV_MAC3(c, SN_K_LANE(d, 0), SN_K_LANE(d, 1), SN_K_LANE(d, 2)), sat);
+    }
+    fv_st3(zqj, d); /* z'_j, for the rows above */
+    fv_st3(zj, z);
+    return d;
+}
 static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t rs, const sn_q *r, sn_q *z, sn_acc *acc,
                      uint32_t *sat) {
     const unsigned char *rp = v->sec[SN_SEC_ROWPTR], *cols = v->sec[SN_SEC_COLS];
     const unsigned char *L = v->sec[SN_SEC_ICHOL], *P = v->sec[SN_SEC_PRECOND];
     const uint32_t nF = v->nF;
     uint32_t j, n = 0;
+    sn_fv nx = FV_SET1(0.0f); /* acc_j: column j - 1 read it (and added to it last, if row j is in it) */
     (void)kk;
     for (j = 0; j < 3 * nF; j++) acc[j] = 0;
     for (j = 0; j < nF; j++) {
         const uint32_t e = sn_rd_u32(rp + 4 * j), end = sn_rd_u32(rp + 4 * j + 4);
+        const unsigned char *blk = L + (size_t)n * SN_ELEM_ICHOL;
         const sn_q *rj = r + 3 * j;
-        sn_fv c[3], y;
+        sn_fv c[3], y, y0, y1, y2;
         uint32_t m;
-        fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t) */
-        y = fv_out3(FV_SUB(fv_out3(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), sat), fv_ld3(acc + 3 * j)), sat);
+        fv_rows(R + rs * j, c); /* t = R^T r_j (sn_k_rot_t), y = sn_out(t - acc_j) */
+        y = ic_out_sub(FV_MAC3(c, FV_SET1(rj[0]), FV_SET1(rj[1]), FV_SET1(rj[2])), nx, sat);
         fv_st3(z + 3 * j, y);
-        m = sn_k_ic_fwd_ops(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * e, cols + 2 * end, SN_K_LANE(y, 0), SN_K_LANE(y, 1),
-                            SN_K_LANE(y, 2), nF, acc);
-        acc[3 * j] = (sn_acc)m; /* acc_j is consumed: row j's free column count */
+        y0 = SN_K_LANE(y, 0); y1 = SN_K_LANE(y, 1); y2 = SN_K_LANE(y, 2);
+        /* acc_j+1 is final but for row j + 1 of this column, its first
+         * block if there (rows ascend, the validator): the sum goes to the
+         * next column in a register, off memory on the sweep's chain (fix
+         * round 4; the same floats) */
+        m = 0;
+        if (j + 1 < nF) {
+            nx = fv_ld3(acc + 3 * j + 3);
+            if (e < end && sn_rd_u16(cols + 2 * e) == j + 1) {
+                sn_fv u[3];
+                sn_k_ic_rows(blk, u);
+                nx = FV_ADD(nx, FV_MAC3(u, y0, y1, y2));
+                m = 1;
+            }
+        }
+        m += sn_k_ic_fwd_ops(blk + m * SN_ELEM_ICHOL, cols + 2 * (e + m), cols + 2 * end, y0, y1, y2, nF, acc);
+        memcpy(acc + 3 * j, &m, 4); /* acc_j is consumed: row j's free column count (its bits: no conversion) */
         n += m;
     }
     j = nF;
+    nx = FV_SET1(0.0f); /* z'_j+1 (the previous vertex's) */
     while (j-- > 0) {
-        const uint32_t m = (uint32_t)acc[3 * j], b = sn_rd_u32(rp + 4 * j);
+        const uint32_t b = sn_rd_u32(rp + 4 * j);
         const sn_q *yj = z + 3 * j;
-        sn_fv c[3], w;
+        uint32_t m;
+        sn_fv c[3], w, l;
+        memcpy(&m, acc + 3 * j, 4);
         sn_k_sym_cols(P + (size_t)j * 6 * SN_REAL_BYTES, c); /* w = D^-1 y_j (sn_k_sym_out) */
-        w = fv_out3(FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(yj[0]), FV_SET1(yj[1]), FV_SET1(yj[2]))), sat);
+        w = FV_ADD(FV_SET1(0.0f), FV_MAC3(c, FV_SET1(yj[0]), FV_SET1(yj[1]), FV_SET1(yj[2])));
         n -= m;
-        w = fv_out3(FV_SUB(w, sn_k_ic_bwd_rowv(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc)), sat);
-        fv_st3(acc + 3 * j, w); /* z'_j, for the rows above */
+        /* column j + 1 first in row j (free columns ascend): z'_j+1 from the register */
+        l = sn_k_ic_bwd_rowr(L + (size_t)n * SN_ELEM_ICHOL, cols + 2 * b, m, acc, nx, m && sn_rd_u16(cols + 2 * b) == j + 1);
         fv_cols(R + rs * j, c); /* z_j = R z'_j (sn_k_rot) */
-        fv_st3(z + 3 * j, fv_out3(FV_MAC3(c, SN_K_LANE(w, 0), SN_K_LANE(w, 1), SN_K_LANE(w, 2)), sat));
+        nx = ic_zstep(w, l, c, acc + 3 * j, z + 3 * j, sat);
     }
 }
 #else
