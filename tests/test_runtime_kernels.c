@@ -2003,6 +2003,57 @@ static void test_fdot(void) {
 }
 #endif
 
+#if defined(SN_K_SKEL)
+/* sn_k_skeleton against sn_skeleton's loop written here with the reference
+ * helpers (sn_rot, sn_add: the same floats and clamp count, tolerance 0):
+ * random bones, rest positions, frames (any floats: the kernel is the
+ * reference's arithmetic), translations, positions and velocities; wild
+ * cases with values beyond SN_FLIM and NaN, near cases within +-0.6 SN_FLIM
+ * so that one sum alone clamps */
+static void test_skeleton(void) {
+    enum { NV = 40, NJ = 6 };
+    static unsigned char fr[4 * NV], rest[4 * 3 * NV];
+    static sn_q jR[9 * NJ], jT[3 * NJ], p1[3 * NV], p2[3 * NV], v1[3 * NV], v2[3 * NV], d1[3 * NV], d2[3 * NV];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        const int wild = t % 4 == 0, near = t % 4 == 1;
+        const uint32_t nV = 1u + rnd32() % NV, nF = rnd32() % nV;
+        uint32_t i, k, s1 = 0, s2 = 0;
+        for (i = 0; i < NV; i++) {
+            fr[4 * i] = (unsigned char)(rnd32() % NJ);
+            for (k = 0; k < 3; k++) put32(rest + 4 * (3 * i + k), fbits(near ? fnear() : frnd(wild)));
+        }
+        for (i = 0; i < 9 * NJ; i++) jR[i] = wild ? frnd(0) : (float)rnd_in(1 << 20) / 1048576.0f;
+        for (i = 0; i < 3 * NJ; i++) jT[i] = near ? fnear() : frnd(wild);
+        for (i = 0; i < 3 * NV; i++) {
+            p1[i] = p2[i] = near ? fnear() : frnd(wild);
+            v1[i] = v2[i] = near ? fnear() : frnd(wild);
+            d1[i] = d2[i] = 0.0f;
+        }
+        sn_k_skeleton(jR, jT, fr, rest, nF, nV, p1, v1, d1, &s1);
+        for (i = nF; i < nV; i++) { /* sn_skeleton's loop, have_prev */
+            const uint32_t b = fr[4 * i];
+            sn_q x[3], p[3];
+            for (k = 0; k < 3; k++) x[k] = rd_real(rest, 3 * i + k);
+            sn_rot(jR + 9 * b, x, p, &s2);
+            for (k = 0; k < 3; k++) {
+                sn_q pn = sn_add(p[k], jT[3 * b + k], &s2);
+                sn_q vn = sn_add(pn, -p2[3 * i + k], &s2);
+                d2[3 * (i - nF) + k] = sn_add(vn, -v2[3 * i + k], &s2);
+                v2[3 * i + k] = vn;
+                p2[3 * i + k] = pn;
+            }
+        }
+        bad += memcmp(p1, p2, sizeof p1) != 0 || memcmp(v1, v2, sizeof v1) != 0 || memcmp(d1, d2, sizeof d1) != 0 ||
+               s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_skeleton (path %s): %d of 4000 cases differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("skeleton vertices: 4000 cases, %u clamps and NaN replacements", clamps);
+}
+#endif
+
 #if defined(SN_K_CORNER0)
 /* sn_k_corner_c0 (cell_forces' corner, corner 0's operands loaded once)
  * against the reference loop of cell_forces: t = sn_add(p_a, -p_0),
@@ -2757,6 +2808,9 @@ int main(void) {
 #endif
 #if defined(SN_K_CORNER0)
     test_corner_c0();
+#endif
+#if defined(SN_K_SKEL)
+    test_skeleton();
 #endif
 #if defined(SN_K_FREE8)
     test_free8();

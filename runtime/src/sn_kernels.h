@@ -265,6 +265,14 @@ void sn_k_mass_rhs(const unsigned char *rp, const unsigned char *cols, const uns
 void sn_k_grav_rhs(sn_q *b, const sn_acc *acc, const sn_q *R, const unsigned char *ml, const sn_q g[3], int modelled,
                    uint32_t nF, uint32_t *sat);
 float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n);
+/* sn_skeleton's loop after the first pose (sn_pose.c), x86-64 float: per
+ * skeleton vertex i in [nF, nV) of bone b = fr[4 i], p = sn_rot(jR_b, x_i)
+ * (x_i the rest position, REST), pn = sn_add(p, jT_b), vn = sn_add(pn,
+ * -pos_i), ds_(i-nF) = sn_add(vn, -vel_i), vel_i = vn, pos_i = pn: a
+ * vertex's 3 entries in lanes, the same floats and clamp counts */
+#define SN_K_SKEL 1
+void sn_k_skeleton(const sn_q *jR, const sn_q *jT, const unsigned char *fr, const unsigned char *rest, uint32_t nF,
+                   uint32_t nV, sn_q *pos, sn_q *vel, sn_q *ds, uint32_t *sat);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

@@ -423,6 +423,26 @@ float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n) {
     for (; i < n; i++) s += a[i] * b[i];
     return s;
 }
+/* sn_skeleton: lane k holds entry k of the reference's sn_rot / sn_add
+ * (((R_k0 x0 + R_k1 x1) + R_k2 x2), then each sum clamped by fv_out3 as
+ * sn_out would, its count per lane) */
+void sn_k_skeleton(const sn_q *jR, const sn_q *jT, const unsigned char *fr, const unsigned char *rest, uint32_t nF,
+                   uint32_t nV, sn_q *pos, sn_q *vel, sn_q *ds, uint32_t *sat) {
+    const sn_fv sg = FV_SET1(-0.0f);
+    uint32_t i;
+    for (i = nF; i < nV; i++) {
+        const uint32_t b = fr[4 * (size_t)i];
+        sn_fv c[3], pn, vn;
+        fv_cols(jR + 9 * b, c);
+        pn = fv_out3(FV_MAC3(c, FV_SET1(rd_real(rest, 3 * i)), FV_SET1(rd_real(rest, 3 * i + 1)),
+                             FV_SET1(rd_real(rest, 3 * i + 2))), sat);
+        pn = fv_out3(FV_ADD(pn, fv_ld3(jT + 3 * b)), sat);
+        vn = fv_out3(FV_ADD(pn, _mm_xor_ps(fv_ld3(pos + 3 * i), sg)), sat);
+        fv_st3(ds + 3 * (i - nF), fv_out3(FV_ADD(vn, _mm_xor_ps(fv_ld3(vel + 3 * i), sg)), sat));
+        fv_st3(vel + 3 * i, vn);
+        fv_st3(pos + 3 * i, pn);
+    }
+}
 #undef BITS4
 #endif
 

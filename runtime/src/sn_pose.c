@@ -450,6 +450,10 @@ void sn_skeleton(sn_ihdr *h, uint32_t *sat) {
     sn_q *pos = ARR(h, o_pos, sn_q), *vel = ARR(h, o_vel, sn_q), *ds = ARR(h, o_ds, sn_q); /* ds: in d's storage, live until rhs */
     const unsigned char *fr = v->sec[SN_SEC_FRAMES], *rest = v->sec[SN_SEC_REST];
     uint32_t i, k;
+#if defined(SN_K_SKEL) /* x86-64 float: the loop below in lanes (sn_kernels.h) */
+    if (h->have_prev) sn_k_skeleton(jR, jT, fr, rest, v->nF, v->nV, pos, vel, ds, sat);
+    else
+#endif
     for (i = v->nF; i < v->nV; i++) {
         uint32_t b = fr[4 * i];
         sn_q x[3], p[3];
