@@ -2054,6 +2054,46 @@ static void test_skeleton(void) {
 }
 #endif
 
+#if defined(SN_K_RIG)
+/* sn_k_rig against sn_rigs' loop written here with the reference helpers
+ * (sn_out, sn_rot, sn_add; tolerance 0, the same clamp count): random
+ * entries (vertices repeat: a later entry adds to an earlier one's sum),
+ * forces, frames (any floats), eta and b; wild cases with values beyond
+ * SN_FLIM and NaN, near cases within +-0.6 SN_FLIM */
+static void test_rig(void) {
+    enum { NE = 60, NVX = 20 };
+    static unsigned char F[4 * 3 * NE], vx[2 * NE];
+    static sn_q R[9 * NVX], b1[3 * NVX], b2[3 * NVX];
+    int t, bad = 0;
+    uint32_t clamps = 0;
+    for (t = 0; t < 4000; t++) {
+        const int wild = t % 4 == 0, near = t % 4 == 1;
+        const uint32_t first = rnd32() % NE, cnt = rnd32() % (NE - first + 1u);
+        const sn_q eta = near ? fnear() / SN_FLIM : frnd(wild);
+        uint32_t e, i, k, s1 = 0, s2 = 0;
+        for (e = 0; e < NE; e++) {
+            const uint32_t vi = rnd32() % NVX;
+            vx[2 * e] = (unsigned char)vi; vx[2 * e + 1] = 0;
+            for (k = 0; k < 3; k++) put32(F + 4 * (3 * e + k), fbits(near ? fnear() : frnd(wild)));
+        }
+        for (i = 0; i < 9 * NVX; i++) R[i] = wild ? frnd(0) : (float)rnd_in(1 << 20) / 1048576.0f;
+        for (i = 0; i < 3 * NVX; i++) b1[i] = b2[i] = near ? fnear() : frnd(wild);
+        sn_k_rig(eta, F, vx, first, cnt, R, b1, &s1);
+        for (e = first; e < first + cnt; e++) { /* sn_rigs' loop */
+            const uint32_t vi = sn_rd_u16(vx + 2 * e);
+            sn_q tt[3], f[3];
+            for (k = 0; k < 3; k++) tt[k] = sn_out(eta * rd_real(F, 3 * e + k), 0, &s2);
+            sn_rot(R + 9 * vi, tt, f, &s2);
+            for (k = 0; k < 3; k++) b2[3 * vi + k] = sn_add(b2[3 * vi + k], f[k], &s2);
+        }
+        bad += memcmp(b1, b2, sizeof b1) != 0 || s1 != s2;
+        clamps += s2;
+    }
+    T_CHECK(bad == 0, "sn_k_rig (path %s): %d of 4000 rigs differ from the reference loop", sn_kernels_name(), bad);
+    T_FIGURE("rig entries: 4000 rigs, %u clamps and NaN replacements", clamps);
+}
+#endif
+
 #if defined(SN_K_CORNER0)
 /* sn_k_corner_c0 (cell_forces' corner, corner 0's operands loaded once)
  * against the reference loop of cell_forces: t = sn_add(p_a, -p_0),
@@ -2811,6 +2851,9 @@ int main(void) {
 #endif
 #if defined(SN_K_SKEL)
     test_skeleton();
+#endif
+#if defined(SN_K_RIG)
+    test_rig();
 #endif
 #if defined(SN_K_FREE8)
     test_free8();

@@ -273,6 +273,12 @@ float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n);
 #define SN_K_SKEL 1
 void sn_k_skeleton(const sn_q *jR, const sn_q *jT, const unsigned char *fr, const unsigned char *rest, uint32_t nF,
                    uint32_t nV, sn_q *pos, sn_q *vel, sn_q *ds, uint32_t *sat);
+/* sn_rigs' entries of one rig (sn_rig.c), x86-64 float: for e in
+ * [first, first + cnt), vertex i = vx[e], t = sn_out(eta F_e), b_i =
+ * sn_add(b_i, sn_rot(R_i, t)), in lanes, the same floats and counts */
+#define SN_K_RIG 1
+void sn_k_rig(sn_q eta, const unsigned char *F, const unsigned char *vx, uint32_t first, uint32_t cnt, const sn_q *R,
+              sn_q *b, uint32_t *sat);
 #endif
 
 /* Which path this library was built with ("scalar", "avx2", "avx512", "neon", "m4"). */

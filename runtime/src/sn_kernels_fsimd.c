@@ -443,6 +443,22 @@ void sn_k_skeleton(const sn_q *jR, const sn_q *jT, const unsigned char *fr, cons
         fv_st3(pos + 3 * i, pn);
     }
 }
+/* sn_rigs' entries: t by fv_out3 (lane k: sn_out(eta F_k)), then the
+ * rotation's ((R_k0 t0 + R_k1 t1) + R_k2 t2) and the sum, each clamped as
+ * sn_out would, counted per lane */
+void sn_k_rig(sn_q eta, const unsigned char *F, const unsigned char *vx, uint32_t first, uint32_t cnt, const sn_q *R,
+              sn_q *b, uint32_t *sat) {
+    const sn_fv ev = FV_SET1(eta);
+    uint32_t e;
+    for (e = first; e < first + cnt; e++) {
+        const uint32_t i = sn_rd_u16(vx + 2 * (size_t)e);
+        const sn_fv t = fv_out3(FV_MUL(ev, fv_ld3((const float *)(const void *)(F + (size_t)12 * e))), sat);
+        sn_fv c[3], f;
+        fv_cols(R + 9 * i, c);
+        f = fv_out3(FV_MAC3(c, _mm_shuffle_ps(t, t, 0x00), _mm_shuffle_ps(t, t, 0x55), _mm_shuffle_ps(t, t, 0xAA)), sat);
+        fv_st3(b + 3 * i, fv_out3(FV_ADD(fv_ld3(b + 3 * i), f), sat));
+    }
+}
 #undef BITS4
 #endif
 

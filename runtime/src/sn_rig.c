@@ -88,6 +88,10 @@ void sn_rigs(sn_ihdr *h, sn_q *b, uint32_t *sat) {
 #if !defined(SN_FLOAT)
         int frac = rig[3]; /* validated: 5..50 */
 #endif
+#if defined(SN_K_RIG) /* x86-64 float: the loop below in lanes (sn_kernels.h) */
+        sn_k_rig(eta, F, vx, first, cnt, R, b, sat);
+        continue;
+#endif
         for (e = first; e < first + cnt; e++) {
             uint32_t i = sn_rd_u16(vx + 2 * e);
             sn_q t[3], f[3];
