@@ -249,7 +249,7 @@ void sn_k_mass_ff(const unsigned char *rp, const unsigned char *cols, const unsi
  *     (skeleton j: y per block), then acc_i += l
  *   sn_k_grav_rhs: per free vertex, b_i = sn_add(sn_add(b_i, sn_mulq(m_i,
  *     g_i)), -sn_out(acc_i)), g_i = sn_add(g, -R_i g) (modelled) or g
- *   sn_k_fdot:    s = 0, s += a_i b_i in i order (the CG's float dot) */
+ *   sn_k_fdot:    the CG's float dot, sn_solve.c dot's order (8 partial sums) */
 /* cell_stiff without a mask (sn_solve.c) on x86-64 float: acc += R S^ R^T d
  * over the cell's free corners (K its CELLK record, cl its CELLS record),
  * the same floats and counts as cell_stiff's loop (sn_kernels_fsimd.c) */

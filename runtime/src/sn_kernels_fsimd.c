@@ -409,19 +409,23 @@ void sn_k_grav_rhs(sn_q *b, const sn_acc *acc, const sn_q *R, const unsigned cha
         fv_st3(b + 3 * i, fv_out3(FV_ADD(t, _mm_xor_ps(fv_out3(fv_ld3(acc + 3 * i), sat), sg)), sat));
     }
 }
-/* products 4 at a time (the same floats), added to s one by one in i order */
+/* the CG's float dot (sn_solve.c dot): entry i into lane i mod 8, the tail
+ * by a masked load (its zero lanes add +0: a partial sum is never -0, so
+ * exactly nothing), then ((p0 + p1) + (p2 + p3)) + ((p4 + p5) + (p6 + p7))
+ * by two HADDs and the halves' sum: the reference's floats */
 float sn_k_fdot(const sn_q *a, const sn_q *b, uint32_t n) {
-    float s = 0.0f;
+    __m256 p = _mm256_setzero_ps();
+    __m128 q;
     uint32_t i;
-    for (i = 0; i + 4 <= n; i += 4) {
-        const sn_fv p = FV_MUL(FV_LD4(a + i), FV_LD4(b + i));
-        s += _mm_cvtss_f32(p);
-        s += _mm_cvtss_f32(_mm_movehdup_ps(p));
-        s += _mm_cvtss_f32(_mm_movehl_ps(p, p));
-        s += _mm_cvtss_f32(_mm_shuffle_ps(p, p, _MM_SHUFFLE(3, 3, 3, 3)));
+    for (i = 0; i + 8 <= n; i += 8) p = _mm256_add_ps(p, _mm256_mul_ps(_mm256_loadu_ps(a + i), _mm256_loadu_ps(b + i)));
+    if (i < n) {
+        const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)(n - i)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        p = _mm256_add_ps(p, _mm256_mul_ps(_mm256_maskload_ps(a + i, m), _mm256_maskload_ps(b + i, m)));
     }
-    for (; i < n; i++) s += a[i] * b[i];
-    return s;
+    p = _mm256_hadd_ps(p, p); /* p0+p1, p2+p3, ., . | p4+p5, p6+p7, ., . */
+    p = _mm256_hadd_ps(p, p); /* (p0+p1)+(p2+p3) x4 | (p4+p5)+(p6+p7) x4 */
+    q = _mm_add_ss(_mm256_castps256_ps128(p), _mm256_extractf128_ps(p, 1));
+    return _mm_cvtss_f32(q);
 }
 /* sn_skeleton: lane k holds entry k of the reference's sn_rot / sn_add
  * (((R_k0 x0 + R_k1 x1) + R_k2 x2), then each sum clamped by fv_out3 as
