@@ -916,16 +916,16 @@ void sn_solve(sn_ihdr *h, uint32_t *sat) {
         x = xf;
     }
     /* v += dv, p += h v  (velocities are per step: h folded in) */
+    for (i = 0; i < n3; i++) {
+        vel[i] = sn_add(vel[i], x[i], sat);
+        pos[i] = sn_add(pos[i], vel[i], sat);
+    }
     /* The folded rhs clamped (a torn state: the state range's guard or a
      * cell row beyond it, where b's terms and A x0's are not kept apart): the
      * next step starts cold, x0 = 0, so its folded residual is b itself
      * whatever clamps (NUMERICS.md "The initial residual folded in"). One
      * memset of 12 nF bytes in such a step, like a clamp's branch (an
      * unconditional select cost every step 2-3 k instructions on cow_fem). */
-    for (i = 0; i < n3; i++) {
-        vel[i] = sn_add(vel[i], x[i], sat);
-        pos[i] = sn_add(pos[i], vel[i], sat);
-    }
     if (cold) memset(x, 0, n3 * sizeof(sn_q));
     h->cg_clamps = sn_count(h->cg_clamps, clamps);
 }
