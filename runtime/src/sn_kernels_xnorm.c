@@ -10,42 +10,30 @@
  *   cannot saturate: the first pass counts every vertex's faces (in out,
  *   zeroed after) and, when all are below 128, the sums are plain adds;
  * - the unit step, sn_unit's (sn_math.c) integers on (x, y, z, 0).
- * x86-64 (not SIMD=scalar): the unit step's rounded root from the double
- * root, corrected exactly (sn_k_xrsqrt); AVX2: both triangle
- * passes' cross products eight faces at a time in lanes. */
+ * x86-64 (not SIMD=scalar): the unit step on int64 operands without
+ * sn_unit's generic loop; AVX2: both triangle passes' cross products eight
+ * faces at a time in lanes. Integers only: the fixed library has no float
+ * instruction (tests/scripts/test_nofloat.sh; a root or quotient from
+ * doubles, corrected exactly, was measured faster: KERNELS.md "Outputs and
+ * contacts, round 2"). */
 #include "sn_kernels_xnorm.h"
 #include "sn_kernels.h"
 
 #if !defined(SN_FLOAT)
 #if defined(__x86_64__) && defined(__SSE2__) && defined(__GNUC__) && !defined(SN_SIMD_SCALAR)
-#define SN_XN_DSQRT 1
+#define SN_XN_X64 1
 #include <emmintrin.h>
 #endif
 #if defined(SN_KERNELS_AVX2)
 #include <immintrin.h>
 #endif
 
-/* the nearest integer to sqrt(x) for 16 <= x < 3 2^62 (sn_unit's rounded
- * root: floor, plus one when x - floor^2 > floor). x86-64: sqrt(2 (x >> 1))
- * in double (x >> 1 < 2^62 converts as int64; 2 d is exact; the conversion
- * and the root each round by <= 2^-53 relative and the dropped bit moves
- * the root by < 2^-3 for x >= 16): within 1/2 + 2^-3 of the root, so the
- * nearest integer to it is the answer or one off; one exact test either
- * way fixes it (R is the answer iff R^2 - R < x <= R^2 + R; R < 2^32: no
- * overflow). Elsewhere sn_isqrt64 and the rounding step. */
+/* the nearest integer to sqrt(x) (sn_unit's rounded root: floor, plus one
+ * when x - floor^2 > floor) */
 SN_INLINE uint64_t xrsqrt(uint64_t x) {
-#if defined(SN_XN_DSQRT)
-    const __m128d d = _mm_cvtsi64_sd(_mm_setzero_pd(), (long long)(x >> 1));
-    uint64_t R = (uint64_t)(int64_t)(_mm_cvtsd_f64(_mm_sqrt_sd(d, _mm_add_sd(d, d))) + 0.5), R2;
-    R2 = R * R;
-    if (x > R2 + R) R++;
-    else if (x <= R2 - R) R--;
-    return R;
-#else
     uint64_t N = sn_isqrt64(x);
     if (x - N * N > N) N++;
     return N;
-#endif
 }
 uint32_t sn_k_xrsqrt(uint64_t x) { return (uint32_t)xrsqrt(x); }
 
@@ -54,7 +42,7 @@ uint32_t sn_k_xrsqrt(uint64_t x) { return (uint32_t)xrsqrt(x); }
  * maximum or the squares); a zero sum gives (0, 0, 1). Off x86-64
  * sn_qnormalize itself. */
 SN_INLINE void xunit1(sn_vec3 *o) {
-#if defined(SN_XN_DSQRT)
+#if defined(SN_XN_X64)
     const int32_t c0 = o->x, c1 = o->y, c2 = o->z;
     uint64_t a0 = c0 < 0 ? (uint64_t)0 - (uint64_t)(int64_t)c0 : (uint64_t)c0;
     uint64_t a1 = c1 < 0 ? (uint64_t)0 - (uint64_t)(int64_t)c1 : (uint64_t)c1;
@@ -86,85 +74,9 @@ SN_INLINE void xunit1(sn_vec3 *o) {
     o->x = q[0]; o->y = q[1]; o->z = q[2];
 #endif
 }
-#if defined(SN_KERNELS_AVX2)
-/* uint64 lanes below 2^52 as doubles, exact (the 2^52 exponent trick) */
-SN_INLINE __m256d xu2d(__m256i v) {
-    const __m256i mg = _mm256_set1_epi64x(0x4330000000000000);
-    return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(v, mg)), _mm256_castsi256_pd(mg));
-}
-/* doubles in [0, 2^51) to the nearest integer (d + 2^52 has ulp 1) */
-SN_INLINE __m256i xd2u(__m256d d) {
-    const __m256d mg = _mm256_set1_pd(4503599627370496.0);
-    return _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(d, mg)), _mm256_castpd_si256(mg));
-}
-/* xunit1 for four vertices in int64 lanes, the same integers: |c| in
- * int32 (INT32_MIN's as 2^31), b from the exponent of m as an exact double,
- * the scaling by per-lane shifts, the squares 32 x 32 -> 64 (a < 2^31);
- * N from the double root of n2 (its two 32-bit halves, one rounding) to
- * the nearest integer, corrected exactly as in xrsqrt (n2 and the bounds
- * compared as unsigned: sign bits flipped); r = floor((2^62 + N/2) / N)
- * from the double quotient minus 1/2 to the nearest integer (within 1 of
- * r: the numerator rounds by <= 2^9, the quotient by <= 2^-21), at most
- * 2^32 - 1, then q N > num: q - 1, (q + 1) N <= num: q + 1 (q N < 2^63);
- * N <= 2^30: r = 2^32, v = a. Zero lanes take N = 2^31 for the unused
- * quotient (no division by 0: no floating-point exception raised). */
-static void xunit4(sn_vec3 *o) {
-    const int *P = (const int *)(void *)o;
-    const __m128i ix = _mm_setr_epi32(0, 3, 6, 9);
-    const __m128i cx = _mm_i32gather_epi32(P, ix, 4), cy = _mm_i32gather_epi32(P + 1, ix, 4), cz = _mm_i32gather_epi32(P + 2, ix, 4);
-    const __m128i z32 = _mm_cmpeq_epi32(_mm_or_si128(_mm_or_si128(cx, cy), cz), _mm_setzero_si128());
-    const __m256i a0 = _mm256_cvtepu32_epi64(_mm_abs_epi32(cx)), a1 = _mm256_cvtepu32_epi64(_mm_abs_epi32(cy)),
-                  a2 = _mm256_cvtepu32_epi64(_mm_abs_epi32(cz));
-    const __m256i m = _mm256_or_si256(_mm256_or_si256(a0, a1), a2);
-    const __m256i b = _mm256_sub_epi64(_mm256_srli_epi64(_mm256_castpd_si256(xu2d(m)), 52), _mm256_set1_epi64x(1022));
-    const __m256i sl = _mm256_sub_epi64(_mm256_set1_epi64x(31), b), sr = _mm256_sub_epi64(b, _mm256_set1_epi64x(31));
-    /* counts beyond 63 (a negative count) give 0: b <= 31 shifts left, b = 32 right by 1 */
-    const __m256i s0 = _mm256_or_si256(_mm256_sllv_epi64(a0, sl), _mm256_srlv_epi64(a0, sr)),
-                  s1 = _mm256_or_si256(_mm256_sllv_epi64(a1, sl), _mm256_srlv_epi64(a1, sr)),
-                  s2 = _mm256_or_si256(_mm256_sllv_epi64(a2, sl), _mm256_srlv_epi64(a2, sr));
-    const __m256i n2 = _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(s0, s0), _mm256_mul_epu32(s1, s1)), _mm256_mul_epu32(s2, s2));
-    const __m256i sg = _mm256_set1_epi64x(INT64_MIN), ones = _mm256_set1_epi64x(-1), lo32 = _mm256_set1_epi64x(0xFFFFFFFF);
-    const __m256d dn2 = _mm256_add_pd(_mm256_mul_pd(xu2d(_mm256_srli_epi64(n2, 32)), _mm256_set1_pd(4294967296.0)),
-                                      xu2d(_mm256_and_si256(n2, lo32)));
-    const __m256i zero = _mm256_cvtepi32_epi64(z32), ux = _mm256_xor_si256(n2, sg);
-    __m256i R = xd2u(_mm256_sqrt_pd(dn2)), R2, big, num, q, qn, v0, v1, v2;
-    __m256d qd;
-    __m128i ox, oy, oz;
-    int32_t fx[4], fy[4], fz[4];
-    int k;
-    R2 = _mm256_mul_epu32(R, R);
-    R = _mm256_sub_epi64(R, _mm256_cmpgt_epi64(ux, _mm256_xor_si256(_mm256_add_epi64(R2, R), sg)));          /* x > R^2 + R: + 1 */
-    R = _mm256_add_epi64(R, _mm256_xor_si256(_mm256_cmpgt_epi64(ux, _mm256_xor_si256(_mm256_sub_epi64(R2, R), sg)), ones)); /* x <= R^2 - R: - 1 */
-    R = _mm256_blendv_epi8(R, _mm256_set1_epi64x((int64_t)1 << 31), zero);
-    big = _mm256_cmpgt_epi64(R, _mm256_set1_epi64x((int64_t)1 << 30));
-    num = _mm256_add_epi64(_mm256_set1_epi64x((int64_t)1 << 62), _mm256_srli_epi64(R, 1));
-    qd = _mm256_div_pd(_mm256_add_pd(xu2d(_mm256_srli_epi64(R, 1)), _mm256_set1_pd(4611686018427387904.0)), xu2d(R));
-    q = xd2u(_mm256_sub_pd(qd, _mm256_set1_pd(0.5)));
-    q = _mm256_blendv_epi8(q, lo32, _mm256_cmpgt_epi64(q, lo32));
-    qn = _mm256_mul_epu32(q, R);
-    q = _mm256_add_epi64(q, _mm256_cmpgt_epi64(qn, num));                                                    /* q N > num: - 1 */
-    q = _mm256_sub_epi64(q, _mm256_xor_si256(_mm256_cmpgt_epi64(_mm256_add_epi64(qn, R), num), ones));       /* (q + 1) N <= num: + 1 */
-    {
-        const __m256i half = _mm256_set1_epi64x((int64_t)1 << 31), hi = _mm256_setr_epi32(1, 3, 5, 7, 1, 3, 5, 7),
-                      lo = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6), big32 = _mm256_permutevar8x32_epi32(big, lo);
-        /* (a r + 2^31) >> 32: the high words; N <= 2^30: a itself (low words); the four lanes' words packed low */
-        v0 = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(s0, lo), _mm256_permutevar8x32_epi32(_mm256_add_epi64(_mm256_mul_epu32(s0, q), half), hi), big32);
-        v1 = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(s1, lo), _mm256_permutevar8x32_epi32(_mm256_add_epi64(_mm256_mul_epu32(s1, q), half), hi), big32);
-        v2 = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(s2, lo), _mm256_permutevar8x32_epi32(_mm256_add_epi64(_mm256_mul_epu32(s2, q), half), hi), big32);
-    }
-    ox = _mm_sign_epi32(_mm256_castsi256_si128(v0), cx); /* c < 0: -v, c = 0: 0 (v = 0 there) */
-    oy = _mm_sign_epi32(_mm256_castsi256_si128(v1), cy);
-    oz = _mm_blendv_epi8(_mm_sign_epi32(_mm256_castsi256_si128(v2), cz), _mm_set1_epi32(SN_ONE_ROT), z32);
-    _mm_storeu_si128((__m128i *)(void *)fx, ox); _mm_storeu_si128((__m128i *)(void *)fy, oy); _mm_storeu_si128((__m128i *)(void *)fz, oz);
-    for (k = 0; k < 4; k++) { o[k].x = fx[k]; o[k].y = fy[k]; o[k].z = fz[k]; }
-}
-#endif
 void sn_k_xunit(sn_vec3 *out, uint32_t n) {
-    uint32_t i = 0;
-#if defined(SN_KERNELS_AVX2)
-    for (; i + 4 <= n; i += 4) xunit4(out + i);
-#endif
-    for (; i < n; i++) xunit1(out + i);
+    uint32_t i;
+    for (i = 0; i < n; i++) xunit1(out + i);
 }
 
 /* e1 x e2 of triangle (a, b, c), exact in int64; clamp: each edge
@@ -256,7 +168,7 @@ void sn_k_xnormals(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uin
     {   /* positions within +-2^29: no edge reaches the clamp (one loop over the 3 nS int32: vectorized) */
         const int32_t *q = (const int32_t *)(const void *)p;
         i = 0;
-#if defined(SN_XN_DSQRT)
+#if defined(SN_XN_X64)
         {
             const __m128i hi = _mm_set1_epi32(1 << 29), lo = _mm_set1_epi32(-(1 << 29));
             __m128i w = _mm_setzero_si128();
