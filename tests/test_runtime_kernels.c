@@ -2529,8 +2529,11 @@ static void test_udiv64(void) {
 }
 
 #if !defined(SN_FLOAT)
-/* The fixed normals' unit step (sn_kernels_xnorm.c; x86-64: the rounded
- * root from the double root, corrected). sn_k_xrsqrt against its
+/* The fixed normals' unit step (sn_kernels_xnorm.c; x86-64: on int64
+ * operands, the root by sn_isqrt64 and the rounding step; the cases below
+ * were searched for a double root and quotient, corrected exactly, which
+ * the fixed library no longer uses: they stay as edge cases of the
+ * rounding). sn_k_xrsqrt against its
  * definition, the nearest integer R to sqrt(x): R^2 - R < x <= R^2 + R
  * (checked in exact integers) and against sn_isqrt64 rounded as sn_unit
  * rounds it, on 60,000 x in [16, 3 2^62): random magnitudes, and the
