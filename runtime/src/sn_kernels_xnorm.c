@@ -225,7 +225,8 @@ void sn_k_xnormals(const unsigned char *tris, uint32_t nT, const sn_vec3 *p, uin
         t = 0;
 #if defined(SN_KERNELS_AVX2)
         {
-            const __m256i h = _mm256_set1_epi64x(shift ? (int64_t)1 << (shift - 1) : 0);
+            const long long hv = shift ? (long long)1 << (shift - 1) : 0; /* long long: clang's -Wsign-conversion on ?: */
+            const __m256i h = _mm256_set1_epi64x(hv);
             const __m128i cnt = _mm_cvtsi32_si128(shift);
             const __m256i bias = _mm256_srl_epi64(_mm256_set1_epi64x(INT64_MIN), cnt);
             for (; t + 8 <= nT; t += 8) {
