@@ -212,7 +212,7 @@ static void ic_fused(const sn_view *v, const uint8_t *kk, const sn_q *R, size_t 
         y0 = SN_K_LANE(y, 0); y1 = SN_K_LANE(y, 1); y2 = SN_K_LANE(y, 2);
         /* acc_j+1 is final but for row j + 1 of this column, its first
          * block if there (rows ascend, the validator): the sum goes to the
-         * next column in a register, off memory on the sweep's chain (fix
+         * next column in a register, off memory on the sweep's chain (x86-64
          * round 4; the same floats) */
         m = 0;
         if (j + 1 < nF) {
