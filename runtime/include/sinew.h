@@ -224,9 +224,9 @@ void sn_pose_from_local(const sn_blob *blob, const sn_quat *local,
 /// the iteration count: no data-dependent loop exits (its bound includes, in
 /// the float flavour, one zeroing of the solver's warm start, 12 bytes a free
 /// lattice vertex, in a step whose right-hand side clamps). Stack: under 3 KB
-/// (Cortex-M4 peaks 2,568 B for the cow, 2,512 B on its cut level; x86-64
-/// worst case 1,808 B, which tests/scripts/test_runtime_rules.sh prints per
-/// entry point): the frames' shared work is in the blob (format 6.4). SN_ERR_NULL or
+/// on the Cortex-M4 (peaks 2,568 B for the cow, 2,512 B on its cut level);
+/// x86-64 worst case 3,552 B (gcc -O2), which tests/scripts/test_runtime_rules.sh
+/// prints per entry point: the frames' shared work is in the blob (format 6.4). SN_ERR_NULL or
 /// SN_ERR_INSTANCE (nothing happens) if inst is not an initialised instance;
 /// SN_ERR_MEMORY (nothing happens) for an sn_instance_init_shared instance,
 /// which steps with sn_step_with.
